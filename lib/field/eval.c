@@ -1,0 +1,443 @@
+/*
+** eval.c — evaluation of a compiled program: value, and value with
+** gradient. Read-only on the program, allocation-free, recursion bounded by
+** OC_MAX_DEPTH (checked at compile time).
+*/
+#include <math.h>
+
+#include "core/falloff.h"
+#include "core/noise.h"
+#include "core/rng.h"
+#include "core/vec.h"
+#include "field/prim.h"
+#include "field/program.h"
+
+#define BVH_STACK 64
+
+typedef struct noisep {
+  double wl, amp, off;
+  int oct;
+  uint64_t seed;
+} noisep;
+
+static noisep unpack_noise(const double *v) {
+  noisep n = {v[0], v[1], v[2], (int)v[3],
+              ((uint64_t)v[4] << 32) | (uint64_t)v[5]};
+  return n;
+}
+
+static double ev(const oc_program *P, uint32_t i, oc_vec3 p);
+static double evg(const oc_program *P, uint32_t i, oc_vec3 p, oc_vec3 *g);
+
+static inline int in_op_box(const oc_op *o, oc_vec3 p) {
+  return p.x >= o->lo[0] && p.x <= o->hi[0] && p.y >= o->lo[1] &&
+         p.y <= o->hi[1] && p.z >= o->lo[2] && p.z <= o->hi[2];
+}
+
+static inline int in_node(const oc_bvhnode *nd, oc_vec3 p) {
+  return p.x >= nd->lo[0] && p.x <= nd->hi[0] && p.y >= nd->lo[1] &&
+         p.y <= nd->hi[1] && p.z >= nd->lo[2] && p.z <= nd->hi[2];
+}
+
+/* ---- distance primitives -------------------------------------------- */
+
+static double prim(oc_kind kind, const double *par, oc_vec3 p, oc_vec3 *g) {
+  double E = par[OC_P_E], R = par[OC_P_R];
+  if (kind == OC_K_POINT) {
+    oc_vec3 d = oc_v3(p.x - par[OC_P_C], p.y - par[OC_P_C + 1],
+                      p.z - par[OC_P_C + 2]);
+    double q = oc_dot(d, d) / (R * R);
+    if (g) *g = oc_mul(d, E * oc_falloff_dq(q) * 2 / (R * R));
+    return E * oc_falloff_q(q);
+  }
+  oc_vec3 s;
+  double d = oc_prim_project(kind, par, p, &s);
+  double x = d / R;
+  if (g) {
+    double gd = E * oc_falloff_d(x) / R;
+    *g = d > 0 ? oc_mul(oc_sub(p, s), gd / d) : oc_v3(0, 0, 0);
+  }
+  return E * oc_falloff(x);
+}
+
+/* ---- perturbation ----------------------------------------------------- */
+
+static double perturb(const oc_op *o, const double *par, oc_vec3 p) {
+  double E = par[OC_P_E], R = par[OC_P_R];
+  noisep nz = unpack_noise(par + o->nkid);
+  oc_vec3 s;
+  double d = oc_prim_project((oc_kind)o->sub, par, p, &s);
+  if (!(d > 0)) return d == 0 ? E : d; /* NaN propagates */
+  oc_vec3 u = oc_mul(oc_sub(p, s), 1 / d);
+  oc_vec3 v = oc_add(s, oc_mul(u, R));
+  double rho =
+      R + nz.amp * oc_turb3(nz.seed, nz.oct, oc_mul(v, 1 / nz.wl), NULL);
+  return E * oc_falloff(d / rho);
+}
+
+/* ---- groups ------------------------------------------------------------ */
+
+static inline double point_ent(const oc_ent *e, oc_vec3 p, oc_vec3 *g) {
+  double dx = p.x - e->c[0], dy = p.y - e->c[1], dz = p.z - e->c[2];
+  double q = (dx * dx + dy * dy + dz * dz) * e->ir2;
+  if (!(q < 1)) return 0;
+  double u = 1 - q, E = e->e;
+  if (g) {
+    double k = -6 * E * u * u * e->ir2;
+    *g = oc_v3(k * dx, k * dy, k * dz);
+  }
+  return E * u * u * u;
+}
+
+/* One child's contribution: value (and gradient when g). Returns 0 without
+** evaluating when p is outside the child's box; *hit tells whether the
+** child was evaluated (unions need to know). */
+static inline double ent_eval(const oc_program *P, const oc_ent *e,
+                              oc_vec3 p, oc_vec3 *g, int *hit) {
+  if (e->ref == OC_NONE) {
+    *hit = 1;
+    return point_ent(e, p, g);
+  }
+  const oc_op *o = &P->ops[e->ref];
+  if (!in_op_box(o, p)) {
+    *hit = 0;
+    return 0;
+  }
+  *hit = 1;
+  return g ? evg(P, e->ref, p, g) : ev(P, e->ref, p);
+}
+
+static double group(const oc_program *P, const oc_op *o, oc_vec3 p,
+                    oc_vec3 *g) {
+  int uni = o->kind == OC_K_UNION;
+  double acc = uni ? -INFINITY : 0;
+  oc_vec3 gacc = oc_v3(0, 0, 0), gk;
+  uint32_t visited = 0;
+#define TAKE(val)                                                            \
+  do {                                                                       \
+    double v_ = (val);                                                       \
+    if (uni) {                                                               \
+      if (v_ > acc || visited == 0) {                                        \
+        acc = v_;                                                            \
+        if (g) gacc = gk;                                                    \
+      }                                                                      \
+    } else {                                                                 \
+      acc += v_;                                                             \
+      if (g) gacc = oc_add(gacc, gk);                                        \
+    }                                                                        \
+    visited++;                                                               \
+  } while (0)
+  gk = oc_v3(0, 0, 0);
+  for (uint32_t k = 0; k < o->nkid; k++) {
+    uint32_t ki = P->kids[o->kid + k];
+    TAKE(g ? evg(P, ki, p, &gk) : ev(P, ki, p));
+  }
+  const oc_ent *ent = P->ent;
+  if (o->nent && (o->nobvh || o->bvh == OC_NONE)) {
+    for (uint32_t j = o->ent; j < o->ent + o->nent; j++) {
+      int hit;
+      gk = oc_v3(0, 0, 0);
+      double v = ent_eval(P, &ent[j], p, g ? &gk : NULL, &hit);
+      if (hit) TAKE(v);
+    }
+  } else if (o->nent) {
+    /* children are tested before being pushed: misses cost no stack
+    ** traffic, and the stack only holds nodes that contain p */
+    uint32_t stack[BVH_STACK];
+    int sp = 0;
+    if (in_node(&P->bvh[o->bvh], p)) stack[sp++] = o->bvh;
+    while (sp) {
+      const oc_bvhnode *nd = &P->bvh[stack[--sp]];
+      if (nd->count) {
+        for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
+          int hit;
+          gk = oc_v3(0, 0, 0);
+          double v = ent_eval(P, &ent[j], p, g ? &gk : NULL, &hit);
+          if (hit) TAKE(v);
+        }
+        continue;
+      }
+      const oc_bvhnode *l = &P->bvh[nd->first];
+      int hr = in_node(l + 1, p), hl = in_node(l, p);
+      if (sp + 2 > BVH_STACK) continue; /* cannot happen: depth <= 32 */
+      if (hr) stack[sp++] = nd->first + 1;
+      if (hl) stack[sp++] = nd->first;
+    }
+  }
+#undef TAKE
+  /* children not visited are exactly 0 here */
+  if (uni && visited < o->ntotal && acc < 0) {
+    acc = 0;
+    gacc = oc_v3(0, 0, 0);
+  }
+  if (g) *g = gacc;
+  return acc;
+}
+
+/* ---- smooth operators --------------------------------------------------- */
+
+/* C^1 ramp: 3u^2 - 2u^3 on [0, 1]; derivative through *d. */
+static inline double ramp(double s, double *d) {
+  if (s <= 0) {
+    *d = 0;
+    return 0;
+  }
+  if (s >= 1) {
+    *d = 0;
+    return 1;
+  }
+  *d = 6 * s * (1 - s);
+  return s * s * (3 - 2 * s);
+}
+
+/* Value of the smooth operator and its partial derivatives da, db. */
+static double smooth(int uni, double a, double b, double r, double T,
+                     double *da, double *db) {
+  double gd, re, dre_da, dre_db;
+  if (uni) {
+    re = r * ramp((a + b) / T, &gd);
+    dre_da = dre_db = r * gd / T;
+  } else {
+    re = r * ramp(a * b / (T * T), &gd);
+    dre_da = r * gd * b / (T * T);
+    dre_db = r * gd * a / (T * T);
+  }
+  double m, ma, mb;
+  if (a == b) {
+    m = a;
+    ma = mb = 0.5;
+  } else if ((a > b) == uni) {
+    m = a;
+    ma = 1;
+    mb = 0;
+  } else {
+    m = b;
+    ma = 0;
+    mb = 1;
+  }
+  double delta = fabs(a - b);
+  double sg = a > b ? 1 : a < b ? -1 : 0;
+  double corr = 0, ca = 0, cb = 0;
+  if (re > 0 && delta < re) {
+    double k = 1 - delta / re;
+    corr = re * k * k * k / 6;
+    double cdelta = -k * k / 2;                         /* d corr / d delta */
+    double cre = k * k * (1 + 2 * delta / re) / 6;      /* d corr / d re */
+    ca = cdelta * sg + cre * dre_da;
+    cb = -cdelta * sg + cre * dre_db;
+  }
+  if (uni) {
+    *da = ma + ca;
+    *db = mb + cb;
+    return m + corr;
+  }
+  *da = ma - ca;
+  *db = mb - cb;
+  return m - corr;
+}
+
+/* ---- warp ---------------------------------------------------------------- */
+
+/* Displacement delta(p) = A (t_i(p / wl) - tmax/2), i = 1..3; with jac
+** (when not NULL) its Jacobian rows. */
+static oc_vec3 displacement(const noisep *nz, oc_vec3 p, oc_vec3 jac[3]) {
+  oc_vec3 q = oc_mul(p, 1 / nz->wl);
+  double half = oc_turb3_max(nz->oct) / 2, d[3];
+  for (int i = 0; i < 3; i++) {
+    uint64_t seed = oc_mix64(nz->seed + 0x9e3779b97f4a7c15ull * (i + 1));
+    oc_vec3 gr;
+    d[i] = nz->amp * (oc_turb3(seed, nz->oct, q, jac ? &gr : NULL) - half);
+    if (jac) jac[i] = oc_mul(gr, nz->amp / nz->wl);
+  }
+  return oc_v3(d[0], d[1], d[2]);
+}
+
+static double warp(const oc_program *P, const oc_op *o, oc_vec3 p,
+                   oc_vec3 *g) {
+  noisep nz = unpack_noise(P->par + o->par);
+  uint32_t child = P->kids[o->kid];
+  double w = 1;
+  oc_vec3 gw = oc_v3(0, 0, 0);
+  if (o->nkid > 1) {
+    uint32_t ctl = P->kids[o->kid + 1];
+    w = g ? evg(P, ctl, p, &gw) : ev(P, ctl, p);
+    if (w <= 0) {
+      w = 0;
+      gw = oc_v3(0, 0, 0);
+    } else if (w >= 1) {
+      w = 1;
+      gw = oc_v3(0, 0, 0);
+    }
+    if (w == 0) return g ? evg(P, child, p, g) : ev(P, child, p);
+  }
+  oc_vec3 jac[3];
+  oc_vec3 dsp = displacement(&nz, p, g ? jac : NULL);
+  oc_vec3 q = oc_add(p, oc_mul(dsp, w));
+  if (!g) return ev(P, child, q);
+  oc_vec3 gc;
+  double v = evg(P, child, q, &gc);
+  /* grad = Jq^T gc, Jq = I + w J_delta + delta gw^T */
+  oc_vec3 r = gc;
+  r = oc_add(r, oc_mul(jac[0], w * gc.x));
+  r = oc_add(r, oc_mul(jac[1], w * gc.y));
+  r = oc_add(r, oc_mul(jac[2], w * gc.z));
+  r = oc_add(r, oc_mul(gw, oc_dot(dsp, gc)));
+  *g = r;
+  return v;
+}
+
+/* ---- dispatch ------------------------------------------------------------ */
+
+static inline oc_vec3 affine(const double *m, oc_vec3 p) {
+  return oc_v3(m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3],
+               m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
+               m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]);
+}
+
+static double ev(const oc_program *P, uint32_t i, oc_vec3 p) {
+  const oc_op *o = &P->ops[i];
+  const double *par = P->par + o->par;
+  switch ((oc_kind)o->kind) {
+  case OC_K_BLEND:
+  case OC_K_UNION:
+    return group(P, o, p, NULL);
+  case OC_K_TURB: {
+    noisep nz = unpack_noise(par);
+    return nz.off +
+           nz.amp * oc_turb3(nz.seed, nz.oct, oc_mul(p, 1 / nz.wl), NULL);
+  }
+  case OC_K_INTER: {
+    double m = INFINITY;
+    for (uint32_t k = 0; k < o->nkid; k++) {
+      double v = ev(P, P->kids[o->kid + k], p);
+      if (v < m || isnan(v)) m = v;
+    }
+    return m;
+  }
+  case OC_K_DIFF: {
+    double a = ev(P, P->kids[o->kid], p);
+    double b = ev(P, P->kids[o->kid + 1], p);
+    double c = 2 * P->T - b;
+    return isnan(b) ? b : a < c ? a : c;
+  }
+  case OC_K_SUNION:
+  case OC_K_SINTER: {
+    double da, db;
+    double a = ev(P, P->kids[o->kid], p), b = ev(P, P->kids[o->kid + 1], p);
+    return smooth(o->kind == OC_K_SUNION, a, b, par[0], P->T, &da, &db);
+  }
+  case OC_K_SCALE:
+    return par[0] * ev(P, P->kids[o->kid], p);
+  case OC_K_WARP:
+    return warp(P, o, p, NULL);
+  case OC_K_XFORM:
+    return ev(P, P->kids[o->kid], affine(par + OC_P_INV, p));
+  case OC_K_PERTURB:
+    return perturb(o, par, p);
+  default:
+    return prim((oc_kind)o->kind, par, p, NULL);
+  }
+}
+
+static double evg(const oc_program *P, uint32_t i, oc_vec3 p, oc_vec3 *g) {
+  const oc_op *o = &P->ops[i];
+  const double *par = P->par + o->par;
+  switch ((oc_kind)o->kind) {
+  case OC_K_BLEND:
+  case OC_K_UNION:
+    return group(P, o, p, g);
+  case OC_K_TURB: {
+    noisep nz = unpack_noise(par);
+    oc_vec3 gt;
+    double t = oc_turb3(nz.seed, nz.oct, oc_mul(p, 1 / nz.wl), &gt);
+    *g = oc_mul(gt, nz.amp / nz.wl);
+    return nz.off + nz.amp * t;
+  }
+  case OC_K_INTER: {
+    double m = INFINITY;
+    *g = oc_v3(0, 0, 0);
+    for (uint32_t k = 0; k < o->nkid; k++) {
+      oc_vec3 gk;
+      double v = evg(P, P->kids[o->kid + k], p, &gk);
+      if (v < m || isnan(v)) {
+        m = v;
+        *g = gk;
+      }
+    }
+    return m;
+  }
+  case OC_K_DIFF: {
+    oc_vec3 ga, gb;
+    double a = evg(P, P->kids[o->kid], p, &ga);
+    double b = evg(P, P->kids[o->kid + 1], p, &gb);
+    double c = 2 * P->T - b;
+    if (a < c) {
+      *g = ga;
+      return a;
+    }
+    *g = oc_mul(gb, -1);
+    return c;
+  }
+  case OC_K_SUNION:
+  case OC_K_SINTER: {
+    oc_vec3 ga, gb;
+    double da, db;
+    double a = evg(P, P->kids[o->kid], p, &ga);
+    double b = evg(P, P->kids[o->kid + 1], p, &gb);
+    double v = smooth(o->kind == OC_K_SUNION, a, b, par[0], P->T, &da, &db);
+    *g = oc_add(oc_mul(ga, da), oc_mul(gb, db));
+    return v;
+  }
+  case OC_K_SCALE: {
+    double v = evg(P, P->kids[o->kid], p, g);
+    *g = oc_mul(*g, par[0]);
+    return par[0] * v;
+  }
+  case OC_K_WARP:
+    return warp(P, o, p, g);
+  case OC_K_XFORM: {
+    const double *m = par + OC_P_INV;
+    oc_vec3 gc;
+    double v = evg(P, P->kids[o->kid], affine(m, p), &gc);
+    /* grad = Minv^T gc */
+    *g = oc_v3(m[0] * gc.x + m[4] * gc.y + m[8] * gc.z,
+               m[1] * gc.x + m[5] * gc.y + m[9] * gc.z,
+               m[2] * gc.x + m[6] * gc.y + m[10] * gc.z);
+    return v;
+  }
+  case OC_K_PERTURB: {
+    /* The projection's Jacobian differs per skeleton and is not continuous
+    ** on medial axes; central differences are robust and cheap here. */
+    double h = 1e-6 * fmax(par[OC_P_R], 1e-3);
+    double v = perturb(o, par, p);
+    double gx = perturb(o, par, oc_v3(p.x + h, p.y, p.z)) -
+                perturb(o, par, oc_v3(p.x - h, p.y, p.z));
+    double gy = perturb(o, par, oc_v3(p.x, p.y + h, p.z)) -
+                perturb(o, par, oc_v3(p.x, p.y - h, p.z));
+    double gz = perturb(o, par, oc_v3(p.x, p.y, p.z + h)) -
+                perturb(o, par, oc_v3(p.x, p.y, p.z - h));
+    *g = oc_mul(oc_v3(gx, gy, gz), 0.5 / h);
+    return v;
+  }
+  default:
+    return prim((oc_kind)o->kind, par, p, g);
+  }
+}
+
+double oc_program_eval(const oc_program *P, oc_vec3 p) {
+  return ev(P, P->root, p);
+}
+
+double oc_program_gradient(const oc_program *P, oc_vec3 p, oc_vec3 *grad) {
+  oc_vec3 g;
+  double v = evg(P, P->root, p, &g);
+  if (grad) *grad = g;
+  return v;
+}
+
+void oc_program_eval_many(const oc_program *P, const oc_vec3 *p, double *out,
+                          size_t n) {
+  long long nn = (long long)n;
+#pragma omp parallel for schedule(static, 4096) if (nn > 8192)
+  for (long long i = 0; i < nn; i++) out[i] = ev(P, P->root, p[i]);
+}

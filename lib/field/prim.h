@@ -1,0 +1,28 @@
+/*
+** prim.h — distance to the skeleton or solid of a primitive (internal).
+**
+** Parameters follow the oc_node.par layout (node.h); a curve's polyline
+** follows as par[2] = number of points, then x, y, z triples from par[3].
+*/
+#ifndef OC_PRIM_H
+#define OC_PRIM_H
+
+#include <stddef.h>
+
+#include "field/node.h"
+
+/* Distance d from p to the primitive's skeleton (point, segment, curve) or
+** solid (sphere, box, cone, half-space); stores the closest point in *s.
+** d = 0 (and s = p) inside solids. */
+double oc_prim_project(oc_kind kind, const double *par, oc_vec3 p,
+                       oc_vec3 *s);
+
+/* Number of doubles a distance primitive needs in a program. */
+size_t oc_prim_npar(const oc_node *n);
+/* Writes those doubles. */
+void oc_prim_pack(const oc_node *n, double *out);
+
+/* Box of the skeleton/solid (not grown by R). Infinite for most planes. */
+oc_aabb oc_prim_skeleton_box(oc_kind kind, const double *par);
+
+#endif

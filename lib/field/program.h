@@ -1,0 +1,76 @@
+/*
+** program.h — the compiled, read-only evaluation program (internal).
+**
+** A program is a flat array of ops; an op refers to its children by index.
+** Blend and union ops hold their bounded children as "entries" under a
+** bounding volume hierarchy; plain point primitives are stored inline in
+** their entry (single precision) so that a blend of many points costs a
+** few dozen bytes per point and no indirection.
+*/
+#ifndef OC_PROGRAM_H
+#define OC_PROGRAM_H
+
+#include <stdint.h>
+
+#include "field/node.h"
+
+#define OC_NONE UINT32_MAX
+
+/* A child of a blend/union under its BVH. ref == OC_NONE: an inline point
+** primitive e * g(|p - c|^2 * ir2); otherwise the op index of the child. */
+typedef struct oc_ent {
+  float c[3];
+  float ir2;
+  float e;
+  uint32_t ref;
+} oc_ent;
+
+/* count == 0: interior node, children at first and first + 1;
+** otherwise a leaf over entries [first, first + count). */
+typedef struct oc_bvhnode {
+  float lo[3], hi[3];
+  uint32_t first, count;
+} oc_bvhnode;
+
+typedef struct oc_op {
+  uint8_t kind;   /* oc_kind */
+  uint8_t sub;    /* perturb: the primitive's kind */
+  uint8_t nobvh;  /* groups: evaluate every entry (brute force) */
+  uint32_t par;   /* first parameter in prog->par */
+  uint32_t kid;   /* first child in prog->kids */
+  uint32_t nkid;  /* groups: unbounded children, always evaluated */
+  uint32_t ent;   /* groups: first entry */
+  uint32_t nent;
+  uint32_t bvh;   /* groups: BVH root, or OC_NONE */
+  uint32_t ntotal; /* groups: number of children in all */
+  float lo[3], hi[3]; /* support box, rounded outwards */
+} oc_op;
+
+struct oc_program {
+  oc_op *ops;
+  uint32_t nops, root;
+  double *par;
+  size_t npar;
+  uint32_t *kids;
+  size_t nkids;
+  oc_ent *ent;
+  size_t nent;
+  oc_bvhnode *bvh;
+  size_t nbvh;
+  double T;
+  oc_aabb bounds;
+  double lip;
+  oc_program_stats stats;
+  oc_node *node; /* retained source */
+};
+
+/* BVH construction over n boxes; fills nodes (capacity 2n) and the entry
+** order perm (n). Returns the node count. Leaves hold <= OC_BVH_LEAF. */
+#define OC_BVH_LEAF 8
+size_t oc_bvh_build(const oc_aabb *boxes, size_t n, oc_bvhnode *nodes,
+                    uint32_t *perm);
+
+/* Float box rounded outwards so that it contains the double box. */
+void oc_box_to_float(oc_aabb b, float lo[3], float hi[3]);
+
+#endif
