@@ -144,9 +144,17 @@ demo: deps
 	$(BIN) run examples/demo.lua --out out/demo
 	@echo "demo outputs are in $(abspath out/demo)/"
 
+BENCH_SRC := $(wildcard scripts/bench/bench_*.c)
+BENCH_BIN := $(BENCH_SRC:scripts/bench/%.c=$(B)/bench/%)
+
+$(B)/bench/%: scripts/bench/%.c $(LIBA)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -o $@ $< $(LIBA) $(OIIO_LIBS) -lstdc++ $(LDLIBS)
+
 bench: deps
-	@$(MAKE) --no-print-directory all
-	@$(MAKE) --no-print-directory -f scripts/bench/bench.mk B=$(B) run
+	@$(MAKE) --no-print-directory all $(BENCH_BIN)
+	@OUTCROP=$(abspath $(BIN)) BENCH_BIN="$(abspath $(BENCH_BIN))" \
+	  bash scripts/bench/run.sh
 
 format:
 	clang-format -i $$(find lib bindings runtime tests/c scripts -name '*.[ch]' -o -name '*.cpp')

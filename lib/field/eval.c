@@ -424,12 +424,23 @@ static double evg(const oc_program *P, uint32_t i, oc_vec3 p, oc_vec3 *g) {
   }
 }
 
+/* NaN in gives NaN out: checked once here, since deep inside a NaN would
+** simply fail every support test and read as 0. */
+static inline int has_nan(oc_vec3 p) {
+  return isnan(p.x) || isnan(p.y) || isnan(p.z);
+}
+
 double oc_program_eval(const oc_program *P, oc_vec3 p) {
+  if (has_nan(p)) return NAN;
   return ev(P, P->root, p);
 }
 
 double oc_program_gradient(const oc_program *P, oc_vec3 p, oc_vec3 *grad) {
   oc_vec3 g;
+  if (has_nan(p)) {
+    if (grad) *grad = oc_v3(NAN, NAN, NAN);
+    return NAN;
+  }
   double v = evg(P, P->root, p, &g);
   if (grad) *grad = g;
   return v;
@@ -439,5 +450,6 @@ void oc_program_eval_many(const oc_program *P, const oc_vec3 *p, double *out,
                           size_t n) {
   long long nn = (long long)n;
 #pragma omp parallel for schedule(static, 4096) if (nn > 8192)
-  for (long long i = 0; i < nn; i++) out[i] = ev(P, P->root, p[i]);
+  for (long long i = 0; i < nn; i++)
+    out[i] = has_nan(p[i]) ? NAN : ev(P, P->root, p[i]);
 }

@@ -258,8 +258,8 @@ oc_node *oc_perturb(oc_node *prim, const oc_noise *noise, oc_error *err) {
   if (!check_kids(&prim, 1, err) || !oc_check_noise(noise, err)) return NULL;
   if (!OC_KIND_IS_DIST(prim->kind) || prim->kind == OC_K_PLANE) {
     oc_seterr(err, OC_EINVAL,
-              "perturb needs a point, sphere, box, segment, curve or cone "
-              "primitive (got %s)",
+              "the node to perturb must be a point, sphere, box, segment, curve "
+              "or cone primitive (got %s)",
               oc_kind_name(prim->kind));
     return NULL;
   }

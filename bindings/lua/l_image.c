@@ -1,0 +1,222 @@
+/*
+** l_image.c — the image userdata (write, size, get, channels) and
+** outcrop.slice, which samples a node on an axis-aligned plane.
+**
+** slice defaults: plane = "xz", at = 0, size = {256, 256}, box = the
+** node's bounds on the plane's two axes (an error when they are infinite
+** or empty). write: bits = 0 (the format's default: 8 for PNG/JPEG, 16
+** for TIFF, half floats for EXR).
+*/
+#include <math.h>
+
+#include "l_field.h"
+#include "l_image.h"
+
+#define DEFAULT_SLICE_SIZE 256
+#define MAX_SLICE_SIZE 16384
+
+oclua_image *oclua_newimage(lua_State *L) {
+  oclua_image *u = lua_newuserdatauv(L, sizeof *u, 0);
+  u->img = NULL;
+  luaL_setmetatable(L, OCLUA_IMAGE);
+  return u;
+}
+
+oc_image *oclua_checkimage(lua_State *L, int idx, const char *fname) {
+  oclua_image *u = luaL_checkudata(L, idx, OCLUA_IMAGE);
+  if (u->img == NULL) oclua_error(L, fname, "the image is closed");
+  return u->img;
+}
+
+/* ---- methods --------------------------------------------------------- */
+
+static int image_write(lua_State *L) {
+  static const char *const known[] = {"bits", NULL};
+  const char *fname = "image:write";
+  oc_image *img = oclua_checkimage(L, 1, fname);
+  oc_error err = {OC_OK, ""};
+  int bits = 0;
+  if (lua_type(L, 2) != LUA_TSTRING)
+    oclua_error(L, fname, "the path must be a string (got %s)",
+                oclua_got(L, 2));
+  oclua_checkargs(L, 3, fname, "(path [, {bits = 8 or 16}])");
+  if (!lua_isnoneornil(L, 3)) {
+    oclua_fields f;
+    oclua_fields_open(&f, L, 3, fname, NULL, known, 0);
+    bits = (int)oclua_field_optint(&f, "bits", 0, 16, 0);
+    if (bits != 0 && bits != 8 && bits != 16)
+      oclua_error(L, fname, "'bits' must be 8 or 16 (got %d)", bits);
+  }
+  const char *path = oclua_output_path(L, fname, lua_tostring(L, 2));
+  if (oc_image_write(img, path, bits, &err) != OC_OK) {
+    /* A file that cannot be written is an expected failure, as io.open. */
+    if (err.code == OC_EIO) {
+      luaL_pushfail(L);
+      lua_pushstring(L, err.msg[0] ? err.msg : "cannot write the image");
+      return 2;
+    }
+    oclua_liberror(L, fname, &err);
+  }
+  lua_pushboolean(L, 1);
+  return 1;
+}
+
+static int image_size(lua_State *L) {
+  oc_image *img = oclua_checkimage(L, 1, "image:size");
+  lua_pushinteger(L, oc_image_width(img));
+  lua_pushinteger(L, oc_image_height(img));
+  return 2;
+}
+
+static int image_channels(lua_State *L) {
+  lua_pushinteger(L,
+                  oc_image_channels(oclua_checkimage(L, 1, "image:channels")));
+  return 1;
+}
+
+/* get(i, j): column i from the left, row j from the top, both 1-based. */
+static int image_get(lua_State *L) {
+  const char *fname = "image:get";
+  const oc_image *img = oclua_checkimage(L, 1, fname);
+  int w = oc_image_width(img), h = oc_image_height(img);
+  int nc = oc_image_channels(img);
+  lua_Integer ij[2];
+  oclua_checkargs(L, 3, fname, "(i, j)");
+  for (int k = 0; k < 2; k++) {
+    int isint;
+    lua_Integer lim = k == 0 ? w : h;
+    ij[k] = lua_tointegerx(L, 2 + k, &isint);
+    if (lua_type(L, 2 + k) != LUA_TNUMBER || !isint || ij[k] < 1 || ij[k] > lim)
+      oclua_error(L, fname, "%s must be an integer in 1..%I (got %s)",
+                  k == 0 ? "the column i" : "the row j", (LUAI_UACINT)lim,
+                  oclua_got(L, 2 + k));
+  }
+  const float *px =
+      oc_image_cdata(img) +
+      ((size_t)(ij[1] - 1) * (size_t)w + (size_t)(ij[0] - 1)) * (size_t)nc;
+  luaL_checkstack(L, nc, "too many channels");
+  for (int c = 0; c < nc; c++)
+    lua_pushnumber(L, px[c]);
+  return nc;
+}
+
+static int image_gc(lua_State *L) {
+  oclua_image *u = luaL_checkudata(L, 1, OCLUA_IMAGE);
+  if (u->img) oc_image_free(u->img);
+  u->img = NULL;
+  return 0;
+}
+
+static int image_tostring(lua_State *L) {
+  oclua_image *u = luaL_checkudata(L, 1, OCLUA_IMAGE);
+  if (u->img == NULL)
+    lua_pushliteral(L, OCLUA_IMAGE ": (closed)");
+  else
+    lua_pushfstring(L, OCLUA_IMAGE ": %dx%d, %d channels",
+                    oc_image_width(u->img), oc_image_height(u->img),
+                    oc_image_channels(u->img));
+  return 1;
+}
+
+/* ---- outcrop.slice --------------------------------------------------- */
+
+/* Reads an array of exactly n finite numbers. Returns 0 when absent. */
+static int field_numbers(const oclua_fields *f, const char *name, int n,
+                         double *out, const char *what) {
+  lua_State *L = f->L;
+  if (oclua_field_push(f, name) == LUA_TNIL) {
+    lua_pop(L, 1);
+    return 0;
+  }
+  if (!lua_istable(L, -1) || lua_rawlen(L, -1) != (size_t)n)
+    oclua_field_error(f, name, -1, what);
+  for (int i = 0; i < n; i++) {
+    if (lua_geti(L, -1, i + 1) != LUA_TNUMBER || !isfinite(lua_tonumber(L, -1)))
+      oclua_error(L, f->fname, "'%s' %s (item %d is %s)", name, what, i + 1,
+                  oclua_got(L, -1));
+    out[i] = lua_tonumber(L, -1);
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+  return 1;
+}
+
+static int l_slice(lua_State *L) {
+  static const char *const known[] = {"plane", "at", "box", "size", NULL};
+  static const char *const planes[] = {"xy", "xz", "yz", NULL};
+  const char *fname = "outcrop.slice";
+  oclua_fields f;
+  oc_error err = {OC_OK, ""};
+  oc_slice_params sp;
+  double box[4], size[2] = {DEFAULT_SLICE_SIZE, DEFAULT_SLICE_SIZE};
+  oclua_checkargs(L, 2, fname, "(node, {plane =, at =, box =, size =})");
+  oclua_checknode(L, 1, fname, "argument #1");
+  if (lua_isnoneornil(L, 2)) lua_newtable(L);
+  oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
+  int plane = oclua_field_optoption(&f, "plane", planes, 1);
+  sp.plane = plane == 0 ? OC_PLANE_XY : plane == 1 ? OC_PLANE_XZ : OC_PLANE_YZ;
+  sp.at = oclua_field_optnumber(&f, "at", OCLUA_FINITE, 0.0);
+  field_numbers(&f, "size", 2, size, "must be {width, height}");
+  for (int k = 0; k < 2; k++)
+    if (size[k] != floor(size[k]) || size[k] < 1 || size[k] > MAX_SLICE_SIZE) {
+      if (size[k] == floor(size[k]) && fabs(size[k]) < 1e18)
+        lua_pushinteger(L, (lua_Integer)size[k]);
+      else
+        lua_pushnumber(L, size[k]);
+      oclua_error(L, fname,
+                  "'size' must be {width, height} with integers in "
+                  "1..%d (got %s)",
+                  MAX_SLICE_SIZE, oclua_got(L, -1));
+    }
+  sp.width = (int)size[0];
+  sp.height = (int)size[1];
+  int given = field_numbers(&f, "box", 4, box, "must be {u0, v0, u1, v1}");
+  const oc_program *prog = oclua_program(L, 1, fname);
+  if (!given) {
+    oc_aabb b = oc_program_bounds(prog);
+    double lo[3] = {b.lo.x, b.lo.y, b.lo.z}, hi[3] = {b.hi.x, b.hi.y, b.hi.z};
+    int u = sp.plane == OC_PLANE_YZ ? 1 : 0;
+    int v = sp.plane == OC_PLANE_XY ? 1 : 2;
+    box[0] = lo[u], box[1] = lo[v], box[2] = hi[u], box[3] = hi[v];
+    if (!(isfinite(box[0]) && isfinite(box[1]) && isfinite(box[2]) &&
+          isfinite(box[3])))
+      oclua_error(L, fname,
+                  "the node's bounds are infinite: give 'box' = "
+                  "{u0, v0, u1, v1}");
+  }
+  if (!(box[0] < box[2] && box[1] < box[3]))
+    oclua_error(L, fname,
+                "'box' = {u0, v0, u1, v1} needs u0 < u1 and v0 < v1 "
+                "(got {%f, %f, %f, %f})%s",
+                box[0], box[1], box[2], box[3],
+                given ? "" : " (from the node's bounds)");
+  sp.u0 = box[0], sp.v0 = box[1], sp.u1 = box[2], sp.v1 = box[3];
+  oclua_image *u = oclua_newimage(L);
+  u->img = oc_slice(prog, &sp, &err);
+  if (u->img == NULL) oclua_liberror(L, fname, &err);
+  return 1;
+}
+
+static const luaL_Reg image_methods[] = {{"write", image_write},
+                                         {"size", image_size},
+                                         {"get", image_get},
+                                         {"channels", image_channels},
+                                         {NULL, NULL}};
+
+static const luaL_Reg image_meta[] = {
+    {"__gc", image_gc},
+    {"__close", image_gc}, /* `local img <close>` frees the pixels early */
+    {"__tostring", image_tostring},
+    {"__index", NULL},
+    {NULL, NULL}};
+
+static const luaL_Reg image_funcs[] = {{"slice", l_slice}, {NULL, NULL}};
+
+void oclua_open_image(lua_State *L) {
+  luaL_newmetatable(L, OCLUA_IMAGE);
+  luaL_setfuncs(L, image_meta, 0);
+  luaL_newlib(L, image_methods);
+  lua_setfield(L, -2, "__index");
+  lua_pop(L, 1);
+  luaL_setfuncs(L, image_funcs, 0);
+}

@@ -1,0 +1,26 @@
+/*
+** l_image.h — the image userdata, for every binding file that returns
+** images (slices now, renders later).
+*/
+#ifndef L_IMAGE_H
+#define L_IMAGE_H
+
+#include "l_util.h"
+
+#define OCLUA_IMAGE "outcrop.image"
+
+typedef struct oclua_image {
+  oc_image *img; /* NULL while being made, or once closed */
+} oclua_image;
+
+/* Pushes an image userdata owning nothing yet: create it BEFORE making
+** the oc_image, then store the image in it, so an error cannot leak. */
+oclua_image *oclua_newimage(lua_State *L);
+/* Raises unless idx is an open image. */
+oc_image *oclua_checkimage(lua_State *L, int idx, const char *fname);
+
+/* Adds outcrop.slice to the module table at the stack top and sets up
+** the image metatable. */
+void oclua_open_image(lua_State *L);
+
+#endif

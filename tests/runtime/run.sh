@@ -1,0 +1,412 @@
+#!/bin/bash
+# run.sh — integration tests of the `outcrop` interpreter: command line,
+# exit statuses, error reports, parameters, seed, sandbox, Ctrl-C, threads.
+#
+#   OUTCROP=/abs/path/to/outcrop bash tests/runtime/run.sh
+#
+# Prints "ok NAME" or "FAIL NAME: reasons" (with the case's stderr) for
+# every case and exits 1 if any failed. Each case runs in its own folder
+# under a temporary directory that is removed at the end. A sanitizer
+# report on stderr fails the case whatever the exit status.
+
+set -u
+
+if [ -z "${OUTCROP:-}" ] || [ ! -x "$OUTCROP" ]; then
+  echo "run.sh: set OUTCROP to the outcrop binary" >&2
+  exit 2
+fi
+HERE=$(cd "$(dirname "$0")" && pwd)
+S=$HERE/scenes
+T=$(mktemp -d "${TMPDIR:-/tmp}/outcrop-rt.XXXXXX") || exit 2
+trap 'rm -rf "$T"' EXIT
+OUT=$T/stdout
+ERR=$T/stderr
+npass=0
+nfail=0
+
+# begin NAME: a fresh folder $W, the current folder of the runs that follow
+begin() {
+  name=$1
+  W=$T/cases/$1
+  mkdir -p "$W"
+  why=
+}
+
+because() { why="$why${why:+; }$*"; }
+
+sanitizer_check() {
+  if grep -qE 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$ERR"; then
+    because "sanitizer report"
+  fi
+}
+
+# run ARGS...: outcrop ARGS in $W, stdin empty; sets rc
+run() {
+  (cd "$W" && exec "$OUTCROP" "$@") >"$OUT" 2>"$ERR" </dev/null
+  rc=$?
+  sanitizer_check
+}
+
+# run_in DIR ARGS...: the same from another current folder
+run_in() {
+  local dir=$1
+  shift
+  (cd "$dir" && exec "$OUTCROP" "$@") >"$OUT" 2>"$ERR" </dev/null
+  rc=$?
+  sanitizer_check
+}
+
+status_is() { [ "$rc" -eq "$1" ] || because "exit status $rc, expected $1"; }
+out_has() { grep -qF -- "$1" "$OUT" || because "stdout lacks '$1'"; }
+out_lacks() { ! grep -qF -- "$1" "$OUT" || because "stdout has '$1'"; }
+err_has() { grep -qF -- "$1" "$ERR" || because "stderr lacks '$1'"; }
+err_starts() {
+  [ "$(head -c ${#1} "$ERR")" = "$1" ] || because "stderr does not start with '$1'"
+}
+file_has() {
+  [ -f "$1" ] && grep -qF -- "$2" "$1" || because "$1 missing or lacks '$2'"
+}
+no_file() { [ ! -e "$1" ] || because "$1 exists"; }
+
+end() {
+  if [ -z "$why" ]; then
+    echo "ok   $name"
+    npass=$((npass + 1))
+  else
+    echo "FAIL $name: $why"
+    sed -e 's/^/     | /' "$ERR" | head -n 20
+    nfail=$((nfail + 1))
+  fi
+}
+
+# ---- command line --------------------------------------------------------
+
+begin help
+run --help
+status_is 0; out_has "usage: outcrop"; out_has "--unsafe"
+end
+
+begin version
+run --version
+status_is 0; out_has "outcrop 0.1.0"; out_has "Lua 5.4"
+end
+
+begin no-arguments
+run
+status_is 2; err_has "no scene given"
+end
+
+begin run-without-scene
+run run --seed 3
+status_is 2; err_has "no scene given"
+end
+
+begin unknown-option
+run --frobnicate "$S/hello.lua"
+status_is 2; err_has "unknown option '--frobnicate'"; out_lacks "module"
+end
+
+begin missing-scene
+run "$W/missing.lua" --out "$W/newout"
+status_is 2; err_has "cannot open"; err_has "missing.lua"
+no_file "$W/newout" # nothing is created for a command that fails
+end
+
+begin scene-is-a-folder
+run "$W"
+status_is 2; err_has "cannot read"
+end
+
+begin option-without-value
+run "$S/hello.lua" --seed
+status_is 2; err_has "option '--seed' needs a value"
+end
+
+begin bad-seed
+for v in -1 1.5 abc "" " 3" 9223372036854775808; do
+  run --seed "$v" "$S/hello.lua"
+  [ "$rc" -eq 2 ] || because "--seed '$v' gave status $rc"
+done
+err_has "--seed expects"
+end
+
+begin bad-threads
+for v in 0 -2 two 1025 ""; do
+  run --threads "$v" "$S/hello.lua"
+  [ "$rc" -eq 2 ] || because "--threads '$v' gave status $rc"
+done
+err_has "--threads expects"
+end
+
+begin set-without-equals
+run --set novalue "$S/hello.lua"
+status_is 2; err_has "NAME=VALUE"
+run --set =value "$S/hello.lua"
+status_is 2
+end
+
+begin out-not-creatable
+: >"$W/file"
+run "$S/hello.lua" --out "$W/file/sub"
+status_is 2; err_has "cannot create output folder"
+end
+
+begin out-created
+run "$S/write.lua" --out "$W/a/b/c" rel.txt
+status_is 0; file_has "$W/a/b/c/rel.txt" written
+end
+
+# ---- running, arguments, errors --------------------------------------------
+
+begin plain-equals-run
+run "$S/hello.lua" x y
+status_is 0
+cp "$OUT" "$W/plain"
+run run "$S/hello.lua" x y
+status_is 0
+cmp -s "$OUT" "$W/plain" || because "outputs differ"
+out_has "module	table	true"; out_has "args	2	x	y"
+end
+
+begin script-args
+run "$S/hello.lua" one --seed 4 -- --two
+status_is 0; out_has "arg0	$S/hello.lua"; out_has "args	2	one	--two"
+end
+
+begin stdin-scene
+(cd "$W" && echo 'print("from stdin", ...)' | "$OUTCROP" - a) >"$OUT" 2>"$ERR"
+rc=$?
+sanitizer_check
+status_is 0; out_has "from stdin	a"
+end
+
+begin script-error
+run_in "$HERE" scenes/error.lua --out "$W"
+status_is 1
+err_starts "outcrop: scenes/error.lua:5: attempt to index a nil value"
+err_has "traceback"; err_has "scenes/error.lua:9:"; err_has "scenes/error.lua:13:"
+end
+
+begin syntax-error
+run "$S/syntax.lua"
+status_is 1; err_starts "outcrop: $S/syntax.lua:3:"
+end
+
+begin error-object
+run "$S/errobj.lua"
+status_is 1; err_has "(error object is a table value)"
+run "$S/errobj.lua" tostring
+status_is 1; err_has "outcrop: custom error object"
+end
+
+begin os-exit
+run "$S/exit.lua" 3
+status_is 3; out_lacks "not reached"
+run "$S/exit.lua"
+status_is 0; out_lacks "not reached"
+run "$S/exit.lua" 4 co
+status_is 4; out_lacks "not reached"
+end
+
+begin coroutines
+run "$S/coroutine.lua"
+status_is 0; out_has "coroutines ok"
+run --unsafe "$S/coroutine.lua"
+status_is 0; out_has "coroutines ok"
+end
+
+# ---- parameters and seed -----------------------------------------------------
+
+begin params
+run "$S/params.lua" --set a=3 --set b=hello --set c=true --set d=x=y
+status_is 0; out_has "params	3	hello	true"; out_has "d	x=y"
+end
+
+begin params-before-scene
+run run --set=a=3 --set b=hello --set c=false --set c=true "$S/params.lua"
+status_is 0; out_has "params	3	hello	true"; out_has "d	nil"
+end
+
+begin seed
+run "$S/seed.lua"
+status_is 0; out_has "seed	1	integer"
+run "$S/seed.lua" --seed 42
+status_is 0; out_has "seed	42	integer"
+run --seed=7 "$S/seed.lua"
+status_is 0; out_has "seed	7	integer"
+run run --seed 9223372036854775807 "$S/seed.lua"
+status_is 0; out_has "seed	9223372036854775807	integer"
+end
+
+begin threads
+run --threads 1 "$S/threads.lua" --seed 3
+status_is 0
+cp "$OUT" "$W/one"
+run "$S/threads.lua" --threads=2 --seed 3
+status_is 0; out_has "threads"
+cmp -s "$OUT" "$W/one" || because "outputs differ between 1 and 2 threads"
+end
+
+# ---- sandbox -----------------------------------------------------------------
+
+begin sandbox-library
+run "$S/sandbox.lua"
+status_is 0; out_has "sandbox ok"
+end
+
+begin sandbox-require
+run "$S/require.lua"
+status_is 0; out_has "C module refused"
+if lua5.4 -e 'require "lfs"' 2>/dev/null; then
+  run --unsafe "$S/require.lua"
+  status_is 0; out_has "C module loaded"
+fi
+end
+
+begin write-relative-into-out
+run "$S/write.lua" rel.txt --out "$W/o"
+status_is 0; file_has "$W/o/rel.txt" written; no_file "$W/rel.txt"
+end
+
+begin write-default-out-is-cwd
+run "$S/write.lua" rel.txt
+status_is 0; file_has "$W/rel.txt" written
+end
+
+begin write-relative-out
+run "$S/write.lua" --out o/p rel.txt
+status_is 0; file_has "$W/o/p/rel.txt" written
+end
+
+begin write-subfolder
+run "$S/write.lua" sub/dir/x.txt --out "$W/o"
+status_is 0; file_has "$W/o/sub/dir/x.txt" written
+end
+
+begin write-absolute-inside
+run "$S/write.lua" "$W/o/abs.txt" --out "$W/o"
+status_is 0; file_has "$W/o/abs.txt" written
+end
+
+begin write-absolute-outside-denied
+run "$S/write.lua" "$W/outside.txt" --out "$W/o"
+status_is 1; err_has "io.open"; err_has "outside.txt"; no_file "$W/outside.txt"
+run "$S/write.lua" "$W/outside.txt" a --out "$W/o"
+status_is 1; no_file "$W/outside.txt"
+end
+
+begin update-outside-denied
+echo original >"$W/existing.txt"
+run "$S/write.lua" "$W/existing.txt" r+ --out "$W/o"
+status_is 1
+file_has "$W/existing.txt" original
+end
+
+begin escape-denied
+run "$S/write.lua" ../escape.txt --out "$W/o"
+status_is 1; err_has "io.open"; no_file "$W/escape.txt"
+end
+
+begin symlink-escape-denied
+mkdir -p "$W/o" "$W/elsewhere"
+ln -s "$W/elsewhere" "$W/o/link"
+run "$S/write.lua" link/x.txt --out "$W/o"
+status_is 1; no_file "$W/elsewhere/x.txt"
+end
+
+begin read-absolute-allowed
+echo hello-input >"$T/input.txt"
+run "$S/read.lua" "$T/input.txt" --out "$W/o"
+status_is 0; out_has "read	hello-input"
+end
+
+begin read-relative-from-cwd
+echo in-cwd >"$W/input.txt"
+mkdir -p "$W/o"
+echo in-out >"$W/o/input.txt"
+run "$S/read.lua" input.txt --out "$W/o"
+status_is 0; out_has "read	in-cwd"
+end
+
+begin io-output
+run "$S/output.lua" x.txt --out "$W/o"
+status_is 0; file_has "$W/o/x.txt" output
+run "$S/output.lua" "$W/out.txt" --out "$W/o"
+status_is 1; err_has "io.output"; no_file "$W/out.txt"
+end
+
+begin remove-rename
+mkdir -p "$W/o"
+echo a >"$W/o/a.txt"
+echo b >"$W/o/b.txt"
+echo keep >"$W/keep.txt"
+run "$S/remove.lua" remove a.txt --out "$W/o"
+status_is 0; no_file "$W/o/a.txt"
+run "$S/remove.lua" rename b.txt c.txt --out "$W/o"
+status_is 0; file_has "$W/o/c.txt" b
+run "$S/remove.lua" remove "$W/keep.txt" --out "$W/o"
+status_is 1; err_has "os.remove"; file_has "$W/keep.txt" keep
+run "$S/remove.lua" rename c.txt ../moved.txt --out "$W/o"
+status_is 1; err_has "os.rename"; no_file "$W/moved.txt"; file_has "$W/o/c.txt" b
+run "$S/remove.lua" rename "$W/keep.txt" d.txt --out "$W/o"
+status_is 1; file_has "$W/keep.txt" keep
+end
+
+begin unsafe
+run "$S/unsafe.lua" --out "$W/o"
+status_is 1
+run "$S/unsafe.lua" --unsafe --out "$W/o"
+status_is 0; out_has "unsafe ok"; file_has "$W/unsafe.txt" unsafe
+no_file "$W/o/unsafe.txt"
+run --unsafe "$S/write.lua" "$W/anywhere.txt" --out "$W/o"
+status_is 0; file_has "$W/anywhere.txt" written
+end
+
+# ---- Ctrl-C ----------------------------------------------------------------
+
+# Bash starts background jobs with SIGINT ignored, and outcrop (rightly)
+# keeps an ignored SIGINT ignored: restore the default for the child.
+if env --default-signal=INT true 2>/dev/null; then
+  DEFSIG=(env --default-signal=INT)
+else
+  DEFSIG=()
+  set -m # with job control, background jobs keep default signals
+fi
+
+# interrupt NAME [HOW]: Ctrl-C half a second into loop.lua HOW
+interrupt() {
+  begin "$1"
+  (cd "$W" && exec "${DEFSIG[@]}" "$OUTCROP" "$S/loop.lua" --out "$W/o" ${2:-}) \
+    >"$OUT" 2>"$ERR" </dev/null &
+  pid=$!
+  for _ in $(seq 200); do # up to 20 s for a slow (sanitized) start
+    [ -e "$W/o/started.txt" ] && break
+    sleep 0.1
+  done
+  sleep 0.5
+  kill -INT "$pid" 2>/dev/null
+  for _ in $(seq 100); do
+    kill -0 "$pid" 2>/dev/null || break
+    sleep 0.1
+  done
+  if kill -0 "$pid" 2>/dev/null; then
+    because "still running 10 s after SIGINT"
+    kill -KILL "$pid" 2>/dev/null
+  fi
+  wait "$pid"
+  rc=$?
+  sanitizer_check
+  [ -e "$W/o/started.txt" ] || because "the scene never started"
+  status_is 130; err_has "outcrop: interrupted"; no_file "$W/o/after.txt"
+  end
+}
+
+interrupt interrupt
+interrupt interrupt-coroutine-wrap wrap
+interrupt interrupt-coroutine-resume resume
+interrupt interrupt-coroutine-nested nested
+
+set +m
+
+echo "runtime tests: $npass passed, $nfail failed"
+[ "$nfail" -eq 0 ]
