@@ -1,0 +1,219 @@
+/*
+** oiio.cpp — the bridge from lib/io to OpenImageIO: plain C functions
+** (declared in lib/io/oiio.h) that read and write image files.
+**
+** The only C++ in the project. Every entry point catches every exception:
+** C callers get a status code and a message, never an unwinding stack.
+*/
+#include <OpenImageIO/imageio.h>
+
+#include <cstdarg>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <memory>
+#include <new>
+#include <string>
+
+#include <strings.h>
+
+#include "io/oiio.h"
+
+extern "C" {
+#include "core/error.h"
+}
+
+using OIIO::ImageInput;
+using OIIO::ImageOutput;
+using OIIO::ImageSpec;
+using OIIO::TypeDesc;
+
+namespace {
+
+int say(char *why, size_t n, int code, const char *fmt, ...) {
+  if (why && n) {
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(why, n, fmt, ap);
+    va_end(ap);
+  }
+  return code;
+}
+
+/* OpenImageIO messages may span lines; ours are one line. */
+std::string oneline(std::string s) {
+  for (char &c : s)
+    if (c == '\n' || c == '\r') c = ' ';
+  while (!s.empty() && s.back() == ' ')
+    s.pop_back();
+  return s.empty() ? std::string("unknown OpenImageIO error") : s;
+}
+
+/* String attributes the TIFF and JPEG writers store in a tag of their
+** own; any other key would be silently dropped by those writers. */
+bool native_text(const char *format, const char *key) {
+  static const char *const tiff[] = {
+      "Artist",       "Copyright",    "DateTime",
+      "DocumentName", "HostComputer", "ImageDescription",
+      "Make",         "Model",        "Software"};
+  static const char *const jpeg[] = {"ImageDescription", "Software", "Artist",
+                                     "Copyright", "DateTime"};
+  if (std::strcmp(format, "tiff") == 0) {
+    for (const char *k : tiff)
+      if (strcasecmp(k, key) == 0) return true;
+    return false;
+  }
+  if (std::strcmp(format, "jpeg") == 0) {
+    for (const char *k : jpeg)
+      if (strcasecmp(k, key) == 0) return true;
+    return false;
+  }
+  return true;
+}
+
+void describe(const char *format, const oc_oiio_out *im, ImageSpec &spec) {
+  std::string folded;
+  for (size_t i = 0; i < im->nmeta; i++) {
+    const char *k = im->meta[2 * i], *v = im->meta[2 * i + 1];
+    if (native_text(format, k)) {
+      spec.attribute(k, v);
+    } else {
+      folded += k;
+      folded += '=';
+      folded += v;
+      folded += '\n';
+    }
+  }
+  if (!folded.empty()) {
+    folded.pop_back();
+    std::string d = spec.get_string_attribute("ImageDescription");
+    spec.attribute("ImageDescription", d.empty() ? folded : d + "\n" + folded);
+  }
+  /* The TIFF and EXR writers stamp the current time unless a DateTime is
+  ** present; an empty one is written as nothing (TIFF) or an empty
+  ** capDate (EXR), which keeps repeated writes byte-identical. */
+  if (!spec.find_attribute("DateTime")) spec.attribute("DateTime", "");
+}
+
+int write_file(const char *path, const oc_oiio_out *im, char *why, size_t n) {
+  TypeDesc file, mem;
+  switch (im->type) {
+  case OC_OIIO_U8:
+    file = mem = TypeDesc::UINT8;
+    break;
+  case OC_OIIO_U16:
+    file = mem = TypeDesc::UINT16;
+    break;
+  case OC_OIIO_HALF:
+    file = TypeDesc::HALF;
+    mem = TypeDesc::FLOAT;
+    break;
+  case OC_OIIO_F32:
+    file = mem = TypeDesc::FLOAT;
+    break;
+  default:
+    return say(why, n, OC_EIO, "unknown sample type %d", (int)im->type);
+  }
+  auto out = ImageOutput::create(im->format);
+  if (!out) return say(why, n, OC_EIO, "%s", oneline(OIIO::geterror()).c_str());
+  ImageSpec spec(im->width, im->height, im->channels, file);
+  for (int c = 0; c < im->channels; c++)
+    spec.channelnames[c] = im->channel_names[c];
+  spec.alpha_channel = im->alpha;
+  /* Values are written as given: no division by alpha on the way out. */
+  if (im->alpha >= 0) spec.attribute("oiio:UnassociatedAlpha", 1);
+  describe(im->format, im, spec);
+  if (!out->open(path, spec))
+    return say(why, n, OC_EIO, "%s", oneline(out->geterror()).c_str());
+  bool ok = out->write_image(mem, im->pixels);
+  std::string e = ok ? std::string() : out->geterror();
+  ok = out->close() && ok;
+  if (!ok) {
+    if (e.empty()) e = out->geterror();
+    return say(why, n, OC_EIO, "%s", oneline(e).c_str());
+  }
+  return OC_OK;
+}
+
+struct image_deleter {
+  void operator()(oc_image *img) const { oc_image_free(img); }
+};
+
+oc_image *read_file(const char *path, oc_error *err) {
+  ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  auto in = ImageInput::open(path, &config);
+  if (!in) {
+    oc_seterr(err, OC_EIO, "cannot read '%s': %s", path,
+              oneline(OIIO::geterror()).c_str());
+    return nullptr;
+  }
+  const ImageSpec &spec = in->spec();
+  if (spec.deep || spec.depth > 1) {
+    oc_seterr(err, OC_EUNSUPPORTED,
+              "cannot read '%s': deep and volume images "
+              "are not supported",
+              path);
+    return nullptr;
+  }
+  oc_error sub;
+  std::unique_ptr<oc_image, image_deleter> img(
+      oc_image_new(spec.width, spec.height, spec.nchannels, &sub));
+  if (!img) {
+    oc_seterr(err, sub.code, "cannot read '%s': %s", path, sub.msg);
+    return nullptr;
+  }
+  if (!in->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT,
+                      oc_image_data(img.get()))) {
+    oc_seterr(err, OC_EIO, "cannot read '%s': %s", path,
+              oneline(in->geterror()).c_str());
+    return nullptr;
+  }
+  /* Names and attributes the image model refuses (odd characters,
+  ** encoding settings such as "compression") are left out. */
+  for (int c = 0; c < spec.nchannels && c < (int)spec.channelnames.size(); c++)
+    oc_image_set_channel_name(img.get(), c, spec.channelnames[c].c_str(),
+                              nullptr);
+  for (const auto &p : spec.extra_attribs) {
+    /* Strings whole; arrays of numbers capped, they are not provenance. */
+    std::string v;
+    if (p.type() == TypeDesc::STRING) {
+      const char *s = *(const char *const *)p.data();
+      v = s ? s : "";
+    } else {
+      v = p.get_string(64);
+    }
+    oc_image_set_meta(img.get(), p.name().c_str(), v.c_str(), nullptr);
+  }
+  in->close();
+  return img.release();
+}
+
+} // namespace
+
+extern "C" int oc_oiio_write(const char *path, const oc_oiio_out *im, char *why,
+                             size_t whysize) {
+  try {
+    return write_file(path, im, why, whysize);
+  } catch (const std::bad_alloc &) {
+    return say(why, whysize, OC_EIO, "out of memory");
+  } catch (const std::exception &e) {
+    return say(why, whysize, OC_EIO, "OpenImageIO failed: %s", e.what());
+  } catch (...) {
+    return say(why, whysize, OC_EIO, "OpenImageIO failed");
+  }
+}
+
+extern "C" oc_image *oc_oiio_read(const char *path, oc_error *err) {
+  try {
+    return read_file(path, err);
+  } catch (const std::bad_alloc &) {
+    oc_seterr(err, OC_ENOMEM, "cannot read '%s': out of memory", path);
+  } catch (const std::exception &e) {
+    oc_seterr(err, OC_EIO, "cannot read '%s': OpenImageIO failed: %s", path,
+              e.what());
+  } catch (...) {
+    oc_seterr(err, OC_EIO, "cannot read '%s': OpenImageIO failed", path);
+  }
+  return nullptr;
+}

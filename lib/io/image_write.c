@@ -1,0 +1,234 @@
+/*
+** image_write.c — oc_image_write: the format from the extension, samples
+** converted to what the format stores, and an atomic write (temporary
+** name in the same folder, then rename) so that no reader ever sees a
+** partial file under the final name.
+*/
+#include <errno.h>
+#include <fcntl.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <unistd.h>
+
+#include "core/error.h"
+#include "io/oiio.h"
+#include "outcrop.h"
+
+#define SUPPORTED ".png, .jpg, .jpeg, .tif, .tiff or .exr"
+
+typedef enum kind { PNG, JPEG, TIFF, EXR } kind;
+
+static const struct {
+  const char *ext;
+  kind kind;
+} extensions[] = {{".png", PNG},  {".jpg", JPEG},  {".jpeg", JPEG},
+                  {".tif", TIFF}, {".tiff", TIFF}, {".exr", EXR}};
+
+static const char *const oiio_names[] = {"png", "jpeg", "tiff", "openexr"};
+static const char *const labels[] = {"PNG", "JPEG", "TIFF", "EXR"};
+
+/* The extension of the last path component, or NULL. */
+static const char *extension(const char *path) {
+  const char *slash = strrchr(path, '/');
+  const char *base = slash ? slash + 1 : path;
+  const char *dot = strrchr(base, '.');
+  return dot && dot != base ? dot : NULL;
+}
+
+/* Sample type for `bits`, or -1 when the format cannot store it. */
+static int sample_type(kind k, int bits) {
+  switch (k) {
+  case PNG:
+    return bits == 0 || bits == 8 ? OC_OIIO_U8 : bits == 16 ? OC_OIIO_U16 : -1;
+  case JPEG:
+    return bits == 0 || bits == 8 ? OC_OIIO_U8 : -1;
+  case TIFF:
+    return bits == 8                 ? OC_OIIO_U8
+           : bits == 0 || bits == 16 ? OC_OIIO_U16
+           : bits == 32              ? OC_OIIO_F32
+                                     : -1;
+  case EXR:
+    return bits == 0 || bits == 16 ? OC_OIIO_HALF
+           : bits == 32            ? OC_OIIO_F32
+                                   : -1;
+  }
+  return -1;
+}
+
+static const char *const bits_allowed[] = {"8 or 16", "8", "8, 16 or 32",
+                                           "16 (half) or 32 (float)"};
+
+/* JPEG holds grey or RGB; the others hold grey, grey+alpha, RGB or RGBA,
+** except EXR which holds every channel. */
+static int written_channels(kind k, int channels) {
+  switch (k) {
+  case JPEG:
+    return channels >= 3 ? 3 : 1;
+  case EXR:
+    return channels;
+  default:
+    return channels > 4 ? 4 : channels;
+  }
+}
+
+/* Clamp to [0, 1] (NaN to 0) and round to nearest. Values are taken as
+** display-referred: no transfer function is applied. */
+static double unit(float x) {
+  return x > 0.0f ? (x < 1.0f ? x : 1.0) : 0.0;
+}
+
+/* The buffer handed to the bridge: `img`'s own pixels when they can go
+** as they are, else a converted copy of the first `nch` channels. */
+static const void *samples(const oc_image *img, int nch, oc_oiio_type t,
+                           void **owned) {
+  size_t npix = (size_t)oc_image_width(img) * oc_image_height(img);
+  int stride = oc_image_channels(img);
+  const float *src = oc_image_cdata(img);
+  *owned = NULL;
+  if ((t == OC_OIIO_HALF || t == OC_OIIO_F32) && nch == stride) return src;
+  size_t size = t == OC_OIIO_U8 ? 1 : t == OC_OIIO_U16 ? 2 : sizeof(float);
+  void *buf = malloc(npix * nch * size);
+  if (!buf) return NULL;
+  for (size_t p = 0; p < npix; p++) {
+    const float *s = src + p * stride;
+    for (int c = 0; c < nch; c++) {
+      size_t i = p * nch + c;
+      if (t == OC_OIIO_U8)
+        ((uint8_t *)buf)[i] = (uint8_t)(unit(s[c]) * 255.0 + 0.5);
+      else if (t == OC_OIIO_U16)
+        ((uint16_t *)buf)[i] = (uint16_t)(unit(s[c]) * 65535.0 + 0.5);
+      else
+        ((float *)buf)[i] = s[c];
+    }
+  }
+  *owned = buf;
+  return buf;
+}
+
+/* Creates an empty temporary file next to `path`, named
+** ".<base>.tmp-<pid>-<n><ext>": hidden, unique among processes (pid) and
+** threads (O_EXCL, trying the next n), and ending in the real extension.
+** Returns the malloc'ed name, or NULL with errno set. */
+static char *make_temp(const char *path, const char *ext) {
+  const char *slash = strrchr(path, '/');
+  int dirlen = slash ? (int)(slash - path + 1) : 0;
+  const char *base = path + dirlen;
+  size_t size = strlen(path) + strlen(ext) + 64;
+  char *tmp = malloc(size);
+  if (!tmp) {
+    errno = ENOMEM;
+    return NULL;
+  }
+  for (unsigned n = 0; n < 1000; n++) {
+    snprintf(tmp, size, "%.*s.%s.tmp-%ld-%u%s", dirlen, path, base,
+             (long)getpid(), n, ext);
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd >= 0) {
+      close(fd);
+      return tmp;
+    }
+    if (errno != EEXIST) break;
+  }
+  int e = errno;
+  free(tmp);
+  errno = e;
+  return NULL;
+}
+
+/* Flushes the data to disk before the rename, so that after a crash the
+** final name holds either the old file or the whole new one. */
+static int sync_file(const char *name) {
+  int fd = open(name, O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return -1;
+  int rc = fsync(fd);
+  int e = errno;
+  /* Some file systems (pipes, special mounts) cannot sync: not an error. */
+  if (rc != 0 && (e == EINVAL || e == ENOTSUP)) rc = 0;
+  close(fd);
+  errno = e;
+  return rc;
+}
+
+static int check_names(const oc_image *img, oc_error *err) {
+  int n = oc_image_channels(img);
+  for (int a = 0; a < n; a++)
+    for (int b = a + 1; b < n; b++)
+      if (strcmp(oc_image_channel_name(img, a),
+                 oc_image_channel_name(img, b)) == 0)
+        return oc_seterr(err, OC_EINVAL,
+                         "channels %d and %d are both named '%s'; EXR channel "
+                         "names must be unique",
+                         a, b, oc_image_channel_name(img, a));
+  return OC_OK;
+}
+
+int oc_image_write(const oc_image *img, const char *path, int bits,
+                   oc_error *err) {
+  if (!img) return oc_seterr(err, OC_EINVAL, "'image' is NULL");
+  if (!path || !*path)
+    return oc_seterr(err, OC_EINVAL, "'path' must be a non-empty file name");
+  const char *ext = extension(path);
+  int k = -1;
+  for (size_t i = 0; ext && i < sizeof extensions / sizeof *extensions; i++)
+    if (strcasecmp(ext, extensions[i].ext) == 0) k = (int)extensions[i].kind;
+  if (k < 0)
+    return oc_seterr(
+        err, OC_EINVAL,
+        "cannot write '%s': unknown image format (use " SUPPORTED ")", path);
+  int t = sample_type((kind)k, bits);
+  if (t < 0)
+    return oc_seterr(err, OC_EINVAL, "'bits' must be %s for %s (got %d)",
+                     bits_allowed[k], labels[k], bits);
+  if (k == EXR) {
+    int rc = check_names(img, err);
+    if (rc) return rc;
+  }
+
+  int nch = written_channels((kind)k, oc_image_channels(img));
+  const char *names[64];
+  for (int c = 0; c < nch; c++)
+    names[c] = oc_image_channel_name(img, c);
+  size_t nmeta = oc_image_meta_count(img);
+  const char **meta = malloc((2 * nmeta + 1) * sizeof *meta);
+  void *owned = NULL;
+  const void *px = meta ? samples(img, nch, (oc_oiio_type)t, &owned) : NULL;
+  if (!px) {
+    free(meta);
+    return oc_seterr(err, OC_ENOMEM, "cannot write '%s': out of memory", path);
+  }
+  for (size_t i = 0; i < nmeta; i++) {
+    meta[2 * i] = oc_image_meta_key(img, i);
+    meta[2 * i + 1] = oc_image_meta_value(img, i);
+  }
+  oc_oiio_out out = {
+      .format = oiio_names[k],
+      .width = oc_image_width(img),
+      .height = oc_image_height(img),
+      .channels = nch,
+      .type = (oc_oiio_type)t,
+      .pixels = px,
+      .alpha = k != EXR && (nch == 2 || nch == 4) ? nch - 1 : -1,
+      .channel_names = names,
+      .meta = meta,
+      .nmeta = nmeta,
+  };
+
+  int rc = OC_OK;
+  char why[OC_ERRMSG] = "";
+  char *tmp = make_temp(path, ext);
+  if (!tmp) {
+    rc = oc_seterr(err, OC_EIO, "cannot write '%s': %s", path, strerror(errno));
+  } else if (oc_oiio_write(tmp, &out, why, sizeof why) != OC_OK) {
+    rc = oc_seterr(err, OC_EIO, "cannot write '%s': %s", path, why);
+  } else if (sync_file(tmp) != 0 || rename(tmp, path) != 0) {
+    rc = oc_seterr(err, OC_EIO, "cannot write '%s': %s", path, strerror(errno));
+  }
+  if (tmp && rc != OC_OK) unlink(tmp);
+  free(tmp);
+  free(owned);
+  free(meta);
+  return rc;
+}

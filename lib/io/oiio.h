@@ -1,0 +1,68 @@
+/*
+** oiio.h — the C interface of the OpenImageIO bridge
+** (bindings/oiio/oiio.cpp, the project's only C++).
+**
+** The bridge knows file formats; it does not know about temporary names,
+** quantization or which channels a format keeps: lib/io decides those and
+** hands the bridge a ready buffer. No C++ exception crosses this
+** interface: every failure comes back as a status and a message.
+*/
+#ifndef OC_OIIO_H
+#define OC_OIIO_H
+
+#include <stddef.h>
+
+#include "outcrop.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Storage type of the samples in the file. */
+typedef enum oc_oiio_type {
+  OC_OIIO_U8,   /* pixels are uint8_t */
+  OC_OIIO_U16,  /* pixels are uint16_t */
+  OC_OIIO_HALF, /* pixels are float, stored as half */
+  OC_OIIO_F32   /* pixels are float */
+} oc_oiio_type;
+
+typedef struct oc_oiio_out {
+  const char *format; /* OpenImageIO format: "png", "jpeg", "tiff", "openexr" */
+  int width, height, channels;
+  oc_oiio_type type;
+  const void *pixels; /* interleaved, row 0 at the top, tightly packed */
+  int alpha;          /* index of an unassociated alpha channel, or -1 */
+  const char *const *channel_names; /* `channels` names */
+  const char *const *meta;          /* key0, value0, key1, value1, ... */
+  size_t nmeta;                     /* number of (key, value) pairs */
+} oc_oiio_out;
+
+/* Writes `im` to `path`, which must not be a name other threads use.
+** Every metadata pair becomes a string attribute; where the format has no
+** free text fields (TIFF) the keys it cannot hold are appended to the
+** ImageDescription as "key=value" lines. No timestamp is added, so equal
+** inputs give equal bytes. Returns OC_OK, or OC_EIO with the reason in
+** `why` (not naming the path: the caller knows which name to report). */
+int oc_oiio_write(const char *path, const oc_oiio_out *im, char *why,
+                  size_t whysize);
+
+/* Reads the first subimage of `path` into a new float image owned by the
+** caller (oc_image_free). Integer samples map to [0, 1]; alpha is left as
+** stored (never premultiplied). Channel names are copied, and every file
+** attribute that oc_image_set_meta accepts becomes metadata (numbers as
+** text). NULL on failure with `err` set: OC_EIO naming the path, or the
+** error of oc_image_new for images too large. */
+oc_image *oc_oiio_read(const char *path, oc_error *err);
+
+/* Read access to an image's metadata, for the writer and the reader's
+** tests (defined in render/image.c; not in outcrop.h yet). Keys compare
+** without case. */
+size_t oc_image_meta_count(const oc_image *img);
+const char *oc_image_meta_key(const oc_image *img, size_t i);
+const char *oc_image_meta_value(const oc_image *img, size_t i);
+const char *oc_image_meta_get(const oc_image *img, const char *key);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
