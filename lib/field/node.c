@@ -243,7 +243,7 @@ oc_node *oc_transform(oc_node *child, const double m[12], oc_error *err) {
     }
   if (!affine_inverse(m, inv)) {
     oc_seterr(err, OC_EINVAL,
-              "transform is not invertible (a 'scale' of 0?)");
+              "transform is not invertible (a 'scale' of 0, or too small or too large)");
     return NULL;
   }
   oc_node *n = oc_node_alloc(OC_K_XFORM, &child, 1, err);
