@@ -178,6 +178,89 @@ typedef struct oc_program_stats {
 } oc_program_stats;
 void oc_program_get_stats(const oc_program *prog, oc_program_stats *st);
 
+/* Local queries, for meshing and tracing. Both are conservative: they may
+** overestimate, never underestimate.
+**
+** Column spans: z-intervals covering every z at which the field may vary
+** anywhere in the column footprint [x0, x1] x [y0, y1] (x0 <= x1,
+** y0 <= y1). Between two spans the field is constant over the whole
+** footprint, so no surface crosses a cell lying there. Volumetric nodes
+** report their support box; heightfield-like nodes (a plane, later
+** terrains) the thin z-range where they vary; operators the union of their
+** children's. Writes at most `max` sorted, disjoint spans to out (merging
+** the closest when there are more) and returns the count; returns -1 when
+** the whole column must be considered. */
+typedef struct oc_zspan {
+  double lo, hi;
+} oc_zspan;
+int oc_program_column_spans(const oc_program *prog, double x0, double y0,
+                            double x1, double y1, oc_zspan *out, int max);
+
+/* A Lipschitz bound of the field valid inside `box` only: it counts only
+** the nodes whose support meets the box (through the BVH). */
+double oc_program_lipschitz_in(const oc_program *prog, oc_aabb box);
+
+/* ---- progress and cancellation --------------------------------------- */
+
+/* Long work calls fn from one thread with the fraction done, in [0, 1];
+** a non-zero return cancels the work (OC_ECANCEL, nothing written). */
+typedef struct oc_progress {
+  int (*fn)(void *ud, double fraction);
+  void *ud;
+} oc_progress;
+
+/* ---- meshes ------------------------------------------------------------ */
+
+typedef struct oc_mesh oc_mesh;
+
+typedef struct oc_polygonize_params {
+  oc_aabb box;       /* region to mesh: finite, non-empty */
+  double cell;       /* cell size; or 0 to use nx, ny, nz */
+  int nx, ny, nz;    /* cells per axis when cell == 0 */
+  double threshold;  /* iso-value; 0 means the program's T */
+  int open;          /* 1: drop the cap faces lying on the box */
+  int steps;         /* root-finding steps per edge (0: default 6) */
+  int full_grid;     /* 1: ignore surface bounds (benchmarks, tests) */
+  oc_progress progress;
+} oc_polygonize_params;
+
+/* Marching cubes over the box with a topologically consistent case table:
+** a closed, manifold, consistently oriented mesh (outward normals), capped
+** where a solid meets the box unless `open`. Returns a new mesh (caller
+** frees with oc_mesh_free) or NULL with err. Byte-identical for any
+** thread count. */
+oc_mesh *oc_polygonize(const oc_program *prog, const oc_polygonize_params *pp,
+                       oc_error *err);
+void oc_mesh_free(oc_mesh *mesh);
+
+size_t oc_mesh_vertex_count(const oc_mesh *mesh);
+size_t oc_mesh_triangle_count(const oc_mesh *mesh);
+const float *oc_mesh_positions(const oc_mesh *mesh); /* 3 per vertex */
+const float *oc_mesh_normals(const oc_mesh *mesh);   /* 3 per vertex, unit */
+const float *oc_mesh_colors(const oc_mesh *mesh);    /* 3 per vertex or NULL */
+const uint32_t *oc_mesh_indices(const oc_mesh *mesh); /* 3 per triangle, CCW
+                                                      ** seen from outside */
+
+typedef struct oc_mesh_stats {
+  size_t vertices, triangles;
+  size_t field_calls;   /* value and gradient evaluations */
+  size_t cells_visited; /* cells whose corners were sampled */
+  double seconds;
+} oc_mesh_stats;
+void oc_mesh_get_stats(const oc_mesh *mesh, oc_mesh_stats *st);
+
+/* Per-vertex colours: rgb has 3 floats per vertex in [0, 1] (copied). */
+int oc_mesh_set_colors(oc_mesh *mesh, const float *rgb, oc_error *err);
+/* Colours from a field through a palette: `n` stops (value, r, g, b)
+** sorted by value, linearly interpolated, clamped at the ends. */
+int oc_mesh_color_by_field(oc_mesh *mesh, const oc_program *field,
+                           const double *stops, int n, oc_error *err);
+
+/* Writes by extension: .ply (binary little-endian: positions, normals,
+** colours when set), .obj (positions, normals), .glb (glTF 2.0 binary).
+** Atomic (temporary name, then rename); on error no file is left. */
+int oc_mesh_write(const oc_mesh *mesh, const char *path, oc_error *err);
+
 /* ---- images ---------------------------------------------------------- */
 
 /* Float pixels, row 0 at the top, channels interleaved. */

@@ -764,12 +764,15 @@ static uint32_t compile_warp(comp *c, const oc_node *n) {
 static uint32_t compile_xform(comp *c, const oc_node *n) {
   uint32_t k = compile_node(c, n->kids[0]);
   if (k == OC_NONE) return k;
-  uint32_t op = emit(c, OC_K_XFORM, &k, 1, n->par, 24);
+  double par[OC_NPAR + 1];
+  memcpy(par, n->par, OC_NPAR * sizeof *par);
+  par[OC_NPAR] = sigma_max(n->par + OC_P_INV); /* for local bounds */
+  uint32_t op = emit(c, OC_K_XFORM, &k, 1, par, OC_NPAR + 1);
   if (op == OC_NONE) return op;
   info *C = &c->inf[k], *in = &c->inf[op];
   in->lo = C->lo;
   in->hi = C->hi;
-  in->lip = C->lip * sigma_max(n->par + OC_P_INV);
+  in->lip = C->lip * par[OC_NPAR];
   set_box(c, op, xform_box(n->par + OC_P_FWD, C->box));
   return op;
 }
@@ -932,6 +935,7 @@ oc_program *oc_compile(oc_node *root, const oc_compile_options *opts,
     oc_program_free(P);
     return NULL;
   }
+  for (uint32_t i = 0; i < P->nops; i++) P->ops[i].lip = c.inf[i].lip;
   P->root = r;
   P->bounds = c.inf[r].box;
   P->lip = c.inf[r].lip;

@@ -44,6 +44,7 @@ typedef struct oc_op {
   uint32_t bvh;   /* groups: BVH root, or OC_NONE */
   uint32_t ntotal; /* groups: number of children in all */
   float lo[3], hi[3]; /* support box, rounded outwards */
+  double lip;         /* global Lipschitz bound of this op */
 } oc_op;
 
 struct oc_program {

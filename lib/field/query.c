@@ -1,0 +1,342 @@
+/*
+** query.c — local queries on a compiled program: the z-spans where a
+** column may vary (surface bounds for the mesher, seed 000 section 7) and
+** Lipschitz bounds restricted to a box (for culling and sphere tracing).
+** Both walk the program like evaluation does, pruning by support boxes and
+** through the BVHs, and are read-only and allocation-free.
+*/
+#include <math.h>
+
+#include "core/falloff.h"
+#include "core/noise.h"
+#include "core/vec.h"
+#include "field/prim.h"
+#include "field/program.h"
+
+#define SPAN_CAP 64
+#define BVH_STACK 64
+
+/* ---- span sets ---------------------------------------------------------- */
+
+typedef struct spans {
+  oc_zspan s[SPAN_CAP];
+  int n;
+  int all; /* the whole column */
+} spans;
+
+/* Keeps spans sorted and disjoint; past the capacity, merges the two
+** neighbours with the smallest gap (still a cover, just looser). */
+static void span_add(spans *S, double lo, double hi) {
+  if (S->all || !(lo <= hi)) return;
+  if (isinf(lo) && isinf(hi)) {
+    S->all = 1;
+    return;
+  }
+  int i = 0;
+  while (i < S->n && S->s[i].hi < lo) i++;
+  /* merge every span overlapping [lo, hi] */
+  int j = i;
+  while (j < S->n && S->s[j].lo <= hi) {
+    lo = fmin(lo, S->s[j].lo);
+    hi = fmax(hi, S->s[j].hi);
+    j++;
+  }
+  int removed = j - i;
+  if (removed == 0) {
+    if (S->n == SPAN_CAP) {
+      /* merge the closest pair to make room */
+      int best = 0;
+      double gap = INFINITY;
+      for (int k = 0; k + 1 < S->n; k++)
+        if (S->s[k + 1].lo - S->s[k].hi < gap) {
+          gap = S->s[k + 1].lo - S->s[k].hi;
+          best = k;
+        }
+      S->s[best].hi = S->s[best + 1].hi;
+      for (int k = best + 1; k + 1 < S->n; k++) S->s[k] = S->s[k + 1];
+      S->n--;
+      span_add(S, lo, hi);
+      return;
+    }
+    for (int k = S->n; k > i; k--) S->s[k] = S->s[k - 1];
+    S->n++;
+  } else if (removed > 1) {
+    for (int k = i + 1; k + removed - 1 < S->n; k++)
+      S->s[k] = S->s[k + removed - 1];
+    S->n -= removed - 1;
+  }
+  S->s[i].lo = lo;
+  S->s[i].hi = hi;
+}
+
+typedef struct foot {
+  double x0, y0, x1, y1;
+} foot;
+
+static int foot_meets(const float *lo, const float *hi, const foot *f) {
+  return lo[0] <= f->x1 && hi[0] >= f->x0 && lo[1] <= f->y1 && hi[1] >= f->y0;
+}
+
+/* The slab 0 < (p - o).n < R where a plane's field varies, over the
+** footprint. */
+static void plane_spans(const double *par, const foot *f, spans *S) {
+  double ox = par[OC_P_O], oy = par[OC_P_O + 1], oz = par[OC_P_O + 2];
+  double nx = par[OC_P_N], ny = par[OC_P_N + 1], nz = par[OC_P_N + 2];
+  double R = par[OC_P_R];
+  /* range of n_x (x - ox) + n_y (y - oy) over the footprint */
+  double a = fmin(nx * (f->x0 - ox), nx * (f->x1 - ox)) +
+             fmin(ny * (f->y0 - oy), ny * (f->y1 - oy));
+  double b = fmax(nx * (f->x0 - ox), nx * (f->x1 - ox)) +
+             fmax(ny * (f->y0 - oy), ny * (f->y1 - oy));
+  if (fabs(nz) < 1e-12) {
+    /* vertical: varies at every z wherever the slab meets the footprint */
+    if (b > 0 && a < R) S->all = 1;
+    return;
+  }
+  /* z = oz + (s - h) / nz for s in [0, R], h in [a, b] */
+  double z1 = oz + (0 - a) / nz, z2 = oz + (0 - b) / nz;
+  double z3 = oz + (R - a) / nz, z4 = oz + (R - b) / nz;
+  double lo = fmin(fmin(z1, z2), fmin(z3, z4));
+  double hi = fmax(fmax(z1, z2), fmax(z3, z4));
+  /* pad by a relative epsilon for the rounding of the formula */
+  double pad = 1e-9 * (fabs(lo) + fabs(hi) + R);
+  span_add(S, lo - pad, hi + pad);
+}
+
+static void op_spans(const oc_program *P, uint32_t i, const foot *f,
+                     spans *S, int depth);
+
+static void group_spans(const oc_program *P, const oc_op *o, const foot *f,
+                        spans *S, int depth) {
+  for (uint32_t k = 0; k < o->nkid && !S->all; k++)
+    op_spans(P, P->kids[o->kid + k], f, S, depth + 1);
+  if (!o->nent || S->all) return;
+  uint32_t stack[BVH_STACK];
+  int sp = 0;
+  stack[sp++] = o->bvh;
+  while (sp && !S->all) {
+    const oc_bvhnode *nd = &P->bvh[stack[--sp]];
+    if (!foot_meets(nd->lo, nd->hi, f)) continue;
+    if (nd->count) {
+      for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
+        const oc_ent *e = &P->ent[j];
+        if (e->ref != OC_NONE) {
+          op_spans(P, e->ref, f, S, depth + 1);
+          continue;
+        }
+        double R = 1.0 / sqrt((double)e->ir2) * (1 + 1e-6);
+        if (e->c[0] - R > f->x1 || e->c[0] + R < f->x0 ||
+            e->c[1] - R > f->y1 || e->c[1] + R < f->y0)
+          continue;
+        span_add(S, e->c[2] - R, e->c[2] + R);
+      }
+    } else if (sp + 2 <= BVH_STACK) {
+      stack[sp++] = nd->first + 1;
+      stack[sp++] = nd->first;
+    }
+  }
+}
+
+/* A transform keeps columns when it maps z to z and xy to xy. */
+static int column_preserving(const double *m) {
+  return m[2] == 0 && m[6] == 0 && m[8] == 0 && m[9] == 0 && m[10] != 0;
+}
+
+static void op_spans(const oc_program *P, uint32_t i, const foot *f,
+                     spans *S, int depth) {
+  const oc_op *o = &P->ops[i];
+  if (S->all) return;
+  if (depth > OC_MAX_DEPTH + 8) {
+    S->all = 1;
+    return;
+  }
+  if (!foot_meets(o->lo, o->hi, f)) return; /* f == 0 over the column */
+  const double *par = P->par + o->par;
+  switch ((oc_kind)o->kind) {
+  case OC_K_PLANE:
+    plane_spans(par, f, S);
+    return;
+  case OC_K_TURB:
+    S->all = 1;
+    return;
+  case OC_K_BLEND:
+  case OC_K_UNION:
+    group_spans(P, o, f, S, depth);
+    return;
+  case OC_K_INTER:
+  case OC_K_DIFF:
+  case OC_K_SUNION:
+  case OC_K_SINTER:
+  case OC_K_SCALE:
+    if (o->kind == OC_K_SCALE && par[0] == 0) return;
+    for (uint32_t k = 0; k < o->nkid && !S->all; k++)
+      op_spans(P, P->kids[o->kid + k], f, S, depth + 1);
+    return;
+  case OC_K_WARP: {
+    /* the child's spans around the displaced column, grown by the
+    ** largest displacement */
+    double A = fabs(par[1]) * oc_turb3_max((int)par[3]) / 2;
+    foot g = {f->x0 - A, f->y0 - A, f->x1 + A, f->y1 + A};
+    spans C = {.n = 0, .all = 0};
+    op_spans(P, P->kids[o->kid], &g, &C, depth + 1);
+    if (C.all) {
+      S->all = 1;
+      return;
+    }
+    for (int k = 0; k < C.n; k++) span_add(S, C.s[k].lo - A, C.s[k].hi + A);
+    return;
+  }
+  case OC_K_XFORM: {
+    const double *m = par + OC_P_FWD, *inv = par + OC_P_INV;
+    if (column_preserving(m)) {
+      /* the footprint's preimage (its box), then z back to world */
+      double xs[2] = {f->x0, f->x1}, ys[2] = {f->y0, f->y1};
+      foot g = {INFINITY, INFINITY, -INFINITY, -INFINITY};
+      for (int a = 0; a < 2; a++)
+        for (int b = 0; b < 2; b++) {
+          double u = inv[0] * xs[a] + inv[1] * ys[b] + inv[3];
+          double v = inv[4] * xs[a] + inv[5] * ys[b] + inv[7];
+          g.x0 = fmin(g.x0, u);
+          g.x1 = fmax(g.x1, u);
+          g.y0 = fmin(g.y0, v);
+          g.y1 = fmax(g.y1, v);
+        }
+      spans C = {.n = 0, .all = 0};
+      op_spans(P, P->kids[o->kid], &g, &C, depth + 1);
+      if (C.all) {
+        S->all = 1;
+        return;
+      }
+      for (int k = 0; k < C.n; k++) {
+        double z1 = m[10] * C.s[k].lo + m[11], z2 = m[10] * C.s[k].hi + m[11];
+        span_add(S, fmin(z1, z2), fmax(z1, z2));
+      }
+      return;
+    }
+    if (isinf(o->lo[2]) || isinf(o->hi[2]))
+      S->all = 1;
+    else
+      span_add(S, o->lo[2], o->hi[2]);
+    return;
+  }
+  default: /* bounded primitives and perturb: their support box */
+    if (isinf(o->lo[2]) || isinf(o->hi[2]))
+      S->all = 1;
+    else
+      span_add(S, o->lo[2], o->hi[2]);
+    return;
+  }
+}
+
+int oc_program_column_spans(const oc_program *P, double x0, double y0,
+                            double x1, double y1, oc_zspan *out, int max) {
+  if (!(x0 <= x1 && y0 <= y1) || max < 1) return -1;
+  foot f = {x0, y0, x1, y1};
+  spans S = {.n = 0, .all = 0};
+  op_spans(P, P->root, &f, &S, 0);
+  if (S.all) return -1;
+  /* reduce to max spans by closing the smallest gaps */
+  while (S.n > max) {
+    int best = 0;
+    double gap = INFINITY;
+    for (int k = 0; k + 1 < S.n; k++)
+      if (S.s[k + 1].lo - S.s[k].hi < gap) {
+        gap = S.s[k + 1].lo - S.s[k].hi;
+        best = k;
+      }
+    S.s[best].hi = S.s[best + 1].hi;
+    for (int k = best + 1; k + 1 < S.n; k++) S.s[k] = S.s[k + 1];
+    S.n--;
+  }
+  for (int k = 0; k < S.n; k++) out[k] = S.s[k];
+  return S.n;
+}
+
+/* ---- local Lipschitz bounds --------------------------------------------- */
+
+static int box_meets(const float *lo, const float *hi, const oc_aabb *b) {
+  return lo[0] <= b->hi.x && hi[0] >= b->lo.x && lo[1] <= b->hi.y &&
+         hi[1] >= b->lo.y && lo[2] <= b->hi.z && hi[2] >= b->lo.z;
+}
+
+static double op_lip(const oc_program *P, uint32_t i, const oc_aabb *b,
+                     int depth) {
+  const oc_op *o = &P->ops[i];
+  if (!box_meets(o->lo, o->hi, b)) return 0; /* f == 0 on the box */
+  if (depth > OC_MAX_DEPTH + 8) return o->lip;
+  const double *par = P->par + o->par;
+  switch ((oc_kind)o->kind) {
+  case OC_K_BLEND:
+  case OC_K_UNION: {
+    int uni = o->kind == OC_K_UNION;
+    double acc = 0;
+    for (uint32_t k = 0; k < o->nkid; k++) {
+      double l = op_lip(P, P->kids[o->kid + k], b, depth + 1);
+      acc = uni ? fmax(acc, l) : acc + l;
+    }
+    if (!o->nent) return acc;
+    uint32_t stack[BVH_STACK];
+    int sp = 0;
+    stack[sp++] = o->bvh;
+    while (sp) {
+      const oc_bvhnode *nd = &P->bvh[stack[--sp]];
+      if (!box_meets(nd->lo, nd->hi, b)) continue;
+      if (nd->count) {
+        for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
+          const oc_ent *e = &P->ent[j];
+          double l;
+          if (e->ref != OC_NONE) {
+            l = op_lip(P, e->ref, b, depth + 1);
+          } else {
+            double R = 1.0 / sqrt((double)e->ir2);
+            double Rp = R * (1 + 1e-6);
+            if (e->c[0] - Rp > b->hi.x || e->c[0] + Rp < b->lo.x ||
+                e->c[1] - Rp > b->hi.y || e->c[1] + Rp < b->lo.y ||
+                e->c[2] - Rp > b->hi.z || e->c[2] + Rp < b->lo.z)
+              continue;
+            l = fabs((double)e->e) * OC_FALLOFF_LIPSCHITZ / R * (1 + 1e-6);
+          }
+          acc = uni ? fmax(acc, l) : acc + l;
+        }
+      } else if (sp + 2 <= BVH_STACK) {
+        stack[sp++] = nd->first + 1;
+        stack[sp++] = nd->first;
+      }
+    }
+    return fmin(acc, o->lip);
+  }
+  case OC_K_INTER:
+  case OC_K_DIFF: {
+    double m = 0;
+    for (uint32_t k = 0; k < o->nkid; k++)
+      m = fmax(m, op_lip(P, P->kids[o->kid + k], b, depth + 1));
+    return m;
+  }
+  case OC_K_SCALE:
+    return fabs(par[0]) * op_lip(P, P->kids[o->kid], b, depth + 1);
+  case OC_K_XFORM: {
+    /* the child's bound on the preimage of the box */
+    const double *inv = par + OC_P_INV;
+    oc_aabb c = {{INFINITY, INFINITY, INFINITY},
+                 {-INFINITY, -INFINITY, -INFINITY}};
+    for (int k = 0; k < 8; k++) {
+      oc_vec3 p = oc_v3(k & 1 ? b->hi.x : b->lo.x, k & 2 ? b->hi.y : b->lo.y,
+                        k & 4 ? b->hi.z : b->lo.z);
+      oc_vec3 q = oc_v3(inv[0] * p.x + inv[1] * p.y + inv[2] * p.z + inv[3],
+                        inv[4] * p.x + inv[5] * p.y + inv[6] * p.z + inv[7],
+                        inv[8] * p.x + inv[9] * p.y + inv[10] * p.z + inv[11]);
+      c.lo = oc_vmin(c.lo, q);
+      c.hi = oc_vmax(c.hi, q);
+    }
+    if (!oc_vfinite(c.lo) || !oc_vfinite(c.hi)) return o->lip;
+    return par[OC_NPAR] * op_lip(P, P->kids[o->kid], &c, depth + 1);
+  }
+  default: /* primitives, perturb, warp, smooth operators: their bound */
+    return o->lip;
+  }
+}
+
+double oc_program_lipschitz_in(const oc_program *P, oc_aabb box) {
+  if (oc_aabb_is_empty(box)) return 0;
+  return op_lip(P, P->root, &box, 0);
+}

@@ -1,0 +1,182 @@
+/*
+** test_query.c — local queries: column spans (surface bounds) and
+** Lipschitz bounds restricted to a box.
+**
+** Spans are checked by their contract: between spans the field is constant
+** over the whole footprint, so many random points of a gap must all give
+** the same value. Local Lipschitz bounds must never be exceeded by point
+** pairs inside their box and never exceed the global bound.
+*/
+#include <stdlib.h>
+
+#include "ocheck.h"
+
+/* A terrain-like scene: a ground plane (optionally tilted), carved and
+** raised primitives, a transformed instance and a warped one. */
+static oc_program *scene(int tilted, int with_warp) {
+  oct_rng r = oct_rng_new(7);
+  oc_error err;
+  enum { N = 300 };
+  oc_node *k[N + 4];
+  size_t n = 0;
+  oc_vec3 nrm = tilted ? oct_v(0.2, -0.1, 1) : oct_v(0, 0, 1);
+  k[n++] = OCT_OK(oc_plane(oct_v(0, 0, 0), nrm, 3, 1, &err));
+  for (int i = 0; i < N; i++)
+    k[n++] = oct_random_prim(&r, oct_v(0, 0, -8), oct_v(200, 200, 8), 1, 6,
+                             0.5);
+  oc_node *rock = OCT_OK(oc_sphere(oct_v(0, 0, 0), 3, 2, 1, &err));
+  double m[12] = {2, 0, 0, 50, 0, 2, 0, 60, 0, 0, 1.5, 10};
+  k[n++] = OCT_OK(oc_transform(rock, m, &err));
+  if (with_warp) {
+    oc_noise nz = {8, 2, 0, 2, 5};
+    k[n++] = OCT_OK(oc_warp(rock, &nz, NULL, &err));
+  }
+  oc_node_release(rock);
+  oc_node *b = OCT_OK(oc_blend(k, n, &err));
+  for (size_t i = 0; i < n; i++) oc_node_release(k[i]);
+  return oct_compile(b, 0, 0);
+}
+
+static void check_gaps(const oc_program *pr, oct_rng *r, double x0,
+                       double y0, double x1, double y1) {
+  oc_zspan s[8];
+  int n = oc_program_column_spans(pr, x0, y0, x1, y1, s, 8);
+  if (n < 0) return;
+  ck_assert_int_le(n, 8);
+  for (int i = 0; i + 1 < n; i++) ck_assert(s[i].hi < s[i + 1].lo);
+  /* gaps: below the first, between, above the last (bounded for sampling) */
+  for (int g = 0; g <= n; g++) {
+    double lo = g == 0 ? -60 : s[g - 1].hi, hi = g == n ? 60 : s[g].lo;
+    if (g == 0 && n > 0) lo = fmin(lo, s[0].lo - 10);
+    if (g == n && n > 0) hi = fmax(hi, s[n - 1].hi + 10);
+    if (!(hi > lo)) continue;
+    double ref = NAN;
+    for (int t = 0; t < 40; t++) {
+      oc_vec3 p = oct_v(oct_unif(r, x0, x1), oct_unif(r, y0, y1),
+                        oct_unif(r, lo, hi));
+      if (p.z <= lo || p.z >= hi) continue;
+      double v = oc_program_eval(pr, p);
+      if (isnan(ref))
+        ref = v;
+      else
+        ck_assert_msg(fabs(v - ref) <= 1e-12,
+                      "field varies in a gap (%g, %g) of column [%g,%g]x[%g,%g]:"
+                      " %.17g vs %.17g at z %g",
+                      lo, hi, x0, x1, y0, y1, v, ref, p.z);
+    }
+  }
+}
+
+START_TEST(spans_cover_variation) {
+  for (int tilted = 0; tilted < 2; tilted++) {
+    oc_program *pr = scene(tilted, 1);
+    oct_rng r = oct_rng_new(11 + tilted);
+    int bounded = 0;
+    for (int c = 0; c < 400; c++) {
+      double x = oct_unif(&r, -20, 220), y = oct_unif(&r, -20, 220);
+      double w = oct_unif(&r, 0.1, 6);
+      oc_zspan s[8];
+      if (oc_program_column_spans(pr, x, y, x + w, y + w, s, 8) >= 0)
+        bounded++;
+      check_gaps(pr, &r, x, y, x + w, y + w);
+    }
+    /* the point of spans: most columns are bounded */
+    ck_assert_int_gt(bounded, 300);
+    oc_program_free(pr);
+  }
+}
+END_TEST
+
+START_TEST(spans_of_plane_are_thin) {
+  oc_error err;
+  oc_node *pl = OCT_OK(oc_plane(oct_v(0, 0, 5), oct_v(0, 0, 1), 2, 1, &err));
+  oc_program *pr = oct_compile(pl, 0, 0);
+  oc_zspan s[4];
+  int n = oc_program_column_spans(pr, 0, 0, 10, 10, s, 4);
+  ck_assert_int_eq(n, 1);
+  ck_assert(s[0].lo <= 5 && s[0].lo > 4.99);
+  ck_assert(s[0].hi >= 7 && s[0].hi < 7.01);
+  oc_program_free(pr);
+  /* a vertical plane varies at every z */
+  pl = OCT_OK(oc_plane(oct_v(3, 0, 0), oct_v(1, 0, 0), 2, 1, &err));
+  pr = oct_compile(pl, 0, 0);
+  ck_assert_int_eq(oc_program_column_spans(pr, 0, 0, 10, 10, s, 4), -1);
+  /* but not in a column away from its slab */
+  ck_assert_int_eq(oc_program_column_spans(pr, 20, 0, 30, 10, s, 4), 0);
+  oc_program_free(pr);
+}
+END_TEST
+
+START_TEST(spans_merge_to_max) {
+  oc_error err;
+  oc_node *k[10];
+  for (int i = 0; i < 10; i++)
+    k[i] = OCT_OK(oc_point(oct_v(0, 0, 10.0 * i), 1, 1, &err));
+  oc_node *b = OCT_OK(oc_blend(k, 10, &err));
+  for (int i = 0; i < 10; i++) oc_node_release(k[i]);
+  oc_program *pr = oct_compile(b, 0, 0);
+  oc_zspan s[10];
+  ck_assert_int_eq(oc_program_column_spans(pr, -0.5, -0.5, 0.5, 0.5, s, 10),
+                   10);
+  oc_zspan t[3];
+  ck_assert_int_eq(oc_program_column_spans(pr, -0.5, -0.5, 0.5, 0.5, t, 3),
+                   3);
+  ck_assert(t[0].lo <= s[0].lo && t[2].hi >= s[9].hi);
+  ck_assert_int_eq(oc_program_column_spans(pr, 5, 5, 6, 6, t, 3), 0);
+  oc_program_free(pr);
+}
+END_TEST
+
+START_TEST(local_lipschitz_holds) {
+  oc_program *pr = scene(1, 1);
+  oct_rng r = oct_rng_new(3);
+  double L = oc_program_lipschitz(pr);
+  int smaller = 0;
+  for (int b = 0; b < 300; b++) {
+    oc_vec3 lo = oct_v(oct_unif(&r, -10, 200), oct_unif(&r, -10, 200),
+                       oct_unif(&r, -15, 15));
+    double w = oct_unif(&r, 0.5, 12);
+    oc_aabb box = {lo, oct_add(lo, oct_v(w, w, w))};
+    double Lb = oc_program_lipschitz_in(pr, box);
+    ck_assert(Lb <= L * (1 + 1e-12));
+    if (Lb < 0.5 * L) smaller++;
+    for (int t = 0; t < 200; t++) {
+      oc_vec3 p = oct_in_box(&r, box.lo, box.hi);
+      oc_vec3 q = t % 2 ? oct_in_box(&r, box.lo, box.hi)
+                        : oct_add(p, oct_mul(oct_dir(&r), w * 1e-4));
+      if (!oct_box_contains(box, q)) continue;
+      double d = fabs(oc_program_eval(pr, p) - oc_program_eval(pr, q));
+      ck_assert_msg(d <= Lb * oct_len(oct_sub(p, q)) * (1 + 1e-9) + 1e-14,
+                    "local bound %g exceeded: %g over %g", Lb, d,
+                    oct_len(oct_sub(p, q)));
+    }
+  }
+  ck_assert_int_gt(smaller, 100); /* local bounds are worth having */
+  oc_program_free(pr);
+}
+END_TEST
+
+START_TEST(local_lipschitz_zero_far_away) {
+  oc_error err;
+  oc_node *p = OCT_OK(oc_point(oct_v(0, 0, 0), 2, 1, &err));
+  oc_program *pr = oct_compile(p, 0, 0);
+  oc_aabb far = {oct_v(10, 10, 10), oct_v(11, 11, 11)};
+  ck_assert(oc_program_lipschitz_in(pr, far) == 0);
+  oc_aabb near = {oct_v(-1, -1, -1), oct_v(1, 1, 1)};
+  ck_assert(oc_program_lipschitz_in(pr, near) == oc_program_lipschitz(pr));
+  oc_program_free(pr);
+}
+END_TEST
+
+int main(void) {
+  Suite *s = suite_create("query");
+  TCase *tc = tcase_create("query");
+  tcase_set_timeout(tc, 60);
+  tcase_add_test(tc, spans_cover_variation);
+  tcase_add_test(tc, spans_of_plane_are_thin);
+  tcase_add_test(tc, spans_merge_to_max);
+  tcase_add_test(tc, local_lipschitz_holds);
+  tcase_add_test(tc, local_lipschitz_zero_far_away);
+  suite_add_tcase(s, tc);
+  return oct_run(s);
+}
