@@ -57,7 +57,7 @@ LIBSO := $(B)/liboutcrop.so
 MODULE := $(B)/outcrop.so
 BIN := $(B)/outcrop
 
-.PHONY: all deps test check-c check-lua check-runtime check-asan demo bench \
+.PHONY: bench-peer-deps all deps test check-c check-lua check-runtime check-asan demo bench \
         clean format tests-bin
 .DEFAULT_GOAL := all
 
@@ -157,9 +157,22 @@ $(B)/bench/%: scripts/bench/%.c $(LIBA)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -o $@ $< $(LIBA) $(OIIO_LIBS) -lstdc++ $(LDLIBS)
 
+# The peer comparison (OpenVDB's volumeToMesh) is optional: it is built only
+# when libopenvdb-dev is installed (`make bench-peer-deps` installs it).
+HAVE_VDB := $(shell dpkg-query -W -f='$${Status}' libopenvdb-dev 2>/dev/null | grep -q 'install ok installed' && echo 1)
+PEER_SRC := $(if $(HAVE_VDB),$(wildcard scripts/bench/peer_*.cpp))
+PEER_BIN := $(PEER_SRC:scripts/bench/%.cpp=$(B)/bench/%)
+
+$(B)/bench/peer_%: scripts/bench/peer_%.cpp $(LIBA)
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS) -o $@ $< $(LIBA) -lopenvdb -ltbb $(OIIO_LIBS) $(LDLIBS)
+
+bench-peer-deps:
+	@$(MAKE) --no-print-directory deps PKGS=libopenvdb-dev
+
 bench: deps
-	@$(MAKE) --no-print-directory all $(BENCH_BIN)
-	@OUTCROP=$(abspath $(BIN)) BENCH_BIN="$(abspath $(BENCH_BIN))" \
+	@$(MAKE) --no-print-directory all $(BENCH_BIN) $(PEER_BIN)
+	@OUTCROP=$(abspath $(BIN)) BENCH_BIN="$(abspath $(BENCH_BIN) $(PEER_BIN))" \
 	  bash scripts/bench/run.sh
 
 format:

@@ -87,8 +87,8 @@ typedef struct oc_noise {
 /* Primitives. `radius` of skeletal primitives and `falloff` of volumetric
 ** ones is the distance over which the field falls from `energy` to 0. */
 oc_node *oc_point(oc_vec3 center, double radius, double energy, oc_error *err);
-oc_node *oc_sphere(oc_vec3 center, double radius, double falloff,
-                   double energy, oc_error *err);
+oc_node *oc_sphere(oc_vec3 center, double radius, double falloff, double energy,
+                   oc_error *err);
 oc_node *oc_box(oc_vec3 lo, oc_vec3 hi, double falloff, double energy,
                 oc_error *err);
 oc_node *oc_segment(oc_vec3 a, oc_vec3 b, double radius, double energy,
@@ -102,8 +102,8 @@ oc_node *oc_curve(const oc_vec3 *pts, size_t n, int bezier, double radius,
 oc_node *oc_cone(oc_vec3 base, oc_vec3 apex, double radius, double falloff,
                  double energy, oc_error *err);
 /* Half-space {(p - origin) . normal <= 0}; normal points to the outside. */
-oc_node *oc_plane(oc_vec3 origin, oc_vec3 normal, double falloff,
-                  double energy, oc_error *err);
+oc_node *oc_plane(oc_vec3 origin, oc_vec3 normal, double falloff, double energy,
+                  oc_error *err);
 /* offset + amplitude * t(p / wavelength); unbounded support. */
 oc_node *oc_turbulence(const oc_noise *noise, oc_error *err);
 
@@ -115,8 +115,7 @@ oc_node *oc_intersection(oc_node *const *children, size_t n, oc_error *err);
 oc_node *oc_difference(oc_node *a, oc_node *b, oc_error *err);
 /* Cubic smooth max/min of seed 002 section 4.2 with a radius that fades
 ** out where both fields vanish, so compact support is kept. */
-oc_node *oc_smooth_union(oc_node *a, oc_node *b, double radius,
-                         oc_error *err);
+oc_node *oc_smooth_union(oc_node *a, oc_node *b, double radius, oc_error *err);
 oc_node *oc_smooth_intersection(oc_node *a, oc_node *b, double radius,
                                 oc_error *err);
 /* factor * f (negation: factor = -1). */
@@ -163,8 +162,8 @@ double oc_program_eval(const oc_program *prog, oc_vec3 p);
 /* Returns the value and stores the gradient in *grad. */
 double oc_program_gradient(const oc_program *prog, oc_vec3 p, oc_vec3 *grad);
 /* Batch evaluation over both cores (OpenMP); out[i] = f(p[i]). */
-void oc_program_eval_many(const oc_program *prog, const oc_vec3 *p,
-                          double *out, size_t n);
+void oc_program_eval_many(const oc_program *prog, const oc_vec3 *p, double *out,
+                          size_t n);
 
 oc_aabb oc_program_bounds(const oc_program *prog);
 /* Global Lipschitz bound: |f(p) - f(q)| <= L |p - q| for all p, q. */
@@ -214,13 +213,13 @@ typedef struct oc_progress {
 typedef struct oc_mesh oc_mesh;
 
 typedef struct oc_polygonize_params {
-  oc_aabb box;       /* region to mesh: finite, non-empty */
-  double cell;       /* cell size; or 0 to use nx, ny, nz */
-  int nx, ny, nz;    /* cells per axis when cell == 0 */
-  double threshold;  /* iso-value; 0 means the program's T */
-  int open;          /* 1: drop the cap faces lying on the box */
-  int steps;         /* root-finding steps per edge (0: default 6) */
-  int full_grid;     /* 1: ignore surface bounds (benchmarks, tests) */
+  oc_aabb box;      /* region to mesh: finite, non-empty */
+  double cell;      /* cell size; or 0 to use nx, ny, nz */
+  int nx, ny, nz;   /* cells per axis when cell == 0 */
+  double threshold; /* iso-value; 0 means the program's T */
+  int open;         /* 1: drop the cap faces lying on the box */
+  int steps;        /* root-finding steps per edge (0: default 6) */
+  int full_grid;    /* 1: ignore surface bounds (benchmarks, tests) */
   oc_progress progress;
 } oc_polygonize_params;
 
@@ -235,9 +234,9 @@ void oc_mesh_free(oc_mesh *mesh);
 
 size_t oc_mesh_vertex_count(const oc_mesh *mesh);
 size_t oc_mesh_triangle_count(const oc_mesh *mesh);
-const float *oc_mesh_positions(const oc_mesh *mesh); /* 3 per vertex */
-const float *oc_mesh_normals(const oc_mesh *mesh);   /* 3 per vertex, unit */
-const float *oc_mesh_colors(const oc_mesh *mesh);    /* 3 per vertex or NULL */
+const float *oc_mesh_positions(const oc_mesh *mesh);  /* 3 per vertex */
+const float *oc_mesh_normals(const oc_mesh *mesh);    /* 3 per vertex, unit */
+const float *oc_mesh_colors(const oc_mesh *mesh);     /* 3 per vertex or NULL */
 const uint32_t *oc_mesh_indices(const oc_mesh *mesh); /* 3 per triangle, CCW
                                                       ** seen from outside */
 
@@ -290,13 +289,17 @@ int oc_image_write(const oc_image *img, const char *path, int bits,
 
 /* ---- slices ---------------------------------------------------------- */
 
-typedef enum oc_plane_axis { OC_PLANE_XY, OC_PLANE_XZ, OC_PLANE_YZ } oc_plane_axis;
+typedef enum oc_plane_axis {
+  OC_PLANE_XY,
+  OC_PLANE_XZ,
+  OC_PLANE_YZ
+} oc_plane_axis;
 
 typedef struct oc_slice_params {
   oc_plane_axis plane;
-  double at;         /* coordinate on the remaining axis */
+  double at;             /* coordinate on the remaining axis */
   double u0, v0, u1, v1; /* window on the plane's two axes */
-  int width, height; /* pixels, each 1 .. 16384 */
+  int width, height;     /* pixels, each 1 .. 16384 */
 } oc_slice_params;
 
 /* 5-channel image: R, G, B, A (colour map with the T iso-line in black,

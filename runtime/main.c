@@ -9,8 +9,7 @@
 int main(int argc, char **argv) {
   ocrt_options o;
   int status = ocrt_parse(&o, argc, argv);
-  if (status != OCRT_RUN)
-    return status;
+  if (status != OCRT_RUN) return status;
   status = ocrt_run(&o);
   ocrt_options_free(&o);
   if (fflush(stdout) != 0 && status == OCRT_OK) {

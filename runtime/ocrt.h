@@ -10,22 +10,22 @@
 /* Exit statuses of the interpreter (an os.exit in a scene adds its own). */
 enum {
   OCRT_OK = 0,
-  OCRT_ESCRIPT = 1,   /* the scene failed: syntax or runtime error */
-  OCRT_EUSAGE = 2,    /* bad command line, unreadable scene, bad --out */
-  OCRT_EINTR = 130    /* stopped by Ctrl-C, as shells report SIGINT */
+  OCRT_ESCRIPT = 1, /* the scene failed: syntax or runtime error */
+  OCRT_EUSAGE = 2,  /* bad command line, unreadable scene, bad --out */
+  OCRT_EINTR = 130  /* stopped by Ctrl-C, as shells report SIGINT */
 };
 
 /* The command line once parsed. Strings point into argv. */
 typedef struct ocrt_options {
-  const char *scene;     /* path as given; "-" reads standard input */
-  const char **params;   /* "NAME=VALUE" strings, in command-line order */
+  const char *scene;   /* path as given; "-" reads standard input */
+  const char **params; /* "NAME=VALUE" strings, in command-line order */
   int nparams;
-  const char **args;     /* positional arguments after the scene */
+  const char **args; /* positional arguments after the scene */
   int nargs;
-  lua_Integer seed;      /* --seed, default 1 */
-  int threads;           /* --threads, 0 when not given */
-  const char *outdir;    /* --out, NULL for the current folder */
-  int unsafe;            /* --unsafe: no sandbox */
+  lua_Integer seed;   /* --seed, default 1 */
+  int threads;        /* --threads, 0 when not given */
+  const char *outdir; /* --out, NULL for the current folder */
+  int unsafe;         /* --unsafe: no sandbox */
 } ocrt_options;
 
 /* What ocrt_parse decided: run the scene, or stop with a status. */
@@ -53,7 +53,8 @@ void ocrt_sandbox(lua_State *L);
 /* Stopping a running scene. ocrt_stop_open prepares L (once, before the
 ** scene runs); ocrt_stop_arm makes Ctrl-C stop the scene running in L (by
 ** raising an error from a count hook, and again at every Lua instruction
-** until control is back in C); ocrt_stop_disarm undoes it. ocrt_stop_request does the same from inside the state (os.exit in
+** until control is back in C); ocrt_stop_disarm undoes it. ocrt_stop_request
+*does the same from inside the state (os.exit in
 ** the sandbox) with the exit status to report. */
 void ocrt_stop_open(lua_State *L); /* wraps coroutine.resume and .wrap */
 void ocrt_stop_arm(lua_State *L);

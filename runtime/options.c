@@ -31,7 +31,8 @@ static const char usage_text[] =
     "same as '--opt VALUE'.\n"
     "\n"
     "options:\n"
-    "  --set NAME=VALUE  scene parameter, read with outcrop.param (repeatable;\n"
+    "  --set NAME=VALUE  scene parameter, read with outcrop.param "
+    "(repeatable;\n"
     "                    the last value of a name wins)\n"
     "  --seed N          scene seed, an integer >= 0 (default 1)\n"
     "  --threads N       worker threads, 1 to 1024 (default: OpenMP's, all\n"
@@ -77,17 +78,13 @@ static int usage_error(const char *fmt, ...) {
 static int parse_int(const char *s, long long lo, long long hi,
                      long long *out) {
   long long v = 0;
-  if (*s == '\0')
-    return 0;
+  if (*s == '\0') return 0;
   for (; *s; s++) {
-    if (*s < '0' || *s > '9')
-      return 0;
-    if (v > (hi - (*s - '0')) / 10)
-      return 0;
+    if (*s < '0' || *s > '9') return 0;
+    if (v > (hi - (*s - '0')) / 10) return 0;
     v = v * 10 + (*s - '0');
   }
-  if (v < lo)
-    return 0;
+  if (v < lo) return 0;
   *out = v;
   return 1;
 }
@@ -99,13 +96,10 @@ static int parse_int(const char *s, long long lo, long long hi,
 static int match(const char *arg, const char *name, int hasval, int argc,
                  char **argv, int *i, const char **val) {
   size_t n = strlen(name);
-  if (strncmp(arg, name, n) != 0)
-    return 0;
+  if (strncmp(arg, name, n) != 0) return 0;
   if (arg[n] == '\0') {
-    if (!hasval)
-      return 1;
-    if (*i + 1 >= argc)
-      return -1;
+    if (!hasval) return 1;
+    if (*i + 1 >= argc) return -1;
     *val = argv[++*i];
     return 1;
   }
@@ -124,8 +118,8 @@ void ocrt_options_free(ocrt_options *o) {
 
 /* Handles one option word at argv[*i]; returns OCRT_RUN to go on. */
 static int option(ocrt_options *o, int argc, char **argv, int *i) {
-  static const char *const valued[] = {"--set", "--seed", "--threads",
-                                       "--out", NULL};
+  static const char *const valued[] = {"--set", "--seed", "--threads", "--out",
+                                       NULL};
   const char *arg = argv[*i];
   const char *val = NULL;
   long long v;
@@ -144,16 +138,15 @@ static int option(ocrt_options *o, int argc, char **argv, int *i) {
   }
   for (k = 0; valued[k]; k++) {
     m = match(arg, valued[k], 1, argc, argv, i, &val);
-    if (m < 0)
-      return usage_error("option '%s' needs a value", valued[k]);
-    if (m > 0)
-      break;
+    if (m < 0) return usage_error("option '%s' needs a value", valued[k]);
+    if (m > 0) break;
   }
   switch (k) {
   case 0: /* --set */
     if (val[0] == '=' || strchr(val, '=') == NULL)
       return usage_error("--set expects NAME=VALUE with a non-empty NAME "
-                         "(got '%s')", val);
+                         "(got '%s')",
+                         val);
     o->params[o->nparams++] = val;
     return OCRT_RUN;
   case 1: /* --seed */
@@ -164,12 +157,12 @@ static int option(ocrt_options *o, int argc, char **argv, int *i) {
   case 2: /* --threads */
     if (!parse_int(val, 1, MAX_THREADS, &v))
       return usage_error("--threads expects an integer from 1 to 1024 "
-                         "(got '%s')", val);
+                         "(got '%s')",
+                         val);
     o->threads = (int)v;
     return OCRT_RUN;
   case 3: /* --out */
-    if (val[0] == '\0')
-      return usage_error("--out expects a folder name");
+    if (val[0] == '\0') return usage_error("--out expects a folder name");
     o->outdir = val;
     return OCRT_RUN;
   default:

@@ -16,11 +16,9 @@
 /* mkdir for one component; an existing folder is fine. */
 static int mkdir1(const char *path) {
   struct stat st;
-  if (mkdir(path, 0777) == 0)
-    return 0;
+  if (mkdir(path, 0777) == 0) return 0;
   if (errno == EEXIST && stat(path, &st) == 0) {
-    if (S_ISDIR(st.st_mode))
-      return 0;
+    if (S_ISDIR(st.st_mode)) return 0;
     errno = ENOTDIR;
   }
   return -1;
@@ -29,8 +27,7 @@ static int mkdir1(const char *path) {
 char *ocrt_outdir(const char *dir, char *msg, size_t msgsize) {
   char *path, *p, *real;
   int failed = 0;
-  if (dir == NULL)
-    dir = ".";
+  if (dir == NULL) dir = ".";
   path = strdup(dir);
   if (!path) {
     snprintf(msg, msgsize, "not enough memory");
@@ -44,8 +41,7 @@ char *ocrt_outdir(const char *dir, char *msg, size_t msgsize) {
       *p = '/';
     }
   }
-  if (!failed)
-    failed = mkdir1(path) != 0;
+  if (!failed) failed = mkdir1(path) != 0;
   real = failed ? NULL : realpath(path, NULL);
   if (!real)
     snprintf(msg, msgsize, "cannot create output folder '%s': %s", dir,

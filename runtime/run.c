@@ -24,7 +24,8 @@ typedef struct run {
 } run;
 
 static void report(const char *msg) {
-  fprintf(stderr, "outcrop: %s\n", msg ? msg : "(error object is not a string)");
+  fprintf(stderr, "outcrop: %s\n",
+          msg ? msg : "(error object is not a string)");
   fflush(stderr);
 }
 
@@ -34,8 +35,8 @@ static int msghandler(lua_State *L) {
   if (msg == NULL) {
     if (luaL_callmeta(L, 1, "__tostring") && lua_type(L, -1) == LUA_TSTRING)
       return 1;
-    msg = lua_pushfstring(L, "(error object is a %s value)",
-                          luaL_typename(L, 1));
+    msg =
+        lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
   }
   luaL_traceback(L, L, msg, 1);
   return 1;
@@ -125,8 +126,7 @@ static int pmain(lua_State *L) {
   luaL_openlibs(L);
   /* the chunk name is "@" .. path, so messages read "scene.lua:3: ..." */
   st = luaL_loadfile(L, strcmp(o->scene, "-") == 0 ? NULL : o->scene);
-  if (st == LUA_ERRMEM)
-    return lua_error(L);
+  if (st == LUA_ERRMEM) return lua_error(L);
   if (st != LUA_OK) {
     report(lua_tostring(L, -1));
     r->status = st == LUA_ERRFILE ? OCRT_EUSAGE : OCRT_ESCRIPT;
@@ -140,8 +140,7 @@ static int pmain(lua_State *L) {
   }
   set_registry(L, r); /* before the module: it reads the seed when opened */
   open_module(L);
-  if (!o->unsafe)
-    ocrt_sandbox(L);
+  if (!o->unsafe) ocrt_sandbox(L);
   ocrt_stop_open(L);
   lua_gc(L, LUA_GCRESTART);
   lua_gc(L, LUA_GCGEN, 0, 0); /* as stock lua5.4 runs scripts */
@@ -152,8 +151,7 @@ static int pmain(lua_State *L) {
 int ocrt_run(const ocrt_options *o) {
   run r = {o, OCRT_ESCRIPT, NULL};
   lua_State *L;
-  if (o->threads > 0)
-    omp_set_num_threads(o->threads);
+  if (o->threads > 0) omp_set_num_threads(o->threads);
   L = luaL_newstate();
   if (L == NULL) {
     report("cannot create the Lua state: not enough memory");

@@ -48,14 +48,12 @@ static void output_arg(lua_State *L, int arg, const char *fname) {
 static int sb_io_open(lua_State *L) {
   const char *mode = luaL_optstring(L, 2, "r");
   luaL_checkstring(L, 1);
-  if (mode[0] != 'r' || strchr(mode, '+') != NULL)
-    output_arg(L, 1, "io.open");
+  if (mode[0] != 'r' || strchr(mode, '+') != NULL) output_arg(L, 1, "io.open");
   return call_original(L);
 }
 
 static int sb_io_output(lua_State *L) {
-  if (lua_type(L, 1) == LUA_TSTRING)
-    output_arg(L, 1, "io.output");
+  if (lua_type(L, 1) == LUA_TSTRING) output_arg(L, 1, "io.output");
   return call_original(L);
 }
 
@@ -93,16 +91,19 @@ static int text_only(lua_State *L, int arg) {
     lua_pushliteral(L, "binary chunks are not allowed in scenes");
     return 2;
   }
-  if (lua_gettop(L) < arg)
-    lua_settop(L, arg);
+  if (lua_gettop(L) < arg) lua_settop(L, arg);
   lua_pushliteral(L, "t");
   lua_replace(L, arg);
   return call_original(L);
 }
 
-static int sb_load(lua_State *L) { return text_only(L, 3); }
+static int sb_load(lua_State *L) {
+  return text_only(L, 3);
+}
 
-static int sb_loadfile(lua_State *L) { return text_only(L, 2); }
+static int sb_loadfile(lua_State *L) {
+  return text_only(L, 2);
+}
 
 static int dofile_cont(lua_State *L, int status, lua_KContext ctx) {
   (void)status;
@@ -113,8 +114,7 @@ static int dofile_cont(lua_State *L, int status, lua_KContext ctx) {
 static int sb_dofile(lua_State *L) {
   const char *name = luaL_optstring(L, 1, NULL);
   lua_settop(L, 1);
-  if (luaL_loadfilex(L, name, "t") != LUA_OK)
-    return lua_error(L);
+  if (luaL_loadfilex(L, name, "t") != LUA_OK) return lua_error(L);
   lua_callk(L, 0, LUA_MULTRET, 0, dofile_cont);
   return dofile_cont(L, LUA_OK, 0);
 }
@@ -128,8 +128,7 @@ static int sb_search_lua(lua_State *L) {
   if (lua_getfield(L, lua_upvalueindex(1), "path") != LUA_TSTRING)
     return luaL_error(L, "'package.path' must be a string");
   lua_call(L, 2, 2);
-  if (lua_isnil(L, -2))
-    return 1; /* the message listing the files tried */
+  if (lua_isnil(L, -2)) return 1; /* the message listing the files tried */
   lua_pop(L, 1);
   file = lua_tostring(L, -1);
   if (luaL_loadfilex(L, file, "t") != LUA_OK)

@@ -51,10 +51,8 @@ static void on_sigint(int sig) {
   lua_State *co = current;
   (void)sig;
   interrupted = stopping = 1;
-  if (running)
-    lua_sethook(running, stop_hook, LUA_MASKCOUNT, 1);
-  if (co)
-    lua_sethook(co, stop_hook, LUA_MASKCOUNT, 1);
+  if (running) lua_sethook(running, stop_hook, LUA_MASKCOUNT, 1);
+  if (co) lua_sethook(co, stop_hook, LUA_MASKCOUNT, 1);
 }
 
 void ocrt_stop_arm(lua_State *L) {
@@ -64,8 +62,7 @@ void ocrt_stop_arm(lua_State *L) {
   running = L;
   /* a SIGINT ignored at startup (a background job of a script, nohup)
   ** stays ignored, as for any well-behaved Unix program */
-  if (sigaction(SIGINT, NULL, &old) == 0 && old.sa_handler == SIG_IGN)
-    return;
+  if (sigaction(SIGINT, NULL, &old) == 0 && old.sa_handler == SIG_IGN) return;
   sa.sa_handler = on_sigint;
   sa.sa_flags = SA_RESETHAND;
   sigemptyset(&sa.sa_mask);
@@ -84,7 +81,9 @@ void ocrt_stop_disarm(lua_State *L) {
   lua_sethook(L, NULL, 0, 0);
 }
 
-int ocrt_interrupted(void) { return interrupted != 0; }
+int ocrt_interrupted(void) {
+  return interrupted != 0;
+}
 
 int ocrt_stop_request(lua_State *L, int status) {
   lua_pushinteger(L, status);
@@ -122,8 +121,7 @@ static int tracked_call(lua_State *L, lua_State *co, int where) {
     lua_sethook(L, stop_hook, LUA_MASKCOUNT, 1);
     stop_hook(L, NULL);
   }
-  if (st == LUA_OK)
-    return lua_gettop(L);
+  if (st == LUA_OK) return lua_gettop(L);
   if (where && st != LUA_ERRMEM && lua_type(L, -1) == LUA_TSTRING) {
     luaL_where(L, 1);
     lua_insert(L, -2);
@@ -151,8 +149,7 @@ static int co_wrap(lua_State *L) {
   /* lcorolib keeps the thread as the wrapper's only upvalue; should that
   ** change, the plain wrapper is returned (Ctrl-C then reaches such a
   ** coroutine only when it yields) */
-  if (lua_getupvalue(L, -1, 1) == NULL)
-    return 1;
+  if (lua_getupvalue(L, -1, 1) == NULL) return 1;
   if (lua_type(L, -1) != LUA_TTHREAD) {
     lua_pop(L, 1);
     return 1;

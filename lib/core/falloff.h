@@ -23,7 +23,9 @@ static inline double oc_falloff_dq(double q) {
   double u = 1.0 - q;
   return -3.0 * u * u;
 }
-static inline double oc_falloff(double x) { return oc_falloff_q(x * x); }
+static inline double oc_falloff(double x) {
+  return oc_falloff_q(x * x);
+}
 /* dg/dx = -6 x (1 - x^2)^2 */
 static inline double oc_falloff_d(double x) {
   if (!(x < 1.0) || x < 0.0) return 0.0;

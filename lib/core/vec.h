@@ -28,7 +28,9 @@ static inline oc_vec3 oc_cross(oc_vec3 a, oc_vec3 b) {
   return oc_v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z,
                a.x * b.y - a.y * b.x);
 }
-static inline double oc_len(oc_vec3 a) { return sqrt(oc_dot(a, a)); }
+static inline double oc_len(oc_vec3 a) {
+  return sqrt(oc_dot(a, a));
+}
 static inline oc_vec3 oc_vmin(oc_vec3 a, oc_vec3 b) {
   return oc_v3(fmin(a.x, b.x), fmin(a.y, b.y), fmin(a.z, b.z));
 }
@@ -41,11 +43,13 @@ static inline int oc_vfinite(oc_vec3 a) {
 
 /* The empty box: lo = +inf, hi = -inf, so that union with it is identity. */
 static inline oc_aabb oc_aabb_empty(void) {
-  oc_aabb b = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+  oc_aabb b = {{INFINITY, INFINITY, INFINITY},
+               {-INFINITY, -INFINITY, -INFINITY}};
   return b;
 }
 static inline oc_aabb oc_aabb_all(void) {
-  oc_aabb b = {{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, INFINITY}};
+  oc_aabb b = {{-INFINITY, -INFINITY, -INFINITY},
+               {INFINITY, INFINITY, INFINITY}};
   return b;
 }
 static inline int oc_aabb_is_empty(oc_aabb b) {

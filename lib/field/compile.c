@@ -27,15 +27,16 @@
 
 /* ---- growable arrays ------------------------------------------------ */
 
-#define GROW(arr, n, cap, need)                                              \
-  ((n) + (need) <= (cap) ||                                                  \
-           grow((void **)&(arr), &(cap), (n) + (need), sizeof *(arr))        \
-       ? 1                                                                   \
+#define GROW(arr, n, cap, need)                                                \
+  ((n) + (need) <= (cap) ||                                                    \
+           grow((void **)&(arr), &(cap), (n) + (need), sizeof *(arr))          \
+       ? 1                                                                     \
        : 0)
 
 static int grow(void **arr, size_t *cap, size_t need, size_t elem) {
   size_t nc = *cap ? *cap : 16;
-  while (nc < need) nc *= 2;
+  while (nc < need)
+    nc *= 2;
   void *p = realloc(*arr, nc * elem);
   if (!p) return 0;
   *arr = p;
@@ -72,7 +73,8 @@ static uint32_t *pmap_slot(pmap *m, const void *k, int create) {
     for (size_t i = 0; i < m->cap; i++)
       if (m->key[i]) {
         size_t h = phash(m->key[i]) & (nc - 1);
-        while (nk[h]) h = (h + 1) & (nc - 1);
+        while (nk[h])
+          h = (h + 1) & (nc - 1);
         nk[h] = m->key[i];
         nv[h] = m->val[i];
       }
@@ -107,9 +109,9 @@ static void pmap_free(pmap *m) {
 /* ---- compiler state -------------------------------------------------- */
 
 typedef struct info {
-  oc_aabb box;    /* support */
-  double lo, hi;  /* value range (contains 0 for compact nodes) */
-  double lip;     /* Lipschitz bound */
+  oc_aabb box;   /* support */
+  double lo, hi; /* value range (contains 0 for compact nodes) */
+  double lip;    /* Lipschitz bound */
   int depth;
 } info;
 
@@ -173,7 +175,8 @@ static double sigma_max(const double *m) {
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++) {
       double s = 0;
-      for (int k = 0; k < 3; k++) s += m[k * 4 + i] * m[k * 4 + j];
+      for (int k = 0; k < 3; k++)
+        s += m[k * 4 + i] * m[k * 4 + j];
       a[i][j] = s;
     }
   for (int sweep = 0; sweep < 50; sweep++) {
@@ -223,7 +226,9 @@ static oc_aabb xform_box(const double *m, oc_aabb b) {
   return r;
 }
 
-static double tmax_of(int octaves) { return oc_turb3_max(octaves); }
+static double tmax_of(int octaves) {
+  return oc_turb3_max(octaves);
+}
 
 /* ---- primitives ------------------------------------------------------ */
 
@@ -351,7 +356,8 @@ static int collect(comp *c, const oc_node *root, oc_kind kind, leaf **out,
     free(idxnode);
     /* weights: reverse post-order is a topological order (parents first) */
     if (!GROW(w, 0, capw, nidx)) goto fail;
-    for (size_t i = 0; i < nidx; i++) w[i] = 0;
+    for (size_t i = 0; i < nidx; i++)
+      w[i] = 0;
     w[0] = 1;
     pmap lmap = {0};
     for (size_t oi = norder; oi-- > 0;) {
@@ -559,7 +565,8 @@ static uint32_t make_group(comp *c, oc_kind kind, const leaf *lv, size_t nl) {
   o = &P->ops[op];
   o->ent = (uint32_t)P->nent;
   o->nent = (uint32_t)nent;
-  for (size_t j = 0; j < nent; j++) P->ent[P->nent + j] = ent[perm[j]];
+  for (size_t j = 0; j < nent; j++)
+    P->ent[P->nent + j] = ent[perm[j]];
   P->nent += nent;
   if (nnodes) {
     o->bvh = (uint32_t)P->nbvh;
@@ -730,8 +737,8 @@ static uint32_t compile_smooth(comp *c, const oc_node *n) {
            Mb = fmax(fabs(B->lo), fabs(B->hi));
     in->lo = fmin(A->lo, B->lo) - r / 6;
     in->hi = fmin(A->hi, B->hi);
-    in->lip = fmax(A->lip, B->lip) +
-              r * (Mb * A->lip + Ma * B->lip) / (4 * T * T);
+    in->lip =
+        fmax(A->lip, B->lip) + r * (Mb * A->lip + Ma * B->lip) / (4 * T * T);
     oc_aabb b = oc_aabb_inter(A->box, B->box);
     if (A->lo < 0) b = oc_aabb_union(b, A->box);
     if (B->lo < 0) b = oc_aabb_union(b, B->box);
@@ -796,8 +803,8 @@ static uint32_t compile_perturb(comp *c, const oc_node *n) {
   double R = p->par[OC_P_R], E = p->par[OC_P_E];
   double At = nz->amplitude * tmax_of(nz->octaves);
   double rmin = R + fmin(0, At), rmax = R + fmax(0, At);
-  double lt = fabs(nz->amplitude) * oc_turb3_lipschitz(nz->octaves) /
-              nz->wavelength;
+  double lt =
+      fabs(nz->amplitude) * oc_turb3_lipschitz(nz->octaves) / nz->wavelength;
   prim_info(c, op, p->kind, c->P->par + at, rmax);
   c->inf[op].lip = fabs(E) * OC_FALLOFF_LIPSCHITZ *
                    (1 / rmin + lt * (rmax + R) / (rmin * rmin));
@@ -905,8 +912,8 @@ oc_program *oc_compile(oc_node *root, const oc_compile_options *opts,
     oc_seterr(err, OC_EINVAL, "no node to compile");
     return NULL;
   }
-  double T = opts && opts->threshold != 0 ? opts->threshold
-                                          : OC_DEFAULT_THRESHOLD;
+  double T =
+      opts && opts->threshold != 0 ? opts->threshold : OC_DEFAULT_THRESHOLD;
   if (!(isfinite(T) && T > 0)) {
     oc_seterr(err, OC_EINVAL, "'threshold' must be a positive number (got %g)",
               T);
@@ -935,7 +942,8 @@ oc_program *oc_compile(oc_node *root, const oc_compile_options *opts,
     oc_program_free(P);
     return NULL;
   }
-  for (uint32_t i = 0; i < P->nops; i++) P->ops[i].lip = c.inf[i].lip;
+  for (uint32_t i = 0; i < P->nops; i++)
+    P->ops[i].lip = c.inf[i].lip;
   P->root = r;
   P->bounds = c.inf[r].box;
   P->lip = c.inf[r].lip;
@@ -963,9 +971,15 @@ void oc_program_free(oc_program *P) {
   free(P);
 }
 
-oc_aabb oc_program_bounds(const oc_program *P) { return P->bounds; }
-double oc_program_lipschitz(const oc_program *P) { return P->lip; }
-double oc_program_threshold(const oc_program *P) { return P->T; }
+oc_aabb oc_program_bounds(const oc_program *P) {
+  return P->bounds;
+}
+double oc_program_lipschitz(const oc_program *P) {
+  return P->lip;
+}
+double oc_program_threshold(const oc_program *P) {
+  return P->T;
+}
 void oc_program_get_stats(const oc_program *P, oc_program_stats *st) {
   *st = P->stats;
 }

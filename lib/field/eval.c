@@ -44,8 +44,8 @@ static inline int in_node(const oc_bvhnode *nd, oc_vec3 p) {
 static double prim(oc_kind kind, const double *par, oc_vec3 p, oc_vec3 *g) {
   double E = par[OC_P_E], R = par[OC_P_R];
   if (kind == OC_K_POINT) {
-    oc_vec3 d = oc_v3(p.x - par[OC_P_C], p.y - par[OC_P_C + 1],
-                      p.z - par[OC_P_C + 2]);
+    oc_vec3 d =
+        oc_v3(p.x - par[OC_P_C], p.y - par[OC_P_C + 1], p.z - par[OC_P_C + 2]);
     double q = oc_dot(d, d) / (R * R);
     if (g) *g = oc_mul(d, E * oc_falloff_dq(q) * 2 / (R * R));
     return E * oc_falloff_q(q);
@@ -92,8 +92,8 @@ static inline double point_ent(const oc_ent *e, oc_vec3 p, oc_vec3 *g) {
 /* One child's contribution: value (and gradient when g). Returns 0 without
 ** evaluating when p is outside the child's box; *hit tells whether the
 ** child was evaluated (unions need to know). */
-static inline double ent_eval(const oc_program *P, const oc_ent *e,
-                              oc_vec3 p, oc_vec3 *g, int *hit) {
+static inline double ent_eval(const oc_program *P, const oc_ent *e, oc_vec3 p,
+                              oc_vec3 *g, int *hit) {
   if (e->ref == OC_NONE) {
     *hit = 1;
     return point_ent(e, p, g);
@@ -113,19 +113,19 @@ static double group(const oc_program *P, const oc_op *o, oc_vec3 p,
   double acc = uni ? -INFINITY : 0;
   oc_vec3 gacc = oc_v3(0, 0, 0), gk;
   uint32_t visited = 0;
-#define TAKE(val)                                                            \
-  do {                                                                       \
-    double v_ = (val);                                                       \
-    if (uni) {                                                               \
-      if (v_ > acc || visited == 0) {                                        \
-        acc = v_;                                                            \
-        if (g) gacc = gk;                                                    \
-      }                                                                      \
-    } else {                                                                 \
-      acc += v_;                                                             \
-      if (g) gacc = oc_add(gacc, gk);                                        \
-    }                                                                        \
-    visited++;                                                               \
+#define TAKE(val)                                                              \
+  do {                                                                         \
+    double v_ = (val);                                                         \
+    if (uni) {                                                                 \
+      if (v_ > acc || visited == 0) {                                          \
+        acc = v_;                                                              \
+        if (g) gacc = gk;                                                      \
+      }                                                                        \
+    } else {                                                                   \
+      acc += v_;                                                               \
+      if (g) gacc = oc_add(gacc, gk);                                          \
+    }                                                                          \
+    visited++;                                                                 \
   } while (0)
   gk = oc_v3(0, 0, 0);
   for (uint32_t k = 0; k < o->nkid; k++) {
@@ -221,8 +221,8 @@ static double smooth(int uni, double a, double b, double r, double T,
   if (re > 0 && delta < re) {
     double k = 1 - delta / re;
     corr = re * k * k * k / 6;
-    double cdelta = -k * k / 2;                         /* d corr / d delta */
-    double cre = k * k * (1 + 2 * delta / re) / 6;      /* d corr / d re */
+    double cdelta = -k * k / 2;                    /* d corr / d delta */
+    double cre = k * k * (1 + 2 * delta / re) / 6; /* d corr / d re */
     ca = cdelta * sg + cre * dre_da;
     cb = -cdelta * sg + cre * dre_db;
   }
@@ -252,8 +252,7 @@ static oc_vec3 displacement(const noisep *nz, oc_vec3 p, oc_vec3 jac[3]) {
   return oc_v3(d[0], d[1], d[2]);
 }
 
-static double warp(const oc_program *P, const oc_op *o, oc_vec3 p,
-                   oc_vec3 *g) {
+static double warp(const oc_program *P, const oc_op *o, oc_vec3 p, oc_vec3 *g) {
   noisep nz = unpack_noise(P->par + o->par);
   uint32_t child = P->kids[o->kid];
   double w = 1;

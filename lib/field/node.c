@@ -10,11 +10,15 @@
 #include "field/node.h"
 
 static const char *const kind_names[OC_K_COUNT] = {
-    "point",  "sphere", "box",          "segment",
-    "curve",  "cone",   "plane",        "turbulence",
-    "blend",  "union",  "intersection", "difference",
-    "smooth_union", "smooth_intersection", "scale", "warp",
-    "transform", "perturb"};
+    "point",        "sphere",
+    "box",          "segment",
+    "curve",        "cone",
+    "plane",        "turbulence",
+    "blend",        "union",
+    "intersection", "difference",
+    "smooth_union", "smooth_intersection",
+    "scale",        "warp",
+    "transform",    "perturb"};
 
 const char *oc_kind_name(oc_kind kind) {
   return (unsigned)kind < OC_K_COUNT ? kind_names[kind] : "?";
@@ -108,8 +112,7 @@ int oc_check_finite(double v, const char *what, oc_error *err) {
 }
 int oc_check_positive(double v, const char *what, oc_error *err) {
   if (isfinite(v) && v > 0) return 1;
-  oc_seterr(err, OC_EINVAL, "'%s' must be a positive number (got %g)", what,
-            v);
+  oc_seterr(err, OC_EINVAL, "'%s' must be a positive number (got %g)", what, v);
   return 0;
 }
 int oc_check_vec(oc_vec3 v, const char *what, oc_error *err) {
@@ -149,8 +152,7 @@ static int check_kids(oc_node *const *kids, size_t n, oc_error *err) {
   return 1;
 }
 
-static oc_node *nary(oc_kind k, oc_node *const *kids, size_t n,
-                     oc_error *err) {
+static oc_node *nary(oc_kind k, oc_node *const *kids, size_t n, oc_error *err) {
   if (!check_kids(kids, n, err)) return NULL;
   return oc_node_alloc(k, kids, n, err);
 }
@@ -211,18 +213,11 @@ static int affine_inverse(const double m[12], double inv[12]) {
   double det = a * A + b * B + c * C;
   double scale = fabs(a) + fabs(b) + fabs(c) + fabs(d) + fabs(e) + fabs(f) +
                  fabs(g) + fabs(h) + fabs(i);
-  if (!isfinite(det) || fabs(det) <= 1e-12 * scale * scale * scale)
-    return 0;
+  if (!isfinite(det) || fabs(det) <= 1e-12 * scale * scale * scale) return 0;
   double r = 1.0 / det;
-  double R[9] = {A * r,
-                 -(b * i - c * h) * r,
-                 (b * f - c * e) * r,
-                 B * r,
-                 (a * i - c * g) * r,
-                 -(a * f - c * d) * r,
-                 C * r,
-                 -(a * h - b * g) * r,
-                 (a * e - b * d) * r};
+  double R[9] = {A * r, -(b * i - c * h) * r, (b * f - c * e) * r,
+                 B * r, (a * i - c * g) * r,  -(a * f - c * d) * r,
+                 C * r, -(a * h - b * g) * r, (a * e - b * d) * r};
   for (int row = 0; row < 3; row++) {
     inv[row * 4 + 0] = R[row * 3 + 0];
     inv[row * 4 + 1] = R[row * 3 + 1];
@@ -243,7 +238,8 @@ oc_node *oc_transform(oc_node *child, const double m[12], oc_error *err) {
     }
   if (!affine_inverse(m, inv)) {
     oc_seterr(err, OC_EINVAL,
-              "transform is not invertible (a 'scale' of 0, or too small or too large)");
+              "transform is not invertible (a 'scale' of 0, or too small or "
+              "too large)");
     return NULL;
   }
   oc_node *n = oc_node_alloc(OC_K_XFORM, &child, 1, err);
@@ -257,10 +253,11 @@ oc_node *oc_transform(oc_node *child, const double m[12], oc_error *err) {
 oc_node *oc_perturb(oc_node *prim, const oc_noise *noise, oc_error *err) {
   if (!check_kids(&prim, 1, err) || !oc_check_noise(noise, err)) return NULL;
   if (!OC_KIND_IS_DIST(prim->kind) || prim->kind == OC_K_PLANE) {
-    oc_seterr(err, OC_EINVAL,
-              "the node to perturb must be a point, sphere, box, segment, curve "
-              "or cone primitive (got %s)",
-              oc_kind_name(prim->kind));
+    oc_seterr(
+        err, OC_EINVAL,
+        "the node to perturb must be a point, sphere, box, segment, curve "
+        "or cone primitive (got %s)",
+        oc_kind_name(prim->kind));
     return NULL;
   }
   double R = prim->par[OC_P_R];

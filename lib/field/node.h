@@ -70,8 +70,8 @@ struct oc_node {
   size_t nkids;
   oc_node **kids; /* retained */
   double par[OC_NPAR];
-  oc_noise noise;  /* turbulence, warp, perturb */
-  oc_vec3 *pts;    /* curve: the polyline (Beziers already flattened) */
+  oc_noise noise; /* turbulence, warp, perturb */
+  oc_vec3 *pts;   /* curve: the polyline (Beziers already flattened) */
   size_t npts;
   oc_node *inl[2]; /* small inline child storage to avoid an allocation */
 };

@@ -23,8 +23,7 @@ static oc_vec3 get(const double *par, int at) {
 
 static oc_node *dist_prim(oc_kind k, double R, const char *rname, double E,
                           oc_error *err) {
-  if (!oc_check_positive(R, rname, err) ||
-      !oc_check_finite(E, "energy", err))
+  if (!oc_check_positive(R, rname, err) || !oc_check_finite(E, "energy", err))
     return NULL;
   oc_node *n = oc_node_alloc(k, NULL, 0, err);
   if (n) {
@@ -100,8 +99,8 @@ oc_node *oc_cone(oc_vec3 base, oc_vec3 apex, double radius, double falloff,
   return n;
 }
 
-oc_node *oc_plane(oc_vec3 origin, oc_vec3 normal, double falloff,
-                  double energy, oc_error *err) {
+oc_node *oc_plane(oc_vec3 origin, oc_vec3 normal, double falloff, double energy,
+                  oc_error *err) {
   if (!oc_check_vec(origin, "origin", err) ||
       !oc_check_vec(normal, "normal", err))
     return NULL;
@@ -129,8 +128,7 @@ oc_node *oc_turbulence(const oc_noise *noise, oc_error *err) {
 
 static oc_vec3 bezier(const oc_vec3 *c, double t) {
   double u = 1 - t;
-  double b0 = u * u * u, b1 = 3 * u * u * t, b2 = 3 * u * t * t,
-         b3 = t * t * t;
+  double b0 = u * u * u, b1 = 3 * u * u * t, b2 = 3 * u * t * t, b3 = t * t * t;
   return oc_v3(b0 * c[0].x + b1 * c[1].x + b2 * c[2].x + b3 * c[3].x,
                b0 * c[0].y + b1 * c[1].y + b2 * c[2].y + b3 * c[3].y,
                b0 * c[0].z + b1 * c[1].z + b2 * c[2].z + b3 * c[3].z);
@@ -152,8 +150,7 @@ static size_t bezier_steps(const oc_vec3 *c, double tol) {
 oc_node *oc_curve(const oc_vec3 *pts, size_t n, int bz, double radius,
                   double energy, oc_error *err) {
   if (!pts || n < 2) {
-    oc_seterr(err, OC_EINVAL, "'points' needs at least 2 points (got %zu)",
-              n);
+    oc_seterr(err, OC_EINVAL, "'points' needs at least 2 points (got %zu)", n);
     return NULL;
   }
   if (bz && (n < 4 || (n - 1) % 3 != 0)) {
@@ -170,8 +167,8 @@ oc_node *oc_curve(const oc_vec3 *pts, size_t n, int bz, double radius,
   }
   for (size_t i = 0; i < n; i++)
     if (!oc_vfinite(pts[i])) {
-      oc_seterr(err, OC_EINVAL, "'points' has a non-finite coordinate (point %zu)",
-                i + 1);
+      oc_seterr(err, OC_EINVAL,
+                "'points' has a non-finite coordinate (point %zu)", i + 1);
       return NULL;
     }
   oc_node *node = dist_prim(OC_K_CURVE, radius, "radius", energy, err);
@@ -202,8 +199,8 @@ oc_node *oc_curve(const oc_vec3 *pts, size_t n, int bz, double radius,
     for (size_t i = 0; i + 3 < n; i += 3) {
       size_t steps = bezier_steps(pts + i, 1e-4 * radius);
       for (size_t s = 1; s <= steps; s++)
-        node->pts[k++] = s == steps ? pts[i + 3]
-                                    : bezier(pts + i, (double)s / steps);
+        node->pts[k++] =
+            s == steps ? pts[i + 3] : bezier(pts + i, (double)s / steps);
     }
   }
   node->npts = total;
@@ -221,7 +218,8 @@ void oc_prim_pack(const oc_node *n, double *out) {
     out[0] = n->par[OC_P_E];
     out[1] = n->par[OC_P_R];
     out[2] = (double)n->npts;
-    for (size_t i = 0; i < n->npts; i++) put(out, 3 + 3 * (int)i, n->pts[i]);
+    for (size_t i = 0; i < n->npts; i++)
+      put(out, 3 + 3 * (int)i, n->pts[i]);
   } else {
     memcpy(out, n->par, 9 * sizeof *out);
   }
@@ -280,8 +278,7 @@ static double cone_project(const double *par, oc_vec3 p, oc_vec3 *s) {
   return d1;
 }
 
-double oc_prim_project(oc_kind kind, const double *par, oc_vec3 p,
-                       oc_vec3 *s) {
+double oc_prim_project(oc_kind kind, const double *par, oc_vec3 p, oc_vec3 *s) {
   switch (kind) {
   case OC_K_POINT:
     *s = get(par, OC_P_C);

@@ -33,16 +33,16 @@ typedef struct oc_bvhnode {
 } oc_bvhnode;
 
 typedef struct oc_op {
-  uint8_t kind;   /* oc_kind */
-  uint8_t sub;    /* perturb: the primitive's kind */
-  uint8_t nobvh;  /* groups: evaluate every entry (brute force) */
-  uint32_t par;   /* first parameter in prog->par */
-  uint32_t kid;   /* first child in prog->kids */
-  uint32_t nkid;  /* groups: unbounded children, always evaluated */
-  uint32_t ent;   /* groups: first entry */
+  uint8_t kind;  /* oc_kind */
+  uint8_t sub;   /* perturb: the primitive's kind */
+  uint8_t nobvh; /* groups: evaluate every entry (brute force) */
+  uint32_t par;  /* first parameter in prog->par */
+  uint32_t kid;  /* first child in prog->kids */
+  uint32_t nkid; /* groups: unbounded children, always evaluated */
+  uint32_t ent;  /* groups: first entry */
   uint32_t nent;
-  uint32_t bvh;   /* groups: BVH root, or OC_NONE */
-  uint32_t ntotal; /* groups: number of children in all */
+  uint32_t bvh;       /* groups: BVH root, or OC_NONE */
+  uint32_t ntotal;    /* groups: number of children in all */
   float lo[3], hi[3]; /* support box, rounded outwards */
   double lip;         /* global Lipschitz bound of this op */
 } oc_op;

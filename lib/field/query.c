@@ -33,7 +33,8 @@ static void span_add(spans *S, double lo, double hi) {
     return;
   }
   int i = 0;
-  while (i < S->n && S->s[i].hi < lo) i++;
+  while (i < S->n && S->s[i].hi < lo)
+    i++;
   /* merge every span overlapping [lo, hi] */
   int j = i;
   while (j < S->n && S->s[j].lo <= hi) {
@@ -53,12 +54,14 @@ static void span_add(spans *S, double lo, double hi) {
           best = k;
         }
       S->s[best].hi = S->s[best + 1].hi;
-      for (int k = best + 1; k + 1 < S->n; k++) S->s[k] = S->s[k + 1];
+      for (int k = best + 1; k + 1 < S->n; k++)
+        S->s[k] = S->s[k + 1];
       S->n--;
       span_add(S, lo, hi);
       return;
     }
-    for (int k = S->n; k > i; k--) S->s[k] = S->s[k - 1];
+    for (int k = S->n; k > i; k--)
+      S->s[k] = S->s[k - 1];
     S->n++;
   } else if (removed > 1) {
     for (int k = i + 1; k + removed - 1 < S->n; k++)
@@ -103,8 +106,8 @@ static void plane_spans(const double *par, const foot *f, spans *S) {
   span_add(S, lo - pad, hi + pad);
 }
 
-static void op_spans(const oc_program *P, uint32_t i, const foot *f,
-                     spans *S, int depth);
+static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
+                     int depth);
 
 static void group_spans(const oc_program *P, const oc_op *o, const foot *f,
                         spans *S, int depth) {
@@ -125,8 +128,8 @@ static void group_spans(const oc_program *P, const oc_op *o, const foot *f,
           continue;
         }
         double R = 1.0 / sqrt((double)e->ir2) * (1 + 1e-6);
-        if (e->c[0] - R > f->x1 || e->c[0] + R < f->x0 ||
-            e->c[1] - R > f->y1 || e->c[1] + R < f->y0)
+        if (e->c[0] - R > f->x1 || e->c[0] + R < f->x0 || e->c[1] - R > f->y1 ||
+            e->c[1] + R < f->y0)
           continue;
         span_add(S, e->c[2] - R, e->c[2] + R);
       }
@@ -142,8 +145,8 @@ static int column_preserving(const double *m) {
   return m[2] == 0 && m[6] == 0 && m[8] == 0 && m[9] == 0 && m[10] != 0;
 }
 
-static void op_spans(const oc_program *P, uint32_t i, const foot *f,
-                     spans *S, int depth) {
+static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
+                     int depth) {
   const oc_op *o = &P->ops[i];
   if (S->all) return;
   if (depth > OC_MAX_DEPTH + 8) {
@@ -183,7 +186,8 @@ static void op_spans(const oc_program *P, uint32_t i, const foot *f,
       S->all = 1;
       return;
     }
-    for (int k = 0; k < C.n; k++) span_add(S, C.s[k].lo - A, C.s[k].hi + A);
+    for (int k = 0; k < C.n; k++)
+      span_add(S, C.s[k].lo - A, C.s[k].hi + A);
     return;
   }
   case OC_K_XFORM: {
@@ -245,10 +249,12 @@ int oc_program_column_spans(const oc_program *P, double x0, double y0,
         best = k;
       }
     S.s[best].hi = S.s[best + 1].hi;
-    for (int k = best + 1; k + 1 < S.n; k++) S.s[k] = S.s[k + 1];
+    for (int k = best + 1; k + 1 < S.n; k++)
+      S.s[k] = S.s[k + 1];
     S.n--;
   }
-  for (int k = 0; k < S.n; k++) out[k] = S.s[k];
+  for (int k = 0; k < S.n; k++)
+    out[k] = S.s[k];
   return S.n;
 }
 

@@ -41,7 +41,8 @@ int main(void) {
     kids[i] = oc_point(c, oc_rng_range(&rng, 4, 12), -1, &err);
   }
   oc_node *blend = oc_blend(kids, NPRIM, &err);
-  for (int i = 0; i < NPRIM; i++) oc_node_release(kids[i]);
+  for (int i = 0; i < NPRIM; i++)
+    oc_node_release(kids[i]);
   double t0 = omp_get_wtime();
   oc_program *bvh = oc_compile(blend, NULL, &err);
   double tc = omp_get_wtime() - t0;

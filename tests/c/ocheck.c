@@ -32,8 +32,8 @@ oc_vec3 oct_in_box(oct_rng *r, oc_vec3 lo, oc_vec3 hi) {
 
 oc_vec3 oct_dir(oct_rng *r) {
   for (;;) {
-    oc_vec3 v = oct_v(oct_unif(r, -1, 1), oct_unif(r, -1, 1),
-                      oct_unif(r, -1, 1));
+    oc_vec3 v =
+        oct_v(oct_unif(r, -1, 1), oct_unif(r, -1, 1), oct_unif(r, -1, 1));
     double l = oct_len(v);
     if (l > 0.1 && l <= 1.0) return oct_mul(v, 1.0 / l);
   }
@@ -71,8 +71,7 @@ double oct_dist_box(oc_vec3 p, oc_vec3 lo, oc_vec3 hi) {
   return sqrt(dx * dx + dy * dy + dz * dz);
 }
 
-double oct_dist_polyline(oc_vec3 p, const oc_vec3 *pts, size_t n,
-                         double *gap) {
+double oct_dist_polyline(oc_vec3 p, const oc_vec3 *pts, size_t n, double *gap) {
   double best = INFINITY, second = INFINITY;
   oc_vec3 bestcp = {0, 0, 0};
   for (size_t i = 0; i + 1 < n; i++) {
@@ -106,17 +105,21 @@ oc_node *oct_random_prim(oct_rng *r, oc_vec3 lo, oc_vec3 hi, double rmin,
   oc_error e;
   oc_node *n = NULL;
   switch ((int)oct_unif(r, 0, 4)) {
-  case 0: n = oc_point(c, R, E, &e); break;
-  case 1: n = oc_sphere(c, oct_unif(r, 0.1, 1) * R, R, E, &e); break;
+  case 0:
+    n = oc_point(c, R, E, &e);
+    break;
+  case 1:
+    n = oc_sphere(c, oct_unif(r, 0.1, 1) * R, R, E, &e);
+    break;
   case 2: {
     oc_vec3 b = oct_add(c, oct_mul(oct_dir(r), oct_unif(r, 0, 2) * R));
     n = oc_segment(c, b, R, E, &e);
     break;
   }
   default: {
-    oc_vec3 hi2 = oct_add(c, oct_v(oct_unif(r, 0.05, 1) * R,
-                                   oct_unif(r, 0.05, 1) * R,
-                                   oct_unif(r, 0.05, 1) * R));
+    oc_vec3 hi2 =
+        oct_add(c, oct_v(oct_unif(r, 0.05, 1) * R, oct_unif(r, 0.05, 1) * R,
+                         oct_unif(r, 0.05, 1) * R));
     n = oc_box(c, hi2, R, E, &e);
   }
   }
@@ -138,11 +141,14 @@ oc_program *oct_compile(oc_node *n, double T, int no_bvh) {
 oc_vec3 oct_fd_grad(const oc_program *pr, oc_vec3 p, double h) {
   oc_vec3 g;
   g.x = (oc_program_eval(pr, oct_v(p.x + h, p.y, p.z)) -
-         oc_program_eval(pr, oct_v(p.x - h, p.y, p.z))) / (2 * h);
+         oc_program_eval(pr, oct_v(p.x - h, p.y, p.z))) /
+        (2 * h);
   g.y = (oc_program_eval(pr, oct_v(p.x, p.y + h, p.z)) -
-         oc_program_eval(pr, oct_v(p.x, p.y - h, p.z))) / (2 * h);
+         oc_program_eval(pr, oct_v(p.x, p.y - h, p.z))) /
+        (2 * h);
   g.z = (oc_program_eval(pr, oct_v(p.x, p.y, p.z + h)) -
-         oc_program_eval(pr, oct_v(p.x, p.y, p.z - h))) / (2 * h);
+         oc_program_eval(pr, oct_v(p.x, p.y, p.z - h))) /
+        (2 * h);
   return g;
 }
 
@@ -253,8 +259,8 @@ void oct_einval_(oc_node *n, const oc_error *err, const char *param,
     snprintf(quoted, sizeof quoted, "'%s'", tok);
     if (strstr(err->msg, quoted)) return;
   }
-  ck_abort_msg("%s:%d: %s: message \"%s\" does not name '%s'", file, line,
-               what, err->msg, param);
+  ck_abort_msg("%s:%d: %s: message \"%s\" does not name '%s'", file, line, what,
+               err->msg, param);
 }
 
 int oct_run(Suite *s) {

@@ -48,7 +48,9 @@ static inline oc_vec3 oct_mul(oc_vec3 a, double s) {
 static inline double oct_dot(oc_vec3 a, oc_vec3 b) {
   return a.x * b.x + a.y * b.y + a.z * b.z;
 }
-static inline double oct_len(oc_vec3 a) { return sqrt(oct_dot(a, a)); }
+static inline double oct_len(oc_vec3 a) {
+  return sqrt(oct_dot(a, a));
+}
 static inline oc_vec3 oct_cross(oc_vec3 a, oc_vec3 b) {
   return oct_v(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z,
                a.x * b.y - a.y * b.x);
@@ -69,8 +71,7 @@ double oct_dist_box(oc_vec3 p, oc_vec3 lo, oc_vec3 hi); /* 0 inside */
 /* Distance to the polyline; *gap (if non-NULL) gets the difference between
 ** the two smallest segment distances whose closest points differ, which
 ** is ~0 on the medial axis where the distance is not differentiable. */
-double oct_dist_polyline(oc_vec3 p, const oc_vec3 *pts, size_t n,
-                         double *gap);
+double oct_dist_polyline(oc_vec3 p, const oc_vec3 *pts, size_t n, double *gap);
 
 /* ---- building and compiling ------------------------------------------- */
 
@@ -107,7 +108,7 @@ int oct_check_bounds(const oc_program *pr, oc_vec3 lo, oc_vec3 hi, int n,
                      oct_rng *r);
 
 /* Asserts err says EINVAL and names 'param' in single quotes. */
-#define OCT_EINVAL(expr, err, param) \
+#define OCT_EINVAL(expr, err, param)                                           \
   oct_einval_((expr), &(err), (param), #expr, __FILE__, __LINE__)
 void oct_einval_(oc_node *n, const oc_error *err, const char *param,
                  const char *what, const char *file, int line);

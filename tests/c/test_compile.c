@@ -47,7 +47,8 @@ static oc_node **random_children(oct_rng *r, size_t n, int unbounded,
 }
 
 static void free_children(oc_node **c, size_t n) {
-  for (size_t i = 0; i < n; i++) oc_node_release(c[i]);
+  for (size_t i = 0; i < n; i++)
+    oc_node_release(c[i]);
   free(c);
 }
 
@@ -64,10 +65,12 @@ static oc_node *nary(int op, oc_node **c, size_t n) {
 
 /* _i: operator, and (for blend and union) the size. */
 START_TEST(bvh_equals_brute_force) {
-  static const struct { int op; size_t n; } cases[] = {
-      {OP_BLEND, 1000},  {OP_BLEND, 5000}, {OP_BLEND, 20000},
-      {OP_UNION, 1000},  {OP_UNION, 20000}, {OP_INTER, 1000},
-      {OP_BLEND, 3},
+  static const struct {
+    int op;
+    size_t n;
+  } cases[] = {
+      {OP_BLEND, 1000},  {OP_BLEND, 5000}, {OP_BLEND, 20000}, {OP_UNION, 1000},
+      {OP_UNION, 20000}, {OP_INTER, 1000}, {OP_BLEND, 3},
   };
   int op = cases[_i].op;
   size_t n = cases[_i].n, count;
@@ -86,7 +89,8 @@ START_TEST(bvh_equals_brute_force) {
     double fb = oc_program_gradient(brute, p, &gb);
     ck_assert_msg(fabs(ff - fb) <= 1e-9 * (1 + fabs(fb)),
                   "op %d n %zu: BVH %.17g vs brute force %.17g at "
-                  "(%g %g %g)", op, n, ff, fb, p.x, p.y, p.z);
+                  "(%g %g %g)",
+                  op, n, ff, fb, p.x, p.y, p.z);
     ck_assert_msg(oct_len(oct_sub(gf, gb)) <= 1e-9 * (1 + oct_len(gb)),
                   "op %d n %zu: BVH gradient (%g %g %g) vs (%g %g %g)", op, n,
                   gf.x, gf.y, gf.z, gb.x, gb.y, gb.z);
@@ -110,8 +114,8 @@ START_TEST(bvh_bounded_queries) {
   oc_aabb b = oc_program_bounds(pr);
   ck_assert_msg(b.lo.x >= -60 && b.hi.x <= 60 && b.lo.x < -45 && b.hi.x > 45,
                 "bounds x [%g, %g]", b.lo.x, b.hi.x);
-  int nz = oct_check_bounds(pr, oct_v(-70, -70, -70), oct_v(70, 70, 70), 3000,
-                            &r);
+  int nz =
+      oct_check_bounds(pr, oct_v(-70, -70, -70), oct_v(70, 70, 70), 3000, &r);
   ck_assert_int_gt(nz, 100);
   oct_check_lipschitz(pr, oct_v(-55, -55, -55), oct_v(55, 55, 55), 3000, &r);
   oc_program_free(pr);
@@ -124,8 +128,8 @@ START_TEST(stats_and_memory) {
   oc_node **c = malloc(N * sizeof *c);
   oc_error e;
   for (int i = 0; i < N; i++)
-    c[i] = OCT_OK(oc_point(oct_in_box(&r, WLO, WHI), oct_unif(&r, 1, 4), 1,
-                           &e));
+    c[i] =
+        OCT_OK(oc_point(oct_in_box(&r, WLO, WHI), oct_unif(&r, 1, 4), 1, &e));
   oc_node *root = nary(OP_BLEND, c, N);
   free_children(c, N);
   oc_program *pr = oct_compile(root, 0, 0);
@@ -179,13 +183,13 @@ START_TEST(large_point_blend_matches_formula) {
       if (d >= R[i] * (1 + 1e-6)) continue;
       ref += E[i] * oct_g(d / R[i]);
       double cmax = fmax(fabs(c[i].x), fmax(fabs(c[i].y), fabs(c[i].z)));
-      tol += fabs(E[i]) * (OCT_LG / R[i] * 2 * cmax * 0x1p-24 * sqrt(3.0) +
-                           8 * 0x1p-24);
+      tol += fabs(E[i]) *
+             (OCT_LG / R[i] * 2 * cmax * 0x1p-24 * sqrt(3.0) + 8 * 0x1p-24);
     }
     double f = oc_program_eval(pr, p);
     ck_assert_msg(fabs(f - ref) <= tol,
-                  "blend of %d points: %.17g, formula %.17g (allowed %g)", N,
-                  f, ref, tol);
+                  "blend of %d points: %.17g, formula %.17g (allowed %g)", N, f,
+                  ref, tol);
     if (k % 10 == 0) oct_check_grad(pr, p, 1e-5, 1e-6);
   }
   oct_rng r2 = oct_rng_new(1251);
@@ -248,7 +252,8 @@ START_TEST(concurrent_eval) {
   oc_vec3 *p = random_points(1401, N);
   double *ref = malloc(N * sizeof *ref);
   oc_vec3 *gref = malloc(N * sizeof *gref);
-  for (int i = 0; i < N; i++) ref[i] = oc_program_gradient(pr, p[i], &gref[i]);
+  for (int i = 0; i < N; i++)
+    ref[i] = oc_program_gradient(pr, p[i], &gref[i]);
   double *out[2];
   oc_vec3 *gout[2];
   for (int t = 0; t < 2; t++) {

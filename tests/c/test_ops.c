@@ -46,9 +46,12 @@ enum { OP_BLEND, OP_UNION, OP_INTER };
 
 static oc_node *nary(int op, oc_node **c, size_t n, oc_error *e) {
   switch (op) {
-  case OP_BLEND: return oc_blend(c, n, e);
-  case OP_UNION: return oc_union(c, n, e);
-  default: return oc_intersection(c, n, e);
+  case OP_BLEND:
+    return oc_blend(c, n, e);
+  case OP_UNION:
+    return oc_union(c, n, e);
+  default:
+    return oc_intersection(c, n, e);
   }
 }
 
@@ -60,8 +63,7 @@ START_TEST(nary_equals_sum_max_min) {
     oc_node *c[8];
     oc_program *cp[8];
     for (size_t i = 0; i < n; i++) {
-      c[i] = oct_random_prim(&r, oct_v(-3, -3, -3), oct_v(3, 3, 3), 1, 3,
-                             0.3);
+      c[i] = oct_random_prim(&r, oct_v(-3, -3, -3), oct_v(3, 3, 3), 1, 3, 0.3);
       oc_node_retain(c[i]);
       cp[i] = oct_compile(c[i], 0, 0);
     }
@@ -80,8 +82,9 @@ START_TEST(nary_equals_sum_max_min) {
       for (size_t i = 0; i < n; i++) {
         double f = oc_program_eval(cp[i], p);
         mag += fabs(f);
-        acc = op == OP_BLEND ? acc + f : op == OP_UNION ? fmax(acc, f)
-                                                        : fmin(acc, f);
+        acc = op == OP_BLEND   ? acc + f
+              : op == OP_UNION ? fmax(acc, f)
+                               : fmin(acc, f);
       }
       double f = oc_program_eval(pr, p);
       if (op == OP_BLEND)
@@ -93,7 +96,8 @@ START_TEST(nary_equals_sum_max_min) {
     oct_check_bounds(pr, LO, HI, 1000, &r);
     oct_check_lipschitz(pr, LO, HI, 1000, &r);
     oc_program_free(pr);
-    for (size_t i = 0; i < n; i++) oc_program_free(cp[i]);
+    for (size_t i = 0; i < n; i++)
+      oc_program_free(cp[i]);
   }
 }
 END_TEST
@@ -111,12 +115,14 @@ START_TEST(nary_gradients) {
   }
   oc_error e;
   oc_program *pr = oct_compile(OCT_OK(nary(op, c, 3, &e)), 0, 0);
-  for (int i = 0; i < 3; i++) oc_node_release(c[i]);
+  for (int i = 0; i < 3; i++)
+    oc_node_release(c[i]);
   int checked = 0;
   for (int k = 0; k < 400; k++) {
     oc_vec3 p = oct_in_box(&r, oct_v(-4, -4, -4), oct_v(4, 4, 4));
     double v[3];
-    for (int i = 0; i < 3; i++) v[i] = oc_program_eval(cp[i], p);
+    for (int i = 0; i < 3; i++)
+      v[i] = oc_program_eval(cp[i], p);
     if (op != OP_BLEND) {
       /* Distance of the two extreme values: skip near ties. */
       double a = v[0], b = v[1], cc = v[2], gap;
@@ -137,7 +143,8 @@ START_TEST(nary_gradients) {
   /* An intersection of three points is nonzero only where all overlap. */
   ck_assert_int_gt(checked, op == OP_BLEND ? 100 : op == OP_UNION ? 40 : 10);
   oc_program_free(pr);
-  for (int i = 0; i < 3; i++) oc_program_free(cp[i]);
+  for (int i = 0; i < 3; i++)
+    oc_program_free(cp[i]);
 }
 END_TEST
 
@@ -168,10 +175,10 @@ START_TEST(difference_values) {
   double T = _i == 0 ? 0.5 : 0.3;
   oct_rng r = oct_rng_new(30 + (uint64_t)_i);
   for (int t = 0; t < 20; t++) {
-    oc_node *a = oct_random_prim(&r, oct_v(-2, -2, -2), oct_v(2, 2, 2), 1,
-                                 3, 0.2);
-    oc_node *b = oct_random_prim(&r, oct_v(-2, -2, -2), oct_v(2, 2, 2), 1,
-                                 3, 0.2);
+    oc_node *a =
+        oct_random_prim(&r, oct_v(-2, -2, -2), oct_v(2, 2, 2), 1, 3, 0.2);
+    oc_node *b =
+        oct_random_prim(&r, oct_v(-2, -2, -2), oct_v(2, 2, 2), 1, 3, 0.2);
     oc_error e;
     oc_node *d = OCT_OK(oc_difference(a, b, &e));
     ck_assert_ptr_eq(oc_node_child(d, 0), a);
@@ -259,8 +266,10 @@ static oc_vec3 near_crease(const oc_program *pa, const oc_program *pb,
   for (int i = 0; i < 50; i++) {
     oc_vec3 m = oct_mul(oct_add(p, q), 0.5);
     double hm = oc_program_eval(pa, m) - oc_program_eval(pb, m);
-    if (hm * hp < 0) q = m;
-    else p = m, hp = hm;
+    if (hm * hp < 0)
+      q = m;
+    else
+      p = m, hp = hm;
   }
   return oct_add(p, oct_mul(oct_dir(r), oct_unif(r, 0, 0.05)));
 }
@@ -272,10 +281,10 @@ START_TEST(smooth_values) {
   oct_rng r = oct_rng_new(40 + (uint64_t)_i);
   int smoothed = 0;
   for (int t = 0; t < 15; t++) {
-    oc_node *a = oct_random_prim(&r, oct_v(-2, -2, -2), oct_v(2, 2, 2), 1.5,
-                                 3, t % 5 == 4 ? 0.5 : 0);
-    oc_node *b = oct_random_prim(&r, oct_v(-2, -2, -2), oct_v(2, 2, 2), 1.5,
-                                 3, t % 5 == 4 ? 0.5 : 0);
+    oc_node *a = oct_random_prim(&r, oct_v(-2, -2, -2), oct_v(2, 2, 2), 1.5, 3,
+                                 t % 5 == 4 ? 0.5 : 0);
+    oc_node *b = oct_random_prim(&r, oct_v(-2, -2, -2), oct_v(2, 2, 2), 1.5, 3,
+                                 t % 5 == 4 ? 0.5 : 0);
     oc_error e;
     oc_node *s = OCT_OK(inter ? oc_smooth_intersection(a, b, rad, &e)
                               : oc_smooth_union(a, b, rad, &e));
@@ -285,14 +294,14 @@ START_TEST(smooth_values) {
       oc_vec3 p = oct_in_box(&r, oct_v(-4, -4, -4), oct_v(4, 4, 4));
       if (k % 2) p = near_crease(pa, pb, &r, p);
       double fa = oc_program_eval(pa, p), fb = oc_program_eval(pb, p);
-      double ref = inter ? ref_sinter(fa, fb, rad, T)
-                         : ref_sunion(fa, fb, rad, T);
+      double ref =
+          inter ? ref_sinter(fa, fb, rad, T) : ref_sunion(fa, fb, rad, T);
       double f = oc_program_eval(pr, p);
       ck_assert_msg(fabs(f - ref) <= 1e-13 * (1 + fabs(ref)),
                     "%s r=%g T=%g: %.17g, expected %.17g (fa=%.17g "
                     "fb=%.17g)",
-                    inter ? "smooth_intersection" : "smooth_union", rad, T,
-                    f, ref, fa, fb);
+                    inter ? "smooth_intersection" : "smooth_union", rad, T, f,
+                    ref, fa, fb);
       if (ref != (inter ? fmin(fa, fb) : fmax(fa, fb))) smoothed++;
       /* Gradient where the operator is C1 (everywhere but the
       ** crease of a plain max/min, i.e. where the radius has faded). */
@@ -358,7 +367,8 @@ START_TEST(smooth_union_c1) {
     double L = oc_program_lipschitz(ps);
     ck_assert_msg(oct_len(oct_sub(gl, gr)) < 1e-3 * L,
                   "smooth union: gradient jumps across the crease at "
-                  "(0 %g %g): %g", p0.y, p0.z, oct_len(oct_sub(gl, gr)));
+                  "(0 %g %g): %g",
+                  p0.y, p0.z, oct_len(oct_sub(gl, gr)));
     ck_assert_msg(oct_len(oct_sub(al, ar)) < 1e-3 * L,
                   "smooth union: analytic gradient jumps: %g",
                   oct_len(oct_sub(al, ar)));
@@ -408,8 +418,8 @@ START_TEST(scale_field) {
   oct_rng r = oct_rng_new(70);
   double factors[] = {-1, 2.5, -0.3};
   for (int t = 0; t < 3; t++) {
-    oc_node *a = oct_random_prim(&r, oct_v(-2, -2, -2), oct_v(2, 2, 2), 1, 3,
-                                 0.3);
+    oc_node *a =
+        oct_random_prim(&r, oct_v(-2, -2, -2), oct_v(2, 2, 2), 1, 3, 0.3);
     oc_error e;
     oc_node *s = OCT_OK(oc_scale_field(a, factors[t], &e));
     oc_program *pa = oct_compile(a, 0, 0), *ps = oct_compile(s, 0, 0);
@@ -467,7 +477,8 @@ static double sigma_max(const double b[9]) {
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++) {
       s[i][j] = 0;
-      for (int k = 0; k < 3; k++) s[i][j] += b[3 * k + i] * b[3 * k + j];
+      for (int k = 0; k < 3; k++)
+        s[i][j] += b[3 * k + i] * b[3 * k + j];
     }
   for (int sweep = 0; sweep < 50; sweep++)
     for (int p = 0; p < 2; p++)
@@ -502,7 +513,8 @@ static void rotation(oc_vec3 u, double ang, double m[9]) {
 
 static void to34(const double a[9], oc_vec3 t, double m[12]) {
   for (int i = 0; i < 3; i++)
-    for (int j = 0; j < 3; j++) m[4 * i + j] = a[3 * i + j];
+    for (int j = 0; j < 3; j++)
+      m[4 * i + j] = a[3 * i + j];
   m[3] = t.x, m[7] = t.y, m[11] = t.z;
 }
 
@@ -526,7 +538,8 @@ static void random_affine(oct_rng *r, int kind, double a[9], oc_vec3 *t) {
     /* Well conditioned: sigma_min(A) > 0.3. */
     double ai[9];
     do {
-      for (int i = 0; i < 9; i++) a[i] = id[i] + oct_unif(r, -0.6, 0.6);
+      for (int i = 0; i < 9; i++)
+        a[i] = id[i] + oct_unif(r, -0.6, 0.6);
       inv3(a, ai);
     } while (!(sigma_max(ai) < 1 / 0.3));
   }
@@ -541,8 +554,8 @@ START_TEST(transform_values) {
     random_affine(&r, kind, a, &tr);
     to34(a, tr, m);
     inv3(a, ai);
-    oc_node *c = oct_random_prim(&r, oct_v(-2, -2, -2), oct_v(2, 2, 2), 1, 2.5,
-                                 0.2);
+    oc_node *c =
+        oct_random_prim(&r, oct_v(-2, -2, -2), oct_v(2, 2, 2), 1, 2.5, 0.2);
     oc_error e;
     oc_node *x = OCT_OK(oc_transform(c, m, &e));
     oc_program *pc = oct_compile(c, 0, 0), *px = oct_compile(x, 0, 0);
@@ -562,8 +575,8 @@ START_TEST(transform_values) {
                           ai[1] * gc.x + ai[4] * gc.y + ai[7] * gc.z,
                           ai[2] * gc.x + ai[5] * gc.y + ai[8] * gc.z);
         ck_assert_msg(oct_len(oct_sub(g, gx)) <= 1e-8 * (1 + oct_len(g)),
-                      "transform gradient (%g %g %g) vs (%g %g %g)", gx.x,
-                      gx.y, gx.z, g.x, g.y, g.z);
+                      "transform gradient (%g %g %g) vs (%g %g %g)", gx.x, gx.y,
+                      gx.z, g.x, g.y, g.z);
         oct_check_grad(px, p, 1e-6, 1e-7);
       }
     }
@@ -603,8 +616,7 @@ START_TEST(transform_moves_point) {
                               1e-12);
     }
     /* A rotation does not change the Lipschitz bound. */
-    ck_assert_double_eq_tol(oc_program_lipschitz(px),
-                            oc_program_lipschitz(pm),
+    ck_assert_double_eq_tol(oc_program_lipschitz(px), oc_program_lipschitz(pm),
                             1e-9 * oc_program_lipschitz(pm));
     oc_program_free(px);
     oc_program_free(pm);
@@ -636,7 +648,9 @@ END_TEST
 
 /* ---- warp -------------------------------------------------------------- */
 
-static double tmax_of(int o) { return 2 - pow(2, 1 - o); }
+static double tmax_of(int o) {
+  return 2 - pow(2, 1 - o);
+}
 
 START_TEST(warp_amplitude_zero_and_control) {
   oc_error e;
@@ -713,8 +727,8 @@ START_TEST(warp_displacement_bounded) {
     ck_assert(f >= 0 && f <= 1);
     if (f > 1e-6 && f < 0.999) {
       double dw = oct_ginv(f) * R;
-      ck_assert_msg(fabs(dw - d) <= dmax * (1 + 1e-9),
-                    "warp moved by %g > %g", fabs(dw - d), dmax);
+      ck_assert_msg(fabs(dw - d) <= dmax * (1 + 1e-9), "warp moved by %g > %g",
+                    fabs(dw - d), dmax);
       seen = fmax(seen, fabs(dw - d));
     } else if (f == 0) {
       ck_assert(d >= R - dmax * (1 + 1e-9));
@@ -731,8 +745,8 @@ START_TEST(warp_bounds_lipschitz_gradient) {
   double A = -0.7, wl = 2.5;
   int o = 3;
   oc_noise nz = {wl, A, 0, o, 11};
-  oc_node *c = OCT_OK(oc_box(oct_v(-1, -1, -0.5), oct_v(1, 0.5, 1), 1.2, 1,
-                             &e));
+  oc_node *c =
+      OCT_OK(oc_box(oct_v(-1, -1, -0.5), oct_v(1, 0.5, 1), 1.2, 1, &e));
   oc_node *ctl = with_ctl ? pt(1, 0, 0, 2, 1) : NULL;
   oc_node_retain(c);
   oc_program *pc = oct_compile(c, 0, 0);
@@ -787,16 +801,16 @@ START_TEST(perturb_amplitude_zero) {
   oct_rng r = oct_rng_new(110);
   oc_noise n0 = {1.5, 0, 0, 3, 5};
   for (int t = 0; t < 20; t++) {
-    oc_node *a = oct_random_prim(&r, oct_v(-2, -2, -2), oct_v(2, 2, 2), 1, 3,
-                                 0.3);
+    oc_node *a =
+        oct_random_prim(&r, oct_v(-2, -2, -2), oct_v(2, 2, 2), 1, 3, 0.3);
     oc_error e;
     oc_node *pn = OCT_OK(oc_perturb(a, &n0, &e));
     oc_program *pa = oct_compile(a, 0, 0), *pp = oct_compile(pn, 0, 0);
     for (int k = 0; k < 400; k++) {
       oc_vec3 p = oct_in_box(&r, LO, HI);
       double fa = oc_program_eval(pa, p), fp = oc_program_eval(pp, p);
-      ck_assert_msg(fabs(fa - fp) <= 1e-12, "amplitude 0: %.17g vs %.17g",
-                    fp, fa);
+      ck_assert_msg(fabs(fa - fp) <= 1e-12, "amplitude 0: %.17g vs %.17g", fp,
+                    fa);
     }
     oc_program_free(pa);
     oc_program_free(pp);
@@ -812,8 +826,10 @@ static void check_ray(const oc_program *pp, oc_vec3 s, oc_vec3 u, double E,
   for (int k = 1; k <= 60; k++) {
     double d = rmax * 1.1 * k / 60;
     double f = oc_program_eval(pp, oct_add(s, oct_mul(u, d))) / E;
-    ck_assert_msg(f <= prev, "not star-shaped: f grows from %.17g to %.17g "
-                  "at d=%g", prev, f, d);
+    ck_assert_msg(f <= prev,
+                  "not star-shaped: f grows from %.17g to %.17g "
+                  "at d=%g",
+                  prev, f, d);
     prev = f;
     if (f > 0.01 && f < 0.99) {
       double rho = d / oct_ginv(f);
@@ -839,7 +855,8 @@ START_TEST(perturb_star_shaped) {
   oc_program *pp = oct_compile(OCT_OK(oc_perturb(p0, &nz, &e)), 0, 0);
   oc_node_release(p0);
   oct_rng r = oct_rng_new(120 + (uint64_t)_i);
-  for (int k = 0; k < 300; k++) check_ray(pp, c, oct_dir(&r), E, rmin, rmax);
+  for (int k = 0; k < 300; k++)
+    check_ray(pp, c, oct_dir(&r), E, rmin, rmax);
   oc_program_free(pp);
 
   /* A segment: rays perpendicular to it from an interior point. */
@@ -862,8 +879,7 @@ START_TEST(perturb_star_shaped) {
     double f = oc_program_eval(pp, oct_add(c, oct_mul(oct_dir(&r), R * 0.8)));
     lo = fmin(lo, f), hi = fmax(hi, f);
   }
-  ck_assert_msg(hi - lo > 0.01, "perturbation has no effect: [%g, %g]", lo,
-                hi);
+  ck_assert_msg(hi - lo > 0.01, "perturbation has no effect: [%g, %g]", lo, hi);
   oc_program_free(pp);
 }
 END_TEST
@@ -880,10 +896,18 @@ START_TEST(perturb_queries) {
   oc_vec3 lo0 = oct_v(-1, -0.5, -1), hi0 = oct_v(1, 1, 0.5);
   oc_node *p0 = NULL;
   switch (kind) {
-  case 0: p0 = oc_point(lo0, R, E, &e); break;
-  case 1: p0 = oc_sphere(lo0, 0.8, R, E, &e); break;
-  case 2: p0 = oc_box(lo0, hi0, R, E, &e); break;
-  case 3: p0 = oc_segment(lo0, hi0, R, E, &e); break;
+  case 0:
+    p0 = oc_point(lo0, R, E, &e);
+    break;
+  case 1:
+    p0 = oc_sphere(lo0, 0.8, R, E, &e);
+    break;
+  case 2:
+    p0 = oc_box(lo0, hi0, R, E, &e);
+    break;
+  case 3:
+    p0 = oc_segment(lo0, hi0, R, E, &e);
+    break;
   }
   OCT_OK(p0);
   oc_program *pp = oct_compile(OCT_OK(oc_perturb(p0, &nz, &e)), 0, 0);
@@ -904,18 +928,23 @@ START_TEST(perturb_queries) {
   int checked = 0;
   for (int k = 0; k < 600; k++) {
     /* near the skeleton / solid, within the support */
-    oc_vec3 s = kind == 0   ? lo0
-                : kind == 1 ? oct_add(lo0, oct_mul(oct_dir(&r), 0.8))
-                : kind == 2 ? oct_in_box(&r, lo0, hi0)
-                            : oct_add(lo0, oct_mul(oct_sub(hi0, lo0),
-                                                   oct_unif(&r, 0, 1)));
+    oc_vec3 s =
+        kind == 0   ? lo0
+        : kind == 1 ? oct_add(lo0, oct_mul(oct_dir(&r), 0.8))
+        : kind == 2
+            ? oct_in_box(&r, lo0, hi0)
+            : oct_add(lo0, oct_mul(oct_sub(hi0, lo0), oct_unif(&r, 0, 1)));
     oc_vec3 p = oct_add(s, oct_mul(oct_dir(&r), oct_unif(&r, 0, rmax)));
     double d;
     const double *pc = &p.x, *l = &lo0.x, *h = &hi0.x;
     int seam = 0;
     switch (kind) {
-    case 0: d = oct_len(oct_sub(p, lo0)); break;
-    case 1: d = oct_len(oct_sub(p, lo0)) - 0.8; break;
+    case 0:
+      d = oct_len(oct_sub(p, lo0));
+      break;
+    case 1:
+      d = oct_len(oct_sub(p, lo0)) - 0.8;
+      break;
     case 2:
       d = oct_dist_box(p, lo0, hi0);
       for (int a = 0; a < 3; a++)
@@ -1136,8 +1165,7 @@ START_TEST(depth_limit) {
       /* Well under the limit: compiles and evaluates. */
       oc_program *pr = oc_compile(n, NULL, &e);
       ck_assert_msg(pr != NULL, "400 transforms: %s", e.msg);
-      ck_assert_double_eq_tol(oc_program_eval(pr, oct_v(0.4, 0, 0)), 1.0,
-                              1e-9);
+      ck_assert_double_eq_tol(oc_program_eval(pr, oct_v(0.4, 0, 0)), 1.0, 1e-9);
       oc_program_free(pr);
     }
   }

@@ -12,9 +12,18 @@
 
 /* ---- a primitive described on the test side --------------------------- */
 
-enum { P_POINT, P_SPHERE, P_BOX, P_SEGMENT, P_CURVE, P_BEZIER, P_CONE,
-       P_PLANE, P_NKINDS };
-static const char *kind_name[] = {"point", "sphere", "box", "segment",
+enum {
+  P_POINT,
+  P_SPHERE,
+  P_BOX,
+  P_SEGMENT,
+  P_CURVE,
+  P_BEZIER,
+  P_CONE,
+  P_PLANE,
+  P_NKINDS
+};
+static const char *kind_name[] = {"point", "sphere", "box",  "segment",
                                   "curve", "bezier", "cone", "plane"};
 
 #define MAXPTS 10
@@ -22,9 +31,9 @@ static const char *kind_name[] = {"point", "sphere", "box", "segment",
 
 typedef struct prim {
   int kind;
-  oc_vec3 a, b;  /* centre / min / a / base / origin ; max / b / apex / normal */
-  double r;      /* sphere and cone radius */
-  double R;      /* radius of skeletal, falloff of volumetric primitives */
+  oc_vec3 a, b; /* centre / min / a / base / origin ; max / b / apex / normal */
+  double r;     /* sphere and cone radius */
+  double R;     /* radius of skeletal, falloff of volumetric primitives */
   double E;
   oc_vec3 pts[MAXPTS];
   size_t n;
@@ -65,17 +74,22 @@ static prim prim_random(int kind, oct_rng *r) {
   pm.R = oct_unif(r, 0.5, 3);
   pm.E = rand_energy(r);
   switch (kind) {
-  case P_SPHERE: pm.r = oct_unif(r, 0.2, 3); break;
+  case P_SPHERE:
+    pm.r = oct_unif(r, 0.2, 3);
+    break;
   case P_BOX:
     pm.b = oct_add(pm.a, oct_v(oct_unif(r, 0.1, 4), oct_unif(r, 0.1, 4),
                                oct_unif(r, 0.1, 4)));
     break;
-  case P_SEGMENT: pm.b = oct_in_box(r, lo, hi); break;
+  case P_SEGMENT:
+    pm.b = oct_in_box(r, lo, hi);
+    break;
   case P_CURVE:
     pm.n = 2 + (size_t)oct_unif(r, 0, 6);
     pm.pts[0] = pm.a;
     for (size_t i = 1; i < pm.n; i++)
-      pm.pts[i] = oct_add(pm.pts[i - 1], oct_mul(oct_dir(r), oct_unif(r, 1, 4)));
+      pm.pts[i] =
+          oct_add(pm.pts[i - 1], oct_mul(oct_dir(r), oct_unif(r, 1, 4)));
     break;
   case P_BEZIER: {
     /* Gentle pieces (curvature radius well above R), joined with a
@@ -109,18 +123,28 @@ static prim prim_random(int kind, oct_rng *r) {
   return pm;
 }
 
-static void prim_free(prim *pm) { free(pm->dense); }
+static void prim_free(prim *pm) {
+  free(pm->dense);
+}
 
 static oc_node *prim_node(const prim *pm, oc_error *e) {
   switch (pm->kind) {
-  case P_POINT: return oc_point(pm->a, pm->R, pm->E, e);
-  case P_SPHERE: return oc_sphere(pm->a, pm->r, pm->R, pm->E, e);
-  case P_BOX: return oc_box(pm->a, pm->b, pm->R, pm->E, e);
-  case P_SEGMENT: return oc_segment(pm->a, pm->b, pm->R, pm->E, e);
-  case P_CURVE: return oc_curve(pm->pts, pm->n, 0, pm->R, pm->E, e);
-  case P_BEZIER: return oc_curve(pm->pts, pm->n, 1, pm->R, pm->E, e);
-  case P_CONE: return oc_cone(pm->a, pm->b, pm->r, pm->R, pm->E, e);
-  case P_PLANE: return oc_plane(pm->a, pm->b, pm->R, pm->E, e);
+  case P_POINT:
+    return oc_point(pm->a, pm->R, pm->E, e);
+  case P_SPHERE:
+    return oc_sphere(pm->a, pm->r, pm->R, pm->E, e);
+  case P_BOX:
+    return oc_box(pm->a, pm->b, pm->R, pm->E, e);
+  case P_SEGMENT:
+    return oc_segment(pm->a, pm->b, pm->R, pm->E, e);
+  case P_CURVE:
+    return oc_curve(pm->pts, pm->n, 0, pm->R, pm->E, e);
+  case P_BEZIER:
+    return oc_curve(pm->pts, pm->n, 1, pm->R, pm->E, e);
+  case P_CONE:
+    return oc_cone(pm->a, pm->b, pm->r, pm->R, pm->E, e);
+  case P_PLANE:
+    return oc_plane(pm->a, pm->b, pm->R, pm->E, e);
   }
   return NULL;
 }
@@ -146,13 +170,20 @@ static double cone_dist(oc_vec3 p, oc_vec3 base, oc_vec3 apex, double r) {
 static double prim_dist(const prim *pm, oc_vec3 p, double *gap) {
   if (gap) *gap = INFINITY;
   switch (pm->kind) {
-  case P_POINT: return oct_len(oct_sub(p, pm->a));
-  case P_SPHERE: return fmax(0, oct_len(oct_sub(p, pm->a)) - pm->r);
-  case P_BOX: return oct_dist_box(p, pm->a, pm->b);
-  case P_SEGMENT: return oct_dist_segment(p, pm->a, pm->b, NULL);
-  case P_CURVE: return oct_dist_polyline(p, pm->pts, pm->n, gap);
-  case P_BEZIER: return oct_dist_polyline(p, pm->dense, pm->ndense, NULL);
-  case P_CONE: return cone_dist(p, pm->a, pm->b, pm->r);
+  case P_POINT:
+    return oct_len(oct_sub(p, pm->a));
+  case P_SPHERE:
+    return fmax(0, oct_len(oct_sub(p, pm->a)) - pm->r);
+  case P_BOX:
+    return oct_dist_box(p, pm->a, pm->b);
+  case P_SEGMENT:
+    return oct_dist_segment(p, pm->a, pm->b, NULL);
+  case P_CURVE:
+    return oct_dist_polyline(p, pm->pts, pm->n, gap);
+  case P_BEZIER:
+    return oct_dist_polyline(p, pm->dense, pm->ndense, NULL);
+  case P_CONE:
+    return cone_dist(p, pm->a, pm->b, pm->r);
   case P_PLANE:
     return fmax(0, oct_dot(oct_sub(p, pm->a), pm->b) / oct_len(pm->b));
   }
@@ -233,21 +264,27 @@ static void sample_box(const prim *pm, oc_vec3 *lo, oc_vec3 *hi) {
 static oc_vec3 sample_near(const prim *pm, oct_rng *r) {
   oc_vec3 s;
   switch (pm->kind) {
-  case P_POINT: s = pm->a; break;
+  case P_POINT:
+    s = pm->a;
+    break;
   case P_SPHERE:
     s = oct_add(pm->a, oct_mul(oct_dir(r), oct_unif(r, 0, pm->r)));
     break;
-  case P_BOX: s = oct_in_box(r, pm->a, pm->b); break;
+  case P_BOX:
+    s = oct_in_box(r, pm->a, pm->b);
+    break;
   case P_SEGMENT:
     s = oct_add(pm->a, oct_mul(oct_sub(pm->b, pm->a), oct_unif(r, 0, 1)));
     break;
   case P_CURVE: {
     size_t i = (size_t)oct_unif(r, 0, (double)(pm->n - 1));
-    s = oct_add(pm->pts[i],
-                oct_mul(oct_sub(pm->pts[i + 1], pm->pts[i]), oct_unif(r, 0, 1)));
+    s = oct_add(pm->pts[i], oct_mul(oct_sub(pm->pts[i + 1], pm->pts[i]),
+                                    oct_unif(r, 0, 1)));
     break;
   }
-  case P_BEZIER: s = pm->dense[(size_t)oct_unif(r, 0, (double)pm->ndense)]; break;
+  case P_BEZIER:
+    s = pm->dense[(size_t)oct_unif(r, 0, (double)pm->ndense)];
+    break;
   case P_CONE: {
     double t = oct_unif(r, 0, 1);
     s = oct_add(pm->a, oct_mul(oct_sub(pm->b, pm->a), t));
@@ -281,8 +318,8 @@ START_TEST(value_matches_formula) {
     prim pm = prim_random(kind, &r);
     oc_error e;
     oc_program *pr = oct_compile(OCT_OK(prim_node(&pm, &e)), 0, 0);
-    double tol = kind == P_BEZIER ? fabs(pm.E) * OCT_LG * 1e-3
-                                  : 1e-9 * fabs(pm.E);
+    double tol =
+        kind == P_BEZIER ? fabs(pm.E) * OCT_LG * 1e-3 : 1e-9 * fabs(pm.E);
     oc_vec3 lo, hi;
     sample_box(&pm, &lo, &hi);
     for (int i = 0; i < 400; i++) {
@@ -292,9 +329,12 @@ START_TEST(value_matches_formula) {
                     "%s #%d: f=%.17g, formula %.17g at (%.9g %.9g %.9g)",
                     kind_name[kind], t, f, ref, p.x, p.y, p.z);
       double d = prim_dist(&pm, p, NULL);
-      if (d == 0) inside++;
-      else if (d < pm.R) falloff++;
-      else outside++;
+      if (d == 0)
+        inside++;
+      else if (d < pm.R)
+        falloff++;
+      else
+        outside++;
     }
     oc_program_free(pr);
     prim_free(&pm);
@@ -333,8 +373,8 @@ START_TEST(value_on_boundaries) {
   oc_program_free(pr);
 
   /* Box: E inside and on the faces; corner falloff is Euclidean. */
-  pr = oct_compile(
-      OCT_OK(oc_box(oct_v(0, 0, 0), oct_v(1, 2, 3), 1.0, 1.0, &e)), 0, 0);
+  pr = oct_compile(OCT_OK(oc_box(oct_v(0, 0, 0), oct_v(1, 2, 3), 1.0, 1.0, &e)),
+                   0, 0);
   ck_assert_double_eq(oc_program_eval(pr, oct_v(0.5, 1, 1.5)), 1.0);
   ck_assert_double_eq(oc_program_eval(pr, oct_v(1, 2, 3)), 1.0);
   ck_assert_double_eq_tol(oc_program_eval(pr, oct_v(1.3, 2.4, 1)),
@@ -343,14 +383,13 @@ START_TEST(value_on_boundaries) {
   oc_program_free(pr);
 
   /* Segment: capsule; a segment with a = b is a point. */
-  pr = oct_compile(OCT_OK(oc_segment(oct_v(0, 0, 0), oct_v(4, 0, 0), 1, 1,
-                                     &e)),
+  pr = oct_compile(OCT_OK(oc_segment(oct_v(0, 0, 0), oct_v(4, 0, 0), 1, 1, &e)),
                    0, 0);
   ck_assert_double_eq(oc_program_eval(pr, oct_v(2, 0, 0)), 1.0);
-  ck_assert_double_eq_tol(oc_program_eval(pr, oct_v(2, 0.5, 0)),
-                          pow(0.75, 3), 1e-14);
-  ck_assert_double_eq_tol(oc_program_eval(pr, oct_v(-0.5, 0, 0)),
-                          pow(0.75, 3), 1e-14);
+  ck_assert_double_eq_tol(oc_program_eval(pr, oct_v(2, 0.5, 0)), pow(0.75, 3),
+                          1e-14);
+  ck_assert_double_eq_tol(oc_program_eval(pr, oct_v(-0.5, 0, 0)), pow(0.75, 3),
+                          1e-14);
   ck_assert_double_eq(oc_program_eval(pr, oct_v(5, 0, 0)), 0.0);
   oc_program_free(pr);
   oc_program *ps = oct_compile(OCT_OK(oc_segment(c, c, R, E, &e)), 0, 0);
@@ -370,29 +409,27 @@ START_TEST(value_on_boundaries) {
 
   /* Cone: E on the axis, in the base disc and at the apex; falls along
   ** the axis beyond the apex and below the base. */
-  pr = oct_compile(OCT_OK(oc_cone(oct_v(0, 0, 0), oct_v(0, 0, 4), 2, 1, 1,
-                                  &e)),
+  pr = oct_compile(OCT_OK(oc_cone(oct_v(0, 0, 0), oct_v(0, 0, 4), 2, 1, 1, &e)),
                    0, 0);
   ck_assert_double_eq(oc_program_eval(pr, oct_v(0, 0, 2)), 1.0);
   ck_assert_double_eq(oc_program_eval(pr, oct_v(0, 0, 4)), 1.0);
   ck_assert_double_eq(oc_program_eval(pr, oct_v(1.9, 0, 0)), 1.0);
-  ck_assert_double_eq_tol(oc_program_eval(pr, oct_v(0, 0, 4.5)),
-                          pow(0.75, 3), 1e-13);
-  ck_assert_double_eq_tol(oc_program_eval(pr, oct_v(0, 1, -0.5)),
-                          pow(0.75, 3), 1e-13);
+  ck_assert_double_eq_tol(oc_program_eval(pr, oct_v(0, 0, 4.5)), pow(0.75, 3),
+                          1e-13);
+  ck_assert_double_eq_tol(oc_program_eval(pr, oct_v(0, 1, -0.5)), pow(0.75, 3),
+                          1e-13);
   /* Beyond the rim, radially: distance to the rim circle. */
   ck_assert_double_eq_tol(oc_program_eval(pr, oct_v(2.3, 0, -0.4)),
                           pow(0.75, 3), 1e-13);
   /* The slant face: x/2 + z/4 = 1 at (1, 0, 2); outward normal (2,0,1)/√5. */
-  ck_assert_double_eq_tol(
-      oc_program_eval(pr, oct_v(1 + 0.5 * 2 / sqrt(5.0), 0, 2 + 0.5 / sqrt(5.0))),
-      pow(0.75, 3), 1e-12);
+  ck_assert_double_eq_tol(oc_program_eval(pr, oct_v(1 + 0.5 * 2 / sqrt(5.0), 0,
+                                                    2 + 0.5 / sqrt(5.0))),
+                          pow(0.75, 3), 1e-12);
   oc_program_free(pr);
 
   /* Plane: E on the side opposite to the normal, falls over R along it;
   ** the normal is normalised. */
-  pr = oct_compile(OCT_OK(oc_plane(oct_v(0, 0, 1), oct_v(0, 0, 5), 2, 0.8,
-                                   &e)),
+  pr = oct_compile(OCT_OK(oc_plane(oct_v(0, 0, 1), oct_v(0, 0, 5), 2, 0.8, &e)),
                    0, 0);
   ck_assert_double_eq(oc_program_eval(pr, oct_v(10, -7, 1)), 0.8);
   ck_assert_double_eq(oc_program_eval(pr, oct_v(1e6, 1e6, -1e6)), 0.8);
@@ -410,8 +447,8 @@ START_TEST(curve_special_cases) {
   oc_program *pr = oct_compile(OCT_OK(oc_curve(sq, 5, 0, 1, 1, &e)), 0, 0);
   /* The closing edge counts. */
   ck_assert_double_eq(oc_program_eval(pr, oct_v(0, 2, 0)), 1.0);
-  ck_assert_double_eq_tol(oc_program_eval(pr, oct_v(-0.5, 2, 0)),
-                          pow(0.75, 3), 1e-14);
+  ck_assert_double_eq_tol(oc_program_eval(pr, oct_v(-0.5, 2, 0)), pow(0.75, 3),
+                          1e-14);
   ck_assert_double_eq(oc_program_eval(pr, oct_v(2, 2, 0)), 0.0);
   oc_program_free(pr);
 
@@ -423,8 +460,8 @@ START_TEST(curve_special_cases) {
     double ref = oct_g(oct_dist_polyline(p, rep, 5, NULL));
     oc_vec3 g;
     double f = oc_program_gradient(pr, p, &g);
-    ck_assert_msg(fabs(f - ref) < 1e-12, "repeated points: %.17g vs %.17g",
-                  f, ref);
+    ck_assert_msg(fabs(f - ref) < 1e-12, "repeated points: %.17g vs %.17g", f,
+                  ref);
     ck_assert(!isnan(g.x) && !isnan(g.y) && !isnan(g.z));
   }
   oc_program_free(pr);
@@ -432,13 +469,15 @@ START_TEST(curve_special_cases) {
   /* Evenly spaced collinear control points: the Bezier is the segment. */
   oc_vec3 line[4] = {{0, 0, 0}, {1, 1, 0}, {2, 2, 0}, {3, 3, 0}};
   oc_program *pb = oct_compile(OCT_OK(oc_curve(line, 4, 1, 0.7, 1, &e)), 0, 0);
-  oc_program *ps = oct_compile(
-      OCT_OK(oc_segment(line[0], line[3], 0.7, 1, &e)), 0, 0);
+  oc_program *ps =
+      oct_compile(OCT_OK(oc_segment(line[0], line[3], 0.7, 1, &e)), 0, 0);
   for (int i = 0; i < 300; i++) {
     oc_vec3 p = oct_in_box(&r, oct_v(-1, -1, -1), oct_v(4, 4, 1));
     double a = oc_program_eval(pb, p), b = oc_program_eval(ps, p);
-    ck_assert_msg(fabs(a - b) <= 1e-4 * OCT_LG, "straight Bezier %.17g vs "
-                  "segment %.17g", a, b);
+    ck_assert_msg(fabs(a - b) <= 1e-4 * OCT_LG,
+                  "straight Bezier %.17g vs "
+                  "segment %.17g",
+                  a, b);
   }
   oc_program_free(pb);
   oc_program_free(ps);
@@ -593,8 +632,8 @@ START_TEST(bounds_of_axis_plane) {
   oc_aabb b = oc_program_bounds(pr);
   /* The support is z < 2.5, unbounded elsewhere. */
   ck_assert(b.hi.z >= 2.5);
-  ck_assert(isinf(b.lo.x) && isinf(b.hi.x) && isinf(b.lo.y) &&
-            isinf(b.hi.y) && isinf(b.lo.z));
+  ck_assert(isinf(b.lo.x) && isinf(b.hi.x) && isinf(b.lo.y) && isinf(b.hi.y) &&
+            isinf(b.lo.z));
   oc_program_free(pr);
 }
 END_TEST
@@ -620,8 +659,8 @@ START_TEST(lipschitz_bound) {
   }
   /* The bound is tight for every primitive: the falloff's steepest slope
   ** is reached along some ray. */
-  ck_assert_msg(worst > 0.3, "%s: largest slope only %g of L",
-                kind_name[kind], worst);
+  ck_assert_msg(worst > 0.3, "%s: largest slope only %g of L", kind_name[kind],
+                worst);
   ck_assert_msg(Lbad == 0, "%s: L = %.17g, expected |E| Lg / R = %.17g",
                 kind_name[kind], Lbad, Lref);
 }
@@ -641,8 +680,8 @@ START_TEST(lipschitz_point_exact) {
   oc_vec3 q = oct_add(p, oct_v(1e-6, 0, 0));
   double s = fabs(oc_program_eval(pr, p) - oc_program_eval(pr, q)) / 1e-6;
   /* (a difference quotient carries ~1e-10 of rounding at this step) */
-  ck_assert_msg(s <= L * (1 + 1e-8) && s > 0.9999 * L,
-                "slope %.17g vs L %.17g", s, L);
+  ck_assert_msg(s <= L * (1 + 1e-8) && s > 0.9999 * L, "slope %.17g vs L %.17g",
+                s, L);
   oc_program_free(pr);
 }
 END_TEST
@@ -668,8 +707,7 @@ START_TEST(turbulence_values) {
   for (int i = 0; i < 3000; i++) {
     oc_vec3 p = oct_in_box(&r, oct_v(-50, -50, -50), oct_v(50, 50, 50));
     double f1 = oc_program_eval(t1, p);
-    ck_assert_msg(f1 >= 0 && f1 <= tmax, "t = %.17g outside [0, %g]", f1,
-                  tmax);
+    ck_assert_msg(f1 >= 0 && f1 <= tmax, "t = %.17g outside [0, %g]", f1, tmax);
     lo1 = fmin(lo1, f1), hi1 = fmax(hi1, f1);
     /* Linear in amplitude and offset. */
     double f2 = oc_program_eval(t2, p);
@@ -730,7 +768,8 @@ END_TEST
 
 START_TEST(invalid_parameters) {
   oc_error e;
-  oc_vec3 o = {0, 0, 0}, x = {1, 0, 0}, bad = {NAN, 0, 0}, inf = {0, INFINITY, 0};
+  oc_vec3 o = {0, 0, 0}, x = {1, 0, 0}, bad = {NAN, 0, 0},
+          inf = {0, INFINITY, 0};
   double radii[] = {0, -1, NAN, INFINITY, -INFINITY};
   for (int i = 0; i < 5; i++) {
     double v = radii[i];
@@ -789,10 +828,9 @@ START_TEST(invalid_parameters) {
                      {1, NAN, 0, 3, 0}, {1, INFINITY, 0, 3, 0},
                      {1, 1, NAN, 3, 0}, {1, 1, 0, 0, 0},
                      {1, 1, 0, 17, 0},  {1, 1, 0, -1, 0}};
-  const char *names[] = {"wavelength", "wavelength", "wavelength",
-                         "wavelength", "amplitude",  "amplitude",
-                         "offset",     "octaves",    "octaves",
-                         "octaves"};
+  const char *names[] = {"wavelength", "wavelength", "wavelength", "wavelength",
+                         "amplitude",  "amplitude",  "offset",     "octaves",
+                         "octaves",    "octaves"};
   for (int i = 0; i < 10; i++)
     OCT_EINVAL(oc_turbulence(&bads[i], &e), e, names[i]);
   nz.octaves = 16;

@@ -22,8 +22,8 @@ static oc_program *scene(int tilted, int with_warp) {
   oc_vec3 nrm = tilted ? oct_v(0.2, -0.1, 1) : oct_v(0, 0, 1);
   k[n++] = OCT_OK(oc_plane(oct_v(0, 0, 0), nrm, 3, 1, &err));
   for (int i = 0; i < N; i++)
-    k[n++] = oct_random_prim(&r, oct_v(0, 0, -8), oct_v(200, 200, 8), 1, 6,
-                             0.5);
+    k[n++] =
+        oct_random_prim(&r, oct_v(0, 0, -8), oct_v(200, 200, 8), 1, 6, 0.5);
   oc_node *rock = OCT_OK(oc_sphere(oct_v(0, 0, 0), 3, 2, 1, &err));
   double m[12] = {2, 0, 0, 50, 0, 2, 0, 60, 0, 0, 1.5, 10};
   k[n++] = OCT_OK(oc_transform(rock, m, &err));
@@ -33,17 +33,19 @@ static oc_program *scene(int tilted, int with_warp) {
   }
   oc_node_release(rock);
   oc_node *b = OCT_OK(oc_blend(k, n, &err));
-  for (size_t i = 0; i < n; i++) oc_node_release(k[i]);
+  for (size_t i = 0; i < n; i++)
+    oc_node_release(k[i]);
   return oct_compile(b, 0, 0);
 }
 
-static void check_gaps(const oc_program *pr, oct_rng *r, double x0,
-                       double y0, double x1, double y1) {
+static void check_gaps(const oc_program *pr, oct_rng *r, double x0, double y0,
+                       double x1, double y1) {
   oc_zspan s[8];
   int n = oc_program_column_spans(pr, x0, y0, x1, y1, s, 8);
   if (n < 0) return;
   ck_assert_int_le(n, 8);
-  for (int i = 0; i + 1 < n; i++) ck_assert(s[i].hi < s[i + 1].lo);
+  for (int i = 0; i + 1 < n; i++)
+    ck_assert(s[i].hi < s[i + 1].lo);
   /* gaps: below the first, between, above the last (bounded for sampling) */
   for (int g = 0; g <= n; g++) {
     double lo = g == 0 ? -60 : s[g - 1].hi, hi = g == n ? 60 : s[g].lo;
@@ -52,17 +54,18 @@ static void check_gaps(const oc_program *pr, oct_rng *r, double x0,
     if (!(hi > lo)) continue;
     double ref = NAN;
     for (int t = 0; t < 40; t++) {
-      oc_vec3 p = oct_v(oct_unif(r, x0, x1), oct_unif(r, y0, y1),
-                        oct_unif(r, lo, hi));
+      oc_vec3 p =
+          oct_v(oct_unif(r, x0, x1), oct_unif(r, y0, y1), oct_unif(r, lo, hi));
       if (p.z <= lo || p.z >= hi) continue;
       double v = oc_program_eval(pr, p);
       if (isnan(ref))
         ref = v;
       else
-        ck_assert_msg(fabs(v - ref) <= 1e-12,
-                      "field varies in a gap (%g, %g) of column [%g,%g]x[%g,%g]:"
-                      " %.17g vs %.17g at z %g",
-                      lo, hi, x0, x1, y0, y1, v, ref, p.z);
+        ck_assert_msg(
+            fabs(v - ref) <= 1e-12,
+            "field varies in a gap (%g, %g) of column [%g,%g]x[%g,%g]:"
+            " %.17g vs %.17g at z %g",
+            lo, hi, x0, x1, y0, y1, v, ref, p.z);
     }
   }
 }
@@ -76,8 +79,7 @@ START_TEST(spans_cover_variation) {
       double x = oct_unif(&r, -20, 220), y = oct_unif(&r, -20, 220);
       double w = oct_unif(&r, 0.1, 6);
       oc_zspan s[8];
-      if (oc_program_column_spans(pr, x, y, x + w, y + w, s, 8) >= 0)
-        bounded++;
+      if (oc_program_column_spans(pr, x, y, x + w, y + w, s, 8) >= 0) bounded++;
       check_gaps(pr, &r, x, y, x + w, y + w);
     }
     /* the point of spans: most columns are bounded */
@@ -113,14 +115,14 @@ START_TEST(spans_merge_to_max) {
   for (int i = 0; i < 10; i++)
     k[i] = OCT_OK(oc_point(oct_v(0, 0, 10.0 * i), 1, 1, &err));
   oc_node *b = OCT_OK(oc_blend(k, 10, &err));
-  for (int i = 0; i < 10; i++) oc_node_release(k[i]);
+  for (int i = 0; i < 10; i++)
+    oc_node_release(k[i]);
   oc_program *pr = oct_compile(b, 0, 0);
   oc_zspan s[10];
   ck_assert_int_eq(oc_program_column_spans(pr, -0.5, -0.5, 0.5, 0.5, s, 10),
                    10);
   oc_zspan t[3];
-  ck_assert_int_eq(oc_program_column_spans(pr, -0.5, -0.5, 0.5, 0.5, t, 3),
-                   3);
+  ck_assert_int_eq(oc_program_column_spans(pr, -0.5, -0.5, 0.5, 0.5, t, 3), 3);
   ck_assert(t[0].lo <= s[0].lo && t[2].hi >= s[9].hi);
   ck_assert_int_eq(oc_program_column_spans(pr, 5, 5, 6, 6, t, 3), 0);
   oc_program_free(pr);

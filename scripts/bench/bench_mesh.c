@@ -1,0 +1,244 @@
+/*
+** bench_mesh.c — polygonization speed (issue 3).
+**
+** 1. A terrain-like scene: a ground plane with about 2 % of its area
+**    covered by 3D features (carved spheres, perturbed boulders, an arch),
+**    meshed over the same box and cell with surface bounds and on the full
+**    grid; the meshes must be the same up to vertex order.
+** 2. The same kind of scene over 2000 x 2000 columns, a band 64 cells
+**    thick, 2 threads: seconds and peak memory (in a child process, so the
+**    peak is that run's own).
+** 3. 1000 spheres blended with a ground plane at cell 0.25.
+** Prints `name: value unit` lines; '#' lines are context.
+*/
+#define _GNU_SOURCE
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "core/rng.h"
+#include "outcrop.h"
+
+static oc_node *must(oc_node *n, const oc_error *err) {
+  if (!n) {
+    fprintf(stderr, "bench_mesh: %s\n", err->msg);
+    exit(1);
+  }
+  return n;
+}
+
+/* Ground at z = 0 over [0, w] x [0, w] with features covering ~2 % of it. */
+static oc_node *terrain(double w, uint64_t seed) {
+  oc_error err;
+  oc_rng r = oc_rng_stream(seed, 1);
+  size_t cap = 64 + (size_t)(w * w * 0.02 / 20), n = 0;
+  oc_node **k = malloc(cap * sizeof *k);
+  k[n++] =
+      must(oc_plane((oc_vec3){0, 0, 0}, (oc_vec3){0, 0, 1}, 4, 1, &err), &err);
+  /* each feature covers ~ pi 4^2 = 50 m^2 of ground: 2 % of w^2 */
+  size_t nf = (size_t)(0.02 * w * w / 50);
+  oc_noise nz = {6, 1.5, 0, 3, seed};
+  for (size_t i = 0; i < nf && n + 2 < cap; i++) {
+    oc_vec3 c = {oc_rng_range(&r, 0, w), oc_rng_range(&r, 0, w),
+                 oc_rng_range(&r, -3, 3)};
+    double kind = oc_rng_uniform(&r);
+    if (kind < 0.5) { /* carved hollow */
+      k[n++] = must(oc_sphere(c, oc_rng_range(&r, 1, 3), 2, -1.5, &err), &err);
+    } else { /* perturbed boulder */
+      oc_node *p = must(oc_point(c, oc_rng_range(&r, 3, 5), 1.2, &err), &err);
+      k[n++] = must(oc_perturb(p, &nz, &err), &err);
+      oc_node_release(p);
+    }
+  }
+  /* an arch near the middle */
+  double m = w / 2;
+  oc_vec3 spine[4] = {
+      {m - 20, m, -2}, {m - 22, m, 28}, {m + 22, m, 28}, {m + 20, m, -2}};
+  oc_node *arch = must(oc_curve(spine, 4, 1, 6, 1, &err), &err);
+  k[n++] = must(oc_perturb(arch, &nz, &err), &err);
+  oc_node_release(arch);
+  oc_node *b = must(oc_blend(k, n, &err), &err);
+  for (size_t i = 0; i < n; i++)
+    oc_node_release(k[i]);
+  free(k);
+  return b;
+}
+
+static oc_mesh *mesh(const oc_program *p, oc_aabb box, double cell, int full,
+                     double *sec) {
+  oc_error err;
+  oc_polygonize_params pp = {0};
+  pp.box = box;
+  pp.cell = cell;
+  pp.full_grid = full;
+  double t0 = omp_get_wtime();
+  oc_mesh *m = oc_polygonize(p, &pp, &err);
+  *sec = omp_get_wtime() - t0;
+  if (!m) {
+    fprintf(stderr, "bench_mesh: %s\n", err.msg);
+    exit(1);
+  }
+  return m;
+}
+
+/* Triangles as sorted position triples, to compare meshes up to vertex
+** order. */
+typedef struct tri9 {
+  float v[9];
+} tri9;
+static int cmp3(const float *a, const float *b) {
+  for (int i = 0; i < 3; i++)
+    if (a[i] != b[i]) return a[i] < b[i] ? -1 : 1;
+  return 0;
+}
+static int cmp9(const void *x, const void *y) {
+  return memcmp(x, y, sizeof(tri9)) < 0 ? -1 : memcmp(x, y, sizeof(tri9)) > 0;
+}
+static tri9 *canon(const oc_mesh *m, size_t *n) {
+  *n = oc_mesh_triangle_count(m);
+  const float *P = oc_mesh_positions(m);
+  const uint32_t *I = oc_mesh_indices(m);
+  tri9 *t = malloc((*n ? *n : 1) * sizeof *t);
+  for (size_t i = 0; i < *n; i++) {
+    /* rotate so the smallest vertex comes first (keeps orientation) */
+    int s = 0;
+    for (int k = 1; k < 3; k++)
+      if (cmp3(P + 3 * I[3 * i + k], P + 3 * I[3 * i + s]) < 0) s = k;
+    for (int k = 0; k < 3; k++)
+      memcpy(t[i].v + 3 * k, P + 3 * I[3 * i + (s + k) % 3], 3 * sizeof(float));
+  }
+  qsort(t, *n, sizeof *t, cmp9);
+  return t;
+}
+
+static void terrain_speedup(void) {
+  oc_error err;
+  double w = 400;
+  oc_node *t = terrain(w, 11);
+  oc_program *p = oc_compile(t, NULL, &err);
+  if (!p) {
+    fprintf(stderr, "bench_mesh: %s\n", err.msg);
+    exit(1);
+  }
+  oc_aabb box = {{0, 0, -64}, {w, w, 64}};
+  double sb, sf;
+  omp_set_num_threads(2);
+  oc_mesh *mb = mesh(p, box, 1.0, 0, &sb);
+  oc_mesh *mf = mesh(p, box, 1.0, 1, &sf);
+  oc_mesh_stats stb, stf;
+  oc_mesh_get_stats(mb, &stb);
+  oc_mesh_get_stats(mf, &stf);
+  size_t nb, nf;
+  tri9 *tb = canon(mb, &nb), *tf = canon(mf, &nf);
+  int same = nb == nf && !memcmp(tb, tf, nb * sizeof *tb);
+  printf("# terrain %g x %g m, cell 1 m, box z -64..64 (%g M cells): %zu "
+         "triangles; full grid %.2f s, bounded %.2f s; meshes %s\n",
+         w, w, w * w * 128 / 1e6, stb.triangles, sf, sb,
+         same ? "identical up to vertex order" : "DIFFER");
+  printf("mesh.bounds_speedup: %.1f x\n", sf / sb);
+  printf("mesh.field_call_ratio: %.1f x\n",
+         (double)stf.field_calls / (double)stb.field_calls);
+  free(tb);
+  free(tf);
+  oc_mesh_free(mb);
+  oc_mesh_free(mf);
+  oc_program_free(p);
+  oc_node_release(t);
+  if (!same) exit(1);
+}
+
+/* Runs fn in a child process and reports its peak resident memory. */
+static double child_peak_mb(void (*fn)(void)) {
+  fflush(stdout);
+  pid_t pid = fork();
+  if (pid == 0) {
+    fn();
+    fflush(stdout);
+    _exit(0);
+  }
+  int status;
+  struct rusage ru;
+  if (wait4(pid, &status, 0, &ru) < 0 || !WIFEXITED(status) ||
+      WEXITSTATUS(status) != 0) {
+    fprintf(stderr, "bench_mesh: child failed\n");
+    exit(1);
+  }
+  return ru.ru_maxrss / 1024.0;
+}
+
+static void band_run(void) {
+  oc_error err;
+  double w = 2000;
+  oc_node *t = terrain(w, 12);
+  oc_program *p = oc_compile(t, NULL, &err);
+  if (!p) exit(1);
+  oc_aabb box = {{0, 0, -32}, {w, w, 32}};
+  double s;
+  omp_set_num_threads(2);
+  oc_mesh *m = mesh(p, box, 1.0, 0, &s);
+  oc_mesh_stats st;
+  oc_mesh_get_stats(m, &st);
+  printf("# band: %g x %g columns, 64 cells thick, cell 1 m: %zu triangles, "
+         "%zu cells visited, %zu field calls\n",
+         w, w, st.triangles, st.cells_visited, st.field_calls);
+  printf("mesh.band_seconds_2t: %.2f s\n", s);
+  oc_mesh_free(m);
+  oc_program_free(p);
+  oc_node_release(t);
+}
+
+static void spheres1000(void) {
+  oc_error err;
+  oc_rng r = oc_rng_stream(1000, 3);
+  oc_node *k[1001];
+  k[0] =
+      must(oc_plane((oc_vec3){0, 0, 0}, (oc_vec3){0, 0, 1}, 1, 1, &err), &err);
+  for (int i = 1; i <= 1000; i++) {
+    oc_vec3 c = {oc_rng_range(&r, 0, 100), oc_rng_range(&r, 0, 100),
+                 oc_rng_range(&r, 0, 20)};
+    k[i] = must(oc_sphere(c, oc_rng_range(&r, 1, 3), 1, 1, &err), &err);
+  }
+  oc_node *b = must(oc_blend(k, 1001, &err), &err);
+  for (int i = 0; i <= 1000; i++)
+    oc_node_release(k[i]);
+  oc_program *p = oc_compile(b, NULL, &err);
+  oc_aabb box = {{-13.75, -13.75, -5}, {113.75, 113.75, 122.5}};
+  double s1, s2;
+  omp_set_num_threads(1);
+  oc_mesh *m1 = mesh(p, box, 0.25, 0, &s1);
+  omp_set_num_threads(2);
+  oc_mesh *m2 = mesh(p, box, 0.25, 0, &s2);
+  oc_mesh_stats st;
+  oc_mesh_get_stats(m2, &st);
+  int same = oc_mesh_vertex_count(m1) == oc_mesh_vertex_count(m2) &&
+             oc_mesh_triangle_count(m1) == oc_mesh_triangle_count(m2) &&
+             !memcmp(oc_mesh_positions(m1), oc_mesh_positions(m2),
+                     3 * sizeof(float) * oc_mesh_vertex_count(m1)) &&
+             !memcmp(oc_mesh_indices(m1), oc_mesh_indices(m2),
+                     3 * sizeof(uint32_t) * oc_mesh_triangle_count(m1));
+  printf("# 1000 spheres + ground, cell 0.25: %zu triangles, %zu field "
+         "calls; 1 thread %.2f s; 1 and 2 threads %s\n",
+         st.triangles, st.field_calls, s1, same ? "byte-identical" : "DIFFER");
+  printf("mesh.spheres1000_seconds_2t: %.2f s\n", s2);
+  printf("mesh.spheres1000_triangles: %zu triangles\n", st.triangles);
+  oc_mesh_free(m1);
+  oc_mesh_free(m2);
+  oc_program_free(p);
+  oc_node_release(b);
+  if (!same) exit(1);
+}
+
+int main(void) {
+  printf("# targets: mesh.bounds_speedup >= 8, mesh.band_seconds_2t <= 10, "
+         "mesh.spheres1000_seconds_2t <= 1.0\n");
+  terrain_speedup();
+  double peak = child_peak_mb(band_run);
+  printf("mesh.peak_mb: %.0f MB\n", peak);
+  spheres1000();
+  return 0;
+}
