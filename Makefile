@@ -159,7 +159,9 @@ $(B)/bench/%: scripts/bench/%.c $(LIBA)
 
 # The peer comparison (OpenVDB's volumeToMesh) is optional: it is built only
 # when libopenvdb-dev is installed (`make bench-peer-deps` installs it).
-HAVE_VDB := $(shell dpkg-query -W -f='$${Status}' libopenvdb-dev 2>/dev/null | grep -q 'install ok installed' && echo 1)
+# (libopenvdb-dev needs Boost's headers but does not depend on them.)
+VDB_PKGS := libopenvdb-dev libboost-dev
+HAVE_VDB := $(shell for p in $(VDB_PKGS); do dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'install ok installed' || exit 1; done && echo 1)
 PEER_SRC := $(if $(HAVE_VDB),$(wildcard scripts/bench/peer_*.cpp))
 PEER_BIN := $(PEER_SRC:scripts/bench/%.cpp=$(B)/bench/%)
 
@@ -168,7 +170,7 @@ $(B)/bench/peer_%: scripts/bench/peer_%.cpp $(LIBA)
 	$(CXX) $(CXXFLAGS) -o $@ $< $(LIBA) -lopenvdb -ltbb $(OIIO_LIBS) $(LDLIBS)
 
 bench-peer-deps:
-	@$(MAKE) --no-print-directory deps PKGS=libopenvdb-dev
+	@$(MAKE) --no-print-directory deps PKGS="$(VDB_PKGS)"
 
 bench: deps
 	@$(MAKE) --no-print-directory all $(BENCH_BIN) $(PEER_BIN)

@@ -72,3 +72,20 @@ for _, o in ipairs(outputs) do
   assert(img:write(o[1]))
   print("demo: wrote " .. o[1])
 end
+
+-- The arch as a mesh, for Blender, Godot, MeshLab or three.js: rock
+-- coloured by height through a palette.
+local mesh = oc.polygonize(scene, {box = {-80, -45, -30, 80, 45, 60},
+                                   cell = oc.param("cell", 0.75)})
+-- 1 at the bottom of the box, falling to 0 at its top
+local height = oc.plane{origin = {0, 0, -30}, normal = {0, 0, 1}, falloff = 90}
+local colors = {field = height, palette = {{0.0, {0.55, 0.45, 0.35}},
+                                           {0.6, {0.70, 0.58, 0.42}},
+                                           {1.0, {0.45, 0.40, 0.36}}}}
+for _, name in ipairs{"arch.ply", "arch.glb"} do
+  assert(mesh:write(name, {colors = colors}))
+  print("demo: wrote " .. name)
+end
+local ms = mesh:stats()
+print(string.format("demo: mesh of %d vertices, %d triangles in %.2f s",
+                    ms.vertices, ms.triangles, ms.seconds))

@@ -22,10 +22,12 @@
 */
 #include <signal.h>
 #include <stddef.h>
+#include <stdint.h>
 
 #include <lauxlib.h>
 #include <lualib.h>
 
+#include "../bindings/lua/oclua.h"
 #include "ocrt.h"
 
 /* registry key of the status requested by ocrt_stop_request */
@@ -60,6 +62,9 @@ void ocrt_stop_arm(lua_State *L) {
   interrupted = stopping = 0;
   current = NULL;
   running = L;
+  /* long C work in the module polls the flag (see oclua.h) */
+  lua_pushlightuserdata(L, (void *)(uintptr_t)&interrupted);
+  lua_setfield(L, LUA_REGISTRYINDEX, OCLUA_INTERRUPT);
   /* a SIGINT ignored at startup (a background job of a script, nohup)
   ** stays ignored, as for any well-behaved Unix program */
   if (sigaction(SIGINT, NULL, &old) == 0 && old.sa_handler == SIG_IGN) return;

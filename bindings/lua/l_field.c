@@ -54,8 +54,12 @@ double oclua_threshold(lua_State *L, const char *fname) {
 }
 
 const oc_program *oclua_program(lua_State *L, int idx, const char *fname) {
+  return oclua_program_at(L, idx, fname, oclua_threshold(L, fname));
+}
+
+const oc_program *oclua_program_at(lua_State *L, int idx, const char *fname,
+                                   double t) {
   oclua_node *u = luaL_checkudata(L, idx, OCLUA_NODE);
-  double t = oclua_threshold(L, fname);
   oc_compile_options opts = {t, 0};
   oc_error err = {OC_OK, ""};
   if (u->node == NULL) oclua_error(L, fname, "the node was collected");

@@ -38,6 +38,10 @@ oc_node *oclua_checknode(lua_State *L, int idx, const char *fname,
 double oclua_threshold(lua_State *L, const char *fname);
 /* The node at idx compiled with the current threshold (cached). */
 const oc_program *oclua_program(lua_State *L, int idx, const char *fname);
+/* The same with threshold t (t > 0); the cache then holds that program
+** until a query with another threshold replaces it. */
+const oc_program *oclua_program_at(lua_State *L, int idx, const char *fname,
+                                   double t);
 
 /* Each adds its functions to the module table at the stack top. */
 void oclua_open_field(lua_State *L);

@@ -151,7 +151,10 @@ static int l_slice(lua_State *L) {
   double box[4], size[2] = {DEFAULT_SLICE_SIZE, DEFAULT_SLICE_SIZE};
   oclua_checkargs(L, 2, fname, "(node, {plane =, at =, box =, size =})");
   oclua_checknode(L, 1, fname, "argument #1");
-  if (lua_isnoneornil(L, 2)) lua_newtable(L);
+  if (lua_isnoneornil(L, 2)) { /* no options: an empty table at index 2 */
+    lua_settop(L, 1);
+    lua_newtable(L);
+  }
   oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
   int plane = oclua_field_optoption(&f, "plane", planes, 1);
   sp.plane = plane == 0 ? OC_PLANE_XY : plane == 1 ? OC_PLANE_XZ : OC_PLANE_YZ;

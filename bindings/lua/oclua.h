@@ -22,6 +22,11 @@ int luaopen_outcrop(lua_State *L);
 /* integer: the scene seed (--seed), default 1; also outcrop.seed */
 #define OCLUA_SEED "outcrop.seed"
 
+/* light userdata: address of a `volatile sig_atomic_t` the interpreter sets
+** to non-zero on Ctrl-C; long work polls it through its progress callback
+** and stops (OC_ECANCEL), after which the binding raises "interrupted" */
+#define OCLUA_INTERRUPT "outcrop.interrupt"
+
 /* Resolves an output path given by a script: a relative path is joined to
 ** OCLUA_OUTDIR (when set); in sandbox mode a path that would land outside
 ** OCLUA_OUTDIR (absolute elsewhere, or escaping with "..", or through a

@@ -14,6 +14,7 @@
 
 #include "l_field.h"
 #include "l_image.h"
+#include "l_mesh.h"
 
 /* outcrop.param(name, default): the --set value for name, as a number
 ** when it reads as one ("3", "1e-2", "0x10"), a boolean for "true" and
@@ -77,6 +78,7 @@ int luaopen_outcrop(lua_State *L) {
   oclua_open_prim(L);
   oclua_open_ops(L);
   oclua_open_image(L);
+  oclua_open_mesh(L);
   lua_pushliteral(L, OC_VERSION);
   lua_setfield(L, -2, "version");
   lua_pushnumber(L, OC_DEFAULT_THRESHOLD);

@@ -1,19 +1,17 @@
 /*
 ** image_write.c — oc_image_write: the format from the extension, samples
-** converted to what the format stores, and an atomic write (temporary
-** name in the same folder, then rename) so that no reader ever sees a
-** partial file under the final name.
+** converted to what the format stores, and an atomic write (io/atomic.h:
+** temporary name in the same folder, then rename) so that no reader ever
+** sees a partial file under the final name.
 */
-#include <errno.h>
-#include <fcntl.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <unistd.h>
 
 #include "core/error.h"
+#include "io/atomic.h"
 #include "io/oiio.h"
 #include "outcrop.h"
 
@@ -108,50 +106,6 @@ static const void *samples(const oc_image *img, int nch, oc_oiio_type t,
   return buf;
 }
 
-/* Creates an empty temporary file next to `path`, named
-** ".<base>.tmp-<pid>-<n><ext>": hidden, unique among processes (pid) and
-** threads (O_EXCL, trying the next n), and ending in the real extension.
-** Returns the malloc'ed name, or NULL with errno set. */
-static char *make_temp(const char *path, const char *ext) {
-  const char *slash = strrchr(path, '/');
-  int dirlen = slash ? (int)(slash - path + 1) : 0;
-  const char *base = path + dirlen;
-  size_t size = strlen(path) + strlen(ext) + 64;
-  char *tmp = malloc(size);
-  if (!tmp) {
-    errno = ENOMEM;
-    return NULL;
-  }
-  for (unsigned n = 0; n < 1000; n++) {
-    snprintf(tmp, size, "%.*s.%s.tmp-%ld-%u%s", dirlen, path, base,
-             (long)getpid(), n, ext);
-    int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd >= 0) {
-      close(fd);
-      return tmp;
-    }
-    if (errno != EEXIST) break;
-  }
-  int e = errno;
-  free(tmp);
-  errno = e;
-  return NULL;
-}
-
-/* Flushes the data to disk before the rename, so that after a crash the
-** final name holds either the old file or the whole new one. */
-static int sync_file(const char *name) {
-  int fd = open(name, O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return -1;
-  int rc = fsync(fd);
-  int e = errno;
-  /* Some file systems (pipes, special mounts) cannot sync: not an error. */
-  if (rc != 0 && (e == EINVAL || e == ENOTSUP)) rc = 0;
-  close(fd);
-  errno = e;
-  return rc;
-}
-
 static int check_names(const oc_image *img, oc_error *err) {
   int n = oc_image_channels(img);
   for (int a = 0; a < n; a++)
@@ -216,18 +170,18 @@ int oc_image_write(const oc_image *img, const char *path, int bits,
       .nmeta = nmeta,
   };
 
-  int rc = OC_OK;
   char why[OC_ERRMSG] = "";
-  char *tmp = make_temp(path, ext);
-  if (!tmp) {
-    rc = oc_seterr(err, OC_EIO, "cannot write '%s': %s", path, strerror(errno));
-  } else if (oc_oiio_write(tmp, &out, why, sizeof why) != OC_OK) {
-    rc = oc_seterr(err, OC_EIO, "cannot write '%s': %s", path, why);
-  } else if (sync_file(tmp) != 0 || rename(tmp, path) != 0) {
-    rc = oc_seterr(err, OC_EIO, "cannot write '%s': %s", path, strerror(errno));
+  oc_atomic a;
+  int rc = oc_atomic_begin(&a, path, err);
+  if (rc == OC_OK) {
+    /* The bridge writes by name; the atomic helper syncs and renames. */
+    if (oc_oiio_write(a.tmp, &out, why, sizeof why) != OC_OK) {
+      oc_atomic_abort(&a);
+      rc = oc_seterr(err, OC_EIO, "cannot write '%s': %s", path, why);
+    } else {
+      rc = oc_atomic_commit(&a, err);
+    }
   }
-  if (tmp && rc != OC_OK) unlink(tmp);
-  free(tmp);
   free(owned);
   free(meta);
   return rc;

@@ -48,6 +48,8 @@ describe("outcrop.slice", function()
     local w, h = img:size()
     assert.are.equal(256, w)
     assert.are.equal(256, h)
+    -- an explicit nil is the same as no options
+    assert.are.equal(256, (oc.slice(p, nil):size()))
     local x0, _, z0, x1, _, z1 = p:bounds()
     local i, j = 100, 40
     local u = x0 + (i - 0.5) * (x1 - x0) / 256

@@ -1,0 +1,533 @@
+/*
+** l_mesh.c — outcrop.polygonize and the mesh userdata (write, stats,
+** counts, vertex, triangle).
+**
+** polygonize defaults: box = the node's bounds (an error when they are
+** infinite or empty); when neither 'cell' nor 'resolution' is given,
+** cubic cells of 1/64 of the box's longest side; threshold =
+** outcrop.threshold; open = false; steps = 6; full_grid = false. The node
+** is compiled with the threshold it is meshed at, since difference and
+** the smooth operators depend on T.
+**
+** Colours are a property of the mesh: `colors =` in polygonize's table or
+** in write's options stores them, and every later write carries them
+** (.ply and .glb; .obj has no colours). Either
+**   {field = node, palette = {{value, {r, g, b}}, ...}}
+** (the node evaluated at each vertex with outcrop.threshold, mapped
+** through the palette: values ascending, linear between stops, clamped
+** at the ends) or a function (x, y, z, nx, ny, nz) -> r, g, b called
+** once per vertex in index order. Components are in [0, 1].
+*/
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "l_field.h"
+#include "l_mesh.h"
+
+#define DEFAULT_RESOLUTION 64 /* cells along the longest side */
+#define MAX_CELLS (1 << 20)   /* per axis, as the lib allows */
+#define DEFAULT_STEPS 6
+#define MAX_STEPS 64
+#define MAX_STOPS 65536
+/* A progress line appears only for work that lasts, so quick meshes do
+** not flicker on the terminal. */
+#define PROGRESS_DELAY 0.5
+
+static oclua_mesh *newmesh(lua_State *L) {
+  oclua_mesh *u = lua_newuserdatauv(L, sizeof *u, 0);
+  u->mesh = NULL;
+  luaL_setmetatable(L, OCLUA_MESH);
+  return u;
+}
+
+static oclua_mesh *checkmesh(lua_State *L, const char *fname) {
+  oclua_mesh *u = luaL_checkudata(L, 1, OCLUA_MESH);
+  if (u->mesh == NULL) oclua_error(L, fname, "the mesh is closed");
+  return u;
+}
+
+/* ---- colours --------------------------------------------------------- */
+
+enum { COLORS_NONE, COLORS_FUNCTION, COLORS_FIELD };
+
+/* What a `colors` field asked for. Everything it points to stays on the
+** Lua stack (the function or node at `idx`, the stops in a userdata)
+** until the colours are applied. */
+typedef struct colors {
+  int kind;
+  int idx;
+  const double *stops; /* value, r, g, b per stop */
+  int nstops;
+} colors;
+
+static const char *const rgb_names[3] = {"r", "g", "b"};
+
+static void read_palette(const oclua_fields *cf, colors *c) {
+  lua_State *L = cf->L;
+  const char *what = "must be an array of {value, {r, g, b}}";
+  double *stops;
+  lua_Integer n;
+  int pal;
+  if (oclua_field_push(cf, "palette") == LUA_TNIL)
+    oclua_field_missing(cf, "palette", "an array of {value, {r, g, b}}");
+  pal = lua_gettop(L);
+  n = lua_istable(L, pal) ? (lua_Integer)lua_rawlen(L, pal) : 0;
+  if (n < 1) oclua_field_error(cf, "palette", pal, what);
+  if (n > MAX_STOPS)
+    oclua_error(L, cf->fname, "'colors.palette' has %I stops (at most %d)",
+                (LUAI_UACINT)n, MAX_STOPS);
+  stops = lua_newuserdatauv(L, (size_t)n * 4 * sizeof *stops, 0);
+  for (lua_Integer k = 1; k <= n; k++) {
+    double *s = stops + 4 * (k - 1);
+    lua_geti(L, pal, k);
+    if (!lua_istable(L, -1) || lua_rawlen(L, -1) != 2)
+      oclua_error(L, cf->fname,
+                  "'colors.palette[%I]' must be {value, {r, g, b}} (got %s)",
+                  (LUAI_UACINT)k, oclua_got(L, -1));
+    if (lua_geti(L, -1, 1) != LUA_TNUMBER || !isfinite(lua_tonumber(L, -1)))
+      oclua_error(L, cf->fname,
+                  "'colors.palette[%I]' value must be a finite number "
+                  "(got %s)",
+                  (LUAI_UACINT)k, oclua_got(L, -1));
+    s[0] = lua_tonumber(L, -1);
+    lua_pop(L, 1);
+    if (k > 1 && s[0] < s[-4])
+      oclua_error(L, cf->fname,
+                  "'colors.palette' values must be in ascending order "
+                  "(item %I: %f after %f)",
+                  (LUAI_UACINT)k, (LUAI_UACNUMBER)s[0], (LUAI_UACNUMBER)s[-4]);
+    if (lua_geti(L, -1, 2) != LUA_TTABLE || lua_rawlen(L, -1) != 3)
+      oclua_error(L, cf->fname,
+                  "'colors.palette[%I]' colour must be {r, g, b} (got %s)",
+                  (LUAI_UACINT)k, oclua_got(L, -1));
+    for (int j = 0; j < 3; j++) {
+      double x;
+      int t = lua_geti(L, -1, j + 1);
+      x = lua_tonumber(L, -1);
+      if (t != LUA_TNUMBER || !(x >= 0 && x <= 1))
+        oclua_error(L, cf->fname,
+                    "'colors.palette[%I]' colour components must be in "
+                    "[0, 1] (got %s = %s)",
+                    (LUAI_UACINT)k, rgb_names[j], oclua_got(L, -1));
+      s[1 + j] = x;
+      lua_pop(L, 1);
+    }
+    lua_pop(L, 2);
+  }
+  c->stops = stops;
+  c->nstops = (int)n;
+}
+
+/* Reads the optional `colors` field of f, leaving what it needs on the
+** stack. */
+static void read_colors(const oclua_fields *f, colors *c) {
+  static const char *const known[] = {"field", "palette", NULL};
+  lua_State *L = f->L;
+  oclua_fields cf;
+  int t = oclua_field_push(f, "colors");
+  c->kind = COLORS_NONE;
+  if (t == LUA_TNIL) {
+    lua_pop(L, 1);
+    return;
+  }
+  if (t == LUA_TFUNCTION) {
+    c->kind = COLORS_FUNCTION;
+    c->idx = lua_gettop(L);
+    return;
+  }
+  if (t != LUA_TTABLE)
+    oclua_field_error(f, "colors", -1,
+                      "must be a function or a table {field =, palette =}");
+  oclua_fields_open(&cf, L, -1, f->fname, "colors.", known, 0);
+  if (oclua_field_push(&cf, "field") == LUA_TNIL)
+    oclua_field_missing(&cf, "field", "an outcrop node");
+  if (oclua_testnode(L, -1) == NULL)
+    oclua_field_error(&cf, "field", -1, "must be an outcrop node");
+  c->kind = COLORS_FIELD;
+  c->idx = lua_gettop(L);
+  read_palette(&cf, c);
+}
+
+/* Calls the function at fn for every vertex. The function may do
+** anything, closing this very mesh included, so the mesh is looked up
+** again after each call; the colours gather in a Lua-owned buffer, so an
+** error raised in the function leaks nothing. */
+static void color_by_function(lua_State *L, oclua_mesh *u, int fn,
+                              const char *fname) {
+  oc_error err = {OC_OK, ""};
+  size_t nv = oc_mesh_vertex_count(u->mesh);
+  float *rgb;
+  if (nv > ((size_t)-1) / (3 * sizeof *rgb) - 1)
+    oclua_error(L, fname, "too many vertices to colour (%I)", (LUAI_UACINT)nv);
+  rgb = lua_newuserdatauv(L, (nv ? nv : 1) * 3 * sizeof *rgb, 0);
+  luaL_checkstack(L, 8, NULL);
+  for (size_t i = 0; i < nv; i++) {
+    const float *p, *n;
+    if (u->mesh == NULL) break;
+    p = oc_mesh_positions(u->mesh) + 3 * i;
+    n = oc_mesh_normals(u->mesh) + 3 * i;
+    lua_pushvalue(L, fn);
+    for (int k = 0; k < 3; k++)
+      lua_pushnumber(L, p[k]);
+    for (int k = 0; k < 3; k++)
+      lua_pushnumber(L, n[k]);
+    lua_call(L, 6, 3);
+    for (int k = 0; k < 3; k++) {
+      int idx = k - 3;
+      double x = lua_tonumber(L, idx);
+      if (lua_type(L, idx) != LUA_TNUMBER || !(x >= 0 && x <= 1))
+        oclua_error(L, fname,
+                    "the colors function must return r, g, b in [0, 1] "
+                    "(got %s = %s at vertex %I)",
+                    rgb_names[k], oclua_got(L, idx), (LUAI_UACINT)(i + 1));
+      rgb[3 * i + (size_t)k] = (float)x;
+    }
+    lua_pop(L, 3);
+  }
+  if (u->mesh == NULL)
+    oclua_error(L, fname, "the mesh was closed by the colors function");
+  if (oc_mesh_set_colors(u->mesh, rgb, &err) != OC_OK)
+    oclua_liberror(L, fname, &err);
+  lua_pop(L, 1);
+}
+
+static void apply_colors(lua_State *L, oclua_mesh *u, const colors *c,
+                         const char *fname) {
+  oc_error err = {OC_OK, ""};
+  if (c->kind == COLORS_FUNCTION) {
+    color_by_function(L, u, c->idx, fname);
+  } else if (c->kind == COLORS_FIELD) {
+    const oc_program *prog = oclua_program(L, c->idx, fname);
+    if (oc_mesh_color_by_field(u->mesh, prog, c->stops, c->nstops, &err) !=
+        OC_OK)
+      oclua_liberror(L, fname, &err);
+  }
+}
+
+/* ---- methods --------------------------------------------------------- */
+
+static int mesh_write(lua_State *L) {
+  static const char *const known[] = {"colors", NULL};
+  const char *fname = "mesh:write";
+  oclua_mesh *u = checkmesh(L, fname);
+  oc_error err = {OC_OK, ""};
+  colors c = {COLORS_NONE, 0, NULL, 0};
+  const char *path;
+  if (lua_type(L, 2) != LUA_TSTRING)
+    oclua_error(L, fname, "the path must be a string (got %s)",
+                oclua_got(L, 2));
+  oclua_checkargs(L, 3, fname, "(path [, {colors = ...}])");
+  lua_settop(L, 3);
+  if (!lua_isnil(L, 3)) {
+    oclua_fields f;
+    oclua_fields_open(&f, L, 3, fname, NULL, known, 0);
+    read_colors(&f, &c);
+  }
+  path = oclua_output_path(L, fname, lua_tostring(L, 2));
+  apply_colors(L, u, &c, fname);
+  if (oc_mesh_write(u->mesh, path, &err) != OC_OK) {
+    /* A file that cannot be written is an expected failure, as io.open. */
+    if (err.code == OC_EIO) {
+      luaL_pushfail(L);
+      lua_pushstring(L, err.msg[0] ? err.msg : "cannot write the mesh");
+      return 2;
+    }
+    oclua_liberror(L, fname, &err);
+  }
+  lua_pushboolean(L, 1);
+  return 1;
+}
+
+static int mesh_stats(lua_State *L) {
+  oc_mesh_stats st;
+  oclua_checkargs(L, 1, "mesh:stats", "()");
+  oc_mesh_get_stats(checkmesh(L, "mesh:stats")->mesh, &st);
+  lua_createtable(L, 0, 5);
+  lua_pushinteger(L, (lua_Integer)st.vertices);
+  lua_setfield(L, -2, "vertices");
+  lua_pushinteger(L, (lua_Integer)st.triangles);
+  lua_setfield(L, -2, "triangles");
+  lua_pushinteger(L, (lua_Integer)st.field_calls);
+  lua_setfield(L, -2, "field_calls");
+  lua_pushinteger(L, (lua_Integer)st.cells_visited);
+  lua_setfield(L, -2, "cells_visited");
+  lua_pushnumber(L, st.seconds);
+  lua_setfield(L, -2, "seconds");
+  return 1;
+}
+
+static int mesh_counts(lua_State *L) {
+  const oc_mesh *m;
+  oclua_checkargs(L, 1, "mesh:counts", "()");
+  m = checkmesh(L, "mesh:counts")->mesh;
+  lua_pushinteger(L, (lua_Integer)oc_mesh_vertex_count(m));
+  lua_pushinteger(L, (lua_Integer)oc_mesh_triangle_count(m));
+  return 2;
+}
+
+/* The 1-based index at argument 2, checked against 1..n; `what` names
+** the item, `whats` its plural. */
+static size_t checkindex(lua_State *L, const char *fname, const char *what,
+                         const char *whats, size_t n) {
+  int isint;
+  lua_Integer i = lua_tointegerx(L, 2, &isint);
+  oclua_checkargs(L, 2, fname, "(i)");
+  if (n == 0)
+    oclua_error(L, fname, "the mesh has no %s (got %s)", whats,
+                oclua_got(L, 2));
+  if (lua_type(L, 2) != LUA_TNUMBER || !isint || i < 1 ||
+      (lua_Unsigned)i > (lua_Unsigned)n)
+    oclua_error(L, fname, "the %s index must be an integer in 1..%I (got %s)",
+                what, (LUAI_UACINT)n, oclua_got(L, 2));
+  return (size_t)(i - 1);
+}
+
+static int mesh_vertex(lua_State *L) {
+  const char *fname = "mesh:vertex";
+  const oc_mesh *m = checkmesh(L, fname)->mesh;
+  size_t i =
+      checkindex(L, fname, "vertex", "vertices", oc_mesh_vertex_count(m));
+  const float *p = oc_mesh_positions(m) + 3 * i;
+  const float *n = oc_mesh_normals(m) + 3 * i;
+  for (int k = 0; k < 3; k++)
+    lua_pushnumber(L, p[k]);
+  for (int k = 0; k < 3; k++)
+    lua_pushnumber(L, n[k]);
+  return 6;
+}
+
+static int mesh_triangle(lua_State *L) {
+  const char *fname = "mesh:triangle";
+  const oc_mesh *m = checkmesh(L, fname)->mesh;
+  size_t i =
+      checkindex(L, fname, "triangle", "triangles", oc_mesh_triangle_count(m));
+  const uint32_t *t = oc_mesh_indices(m) + 3 * i;
+  for (int k = 0; k < 3; k++)
+    lua_pushinteger(L, (lua_Integer)t[k] + 1);
+  return 3;
+}
+
+static int mesh_gc(lua_State *L) {
+  oclua_mesh *u = luaL_checkudata(L, 1, OCLUA_MESH);
+  if (u->mesh) oc_mesh_free(u->mesh);
+  u->mesh = NULL;
+  return 0;
+}
+
+static int mesh_tostring(lua_State *L) {
+  oclua_mesh *u = luaL_checkudata(L, 1, OCLUA_MESH);
+  if (u->mesh == NULL)
+    lua_pushliteral(L, OCLUA_MESH ": (closed)");
+  else
+    lua_pushfstring(L, OCLUA_MESH ": %I vertices, %I triangles",
+                    (LUAI_UACINT)oc_mesh_vertex_count(u->mesh),
+                    (LUAI_UACINT)oc_mesh_triangle_count(u->mesh));
+  return 1;
+}
+
+/* ---- progress -------------------------------------------------------- */
+
+typedef struct progress_line {
+  const char *fname;
+  struct timespec start;
+  int shown; /* percentage on the line, or -1 while nothing is shown */
+  int tty;   /* stderr is a terminal: draw the line */
+  volatile sig_atomic_t *stop; /* the interpreter's Ctrl-C flag, or NULL */
+} progress_line;
+
+static double seconds_since(const struct timespec *t0) {
+  struct timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return (double)(t.tv_sec - t0->tv_sec) +
+         1e-9 * (double)(t.tv_nsec - t0->tv_nsec);
+}
+
+/* Called by the lib from one thread, not necessarily the Lua state's, so
+** it touches nothing but the line and the Ctrl-C flag, which cancels. */
+static int show_progress(void *ud, double fraction) {
+  progress_line *pl = ud;
+  if (pl->stop && *pl->stop) return 1;
+  if (!pl->tty) return 0;
+  int pct = fraction > 0 ? (fraction < 1 ? (int)(fraction * 100) : 100) : 0;
+  if (pct != pl->shown && seconds_since(&pl->start) >= PROGRESS_DELAY) {
+    fprintf(stderr, "\r%s: %3d %%", pl->fname, pct);
+    fflush(stderr);
+    pl->shown = pct;
+  }
+  return 0;
+}
+
+static void clear_progress(const progress_line *pl) {
+  if (pl->shown < 0) return;
+  fprintf(stderr, "\r%*s\r", (int)strlen(pl->fname) + 8, "");
+  fflush(stderr);
+}
+
+/* ---- outcrop.polygonize ---------------------------------------------- */
+
+/* Reads an array of exactly n finite numbers. Returns 0 when absent. */
+static int field_numbers(const oclua_fields *f, const char *name, int n,
+                         double *out, const char *what) {
+  lua_State *L = f->L;
+  if (oclua_field_push(f, name) == LUA_TNIL) {
+    lua_pop(L, 1);
+    return 0;
+  }
+  if (!lua_istable(L, -1) || lua_rawlen(L, -1) != (size_t)n)
+    oclua_field_error(f, name, -1, what);
+  for (int i = 0; i < n; i++) {
+    if (lua_geti(L, -1, i + 1) != LUA_TNUMBER || !isfinite(lua_tonumber(L, -1)))
+      oclua_error(L, f->fname, "'%s' %s (item %d is %s)", name, what, i + 1,
+                  oclua_got(L, -1));
+    out[i] = lua_tonumber(L, -1);
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+  return 1;
+}
+
+static int field_resolution(const oclua_fields *f, int res[3]) {
+  lua_State *L = f->L;
+  double r[3];
+  const char *what = lua_pushfstring(
+      L, "must be {nx, ny, nz} with integers in 1..%d", MAX_CELLS);
+  int given = field_numbers(f, "resolution", 3, r, what);
+  for (int k = 0; given && k < 3; k++) {
+    if (r[k] != floor(r[k]) || r[k] < 1 || r[k] > MAX_CELLS) {
+      if (r[k] == floor(r[k]) && fabs(r[k]) < 1e18)
+        lua_pushinteger(L, (lua_Integer)r[k]);
+      else
+        lua_pushnumber(L, r[k]);
+      oclua_error(L, f->fname, "'resolution' %s (item %d is %s)", what, k + 1,
+                  oclua_got(L, -1));
+    }
+    res[k] = (int)r[k];
+  }
+  lua_pop(L, 1);
+  return given;
+}
+
+static int l_polygonize(lua_State *L) {
+  static const char *const known[] = {"box",       "cell",   "resolution",
+                                      "threshold", "open",   "steps",
+                                      "full_grid", "colors", NULL};
+  const char *fname = "outcrop.polygonize";
+  oclua_fields f;
+  oc_error err = {OC_OK, ""};
+  oc_polygonize_params pp;
+  progress_line pl = {fname, {0, 0}, -1, 0, NULL};
+  colors c;
+  double box[6], cell, t;
+  int res[3] = {0, 0, 0}, hasbox, hasres, open, steps, full_grid;
+  oclua_checkargs(L, 2, fname,
+                  "(node, {box =, cell = or resolution =, threshold =, "
+                  "open =, steps =, full_grid =, colors =})");
+  oclua_checknode(L, 1, fname, "argument #1");
+  lua_settop(L, 2);
+  if (lua_isnil(L, 2)) {
+    lua_newtable(L);
+    lua_replace(L, 2);
+  }
+  oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
+  hasbox = field_numbers(&f, "box", 6, box, "must be {x0, y0, z0, x1, y1, z1}");
+  cell = oclua_field_optnumber(&f, "cell", OCLUA_POSITIVE, 0);
+  hasres = field_resolution(&f, res);
+  if (cell > 0 && hasres)
+    oclua_error(L, fname, "give either 'cell' or 'resolution', not both");
+  t = oclua_field_optnumber(&f, "threshold", OCLUA_POSITIVE, 0);
+  if (t == 0) t = oclua_threshold(L, fname);
+  open = oclua_field_optbool(&f, "open", 0);
+  steps = (int)oclua_field_optint(&f, "steps", 1, MAX_STEPS, DEFAULT_STEPS);
+  full_grid = oclua_field_optbool(&f, "full_grid", 0);
+  read_colors(&f, &c);
+
+  const oc_program *prog = oclua_program_at(L, 1, fname, t);
+  if (!hasbox) {
+    oc_aabb b = oc_program_bounds(prog);
+    box[0] = b.lo.x, box[1] = b.lo.y, box[2] = b.lo.z;
+    box[3] = b.hi.x, box[4] = b.hi.y, box[5] = b.hi.z;
+    for (int k = 0; k < 3; k++)
+      if (box[k] > box[k + 3])
+        oclua_error(L, fname,
+                    "the node's bounds are empty (its field is 0 "
+                    "everywhere): give 'box' = {x0, y0, z0, x1, y1, z1}");
+    for (int k = 0; k < 6; k++)
+      if (!isfinite(box[k]))
+        oclua_error(L, fname,
+                    "the node's bounds are infinite: give 'box' = "
+                    "{x0, y0, z0, x1, y1, z1}");
+  }
+  for (int k = 0; k < 3; k++)
+    if (!(box[k] < box[k + 3]))
+      oclua_error(L, fname,
+                  "'box' = {x0, y0, z0, x1, y1, z1} needs x0 < x1, y0 < y1 "
+                  "and z0 < z1 (got {%f, %f, %f, %f, %f, %f})%s",
+                  box[0], box[1], box[2], box[3], box[4], box[5],
+                  hasbox ? "" : " (from the node's bounds)");
+  /* A cell too small for the box is the lib's to refuse: it knows its
+  ** grid limits. */
+  if (!hasres && cell == 0) {
+    double longest = 0;
+    for (int k = 0; k < 3; k++)
+      longest = fmax(longest, box[k + 3] - box[k]);
+    cell = longest / DEFAULT_RESOLUTION;
+  }
+
+  memset(&pp, 0, sizeof pp);
+  pp.box = (oc_aabb){{box[0], box[1], box[2]}, {box[3], box[4], box[5]}};
+  pp.cell = hasres ? 0 : cell;
+  pp.nx = res[0], pp.ny = res[1], pp.nz = res[2];
+  pp.threshold = t;
+  pp.open = open;
+  pp.steps = steps;
+  pp.full_grid = full_grid;
+  pl.tty = isatty(2);
+  if (lua_getfield(L, LUA_REGISTRYINDEX, OCLUA_INTERRUPT) ==
+      LUA_TLIGHTUSERDATA)
+    pl.stop = (volatile sig_atomic_t *)lua_touserdata(L, -1);
+  lua_pop(L, 1);
+  if (pl.tty || pl.stop) {
+    clock_gettime(CLOCK_MONOTONIC, &pl.start);
+    pp.progress.fn = show_progress;
+    pp.progress.ud = &pl;
+  }
+  /* The userdata first, so that nothing can leak once the mesh exists. */
+  oclua_mesh *u = newmesh(L);
+  int midx = lua_gettop(L);
+  u->mesh = oc_polygonize(prog, &pp, &err);
+  clear_progress(&pl);
+  if (u->mesh == NULL && err.code == OC_ECANCEL)
+    return luaL_error(L, "interrupted");
+  if (u->mesh == NULL) oclua_liberror(L, fname, &err);
+  apply_colors(L, u, &c, fname);
+  lua_pushvalue(L, midx);
+  return 1;
+}
+
+static const luaL_Reg mesh_methods[] = {
+    {"write", mesh_write},       {"stats", mesh_stats},
+    {"counts", mesh_counts},     {"vertex", mesh_vertex},
+    {"triangle", mesh_triangle}, {NULL, NULL}};
+
+static const luaL_Reg mesh_meta[] = {
+    {"__gc", mesh_gc},
+    {"__close", mesh_gc}, /* `local m <close>` frees the mesh early */
+    {"__tostring", mesh_tostring},
+    {"__index", NULL},
+    {NULL, NULL}};
+
+static const luaL_Reg mesh_funcs[] = {{"polygonize", l_polygonize},
+                                      {NULL, NULL}};
+
+void oclua_open_mesh(lua_State *L) {
+  luaL_newmetatable(L, OCLUA_MESH);
+  luaL_setfuncs(L, mesh_meta, 0);
+  luaL_newlib(L, mesh_methods);
+  lua_setfield(L, -2, "__index");
+  lua_pop(L, 1);
+  luaL_setfuncs(L, mesh_funcs, 0);
+}

@@ -1,0 +1,191 @@
+/*
+** mcband.c — the surface band of a slab: which cubes to visit.
+**
+** 1. Every cube column asks the program for the z-spans where the field
+**    may vary over its footprint grown by one cube (the 1-ring of seed 000
+**    section 7); the cubes meeting a span, grown by one cube in z, are
+**    visited, plus the cap cubes against the bottom and top padding, plus
+**    whole columns along the box's sides (caps). The spans also tell,
+**    per column, which samples lie in gaps, where the field is constant.
+** 2. The band is cut into blocks of OC_MC_BLOCK^3 cubes; a block whose
+**    samples all lie on one side of T, by the field at the centre of their
+**    box and the Lipschitz bound inside it, is dropped.
+*/
+#include <math.h>
+#include <string.h>
+
+#include "mesh/mcwork.h"
+
+#define MAXSPANS 16
+#define B OC_MC_BLOCK
+
+static int32_t clampi(double v, int32_t lo, int32_t hi) {
+  if (!(v >= lo)) return lo; /* NaN too */
+  if (v > hi) return hi;
+  return (int32_t)v;
+}
+
+/* ---- 1. the band ------------------------------------------------------- */
+
+/* Cube and sample k-ranges of the z-span [zl, zh]: the cubes meeting it,
+** grown by one cube (seed 000's dilation), and the samples in it, with a
+** margin far above the rounding of this arithmetic (a sample outside is
+** in a gap, where the field is exactly constant along the column). */
+static void span_ranges(const oc_mcgrid *g, double zl, double zh,
+                        oc_mc_irange *c, oc_mc_irange *s) {
+  int nz = g->n[2];
+  double a = (zl - g->lo[2]) / g->h[2], b = (zh - g->lo[2]) / g->h[2];
+  c->lo = clampi(ceil(a - 1.5) - 1, -1, nz - 1);
+  c->hi = clampi(floor(b - 0.5) + 1, -1, nz - 1);
+  s->lo = clampi(ceil(a - 0.5 - 1e-6), 0, nz - 1);
+  s->hi = clampi(floor(b - 0.5 + 1e-6), 0, nz - 1);
+}
+
+/* Cube ranges (rows ja .. jb - 1) and varying sample ranges (rows ja ..
+** min(jb, ny - 1)) of every cube column i = -1 .. nx - 1. */
+int oc_mc_band(const oc_mcgrid *g, int ja, int jb, int jr, oc_mcwork *w) {
+  int nx = g->n[0], ny = g->n[1], nz = g->n[2];
+  size_t ncol = (size_t)(jr - ja + 1) * (size_t)(nx + 1);
+  if (oc_mc_rlist_columns(&w->cube, ncol) || oc_mc_rlist_columns(&w->var, ncol))
+    return -1;
+  oc_zspan sp[MAXSPANS];
+  size_t c = 0;
+  for (int j = ja; j <= jr; j++) {
+    for (int i = -1; i < nx; i++, c++) {
+      size_t fc = w->cube.n, fv = w->var.n;
+      int ns = -1;
+      if (!g->full)
+        ns = oc_program_column_spans(
+            g->prog, oc_mc_coord(g, 0, i - 1), oc_mc_coord(g, 1, j - 1),
+            oc_mc_coord(g, 0, i + 2), oc_mc_coord(g, 1, j + 2), sp, MAXSPANS);
+      int whole = ns < 0 || i == -1 || i == nx - 1 || j == -1 || j == ny - 1;
+      if (j < jb) {
+        if (whole) {
+          if (oc_mc_rlist_add(&w->cube, fc, -1, nz - 1)) return -1;
+        } else {
+          if (oc_mc_rlist_add(&w->cube, fc, -1, -1)) return -1;
+          for (int s = 0; s < ns; s++) {
+            oc_mc_irange cr, sr;
+            if (!(sp[s].lo <= sp[s].hi)) continue;
+            span_ranges(g, sp[s].lo, sp[s].hi, &cr, &sr);
+            if (oc_mc_rlist_add(&w->cube, fc, cr.lo, cr.hi)) return -1;
+          }
+          if (oc_mc_rlist_add(&w->cube, fc, nz - 1, nz - 1)) return -1;
+        }
+      }
+      if (ns < 0) {
+        if (oc_mc_rlist_add(&w->var, fv, 0, nz - 1)) return -1;
+      } else {
+        for (int s = 0; s < ns; s++) {
+          oc_mc_irange cr, sr;
+          if (!(sp[s].lo <= sp[s].hi)) continue;
+          span_ranges(g, sp[s].lo, sp[s].hi, &cr, &sr);
+          if (oc_mc_rlist_add(&w->var, fv, sr.lo, sr.hi)) return -1;
+        }
+      }
+      w->cube.at[c + 1] = w->cube.n;
+      w->var.at[c + 1] = w->var.n;
+    }
+  }
+  return 0;
+}
+
+/* ---- 2. Lipschitz culling ---------------------------------------------- */
+
+/* 1 when every sample the block's cubes use is on one side of T. Cubes
+** i0 .. i1 (per axis) use samples i0 .. i1 + 1; padding samples are
+** outside, so a block touching them may only be dropped when outside. */
+static int block_uniform(const oc_mcgrid *g, const int c0[3], const int c1[3],
+                         size_t *calls) {
+  double lo[3], hi[3], r2 = 0;
+  int pad = 0;
+  oc_vec3 ctr;
+  for (int a = 0; a < 3; a++) {
+    int s0 = c0[a], s1 = c1[a] + 1;
+    if (s0 < 0) s0 = 0, pad = 1;
+    if (s1 > g->n[a] - 1) s1 = g->n[a] - 1, pad = 1;
+    lo[a] = oc_mc_coord(g, a, s0);
+    hi[a] = oc_mc_coord(g, a, s1);
+    r2 += (hi[a] - lo[a]) * (hi[a] - lo[a]);
+  }
+  ctr.x = 0.5 * (lo[0] + hi[0]);
+  ctr.y = 0.5 * (lo[1] + hi[1]);
+  ctr.z = 0.5 * (lo[2] + hi[2]);
+  double fc = oc_program_eval(g->prog, ctr);
+  (*calls)++;
+  oc_aabb box = {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}};
+  double L = oc_program_lipschitz_in(g->prog, box);
+  /* margin for the rounding of the centre and of this product */
+  double m = L * 0.5 * sqrt(r2) * (1 + 1e-9) + 1e-12 * (fabs(g->T) + 1);
+  if (!(m < INFINITY)) return 0;
+  if (g->T - fc > m) return 1;
+  if (!pad && fc - g->T > m) return 1;
+  return 0;
+}
+
+int oc_mc_cull(const oc_mcgrid *g, int ja, int jb, oc_mcwork *w,
+               size_t *calls) {
+  int nx = g->n[0], nz = g->n[2];
+  int nbu = (nx + 1 + B - 1) / B, nbv = (jb - ja + B - 1) / B;
+  if (oc_mc_rlist_columns(&w->cull, (size_t)nbu * nbv)) return -1;
+  size_t bc = 0;
+  for (int bv = 0; bv < nbv; bv++) {
+    int j0 = ja + bv * B, j1 = j0 + B - 1 < jb - 1 ? j0 + B - 1 : jb - 1;
+    for (int bu = 0; bu < nbu; bu++, bc++) {
+      int i0 = bu * B - 1, i1 = i0 + B - 1 < nx - 1 ? i0 + B - 1 : nx - 1;
+      size_t first = w->cull.n;
+      /* union of the block column's cube ranges */
+      size_t nt = 0;
+      for (int j = j0; j <= j1; j++) {
+        size_t c = (size_t)(j - ja) * (nx + 1) + (size_t)(i0 + 1);
+        size_t a = w->cube.at[c], e = w->cube.at[c + (size_t)(i1 - i0) + 1];
+        if (oc_mc_grow(&w->tmp, &w->capt, nt + (e - a), sizeof *w->tmp))
+          return -1;
+        memcpy(w->tmp + nt, w->cube.r + a, (e - a) * sizeof *w->tmp);
+        nt += e - a;
+      }
+      oc_mc_sort_ranges(w->tmp, nt);
+      int last = -1; /* last block tested */
+      for (size_t t = 0; t < nt; t++) {
+        int k0 = (w->tmp[t].lo + 1) / B, k1 = (w->tmp[t].hi + 1) / B;
+        for (int bk = k0 > last + 1 ? k0 : last + 1; bk <= k1; bk++) {
+          int lo[3] = {i0, j0, bk * B - 1};
+          int hi[3] = {i1, j1,
+                       bk * B + B - 2 < nz - 1 ? bk * B + B - 2 : nz - 1};
+          if (block_uniform(g, lo, hi, calls) &&
+              oc_mc_rlist_add(&w->cull, first, lo[2], hi[2]))
+            return -1;
+          last = bk;
+        }
+      }
+      w->cull.at[bc + 1] = w->cull.n;
+    }
+  }
+  /* kept = cube ranges minus the culled blocks */
+  size_t ncol = (size_t)(jb - ja) * (size_t)(nx + 1);
+  if (oc_mc_rlist_columns(&w->kept, ncol)) return -1;
+  size_t c = 0;
+  for (int j = ja; j < jb; j++) {
+    for (int i = -1; i < nx; i++, c++) {
+      size_t b = (size_t)((j - ja) / B) * nbu + (size_t)((i + 1) / B);
+      const oc_mc_irange *cu = w->cull.r + w->cull.at[b];
+      size_t ncu = w->cull.at[b + 1] - w->cull.at[b], u = 0, first = w->kept.n;
+      for (size_t r = w->cube.at[c]; r < w->cube.at[c + 1]; r++) {
+        int32_t lo = w->cube.r[r].lo, hi = w->cube.r[r].hi;
+        while (lo <= hi) {
+          while (u < ncu && cu[u].hi < lo)
+            u++;
+          if (u < ncu && cu[u].lo <= lo) { /* lo is culled */
+            lo = cu[u].hi + 1;
+            continue;
+          }
+          int32_t e = u < ncu && cu[u].lo <= hi ? cu[u].lo - 1 : hi;
+          if (oc_mc_rlist_add(&w->kept, first, lo, e)) return -1;
+          lo = e + 1;
+        }
+      }
+      w->kept.at[c + 1] = w->kept.n;
+    }
+  }
+  return 0;
+}

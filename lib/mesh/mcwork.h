@@ -1,0 +1,74 @@
+/*
+** mcwork.h — the scratch state of the slab mesher and its steps
+** (internal): per-column k-ranges of the band, the sample store, and the
+** functions of each step (see mcslab.c for the whole).
+*/
+#ifndef OC_MCWORK_H
+#define OC_MCWORK_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "mesh/mcgrid.h"
+
+typedef struct oc_mc_irange {
+  int32_t lo, hi; /* inclusive */
+} oc_mc_irange;
+
+typedef struct oc_mc_srange {
+  int32_t lo, hi; /* samples lo .. hi of the column */
+  ptrdiff_t off;  /* sample k is at val[off + k] */
+} oc_mc_srange;
+
+/* A list of ranges per column, in compressed row form. */
+typedef struct oc_mc_rlist {
+  oc_mc_irange *r;
+  size_t n, cap;
+  size_t *at; /* column c has r[at[c] .. at[c + 1]) */
+  size_t capat;
+} oc_mc_rlist;
+
+struct oc_mcwork {
+  /* cube ranges before and after culling, varying sample ranges (from
+  ** the spans), culled k-ranges per block column */
+  oc_mc_rlist cube, kept, var, cull;
+  oc_mc_srange *sr;
+  size_t nsr, capsr;
+  size_t *srat, capsrat;
+  double *val;
+  uint32_t *slot; /* 3 per sample: vertex on its +x, +y, +z edge */
+  size_t capval, capslot;
+  oc_mc_irange *tmp;
+  size_t capt;
+  uint32_t *flat;
+  size_t nflat, capflat;
+  size_t last_nv, last_nt; /* output sizes of the previous slab */
+};
+
+/* Grows *pp (an array of elem-byte items, capacity *cap) to hold need
+** items, doubling; 0 or -1 when out of memory. */
+int oc_mc_grow(void *pp, size_t *cap, size_t need, size_t elem);
+
+/* Starts a list of ncol columns (ranges are then added column by column,
+** at[c + 1] set by the caller after column c). */
+int oc_mc_rlist_columns(oc_mc_rlist *l, size_t ncol);
+/* Appends [lo, hi] to the column whose ranges start at `first`, merging
+** with the last range when they touch (ranges must come sorted by lo). */
+int oc_mc_rlist_add(oc_mc_rlist *l, size_t first, int32_t lo, int32_t hi);
+/* Sorts ranges by lo (short lists). */
+void oc_mc_sort_ranges(oc_mc_irange *t, size_t n);
+
+/* Step 1: cube ranges of cube rows ja .. jb - 1 into w->cube, varying
+** sample ranges of rows ja .. jr into w->var (mcband.c). */
+int oc_mc_band(const oc_mcgrid *g, int ja, int jb, int jr, oc_mcwork *w);
+/* Step 2: w->kept = w->cube minus the blocks Lipschitz-proven uniform;
+** counts the field calls made (mcband.c). */
+int oc_mc_cull(const oc_mcgrid *g, int ja, int jb, oc_mcwork *w, size_t *calls);
+/* Step 3: the sample ranges the cubes need (*total samples), then their
+** values (mcsample.c). */
+int oc_mc_sample_ranges(const oc_mcgrid *g, int ja, int jb, oc_mcwork *w,
+                        const oc_mc_rlist *cubes, size_t *total);
+void oc_mc_samples(const oc_mcgrid *g, int ja, int jb, oc_mcwork *w,
+                   size_t *calls);
+
+#endif
