@@ -51,7 +51,7 @@ static double prim(oc_kind kind, const double *par, oc_vec3 p, oc_vec3 *g) {
     return E * oc_falloff_q(q);
   }
   oc_vec3 s;
-  double d = oc_prim_project(kind, par, p, &s);
+  double d = oc_prim_project(kind, par, p, &s, R);
   double x = d / R;
   if (g) {
     double gd = E * oc_falloff_d(x) / R;
@@ -62,12 +62,20 @@ static double prim(oc_kind kind, const double *par, oc_vec3 p, oc_vec3 *g) {
 
 /* ---- perturbation ----------------------------------------------------- */
 
+/* The largest radius the perturbation can reach: R + max(0, A) tmax. */
+static inline double rho_max(const oc_op *o, const double *par) {
+  const double *nz = par + o->nkid;
+  return par[OC_P_R] + fmax(0, nz[1]) * oc_turb3_max((int)nz[3]);
+}
+
 static double perturb(const oc_op *o, const double *par, oc_vec3 p) {
   double E = par[OC_P_E], R = par[OC_P_R];
   noisep nz = unpack_noise(par + o->nkid);
   oc_vec3 s;
-  double d = oc_prim_project((oc_kind)o->sub, par, p, &s);
+  double rmax = rho_max(o, par);
+  double d = oc_prim_project((oc_kind)o->sub, par, p, &s, rmax);
   if (!(d > 0)) return d == 0 ? E : d; /* NaN propagates */
+  if (d >= rmax) return 0;              /* beyond any perturbed radius */
   oc_vec3 u = oc_mul(oc_sub(p, s), 1 / d);
   oc_vec3 v = oc_add(s, oc_mul(u, R));
   double rho =

@@ -209,8 +209,17 @@ oc_node *oc_curve(const oc_vec3 *pts, size_t n, int bz, double radius,
 
 /* ---- packing for programs ------------------------------------------ */
 
+/* A curve's segments are grouped in chunks of CHUNK with a bounding box
+** each, stored after the points, so a query skips whole chunks farther
+** than the best distance found so far. */
+#define CHUNK 8
+
+static size_t nchunks(size_t npts) {
+  return npts > 1 ? (npts - 2) / CHUNK + 1 : 0;
+}
+
 size_t oc_prim_npar(const oc_node *n) {
-  return n->kind == OC_K_CURVE ? 3 + 3 * n->npts : 9;
+  return n->kind == OC_K_CURVE ? 3 + 3 * n->npts + 6 * nchunks(n->npts) : 9;
 }
 
 void oc_prim_pack(const oc_node *n, double *out) {
@@ -220,6 +229,17 @@ void oc_prim_pack(const oc_node *n, double *out) {
     out[2] = (double)n->npts;
     for (size_t i = 0; i < n->npts; i++)
       put(out, 3 + 3 * (int)i, n->pts[i]);
+    double *box = out + 3 + 3 * n->npts;
+    for (size_t c = 0; c < nchunks(n->npts); c++, box += 6) {
+      oc_vec3 lo = n->pts[c * CHUNK], hi = lo;
+      for (size_t i = c * CHUNK + 1; i <= (c + 1) * CHUNK && i < n->npts;
+           i++) {
+        lo = oc_vmin(lo, n->pts[i]);
+        hi = oc_vmax(hi, n->pts[i]);
+      }
+      put(box, 0, lo);
+      put(box, 3, hi);
+    }
   } else {
     memcpy(out, n->par, 9 * sizeof *out);
   }
@@ -278,7 +298,8 @@ static double cone_project(const double *par, oc_vec3 p, oc_vec3 *s) {
   return d1;
 }
 
-double oc_prim_project(oc_kind kind, const double *par, oc_vec3 p, oc_vec3 *s) {
+double oc_prim_project(oc_kind kind, const double *par, oc_vec3 p, oc_vec3 *s,
+                       double cutoff) {
   switch (kind) {
   case OC_K_POINT:
     *s = get(par, OC_P_C);
@@ -302,30 +323,31 @@ double oc_prim_project(oc_kind kind, const double *par, oc_vec3 p, oc_vec3 *s) {
     return seg_project(get(par, OC_P_A), get(par, OC_P_B), p, s);
   case OC_K_CURVE: {
     size_t n = (size_t)par[2];
-    const double *v = par + 3;
-    double best = INFINITY;
-    for (size_t i = 0; i + 1 < n; i++, v += 3) {
-      /* cheap reject: the segment's box grown by the best distance */
-      double lo, hi;
-      lo = fmin(v[0], v[3]);
-      hi = fmax(v[0], v[3]);
-      if (p.x < lo - best || p.x > hi + best) continue;
-      lo = fmin(v[1], v[4]);
-      hi = fmax(v[1], v[4]);
-      if (p.y < lo - best || p.y > hi + best) continue;
-      lo = fmin(v[2], v[5]);
-      hi = fmax(v[2], v[5]);
-      if (p.z < lo - best || p.z > hi + best) continue;
-      oc_vec3 c;
-      double d = seg_project(get(v, 0), get(v, 3), p, &c);
-      if (d < best) {
-        best = d;
-        *s = c;
-      }
-    }
     if (n == 1) {
       *s = get(par, 3);
-      best = oc_len(oc_sub(p, *s));
+      return oc_len(oc_sub(p, *s));
+    }
+    const double *box = par + 3 + 3 * n;
+    double best = cutoff, best2 = cutoff * cutoff;
+    *s = p;
+    for (size_t c = 0; c < nchunks(n); c++, box += 6) {
+      /* squared distance from p to the chunk's box (plain comparisons:
+      ** fmax is a library call at -O2) */
+      double dx = p.x < box[0] ? box[0] - p.x : p.x > box[3] ? p.x - box[3] : 0;
+      double dy = p.y < box[1] ? box[1] - p.y : p.y > box[4] ? p.y - box[4] : 0;
+      double dz = p.z < box[2] ? box[2] - p.z : p.z > box[5] ? p.z - box[5] : 0;
+      if (dx * dx + dy * dy + dz * dz >= best2) continue;
+      size_t end = (c + 1) * CHUNK < n - 1 ? (c + 1) * CHUNK : n - 1;
+      for (size_t i = c * CHUNK; i < end; i++) {
+        const double *v = par + 3 + 3 * i;
+        oc_vec3 q;
+        double d = seg_project(get(v, 0), get(v, 3), p, &q);
+        if (d < best) {
+          best = d;
+          best2 = d * d;
+          *s = q;
+        }
+      }
     }
     return best;
   }

@@ -13,8 +13,11 @@
 
 /* Distance d from p to the primitive's skeleton (point, segment, curve) or
 ** solid (sphere, box, cone, half-space); stores the closest point in *s.
-** d = 0 (and s = p) inside solids. */
-double oc_prim_project(oc_kind kind, const double *par, oc_vec3 p, oc_vec3 *s);
+** d = 0 (and s = p) inside solids. Callers only interested in distances
+** below `cutoff` (where the field is non-zero) may get any value >= cutoff
+** (and s unset) beyond it: curves use it to skip far chunks. */
+double oc_prim_project(oc_kind kind, const double *par, oc_vec3 p, oc_vec3 *s,
+                       double cutoff);
 
 /* Number of doubles a distance primitive needs in a program. */
 size_t oc_prim_npar(const oc_node *n);

@@ -26,6 +26,11 @@ typedef struct spans {
 
 /* Keeps spans sorted and disjoint; past the capacity, merges the two
 ** neighbours with the smallest gap (still a cover, just looser). */
+static void span_add(spans *S, double lo, double hi);
+static void span_add_v(void *S, double lo, double hi) {
+  span_add(S, lo, hi);
+}
+
 static void span_add(spans *S, double lo, double hi) {
   if (S->all || !(lo <= hi)) return;
   if (isinf(lo) && isinf(hi)) {
@@ -75,6 +80,24 @@ static void span_add(spans *S, double lo, double hi) {
 typedef struct foot {
   double x0, y0, x1, y1;
 } foot;
+
+/* Squared distance from (x, y) to the footprint rectangle. */
+static double foot_d2(const foot *f, double x, double y) {
+  double dx = fmax(fmax(f->x0 - x, x - f->x1), 0);
+  double dy = fmax(fmax(f->y0 - y, y - f->y1), 0);
+  return dx * dx + dy * dy;
+}
+
+/* A ball of radius R around c varies only over the z-range its section
+** above the footprint covers: tighter than its box for round supports. */
+static void ball_span(const foot *f, double cx, double cy, double cz,
+                      double R, void (*add)(void *, double, double),
+                      void *S) {
+  double d2 = foot_d2(f, cx, cy);
+  if (d2 >= R * R) return;
+  double h = sqrt(R * R - d2);
+  add(S, cz - h, cz + h);
+}
 
 static int foot_meets(const float *lo, const float *hi, const foot *f) {
   return lo[0] <= f->x1 && hi[0] >= f->x0 && lo[1] <= f->y1 && hi[1] >= f->y0;
@@ -223,6 +246,13 @@ static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
       span_add(S, o->lo[2], o->hi[2]);
     return;
   }
+  case OC_K_POINT:
+  case OC_K_SPHERE: {
+    double R = par[OC_P_R] + (o->kind == OC_K_SPHERE ? par[OC_P_RAD] : 0);
+    ball_span(f, par[OC_P_C], par[OC_P_C + 1], par[OC_P_C + 2],
+              R * (1 + 1e-9), span_add_v, S);
+    return;
+  }
   default: /* bounded primitives and perturb: their support box */
     if (isinf(o->lo[2]) || isinf(o->hi[2]))
       S->all = 1;
@@ -265,6 +295,20 @@ static int box_meets(const float *lo, const float *hi, const oc_aabb *b) {
          hi[1] >= b->lo.y && lo[2] <= b->hi.z && hi[2] >= b->lo.z;
 }
 
+/* Squared distance from a point to the box, and to its farthest corner. */
+static double box_d2(const oc_aabb *b, double x, double y, double z) {
+  double dx = fmax(fmax(b->lo.x - x, x - b->hi.x), 0);
+  double dy = fmax(fmax(b->lo.y - y, y - b->hi.y), 0);
+  double dz = fmax(fmax(b->lo.z - z, z - b->hi.z), 0);
+  return dx * dx + dy * dy + dz * dz;
+}
+static double box_far2(const oc_aabb *b, double x, double y, double z) {
+  double dx = fmax(fabs(b->lo.x - x), fabs(b->hi.x - x));
+  double dy = fmax(fabs(b->lo.y - y), fabs(b->hi.y - y));
+  double dz = fmax(fabs(b->lo.z - z), fabs(b->hi.z - z));
+  return dx * dx + dy * dy + dz * dz;
+}
+
 static double op_lip(const oc_program *P, uint32_t i, const oc_aabb *b,
                      int depth) {
   const oc_op *o = &P->ops[i];
@@ -296,10 +340,7 @@ static double op_lip(const oc_program *P, uint32_t i, const oc_aabb *b,
           } else {
             double R = 1.0 / sqrt((double)e->ir2);
             double Rp = R * (1 + 1e-6);
-            if (e->c[0] - Rp > b->hi.x || e->c[0] + Rp < b->lo.x ||
-                e->c[1] - Rp > b->hi.y || e->c[1] + Rp < b->lo.y ||
-                e->c[2] - Rp > b->hi.z || e->c[2] + Rp < b->lo.z)
-              continue;
+            if (box_d2(b, e->c[0], e->c[1], e->c[2]) >= Rp * Rp) continue;
             l = fabs((double)e->e) * OC_FALLOFF_LIPSCHITZ / R * (1 + 1e-6);
           }
           acc = uni ? fmax(acc, l) : acc + l;
@@ -336,6 +377,17 @@ static double op_lip(const oc_program *P, uint32_t i, const oc_aabb *b,
     }
     if (!oc_vfinite(c.lo) || !oc_vfinite(c.hi)) return o->lip;
     return par[OC_NPAR] * op_lip(P, P->kids[o->kid], &c, depth + 1);
+  }
+  case OC_K_POINT:
+  case OC_K_SPHERE: {
+    /* zero outside the ball of support, and inside a sphere's core where
+    ** the field is constant */
+    double cx = par[OC_P_C], cy = par[OC_P_C + 1], cz = par[OC_P_C + 2];
+    double r = o->kind == OC_K_SPHERE ? par[OC_P_RAD] : 0;
+    double R = (par[OC_P_R] + r) * (1 + 1e-9);
+    if (box_d2(b, cx, cy, cz) >= R * R) return 0;
+    if (r > 0 && box_far2(b, cx, cy, cz) < r * r * (1 - 1e-9)) return 0;
+    return o->lip;
   }
   default: /* primitives, perturb, warp, smooth operators: their bound */
     return o->lip;

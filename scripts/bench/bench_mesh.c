@@ -32,7 +32,9 @@ static oc_node *must(oc_node *n, const oc_error *err) {
   return n;
 }
 
-/* Ground at z = 0 over [0, w] x [0, w] with features covering ~2 % of it. */
+/* Ground at z = 0 over [0, w] x [0, w] with 3D features covering ~2 % of
+** its area (the issue's scene): carved spheres, rocks, and a perturbed
+** arch near the middle. */
 static oc_node *terrain(double w, uint64_t seed) {
   oc_error err;
   oc_rng r = oc_rng_stream(seed, 1);
@@ -47,13 +49,11 @@ static oc_node *terrain(double w, uint64_t seed) {
     oc_vec3 c = {oc_rng_range(&r, 0, w), oc_rng_range(&r, 0, w),
                  oc_rng_range(&r, -3, 3)};
     double kind = oc_rng_uniform(&r);
-    if (kind < 0.5) { /* carved hollow */
+    if (kind < 0.5) /* carved hollow */
       k[n++] = must(oc_sphere(c, oc_rng_range(&r, 1, 3), 2, -1.5, &err), &err);
-    } else { /* perturbed boulder */
-      oc_node *p = must(oc_point(c, oc_rng_range(&r, 3, 5), 1.2, &err), &err);
-      k[n++] = must(oc_perturb(p, &nz, &err), &err);
-      oc_node_release(p);
-    }
+    else /* a rock on the ground */
+      k[n++] = must(oc_sphere(c, oc_rng_range(&r, 1.5, 3), 1.5, 1, &err),
+                    &err);
   }
   /* an arch near the middle */
   double m = w / 2;
