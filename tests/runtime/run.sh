@@ -398,6 +398,7 @@ interrupt() {
   sanitizer_check
   [ -e "$W/o/started.txt" ] || because "the scene never started"
   status_is 130; err_has "outcrop: interrupted"; no_file "$W/o/after.txt"
+  no_file "$W/o/mesh.ply"
   end
 }
 
@@ -405,6 +406,7 @@ interrupt interrupt
 interrupt interrupt-coroutine-wrap wrap
 interrupt interrupt-coroutine-resume resume
 interrupt interrupt-coroutine-nested nested
+interrupt interrupt-polygonize mesh
 
 set +m
 
