@@ -120,27 +120,6 @@ static int image_tostring(lua_State *L) {
 
 /* ---- outcrop.slice --------------------------------------------------- */
 
-/* Reads an array of exactly n finite numbers. Returns 0 when absent. */
-static int field_numbers(const oclua_fields *f, const char *name, int n,
-                         double *out, const char *what) {
-  lua_State *L = f->L;
-  if (oclua_field_push(f, name) == LUA_TNIL) {
-    lua_pop(L, 1);
-    return 0;
-  }
-  if (!lua_istable(L, -1) || lua_rawlen(L, -1) != (size_t)n)
-    oclua_field_error(f, name, -1, what);
-  for (int i = 0; i < n; i++) {
-    if (lua_geti(L, -1, i + 1) != LUA_TNUMBER || !isfinite(lua_tonumber(L, -1)))
-      oclua_error(L, f->fname, "'%s' %s (item %d is %s)", name, what, i + 1,
-                  oclua_got(L, -1));
-    out[i] = lua_tonumber(L, -1);
-    lua_pop(L, 1);
-  }
-  lua_pop(L, 1);
-  return 1;
-}
-
 static int l_slice(lua_State *L) {
   static const char *const known[] = {"plane", "at", "box", "size", NULL};
   static const char *const planes[] = {"xy", "xz", "yz", NULL};
@@ -159,7 +138,7 @@ static int l_slice(lua_State *L) {
   int plane = oclua_field_optoption(&f, "plane", planes, 1);
   sp.plane = plane == 0 ? OC_PLANE_XY : plane == 1 ? OC_PLANE_XZ : OC_PLANE_YZ;
   sp.at = oclua_field_optnumber(&f, "at", OCLUA_FINITE, 0.0);
-  field_numbers(&f, "size", 2, size, "must be {width, height}");
+  oclua_field_numbers(&f, "size", 2, size, "must be {width, height}");
   for (int k = 0; k < 2; k++)
     if (size[k] != floor(size[k]) || size[k] < 1 || size[k] > MAX_SLICE_SIZE) {
       if (size[k] == floor(size[k]) && fabs(size[k]) < 1e18)
@@ -173,7 +152,8 @@ static int l_slice(lua_State *L) {
     }
   sp.width = (int)size[0];
   sp.height = (int)size[1];
-  int given = field_numbers(&f, "box", 4, box, "must be {u0, v0, u1, v1}");
+  int given =
+      oclua_field_numbers(&f, "box", 4, box, "must be {u0, v0, u1, v1}");
   const oc_program *prog = oclua_program(L, 1, fname);
   if (!given) {
     oc_aabb b = oc_program_bounds(prog);

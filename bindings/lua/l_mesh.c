@@ -369,33 +369,12 @@ static void clear_progress(const progress_line *pl) {
 
 /* ---- outcrop.polygonize ---------------------------------------------- */
 
-/* Reads an array of exactly n finite numbers. Returns 0 when absent. */
-static int field_numbers(const oclua_fields *f, const char *name, int n,
-                         double *out, const char *what) {
-  lua_State *L = f->L;
-  if (oclua_field_push(f, name) == LUA_TNIL) {
-    lua_pop(L, 1);
-    return 0;
-  }
-  if (!lua_istable(L, -1) || lua_rawlen(L, -1) != (size_t)n)
-    oclua_field_error(f, name, -1, what);
-  for (int i = 0; i < n; i++) {
-    if (lua_geti(L, -1, i + 1) != LUA_TNUMBER || !isfinite(lua_tonumber(L, -1)))
-      oclua_error(L, f->fname, "'%s' %s (item %d is %s)", name, what, i + 1,
-                  oclua_got(L, -1));
-    out[i] = lua_tonumber(L, -1);
-    lua_pop(L, 1);
-  }
-  lua_pop(L, 1);
-  return 1;
-}
-
 static int field_resolution(const oclua_fields *f, int res[3]) {
   lua_State *L = f->L;
   double r[3];
   const char *what = lua_pushfstring(
       L, "must be {nx, ny, nz} with integers in 1..%d", MAX_CELLS);
-  int given = field_numbers(f, "resolution", 3, r, what);
+  int given = oclua_field_numbers(f, "resolution", 3, r, what);
   for (int k = 0; given && k < 3; k++) {
     if (r[k] != floor(r[k]) || r[k] < 1 || r[k] > MAX_CELLS) {
       if (r[k] == floor(r[k]) && fabs(r[k]) < 1e18)
@@ -433,7 +412,8 @@ static int l_polygonize(lua_State *L) {
     lua_replace(L, 2);
   }
   oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
-  hasbox = field_numbers(&f, "box", 6, box, "must be {x0, y0, z0, x1, y1, z1}");
+  hasbox = oclua_field_numbers(&f, "box", 6, box,
+                               "must be {x0, y0, z0, x1, y1, z1}");
   cell = oclua_field_optnumber(&f, "cell", OCLUA_POSITIVE, 0);
   hasres = field_resolution(&f, res);
   if (cell > 0 && hasres)
@@ -486,8 +466,7 @@ static int l_polygonize(lua_State *L) {
   pp.steps = steps;
   pp.full_grid = full_grid;
   pl.tty = isatty(2);
-  if (lua_getfield(L, LUA_REGISTRYINDEX, OCLUA_INTERRUPT) ==
-      LUA_TLIGHTUSERDATA)
+  if (lua_getfield(L, LUA_REGISTRYINDEX, OCLUA_INTERRUPT) == LUA_TLIGHTUSERDATA)
     pl.stop = (volatile sig_atomic_t *)lua_touserdata(L, -1);
   lua_pop(L, 1);
   if (pl.tty || pl.stop) {

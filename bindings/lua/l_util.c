@@ -419,3 +419,24 @@ void oclua_checkargs(lua_State *L, int n, const char *fname,
   if (top > n)
     oclua_error(L, fname, "too many arguments (%d; usage: %s)", top, usage);
 }
+
+/* Reads an array of exactly n finite numbers. Returns 0 when absent. */
+int oclua_field_numbers(const oclua_fields *f, const char *name, int n,
+                        double *out, const char *what) {
+  lua_State *L = f->L;
+  if (oclua_field_push(f, name) == LUA_TNIL) {
+    lua_pop(L, 1);
+    return 0;
+  }
+  if (!lua_istable(L, -1) || lua_rawlen(L, -1) != (size_t)n)
+    oclua_field_error(f, name, -1, what);
+  for (int i = 0; i < n; i++) {
+    if (lua_geti(L, -1, i + 1) != LUA_TNUMBER || !isfinite(lua_tonumber(L, -1)))
+      oclua_error(L, f->fname, "'%s' %s (item %d is %s)", name, what, i + 1,
+                  oclua_got(L, -1));
+    out[i] = lua_tonumber(L, -1);
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+  return 1;
+}

@@ -59,6 +59,10 @@ int oclua_field_missing(const oclua_fields *f, const char *name,
                         const char *what);
 
 double oclua_field_number(const oclua_fields *f, const char *name, int rule);
+/* Reads field `name` as an array of exactly n finite numbers into out;
+** returns 0 when the field is absent, raises (with `what`) when malformed. */
+int oclua_field_numbers(const oclua_fields *f, const char *name, int n,
+                        double *out, const char *what);
 double oclua_field_optnumber(const oclua_fields *f, const char *name, int rule,
                              double def);
 lua_Integer oclua_field_optint(const oclua_fields *f, const char *name,

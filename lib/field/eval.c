@@ -75,7 +75,7 @@ static double perturb(const oc_op *o, const double *par, oc_vec3 p) {
   double rmax = rho_max(o, par);
   double d = oc_prim_project((oc_kind)o->sub, par, p, &s, rmax);
   if (!(d > 0)) return d == 0 ? E : d; /* NaN propagates */
-  if (d >= rmax) return 0;              /* beyond any perturbed radius */
+  if (d >= rmax) return 0;             /* beyond any perturbed radius */
   oc_vec3 u = oc_mul(oc_sub(p, s), 1 / d);
   oc_vec3 v = oc_add(s, oc_mul(u, R));
   double rho =

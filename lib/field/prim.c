@@ -232,8 +232,7 @@ void oc_prim_pack(const oc_node *n, double *out) {
     double *box = out + 3 + 3 * n->npts;
     for (size_t c = 0; c < nchunks(n->npts); c++, box += 6) {
       oc_vec3 lo = n->pts[c * CHUNK], hi = lo;
-      for (size_t i = c * CHUNK + 1; i <= (c + 1) * CHUNK && i < n->npts;
-           i++) {
+      for (size_t i = c * CHUNK + 1; i <= (c + 1) * CHUNK && i < n->npts; i++) {
         lo = oc_vmin(lo, n->pts[i]);
         hi = oc_vmax(hi, n->pts[i]);
       }

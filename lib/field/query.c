@@ -90,9 +90,8 @@ static double foot_d2(const foot *f, double x, double y) {
 
 /* A ball of radius R around c varies only over the z-range its section
 ** above the footprint covers: tighter than its box for round supports. */
-static void ball_span(const foot *f, double cx, double cy, double cz,
-                      double R, void (*add)(void *, double, double),
-                      void *S) {
+static void ball_span(const foot *f, double cx, double cy, double cz, double R,
+                      void (*add)(void *, double, double), void *S) {
   double d2 = foot_d2(f, cx, cy);
   if (d2 >= R * R) return;
   double h = sqrt(R * R - d2);
@@ -249,8 +248,8 @@ static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
   case OC_K_POINT:
   case OC_K_SPHERE: {
     double R = par[OC_P_R] + (o->kind == OC_K_SPHERE ? par[OC_P_RAD] : 0);
-    ball_span(f, par[OC_P_C], par[OC_P_C + 1], par[OC_P_C + 2],
-              R * (1 + 1e-9), span_add_v, S);
+    ball_span(f, par[OC_P_C], par[OC_P_C + 1], par[OC_P_C + 2], R * (1 + 1e-9),
+              span_add_v, S);
     return;
   }
   default: /* bounded primitives and perturb: their support box */

@@ -52,8 +52,7 @@ static oc_node *terrain(double w, uint64_t seed) {
     if (kind < 0.5) /* carved hollow */
       k[n++] = must(oc_sphere(c, oc_rng_range(&r, 1, 3), 2, -1.5, &err), &err);
     else /* a rock on the ground */
-      k[n++] = must(oc_sphere(c, oc_rng_range(&r, 1.5, 3), 1.5, 1, &err),
-                    &err);
+      k[n++] = must(oc_sphere(c, oc_rng_range(&r, 1.5, 3), 1.5, 1, &err), &err);
   }
   /* an arch near the middle */
   double m = w / 2;
