@@ -1,6 +1,9 @@
 /*
 ** ocheck.c — shared support of the C field tests (see ocheck.h).
 */
+#include <dirent.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include "ocheck.h"
 
 #include <stdio.h>
@@ -276,4 +279,59 @@ int oct_run(Suite *s) {
   int failed = srunner_ntests_failed(sr);
   srunner_free(sr);
   return failed == 0 ? 0 : 1;
+}
+
+/* ---- scratch folders ---------------------------------------------------- */
+
+const char *oct_tmpdir(const char *tag) {
+  static char dir[128];
+  snprintf(dir, sizeof dir, "/tmp/oc-test-%s-XXXXXX", tag);
+  ck_assert_ptr_nonnull(mkdtemp(dir));
+  return dir;
+}
+
+const char *oct_in_dir(const char *dir, const char *name) {
+  static char buf[8][256];
+  static int k;
+  k = (k + 1) % 8;
+  snprintf(buf[k], sizeof buf[k], "%s/%s", dir, name);
+  return buf[k];
+}
+
+int oct_count_entries(const char *d, char *names, size_t size) {
+  DIR *dp = opendir(d);
+  ck_assert_ptr_nonnull(dp);
+  int n = 0;
+  if (names && size) names[0] = '\0';
+  struct dirent *e;
+  while ((e = readdir(dp))) {
+    if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+    n++;
+    if (names && strlen(names) + strlen(e->d_name) + 2 < size) {
+      strcat(names, e->d_name);
+      strcat(names, " ");
+    }
+  }
+  closedir(dp);
+  return n;
+}
+
+void oct_rm_tree(const char *d) {
+  DIR *dp = opendir(d);
+  if (!dp) return;
+  struct dirent *e;
+  while ((e = readdir(dp))) {
+    if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+    char p[512];
+    snprintf(p, sizeof p, "%s/%s", d, e->d_name);
+    struct stat st;
+    if (lstat(p, &st) == 0 && S_ISDIR(st.st_mode)) {
+      chmod(p, 0755);
+      oct_rm_tree(p);
+    } else {
+      unlink(p);
+    }
+  }
+  closedir(dp);
+  rmdir(d);
 }

@@ -113,6 +113,19 @@ int oct_check_bounds(const oc_program *pr, oc_vec3 lo, oc_vec3 hi, int n,
 void oct_einval_(oc_node *n, const oc_error *err, const char *param,
                  const char *what, const char *file, int line);
 
+/* ---- scratch folders ---------------------------------------------------- */
+
+/* Creates a fresh folder /tmp/oc-test-TAG-XXXXXX; returns its path (static
+** storage, valid until the next call). */
+const char *oct_tmpdir(const char *tag);
+/* "dir/name" in one of 8 rotating static buffers. */
+const char *oct_in_dir(const char *dir, const char *name);
+/* Number of entries in d (without . and ..); their names, space-separated,
+** in `names` when not NULL. */
+int oct_count_entries(const char *d, char *names, size_t size);
+/* Removes a folder tree (making sub-folders writable first). */
+void oct_rm_tree(const char *d);
+
 /* Runs a suite (CK_ENV verbosity) and returns the process exit status. */
 int oct_run(Suite *s);
 

@@ -29,59 +29,11 @@
 static char dir[64];
 
 static void mkdir_tmp(void) {
-  strcpy(dir, "/tmp/oc-test-meshio-XXXXXX");
-  ck_assert_ptr_nonnull(mkdtemp(dir));
-}
-
-static const char *in_dir(const char *name) {
-  static char buf[8][256];
-  static int k;
-  k = (k + 1) % 8;
-  snprintf(buf[k], sizeof buf[k], "%s/%s", dir, name);
-  return buf[k];
-}
-
-/* Number of entries in `d` (without . and ..); their names in `names`. */
-static int count_entries(const char *d, char *names, size_t size) {
-  DIR *dp = opendir(d);
-  ck_assert_ptr_nonnull(dp);
-  int n = 0;
-  if (names) names[0] = '\0';
-  struct dirent *e;
-  while ((e = readdir(dp))) {
-    if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
-    n++;
-    if (names && strlen(names) + strlen(e->d_name) + 2 < size) {
-      strcat(names, e->d_name);
-      strcat(names, " ");
-    }
-  }
-  closedir(dp);
-  return n;
-}
-
-static void rm_tree(const char *d) {
-  DIR *dp = opendir(d);
-  if (!dp) return;
-  struct dirent *e;
-  while ((e = readdir(dp))) {
-    if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
-    char p[512];
-    snprintf(p, sizeof p, "%s/%s", d, e->d_name);
-    struct stat st;
-    if (lstat(p, &st) == 0 && S_ISDIR(st.st_mode)) {
-      chmod(p, 0755);
-      rm_tree(p);
-    } else {
-      unlink(p);
-    }
-  }
-  closedir(dp);
-  rmdir(d);
+  strcpy(dir, oct_tmpdir("meshio"));
 }
 
 static void teardown(void) {
-  rm_tree(dir);
+  oct_rm_tree(dir);
 }
 
 /* ---- meshes built by hand ----------------------------------------------- */
@@ -414,8 +366,8 @@ START_TEST(round_trip_exact) {
   for (int k = 0; k < 3; k++) {
     char name[32];
     snprintf(name, sizeof name, "awkward%s", exts[k]);
-    write_ok(m, in_dir(name));
-    mr_mesh *back = read_ok(in_dir(name));
+    write_ok(m, oct_in_dir(dir, name));
+    mr_mesh *back = read_ok(oct_in_dir(dir, name));
     same_geometry(m, back, name);
     ck_assert_msg(strstr(back->generator, "outcrop " OC_VERSION), "%s: '%s'",
                   name, back->generator);
@@ -428,9 +380,9 @@ END_TEST
 
 START_TEST(ply_layout) {
   oc_mesh *m = tetra();
-  write_ok(m, in_dir("t.ply"));
+  write_ok(m, oct_in_dir(dir, "t.ply"));
   size_t len;
-  unsigned char *d = mr_slurp(in_dir("t.ply"), &len);
+  unsigned char *d = mr_slurp(oct_in_dir(dir, "t.ply"), &len);
   ck_assert_ptr_nonnull(d);
   const char *want = "ply\nformat binary_little_endian 1.0\ncomment written by "
                      "outcrop " OC_VERSION
@@ -463,9 +415,9 @@ START_TEST(ply_colors) {
       0.2f,       0.4f,        0.6f,        0.8f,         0.3f,   0.7f,
       0.9f,       0.1f,        0.05f,       0.95f,        0.33f,  0.66f};
   ck_assert_int_eq(oc_mesh_set_colors(m, rgb, NULL), OC_OK);
-  write_ok(m, in_dir("c.ply"));
-  write_ok(m, in_dir("c.glb"));
-  mr_mesh *back = read_ok(in_dir("c.ply"));
+  write_ok(m, oct_in_dir(dir, "c.ply"));
+  write_ok(m, oct_in_dir(dir, "c.glb"));
+  mr_mesh *back = read_ok(oct_in_dir(dir, "c.ply"));
   same_geometry(m, back, "c.ply");
   ck_assert_ptr_nonnull(back->col);
   for (int i = 0; i < 24; i++) {
@@ -478,14 +430,14 @@ START_TEST(ply_colors) {
   ck_assert_float_eq(back->col[2] * 255, 128); /* 0.5 rounds up */
   mr_free(back);
   /* GLB keeps the float colours (clamped). */
-  back = read_ok(in_dir("c.glb"));
+  back = read_ok(oct_in_dir(dir, "c.glb"));
   ck_assert_ptr_nonnull(back->col);
   for (int i = 0; i < 24; i++)
     ck_assert_float_eq(back->col[i], oc_mesh_colors(m)[i]);
   mr_free(back);
   /* OBJ has no colours. */
-  write_ok(m, in_dir("c.obj"));
-  back = read_ok(in_dir("c.obj"));
+  write_ok(m, oct_in_dir(dir, "c.obj"));
+  back = read_ok(oct_in_dir(dir, "c.obj"));
   ck_assert_ptr_null(back->col);
   mr_free(back);
   oc_mesh_free(m);
@@ -495,9 +447,9 @@ END_TEST
 START_TEST(obj_text) {
   oc_mesh *m = tetra();
   m->pos[3] = 0.1f;
-  write_ok(m, in_dir("t.obj"));
+  write_ok(m, oct_in_dir(dir, "t.obj"));
   size_t len;
-  char *d = (char *)mr_slurp(in_dir("t.obj"), &len);
+  char *d = (char *)mr_slurp(oct_in_dir(dir, "t.obj"), &len);
   ck_assert_ptr_nonnull(d);
   d = realloc(d, len + 1);
   d[len] = '\0';
@@ -529,8 +481,9 @@ START_TEST(glb_structure) {
       oc_mesh_set_colors(m, rgb, NULL);
       free(rgb);
     }
-    write_ok(m, in_dir("s.glb"));
-    mr_mesh *back = read_ok(in_dir("s.glb")); /* validates the structure */
+    write_ok(m, oct_in_dir(dir, "s.glb"));
+    mr_mesh *back =
+        read_ok(oct_in_dir(dir, "s.glb")); /* validates the structure */
     same_geometry(m, back, "s.glb");
     const mr_json *g = back->gltf;
     ck_assert_str_eq(
@@ -538,7 +491,7 @@ START_TEST(glb_structure) {
     ck_assert_str_eq(back->generator, "outcrop " OC_VERSION);
     /* File = header + JSON chunk + BIN chunk, every length consistent. */
     size_t len;
-    unsigned char *d = mr_slurp(in_dir("s.glb"), &len);
+    unsigned char *d = mr_slurp(oct_in_dir(dir, "s.glb"), &len);
     ck_assert_uint_eq(len, 12 + 8 + back->json_length + 8 + back->bin_length);
     ck_assert_uint_eq(back->json_length % 4, 0);
     ck_assert_uint_eq(back->bin_length, 301 * (colours ? 36 : 24) + 301 * 12);
@@ -624,7 +577,7 @@ static void read_fails(const char *path, const char *reason) {
 ** test above could not fail). */
 START_TEST(reader_rejects_broken_glb) {
   oc_mesh *m = cube();
-  const char *p = in_dir("b.glb");
+  const char *p = oct_in_dir(dir, "b.glb");
   struct {
     const char *from, *to, *reason;
   } cases[] = {
@@ -654,7 +607,7 @@ END_TEST
 
 START_TEST(reader_rejects_broken_ply_obj) {
   oc_mesh *m = cube();
-  const char *p = in_dir("b.ply"), *o = in_dir("b.obj");
+  const char *p = oct_in_dir(dir, "b.ply"), *o = oct_in_dir(dir, "b.obj");
   write_ok(m, p);
   struct stat st;
   ck_assert_int_eq(stat(p, &st), 0);
@@ -732,8 +685,8 @@ static mr_report check_all(const oc_mesh *m, const char *base) {
   for (int k = 0; k < 3; k++) {
     char name[64];
     snprintf(name, sizeof name, "%s%s", base, exts[k]);
-    write_ok(m, in_dir(name));
-    r[k] = report_of(in_dir(name));
+    write_ok(m, oct_in_dir(dir, name));
+    r[k] = report_of(oct_in_dir(dir, name));
     if (k) { /* the three files tell the same story */
       ck_assert_msg(r[k].edges == r[0].edges &&
                         r[k].boundary_edges == r[0].boundary_edges &&
@@ -883,8 +836,8 @@ START_TEST(empty_meshes) {
   for (int k = 0; k < 3; k++) {
     char name[32];
     snprintf(name, sizeof name, "empty%s", exts[k]);
-    write_ok(m, in_dir(name));
-    mr_mesh *back = read_ok(in_dir(name));
+    write_ok(m, oct_in_dir(dir, name));
+    mr_mesh *back = read_ok(oct_in_dir(dir, name));
     ck_assert_uint_eq(back->nv, 0);
     ck_assert_uint_eq(back->nt, 0);
     if (k == 2) { /* one empty scene; no node, buffer or mesh */
@@ -903,8 +856,8 @@ START_TEST(empty_meshes) {
   for (int k = 0; k < 3; k++) {
     char name[32];
     snprintf(name, sizeof name, "points%s", exts[k]);
-    write_ok(m, in_dir(name));
-    mr_mesh *back = read_ok(in_dir(name));
+    write_ok(m, oct_in_dir(dir, name));
+    mr_mesh *back = read_ok(oct_in_dir(dir, name));
     ck_assert_uint_eq(back->nv, k == 2 ? 0 : 4);
     ck_assert_uint_eq(back->nt, 0);
     mr_free(back);
@@ -920,10 +873,11 @@ START_TEST(glb_size_limit) {
   huge.nv = 150000000;
   huge.nt = 300000000;
   oc_error e = {0};
-  ck_assert_int_eq(oc_mesh_write(&huge, in_dir("huge.glb"), &e), OC_EINVAL);
+  ck_assert_int_eq(oc_mesh_write(&huge, oct_in_dir(dir, "huge.glb"), &e),
+                   OC_EINVAL);
   ck_assert_msg(strstr(e.msg, "4 GiB") && strstr(e.msg, "huge.glb"), "%s",
                 e.msg);
-  ck_assert_int_eq(count_entries(dir, NULL, 0), 0);
+  ck_assert_int_eq(oct_count_entries(dir, NULL, 0), 0);
 }
 END_TEST
 
@@ -931,22 +885,23 @@ START_TEST(refused_meshes) {
   oc_error e = {0};
   oc_mesh *m = tetra();
   m->tri[5] = 4; /* past the vertices */
-  ck_assert_int_eq(oc_mesh_write(m, in_dir("x.ply"), &e), OC_EINVAL);
+  ck_assert_int_eq(oc_mesh_write(m, oct_in_dir(dir, "x.ply"), &e), OC_EINVAL);
   ck_assert_msg(strstr(e.msg, "triangle 1") && strstr(e.msg, "x.ply"), "%s",
                 e.msg);
   m->tri[5] = 3;
   m->pos[4] = NAN;
-  ck_assert_int_eq(oc_mesh_write(m, in_dir("x.glb"), &e), OC_EINVAL);
+  ck_assert_int_eq(oc_mesh_write(m, oct_in_dir(dir, "x.glb"), &e), OC_EINVAL);
   ck_assert_msg(strstr(e.msg, "vertex 1"), "%s", e.msg);
   m->pos[4] = 0;
   m->nrm[0] = INFINITY;
-  ck_assert_int_eq(oc_mesh_write(m, in_dir("x.obj"), &e), OC_EINVAL);
+  ck_assert_int_eq(oc_mesh_write(m, oct_in_dir(dir, "x.obj"), &e), OC_EINVAL);
   ck_assert_msg(strstr(e.msg, "normal"), "%s", e.msg);
-  ck_assert_int_eq(oc_mesh_write(NULL, in_dir("x.obj"), &e), OC_EINVAL);
+  ck_assert_int_eq(oc_mesh_write(NULL, oct_in_dir(dir, "x.obj"), &e),
+                   OC_EINVAL);
   ck_assert_int_eq(oc_mesh_write(m, NULL, &e), OC_EINVAL);
   ck_assert_int_eq(oc_mesh_write(m, "", &e), OC_EINVAL);
   ck_assert_msg(strstr(e.msg, "'path'"), "%s", e.msg);
-  ck_assert_int_eq(count_entries(dir, NULL, 0), 0);
+  ck_assert_int_eq(oct_count_entries(dir, NULL, 0), 0);
   oc_mesh_free(m);
 }
 END_TEST
@@ -957,24 +912,24 @@ START_TEST(extensions) {
                        "sub.ply/x", ".ply",  "a.gltf"};
   for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
     oc_error e = {0};
-    const char *p = in_dir(bad[i]);
+    const char *p = oct_in_dir(dir, bad[i]);
     ck_assert_int_eq(oc_mesh_write(m, p, &e), OC_EINVAL);
     ck_assert_msg(strstr(e.msg, p) && strstr(e.msg, ".ply") &&
                       strstr(e.msg, ".obj") && strstr(e.msg, ".glb"),
                   "%s", e.msg);
   }
-  ck_assert_int_eq(count_entries(dir, NULL, 0), 0);
+  ck_assert_int_eq(oct_count_entries(dir, NULL, 0), 0);
   /* Any case picks the format. */
   const char *good[] = {"A.PLY", "b.Obj", "c.gLB"};
   for (int i = 0; i < 3; i++) {
-    write_ok(m, in_dir(good[i]));
-    mr_mesh *back = read_ok(in_dir(good[i]));
+    write_ok(m, oct_in_dir(dir, good[i]));
+    mr_mesh *back = read_ok(oct_in_dir(dir, good[i]));
     ck_assert_int_eq(back->format, i == 0 ? MR_PLY : i == 1 ? MR_OBJ : MR_GLB);
     same_geometry(m, back, good[i]);
     mr_free(back);
   }
   char names[256];
-  ck_assert_msg(count_entries(dir, names, sizeof names) == 3, "%s", names);
+  ck_assert_msg(oct_count_entries(dir, names, sizeof names) == 3, "%s", names);
   oc_mesh_free(m);
 }
 END_TEST
@@ -988,13 +943,15 @@ START_TEST(repeat_writes_identical) {
     snprintf(b, sizeof b, "r2%s", exts[k]);
     snprintf(c, sizeof c, "r3%s", exts[k]);
     oc_mesh *m1 = awkward(1000, 5), *m2 = awkward(1000, 5);
-    write_ok(m1, in_dir(a));
-    write_ok(m2, in_dir(b));
-    ck_assert_msg(mr_same_bytes(in_dir(a), in_dir(b)), "%s differs", exts[k]);
+    write_ok(m1, oct_in_dir(dir, a));
+    write_ok(m2, oct_in_dir(dir, b));
+    ck_assert_msg(mr_same_bytes(oct_in_dir(dir, a), oct_in_dir(dir, b)),
+                  "%s differs", exts[k]);
     /* A different mesh does give a different file. */
     m2->pos[3 * 999] = nextafterf(m2->pos[3 * 999], INFINITY);
-    write_ok(m2, in_dir(c));
-    ck_assert_msg(!mr_same_bytes(in_dir(a), in_dir(c)), "%s same", exts[k]);
+    write_ok(m2, oct_in_dir(dir, c));
+    ck_assert_msg(!mr_same_bytes(oct_in_dir(dir, a), oct_in_dir(dir, c)),
+                  "%s same", exts[k]);
     oc_mesh_free(m1);
     oc_mesh_free(m2);
   }
@@ -1008,32 +965,32 @@ START_TEST(unwritable_paths) {
     char name[64], want[400];
     /* A missing folder: the message names the path and the reason. */
     snprintf(name, sizeof name, "missing/y%s", exts[k]);
-    const char *p = in_dir(name);
+    const char *p = oct_in_dir(dir, name);
     ck_assert_int_eq(oc_mesh_write(m, p, &e), OC_EIO);
     snprintf(want, sizeof want, "cannot write '%s': No such file or directory",
              p);
     ck_assert_str_eq(e.msg, want);
-    ck_assert_int_eq(count_entries(dir, NULL, 0), 0);
+    ck_assert_int_eq(oct_count_entries(dir, NULL, 0), 0);
 
     /* The final name is a folder: the temporary file was written, the
     ** rename fails, and the temporary file must be gone. */
     snprintf(name, sizeof name, "taken%s", exts[k]);
-    ck_assert_int_eq(mkdir(in_dir(name), 0777), 0);
-    ck_assert_int_eq(oc_mesh_write(m, in_dir(name), &e), OC_EIO);
+    ck_assert_int_eq(mkdir(oct_in_dir(dir, name), 0777), 0);
+    ck_assert_int_eq(oc_mesh_write(m, oct_in_dir(dir, name), &e), OC_EIO);
     ck_assert_msg(strstr(e.msg, "cannot write '") && strstr(e.msg, name), "%s",
                   e.msg);
     char names[256];
-    ck_assert_msg(count_entries(dir, names, sizeof names) == 1,
+    ck_assert_msg(oct_count_entries(dir, names, sizeof names) == 1,
                   "left behind: %s", names);
-    ck_assert_int_eq(count_entries(in_dir(name), NULL, 0), 0);
-    rmdir(in_dir(name));
+    ck_assert_int_eq(oct_count_entries(oct_in_dir(dir, name), NULL, 0), 0);
+    rmdir(oct_in_dir(dir, name));
   }
   /* A read-only folder (root ignores permissions, so only as a user). */
   if (geteuid() != 0) {
-    ck_assert_int_eq(mkdir(in_dir("ro"), 0555), 0);
-    ck_assert_int_eq(oc_mesh_write(m, in_dir("ro/z.ply"), &e), OC_EIO);
+    ck_assert_int_eq(mkdir(oct_in_dir(dir, "ro"), 0555), 0);
+    ck_assert_int_eq(oc_mesh_write(m, oct_in_dir(dir, "ro/z.ply"), &e), OC_EIO);
     ck_assert_msg(strstr(e.msg, "Permission denied"), "%s", e.msg);
-    chmod(in_dir("ro"), 0755);
+    chmod(oct_in_dir(dir, "ro"), 0755);
   }
   oc_mesh_free(m);
 }
@@ -1047,7 +1004,7 @@ START_TEST(write_fails_midway) {
   for (int k = 0; k < 3; k++) {
     char name[32];
     snprintf(name, sizeof name, "full%s", exts[k]);
-    const char *p = in_dir(name);
+    const char *p = oct_in_dir(dir, name);
     write_ok(small, p);
     struct rlimit old, lim;
     ck_assert_int_eq(getrlimit(RLIMIT_FSIZE, &old), 0);
@@ -1064,7 +1021,7 @@ START_TEST(write_fails_midway) {
     snprintf(want, sizeof want, "cannot write '%s': %s", p, strerror(EFBIG));
     ck_assert_str_eq(e.msg, want);
     char names[256];
-    ck_assert_msg(count_entries(dir, names, sizeof names) == k + 1,
+    ck_assert_msg(oct_count_entries(dir, names, sizeof names) == k + 1,
                   "left behind: %s", names);
     mr_mesh *back = read_ok(p);
     same_geometry(small, back, name);
@@ -1079,7 +1036,7 @@ END_TEST
 ** and the reader always finds one whole file. */
 START_TEST(concurrent_writes) {
   oc_mesh *m[2] = {cube(), awkward(3000, 2)};
-  const char *p = in_dir("race.glb");
+  const char *p = oct_in_dir(dir, "race.glb");
   int failures = 0;
 #pragma omp parallel num_threads(2) reduction(+ : failures)
   {
@@ -1091,7 +1048,7 @@ START_TEST(concurrent_writes) {
   }
   ck_assert_int_eq(failures, 0);
   char names[256];
-  ck_assert_msg(count_entries(dir, names, sizeof names) == 1, "%s", names);
+  ck_assert_msg(oct_count_entries(dir, names, sizeof names) == 1, "%s", names);
   mr_mesh *back = read_ok(p);
   same_geometry(back->nv == 8 ? m[0] : m[1], back, "race.glb");
   mr_free(back);
@@ -1104,7 +1061,7 @@ END_TEST
 START_TEST(atomic_helper) {
   oc_error e = {0};
   oc_atomic a;
-  const char *p = in_dir("h.txt");
+  const char *p = oct_in_dir(dir, "h.txt");
   /* Through the stream, then commit. */
   ck_assert_int_eq(oc_atomic_begin(&a, p, &e), OC_OK);
   ck_assert_msg(strstr(a.tmp, "/.h.txt.tmp-") && strstr(a.tmp, ".txt"), "%s",
@@ -1122,7 +1079,7 @@ START_TEST(atomic_helper) {
   ck_assert_int_eq(oc_atomic_begin(&a, p, &e), OC_OK);
   oc_atomic_write(&a, "x", 1);
   oc_atomic_abort(&a);
-  ck_assert_int_eq(count_entries(dir, NULL, 0), 1);
+  ck_assert_int_eq(oct_count_entries(dir, NULL, 0), 1);
   d = (char *)mr_slurp(p, &len);
   ck_assert_uint_eq(len, 11);
   free(d);
@@ -1137,7 +1094,7 @@ START_TEST(atomic_helper) {
   ck_assert_uint_eq(len, 7);
   ck_assert_int_eq(memcmp(d, "by name", 7), 0);
   free(d);
-  ck_assert_int_eq(count_entries(dir, NULL, 0), 1);
+  ck_assert_int_eq(oct_count_entries(dir, NULL, 0), 1);
   /* Relative names put the temporary file in the current folder. */
   char cwd[512];
   ck_assert_ptr_nonnull(getcwd(cwd, sizeof cwd));
@@ -1146,8 +1103,8 @@ START_TEST(atomic_helper) {
   ck_assert_msg(strncmp(a.tmp, ".rel.tmp-", 9) == 0, "%s", a.tmp);
   ck_assert_int_eq(oc_atomic_commit(&a, &e), OC_OK);
   ck_assert_int_eq(chdir(cwd), 0);
-  ck_assert_int_eq(access(in_dir("rel"), F_OK), 0);
-  ck_assert_int_eq(count_entries(dir, NULL, 0), 2);
+  ck_assert_int_eq(access(oct_in_dir(dir, "rel"), F_OK), 0);
+  ck_assert_int_eq(oct_count_entries(dir, NULL, 0), 2);
 }
 END_TEST
 
@@ -1173,7 +1130,7 @@ static mr_report mesh_files(oc_node *n, oc_aabb box, double cell, int open,
   for (int k = 0; k < 3; k++) { /* what was read is what was meshed */
     char name[64];
     snprintf(name, sizeof name, "%s%s", base, exts[k]);
-    mr_mesh *back = read_ok(in_dir(name));
+    mr_mesh *back = read_ok(oct_in_dir(dir, name));
     same_geometry(m, back, name);
     mr_free(back);
   }
@@ -1311,7 +1268,8 @@ START_TEST(polygonized_threads_identical) {
     char a[16], b[16];
     snprintf(a, sizeof a, "t1%s", exts[k]);
     snprintf(b, sizeof b, "t2%s", exts[k]);
-    ck_assert_msg(mr_same_bytes(in_dir(a), in_dir(b)), "%s differ", exts[k]);
+    ck_assert_msg(mr_same_bytes(oct_in_dir(dir, a), oct_in_dir(dir, b)),
+                  "%s differ", exts[k]);
   }
 }
 END_TEST
