@@ -96,11 +96,6 @@ static uint32_t *pmap_slot(pmap *m, const void *k, int create) {
   return &m->val[h];
 }
 
-static void pmap_clear(pmap *m) {
-  if (m->cap) memset(m->key, 0, m->cap * sizeof *m->key);
-  m->n = 0;
-}
-
 static void pmap_free(pmap *m) {
   free(m->key);
   free(m->val);
@@ -956,7 +951,6 @@ oc_program *oc_compile(oc_node *root, const oc_compile_options *opts,
                    P->nent * sizeof *P->ent + P->nbvh * sizeof *P->bvh;
   free(c.inf);
   pmap_free(&c.memo);
-  (void)pmap_clear;
   return P;
 }
 
