@@ -310,6 +310,41 @@ typedef struct oc_slice_params {
 oc_image *oc_slice(const oc_program *prog, const oc_slice_params *sp,
                    oc_error *err);
 
+/* ---- heightfields ----------------------------------------------------- */
+
+/* A grid of float elevations: sample (i, j), 0 <= i < nx, 0 <= j < ny,
+** lies at (x0 + i cell, y0 + j cell) and is stored at z[j nx + i].
+** Reference counted: oc_heightfield_new returns one reference (release it
+** with oc_heightfield_release); whoever keeps a grid (a terrain node)
+** retains it. A grid is immutable once shared: write its samples through
+** oc_heightfield_samples_mut only while you hold the only reference. */
+typedef struct oc_heightfield oc_heightfield;
+
+/* nx, ny in 2 .. 65535 and nx ny <= 2^28; cell > 0; finite origin. `z`
+** (nx ny floats, all finite) is copied, or the grid starts at 0 when NULL. */
+oc_heightfield *oc_heightfield_new(int nx, int ny, double cell, double x0,
+                                   double y0, const float *z, oc_error *err);
+void oc_heightfield_retain(oc_heightfield *hf);
+void oc_heightfield_release(oc_heightfield *hf);
+
+int oc_heightfield_nx(const oc_heightfield *hf);
+int oc_heightfield_ny(const oc_heightfield *hf);
+double oc_heightfield_cell(const oc_heightfield *hf);
+void oc_heightfield_origin(const oc_heightfield *hf, double *x0, double *y0);
+const float *oc_heightfield_samples(const oc_heightfield *hf);
+float *oc_heightfield_samples_mut(oc_heightfield *hf);
+/* Smallest and largest sample (recomputed on each call). */
+void oc_heightfield_minmax(const oc_heightfield *hf, double *lo, double *hi);
+
+/* C1 interpolation (bicubic Catmull-Rom: it passes through the samples)
+** and its analytic gradient, stored in grad[0..1] when grad is not NULL.
+** Outside the grid the position is clamped to it. Thread-safe. Between
+** samples the value may leave the range of the 4 x 4 samples around by
+** at most OC_HF_OVERSHOOT times their spread. */
+#define OC_HF_OVERSHOOT 0.28125
+double oc_heightfield_height(const oc_heightfield *hf, double x, double y,
+                             double grad[2]);
+
 #ifdef __cplusplus
 }
 #endif

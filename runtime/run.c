@@ -61,6 +61,8 @@ static void set_registry(lua_State *L, const run *r) {
   lua_setfield(L, LUA_REGISTRYINDEX, OCLUA_SANDBOX);
   lua_pushinteger(L, o->seed);
   lua_setfield(L, LUA_REGISTRYINDEX, OCLUA_SEED);
+  lua_pushstring(L, o->scene);
+  lua_setfield(L, LUA_REGISTRYINDEX, OCLUA_SCENE);
 }
 
 /* package.preload.outcrop, package.loaded.outcrop and the global. */

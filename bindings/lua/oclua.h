@@ -21,6 +21,9 @@ int luaopen_outcrop(lua_State *L);
 #define OCLUA_SANDBOX "outcrop.sandbox"
 /* integer: the scene seed (--seed), default 1; also outcrop.seed */
 #define OCLUA_SEED "outcrop.seed"
+/* string: the scene file as given on the command line ("-" for standard
+** input); written into image metadata as provenance */
+#define OCLUA_SCENE "outcrop.scene"
 
 /* light userdata: address of a `volatile sig_atomic_t` the interpreter sets
 ** to non-zero on Ctrl-C; long work polls it through its progress callback

@@ -1,0 +1,35 @@
+/*
+** l_heightfield.h — the heightfield userdata, shared by the binding files
+** that make grids (l_heightfield.c: load, fbm, from, resample, crop),
+** analyse them (l_hfanalysis.c) or consume them (terrain, sampling).
+*/
+#ifndef L_HEIGHTFIELD_H
+#define L_HEIGHTFIELD_H
+
+#include "l_util.h"
+
+#define OCLUA_HEIGHTFIELD "outcrop.heightfield"
+
+typedef struct oclua_heightfield {
+  oc_heightfield *hf; /* one reference, or NULL while being made */
+} oclua_heightfield;
+
+/* Pushes a heightfield userdata holding nothing yet: create it BEFORE
+** making the grid, then store the grid in it, so an error cannot leak. */
+oclua_heightfield *oclua_newheightfield(lua_State *L);
+/* Raises unless idx is a heightfield (names fname in the message). */
+oc_heightfield *oclua_checkheightfield(lua_State *L, int idx,
+                                       const char *fname);
+/* The grid at idx, or NULL when idx is not a heightfield. */
+oc_heightfield *oclua_testheightfield(lua_State *L, int idx);
+
+/* Sets up the metatable (methods of l_heightfield.c plus
+** oclua_heightfield_analysis) and adds outcrop.heightfield to the module
+** table at the stack top. */
+void oclua_open_heightfield(lua_State *L);
+
+/* Analysis methods (slope, filled, drainage, ...), from l_hfanalysis.c;
+** NULL-terminated. */
+extern const luaL_Reg oclua_heightfield_analysis[];
+
+#endif
