@@ -217,7 +217,7 @@ typedef struct oc_polygonize_params {
   double cell;      /* cell size; or 0 to use nx, ny, nz */
   int nx, ny, nz;   /* cells per axis when cell == 0 */
   double threshold; /* iso-value; 0 means the program's T */
-  int open;         /* 1: drop the cap faces lying on the box */
+  int open;         /* 1: no caps; the surface runs up to the box faces */
   int steps;        /* root-finding steps per edge (0: default 6) */
   int full_grid;    /* 1: ignore surface bounds (benchmarks, tests) */
   oc_progress progress;

@@ -4,9 +4,10 @@
 ** 1. Every cube column asks the program for the z-spans where the field
 **    may vary over its footprint grown by one cube (the 1-ring of seed 000
 **    section 7); the cubes meeting a span, grown by one cube in z, are
-**    visited, plus the cap cubes against the bottom and top padding, plus
-**    whole columns along the box's sides (caps). The spans also tell,
-**    per column, which samples lie in gaps, where the field is constant.
+**    visited; closed meshes add the cap cubes against the bottom and top
+**    padding and whole columns along the box's sides (caps). The spans
+**    also tell, per column, which samples lie in gaps, where the field is
+**    constant.
 ** 2. The band is cut into blocks of OC_MC_BLOCK^3 cubes; a block whose
 **    samples all lie on one side of T, by the field at the centre of their
 **    box and the Lipschitz bound inside it, is dropped.
@@ -30,7 +31,9 @@ static int32_t clampi(double v, int32_t lo, int32_t hi) {
 /* Cube and sample k-ranges of the z-span [zl, zh]: the cubes meeting it,
 ** grown by one cube (seed 000's dilation), and the samples in it, with a
 ** margin far above the rounding of this arithmetic (a sample outside is
-** in a gap, where the field is exactly constant along the column). */
+** in a gap, where the field is exactly constant along the column). The
+** padding samples of open meshes lie on the faces: they vary when the
+** span reaches the face. */
 static void span_ranges(const oc_mcgrid *g, double zl, double zh,
                         oc_mc_irange *c, oc_mc_irange *s) {
   int nz = g->n[2];
@@ -39,6 +42,8 @@ static void span_ranges(const oc_mcgrid *g, double zl, double zh,
   c->hi = clampi(floor(b - 0.5) + 1, -1, nz - 1);
   s->lo = clampi(ceil(a - 0.5 - 1e-6), 0, nz - 1);
   s->hi = clampi(floor(b - 0.5 + 1e-6), 0, nz - 1);
+  if (g->open && a <= 1e-6) s->lo = -1;
+  if (g->open && b >= nz - 1e-6) s->hi = nz;
 }
 
 /* Cube ranges (rows ja .. jb - 1) and varying sample ranges (rows ja ..
@@ -58,23 +63,25 @@ int oc_mc_band(const oc_mcgrid *g, int ja, int jb, int jr, oc_mcwork *w) {
         ns = oc_program_column_spans(
             g->prog, oc_mc_coord(g, 0, i - 1), oc_mc_coord(g, 1, j - 1),
             oc_mc_coord(g, 0, i + 2), oc_mc_coord(g, 1, j + 2), sp, MAXSPANS);
-      int whole = ns < 0 || i == -1 || i == nx - 1 || j == -1 || j == ny - 1;
+      int side = i == -1 || i == nx - 1 || j == -1 || j == ny - 1;
+      int whole = ns < 0 || (side && !g->open);
       if (j < jb) {
         if (whole) {
           if (oc_mc_rlist_add(&w->cube, fc, -1, nz - 1)) return -1;
         } else {
-          if (oc_mc_rlist_add(&w->cube, fc, -1, -1)) return -1;
+          if (!g->open && oc_mc_rlist_add(&w->cube, fc, -1, -1)) return -1;
           for (int s = 0; s < ns; s++) {
             oc_mc_irange cr, sr;
             if (!(sp[s].lo <= sp[s].hi)) continue;
             span_ranges(g, sp[s].lo, sp[s].hi, &cr, &sr);
             if (oc_mc_rlist_add(&w->cube, fc, cr.lo, cr.hi)) return -1;
           }
-          if (oc_mc_rlist_add(&w->cube, fc, nz - 1, nz - 1)) return -1;
+          if (!g->open && oc_mc_rlist_add(&w->cube, fc, nz - 1, nz - 1))
+            return -1;
         }
       }
       if (ns < 0) {
-        if (oc_mc_rlist_add(&w->var, fv, 0, nz - 1)) return -1;
+        if (oc_mc_rlist_add(&w->var, fv, -g->open, nz - 1 + g->open)) return -1;
       } else {
         for (int s = 0; s < ns; s++) {
           oc_mc_irange cr, sr;
@@ -93,8 +100,9 @@ int oc_mc_band(const oc_mcgrid *g, int ja, int jb, int jr, oc_mcwork *w) {
 /* ---- 2. Lipschitz culling ---------------------------------------------- */
 
 /* 1 when every sample the block's cubes use is on one side of T. Cubes
-** i0 .. i1 (per axis) use samples i0 .. i1 + 1; padding samples are
-** outside, so a block touching them may only be dropped when outside. */
+** i0 .. i1 (per axis) use samples i0 .. i1 + 1; the padding samples of
+** closed meshes are outside, so a block touching them may only be dropped
+** when outside; those of open meshes lie on the faces, in the box. */
 static int block_uniform(const oc_mcgrid *g, const int c0[3], const int c1[3],
                          size_t *calls) {
   double lo[3], hi[3], r2 = 0;
@@ -102,8 +110,8 @@ static int block_uniform(const oc_mcgrid *g, const int c0[3], const int c1[3],
   oc_vec3 ctr;
   for (int a = 0; a < 3; a++) {
     int s0 = c0[a], s1 = c1[a] + 1;
-    if (s0 < 0) s0 = 0, pad = 1;
-    if (s1 > g->n[a] - 1) s1 = g->n[a] - 1, pad = 1;
+    if (!g->open && s0 < 0) s0 = 0, pad = 1;
+    if (!g->open && s1 > g->n[a] - 1) s1 = g->n[a] - 1, pad = 1;
     lo[a] = oc_mc_coord(g, a, s0);
     hi[a] = oc_mc_coord(g, a, s1);
     r2 += (hi[a] - lo[a]) * (hi[a] - lo[a]);

@@ -3,11 +3,15 @@
 ** (internal).
 **
 ** Samples sit at cell centres: sample i on axis a is at
-** lo[a] + (i + 0.5) h[a], i = 0 .. n[a] - 1. A padding layer at i = -1 and
-** i = n[a] is outside by definition (the outside of the box is empty), so
-** the surface is capped where a solid meets the box: a crossing between a
-** real sample and a padding one lies exactly on the box face. A "cube" of
-** marching cubes joins samples i .. i + 1 on each axis, i = -1 .. n - 1.
+** lo[a] + (i + 0.5) h[a], i = 0 .. n[a] - 1, and a padding layer at i = -1
+** and i = n[a] lies on the box faces. For closed meshes the padding is
+** outside by definition (the outside of the box is empty), so the surface
+** is capped where a solid meets the box: a crossing between a real sample
+** and a padding one lies exactly on the box face. For open meshes the
+** padding samples take the field's values on the faces, so the surface
+** runs right up to the box and stops there (terrain tiles that abut). A
+** "cube" of marching cubes joins samples i .. i + 1 on each axis,
+** i = -1 .. n - 1.
 **
 ** The grid is split into slabs of cube rows along y, meshed independently
 ** (in parallel) and merged in order; see polygonize.c.
@@ -34,14 +38,17 @@ typedef struct oc_mcgrid {
   double T;
   int steps;          /* root-finding iterations per edge (at most) */
   double newton_tol;  /* and the step, in edges, below which they stop */
-  int open;           /* drop cap triangles */
+  int open;           /* padding samples on the faces, no caps */
   int full;           /* ignore surface bounds */
   size_t max_samples; /* per-slab sample budget (memory guard) */
 } oc_mcgrid;
 
-/* Coordinate of sample i on axis a. Every user goes through this, so two
-** slabs computing the same edge agree to the bit. */
+/* Coordinate of sample i on axis a; padding indices (and beyond) map to
+** the box faces. Every user goes through this, so two slabs computing the
+** same edge agree to the bit. */
 static inline double oc_mc_coord(const oc_mcgrid *g, int a, int i) {
+  if (i < 0) return g->lo[a];
+  if (i >= g->n[a]) return g->hi[a];
   return g->lo[a] + ((double)i + 0.5) * g->h[a];
 }
 

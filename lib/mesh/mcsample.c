@@ -3,7 +3,8 @@
 ** sample column (the union of the k-ranges of the four cube columns
 ** around it), and their values. A sample in a gap between spans, where
 ** the field is constant along the column, takes the value of one sample
-** of that gap, evaluated once. Padding samples are -INFINITY (outside).
+** of that gap, evaluated once. Padding samples are -INFINITY (outside)
+** for closed meshes; open meshes evaluate them on the box faces.
 */
 #include <math.h>
 
@@ -71,7 +72,7 @@ static void eval_column(const oc_mcgrid *g, int i, int j, const oc_mc_srange *s,
   for (size_t r = 0; r < ns; r++) {
     for (int32_t k = s[r].lo; k <= s[r].hi; k++) {
       double *out = &val[s[r].off + k];
-      if (k < 0 || k >= nz) {
+      if (!g->open && (k < 0 || k >= nz)) {
         *out = -INFINITY;
         continue;
       }
@@ -110,14 +111,16 @@ void oc_mc_samples(const oc_mcgrid *g, int ja, int jb, oc_mcwork *w,
     for (int i = -1; i <= nx; i++, c++) {
       const oc_mc_srange *s = w->sr + w->srat[c];
       size_t ns = w->srat[c + 1] - w->srat[c];
-      if (i < 0 || i >= nx || j < 0 || j >= ny) {
+      if (!g->open && (i < 0 || i >= nx || j < 0 || j >= ny)) {
         for (size_t r = 0; r < ns; r++)
           for (int32_t k = s[r].lo; k <= s[r].hi; k++)
             w->val[s[r].off + k] = -INFINITY;
         continue;
       }
-      /* the spans of cube column (i, j) cover sample column (i, j) */
-      size_t cc = (size_t)(j - ja) * (nx + 1) + (size_t)(i + 1);
+      /* the spans of cube column (i, j) cover sample column (i, j); those
+      ** of the last cube column and row also cover the padding beyond */
+      int ci = i < nx ? i : nx - 1, cj = j < ny ? j : ny - 1;
+      size_t cc = (size_t)(cj - ja) * (nx + 1) + (size_t)(ci + 1);
       size_t nvar = g->full ? 0 : w->var.at[cc + 1] - w->var.at[cc];
       const oc_mc_irange *var = nvar ? w->var.r + w->var.at[cc] : NULL;
       eval_column(g, i, j, s, ns, var, nvar, w->val, calls);

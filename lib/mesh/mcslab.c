@@ -67,24 +67,11 @@ static int edge_vertex(const oc_mcgrid *g, oc_mcwork *w, oc_mcout *o,
   return 0;
 }
 
-/* 1 when edge e of cube (i, j, k) joins a real sample to a padding one.
-** Only the edge's own axis matters: an edge whose other indices are in
-** the padding joins two padding samples and never crosses. */
-static int cap_edge(const oc_mcgrid *g, int i, int j, int k, int e) {
-  int axis = e / 4, s = axis == 0 ? i : axis == 1 ? j : k;
-  return s < 0 || s + 1 >= g->n[axis];
-}
-
 static int emit(const oc_mcgrid *g, oc_mcwork *w, oc_mcout *o,
                 const oc_mctable *tb, const cubecol *cc, int i, int j, int k,
                 int m) {
-  int border = i < 0 || j < 0 || k < 0 || i + 1 >= g->n[0] ||
-               j + 1 >= g->n[1] || k + 1 >= g->n[2];
   const uint8_t *t = tb->tri[m];
   for (int n = 0; n < tb->ntri[m]; n++, t += 3) {
-    if (g->open && border && cap_edge(g, i, j, k, t[0]) &&
-        cap_edge(g, i, j, k, t[1]) && cap_edge(g, i, j, k, t[2]))
-      continue;
     uint32_t v[3];
     for (int a = 0; a < 3; a++)
       if (edge_vertex(g, w, o, cc, i, j, k, t[a], &v[a])) return -1;

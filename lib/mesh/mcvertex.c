@@ -16,8 +16,9 @@
 ** with a grid point even once rounded to float: distinct edges give
 ** distinct vertices and no triangle degenerates.
 **
-** Edges to padding samples are the caps: their vertex is exactly on the
-** box face.
+** In closed meshes, edges to padding samples are the caps: their vertex is
+** exactly on the box face. In open ones the padding samples are real
+** values on the faces and their edges are searched like any other.
 */
 #include <math.h>
 
@@ -40,28 +41,16 @@ static void unit_or_flag(const oc_vec3 *gr, float nrm[3], int *flat,
   *flat = 1;
 }
 
-/* A vertex on the box face: the edge joins a real sample and a padding
-** one. Closed meshes take the face's normal (the cap is flat); open ones,
-** which keep only the skirt along the face, take the field's. */
+/* A cap vertex: the edge joins a real sample and a padding one (outside),
+** so the crossing is on the box face, where the cap is flat. */
 static int cap_vertex(const oc_mcgrid *g, const int s[3], int axis,
                       float pos[3], float nrm[3], int *flat) {
-  double p[3];
   for (int a = 0; a < 3; a++)
-    p[a] = oc_mc_coord(g, a, s[a]);
-  double sign = s[axis] < 0 ? -1.0 : 1.0;
-  p[axis] = s[axis] < 0 ? g->lo[axis] : g->hi[axis];
-  for (int a = 0; a < 3; a++)
-    pos[a] = (float)p[a];
+    pos[a] = (float)oc_mc_coord(g, a, s[a] + (a == axis && s[a] >= 0));
+  nrm[0] = nrm[1] = nrm[2] = 0.0f;
+  nrm[axis] = s[axis] < 0 ? -1.0f : 1.0f;
   *flat = 0;
-  if (!g->open) {
-    nrm[0] = nrm[1] = nrm[2] = 0.0f;
-    nrm[axis] = (float)sign;
-    return 0;
-  }
-  oc_vec3 gr;
-  oc_program_gradient(g->prog, (oc_vec3){p[0], p[1], p[2]}, &gr);
-  unit_or_flag(&gr, nrm, flat, sign, axis);
-  return 1;
+  return 0;
 }
 
 int oc_mc_vertex(const oc_mcgrid *g, const int s[3], int axis, double va,
@@ -69,7 +58,7 @@ int oc_mc_vertex(const oc_mcgrid *g, const int s[3], int axis, double va,
   /* Off the axis both ends share their indices, so only the axis can
   ** reach the padding (an edge between two padding samples never
   ** crosses). */
-  if (s[axis] < 0 || s[axis] + 1 >= g->n[axis])
+  if (!g->open && (s[axis] < 0 || s[axis] + 1 >= g->n[axis]))
     return cap_vertex(g, s, axis, pos, nrm, flat);
   double T = g->T;
   double p[3];
