@@ -220,6 +220,9 @@ typedef struct oc_polygonize_params {
   int open;         /* 1: no caps; the surface runs up to the box faces */
   int steps;        /* root-finding steps per edge (0: default 6) */
   int full_grid;    /* 1: ignore surface bounds (benchmarks, tests) */
+  int no_direct;    /* 1: no direct elevation extraction: root finding on
+                    ** the field even where one terrain or plane alone
+                    ** governs a column (benchmarks, tests) */
   oc_progress progress;
 } oc_polygonize_params;
 
@@ -283,7 +286,11 @@ int oc_image_set_meta(oc_image *img, const char *key, const char *value,
 /* Writes through OpenImageIO; the format follows the extension (.png,
 ** .jpg, .tif, .exr). `bits` is 8 or 16 for PNG/TIFF (0: 8 for PNG/JPEG,
 ** 16 for TIFF, half for EXR). Atomic: written to a temporary name in the
-** same folder and renamed; on error no file is left. */
+** same folder and renamed; on error no file is left. Values are written
+** as given (clamped to [0, 1] for integer formats), except in an image
+** with the metadata outcrop:colorspace=linear (renders): there the colour
+** channels are sRGB-encoded for integer formats, and files are tagged
+** with their colour space (sRGB, or Linear for float formats). */
 int oc_image_write(const oc_image *img, const char *path, int bits,
                    oc_error *err);
 
@@ -309,6 +316,171 @@ typedef struct oc_slice_params {
 ** height (v grows upwards). */
 oc_image *oc_slice(const oc_program *prog, const oc_slice_params *sp,
                    oc_error *err);
+
+/* ---- rendering --------------------------------------------------------- */
+
+/* Images of a field by sphere tracing the surface f = T, no mesh.
+** Colours are LINEAR RGB (the writers encode sRGB for 8/16-bit files, see
+** oc_image_write). Two ways to call it:
+**  - oc_render(): trace, colour and shade in one call;
+**  - oc_render_geometry(), then oc_render_shade(): for a caller that
+**    computes the albedo of each pixel itself (serially, e.g. a Lua
+**    function) from the hit positions and normals of the first call. */
+
+typedef struct oc_camera {
+  oc_vec3 eye, target; /* distinct points */
+  oc_vec3 up;          /* not parallel to target - eye */
+  double fov;          /* vertical field of view, degrees, in (0, 179] */
+} oc_camera;
+
+typedef enum oc_render_tracer {
+  OC_TRACE_SEGMENT = 0, /* local directional bounds along the ray segment,
+                        ** growing candidate step, empty-space skipping */
+  OC_TRACE_SPHERE       /* plain sphere tracing: one global Lipschitz
+                        ** bound, the ray clipped to the scene's box only */
+} oc_render_tracer;
+
+typedef enum oc_render_color {
+  OC_COLOR_RULES = 0, /* rock, grass, snow, sand by altitude and slope */
+  OC_COLOR_FIELD      /* a program (e.g. geology) through a palette */
+} oc_render_color;
+
+/* Rule palette. Slopes are in degrees from the horizontal. When `levels`
+** is 0, sea_level and snow_line are derived from the altitudes of the
+** visible surface (z0 = lowest hit, z1 = highest): sea_level = z0 +
+** 0.04 (z1 - z0), snow_line = z0 + 0.75 (z1 - z0). */
+typedef struct oc_render_rules {
+  int levels;        /* 1: use sea_level and snow_line as given */
+  double sea_level;  /* sand below sea_level + beach */
+  double snow_line;  /* snow above it where the slope < snow_slope */
+  double beach;      /* metres; 0 allowed; default 1.5% of (z1 - z0) when
+                     ** levels is 0 */
+  double rock_slope; /* steeper: bare rock (default 38) */
+  double snow_slope; /* steeper: no snow (default 45) */
+} oc_render_rules;
+
+typedef struct oc_render_params {
+  oc_camera camera;
+  int width, height; /* 1 .. 16384 each, width height <= 2^25 */
+
+  oc_vec3 sun_direction; /* towards the sun (normalised here) */
+  double sun_color[3];   /* linear RGB, >= 0 */
+  double sun_intensity;  /* >= 0 */
+  double sky[3];         /* linear RGB of the sky: ambient and misses */
+  int shadows;           /* 1: shadow rays towards the sun */
+  int ao;                /* 1: ambient occlusion */
+  double ao_distance;    /* metres between AO samples; 0: auto */
+  double fog_density;    /* per metre, >= 0 (0: none); transmittance
+                         ** exp(-fog_density * distance) */
+  double fog_color[3];   /* linear RGB */
+  int has_background;    /* 1: misses get `background`, else the sky */
+  double background[4];  /* linear RGBA, alpha included */
+  double texture;        /* triplanar colour variation, 0 .. 1 */
+  double texture_scale;  /* metres per texture period; 0: auto */
+
+  oc_render_color color;         /* colour source when no albedo is given */
+  oc_render_rules rules;         /* OC_COLOR_RULES */
+  const oc_program *color_field; /* OC_COLOR_FIELD: evaluated at hits */
+  const double *stops;           /* OC_COLOR_FIELD: n stops (value, r, g, b),
+                                 ** values ascending, components in [0, 1] */
+  int nstops;                    /* 1 .. 256 */
+
+  double threshold;        /* iso-value; 0 means the program's T */
+  double max_distance;     /* farthest hit, metres; 0: auto (the scene's
+                           ** box, or 1000 |target - eye| when unbounded) */
+  oc_render_tracer tracer; /* OC_TRACE_SEGMENT by default */
+  int aov;                 /* 1: add the AOV channels (see oc_render) */
+  oc_progress progress;
+} oc_render_params;
+
+/* Fills `rp` with the defaults: a 640 x 360 view of nothing in particular
+** (set the camera), sun from (-0.5, -0.4, 0.77) colour (1, 0.95, 0.86)
+** intensity 2.2, sky (0.45, 0.6, 0.85), shadows and AO on, no fog (fog
+** colour = sky), no background (sky), texture 0.3, rule colours with
+** derived levels, segment tracer, no AOV. */
+void oc_render_defaults(oc_render_params *rp);
+
+/* Channels of a geometry image (OC_RG_COUNT floats per pixel). */
+enum {
+  OC_RG_HIT = 0, /* 1 on a surface hit, 0 on a miss */
+  OC_RG_Z,       /* ray distance from the eye; +inf on a miss */
+  OC_RG_NX,      /* unit normal (from the gradient, outwards) x, y, z */
+  OC_RG_PX = OC_RG_NX + 3,    /* world position of the hit x, y, z */
+  OC_RG_EVALS = OC_RG_PX + 3, /* field evaluations of the primary ray (its
+                              ** steps, + 1 for the normal on a hit) */
+  OC_RG_COUNT
+};
+
+/* Traces one primary ray per pixel (through the pixel's centre) and
+** returns an image of OC_RG_COUNT channels named "hit", "Z", "N.x",
+** "N.y", "N.z", "P.x", "P.y", "P.z", "evals"; on a miss N and P are 0.
+** Only the camera, size, threshold, max_distance, tracer and progress of
+** `rp` are used. NULL with err: OC_EINVAL (naming the parameter),
+** OC_ENOMEM (sizes checked before allocating), OC_ECANCEL. */
+oc_image *oc_render_geometry(const oc_program *prog, const oc_render_params *rp,
+                             oc_error *err);
+
+/* Shades a geometry image made by oc_render_geometry with the same
+** program and parameters. `albedo` (3 linear floats per pixel, row 0 at
+** the top, read on hit pixels only) replaces the colour source when not
+** NULL. Returns the final image: R, G, B, A, and when rp->aov also "Z",
+** "N.x", "N.y", "N.z", "P.x", "P.y", "P.z", "evals" (evals includes the
+** shadow, AO and colour evaluations). A is 1 on hits, the background's
+** alpha (1 for the sky) on misses. The image carries the metadata
+** outcrop:colorspace=linear, which makes oc_image_write encode its colour
+** channels as sRGB in 8/16-bit files (EXR keeps linear values). */
+oc_image *oc_render_shade(const oc_program *prog, const oc_render_params *rp,
+                          const oc_image *geometry, const float *albedo,
+                          oc_error *err);
+
+/* oc_render_geometry then oc_render_shade; one progress range. */
+oc_image *oc_render(const oc_program *prog, const oc_render_params *rp,
+                    oc_error *err);
+
+/* ---- sampling (gen/poisson.c) -------------------------------------- */
+
+/* A set of points, `dim` coordinates each, stored one after the other
+** (x0, y0[, z0], x1, ...). Made by the samplers below; the caller frees it
+** with oc_samples_free. */
+typedef struct oc_samples oc_samples;
+
+/* Cap on the number of samples a request may need, checked before
+** anything is allocated against an upper bound of the count (the box
+** grown by r/2 on each side, over the area of a disk of radius r/2; a
+** maximal set holds about 55 % of that bound in 2D, 38 % in 3D). */
+#define OC_POISSON_MAX 50000000
+
+typedef struct oc_poisson_params {
+  oc_aabb box;   /* finite, non-empty; poisson2d ignores z */
+  double radius; /* > 0: no two samples closer than this */
+  uint64_t seed;
+  /* 2D only, optional (NULL: keep all): the probability of keeping the
+  ** sample at (x, y), in [0, 1]. Called from the calling thread, once per
+  ** sample of the maximal set, in the order of the result. Anything
+  ** outside [0, 1] (NaN to abort) fails with OC_EINVAL. */
+  double (*density)(void *ud, double x, double y);
+  void *density_ud;
+  oc_progress progress;
+} oc_poisson_params;
+
+/* Maximal Poisson disk (2D) or sphere (3D) sampling of the closed box: no
+** two samples closer than `radius`, and no point of the box farther than
+** `radius` (up to a relative 1e-10) from every sample, so no room is left
+** for another. Darts are thrown uniformly over the uncovered area (the
+** distribution of a dart thrower run to the end), then the last gaps are
+** found exactly and filled. With `density`, each sample of that maximal set
+** is then kept with the probability it gives, drawn from a stream keyed by
+** the seed and the sample's grid cell: the result is still at least
+** `radius` apart, and a higher density keeps a superset. Samples come in
+** the order of the cells of a grid (x fastest). Deterministic: the same
+** bytes for the same parameters and any thread count. Returns a new set or
+** NULL with err (OC_EINVAL, OC_ENOMEM, OC_ECANCEL). */
+oc_samples *oc_poisson2d(const oc_poisson_params *pp, oc_error *err);
+oc_samples *oc_poisson3d(const oc_poisson_params *pp, oc_error *err);
+void oc_samples_free(oc_samples *s);
+size_t oc_samples_count(const oc_samples *s);
+int oc_samples_dim(const oc_samples *s);
+const double *oc_samples_data(const oc_samples *s);
 
 /* ---- heightfields ----------------------------------------------------- */
 
@@ -344,6 +516,313 @@ void oc_heightfield_minmax(const oc_heightfield *hf, double *lo, double *hi);
 #define OC_HF_OVERSHOOT 0.28125
 double oc_heightfield_height(const oc_heightfield *hf, double x, double y,
                              double grad[2]);
+
+/* -- heightfield files (terrain/hf_io.c) -- */
+
+/* The fields of oc_hf_load_params the caller gives; the others come from
+** the file's metadata (outcrop:cell, outcrop:x0, outcrop:y0,
+** outcrop:scale, outcrop:offset, as oc_heightfield_save writes them),
+** else default to cell 1, scale 1, offset 0, origin (0, 0). */
+enum {
+  OC_HF_GIVE_CELL = 1,
+  OC_HF_GIVE_SCALE = 2,
+  OC_HF_GIVE_OFFSET = 4,
+  OC_HF_GIVE_ORIGIN = 8
+};
+
+typedef struct oc_hf_load_params {
+  unsigned given;       /* OC_HF_GIVE_* bits */
+  double cell;          /* > 0 */
+  double scale, offset; /* elevation = stored value * scale + offset */
+  double x0, y0;        /* position of sample (0, 0) */
+} oc_hf_load_params;
+
+/* Reads the first channel of an image file (PNG, TIFF, EXR or anything
+** else OpenImageIO reads) into a new grid. Integer samples are raw counts
+** (0..255 for 8 bits, 0..65535 for 16 bits: not normalized, so `scale` is
+** metres per count); half and float samples are taken as stored. North
+** up: the image's top row is the grid's last row (j = ny - 1), its left
+** column i = 0. p may be NULL. On error NULL and `err`: OC_EIO naming the
+** path for unreadable or corrupt files, OC_EINVAL for an image under
+** 2 x 2 pixels or a non-finite elevation, OC_ENOMEM (before allocating)
+** for images over the size limit of oc_heightfield_new. */
+oc_heightfield *oc_heightfield_load(const char *path,
+                                    const oc_hf_load_params *p, oc_error *err);
+
+typedef struct oc_hf_save_params {
+  /* 0: the format's default: 16 for PNG, 32 (float) for TIFF and EXR.
+  ** PNG takes 8 or 16, TIFF 16 or 32, EXR 16 (half) or 32. */
+  int bits;
+  /* Integer formats: 0 fits scale and offset to the grid (offset = the
+  ** lowest sample, scale = range / (2^bits - 1), 1 for a flat grid), 1
+  ** uses the scale and offset below (an error when a sample falls outside
+  ** the counts). Float formats store elevations as they are: fixed = 1 is
+  ** an error there. */
+  int fixed;
+  double scale, offset;
+  const char *const *meta; /* extra metadata: key0, value0, key1, ... */
+  size_t nmeta;            /* number of (key, value) pairs */
+} oc_hf_save_params;
+
+/* Writes the grid by extension (.png, .tif, .tiff, .exr) as one channel
+** "Y", north up as oc_heightfield_load reads it, integer formats holding
+** round((z - offset) / scale). The cell, origin, scale and offset go into
+** the file as metadata (numbers with 17 significant digits, so they read
+** back exactly). used[0], used[1] (when used is not NULL) get the scale
+** and offset (1 and 0 for float formats). Loading a saved 16-bit PNG gives
+** the quantized elevations, and saving those again gives the same file.
+** Atomic; returns OC_OK or an error code with `err`. */
+int oc_heightfield_save(const oc_heightfield *hf, const char *path,
+                        const oc_hf_save_params *p, double used[2],
+                        oc_error *err);
+
+/* -- procedural grids (terrain/hf_make.c) -- */
+
+/* Where the samples of a grid to be made lie: sample (i, j) at
+** (x0 + i cell, y0 + j cell); the limits of oc_heightfield_new apply. */
+typedef struct oc_hf_grid {
+  int nx, ny;
+  double cell, x0, y0;
+} oc_hf_grid;
+
+/* fBm: z(x, y) = offset + amplitude t((x, y, 0) / wavelength), the
+** turbulence primitive of the same noise on the plane z = 0 (so the grid
+** samples an oc_turbulence node). Rows in parallel; byte-identical for any
+** thread count; cancellable through `progress` (OC_ECANCEL). */
+oc_heightfield *oc_heightfield_fbm(const oc_hf_grid *g, const oc_noise *noise,
+                                   oc_progress progress, oc_error *err);
+
+/* The surface of a field seen from above: at each sample, the highest z in
+** [z0, z1] where f goes from f <= T above to f > T below (T = threshold,
+** 0 for the program's); z1 where f > T at z1 already, z0 where the column
+** holds no inside point. Found by stepping down the column with local
+** Lipschitz bounds (skipping what the column spans prove constant), then
+** bisecting to (z1 - z0) 1e-9. Features thinner than (z1 - z0) 1e-5 may be
+** stepped over. Parallel, deterministic, cancellable. */
+oc_heightfield *oc_heightfield_from_program(const oc_program *prog,
+                                            const oc_hf_grid *g, double z0,
+                                            double z1, double threshold,
+                                            oc_progress progress,
+                                            oc_error *err);
+
+/* The grid sampled on another grid g (positions outside hf are clamped to
+** it): the Catmull-Rom interpolant where g->cell <= the cell of hf; where
+** it is coarser, the samples of hf averaged under a tent of radius
+** g->cell (so downsampling does not alias). Parallel, deterministic,
+** cancellable. */
+oc_heightfield *oc_heightfield_resample(const oc_heightfield *hf,
+                                        const oc_hf_grid *g,
+                                        oc_progress progress, oc_error *err);
+
+/* The samples i0..i1, j0..j1 (0-based, inclusive; at least 2 x 2) as a new
+** grid, its origin at sample (i0, j0). */
+oc_heightfield *oc_heightfield_crop(const oc_heightfield *hf, int i0, int j0,
+                                    int i1, int j1, oc_error *err);
+
+/* -- analysis (terrain/slope.c, fill.c, flow.c, sinks.c, access.c,
+**    edt.c) -- */
+
+/* Each returns a NEW grid (one reference: oc_heightfield_release) with the
+** size, cell and origin of hf, or NULL with err. Heavy ones run over both
+** cores and are byte-identical for any thread count; `progress` (which
+** may hold NULL) can cancel them: NULL with OC_ECANCEL. The 8 neighbours
+** of a sample are its axis and diagonal ones; a border sample has fewer. */
+
+/* |grad h|, rise over run (tan of the slope angle), by central
+** differences (the Catmull-Rom derivative at a sample), one-sided on the
+** border. */
+oc_heightfield *oc_hf_slope(const oc_heightfield *hf, oc_error *err);
+
+/* Depression filling by Priority-Flood+epsilon (Barnes, Lehman, Mulla
+** 2014) from the border: filled >= hf everywhere, and every interior
+** sample has a strictly lower neighbour, so water drains from everywhere
+** to the border. A depression is raised to its spill level, then by one
+** float ulp per sample away from its outlet (flats likewise), so its
+** surface stays within (samples across) ulps of the spill level. Samples
+** with a strictly descending path to the border keep their elevation
+** (up to a few ulps where such a path meets a filled flat). Sequential
+** (the algorithm is): about 4 s for 4096 x 4096 samples. */
+oc_heightfield *oc_hf_fill(const oc_heightfield *hf, oc_progress progress,
+                           oc_error *err);
+
+#define OC_HF_FREEMAN_EXPONENT 1.1
+
+typedef struct oc_hf_flow_params {
+  double exponent; /* Freeman's p in (0, 4]; 0: OC_HF_FREEMAN_EXPONENT */
+  int prefilled;   /* 1: hf is already filled (skip the filling) */
+  oc_progress progress;
+} oc_hf_flow_params;
+
+/* Upstream area in m^2 by Freeman's (1991) multiple flow directions on
+** the filled grid: each sample holds its own cell^2 plus what its higher
+** neighbours send, and sends it all to its strictly lower neighbours k in
+** proportion to tan(b_k)^p (b_k the angle down to k). Samples with no
+** lower neighbour (after filling, border samples only) keep it: it leaves
+** the grid there, and those samples sum to nx ny cell^2. Every sample is
+** >= cell^2. fp may be NULL. */
+oc_heightfield *oc_hf_drainage(const oc_heightfield *hf,
+                               const oc_hf_flow_params *fp, oc_error *err);
+/* Stream power A^(1/2) s (seed 000 section 6.1): A the drainage above, s
+** the slope of the filled grid (so filled lakes are ~0). */
+oc_heightfield *oc_hf_stream_power(const oc_heightfield *hf,
+                                   const oc_hf_flow_params *fp, oc_error *err);
+
+/* Pits: interior samples strictly lower than all 8 neighbours (border
+** samples never are; flat-bottomed depressions have none). Their
+** positions (x0 + i cell, y0 + j cell, z) in row order go to a new array
+** *out that the caller frees with free() (NULL when none), the count to
+** *n. Returns OC_OK or an error code with err. */
+int oc_hf_sinks(const oc_heightfield *hf, oc_vec3 **out, size_t *n,
+                oc_error *err);
+
+typedef struct oc_hf_access_params {
+  int rays;        /* per sample, 1 .. 4096; 0: 64 */
+  double distance; /* ray length in metres, > 0; 0: 50 cells */
+  uint64_t seed;
+  oc_progress progress;
+} oc_hf_access_params;
+
+/* Sky visibility after Miller (1994): per sample, the fraction of `rays`
+** directions, uniform in solid angle over the upper hemisphere about the
+** vertical (a randomly shifted spherical Fibonacci lattice), that the
+** terrain does not block within `distance`. Rays march the bilinear
+** surface in half-cell steps; leaving the grid or rising above its
+** highest sample escapes. A flat plane gives 1, a plane tilted by a gives
+** 1 - a / pi, the bottom of a V valley with sides at a 1 - 2 a / pi. ap
+** may be NULL. */
+oc_heightfield *oc_hf_accessibility(const oc_heightfield *hf,
+                                    const oc_hf_access_params *ap,
+                                    oc_error *err);
+
+/* Horizontal distance in metres from each sample to the nearest sample at
+** or below `level` (0 there; unsigned), exact (Felzenszwalb-Huttenlocher
+** Euclidean distance transform): the float of sqrt(di^2 + dj^2) cell.
+** OC_EINVAL when no sample is at or below the level. */
+oc_heightfield *oc_hf_distance_to_level(const oc_heightfield *hf, double level,
+                                        oc_error *err);
+
+/* ---- terrain: implicitized elevation (terrain/terrain.c) ---------------- */
+
+/* An elevation source: a 2D elevation function h(x, y) over a rectangular
+** domain, as the terrain node consumes it. Heightfields are the first
+** source (oc_heightfield_elevation); feature-primitive trees or diffusion
+** from curves plug in the same way. Every function must be thread-safe
+** and allocation-free; bounds must be conservative (never too small). */
+typedef struct oc_elevation {
+  /* h(x, y); when grad is not NULL, dh/dx and dh/dy go to grad[0..1].
+  ** Called only with finite positions (they may lie outside the domain). */
+  double (*height)(void *ud, double x, double y, double grad[2]);
+  /* lo <= h <= hi everywhere on [x0, x1] x [y0, y1] (x0 <= x1, y0 <= y1). */
+  void (*range)(void *ud, double x0, double y0, double x1, double y1,
+                double *lo, double *hi);
+  /* An upper bound of |grad h| on [x0, x1] x [y0, y1]: h is Lipschitz
+  ** with that constant there. */
+  double (*slope)(void *ud, double x0, double y0, double x1, double y1);
+  /* Reference counting of ud; either may be NULL (a static source). */
+  void (*retain)(void *ud);
+  void (*release)(void *ud);
+  void *ud;
+  double x0, y0, x1, y1; /* the domain: finite, x0 < x1, y0 < y1 */
+} oc_elevation;
+
+/* The source of a heightfield: its Catmull-Rom interpolant over the grid's
+** extent, with a min/max pyramid (per pair of cells, the hull of the
+** bicubic patches' Bezier coefficients) for ranges and slopes. Fills *src
+** holding one reference (drop it with src->release(src->ud)), which
+** retains hf. Returns OC_OK, or OC_ENOMEM with err. */
+int oc_heightfield_elevation(oc_heightfield *hf, oc_elevation *src,
+                             oc_error *err);
+
+typedef struct oc_terrain_params {
+  double falloff;    /* R > 0: the prism P = (Omega shrunk by R) x dz and
+                     ** the distance over which f falls to 0 outside it */
+  double transition; /* W > 0: half-width of sigma (0: 1 metre) */
+  int invert;        /* 1: solid above the surface (sigma(z - h)) */
+  double thickness;  /* >= 0: the prism's z-range, [min h, max h] in the
+                     ** paper, reaches this much farther on the solid side
+                     ** (below; above when inverted): deeper bedrock, or
+                     ** the top of a floating island's inverted underside */
+  /* NULL, or Omega = the nodes of this grid where mask >= 0.5 (and inside
+  ** the source's domain); f then falls off with the distance to the mask
+  ** shrunk by R. Retained by nothing: the node keeps a distance grid. */
+  const oc_heightfield *mask;
+} oc_terrain_params;
+
+/* The implicitization of seed 000 section 5.1: f = min(f_T, f_P) with
+** f_T = sigma(h(x, y) - z) (inverted: sigma(z - h)), sigma the odd cubic
+** of range [0, 2T], and f_P = 2T g(d(p, P) / R), P = (Omega shrunk by R)
+** x [min h, max h]. The surface f = T is z = h(x, y) wherever Omega
+** shrunk by R covers (x, y). The exact definition is in docs/fields.md.
+** Retains the source (src is copied). New reference or NULL with err. */
+oc_node *oc_terrain(const oc_elevation *src, const oc_terrain_params *tp,
+                    oc_error *err);
+
+/* ---- geology: resistance trees and the erosion node ----- */
+
+/* geology/geology.c and geology/erosion.c; docs/fields.md, "Geology", has the
+** formulas. A resistance tree is an ordinary node whose value is rock
+** resistance (0 softest, 1 hardest). Trees are not clamped as they are
+** built, so that blends add up as in seed 000 section 4.2: the erosion
+** node clamps what it reads to [0, 1], palettes clamp at their ends, and
+** oc_clamp() clamps a tree explicitly. Constructors return a new
+** reference, or NULL with err. */
+
+/* Horizontal strata: offset + amplitude * t(p_z / wavelength) / tmax, t
+** the turbulence along a vertical line, tmax = 2 - 2^(1 - octaves): the
+** value spans [offset, offset + amplitude]. Unbounded support. */
+oc_node *oc_strata(const oc_noise *noise, oc_error *err);
+
+/* clamp(f, lo, hi); lo < hi, both finite. Retains child. */
+oc_node *oc_clamp(oc_node *child, double lo, double hi, oc_error *err);
+
+/* A plane layer (seed 000 section 4.2): resistance * g(|d| / radius), d
+** the signed distance to the plane through origin with that normal, plus
+** the turbulence `noise` when not NULL (offset + amplitude t(p/wl)). Built
+** from two half-space primitives (an intersection for resistance >= 0, a
+** union below) blended with the turbulence. */
+oc_node *oc_geology_layer(oc_vec3 origin, oc_vec3 normal, double radius,
+                          double resistance, const oc_noise *noise,
+                          oc_error *err);
+
+/* Tapering: strata compressed by a factor that grows along a direction.
+** rho'(p) = rho(p + (k(u) - 1) clamp(s, -height, height) a), s = (p - o).a,
+** u = (p - o).b, k going from 1 at u = from to `factor` at u = to
+** (smoothstep, constant beyond). */
+typedef struct oc_taper_params {
+  oc_vec3 origin;
+  oc_vec3 axis;    /* a: the direction strata are compressed along */
+  oc_vec3 along;   /* b: the direction the compression grows along */
+  double from, to; /* positions along b from the origin; from != to */
+  double factor;   /* > 0: 2 squeezes the strata to half their thickness */
+  double height;   /* > 0: half-height of the compressed band along a */
+} oc_taper_params;
+oc_node *oc_taper(oc_node *child, const oc_taper_params *tp, oc_error *err);
+
+/* Fault (seed 000 section 4.4): rho(p - offset) strictly inside the
+** domain, rho(p) elsewhere; discontinuous on the domain's boundary, so its
+** global Lipschitz bound is infinite (local bounds of boxes that miss the
+** boundary stay finite). */
+typedef enum oc_fault_kind {
+  OC_FAULT_BOX = 0,  /* the open box lo < p < hi */
+  OC_FAULT_HALF = 1, /* the open half-space (p - origin).normal < 0 */
+  OC_FAULT_NODE = 2  /* where node's field > T (node retained) */
+} oc_fault_kind;
+typedef struct oc_fault_domain {
+  oc_fault_kind kind;
+  oc_vec3 lo, hi;         /* box */
+  oc_vec3 origin, normal; /* half-space */
+  oc_node *node;          /* node */
+} oc_fault_domain;
+oc_node *oc_fault(oc_node *child, const oc_fault_domain *dom, oc_vec3 offset,
+                  oc_error *err);
+
+/* Erosion node (seed 000 section 6): f~ = max(f - f_D (1 - rho^), min(f,
+** 0)), rho^ = clamp(geology, 0, 1), f_D = depth * clamp(control, 0, 1)
+** (depth everywhere when control is NULL). It only removes material: f~
+** <= f, and f~ = 0 wherever f = 0. depth > 0 is in field units. Retains
+** its three nodes. */
+oc_node *oc_erosion(oc_node *terrain, oc_node *geology, oc_node *control,
+                    double depth, oc_error *err);
 
 #ifdef __cplusplus
 }

@@ -5,12 +5,17 @@
 ** slice defaults: plane = "xz", at = 0, size = {256, 256}, box = the
 ** node's bounds on the plane's two axes (an error when they are infinite
 ** or empty). write: bits = 0 (the format's default: 8 for PNG/JPEG, 16
-** for TIFF, half floats for EXR).
+** for TIFF, half floats for EXR; 32 is float for TIFF and EXR); every
+** write stamps the provenance of l_provenance.h, and `meta = {k = v}`
+** adds the caller's own keys (both stay on the image for later writes).
 */
 #include <math.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "l_field.h"
 #include "l_image.h"
+#include "l_provenance.h"
 
 #define DEFAULT_SLICE_SIZE 256
 #define MAX_SLICE_SIZE 16384
@@ -28,10 +33,66 @@ oc_image *oclua_checkimage(lua_State *L, int idx, const char *fname) {
   return u->img;
 }
 
+/* ---- image:write options: meta ------------------------ */
+
+static int by_key(const void *a, const void *b) {
+  return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+/* Reads `meta = {key = "value", ...}` of the write options at f and sets
+** it on img, keys sorted so that the file's bytes do not follow the
+** table's traversal order. Provenance keys are the engine's to write. */
+static void set_user_meta(const oclua_fields *f, oc_image *img) {
+  lua_State *L = f->L;
+  oc_error err = {OC_OK, ""};
+  size_t n = 0, k = 0;
+  int m = lua_gettop(L) + 1;
+  int t = oclua_field_push(f, "meta");
+  if (t == LUA_TNIL) {
+    lua_pop(L, 1);
+    return;
+  }
+  if (t != LUA_TTABLE)
+    oclua_field_error(f, "meta", m, "must be a table {key = \"value\", ...}");
+  lua_pushnil(L);
+  while (lua_next(L, m)) {
+    int vt = lua_type(L, -1);
+    if (lua_type(L, -2) != LUA_TSTRING)
+      oclua_error(L, f->fname, "'meta' keys must be strings (got %s)",
+                  oclua_got(L, -2));
+    const char *key = lua_tostring(L, -2);
+    if (vt != LUA_TSTRING && vt != LUA_TNUMBER)
+      oclua_error(L, f->fname,
+                  "'meta.%s' must be a string or a number (got %s)", key,
+                  oclua_got(L, -1));
+    if (strncmp(key, "outcrop:", 8) == 0 ||
+        strcmp(key, OCLUA_META_SOFTWARE) == 0)
+      oclua_error(L, f->fname,
+                  "'meta.%s' is provenance, written by outcrop itself", key);
+    n++;
+    lua_pop(L, 1);
+  }
+  const char **keys = lua_newuserdatauv(L, (n ? n : 1) * sizeof *keys, 0);
+  lua_pushnil(L);
+  while (lua_next(L, m)) {
+    if (k < n) keys[k++] = lua_tostring(L, -2);
+    lua_pop(L, 1);
+  }
+  qsort(keys, k, sizeof *keys, by_key);
+  for (size_t i = 0; i < k; i++) {
+    lua_getfield(L, m, keys[i]);
+    const char *v = luaL_tolstring(L, -1, NULL);
+    if (oc_image_set_meta(img, keys[i], v, &err) != OC_OK)
+      oclua_error(L, f->fname, "'meta.%s': %s", keys[i], err.msg);
+    lua_pop(L, 2);
+  }
+  lua_settop(L, m - 1);
+}
+
 /* ---- methods --------------------------------------------------------- */
 
 static int image_write(lua_State *L) {
-  static const char *const known[] = {"bits", NULL};
+  static const char *const known[] = {"bits", "meta", NULL};
   const char *fname = "image:write";
   oc_image *img = oclua_checkimage(L, 1, fname);
   oc_error err = {OC_OK, ""};
@@ -39,13 +100,18 @@ static int image_write(lua_State *L) {
   if (lua_type(L, 2) != LUA_TSTRING)
     oclua_error(L, fname, "the path must be a string (got %s)",
                 oclua_got(L, 2));
-  oclua_checkargs(L, 3, fname, "(path [, {bits = 8 or 16}])");
-  if (!lua_isnoneornil(L, 3)) {
+  oclua_checkargs(L, 3, fname, "(path [, {bits = 8, 16 or 32, meta = {}}])");
+  lua_settop(L, 3);
+  oclua_stamp_provenance(L, img);
+  if (!lua_isnil(L, 3)) {
     oclua_fields f;
     oclua_fields_open(&f, L, 3, fname, NULL, known, 0);
-    bits = (int)oclua_field_optint(&f, "bits", 0, 16, 0);
-    if (bits != 0 && bits != 8 && bits != 16)
-      oclua_error(L, fname, "'bits' must be 8 or 16 (got %d)", bits);
+    bits = (int)oclua_field_optint(&f, "bits", -65536, 65536, 0);
+    if (bits != 0 && bits != 8 && bits != 16 && bits != 32)
+      oclua_error(L, fname,
+                  "'bits' must be 8 or 16, or 32 for TIFF and EXR (got %d)",
+                  bits);
+    set_user_meta(&f, img);
   }
   const char *path = oclua_output_path(L, fname, lua_tostring(L, 2));
   if (oc_image_write(img, path, bits, &err) != OC_OK) {

@@ -27,15 +27,13 @@
 
 #include "l_field.h"
 #include "l_mesh.h"
+#include "l_progress.h"
 
 #define DEFAULT_RESOLUTION 64 /* cells along the longest side */
 #define MAX_CELLS (1 << 20)   /* per axis, as the lib allows */
 #define DEFAULT_STEPS 6
 #define MAX_STEPS 64
 #define MAX_STOPS 65536
-/* A progress line appears only for work that lasts, so quick meshes do
-** not flicker on the terminal. */
-#define PROGRESS_DELAY 0.5
 
 static oclua_mesh *newmesh(lua_State *L) {
   oclua_mesh *u = lua_newuserdatauv(L, sizeof *u, 0);
@@ -329,44 +327,6 @@ static int mesh_tostring(lua_State *L) {
   return 1;
 }
 
-/* ---- progress -------------------------------------------------------- */
-
-typedef struct progress_line {
-  const char *fname;
-  struct timespec start;
-  int shown; /* percentage on the line, or -1 while nothing is shown */
-  int tty;   /* stderr is a terminal: draw the line */
-  volatile sig_atomic_t *stop; /* the interpreter's Ctrl-C flag, or NULL */
-} progress_line;
-
-static double seconds_since(const struct timespec *t0) {
-  struct timespec t;
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return (double)(t.tv_sec - t0->tv_sec) +
-         1e-9 * (double)(t.tv_nsec - t0->tv_nsec);
-}
-
-/* Called by the lib from one thread, not necessarily the Lua state's, so
-** it touches nothing but the line and the Ctrl-C flag, which cancels. */
-static int show_progress(void *ud, double fraction) {
-  progress_line *pl = ud;
-  if (pl->stop && *pl->stop) return 1;
-  if (!pl->tty) return 0;
-  int pct = fraction > 0 ? (fraction < 1 ? (int)(fraction * 100) : 100) : 0;
-  if (pct != pl->shown && seconds_since(&pl->start) >= PROGRESS_DELAY) {
-    fprintf(stderr, "\r%s: %3d %%", pl->fname, pct);
-    fflush(stderr);
-    pl->shown = pct;
-  }
-  return 0;
-}
-
-static void clear_progress(const progress_line *pl) {
-  if (pl->shown < 0) return;
-  fprintf(stderr, "\r%*s\r", (int)strlen(pl->fname) + 8, "");
-  fflush(stderr);
-}
-
 /* ---- outcrop.polygonize ---------------------------------------------- */
 
 static int field_resolution(const oclua_fields *f, int res[3]) {
@@ -398,7 +358,7 @@ static int l_polygonize(lua_State *L) {
   oclua_fields f;
   oc_error err = {OC_OK, ""};
   oc_polygonize_params pp;
-  progress_line pl = {fname, {0, 0}, -1, 0, NULL};
+  oclua_progress pl;
   colors c;
   double box[6], cell, t;
   int res[3] = {0, 0, 0}, hasbox, hasres, open, steps, full_grid;
@@ -465,20 +425,12 @@ static int l_polygonize(lua_State *L) {
   pp.open = open;
   pp.steps = steps;
   pp.full_grid = full_grid;
-  pl.tty = isatty(2);
-  if (lua_getfield(L, LUA_REGISTRYINDEX, OCLUA_INTERRUPT) == LUA_TLIGHTUSERDATA)
-    pl.stop = (volatile sig_atomic_t *)lua_touserdata(L, -1);
-  lua_pop(L, 1);
-  if (pl.tty || pl.stop) {
-    clock_gettime(CLOCK_MONOTONIC, &pl.start);
-    pp.progress.fn = show_progress;
-    pp.progress.ud = &pl;
-  }
+  pp.progress = oclua_progress_start(L, &pl, fname);
   /* The userdata first, so that nothing can leak once the mesh exists. */
   oclua_mesh *u = newmesh(L);
   int midx = lua_gettop(L);
   u->mesh = oc_polygonize(prog, &pp, &err);
-  clear_progress(&pl);
+  oclua_progress_end(&pl);
   if (u->mesh == NULL && err.code == OC_ECANCEL)
     return luaL_error(L, "interrupted");
   if (u->mesh == NULL) oclua_liberror(L, fname, &err);

@@ -13,8 +13,13 @@
 #include <string.h>
 
 #include "l_field.h"
+#include "l_geology.h"
+#include "l_heightfield.h"
 #include "l_image.h"
 #include "l_mesh.h"
+#include "l_render.h"
+#include "l_terrain.h"
+#include "l_gen.h"
 
 /* outcrop.param(name, default): the --set value for name, as a number
 ** when it reads as one ("3", "1e-2", "0x10"), a boolean for "true" and
@@ -79,6 +84,11 @@ int luaopen_outcrop(lua_State *L) {
   oclua_open_ops(L);
   oclua_open_image(L);
   oclua_open_mesh(L);
+  oclua_open_heightfield(L); /* outcrop.heightfield */
+  oclua_open_render(L);
+  oclua_open_terrain(L); /* outcrop.terrain */
+  oclua_open_gen(L);     /* outcrop.poisson2d/3d */
+  oclua_open_geology(L); /* outcrop.geology, outcrop.erosion */
   lua_pushliteral(L, OC_VERSION);
   lua_setfield(L, -2, "version");
   lua_pushnumber(L, OC_DEFAULT_THRESHOLD);

@@ -52,6 +52,9 @@ std::string oneline(std::string s) {
 /* String attributes the TIFF and JPEG writers store in a tag of their
 ** own; any other key would be silently dropped by those writers. */
 bool native_text(const char *format, const char *key) {
+  /* OpenImageIO's own attributes (the writer's colour space tag) are
+  ** settings every writer understands, not text to fold */
+  if (strncasecmp(key, "oiio:", 5) == 0) return true;
   static const char *const tiff[] = {
       "Artist",       "Copyright",    "DateTime",
       "DocumentName", "HostComputer", "ImageDescription",

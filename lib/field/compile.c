@@ -17,9 +17,11 @@
 #include "core/falloff.h"
 #include "core/noise.h"
 #include "core/vec.h"
+#include "geology/geology.h"
 #include "field/node.h"
 #include "field/prim.h"
 #include "field/program.h"
+#include "terrain/terrain.h"
 
 /* Groups with at least this many plain point children store them inline
 ** in single precision; smaller groups keep every child as a double op. */
@@ -112,7 +114,7 @@ typedef struct info {
 
 typedef struct comp {
   oc_program *P;
-  size_t capops, cappar, capkids, capent, capbvh;
+  size_t capops, cappar, capkids, capent, capbvh, capterr;
   info *inf; /* parallel to ops */
   size_t capinf;
   pmap memo;
@@ -260,6 +262,30 @@ static uint32_t pack_noise(comp *c, const oc_noise *nz) {
                  (double)(nz->seed >> 32),
                  (double)(nz->seed & 0xffffffffu)};
   return add_par(c, v, 6);
+}
+
+/* The terrain's data stays with its node (the program retains the root);
+** the op holds sigma's constants for this T and the data's index. */
+static uint32_t compile_terrain(comp *c, const oc_node *n) {
+  const oc_tdata *t = n->terrain;
+  oc_program *P = c->P;
+  double par[OC_TPAR_N];
+  oc_terrain_sigma(c->T, t->W, par);
+  uint32_t at = add_par(c, par, OC_TPAR_N);
+  uint32_t op = new_op(c, OC_K_TERRAIN);
+  if (at == OC_NONE || op == OC_NONE ||
+      !GROW(P->terr, P->nterr, c->capterr, 1)) {
+    nomem(c);
+    return OC_NONE;
+  }
+  P->ops[op].par = at;
+  P->ops[op].kid = (uint32_t)P->nterr;
+  P->terr[P->nterr++] = t;
+  c->inf[op].lo = 0;
+  c->inf[op].hi = 2 * c->T;
+  c->inf[op].lip = oc_terrain_lipschitz(t, P->par + at);
+  set_box(c, op, oc_terrain_box(t));
+  return op;
 }
 
 static uint32_t compile_turb(comp *c, const oc_node *n) {
@@ -807,6 +833,28 @@ static uint32_t compile_perturb(comp *c, const oc_node *n) {
   return op;
 }
 
+/* ---- geology kinds (the formulas are in geology/geology.c) --- */
+
+static uint32_t compile_geo(comp *c, const oc_node *n) {
+  uint32_t k[3];
+  oc_geo_info ki[3], out;
+  double par[OC_GP_COUNT];
+  if (n->nkids > 3) return (uint32_t)nomem(c), OC_NONE;
+  for (size_t i = 0; i < n->nkids; i++) {
+    if ((k[i] = compile_node(c, n->kids[i])) == OC_NONE) return OC_NONE;
+    info *ci = &c->inf[k[i]];
+    ki[i] = (oc_geo_info){ci->box, ci->lo, ci->hi, ci->lip};
+  }
+  size_t np = oc_geo_compile(n, c->T, ki, par, &out);
+  uint32_t op = emit(c, n->kind, k, n->nkids, par, np);
+  if (op == OC_NONE) return op;
+  c->inf[op].lo = out.lo;
+  c->inf[op].hi = out.hi;
+  c->inf[op].lip = out.lip;
+  set_box(c, op, out.box);
+  return op;
+}
+
 static uint32_t compile_node(comp *c, const oc_node *n) {
   uint32_t *memo = pmap_slot(&c->memo, n, 0);
   if (memo) return *memo;
@@ -821,6 +869,10 @@ static uint32_t compile_node(comp *c, const oc_node *n) {
   switch (n->kind) {
   case OC_K_TURB:
     op = compile_turb(c, n);
+    break;
+  case OC_K_TERRAIN:
+    op = compile_terrain(c, n);
+    if (op != OC_NONE) c->inf[op].depth = 1;
     break;
   case OC_K_BLEND:
   case OC_K_UNION:
@@ -849,6 +901,13 @@ static uint32_t compile_node(comp *c, const oc_node *n) {
     break;
   case OC_K_PERTURB:
     op = compile_perturb(c, n);
+    break;
+  case OC_K_STRATA:
+  case OC_K_CLAMP:
+  case OC_K_TAPER:
+  case OC_K_FAULT:
+  case OC_K_EROSION:
+    op = compile_geo(c, n);
     break;
   default:
     op = compile_prim(c, n);
@@ -948,7 +1007,8 @@ oc_program *oc_compile(oc_node *root, const oc_compile_options *opts,
   P->stats.primitives = np;
   P->stats.bytes = sizeof *P + P->nops * sizeof *P->ops +
                    P->npar * sizeof *P->par + P->nkids * sizeof *P->kids +
-                   P->nent * sizeof *P->ent + P->nbvh * sizeof *P->bvh;
+                   P->nent * sizeof *P->ent + P->nbvh * sizeof *P->bvh +
+                   P->nterr * sizeof *P->terr;
   free(c.inf);
   pmap_free(&c.memo);
   return P;
@@ -961,6 +1021,7 @@ void oc_program_free(oc_program *P) {
   free(P->kids);
   free(P->ent);
   free(P->bvh);
+  free(P->terr);
   oc_node_release(P->node);
   free(P);
 }

@@ -9,8 +9,10 @@
 #include "core/noise.h"
 #include "core/rng.h"
 #include "core/vec.h"
+#include "geology/geology.h"
 #include "field/prim.h"
 #include "field/program.h"
+#include "terrain/terrain.h"
 
 #define BVH_STACK 64
 
@@ -28,6 +30,11 @@ static noisep unpack_noise(const double *v) {
 
 static double ev(const oc_program *P, uint32_t i, oc_vec3 p);
 static double evg(const oc_program *P, uint32_t i, oc_vec3 p, oc_vec3 *g);
+
+/* Children of the geology kinds (geology/geology.c) */
+static double ev_kid(const oc_program *P, uint32_t i, oc_vec3 p, oc_vec3 *g) {
+  return g ? evg(P, i, p, g) : ev(P, i, p);
+}
 
 static inline int in_op_box(const oc_op *o, oc_vec3 p) {
   return p.x >= o->lo[0] && p.x <= o->hi[0] && p.y >= o->lo[1] &&
@@ -341,6 +348,14 @@ static double ev(const oc_program *P, uint32_t i, oc_vec3 p) {
     return ev(P, P->kids[o->kid], affine(par + OC_P_INV, p));
   case OC_K_PERTURB:
     return perturb(o, par, p);
+  case OC_K_TERRAIN:
+    return oc_terrain_eval(P->terr[o->kid], par, p, NULL);
+  case OC_K_STRATA:
+  case OC_K_CLAMP:
+  case OC_K_TAPER:
+  case OC_K_FAULT:
+  case OC_K_EROSION:
+    return oc_geo_eval(P, o, p, NULL, ev_kid);
   default:
     return prim((oc_kind)o->kind, par, p, NULL);
   }
@@ -426,6 +441,14 @@ static double evg(const oc_program *P, uint32_t i, oc_vec3 p, oc_vec3 *g) {
     *g = oc_mul(oc_v3(gx, gy, gz), 0.5 / h);
     return v;
   }
+  case OC_K_TERRAIN:
+    return oc_terrain_eval(P->terr[o->kid], par, p, g);
+  case OC_K_STRATA:
+  case OC_K_CLAMP:
+  case OC_K_TAPER:
+  case OC_K_FAULT:
+  case OC_K_EROSION:
+    return oc_geo_eval(P, o, p, g, ev_kid);
   default:
     return prim((oc_kind)o->kind, par, p, g);
   }

@@ -8,17 +8,19 @@
 #include "core/error.h"
 #include "core/vec.h"
 #include "field/node.h"
+#include "terrain/terrain.h"
 
 static const char *const kind_names[OC_K_COUNT] = {
-    "point",        "sphere",
-    "box",          "segment",
-    "curve",        "cone",
-    "plane",        "turbulence",
-    "blend",        "union",
-    "intersection", "difference",
-    "smooth_union", "smooth_intersection",
-    "scale",        "warp",
-    "transform",    "perturb"};
+    "point",      "sphere",       "box",
+    "segment",    "curve",        "cone",
+    "plane",      "turbulence",   "terrain",
+    "blend",      "union",        "intersection",
+    "difference", "smooth_union", "smooth_intersection",
+    "scale",      "warp",         "transform",
+    "perturb",
+
+    "strata",     "clamp",        "taper",
+    "fault",      "erosion"};
 
 const char *oc_kind_name(oc_kind kind) {
   return (unsigned)kind < OC_K_COUNT ? kind_names[kind] : "?";
@@ -58,6 +60,7 @@ void oc_node_retain(oc_node *node) {
 static void free_one(oc_node *n) {
   if (n->kids != n->inl) free(n->kids);
   free(n->pts);
+  oc_tdata_free(n->terrain);
   free(n);
 }
 

@@ -18,7 +18,8 @@ typedef enum oc_kind {
   OC_K_CURVE,
   OC_K_CONE,
   OC_K_PLANE,
-  OC_K_TURB, /* offset + A t(p / wavelength) */
+  OC_K_TURB,    /* offset + A t(p / wavelength) */
+  OC_K_TERRAIN, /* implicitized elevation (terrain.c) */
   /* operators */
   OC_K_BLEND,
   OC_K_UNION,
@@ -30,12 +31,18 @@ typedef enum oc_kind {
   OC_K_WARP,
   OC_K_XFORM,
   OC_K_PERTURB,
+  /* geology and erosion (geology/geology.c, geology/erosion.c) */
+  OC_K_STRATA,  /* primitive: offset + A t(p_z / wavelength) / tmax */
+  OC_K_CLAMP,   /* clamp(f, lo, hi) */
+  OC_K_TAPER,   /* strata compressed along an axis */
+  OC_K_FAULT,   /* child translated strictly inside a domain */
+  OC_K_EROSION, /* max(f - f_D (1 - rho), min(f, 0)) */
   OC_K_COUNT
 } oc_kind;
 
 /* Skeletal/volumetric primitives whose field is E g(d / R). */
 #define OC_KIND_IS_DIST(k) ((k) <= OC_K_PLANE)
-#define OC_KIND_IS_PRIM(k) ((k) <= OC_K_TURB)
+#define OC_KIND_IS_PRIM(k) ((k) <= OC_K_TERRAIN || (k) == OC_K_STRATA)
 
 /* Parameter slots in oc_node.par, by kind. Every distance primitive has
 ** E at 0 and R (falloff radius) at 1. */
@@ -74,6 +81,7 @@ struct oc_node {
   oc_vec3 *pts;   /* curve: the polyline (Beziers already flattened) */
   size_t npts;
   oc_node *inl[2]; /* small inline child storage to avoid an allocation */
+  struct oc_tdata *terrain; /* terrain: source, prism, mask distances */
 };
 
 /* Allocates a node with refs = 1 and room for nkids children (retained

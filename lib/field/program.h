@@ -58,6 +58,9 @@ struct oc_program {
   size_t nent;
   oc_bvhnode *bvh;
   size_t nbvh;
+  const struct oc_tdata **terr; /* terrain ops' data (op.kid indexes it;
+                                ** owned by the retained nodes) */
+  size_t nterr;
   double T;
   oc_aabb bounds;
   double lip;

@@ -10,8 +10,10 @@
 #include "core/falloff.h"
 #include "core/noise.h"
 #include "core/vec.h"
+#include "geology/geology.h"
 #include "field/prim.h"
 #include "field/program.h"
+#include "terrain/terrain.h"
 
 #define SPAN_CAP 64
 #define BVH_STACK 64
@@ -21,7 +23,10 @@
 typedef struct spans {
   oc_zspan s[SPAN_CAP];
   int n;
-  int all; /* the whole column */
+  int all;     /* the whole column */
+  int nleaf;   /* ops met other than blends and unions */
+  uint32_t hf; /* a heightfield-like op met through blends and unions only,
+               ** governing its column alone where nothing else is met */
 } spans;
 
 /* Keeps spans sorted and disjoint; past the capacity, merges the two
@@ -129,12 +134,14 @@ static void plane_spans(const double *par, const foot *f, spans *S) {
 }
 
 static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
-                     int depth);
+                     int depth, int direct);
 
+/* `direct`: every operator above is a blend or a union, whose value is
+** the child's own where the other children are 0. */
 static void group_spans(const oc_program *P, const oc_op *o, const foot *f,
-                        spans *S, int depth) {
+                        spans *S, int depth, int direct) {
   for (uint32_t k = 0; k < o->nkid && !S->all; k++)
-    op_spans(P, P->kids[o->kid + k], f, S, depth + 1);
+    op_spans(P, P->kids[o->kid + k], f, S, depth + 1, direct);
   if (!o->nent || S->all) return;
   uint32_t stack[BVH_STACK];
   int sp = 0;
@@ -146,13 +153,14 @@ static void group_spans(const oc_program *P, const oc_op *o, const foot *f,
       for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
         const oc_ent *e = &P->ent[j];
         if (e->ref != OC_NONE) {
-          op_spans(P, e->ref, f, S, depth + 1);
+          op_spans(P, e->ref, f, S, depth + 1, direct);
           continue;
         }
         double R = 1.0 / sqrt((double)e->ir2) * (1 + 1e-6);
         if (e->c[0] - R > f->x1 || e->c[0] + R < f->x0 || e->c[1] - R > f->y1 ||
             e->c[1] + R < f->y0)
           continue;
+        S->nleaf++;
         span_add(S, e->c[2] - R, e->c[2] + R);
       }
     } else if (sp + 2 <= BVH_STACK) {
@@ -168,7 +176,7 @@ static int column_preserving(const double *m) {
 }
 
 static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
-                     int depth) {
+                     int depth, int direct) {
   const oc_op *o = &P->ops[i];
   if (S->all) return;
   if (depth > OC_MAX_DEPTH + 8) {
@@ -177,16 +185,39 @@ static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
   }
   if (!foot_meets(o->lo, o->hi, f)) return; /* f == 0 over the column */
   const double *par = P->par + o->par;
+  if (o->kind != OC_K_BLEND && o->kind != OC_K_UNION) S->nleaf++;
   switch ((oc_kind)o->kind) {
   case OC_K_PLANE:
     plane_spans(par, f, S);
+    if (direct) S->hf = i;
+    return;
+  case OC_K_TERRAIN:
+    if (oc_terrain_spans(P->terr[o->kid], par, f->x0, f->y0, f->x1, f->y1,
+                         span_add_v, S) &&
+        direct)
+      S->hf = i;
     return;
   case OC_K_TURB:
     S->all = 1;
     return;
+  case OC_K_STRATA:
+  case OC_K_CLAMP:
+  case OC_K_TAPER:
+  case OC_K_FAULT:
+  case OC_K_EROSION: { /* geology/geology.c */
+    double zlo, zhi;
+    int r = oc_geo_column(P, o, f->x0, f->y0, f->x1, f->y1, &zlo, &zhi);
+    if (r < 0) {
+      S->all = 1;
+      return;
+    }
+    if (r > 0) span_add(S, zlo, zhi);
+    op_spans(P, P->kids[o->kid], f, S, depth + 1, 0);
+    return;
+  }
   case OC_K_BLEND:
   case OC_K_UNION:
-    group_spans(P, o, f, S, depth);
+    group_spans(P, o, f, S, depth, direct);
     return;
   case OC_K_INTER:
   case OC_K_DIFF:
@@ -195,7 +226,7 @@ static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
   case OC_K_SCALE:
     if (o->kind == OC_K_SCALE && par[0] == 0) return;
     for (uint32_t k = 0; k < o->nkid && !S->all; k++)
-      op_spans(P, P->kids[o->kid + k], f, S, depth + 1);
+      op_spans(P, P->kids[o->kid + k], f, S, depth + 1, 0);
     return;
   case OC_K_WARP: {
     /* the child's spans around the displaced column, grown by the
@@ -203,7 +234,7 @@ static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
     double A = fabs(par[1]) * oc_turb3_max((int)par[3]) / 2;
     foot g = {f->x0 - A, f->y0 - A, f->x1 + A, f->y1 + A};
     spans C = {.n = 0, .all = 0};
-    op_spans(P, P->kids[o->kid], &g, &C, depth + 1);
+    op_spans(P, P->kids[o->kid], &g, &C, depth + 1, 0);
     if (C.all) {
       S->all = 1;
       return;
@@ -228,7 +259,7 @@ static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
           g.y1 = fmax(g.y1, v);
         }
       spans C = {.n = 0, .all = 0};
-      op_spans(P, P->kids[o->kid], &g, &C, depth + 1);
+      op_spans(P, P->kids[o->kid], &g, &C, depth + 1, 0);
       if (C.all) {
         S->all = 1;
         return;
@@ -261,13 +292,16 @@ static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
   }
 }
 
-int oc_program_column_spans(const oc_program *P, double x0, double y0,
-                            double x1, double y1, oc_zspan *out, int max) {
+int oc_program_column_query(const oc_program *P, double x0, double y0,
+                            double x1, double y1, oc_zspan *out, int max,
+                            uint32_t *hf) {
+  if (hf) *hf = OC_NONE;
   if (!(x0 <= x1 && y0 <= y1) || max < 1) return -1;
   foot f = {x0, y0, x1, y1};
-  spans S = {.n = 0, .all = 0};
-  op_spans(P, P->root, &f, &S, 0);
+  spans S = {.n = 0, .all = 0, .nleaf = 0, .hf = OC_NONE};
+  op_spans(P, P->root, &f, &S, 0, 1);
   if (S.all) return -1;
+  if (hf && S.nleaf == 1) *hf = S.hf;
   /* reduce to max spans by closing the smallest gaps */
   while (S.n > max) {
     int best = 0;
@@ -285,6 +319,11 @@ int oc_program_column_spans(const oc_program *P, double x0, double y0,
   for (int k = 0; k < S.n; k++)
     out[k] = S.s[k];
   return S.n;
+}
+
+int oc_program_column_spans(const oc_program *P, double x0, double y0,
+                            double x1, double y1, oc_zspan *out, int max) {
+  return oc_program_column_query(P, x0, y0, x1, y1, out, max, NULL);
 }
 
 /* ---- local Lipschitz bounds --------------------------------------------- */
@@ -306,6 +345,15 @@ static double box_far2(const oc_aabb *b, double x, double y, double z) {
   double dy = fmax(fabs(b->lo.y - y), fabs(b->hi.y - y));
   double dz = fmax(fabs(b->lo.z - z), fabs(b->hi.z - z));
   return dx * dx + dy * dy + dz * dz;
+}
+
+static double op_lip(const oc_program *P, uint32_t i, const oc_aabb *b,
+                     int depth);
+
+/* A child's bound, for the geology kinds; ud is the depth. */
+static double geo_lip(const oc_program *P, uint32_t i, const oc_aabb *b,
+                      void *ud) {
+  return op_lip(P, i, b, *(const int *)ud + 1);
 }
 
 static double op_lip(const oc_program *P, uint32_t i, const oc_aabb *b,
@@ -388,6 +436,12 @@ static double op_lip(const oc_program *P, uint32_t i, const oc_aabb *b,
     if (r > 0 && box_far2(b, cx, cy, cz) < r * r * (1 - 1e-9)) return 0;
     return o->lip;
   }
+  case OC_K_TERRAIN:
+    return fmin(oc_terrain_lipschitz_in(P->terr[o->kid], par, b), o->lip);
+  case OC_K_CLAMP:
+  case OC_K_FAULT:
+  case OC_K_EROSION:
+    return oc_geo_lipschitz_in(P, o, b, geo_lip, &depth);
   default: /* primitives, perturb, warp, smooth operators: their bound */
     return o->lip;
   }

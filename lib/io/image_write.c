@@ -4,6 +4,7 @@
 ** temporary name in the same folder, then rename) so that no reader ever
 ** sees a partial file under the final name.
 */
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -78,6 +79,30 @@ static double unit(float x) {
   return x > 0.0f ? (x < 1.0f ? x : 1.0) : 0.0;
 }
 
+/* ---- linear images (renders) ------------------------------------------
+** An image whose metadata says outcrop:colorspace=linear holds linear
+** light (the renderer's output). Integer files are display-referred, so
+** its colour channels go through the sRGB transfer function there and the
+** file is tagged sRGB; float files (EXR, float TIFF) keep linear values
+** and are tagged linear. Alpha and any other channel stay as they are. */
+
+#define LINEAR_KEY "outcrop:colorspace"
+
+static int is_linear(const oc_image *img) {
+  const char *v = oc_image_meta_get(img, LINEAR_KEY);
+  return v && strcasecmp(v, "linear") == 0;
+}
+
+/* The sRGB encoding (IEC 61966-2-1) of a linear value in [0, 1]. */
+static double srgb(double x) {
+  return x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1 / 2.4) - 0.055;
+}
+
+/* Number of leading colour channels: grey (+ alpha) or RGB (+ alpha). */
+static int colour_channels(int nch) {
+  return nch >= 3 ? 3 : 1;
+}
+
 /* The buffer handed to the bridge: `img`'s own pixels when they can go
 ** as they are, else a converted copy of the first `nch` channels. */
 static const void *samples(const oc_image *img, int nch, oc_oiio_type t,
@@ -90,14 +115,19 @@ static const void *samples(const oc_image *img, int nch, oc_oiio_type t,
   size_t size = t == OC_OIIO_U8 ? 1 : t == OC_OIIO_U16 ? 2 : sizeof(float);
   void *buf = malloc(npix * nch * size);
   if (!buf) return NULL;
+  int ncol = is_linear(img) && (t == OC_OIIO_U8 || t == OC_OIIO_U16)
+                 ? colour_channels(nch)
+                 : 0;
   for (size_t p = 0; p < npix; p++) {
     const float *s = src + p * stride;
     for (int c = 0; c < nch; c++) {
       size_t i = p * nch + c;
+      double v = unit(s[c]);
+      if (c < ncol) v = srgb(v);
       if (t == OC_OIIO_U8)
-        ((uint8_t *)buf)[i] = (uint8_t)(unit(s[c]) * 255.0 + 0.5);
+        ((uint8_t *)buf)[i] = (uint8_t)(v * 255.0 + 0.5);
       else if (t == OC_OIIO_U16)
-        ((uint16_t *)buf)[i] = (uint16_t)(unit(s[c]) * 65535.0 + 0.5);
+        ((uint16_t *)buf)[i] = (uint16_t)(v * 65535.0 + 0.5);
       else
         ((float *)buf)[i] = s[c];
     }
@@ -146,7 +176,8 @@ int oc_image_write(const oc_image *img, const char *path, int bits,
   for (int c = 0; c < nch; c++)
     names[c] = oc_image_channel_name(img, c);
   size_t nmeta = oc_image_meta_count(img);
-  const char **meta = malloc((2 * nmeta + 1) * sizeof *meta);
+  /* one more pair: the colour space tag of linear images */
+  const char **meta = malloc((2 * nmeta + 2) * sizeof *meta);
   void *owned = NULL;
   const void *px = meta ? samples(img, nch, (oc_oiio_type)t, &owned) : NULL;
   if (!px) {
@@ -156,6 +187,12 @@ int oc_image_write(const oc_image *img, const char *path, int bits,
   for (size_t i = 0; i < nmeta; i++) {
     meta[2 * i] = oc_image_meta_key(img, i);
     meta[2 * i + 1] = oc_image_meta_value(img, i);
+  }
+  if (is_linear(img)) {
+    int integer = t == OC_OIIO_U8 || t == OC_OIIO_U16;
+    meta[2 * nmeta] = "oiio:ColorSpace";
+    meta[2 * nmeta + 1] = integer ? "sRGB" : "Linear";
+    nmeta++;
   }
   oc_oiio_out out = {
       .format = oiio_names[k],

@@ -15,6 +15,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "field/column.h"
 #include "mesh/mcwork.h"
 
 #define MAXSPANS 16
@@ -53,16 +54,43 @@ int oc_mc_band(const oc_mcgrid *g, int ja, int jb, int jr, oc_mcwork *w) {
   size_t ncol = (size_t)(jr - ja + 1) * (size_t)(nx + 1);
   if (oc_mc_rlist_columns(&w->cube, ncol) || oc_mc_rlist_columns(&w->var, ncol))
     return -1;
-  oc_zspan sp[MAXSPANS];
+  /* direct sample columns: sample column (i, j) is direct when the
+  ** footprint of cube column (i, j), which covers its four edges, is
+  ** governed by one heightfield-like op alone (mcdirect.c) */
+  size_t nsc = (size_t)(jb - ja + 1) * (size_t)(nx + 2);
+  if (g->direct) {
+    if (oc_mc_grow(&w->dsurf, &w->capdsurf, nsc, sizeof *w->dsurf) ||
+        oc_mc_grow(&w->delev, &w->capdelev, 3 * nsc, sizeof *w->delev))
+      return -1;
+    for (size_t q = 0; q < nsc; q++)
+      w->dsurf[q] = NULL;
+  }
+  oc_zspan sp[MAXSPANS], lsp[2];
   size_t c = 0;
   for (int j = ja; j <= jr; j++) {
     for (int i = -1; i < nx; i++, c++) {
       size_t fc = w->cube.n, fv = w->var.n;
       int ns = -1;
-      if (!g->full)
-        ns = oc_program_column_spans(
-            g->prog, oc_mc_coord(g, 0, i - 1), oc_mc_coord(g, 1, j - 1),
-            oc_mc_coord(g, 0, i + 2), oc_mc_coord(g, 1, j + 2), sp, MAXSPANS);
+      uint32_t hf = OC_MC_NONE;
+      double fx0 = oc_mc_coord(g, 0, i - 1), fy0 = oc_mc_coord(g, 1, j - 1);
+      double fx1 = oc_mc_coord(g, 0, i + 2), fy1 = oc_mc_coord(g, 1, j + 2);
+      if (!g->full || g->direct)
+        ns = oc_program_column_query(g->prog, fx0, fy0, fx1, fy1, sp, MAXSPANS,
+                                     g->nsurf ? &hf : NULL);
+      if (g->full) ns = -1;
+      const struct oc_hfsurf *hs =
+          hf != OC_MC_NONE ? oc_mc_surface(g, hf) : NULL;
+      if (g->direct && i >= 0 && j >= 0 && hs && oc_mc_direct_kind(hs))
+        w->dsurf[(size_t)(j - ja) * (nx + 2) + (size_t)(i + 1)] = hs;
+      /* cubes: where the field may vary, or, in a column one surface
+      ** governs alone, only where that surface may be (seed 000's exact
+      ** elevation bounds): elsewhere no sample is on the other side */
+      const oc_zspan *csp = sp;
+      int ncs = ns;
+      if (hs && ns >= 0) {
+        ncs = oc_hfsurf_level_spans(hs, fx0, fy0, fx1, fy1, lsp);
+        csp = lsp;
+      }
       int side = i == -1 || i == nx - 1 || j == -1 || j == ny - 1;
       int whole = ns < 0 || (side && !g->open);
       if (j < jb) {
@@ -70,10 +98,10 @@ int oc_mc_band(const oc_mcgrid *g, int ja, int jb, int jr, oc_mcwork *w) {
           if (oc_mc_rlist_add(&w->cube, fc, -1, nz - 1)) return -1;
         } else {
           if (!g->open && oc_mc_rlist_add(&w->cube, fc, -1, -1)) return -1;
-          for (int s = 0; s < ns; s++) {
+          for (int s = 0; s < ncs; s++) {
             oc_mc_irange cr, sr;
-            if (!(sp[s].lo <= sp[s].hi)) continue;
-            span_ranges(g, sp[s].lo, sp[s].hi, &cr, &sr);
+            if (!(csp[s].lo <= csp[s].hi)) continue;
+            span_ranges(g, csp[s].lo, csp[s].hi, &cr, &sr);
             if (oc_mc_rlist_add(&w->cube, fc, cr.lo, cr.hi)) return -1;
           }
           if (!g->open && oc_mc_rlist_add(&w->cube, fc, nz - 1, nz - 1))
@@ -131,6 +159,17 @@ static int block_uniform(const oc_mcgrid *g, const int c0[3], const int c1[3],
   return 0;
 }
 
+/* Whether sample columns i0 .. i1 of rows j0 .. j1 are all direct. */
+static int all_direct(const oc_mcgrid *g, const oc_mcwork *w, int ja, int i0,
+                      int i1, int j0, int j1) {
+  if (!g->direct) return 0;
+  for (int j = j0; j <= j1; j++)
+    for (int i = i0; i <= i1; i++)
+      if (!w->dsurf[(size_t)(j - ja) * (g->n[0] + 2) + (size_t)(i + 1)])
+        return 0;
+  return 1;
+}
+
 int oc_mc_cull(const oc_mcgrid *g, int ja, int jb, oc_mcwork *w,
                size_t *calls) {
   int nx = g->n[0], nz = g->n[2];
@@ -142,6 +181,12 @@ int oc_mc_cull(const oc_mcgrid *g, int ja, int jb, oc_mcwork *w,
     for (int bu = 0; bu < nbu; bu++, bc++) {
       int i0 = bu * B - 1, i1 = i0 + B - 1 < nx - 1 ? i0 + B - 1 : nx - 1;
       size_t first = w->cull.n;
+      /* direct columns cost no field call: culling them would cost more
+      ** than it saves */
+      if (all_direct(g, w, ja, i0, i1 + 1, j0, j1 + 1)) {
+        w->cull.at[bc + 1] = w->cull.n;
+        continue;
+      }
       /* union of the block column's cube ranges */
       size_t nt = 0;
       for (int j = j0; j <= j1; j++) {
@@ -149,7 +194,8 @@ int oc_mc_cull(const oc_mcgrid *g, int ja, int jb, oc_mcwork *w,
         size_t a = w->cube.at[c], e = w->cube.at[c + (size_t)(i1 - i0) + 1];
         if (oc_mc_grow(&w->tmp, &w->capt, nt + (e - a), sizeof *w->tmp))
           return -1;
-        memcpy(w->tmp + nt, w->cube.r + a, (e - a) * sizeof *w->tmp);
+        if (e > a) /* w->tmp may still be NULL */
+          memcpy(w->tmp + nt, w->cube.r + a, (e - a) * sizeof *w->tmp);
         nt += e - a;
       }
       oc_mc_sort_ranges(w->tmp, nt);

@@ -41,6 +41,12 @@ typedef struct oc_mcgrid {
   int open;           /* padding samples on the faces, no caps */
   int full;           /* ignore surface bounds */
   size_t max_samples; /* per-slab sample budget (memory guard) */
+  /* the surfaces of the heightfield-like ops at T, sorted by op: they
+  ** narrow the band to the surface in the columns they govern alone
+  ** (mcband.c), and give direct elevation extraction (mcdirect.c) */
+  const struct oc_hfsurf *surf;
+  size_t nsurf;
+  int direct; /* direct extraction: on, and some surface allows it */
 } oc_mcgrid;
 
 /* Coordinate of sample i on axis a; padding indices (and beyond) map to
@@ -90,5 +96,17 @@ int oc_mc_slab(const oc_mcgrid *g, int ja, int jb, oc_mcwork *w, oc_mcout *out,
 ** average of the vertex's triangles. */
 int oc_mc_vertex(const oc_mcgrid *g, const int s[3], int axis, double va,
                  double vb, float pos[3], float nrm[3], int *flat);
+
+/* The surface of the heightfield-like op `op` (OC_MC_NONE for any other
+** op or when direct extraction is off), or NULL (mcdirect.c). */
+const struct oc_hfsurf *oc_mc_surface(const oc_mcgrid *g, uint32_t op);
+/* Whether direct extraction applies to the columns s governs. */
+int oc_mc_direct_kind(const struct oc_hfsurf *s);
+/* Collects g->surf for the program and threshold of g (and g->direct,
+** when `direct` asks for it); g->surf is NULL
+** afterwards when there is none. Returns 0, or -1 out of memory. Free
+** with oc_mc_surfaces_free. */
+int oc_mc_surfaces(oc_mcgrid *g, int direct);
+void oc_mc_surfaces_free(oc_mcgrid *g);
 
 #endif

@@ -117,6 +117,10 @@ void oc_mc_samples(const oc_mcgrid *g, int ja, int jb, oc_mcwork *w,
             w->val[s[r].off + k] = -INFINITY;
         continue;
       }
+      if (g->direct && w->dsurf[c]) {
+        oc_mc_direct_column(g, i, j, c, s, ns, w);
+        continue;
+      }
       /* the spans of cube column (i, j) cover sample column (i, j); those
       ** of the last cube column and row also cover the padding beyond */
       int ci = i < nx ? i : nx - 1, cj = j < ny ? j : ny - 1;

@@ -59,8 +59,9 @@ static int edge_vertex(const oc_mcgrid *g, oc_mcwork *w, oc_mcout *o,
     double va = w->val[at], vb = w->val[cc->off[c2 & 3] + k + (c2 >> 2)];
     int s[3] = {i + (c & 1), j + ((c >> 1) & 1), kk};
     float p[3], n[3];
-    int flat;
-    o->calls += (size_t)oc_mc_vertex(g, s, axis, va, vb, p, n, &flat);
+    int flat = 0;
+    if (!g->direct || !oc_mc_direct_vertex(g, w, s, axis, p, n))
+      o->calls += (size_t)oc_mc_vertex(g, s, axis, va, vb, p, n, &flat);
     if (add_vertex(o, w, p, n, flat, slot)) return -1;
   }
   *out = *slot;
@@ -229,6 +230,7 @@ int oc_mc_slab(const oc_mcgrid *g, int ja, int jb, oc_mcwork *w, oc_mcout *o,
   int jr = jb <= ny - 1 ? jb : ny - 1; /* last row with spans */
   w->cube.n = 0;
   w->nflat = 0;
+  w->ja = ja;
   if (oc_mc_band(g, ja, jb, jr, w)) return nomem(err);
   /* a band this thick (noise, whole columns) would not fit anyway, and
   ** culling it would take long: refuse it first */

@@ -62,6 +62,8 @@ void oc_mcwork_free(oc_mcwork *w) {
   free(w->slot);
   free(w->tmp);
   free(w->flat);
+  free(w->dsurf);
+  free(w->delev);
   free(w);
 }
 

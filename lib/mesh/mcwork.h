@@ -42,6 +42,13 @@ struct oc_mcwork {
   size_t capt;
   uint32_t *flat;
   size_t nflat, capflat;
+  /* direct extraction, per sample column of the slab (rows ja .. jb,
+  ** i = -1 .. nx, as srat): the surface governing it alone or NULL, and
+  ** its elevation and gradient there (3 doubles) */
+  const struct oc_hfsurf **dsurf;
+  double *delev;
+  size_t capdsurf, capdelev;
+  int ja;                  /* first row of the slab being meshed */
   size_t last_nv, last_nt; /* output sizes of the previous slab */
 };
 
@@ -70,5 +77,16 @@ int oc_mc_sample_ranges(const oc_mcgrid *g, int ja, int jb, oc_mcwork *w,
                         const oc_mc_rlist *cubes, size_t *total);
 void oc_mc_samples(const oc_mcgrid *g, int ja, int jb, oc_mcwork *w,
                    size_t *calls);
+
+/* Direct elevation extraction (mcdirect.c). The value of every sample of
+** the direct sample column c = (i, j), from the elevation there (which it
+** stores in w->delev). */
+void oc_mc_direct_column(const oc_mcgrid *g, int i, int j, size_t c,
+                         const oc_mc_srange *s, size_t ns, oc_mcwork *w);
+/* Places the vertex of a crossing edge from the elevation when the edge
+** lies in direct columns (one, or two under the same surface): 1 done, 0
+** when the caller must find the root on the field. */
+int oc_mc_direct_vertex(const oc_mcgrid *g, const oc_mcwork *w, const int s[3],
+                        int axis, float pos[3], float nrm[3]);
 
 #endif

@@ -241,6 +241,10 @@ oc_mesh *oc_polygonize(const oc_program *prog, const oc_polygonize_params *pp,
   double t0 = omp_get_wtime();
   oc_mcgrid g;
   if (setup(prog, pp, &g, err)) return NULL;
+  if (oc_mc_surfaces(&g, !pp->no_direct)) {
+    oc_seterr(err, OC_ENOMEM, "out of memory");
+    return NULL;
+  }
   int rows = slab_rows(&g);
   int nslab = (g.n[1] + 1 + rows - 1) / rows;
   merger M;
@@ -249,6 +253,7 @@ oc_mesh *oc_polygonize(const oc_program *prog, const oc_polygonize_params *pp,
   M.ready = calloc((size_t)nslab, 1);
   if (!M.outs || !M.ready) {
     merger_free(&M, 0);
+    oc_mc_surfaces_free(&g);
     oc_seterr(err, OC_ENOMEM, "out of memory");
     return NULL;
   }
@@ -307,6 +312,7 @@ oc_mesh *oc_polygonize(const oc_program *prog, const oc_polygonize_params *pp,
   else
     m = finish(&M, err);
   merger_free(&M, nslab);
+  oc_mc_surfaces_free(&g);
   if (m) m->stats.seconds = omp_get_wtime() - t0;
   return m;
 }

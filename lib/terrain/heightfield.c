@@ -58,8 +58,8 @@ oc_heightfield *oc_heightfield_new(int nx, int ny, double cell, double x0,
       }
   }
   oc_heightfield *hf = malloc(sizeof *hf);
-  float *data = z ? malloc((size_t)n * sizeof *data)
-                  : calloc((size_t)n, sizeof *data);
+  float *data =
+      z ? malloc((size_t)n * sizeof *data) : calloc((size_t)n, sizeof *data);
   if (!hf || !data) {
     free(hf);
     free(data);
@@ -91,17 +91,27 @@ void oc_heightfield_release(oc_heightfield *hf) {
   }
 }
 
-int oc_heightfield_nx(const oc_heightfield *hf) { return hf->nx; }
-int oc_heightfield_ny(const oc_heightfield *hf) { return hf->ny; }
-double oc_heightfield_cell(const oc_heightfield *hf) { return hf->cell; }
+int oc_heightfield_nx(const oc_heightfield *hf) {
+  return hf->nx;
+}
+int oc_heightfield_ny(const oc_heightfield *hf) {
+  return hf->ny;
+}
+double oc_heightfield_cell(const oc_heightfield *hf) {
+  return hf->cell;
+}
 
 void oc_heightfield_origin(const oc_heightfield *hf, double *x0, double *y0) {
   if (x0) *x0 = hf->x0;
   if (y0) *y0 = hf->y0;
 }
 
-const float *oc_heightfield_samples(const oc_heightfield *hf) { return hf->z; }
-float *oc_heightfield_samples_mut(oc_heightfield *hf) { return hf->z; }
+const float *oc_heightfield_samples(const oc_heightfield *hf) {
+  return hf->z;
+}
+float *oc_heightfield_samples_mut(oc_heightfield *hf) {
+  return hf->z;
+}
 
 void oc_heightfield_minmax(const oc_heightfield *hf, double *lo, double *hi) {
   size_t n = (size_t)hf->nx * (size_t)hf->ny;

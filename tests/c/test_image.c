@@ -628,15 +628,6 @@ static Suite *suite(void) {
   return s;
 }
 
-/* No fork per test: OpenImageIO pulls in liblog4cplus (through OpenVDB),
-** whose static initialisation starts a thread; a forked child that calls
-** exit() then waits forever in log4cplus's finalizer for that thread,
-** which only exists in the parent. */
 int main(void) {
-  SRunner *sr = srunner_create(suite());
-  srunner_set_fork_status(sr, CK_NOFORK);
-  srunner_run_all(sr, CK_ENV);
-  int failed = srunner_ntests_failed(sr);
-  srunner_free(sr);
-  return failed == 0 ? 0 : 1;
+  return oct_run(suite());
 }

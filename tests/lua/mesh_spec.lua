@@ -2,6 +2,9 @@
 -- the field equals T, the options, every error, the written files (read
 -- back and parsed here), colours, and lifetimes under an eager collector.
 local oc = require "outcrop"
+local Fs = require "helpers.files"
+local read_file = Fs.read_file
+local listdir = Fs.listdir
 local R = require "helpers.ref"
 
 local F = "mesh_spec.lua"
@@ -14,22 +17,7 @@ local ball = oc.point{center = C, radius = RADIUS}
 -- g(r / R) = T  =>  r = R sqrt(1 - T^(1/3))
 local function iso_radius(T) return RADIUS * math.sqrt(1 - T ^ (1 / 3)) end
 
-local function read_file(path)
-  local f = io.open(path, "rb")
-  if not f then return nil end
-  local s = f:read("a")
-  f:close()
-  return s
-end
 
-local function listdir(dir)
-  local p = io.popen("ls -A '" .. dir .. "'")
-  local names = {}
-  for name in p:lines() do names[#names + 1] = name end
-  p:close()
-  table.sort(names)
-  return names
-end
 
 local function vertices(m)
   local nv = m:counts()

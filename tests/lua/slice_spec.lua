@@ -1,6 +1,8 @@
 -- slice_spec.lua — outcrop.slice and the image userdata: sizes, pixel
 -- positions, writing, and the output-folder sandbox of oclua_output_path.
 local oc = require "outcrop"
+local Fs = require "helpers.files"
+local read_file = Fs.read_file
 local R = require "helpers.ref"
 
 local F = "slice_spec.lua"
@@ -8,13 +10,6 @@ local reg = debug.getregistry()
 local node = oc.point{center = {0.5, 0.25, -0.5}, radius = 2} +
   oc.box{min = {-1, -1, -1}, max = {0, 0, 0}, falloff = 0.5}
 
-local function read_file(path)
-  local f = io.open(path, "rb")
-  if not f then return nil end
-  local s = f:read("a")
-  f:close()
-  return s
-end
 
 describe("outcrop.slice", function()
   it("samples the documented pixel centres (plane xz)", function()

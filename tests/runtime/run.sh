@@ -408,6 +408,73 @@ interrupt interrupt-coroutine-resume resume
 interrupt interrupt-coroutine-nested nested
 interrupt interrupt-polygonize mesh
 
+# ---- rendering -------------------------------------------------
+
+# interrupt_render NAME [HOW]: Ctrl-C half a second into render_loop.lua HOW
+interrupt_render() {
+  begin "$1"
+  (cd "$W" && exec "${DEFSIG[@]}" "$OUTCROP" "$S/render_loop.lua" --out "$W/o" ${2:-}) \
+    >"$OUT" 2>"$ERR" </dev/null &
+  pid=$!
+  for _ in $(seq 200); do
+    [ -e "$W/o/started.txt" ] && break
+    sleep 0.1
+  done
+  sleep 0.5
+  kill -INT "$pid" 2>/dev/null
+  for _ in $(seq 100); do
+    kill -0 "$pid" 2>/dev/null || break
+    sleep 0.1
+  done
+  if kill -0 "$pid" 2>/dev/null; then
+    because "still running 10 s after SIGINT"
+    kill -KILL "$pid" 2>/dev/null
+  fi
+  wait "$pid"
+  rc=$?
+  sanitizer_check
+  [ -e "$W/o/started.txt" ] || because "the scene never started"
+  status_is 130; err_has "outcrop: interrupted"; no_file "$W/o/after.txt"
+  no_file "$W/o/render.png"
+  [ -z "$(ls "$W/o" | grep -v '^started.txt$')" ] || because "files left in the output folder: $(ls "$W/o")"
+  end
+}
+
+interrupt_render interrupt-render
+interrupt_render interrupt-render-function function
+
+# meta_has FILE KEY VALUE: the image's metadata, read by OpenImageIO
+meta_has() {
+  oiiotool --info -v "$1" 2>/dev/null | grep -qF -- "$2: \"$3\"" ||
+    because "$1 lacks metadata $2 = \"$3\""
+}
+
+begin render-provenance
+run "$S/render_meta.lua" --set b=two --set a=1 --seed 7 --out "$W/o" r.png
+status_is 0
+meta_has "$W/o/r.png" outcrop:scene "$S/render_meta.lua"
+meta_has "$W/o/r.png" outcrop:params "a=1 b=two"
+meta_has "$W/o/r.png" outcrop:seed 7
+meta_has "$W/o/r.png" outcrop:version 0.1.0
+run "$S/render_meta.lua" --out "$W/o" r.exr
+status_is 0
+meta_has "$W/o/r.exr" outcrop:seed 1
+meta_has "$W/o/r.exr" outcrop:params "(none)"
+oiiotool --info -v "$W/o/r.exr" 2>/dev/null | grep -q "channel list: .*P\.z" ||
+  because "r.exr lacks the AOV channels"
+end
+
+begin render-threads
+run --threads 1 "$S/render_meta.lua" --out "$W/o" one.exr
+status_is 0
+run --threads 2 "$S/render_meta.lua" --out "$W/o" two.exr
+status_is 0
+cmp -s "$W/o/one.exr" "$W/o/two.exr" || because "1 and 2 threads give different EXR files"
+run --threads 1 "$S/render_meta.lua" --out "$W/o" one.png
+run --threads 2 "$S/render_meta.lua" --out "$W/o" two.png
+cmp -s "$W/o/one.png" "$W/o/two.png" || because "1 and 2 threads give different PNG files"
+end
+
 set +m
 
 echo "runtime tests: $npass passed, $nfail failed"

@@ -1,0 +1,455 @@
+/*
+** l_geology.c — resistance trees (seed 000 section 4) and the erosion node
+** (section 6): the outcrop.geology table (strata, layer, sphere, curve,
+** fold, taper, fault, clamp, slice) and outcrop.erosion.
+**
+** Resistance trees are ordinary nodes (blend them with +, query them with
+** :eval); they are not clamped as built, so blends add up. Defaults:
+**
+**   strata   octaves 4, amplitude 1, offset 0, seed = the scene seed
+**   layer    noise = none; noise = {wavelength =, amplitude = 1,
+**            octaves = 4, offset = 0, seed =}
+**   sphere   falloff = radius
+**   fold     octaves 3 (a warp: outcrop.warp with no control)
+**   taper    origin {0, 0, 0}, axis {0, 0, 1}, along {1, 0, 0}, from 0
+**   clamp    lo 0, hi 1
+**   slice    plane "xz", at 0, size {256, 256}, palette pale (hard) to
+**            dark (soft), as seed 000 figure 4; box required when the
+**            tree's bounds are infinite (strata always are)
+**   erosion  control = none (erode wherever there is rock)
+*/
+#include <math.h>
+
+#include "l_field.h"
+#include "l_geology.h"
+#include "l_image.h"
+
+#define MAX_STOPS 256
+#define DEFAULT_SLICE_SIZE 256
+#define MAX_SLICE_SIZE 16384
+
+static void begin(oclua_fields *f, lua_State *L, const char *fname,
+                  const char *const *known) {
+  oclua_checkargs(L, 1, fname, "a table of named fields");
+  oclua_fields_open(f, L, 1, fname, NULL, known, 0);
+}
+
+/* (node, {options}): checks the node and opens the options at index 2. */
+static oc_node *node_and_options(lua_State *L, oclua_fields *f,
+                                 const char *fname, const char *usage,
+                                 const char *const *known, int optional) {
+  oclua_checkargs(L, 2, fname, usage);
+  oc_node *n = oclua_checknode(L, 1, fname, "argument #1");
+  if (optional && lua_isnoneornil(L, 2)) {
+    lua_settop(L, 1);
+    lua_newtable(L);
+  }
+  if (!lua_istable(L, 2))
+    oclua_error(L, fname, "argument #2 must be a table %s (got %s)", usage,
+                oclua_got(L, 2));
+  oclua_fields_open(f, L, 2, fname, NULL, known, 0);
+  return n;
+}
+
+/* ---- primitives ------------------------------------------------------- */
+
+static int l_strata(lua_State *L) {
+  static const char *const known[] = {"wavelength", "amplitude", "octaves",
+                                      "offset",     "seed",      NULL};
+  oclua_fields f;
+  oc_error err = {OC_OK, ""};
+  oc_noise nz;
+  begin(&f, L, "outcrop.geology.strata", known);
+  nz.wavelength = oclua_field_number(&f, "wavelength", OCLUA_POSITIVE);
+  nz.amplitude = oclua_field_optnumber(&f, "amplitude", OCLUA_FINITE, 1.0);
+  nz.octaves = (int)oclua_field_optint(&f, "octaves", 1, 16, 4);
+  nz.offset = oclua_field_optnumber(&f, "offset", OCLUA_FINITE, 0.0);
+  nz.seed = oclua_field_seed(&f, "seed");
+  oclua_node *u = oclua_newnode(L);
+  return oclua_setnode(L, u, oc_strata(&nz, &err), &err, f.fname);
+}
+
+static int l_layer(lua_State *L) {
+  static const char *const known[] = {"origin",     "normal", "radius",
+                                      "resistance", "noise",  NULL};
+  static const char *const nknown[] = {"wavelength", "amplitude", "octaves",
+                                       "offset",     "seed",      NULL};
+  oclua_fields f;
+  oc_error err = {OC_OK, ""};
+  oc_noise nz, *pn = NULL;
+  begin(&f, L, "outcrop.geology.layer", known);
+  oc_vec3 o = oclua_field_vec(&f, "origin");
+  oc_vec3 n = oclua_field_vec(&f, "normal");
+  double r = oclua_field_number(&f, "radius", OCLUA_POSITIVE);
+  double e = oclua_field_number(&f, "resistance", OCLUA_FINITE);
+  if (n.x == 0 && n.y == 0 && n.z == 0)
+    oclua_error(L, f.fname, "'normal' must be non-zero");
+  int t = oclua_field_push(&f, "noise");
+  if (t != LUA_TNIL) {
+    oclua_fields nf;
+    if (t != LUA_TTABLE)
+      oclua_field_error(&f, "noise", -1,
+                        "must be a table {wavelength =, amplitude =, ...}");
+    oclua_fields_open(&nf, L, lua_gettop(L), f.fname, "noise.", nknown, 0);
+    nz.wavelength = oclua_field_number(&nf, "wavelength", OCLUA_POSITIVE);
+    nz.amplitude = oclua_field_optnumber(&nf, "amplitude", OCLUA_FINITE, 1.0);
+    nz.octaves = (int)oclua_field_optint(&nf, "octaves", 1, 16, 4);
+    nz.offset = oclua_field_optnumber(&nf, "offset", OCLUA_FINITE, 0.0);
+    nz.seed = oclua_field_seed(&nf, "seed");
+    pn = &nz;
+  }
+  lua_pop(L, 1);
+  oclua_node *u = oclua_newnode(L);
+  return oclua_setnode(L, u, oc_geology_layer(o, n, r, e, pn, &err), &err,
+                       f.fname);
+}
+
+static int l_sphere(lua_State *L) {
+  static const char *const known[] = {"center", "radius", "falloff",
+                                      "resistance", NULL};
+  oclua_fields f;
+  oc_error err = {OC_OK, ""};
+  begin(&f, L, "outcrop.geology.sphere", known);
+  oc_vec3 c = oclua_field_vec(&f, "center");
+  double r = oclua_field_number(&f, "radius", OCLUA_POSITIVE);
+  double fo = oclua_field_optnumber(&f, "falloff", OCLUA_POSITIVE, r);
+  double e = oclua_field_number(&f, "resistance", OCLUA_FINITE);
+  oclua_node *u = oclua_newnode(L);
+  return oclua_setnode(L, u, oc_sphere(c, r, fo, e, &err), &err, f.fname);
+}
+
+static int l_curve(lua_State *L) {
+  static const char *const known[] = {"points", "radius", "resistance",
+                                      "bezier", NULL};
+  oclua_fields f;
+  oc_error err = {OC_OK, ""};
+  begin(&f, L, "outcrop.geology.curve", known);
+  if (oclua_field_push(&f, "points") == LUA_TNIL)
+    oclua_field_missing(&f, "points", "an array of {x, y, z} points");
+  if (!lua_istable(L, -1))
+    oclua_field_error(&f, "points", -1, "must be an array of {x, y, z} points");
+  lua_Integer n = (lua_Integer)lua_rawlen(L, -1);
+  if (n < 2)
+    oclua_error(L, f.fname, "'points' must hold at least 2 points (got %I)",
+                (LUAI_UACINT)n);
+  if ((size_t)n > ((size_t)-1) / sizeof(oc_vec3) / 2)
+    oclua_error(L, f.fname, "'points' is too long");
+  oc_vec3 *pts = lua_newuserdatauv(L, (size_t)n * sizeof *pts, 0);
+  for (lua_Integer i = 1; i <= n; i++) {
+    lua_geti(L, -2, i);
+    pts[i - 1] = oclua_tovec(L, -1, f.fname, "points", i);
+    lua_pop(L, 1);
+  }
+  double r = oclua_field_number(&f, "radius", OCLUA_POSITIVE);
+  double e = oclua_field_number(&f, "resistance", OCLUA_FINITE);
+  int bezier = oclua_field_optbool(&f, "bezier", 0);
+  if (bezier && (n - 1) % 3 != 0)
+    oclua_error(L, f.fname,
+                "'points' of a bezier curve must number 3k+1 (4, 7, 10, ...; "
+                "got %I)",
+                (LUAI_UACINT)n);
+  oclua_node *u = oclua_newnode(L);
+  return oclua_setnode(L, u, oc_curve(pts, (size_t)n, bezier, r, e, &err), &err,
+                       f.fname);
+}
+
+/* ---- operators ------------------------------------------------------- */
+
+static int l_fold(lua_State *L) {
+  static const char *const known[] = {"wavelength", "amplitude", "octaves",
+                                      "seed", NULL};
+  const char *fname = "outcrop.geology.fold";
+  oclua_fields f;
+  oc_error err = {OC_OK, ""};
+  oc_noise nz;
+  oc_node *g = node_and_options(
+      L, &f, fname, "{wavelength =, amplitude =, octaves =, seed =}", known, 0);
+  nz.wavelength = oclua_field_number(&f, "wavelength", OCLUA_POSITIVE);
+  nz.amplitude = oclua_field_number(&f, "amplitude", OCLUA_FINITE);
+  nz.octaves = (int)oclua_field_optint(&f, "octaves", 1, 16, 3);
+  nz.offset = 0;
+  nz.seed = oclua_field_seed(&f, "seed");
+  oclua_node *u = oclua_newnode(L);
+  return oclua_setnode(L, u, oc_warp(g, &nz, NULL, &err), &err, fname);
+}
+
+static int l_taper(lua_State *L) {
+  static const char *const known[] = {"origin", "axis",   "along",  "from",
+                                      "to",     "factor", "height", NULL};
+  const char *fname = "outcrop.geology.taper";
+  oclua_fields f;
+  oc_error err = {OC_OK, ""};
+  oc_taper_params tp = {{0, 0, 0}, {0, 0, 1}, {1, 0, 0}, 0, 0, 1, 1};
+  oc_node *g = node_and_options(L, &f, fname,
+                                "{to =, factor =, height =, from =, origin "
+                                "=, axis =, along =}",
+                                known, 0);
+  oclua_field_optvec(&f, "origin", &tp.origin);
+  oclua_field_optvec(&f, "axis", &tp.axis);
+  oclua_field_optvec(&f, "along", &tp.along);
+  tp.from = oclua_field_optnumber(&f, "from", OCLUA_FINITE, 0.0);
+  tp.to = oclua_field_number(&f, "to", OCLUA_FINITE);
+  tp.factor = oclua_field_number(&f, "factor", OCLUA_POSITIVE);
+  tp.height = oclua_field_number(&f, "height", OCLUA_POSITIVE);
+  oclua_node *u = oclua_newnode(L);
+  return oclua_setnode(L, u, oc_taper(g, &tp, &err), &err, fname);
+}
+
+/* The domain of a fault: a node, {min =, max =} or {origin =, normal =}.
+** A node stays on the stack (pushed here) until the fault retains it. */
+static void read_domain(const oclua_fields *f, oc_fault_domain *d) {
+  static const char *const known[] = {"min", "max", "origin", "normal", NULL};
+  const char *what = "must be a node, {min =, max =} or {origin =, normal =}";
+  lua_State *L = f->L;
+  int t = oclua_field_push(f, "domain");
+  if (t == LUA_TNIL) oclua_field_missing(f, "domain", what + 8);
+  oclua_node *u = oclua_testnode(L, -1);
+  if (u) {
+    d->kind = OC_FAULT_NODE;
+    d->node = u->node;
+    return;
+  }
+  if (t != LUA_TTABLE) oclua_field_error(f, "domain", -1, what);
+  oclua_fields df;
+  oclua_fields_open(&df, L, lua_gettop(L), f->fname, "domain.", known, 0);
+  int box = oclua_field_push(&df, "min") != LUA_TNIL;
+  box |= oclua_field_push(&df, "max") != LUA_TNIL;
+  lua_pop(L, 2);
+  if (box) {
+    d->kind = OC_FAULT_BOX;
+    d->lo = oclua_field_vec(&df, "min");
+    d->hi = oclua_field_vec(&df, "max");
+    if (!(d->lo.x < d->hi.x && d->lo.y < d->hi.y && d->lo.z < d->hi.z))
+      oclua_error(L, f->fname,
+                  "'domain.max' must be above 'domain.min' on every axis "
+                  "(got min {%f, %f, %f}, max {%f, %f, %f})",
+                  d->lo.x, d->lo.y, d->lo.z, d->hi.x, d->hi.y, d->hi.z);
+  } else {
+    d->kind = OC_FAULT_HALF;
+    d->origin = oclua_field_vec(&df, "origin");
+    d->normal = oclua_field_vec(&df, "normal");
+    if (d->normal.x == 0 && d->normal.y == 0 && d->normal.z == 0)
+      oclua_error(L, f->fname, "'domain.normal' must be non-zero");
+  }
+}
+
+static int l_fault(lua_State *L) {
+  static const char *const known[] = {"domain", "offset", NULL};
+  const char *fname = "outcrop.geology.fault";
+  oclua_fields f;
+  oc_error err = {OC_OK, ""};
+  oc_fault_domain d = {OC_FAULT_BOX, {0, 0, 0}, {0, 0, 0},
+                       {0, 0, 0},    {0, 0, 0}, NULL};
+  oc_node *g = node_and_options(L, &f, fname,
+                                "{domain =, offset = {dx, dy, dz}}", known, 0);
+  oc_vec3 off = oclua_field_vec(&f, "offset");
+  read_domain(&f, &d);
+  oclua_node *u = oclua_newnode(L);
+  return oclua_setnode(L, u, oc_fault(g, &d, off, &err), &err, fname);
+}
+
+static int l_clamp(lua_State *L) {
+  static const char *const known[] = {"lo", "hi", NULL};
+  const char *fname = "outcrop.geology.clamp";
+  oclua_fields f;
+  oc_error err = {OC_OK, ""};
+  oc_node *g = node_and_options(L, &f, fname, "{lo =, hi =}", known, 1);
+  double lo = oclua_field_optnumber(&f, "lo", OCLUA_FINITE, 0.0);
+  double hi = oclua_field_optnumber(&f, "hi", OCLUA_FINITE, 1.0);
+  if (!(lo < hi))
+    oclua_error(L, fname, "'lo' must be below 'hi' (got %f and %f)",
+                (LUAI_UACNUMBER)lo, (LUAI_UACNUMBER)hi);
+  oclua_node *u = oclua_newnode(L);
+  return oclua_setnode(L, u, oc_clamp(g, lo, hi, &err), &err, fname);
+}
+
+static int l_erosion(lua_State *L) {
+  static const char *const known[] = {"control", "depth", NULL};
+  const char *fname = "outcrop.erosion";
+  const char *usage = "(terrain, geology, {depth =, control =})";
+  oclua_fields f;
+  oc_error err = {OC_OK, ""};
+  oc_node *control = NULL;
+  oclua_checkargs(L, 3, fname, usage);
+  oc_node *terrain = oclua_checknode(L, 1, fname, "argument #1 (terrain)");
+  oc_node *geology = oclua_checknode(L, 2, fname, "argument #2 (geology)");
+  if (!lua_istable(L, 3))
+    oclua_error(L, fname,
+                "argument #3 must be a table {depth =, control =} "
+                "(got %s)",
+                oclua_got(L, 3));
+  oclua_fields_open(&f, L, 3, fname, NULL, known, 0);
+  double depth = oclua_field_number(&f, "depth", OCLUA_POSITIVE);
+  /* stays on the stack until the erosion node retains it */
+  if (oclua_field_push(&f, "control") != LUA_TNIL) {
+    oclua_node *c = oclua_testnode(L, -1);
+    if (c == NULL)
+      oclua_field_error(&f, "control", -1, "must be an outcrop node");
+    control = c->node;
+  }
+  oclua_node *u = oclua_newnode(L);
+  return oclua_setnode(L, u, oc_erosion(terrain, geology, control, depth, &err),
+                       &err, fname);
+}
+
+/* ---- slices coloured by resistance --------------------------------------- */
+
+/* Pale for hard rock, dark for soft (seed 000 figure 4). */
+static const double default_stops[] = {0.00, 0.22, 0.13, 0.08, 0.35, 0.45,
+                                       0.30, 0.18, 0.65, 0.72, 0.58, 0.40,
+                                       1.00, 0.95, 0.91, 0.82};
+
+static const double *read_palette(const oclua_fields *f, int *nstops) {
+  lua_State *L = f->L;
+  static const char *const rgb[3] = {"r", "g", "b"};
+  if (oclua_field_push(f, "palette") == LUA_TNIL) {
+    lua_pop(L, 1);
+    *nstops = 4;
+    return default_stops;
+  }
+  int pal = lua_gettop(L);
+  lua_Integer n = lua_istable(L, pal) ? (lua_Integer)lua_rawlen(L, pal) : 0;
+  if (n < 1 || n > MAX_STOPS)
+    oclua_error(L, f->fname,
+                "'palette' must be an array of 1..%d {value, {r, g, b}} "
+                "(got %s)",
+                MAX_STOPS, oclua_got(L, pal));
+  double *stops = lua_newuserdatauv(L, (size_t)n * 4 * sizeof *stops, 0);
+  for (lua_Integer k = 1; k <= n; k++) {
+    double *s = stops + 4 * (k - 1);
+    lua_geti(L, pal, k);
+    if (!lua_istable(L, -1) || lua_rawlen(L, -1) != 2)
+      oclua_error(L, f->fname,
+                  "'palette[%I]' must be {value, {r, g, b}} (got "
+                  "%s)",
+                  (LUAI_UACINT)k, oclua_got(L, -1));
+    if (lua_geti(L, -1, 1) != LUA_TNUMBER || !isfinite(lua_tonumber(L, -1)))
+      oclua_error(L, f->fname,
+                  "'palette[%I]' value must be a finite number "
+                  "(got %s)",
+                  (LUAI_UACINT)k, oclua_got(L, -1));
+    s[0] = lua_tonumber(L, -1);
+    lua_pop(L, 1);
+    if (k > 1 && s[0] < s[-4])
+      oclua_error(L, f->fname,
+                  "'palette' values must be in ascending order (item %I: %f "
+                  "after %f)",
+                  (LUAI_UACINT)k, (LUAI_UACNUMBER)s[0], (LUAI_UACNUMBER)s[-4]);
+    if (lua_geti(L, -1, 2) != LUA_TTABLE || lua_rawlen(L, -1) != 3)
+      oclua_error(L, f->fname,
+                  "'palette[%I]' colour must be {r, g, b} (got "
+                  "%s)",
+                  (LUAI_UACINT)k, oclua_got(L, -1));
+    for (int j = 0; j < 3; j++) {
+      int t = lua_geti(L, -1, j + 1);
+      double x = lua_tonumber(L, -1);
+      if (t != LUA_TNUMBER || !(x >= 0 && x <= 1))
+        oclua_error(L, f->fname,
+                    "'palette[%I]' colour components must be in [0, 1] "
+                    "(got %s = %s)",
+                    (LUAI_UACINT)k, rgb[j], oclua_got(L, -1));
+      s[1 + j] = x;
+      lua_pop(L, 1);
+    }
+    lua_pop(L, 2);
+  }
+  *nstops = (int)n;
+  return stops;
+}
+
+/* Linear between stops, clamped at the ends; NaN reads as the first. */
+static void palette(const double *s, int n, double v, float rgb[3]) {
+  int k = 0;
+  if (!(v > s[0])) {
+    k = 0;
+  } else if (v >= s[4 * (n - 1)]) {
+    k = n - 1;
+  } else {
+    while (k + 1 < n && s[4 * (k + 1)] <= v)
+      k++;
+    double a = s[4 * k], b = s[4 * (k + 1)];
+    double t = b > a ? (v - a) / (b - a) : 0;
+    for (int j = 0; j < 3; j++)
+      rgb[j] = (float)(s[4 * k + 1 + j] +
+                       t * (s[4 * (k + 1) + 1 + j] - s[4 * k + 1 + j]));
+    return;
+  }
+  for (int j = 0; j < 3; j++)
+    rgb[j] = (float)s[4 * k + 1 + j];
+}
+
+static int l_slice(lua_State *L) {
+  static const char *const known[] = {"plane", "at",      "box",
+                                      "size",  "palette", NULL};
+  static const char *const planes[] = {"xy", "xz", "yz", NULL};
+  const char *fname = "outcrop.geology.slice";
+  oclua_fields f;
+  oc_error err = {OC_OK, ""};
+  oc_slice_params sp;
+  double box[4], size[2] = {DEFAULT_SLICE_SIZE, DEFAULT_SLICE_SIZE};
+  int nstops;
+  node_and_options(L, &f, fname,
+                   "{plane =, at =, box = {u0, v0, u1, v1}, size =, palette =}",
+                   known, 1);
+  int plane = oclua_field_optoption(&f, "plane", planes, 1);
+  sp.plane = plane == 0 ? OC_PLANE_XY : plane == 1 ? OC_PLANE_XZ : OC_PLANE_YZ;
+  sp.at = oclua_field_optnumber(&f, "at", OCLUA_FINITE, 0.0);
+  oclua_field_numbers(&f, "size", 2, size, "must be {width, height}");
+  for (int k = 0; k < 2; k++)
+    if (size[k] != floor(size[k]) || size[k] < 1 || size[k] > MAX_SLICE_SIZE)
+      oclua_error(L, fname,
+                  "'size' must be {width, height} with integers in 1..%d "
+                  "(got %f)",
+                  MAX_SLICE_SIZE, (LUAI_UACNUMBER)size[k]);
+  sp.width = (int)size[0];
+  sp.height = (int)size[1];
+  int given =
+      oclua_field_numbers(&f, "box", 4, box, "must be {u0, v0, u1, v1}");
+  const double *stops = read_palette(&f, &nstops);
+  const oc_program *prog = oclua_program(L, 1, fname);
+  if (!given) {
+    oc_aabb b = oc_program_bounds(prog);
+    double lo[3] = {b.lo.x, b.lo.y, b.lo.z}, hi[3] = {b.hi.x, b.hi.y, b.hi.z};
+    int u = sp.plane == OC_PLANE_YZ ? 1 : 0;
+    int v = sp.plane == OC_PLANE_XY ? 1 : 2;
+    box[0] = lo[u], box[1] = lo[v], box[2] = hi[u], box[3] = hi[v];
+    if (!(isfinite(box[0]) && isfinite(box[1]) && isfinite(box[2]) &&
+          isfinite(box[3])))
+      oclua_error(L, fname,
+                  "the tree's bounds are infinite: give 'box' = "
+                  "{u0, v0, u1, v1}");
+  }
+  if (!(box[0] < box[2] && box[1] < box[3]))
+    oclua_error(L, fname,
+                "'box' = {u0, v0, u1, v1} needs u0 < u1 and v0 < v1 (got "
+                "{%f, %f, %f, %f})",
+                box[0], box[1], box[2], box[3]);
+  sp.u0 = box[0], sp.v0 = box[1], sp.u1 = box[2], sp.v1 = box[3];
+  oclua_image *u = oclua_newimage(L);
+  u->img = oc_slice(prog, &sp, &err);
+  if (u->img == NULL) oclua_liberror(L, fname, &err);
+  /* the slice's own colours give way to the palette; the "field" channel
+  ** keeps the raw resistance */
+  float *px = oc_image_data(u->img);
+  int nc = oc_image_channels(u->img);
+  size_t npx = (size_t)sp.width * (size_t)sp.height;
+  for (size_t i = 0; i < npx; i++) {
+    float *q = px + i * (size_t)nc;
+    palette(stops, nstops, q[4], q);
+    q[3] = 1;
+  }
+  return 1;
+}
+
+static const luaL_Reg geology_funcs[] = {
+    {"strata", l_strata}, {"layer", l_layer}, {"sphere", l_sphere},
+    {"curve", l_curve},   {"fold", l_fold},   {"taper", l_taper},
+    {"fault", l_fault},   {"clamp", l_clamp}, {"slice", l_slice},
+    {NULL, NULL}};
+
+void oclua_open_geology(lua_State *L) {
+  luaL_newlib(L, geology_funcs);
+  lua_setfield(L, -2, "geology");
+  lua_pushcfunction(L, l_erosion);
+  lua_setfield(L, -2, "erosion");
+}

@@ -1,0 +1,592 @@
+/*
+** l_heightfield.c — the heightfield userdata and outcrop.heightfield:
+** load, fbm, from; methods height, gradient, size, cell, bounds, get,
+** min, max, sum, resample, crop, save (the analysis methods come from
+** l_hfanalysis.c and share the metatable).
+**
+** Sample (i, j), 1-based in Lua, lies at (x0 + (i - 1) cell, y0 + (j - 1)
+** cell): i along x, j along y. Files are north up (the image's top row is
+** j = ny). Defaults: cell 1, origin {0, 0}; load: scale 1, offset 0 unless
+** the file says otherwise (files saved by hf:save do); fbm: octaves 6,
+** offset 0, seed the scene seed; from: zrange the node's z bounds,
+** threshold outcrop.threshold.
+*/
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "io/oiio.h"
+#include "l_field.h"
+#include "l_heightfield.h"
+#include "l_progress.h"
+#include "l_image.h"
+#include "l_provenance.h"
+
+#define MAX_SIDE 65535
+#define DEFAULT_OCTAVES 6
+
+oclua_heightfield *oclua_newheightfield(lua_State *L) {
+  oclua_heightfield *u = lua_newuserdatauv(L, sizeof *u, 0);
+  u->hf = NULL;
+  luaL_setmetatable(L, OCLUA_HEIGHTFIELD);
+  return u;
+}
+
+oc_heightfield *oclua_testheightfield(lua_State *L, int idx) {
+  oclua_heightfield *u = luaL_testudata(L, idx, OCLUA_HEIGHTFIELD);
+  return u ? u->hf : NULL;
+}
+
+oc_heightfield *oclua_checkheightfield(lua_State *L, int idx,
+                                       const char *fname) {
+  oclua_heightfield *u = luaL_testudata(L, idx, OCLUA_HEIGHTFIELD);
+  if (u == NULL)
+    oclua_error(L, fname, "expected a heightfield (got %s)", oclua_got(L, idx));
+  if (u->hf == NULL) oclua_error(L, fname, "the heightfield is closed");
+  return u->hf;
+}
+
+/* Stores a new grid in the userdata on the stack top, or raises. */
+static int sethf(lua_State *L, oclua_heightfield *u, oc_heightfield *hf,
+                 const oc_error *err, const char *fname) {
+  if (hf == NULL) {
+    if (err->code == OC_ECANCEL) return luaL_error(L, "interrupted");
+    oclua_liberror(L, fname, err);
+  }
+  u->hf = hf;
+  return 1;
+}
+
+/* ---- shared field readers --------------------------------------------- */
+
+/* `size` = {nx, ny}, integers in 2..65535; required. */
+static void field_size(const oclua_fields *f, int *nx, int *ny) {
+  lua_State *L = f->L;
+  double s[2];
+  const char *what = "must be {nx, ny} with integers in 2..65535";
+  if (!oclua_field_numbers(f, "size", 2, s, what))
+    oclua_field_missing(f, "size", "{nx, ny} samples");
+  for (int k = 0; k < 2; k++)
+    if (s[k] != floor(s[k]) || s[k] < 2 || s[k] > MAX_SIDE) {
+      if (s[k] == floor(s[k]) && fabs(s[k]) < 1e18)
+        lua_pushinteger(L, (lua_Integer)s[k]);
+      else
+        lua_pushnumber(L, s[k]);
+      oclua_error(L, f->fname, "'size' %s (item %d is %s)", what, k + 1,
+                  oclua_got(L, -1));
+    }
+  *nx = (int)s[0];
+  *ny = (int)s[1];
+}
+
+/* cell, origin and size of a grid to be made. */
+static oc_hf_grid field_grid(const oclua_fields *f) {
+  oc_hf_grid g;
+  double o[2] = {0, 0};
+  field_size(f, &g.nx, &g.ny);
+  g.cell = oclua_field_optnumber(f, "cell", OCLUA_POSITIVE, 1);
+  oclua_field_numbers(f, "origin", 2, o, "must be {x0, y0}");
+  g.x0 = o[0];
+  g.y0 = o[1];
+  return g;
+}
+
+/* An optional options table at idx: an empty one when nil or absent. */
+static void opt_table(lua_State *L, int idx) {
+  if (lua_isnoneornil(L, idx)) {
+    lua_settop(L, idx - 1);
+    lua_newtable(L);
+  }
+}
+
+/* A finite number argument; `what` names it. */
+static double check_coord(lua_State *L, int idx, const char *fname,
+                          const char *what) {
+  double v = lua_tonumber(L, idx);
+  if (lua_type(L, idx) != LUA_TNUMBER || !isfinite(v))
+    oclua_error(L, fname, "%s must be a finite number (got %s)", what,
+                oclua_got(L, idx));
+  return v;
+}
+
+/* ---- outcrop.heightfield.load ----------------------------------------- */
+
+static int l_load(lua_State *L) {
+  static const char *const known[] = {"cell", "scale", "offset", "origin",
+                                      NULL};
+  const char *fname = "outcrop.heightfield.load";
+  oclua_fields f;
+  oc_error err = {OC_OK, ""};
+  oc_hf_load_params p;
+  double o[2];
+  memset(&p, 0, sizeof p);
+  if (lua_type(L, 1) != LUA_TSTRING)
+    oclua_error(L, fname, "the path must be a string (got %s)",
+                oclua_got(L, 1));
+  oclua_checkargs(L, 2, fname,
+                  "(path [, {cell =, scale =, offset =, origin =}])");
+  opt_table(L, 2);
+  oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
+  if (oclua_field_push(&f, "cell") != LUA_TNIL) p.given |= OC_HF_GIVE_CELL;
+  lua_pop(L, 1);
+  p.cell = oclua_field_optnumber(&f, "cell", OCLUA_POSITIVE, 1);
+  if (oclua_field_push(&f, "scale") != LUA_TNIL) p.given |= OC_HF_GIVE_SCALE;
+  lua_pop(L, 1);
+  p.scale = oclua_field_optnumber(&f, "scale", OCLUA_NONZERO, 1);
+  if (oclua_field_push(&f, "offset") != LUA_TNIL) p.given |= OC_HF_GIVE_OFFSET;
+  lua_pop(L, 1);
+  p.offset = oclua_field_optnumber(&f, "offset", OCLUA_FINITE, 0);
+  if (oclua_field_numbers(&f, "origin", 2, o, "must be {x0, y0}")) {
+    p.given |= OC_HF_GIVE_ORIGIN;
+    p.x0 = o[0];
+    p.y0 = o[1];
+  }
+  oclua_heightfield *u = oclua_newheightfield(L);
+  return sethf(L, u, oc_heightfield_load(lua_tostring(L, 1), &p, &err), &err,
+               fname);
+}
+
+/* ---- outcrop.heightfield.fbm ------------------------------------------ */
+
+static int l_fbm(lua_State *L) {
+  static const char *const known[] = {"size",      "cell",       "origin",
+                                      "amplitude", "wavelength", "octaves",
+                                      "seed",      "offset",     NULL};
+  const char *fname = "outcrop.heightfield.fbm";
+  oclua_fields f;
+  oc_error err = {OC_OK, ""};
+  oc_noise nz;
+  oclua_progress pl;
+  oclua_checkargs(L, 1, fname,
+                  "{size =, cell =, origin =, amplitude =, wavelength =, "
+                  "octaves =, seed =, offset =}");
+  oclua_fields_open(&f, L, 1, fname, NULL, known, 0);
+  oc_hf_grid g = field_grid(&f);
+  nz.amplitude = oclua_field_number(&f, "amplitude", OCLUA_FINITE);
+  nz.wavelength = oclua_field_number(&f, "wavelength", OCLUA_POSITIVE);
+  nz.octaves = (int)oclua_field_optint(&f, "octaves", 1, 16, DEFAULT_OCTAVES);
+  nz.seed = oclua_field_seed(&f, "seed");
+  nz.offset = oclua_field_optnumber(&f, "offset", OCLUA_FINITE, 0);
+  oc_progress pr = oclua_progress_start(L, &pl, fname);
+  oclua_heightfield *u = oclua_newheightfield(L);
+  oc_heightfield *hf = oc_heightfield_fbm(&g, &nz, pr, &err);
+  oclua_progress_end(&pl);
+  return sethf(L, u, hf, &err, fname);
+}
+
+/* ---- outcrop.heightfield.from ----------------------------------------- */
+
+/* Calls fn(x, y) for every sample, rows from j = 1 up, serially. The grid
+** is already in its userdata (the only reference: writing is allowed). */
+static void from_function(lua_State *L, int fn, oc_heightfield *hf,
+                          const char *fname) {
+  int nx = oc_heightfield_nx(hf), ny = oc_heightfield_ny(hf);
+  double x0, y0, cell = oc_heightfield_cell(hf);
+  float *z = oc_heightfield_samples_mut(hf);
+  oc_heightfield_origin(hf, &x0, &y0);
+  for (int j = 0; j < ny; j++)
+    for (int i = 0; i < nx; i++) {
+      lua_pushvalue(L, fn);
+      lua_pushnumber(L, x0 + i * cell);
+      lua_pushnumber(L, y0 + j * cell);
+      lua_call(L, 2, 1);
+      double v = lua_tonumber(L, -1);
+      if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(v) || fabs(v) > 3.4e38)
+        oclua_error(L, fname,
+                    "the function must return a finite elevation (got %s at "
+                    "sample (%d, %d), x = %f, y = %f)",
+                    oclua_got(L, -1), i + 1, j + 1,
+                    (LUAI_UACNUMBER)(x0 + i * cell),
+                    (LUAI_UACNUMBER)(y0 + j * cell));
+      z[(size_t)j * (size_t)nx + (size_t)i] = (float)v;
+      lua_pop(L, 1);
+    }
+}
+
+static int l_from(lua_State *L) {
+  static const char *const known[] = {"size",   "cell",      "origin",
+                                      "zrange", "threshold", NULL};
+  const char *fname = "outcrop.heightfield.from";
+  oclua_fields f;
+  oc_error err = {OC_OK, ""};
+  double zr[2];
+  oclua_checkargs(L, 2, fname,
+                  "(function or node, {size =, cell =, origin =, zrange =, "
+                  "threshold =})");
+  int isfn = lua_type(L, 1) == LUA_TFUNCTION;
+  if (!isfn && oclua_testnode(L, 1) == NULL)
+    oclua_error(L, fname,
+                "argument #1 must be a function (x, y) -> z or an outcrop "
+                "node (got %s)",
+                oclua_got(L, 1));
+  oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
+  oc_hf_grid g = field_grid(&f);
+  int hasz = oclua_field_numbers(&f, "zrange", 2, zr, "must be {z0, z1}");
+  double t = oclua_field_optnumber(&f, "threshold", OCLUA_POSITIVE, 0);
+  if (isfn) {
+    if (hasz || t != 0)
+      oclua_error(L, fname,
+                  "'zrange' and 'threshold' apply to nodes, not to functions");
+    oclua_heightfield *u = oclua_newheightfield(L);
+    int ud = lua_gettop(L);
+    u->hf = oc_heightfield_new(g.nx, g.ny, g.cell, g.x0, g.y0, NULL, &err);
+    if (u->hf == NULL) oclua_liberror(L, fname, &err);
+    from_function(L, 1, u->hf, fname);
+    lua_settop(L, ud);
+    return 1;
+  }
+  if (t == 0) t = oclua_threshold(L, fname);
+  const oc_program *prog = oclua_program_at(L, 1, fname, t);
+  if (!hasz) {
+    oc_aabb b = oc_program_bounds(prog);
+    zr[0] = b.lo.z;
+    zr[1] = b.hi.z;
+    if (!isfinite(zr[0]) || !isfinite(zr[1]) || !(zr[0] < zr[1]))
+      oclua_error(L, fname,
+                  "the node's z bounds are infinite or empty: give 'zrange' "
+                  "= {z0, z1}");
+  } else if (!(zr[0] < zr[1])) {
+    oclua_error(L, fname, "'zrange' = {z0, z1} needs z0 < z1 (got {%f, %f})",
+                (LUAI_UACNUMBER)zr[0], (LUAI_UACNUMBER)zr[1]);
+  }
+  oclua_progress pl;
+  oc_progress pr = oclua_progress_start(L, &pl, fname);
+  oclua_heightfield *u = oclua_newheightfield(L);
+  oc_heightfield *hf =
+      oc_heightfield_from_program(prog, &g, zr[0], zr[1], t, pr, &err);
+  oclua_progress_end(&pl);
+  return sethf(L, u, hf, &err, fname);
+}
+
+/* ---- queries ------------------------------------------------------------ */
+
+static int hf_height(lua_State *L) {
+  const char *fname = "heightfield:height";
+  oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
+  oclua_checkargs(L, 3, fname, "(x, y)");
+  double x = check_coord(L, 2, fname, "x"), y = check_coord(L, 3, fname, "y");
+  lua_pushnumber(L, oc_heightfield_height(hf, x, y, NULL));
+  return 1;
+}
+
+static int hf_gradient(lua_State *L) {
+  const char *fname = "heightfield:gradient";
+  oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
+  double g[2];
+  oclua_checkargs(L, 3, fname, "(x, y)");
+  double x = check_coord(L, 2, fname, "x"), y = check_coord(L, 3, fname, "y");
+  oc_heightfield_height(hf, x, y, g);
+  lua_pushnumber(L, g[0]);
+  lua_pushnumber(L, g[1]);
+  return 2;
+}
+
+static int hf_size(lua_State *L) {
+  oc_heightfield *hf = oclua_checkheightfield(L, 1, "heightfield:size");
+  oclua_checkargs(L, 1, "heightfield:size", "()");
+  lua_pushinteger(L, oc_heightfield_nx(hf));
+  lua_pushinteger(L, oc_heightfield_ny(hf));
+  return 2;
+}
+
+static int hf_cell(lua_State *L) {
+  oc_heightfield *hf = oclua_checkheightfield(L, 1, "heightfield:cell");
+  oclua_checkargs(L, 1, "heightfield:cell", "()");
+  lua_pushnumber(L, oc_heightfield_cell(hf));
+  return 1;
+}
+
+static int hf_bounds(lua_State *L) {
+  oc_heightfield *hf = oclua_checkheightfield(L, 1, "heightfield:bounds");
+  double x0, y0, lo, hi, c = oc_heightfield_cell(hf);
+  oclua_checkargs(L, 1, "heightfield:bounds", "()");
+  oc_heightfield_origin(hf, &x0, &y0);
+  oc_heightfield_minmax(hf, &lo, &hi);
+  lua_pushnumber(L, x0);
+  lua_pushnumber(L, y0);
+  lua_pushnumber(L, lo);
+  lua_pushnumber(L, x0 + (oc_heightfield_nx(hf) - 1) * c);
+  lua_pushnumber(L, y0 + (oc_heightfield_ny(hf) - 1) * c);
+  lua_pushnumber(L, hi);
+  return 6;
+}
+
+static int hf_get(lua_State *L) {
+  const char *fname = "heightfield:get";
+  oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
+  int n[2] = {oc_heightfield_nx(hf), oc_heightfield_ny(hf)};
+  lua_Integer ij[2];
+  oclua_checkargs(L, 3, fname, "(i, j)");
+  for (int k = 0; k < 2; k++) {
+    int isint;
+    ij[k] = lua_tointegerx(L, 2 + k, &isint);
+    if (lua_type(L, 2 + k) != LUA_TNUMBER || !isint || ij[k] < 1 ||
+        ij[k] > n[k])
+      oclua_error(L, fname, "%s must be an integer in 1..%d (got %s)",
+                  k == 0 ? "i" : "j", n[k], oclua_got(L, 2 + k));
+  }
+  lua_pushnumber(L, oc_heightfield_samples(
+                        hf)[(size_t)(ij[1] - 1) * n[0] + (size_t)(ij[0] - 1)]);
+  return 1;
+}
+
+static int hf_min(lua_State *L) {
+  oc_heightfield *hf = oclua_checkheightfield(L, 1, "heightfield:min");
+  double lo;
+  oclua_checkargs(L, 1, "heightfield:min", "()");
+  oc_heightfield_minmax(hf, &lo, NULL);
+  lua_pushnumber(L, lo);
+  return 1;
+}
+
+static int hf_max(lua_State *L) {
+  oc_heightfield *hf = oclua_checkheightfield(L, 1, "heightfield:max");
+  double hi;
+  oclua_checkargs(L, 1, "heightfield:max", "()");
+  oc_heightfield_minmax(hf, NULL, &hi);
+  lua_pushnumber(L, hi);
+  return 1;
+}
+
+/* In index order, in double: the same sum for any thread count. */
+static int hf_sum(lua_State *L) {
+  oc_heightfield *hf = oclua_checkheightfield(L, 1, "heightfield:sum");
+  size_t n = (size_t)oc_heightfield_nx(hf) * (size_t)oc_heightfield_ny(hf);
+  const float *z = oc_heightfield_samples(hf);
+  double s = 0;
+  oclua_checkargs(L, 1, "heightfield:sum", "()");
+  for (size_t k = 0; k < n; k++)
+    s += z[k];
+  lua_pushnumber(L, s);
+  return 1;
+}
+
+/* ---- resample and crop ------------------------------------------------- */
+
+/* Samples along an axis of extent w at spacing c: floor(w / c) + 1, with
+** a relative slack so that 100 / 0.1 counts 1001 samples. */
+static double count_samples(double w, double c) {
+  return floor(w / c * (1 + 1e-12)) + 1;
+}
+
+static int hf_resample(lua_State *L) {
+  static const char *const known[] = {"cell", "size", NULL};
+  const char *fname = "heightfield:resample";
+  oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
+  oclua_fields f;
+  oc_error err = {OC_OK, ""};
+  oc_hf_grid g;
+  oclua_progress pl;
+  oclua_checkargs(L, 2, fname, "{cell = or size =}");
+  oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
+  double c = oc_heightfield_cell(hf);
+  double wx = (oc_heightfield_nx(hf) - 1) * c,
+         wy = (oc_heightfield_ny(hf) - 1) * c;
+  int hassize = oclua_field_push(&f, "size") != LUA_TNIL;
+  lua_pop(L, 1);
+  double cell = oclua_field_optnumber(&f, "cell", OCLUA_POSITIVE, 0);
+  if (hassize == (cell > 0))
+    oclua_error(L, fname, "give either 'cell' or 'size' = {nx, ny}");
+  oc_heightfield_origin(hf, &g.x0, &g.y0);
+  if (hassize) {
+    field_size(&f, &g.nx, &g.ny);
+    double cx = wx / (g.nx - 1), cy = wy / (g.ny - 1);
+    if (fabs(cx - cy) > 1e-6 * fmax(cx, cy))
+      oclua_error(L, fname,
+                  "'size' {%d, %d} needs cells of %f along x but %f along y "
+                  "(cells are square): keep the grid's proportions or give "
+                  "'cell'",
+                  g.nx, g.ny, (LUAI_UACNUMBER)cx, (LUAI_UACNUMBER)cy);
+    g.cell = cx;
+  } else {
+    double nx = count_samples(wx, cell), ny = count_samples(wy, cell);
+    if (nx < 2 || ny < 2)
+      oclua_error(L, fname,
+                  "'cell' %f is larger than the grid (%f x %f): it would "
+                  "leave fewer than 2 samples per side",
+                  (LUAI_UACNUMBER)cell, (LUAI_UACNUMBER)wx, (LUAI_UACNUMBER)wy);
+    if (nx > MAX_SIDE || ny > MAX_SIDE)
+      oclua_error(L, fname,
+                  "'cell' %f gives %I x %I samples (at most %d per side)",
+                  (LUAI_UACNUMBER)cell, (LUAI_UACINT)fmin(nx, 1e18),
+                  (LUAI_UACINT)fmin(ny, 1e18), MAX_SIDE);
+    g.nx = (int)nx;
+    g.ny = (int)ny;
+    g.cell = cell;
+  }
+  oc_progress pr = oclua_progress_start(L, &pl, fname);
+  oclua_heightfield *u = oclua_newheightfield(L);
+  oc_heightfield *out = oc_heightfield_resample(hf, &g, pr, &err);
+  oclua_progress_end(&pl);
+  return sethf(L, u, out, &err, fname);
+}
+
+/* crop{i0, j0, i1, j1}: 1-based inclusive sample indices; or
+** crop{box = {x0, y0, x1, y1}}: the samples lying in the box. */
+static int hf_crop(lua_State *L) {
+  static const char *const known[] = {"box", NULL};
+  const char *fname = "heightfield:crop";
+  oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
+  oclua_fields f;
+  oc_error err = {OC_OK, ""};
+  int nx = oc_heightfield_nx(hf), ny = oc_heightfield_ny(hf), ij[4];
+  double box[4];
+  oclua_checkargs(L, 2, fname, "{i0, j0, i1, j1} or {box = {x0, y0, x1, y1}}");
+  oclua_fields_open(&f, L, 2, fname, NULL, known, 1);
+  int hasbox =
+      oclua_field_numbers(&f, "box", 4, box, "must be {x0, y0, x1, y1}");
+  if (hasbox == (f.narray != 0) || (!hasbox && f.narray != 4))
+    oclua_error(L, fname,
+                "give the sample range {i0, j0, i1, j1} (1-based, inclusive) "
+                "or box = {x0, y0, x1, y1}");
+  if (hasbox) {
+    double x0, y0, c = oc_heightfield_cell(hf);
+    oc_heightfield_origin(hf, &x0, &y0);
+    if (!(box[0] < box[2] && box[1] < box[3]))
+      oclua_error(L, fname,
+                  "'box' = {x0, y0, x1, y1} needs x0 < x1 and y0 < y1");
+    /* The samples inside, with a relative slack for rounding. */
+    double e = 1e-9;
+    double a[4] = {ceil((box[0] - x0) / c - e), ceil((box[1] - y0) / c - e),
+                   floor((box[2] - x0) / c + e), floor((box[3] - y0) / c + e)};
+    a[0] = fmax(a[0], 0), a[1] = fmax(a[1], 0);
+    a[2] = fmin(a[2], nx - 1), a[3] = fmin(a[3], ny - 1);
+    if (!(a[2] - a[0] >= 1 && a[3] - a[1] >= 1))
+      oclua_error(L, fname, "'box' holds fewer than 2 x 2 samples of the grid");
+    for (int k = 0; k < 4; k++)
+      ij[k] = (int)a[k];
+  } else {
+    for (int k = 0; k < 4; k++) {
+      int isint, lim = k % 2 == 0 ? nx : ny;
+      lua_geti(L, 2, k + 1);
+      lua_Integer v = lua_tointegerx(L, -1, &isint);
+      if (lua_type(L, -1) != LUA_TNUMBER || !isint || v < 1 || v > lim)
+        oclua_error(L, fname,
+                    "item %d (%s) must be an integer in 1..%d (got %s)", k + 1,
+                    (const char *[]){"i0", "j0", "i1", "j1"}[k], lim,
+                    oclua_got(L, -1));
+      ij[k] = (int)v - 1;
+      lua_pop(L, 1);
+    }
+  }
+  oclua_heightfield *u = oclua_newheightfield(L);
+  return sethf(L, u, oc_heightfield_crop(hf, ij[0], ij[1], ij[2], ij[3], &err),
+               &err, fname);
+}
+
+/* ---- save -------------------------------------------------------------- */
+
+/* The provenance pairs of l_provenance.h, gathered on a scratch image
+** (oclua_stamp_provenance works on images) kept in a userdata on the
+** stack, so the strings live until the write is over. */
+static const char **provenance(lua_State *L, size_t *n) {
+  oc_error err = {OC_OK, ""};
+  oclua_image *scratch = oclua_newimage(L);
+  scratch->img = oc_image_new(1, 1, 1, &err);
+  if (scratch->img == NULL) oclua_liberror(L, "heightfield:save", &err);
+  oclua_stamp_provenance(L, scratch->img);
+  *n = oc_image_meta_count(scratch->img);
+  const char **meta = lua_newuserdatauv(L, (2 * *n + 1) * sizeof *meta, 0);
+  for (size_t i = 0; i < *n; i++) {
+    meta[2 * i] = oc_image_meta_key(scratch->img, i);
+    meta[2 * i + 1] = oc_image_meta_value(scratch->img, i);
+  }
+  return meta;
+}
+
+static int hf_save(lua_State *L) {
+  static const char *const known[] = {"bits", "scale", "offset", NULL};
+  const char *fname = "heightfield:save";
+  oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
+  oclua_fields f;
+  oc_error err = {OC_OK, ""};
+  oc_hf_save_params p;
+  double used[2];
+  memset(&p, 0, sizeof p);
+  if (lua_type(L, 2) != LUA_TSTRING)
+    oclua_error(L, fname, "the path must be a string (got %s)",
+                oclua_got(L, 2));
+  oclua_checkargs(L, 3, fname, "(path [, {bits =, scale =, offset =}])");
+  opt_table(L, 3);
+  oclua_fields_open(&f, L, 3, fname, NULL, known, 0);
+  p.bits = (int)oclua_field_optint(&f, "bits", 8, 32, 0);
+  p.fixed = oclua_field_push(&f, "scale") != LUA_TNIL;
+  p.fixed |= oclua_field_push(&f, "offset") != LUA_TNIL;
+  lua_pop(L, 2);
+  p.scale = oclua_field_optnumber(&f, "scale", OCLUA_POSITIVE, 1);
+  p.offset = oclua_field_optnumber(&f, "offset", OCLUA_FINITE, 0);
+  const char *path = oclua_output_path(L, fname, lua_tostring(L, 2));
+  p.meta = provenance(L, &p.nmeta);
+  if (oc_heightfield_save(hf, path, &p, used, &err) != OC_OK) {
+    /* A file that cannot be written is an expected failure, as io.open. */
+    if (err.code == OC_EIO) {
+      luaL_pushfail(L);
+      lua_pushstring(L, err.msg[0] ? err.msg : "cannot write the heightfield");
+      return 2;
+    }
+    oclua_liberror(L, fname, &err);
+  }
+  lua_pushnumber(L, used[0]);
+  lua_pushnumber(L, used[1]);
+  return 2;
+}
+
+/* ---- metamethods --------------------------------------------------------- */
+
+static int hf_gc(lua_State *L) {
+  oclua_heightfield *u = luaL_checkudata(L, 1, OCLUA_HEIGHTFIELD);
+  oc_heightfield_release(u->hf);
+  u->hf = NULL;
+  return 0;
+}
+
+static int hf_tostring(lua_State *L) {
+  oclua_heightfield *u = luaL_checkudata(L, 1, OCLUA_HEIGHTFIELD);
+  if (u->hf == NULL) {
+    lua_pushliteral(L, OCLUA_HEIGHTFIELD ": (closed)");
+    return 1;
+  }
+  double x0, y0, lo, hi;
+  char buf[200];
+  oc_heightfield_origin(u->hf, &x0, &y0);
+  oc_heightfield_minmax(u->hf, &lo, &hi);
+  snprintf(buf, sizeof buf,
+           OCLUA_HEIGHTFIELD ": %d x %d, cell %g, origin (%g, %g), z %g .. %g",
+           oc_heightfield_nx(u->hf), oc_heightfield_ny(u->hf),
+           oc_heightfield_cell(u->hf), x0, y0, lo, hi);
+  lua_pushstring(L, buf);
+  return 1;
+}
+
+static const luaL_Reg hf_methods[] = {
+    {"height", hf_height}, {"gradient", hf_gradient},
+    {"size", hf_size},     {"cell", hf_cell},
+    {"bounds", hf_bounds}, {"get", hf_get},
+    {"min", hf_min},       {"max", hf_max},
+    {"sum", hf_sum},       {"resample", hf_resample},
+    {"crop", hf_crop},     {"save", hf_save},
+    {NULL, NULL}};
+
+static const luaL_Reg hf_meta[] = {
+    {"__gc", hf_gc},
+    {"__close", hf_gc}, /* `local hf <close>` frees the samples early */
+    {"__tostring", hf_tostring},
+    {"__index", NULL},
+    {NULL, NULL}};
+
+static const luaL_Reg hf_funcs[] = {
+    {"load", l_load}, {"fbm", l_fbm}, {"from", l_from}, {NULL, NULL}};
+
+void oclua_open_heightfield(lua_State *L) {
+  luaL_newmetatable(L, OCLUA_HEIGHTFIELD);
+  luaL_setfuncs(L, hf_meta, 0);
+  luaL_newlib(L, hf_methods);
+  luaL_setfuncs(L, oclua_heightfield_analysis, 0);
+  lua_setfield(L, -2, "__index");
+  lua_pop(L, 1);
+  luaL_newlib(L, hf_funcs);
+  lua_setfield(L, -2, "heightfield");
+}

@@ -1,0 +1,614 @@
+/*
+** l_render.c — outcrop.render(node, {...}): an image of the surface f = T
+** traced by lib/render, with every option checked before any work.
+**
+** Defaults (the lib's, oc_render_defaults, except where said): 640 x 360;
+** camera looking at the centre of the node's bounds from the south-west,
+** 30 degrees up, just far enough for the corners of the bounds to fit the
+** view (an error when the bounds are infinite and camera.eye or
+** camera.target is missing), up = {0, 0, 1}, fov = 40 degrees (vertical);
+** sun, sky, shadows, AO and texture as the lib; no fog; the sky behind
+** the surface; threshold = outcrop.threshold; rule colours by altitude
+** and slope.
+**
+** `color` selects the albedo: nil (rules, tuned by `rules = {...}`), a
+** node mapped through `palette` (a default palette of strata colours for
+** resistances in [0, 1]), {field = node, palette = ...} as polygonize
+** takes it, or a function (x, y, z, nx, ny, nz) -> r, g, b called once
+** per pixel that hits the surface, row by row from the top left, between
+** the lib's two passes (geometry, then shading). Colours are linear RGB.
+*/
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "l_field.h"
+#include "l_image.h"
+#include "l_progress.h"
+#include "l_render.h"
+
+#define FNAME "outcrop.render"
+#define MAX_SIDE 16384
+#define MAX_STOPS 256
+#define DEFAULT_FOV 40.0
+#define MAX_FOV 179.0
+/* Default view: from the south-west, 30 degrees above the horizon. */
+#define VIEW_AZIMUTH (-135.0)
+#define VIEW_ELEVATION 30.0
+/* Fog given as a distance: the transmittance there is exp(-3), 5 %. */
+#define FOG_DISTANCE_FACTOR 3.0
+#define PI 3.14159265358979323846
+
+/* Strata colours for a resistance in [0, 1]: soft sandstone to hard
+** limestone, linear albedos about as bright as the rules' rock, so that
+** layers of different hardness read as bands on cliffs. */
+static const double default_palette[][4] = {{0.00, 0.36, 0.22, 0.11},
+                                            {0.30, 0.28, 0.13, 0.07},
+                                            {0.50, 0.40, 0.32, 0.20},
+                                            {0.70, 0.16, 0.11, 0.08},
+                                            {1.00, 0.30, 0.29, 0.27}};
+#define DEFAULT_PALETTE_STOPS                                                  \
+  (int)(sizeof default_palette / sizeof default_palette[0])
+
+static const char *const rgb_names[3] = {"r", "g", "b"};
+
+/* Raises for a failed lib call: "interrupted" (as polygonize) when it was
+** cancelled, else the lib's message. */
+static int render_error(lua_State *L, oclua_progress *pl, const oc_error *err) {
+  oclua_progress_end(pl);
+  if (err->code == OC_ECANCEL) return luaL_error(L, "interrupted");
+  return oclua_liberror(L, FNAME, err);
+}
+
+/* ---- small readers ---------------------------------------------------- */
+
+/* Reads field `name` of f as {r, g, b} (or, when `alpha`, also
+** {r, g, b, a}): linear colours, components finite and >= 0, alpha in
+** [0, 1]. Returns the count read, 0 when absent. */
+static int read_rgb(const oclua_fields *f, const char *name, double *out,
+                    int alpha) {
+  lua_State *L = f->L;
+  const char *what =
+      alpha ? "must be {r, g, b} or {r, g, b, a}" : "must be {r, g, b}";
+  int t = oclua_field_push(f, name);
+  if (t == LUA_TNIL) {
+    lua_pop(L, 1);
+    return 0;
+  }
+  size_t n = t == LUA_TTABLE ? lua_rawlen(L, -1) : 0;
+  if (n != 3 && !(alpha && n == 4)) oclua_field_error(f, name, -1, what);
+  for (size_t i = 0; i < n; i++) {
+    int ti = lua_geti(L, -1, (lua_Integer)i + 1);
+    double x = lua_tonumber(L, -1);
+    if (!(ti == LUA_TNUMBER && isfinite(x) && x >= 0 && (x <= 1 || i < 3)))
+      oclua_error(L, f->fname, "'%s%s' %s with components %s (item %d is %s)",
+                  f->prefix, name, what,
+                  alpha ? "finite and >= 0, alpha <= 1" : "finite and >= 0",
+                  (int)i + 1, oclua_got(L, -1));
+    out[i] = x;
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+  return (int)n;
+}
+
+static double read_range(const oclua_fields *f, const char *name, double lo,
+                         double hi, double def) {
+  lua_State *L = f->L;
+  if (oclua_field_push(f, name) == LUA_TNIL) {
+    lua_pop(L, 1);
+    return def;
+  }
+  double x = lua_tonumber(L, -1);
+  if (lua_type(L, -1) != LUA_TNUMBER || !(x >= lo && x <= hi)) {
+    const char *what =
+        lua_pushfstring(L, "must be a number in [%f, %f]", lo, hi);
+    oclua_field_error(f, name, -2, what);
+  }
+  lua_pop(L, 1);
+  return x;
+}
+
+/* Opens the sub-table `name` of f (pushed on the stack) into sub;
+** returns 0 (nothing pushed) when the field is absent. */
+static int open_sub(const oclua_fields *f, const char *name, oclua_fields *sub,
+                    const char *const *known) {
+  lua_State *L = f->L;
+  if (oclua_field_push(f, name) == LUA_TNIL) {
+    lua_pop(L, 1);
+    return 0;
+  }
+  const char *prefix = lua_pushfstring(L, "%s%s.", f->prefix, name);
+  lua_insert(L, -2); /* the prefix string stays alive below the table */
+  oclua_fields_open(sub, L, -1, f->fname, prefix, known, 0);
+  return 1;
+}
+
+static void close_sub(lua_State *L) {
+  lua_pop(L, 2);
+}
+
+/* ---- fields ------------------------------------------------------------ */
+
+static void read_size(const oclua_fields *f, oc_render_params *rp) {
+  lua_State *L = f->L;
+  double size[2];
+  if (!oclua_field_numbers(f, "size", 2, size, "must be {width, height}"))
+    return;
+  for (int k = 0; k < 2; k++)
+    if (size[k] != floor(size[k]) || size[k] < 1 || size[k] > MAX_SIDE) {
+      if (size[k] == floor(size[k]) && fabs(size[k]) < 1e18)
+        lua_pushinteger(L, (lua_Integer)size[k]);
+      else
+        lua_pushnumber(L, size[k]);
+      oclua_error(L, f->fname,
+                  "'size' must be {width, height} with integers in "
+                  "1..%d (got %s)",
+                  MAX_SIDE, oclua_got(L, -1));
+    }
+  rp->width = (int)size[0];
+  rp->height = (int)size[1];
+}
+
+typedef struct camera_in {
+  int has_eye, has_target;
+} camera_in;
+
+static void read_camera(const oclua_fields *f, oc_render_params *rp,
+                        camera_in *ci) {
+  static const char *const known[] = {"eye", "target", "up", "fov", NULL};
+  oclua_fields c;
+  rp->camera.up = (oc_vec3){0, 0, 1};
+  rp->camera.fov = DEFAULT_FOV;
+  ci->has_eye = ci->has_target = 0;
+  if (!open_sub(f, "camera", &c, known)) return;
+  ci->has_eye = oclua_field_optvec(&c, "eye", &rp->camera.eye);
+  ci->has_target = oclua_field_optvec(&c, "target", &rp->camera.target);
+  oclua_field_optvec(&c, "up", &rp->camera.up);
+  rp->camera.fov =
+      oclua_field_optnumber(&c, "fov", OCLUA_POSITIVE, DEFAULT_FOV);
+  if (rp->camera.fov > MAX_FOV)
+    oclua_error(f->L, f->fname,
+                "'camera.fov' must be in (0, %d] degrees (got %f)",
+                (int)MAX_FOV, rp->camera.fov);
+  close_sub(f->L);
+}
+
+static void read_sun(const oclua_fields *f, oc_render_params *rp) {
+  static const char *const known[] = {"direction", "color", "intensity", NULL};
+  oclua_fields s;
+  oc_vec3 d;
+  if (!open_sub(f, "sun", &s, known)) return;
+  if (oclua_field_optvec(&s, "direction", &d)) {
+    if (d.x == 0 && d.y == 0 && d.z == 0)
+      oclua_error(f->L, f->fname, "'sun.direction' must not be {0, 0, 0}");
+    rp->sun_direction = d;
+  }
+  read_rgb(&s, "color", rp->sun_color, 0);
+  double i =
+      oclua_field_optnumber(&s, "intensity", OCLUA_FINITE, rp->sun_intensity);
+  if (i < 0)
+    oclua_error(f->L, f->fname, "'sun.intensity' must be >= 0 (got %f)", i);
+  rp->sun_intensity = i;
+  close_sub(f->L);
+}
+
+/* fog = density (per metre) or {density = | distance =, color =}. */
+static void read_fog(const oclua_fields *f, oc_render_params *rp) {
+  static const char *const known[] = {"density", "distance", "color", NULL};
+  lua_State *L = f->L;
+  oclua_fields g;
+  int t = oclua_field_push(f, "fog");
+  lua_pop(L, 1);
+  if (t == LUA_TNIL) return;
+  if (t == LUA_TNUMBER) {
+    rp->fog_density = read_range(f, "fog", 0, HUGE_VAL, 0);
+    return;
+  }
+  if (t != LUA_TTABLE) {
+    oclua_field_push(f, "fog");
+    oclua_field_error(f, "fog", -1,
+                      "must be a density per metre or {density = or "
+                      "distance =, color =}");
+  }
+  open_sub(f, "fog", &g, known);
+  double density = read_range(&g, "density", 0, HUGE_VAL, -1);
+  double distance = oclua_field_optnumber(&g, "distance", OCLUA_POSITIVE, 0);
+  if (density >= 0 && distance > 0)
+    oclua_error(L, f->fname, "give either 'fog.density' or 'fog.distance'");
+  if (density < 0 && distance == 0)
+    oclua_field_missing(&g, "density",
+                        "or 'fog.distance': how thick the fog is");
+  rp->fog_density = distance > 0 ? FOG_DISTANCE_FACTOR / distance : density;
+  read_rgb(&g, "color", rp->fog_color, 0);
+  close_sub(L);
+}
+
+static void read_rules(const oclua_fields *f, oc_render_params *rp) {
+  static const char *const known[] = {"sea_level",  "snow_line",  "beach",
+                                      "rock_slope", "snow_slope", NULL};
+  lua_State *L = f->L;
+  oclua_fields r;
+  if (!open_sub(f, "rules", &r, known)) return;
+  oc_render_rules *ru = &rp->rules;
+  int sea = oclua_field_push(&r, "sea_level") != LUA_TNIL;
+  int snow = oclua_field_push(&r, "snow_line") != LUA_TNIL;
+  lua_pop(L, 2);
+  if (sea != snow)
+    oclua_error(L, f->fname,
+                "give both 'rules.sea_level' and 'rules.snow_line' (or "
+                "neither: they then follow the visible altitudes)");
+  if (sea) {
+    ru->levels = 1;
+    ru->sea_level = oclua_field_number(&r, "sea_level", OCLUA_FINITE);
+    ru->snow_line = oclua_field_number(&r, "snow_line", OCLUA_FINITE);
+    if (!(ru->sea_level < ru->snow_line))
+      oclua_error(L, f->fname,
+                  "'rules.sea_level' must be below 'rules.snow_line' "
+                  "(got %f and %f)",
+                  ru->sea_level, ru->snow_line);
+  }
+  ru->beach = read_range(&r, "beach", 0, HUGE_VAL, ru->beach);
+  ru->rock_slope = read_range(&r, "rock_slope", 0, 90, ru->rock_slope);
+  ru->snow_slope = read_range(&r, "snow_slope", 0, 90, ru->snow_slope);
+  close_sub(L);
+}
+
+/* Reads a palette at stack index pal into a Lua-owned array of stops
+** (value, r, g, b), pushed on the stack. `label` names the field. */
+static const double *read_palette(lua_State *L, int pal, const char *label,
+                                  int *nstops) {
+  lua_Integer n = lua_istable(L, pal) ? (lua_Integer)lua_rawlen(L, pal) : 0;
+  if (n < 1 || n > MAX_STOPS)
+    oclua_error(L, FNAME,
+                "'%s' must be an array of 1..%d {value, {r, g, b}} "
+                "(got %s)",
+                label, MAX_STOPS, oclua_got(L, pal));
+  double *stops = lua_newuserdatauv(L, (size_t)n * 4 * sizeof *stops, 0);
+  for (lua_Integer k = 1; k <= n; k++) {
+    double *s = stops + 4 * (k - 1);
+    lua_geti(L, pal, k);
+    if (!lua_istable(L, -1) || lua_rawlen(L, -1) != 2)
+      oclua_error(L, FNAME, "'%s[%I]' must be {value, {r, g, b}} (got %s)",
+                  label, (LUAI_UACINT)k, oclua_got(L, -1));
+    if (lua_geti(L, -1, 1) != LUA_TNUMBER || !isfinite(lua_tonumber(L, -1)))
+      oclua_error(L, FNAME, "'%s[%I]' value must be a finite number (got %s)",
+                  label, (LUAI_UACINT)k, oclua_got(L, -1));
+    s[0] = lua_tonumber(L, -1);
+    lua_pop(L, 1);
+    if (k > 1 && s[0] < s[-4])
+      oclua_error(L, FNAME,
+                  "'%s' values must be in ascending order (item %I: %f "
+                  "after %f)",
+                  label, (LUAI_UACINT)k, (LUAI_UACNUMBER)s[0],
+                  (LUAI_UACNUMBER)s[-4]);
+    if (lua_geti(L, -1, 2) != LUA_TTABLE || lua_rawlen(L, -1) != 3)
+      oclua_error(L, FNAME, "'%s[%I]' colour must be {r, g, b} (got %s)", label,
+                  (LUAI_UACINT)k, oclua_got(L, -1));
+    for (int j = 0; j < 3; j++) {
+      int t = lua_geti(L, -1, j + 1);
+      double x = lua_tonumber(L, -1);
+      if (t != LUA_TNUMBER || !(x >= 0 && x <= 1))
+        oclua_error(L, FNAME,
+                    "'%s[%I]' colour components must be in [0, 1] (got "
+                    "%s = %s)",
+                    label, (LUAI_UACINT)k, rgb_names[j], oclua_got(L, -1));
+      s[1 + j] = x;
+      lua_pop(L, 1);
+    }
+    lua_pop(L, 2);
+  }
+  *nstops = (int)n;
+  return stops;
+}
+
+enum { SRC_RULES, SRC_FIELD, SRC_FUNCTION };
+
+/* What `color` asked for; the node or function stays on the stack at idx
+** (and the stops in a userdata) until the image is made. */
+typedef struct source {
+  int kind;
+  int idx;
+} source;
+
+static void read_color(const oclua_fields *f, oc_render_params *rp,
+                       source *src) {
+  static const char *const known[] = {"field", "palette", NULL};
+  lua_State *L = f->L;
+  int t = oclua_field_push(f, "color");
+  int has_palette = oclua_field_push(f, "palette") != LUA_TNIL;
+  int has_rules = oclua_field_push(f, "rules") != LUA_TNIL;
+  lua_pop(L, 2);
+  src->kind = SRC_RULES;
+  src->idx = lua_gettop(L);
+  rp->color = OC_COLOR_RULES;
+  if (has_rules && t != LUA_TNIL)
+    oclua_error(L, f->fname,
+                "'rules' tune the default colours: it cannot go with "
+                "'color'");
+  if (has_palette && t != LUA_TUSERDATA)
+    oclua_error(L, f->fname,
+                "'palette' maps a 'color' node: give 'color' = node "
+                "with it");
+  if (t == LUA_TNIL) {
+    read_rules(f, rp);
+    return;
+  }
+  if (t == LUA_TFUNCTION) {
+    src->kind = SRC_FUNCTION;
+    return;
+  }
+  if (t == LUA_TUSERDATA && oclua_testnode(L, -1)) {
+    src->kind = SRC_FIELD;
+    rp->color = OC_COLOR_FIELD;
+    if (has_palette) {
+      oclua_field_push(f, "palette");
+      rp->stops = read_palette(L, lua_gettop(L), "palette", &rp->nstops);
+    }
+    return;
+  }
+  if (t == LUA_TTABLE) { /* {field =, palette =}, as polygonize's colors */
+    oclua_fields c;
+    oclua_fields_open(&c, L, -1, f->fname, "color.", known, 0);
+    if (oclua_field_push(&c, "field") == LUA_TNIL)
+      oclua_field_missing(&c, "field", "an outcrop node");
+    if (oclua_testnode(L, -1) == NULL)
+      oclua_field_error(&c, "field", -1, "must be an outcrop node");
+    src->kind = SRC_FIELD;
+    src->idx = lua_gettop(L);
+    rp->color = OC_COLOR_FIELD;
+    if (oclua_field_push(&c, "palette") != LUA_TNIL)
+      rp->stops = read_palette(L, lua_gettop(L), "color.palette", &rp->nstops);
+    return;
+  }
+  oclua_field_error(f, "color", -1,
+                    "must be an outcrop node, a function (x, y, z, nx, ny, "
+                    "nz) -> r, g, b, or {field = node, palette = ...}");
+}
+
+/* ---- the default camera ---------------------------------------------- */
+
+/* Points the camera at the node's bounds where the script did not: the
+** target at their centre, the eye back along the default view direction
+** (or the given eye's) just far enough for the eight corners of the
+** bounds to fall inside the view. */
+static void default_camera(lua_State *L, const oc_program *prog,
+                           oc_render_params *rp, const camera_in *ci) {
+  oc_aabb b = oc_program_bounds(prog);
+  double lo[3] = {b.lo.x, b.lo.y, b.lo.z}, hi[3] = {b.hi.x, b.hi.y, b.hi.z};
+  if (ci->has_eye && ci->has_target) return;
+  for (int k = 0; k < 3; k++) {
+    if (lo[k] > hi[k])
+      oclua_error(L, FNAME,
+                  "the node's bounds are empty (its field is 0 everywhere): "
+                  "give 'camera' = {eye =, target =}");
+    if (!isfinite(lo[k]) || !isfinite(hi[k]))
+      oclua_error(L, FNAME,
+                  "the node's bounds are infinite: give 'camera' = "
+                  "{eye =, target =}");
+  }
+  double c[3] = {(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2};
+  if (!ci->has_target) rp->camera.target = (oc_vec3){c[0], c[1], c[2]};
+  if (ci->has_eye) return;
+  /* Viewing direction (from the eye to the target) and the camera's
+  ** right and up vectors; a vertical view falls back to the default. */
+  double az = VIEW_AZIMUTH * PI / 180, el = VIEW_ELEVATION * PI / 180;
+  double fw[3] = {-cos(el) * cos(az), -cos(el) * sin(az), -sin(el)};
+  oc_vec3 u = rp->camera.up;
+  double rt[3] = {fw[1] * u.z - fw[2] * u.y, fw[2] * u.x - fw[0] * u.z,
+                  fw[0] * u.y - fw[1] * u.x};
+  double n = sqrt(rt[0] * rt[0] + rt[1] * rt[1] + rt[2] * rt[2]);
+  if (!(n > 1e-9 * sqrt(u.x * u.x + u.y * u.y + u.z * u.z)))
+    oclua_error(L, FNAME,
+                "'camera.up' is parallel to the default view direction: "
+                "give 'camera.eye'");
+  for (int k = 0; k < 3; k++)
+    rt[k] /= n;
+  double up[3] = {rt[1] * fw[2] - rt[2] * fw[1], rt[2] * fw[0] - rt[0] * fw[2],
+                  rt[0] * fw[1] - rt[1] * fw[0]};
+  double tv = tan(rp->camera.fov * PI / 360);
+  double th = tv * (double)rp->width / (double)rp->height;
+  double t[3] = {rp->camera.target.x, rp->camera.target.y, rp->camera.target.z};
+  double dist = 0, radius = 0;
+  for (int corner = 0; corner < 8; corner++) {
+    double q[3], x = 0, y = 0, z = 0;
+    for (int k = 0; k < 3; k++) {
+      q[k] = ((corner >> k) & 1 ? hi[k] : lo[k]) - t[k];
+      x += q[k] * rt[k], y += q[k] * up[k], z += q[k] * fw[k];
+    }
+    /* The corner is in view when |x| <= th (dist + z), |y| <= tv (dist + z). */
+    dist = fmax(dist, fmax(fabs(x) / th, fabs(y) / tv) - z);
+    radius = fmax(radius, sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]));
+  }
+  /* A small margin, and never inside the bounds' sphere. */
+  dist = fmax(1.04 * dist, 1.01 * radius);
+  if (!(dist > 0)) dist = 1;
+  rp->camera.eye =
+      (oc_vec3){t[0] - dist * fw[0], t[1] - dist * fw[1], t[2] - dist * fw[2]};
+}
+
+/* ---- the colour function ----------------------------------------------- */
+
+/* Calls the function at fn for every hit pixel of the geometry image g
+** (row by row, from the top left), gathering albedos in a Lua-owned
+** buffer that it pushes and returns. */
+static const float *albedo_by_function(lua_State *L, int fn, const oc_image *g,
+                                       oclua_progress *pl) {
+  size_t w = (size_t)oc_image_width(g), h = (size_t)oc_image_height(g);
+  const float *px = oc_image_cdata(g);
+  float *rgb = lua_newuserdatauv(L, w * h * 3 * sizeof *rgb, 0);
+  luaL_checkstack(L, 8, NULL);
+  for (size_t i = 0; i < w * h; i++) {
+    const float *p = px + i * OC_RG_COUNT;
+    /* (Ctrl-C in the function is the interpreter's hook's to catch.) */
+    if (i % w == 0) oclua_progress_report(pl, (double)i / (double)(w * h));
+    float *out = rgb + 3 * i;
+    if (!(p[OC_RG_HIT] > 0.5f)) {
+      out[0] = out[1] = out[2] = 0;
+      continue;
+    }
+    lua_pushvalue(L, fn);
+    for (int k = 0; k < 3; k++)
+      lua_pushnumber(L, p[OC_RG_PX + k]);
+    for (int k = 0; k < 3; k++)
+      lua_pushnumber(L, p[OC_RG_NX + k]);
+    lua_call(L, 6, 3);
+    for (int k = 0; k < 3; k++) {
+      int idx = k - 3;
+      double x = lua_tonumber(L, idx);
+      if (lua_type(L, idx) != LUA_TNUMBER || !(x >= 0 && x <= 1))
+        oclua_error(L, FNAME,
+                    "the color function must return r, g, b in [0, 1] "
+                    "(got %s = %s at pixel %I, %I)",
+                    rgb_names[k], oclua_got(L, idx), (LUAI_UACINT)(i % w + 1),
+                    (LUAI_UACINT)(i / w + 1));
+      out[k] = (float)x;
+    }
+    lua_pop(L, 3);
+  }
+  return rgb;
+}
+
+typedef struct albedo_call {
+  const oc_image *g;
+  oclua_progress *pl;
+  const float *rgb;
+} albedo_call;
+
+/* albedo_by_function under lua_pcall: the function at 1, the call's
+** description at 2. */
+static int protected_albedo(lua_State *L) {
+  albedo_call *ac = lua_touserdata(L, 2);
+  ac->rgb = albedo_by_function(L, 1, ac->g, ac->pl);
+  return 1;
+}
+
+/* Runs the colour function over every hit pixel of g and pushes the
+** albedo buffer. With a progress line on the terminal the calls are
+** protected, so that an error (or Ctrl-C) clears the line before the
+** message is printed; the error then goes on from here, its message
+** still naming the line of the function that failed. */
+static const float *run_colour_function(lua_State *L, int fn, const oc_image *g,
+                                        oclua_progress *pl) {
+  if (!pl->tty) return albedo_by_function(L, fn, g, pl);
+  albedo_call ac = {g, pl, NULL};
+  lua_pushcfunction(L, protected_albedo);
+  lua_pushvalue(L, fn);
+  lua_pushlightuserdata(L, &ac);
+  if (lua_pcall(L, 2, 1, 0) != LUA_OK) {
+    oclua_progress_end(pl);
+    lua_error(L);
+  }
+  return ac.rgb;
+}
+
+/* ---- outcrop.render -------------------------------------------------- */
+
+static int l_render(lua_State *L) {
+  static const char *const known[] = {
+      "camera",      "size",          "sun",
+      "sky",         "shadows",       "ao",
+      "ao_distance", "fog",           "color",
+      "palette",     "rules",         "background",
+      "texture",     "texture_scale", "aov",
+      "threshold",   "max_distance",  "tracer",
+      NULL};
+  static const char *const tracers[] = {"segment", "sphere", NULL};
+  oclua_fields f;
+  oc_error err = {OC_OK, ""};
+  oc_render_params rp;
+  oclua_progress pl;
+  camera_in ci;
+  source src;
+  double bg[4] = {0, 0, 0, 1};
+  oclua_checkargs(L, 2, FNAME,
+                  "(node, {camera =, size =, sun =, sky =, shadows =, ao =, "
+                  "fog =, color =, background =, aov =, ...})");
+  oclua_checknode(L, 1, FNAME, "argument #1");
+  lua_settop(L, 2);
+  if (lua_isnil(L, 2)) {
+    lua_newtable(L);
+    lua_replace(L, 2);
+  }
+  oclua_fields_open(&f, L, 2, FNAME, NULL, known, 0);
+  oc_render_defaults(&rp);
+  read_size(&f, &rp);
+  read_camera(&f, &rp, &ci);
+  read_sun(&f, &rp);
+  int has_sky = read_rgb(&f, "sky", rp.sky, 0);
+  if (has_sky) memcpy(rp.fog_color, rp.sky, sizeof rp.sky);
+  rp.shadows = oclua_field_optbool(&f, "shadows", rp.shadows);
+  rp.ao = oclua_field_optbool(&f, "ao", rp.ao);
+  rp.ao_distance =
+      oclua_field_optnumber(&f, "ao_distance", OCLUA_POSITIVE, rp.ao_distance);
+  read_fog(&f, &rp);
+  int nbg = read_rgb(&f, "background", bg, 1);
+  if (nbg) {
+    rp.has_background = 1;
+    memcpy(rp.background, bg, sizeof bg);
+  }
+  rp.texture = read_range(&f, "texture", 0, 1, rp.texture);
+  rp.texture_scale = oclua_field_optnumber(&f, "texture_scale", OCLUA_POSITIVE,
+                                           rp.texture_scale);
+  rp.aov = oclua_field_optbool(&f, "aov", 0);
+  double t = oclua_field_optnumber(&f, "threshold", OCLUA_POSITIVE, 0);
+  if (t == 0) t = oclua_threshold(L, FNAME);
+  rp.threshold = t;
+  rp.max_distance =
+      oclua_field_optnumber(&f, "max_distance", OCLUA_POSITIVE, 0);
+  rp.tracer = oclua_field_optoption(&f, "tracer", tracers, 0) == 1
+                  ? OC_TRACE_SPHERE
+                  : OC_TRACE_SEGMENT;
+  read_color(&f, &rp, &src);
+  if (src.kind == SRC_FIELD && rp.stops == NULL) {
+    rp.stops = default_palette[0];
+    rp.nstops = DEFAULT_PALETTE_STOPS;
+  }
+
+  const oc_program *prog = oclua_program_at(L, 1, FNAME, t);
+  default_camera(L, prog, &rp, &ci);
+  memset(&rp.progress, 0, sizeof rp.progress);
+  rp.progress = oclua_progress_start(L, &pl, FNAME);
+
+  if (src.kind != SRC_FUNCTION) {
+    /* The colour node is compiled at the render's threshold: were it the
+    ** main node itself, another threshold would replace (and free) the
+    ** program in use. */
+    if (src.kind == SRC_FIELD)
+      rp.color_field = oclua_program_at(L, src.idx, FNAME, t);
+    oclua_image *u = oclua_newimage(L);
+    u->img = oc_render(prog, &rp, &err);
+    if (u->img == NULL) render_error(L, &pl, &err);
+    oclua_progress_end(&pl);
+    return 1;
+  }
+
+  /* A Lua function colours the pixels, serially, between the two passes;
+  ** every buffer is a userdata, so an error in it leaks nothing. */
+  oclua_image *g = oclua_newimage(L);
+  pl.span = 0.2;
+  g->img = oc_render_geometry(prog, &rp, &err);
+  if (g->img == NULL) render_error(L, &pl, &err);
+  pl.base = 0.2, pl.span = 0.6;
+  const float *albedo = run_colour_function(L, src.idx, g->img, &pl);
+  pl.base = 0.8, pl.span = 0.2;
+  /* The function may have queried the node at another threshold, which
+  ** recompiles it: fetch the program again. */
+  prog = oclua_program_at(L, 1, FNAME, t);
+  oclua_image *u = oclua_newimage(L);
+  u->img = oc_render_shade(prog, &rp, g->img, albedo, &err);
+  if (u->img == NULL) render_error(L, &pl, &err);
+  oclua_progress_end(&pl);
+  oc_image_free(g->img); /* big: not left to the collector */
+  g->img = NULL;
+  return 1;
+}
+
+static const luaL_Reg render_funcs[] = {{"render", l_render}, {NULL, NULL}};
+
+void oclua_open_render(lua_State *L) {
+  luaL_setfuncs(L, render_funcs, 0);
+}

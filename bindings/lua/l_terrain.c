@@ -1,0 +1,104 @@
+/*
+** l_terrain.c — outcrop.terrain(hf, {falloff=, transition=, mask=,
+** invert=}): a heightfield implicitized into a terrain node (seed 000
+** section 5.1; docs/fields.md has the field).
+**
+**   field      | default
+**   -----------+-----------------------------------------------------------
+**   falloff    | 4 cells of the heightfield: the prism's falloff R
+**   transition | 1 (metre): the half-width W of sigma
+**   mask       | none: a heightfield (Omega where it is >= 0.5), or the
+**              | path of a grey image stretched over the heightfield's
+**              | width (Omega where it is >= half its brightest pixel)
+**   thickness  | 0: how much farther than the elevations the prism reaches
+**              | on the solid side (below; above when inverted)
+**   invert     | false: solid above the surface instead of below
+**
+** The table is optional. Everything is checked before anything is made;
+** the node keeps the grid alive.
+*/
+#include <string.h>
+
+#include "l_field.h"
+#include "l_heightfield.h"
+#include "l_terrain.h"
+
+/* A mask image read from `path`, stretched over hf's width, its samples
+** divided by the largest one so that Omega is where they are >= 0.5.
+** Raises on error (nothing to release then). */
+static oc_heightfield *mask_from_path(lua_State *L, const char *fname,
+                                      const char *path,
+                                      const oc_heightfield *hf) {
+  oc_error err = {OC_OK, ""};
+  oc_heightfield *m = oc_heightfield_load(path, NULL, &err);
+  if (!m) oclua_error(L, fname, "'mask': %s", err.msg);
+  int nx = oc_heightfield_nx(m), ny = oc_heightfield_ny(m);
+  double lo, hi, x0, y0;
+  oc_heightfield_minmax(m, &lo, &hi);
+  oc_heightfield_origin(hf, &x0, &y0);
+  double cell =
+      oc_heightfield_cell(hf) * (oc_heightfield_nx(hf) - 1) / (double)(nx - 1);
+  oc_heightfield *s = NULL;
+  if (hi > 0) s = oc_heightfield_new(nx, ny, cell, x0, y0, NULL, &err);
+  if (s) {
+    const float *a = oc_heightfield_samples(m);
+    float *b = oc_heightfield_samples_mut(s);
+    for (size_t k = 0; k < (size_t)nx * (size_t)ny; k++)
+      b[k] = (float)(a[k] / hi);
+  }
+  oc_heightfield_release(m);
+  if (!s && hi > 0) oclua_error(L, fname, "'mask': %s", err.msg);
+  if (!s)
+    oclua_error(L, fname, "'mask' image '%s' is black: nothing is inside",
+                path);
+  return s;
+}
+
+static int l_terrain(lua_State *L) {
+  static const char *const known[] = {"falloff", "transition", "thickness",
+                                      "mask",    "invert",     NULL};
+  const char *fname = "outcrop.terrain";
+  oclua_checkargs(L, 2, fname,
+                  "(heightfield [, {falloff=, transition=, "
+                  "mask=, invert=}])");
+  oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
+  oc_terrain_params tp = {0};
+  tp.falloff = 4 * oc_heightfield_cell(hf);
+  const char *mask_path = NULL;
+  oc_heightfield *mask = NULL;
+  if (!lua_isnoneornil(L, 2)) {
+    oclua_fields f;
+    oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
+    tp.falloff =
+        oclua_field_optnumber(&f, "falloff", OCLUA_POSITIVE, tp.falloff);
+    tp.transition = oclua_field_optnumber(&f, "transition", OCLUA_POSITIVE, 1);
+    tp.thickness = oclua_field_optnumber(&f, "thickness", OCLUA_FINITE, 0);
+    if (tp.thickness < 0)
+      oclua_error(L, fname, "'thickness' must be >= 0 (got %f)", tp.thickness);
+    tp.invert = oclua_field_optbool(&f, "invert", 0);
+    int t = oclua_field_push(&f, "mask");
+    if (t == LUA_TSTRING)
+      mask_path = lua_tostring(L, -1);
+    else if (t != LUA_TNIL && !(mask = oclua_testheightfield(L, -1)))
+      oclua_field_error(&f, "mask", -1, "must be a heightfield or a path");
+    lua_pop(L, 1); /* the string stays alive in the table */
+  }
+  oclua_node *u = oclua_newnode(L);
+  oc_heightfield *own =
+      mask_path ? mask_from_path(L, fname, mask_path, hf) : NULL;
+  tp.mask = own ? own : mask;
+  oc_error err = {OC_OK, ""};
+  oc_elevation src;
+  oc_node *n = NULL;
+  if (oc_heightfield_elevation(hf, &src, &err) == OC_OK) {
+    n = oc_terrain(&src, &tp, &err);
+    src.release(src.ud); /* the node holds its own reference */
+  }
+  oc_heightfield_release(own);
+  return oclua_setnode(L, u, n, &err, fname);
+}
+
+void oclua_open_terrain(lua_State *L) {
+  lua_pushcfunction(L, l_terrain);
+  lua_setfield(L, -2, "terrain");
+}

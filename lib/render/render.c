@@ -1,0 +1,325 @@
+/*
+** render.c — oc_render and its two phases: primary rays into a geometry
+** image (hit, distance, normal, position, evaluation count per pixel),
+** then colour and light into the final image.
+**
+** Pixels are independent, and each depends only on its own ray, so the
+** image is byte-identical for any thread count: tiles are handed out
+** dynamically over both cores, and only their order varies. Nothing is
+** allocated per pixel.
+*/
+#include <math.h>
+#include <omp.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "core/vec.h"
+#include "render/render.h"
+#include "render/shade.h"
+#include "render/trace.h"
+
+#define TILE 16
+#define NAOV 8
+#define GEOM_SHARE 0.7 /* oc_render's progress: tracing, then shading */
+/* Hit tolerance: this fraction of a pixel's angular size. */
+#define EPS_PIXEL 0.25
+
+static const char *const geom_names[OC_RG_COUNT] = {
+    "hit", "Z", "N.x", "N.y", "N.z", "P.x", "P.y", "P.z", "evals"};
+static const char *const aov_names[NAOV] = {"Z",   "N.x", "N.y", "N.z",
+                                            "P.x", "P.y", "P.z", "evals"};
+
+typedef struct camera {
+  oc_vec3 eye, w, right, up; /* w forward, right x up the image plane */
+  double th, aspect;         /* tan(fov / 2), width / height */
+  int width, height;
+  double scale; /* |target - eye|: the scene's scale for defaults */
+} camera;
+
+static void camera_init(camera *c, const oc_render_params *rp) {
+  const oc_camera *k = &rp->camera;
+  c->eye = k->eye;
+  oc_vec3 w = oc_sub(k->target, k->eye);
+  c->scale = oc_len(w);
+  c->w = oc_mul(w, 1 / c->scale);
+  oc_vec3 r = oc_cross(c->w, k->up);
+  c->right = oc_mul(r, 1 / oc_len(r));
+  c->up = oc_cross(c->right, c->w);
+  c->th = tan(k->fov * (3.14159265358979323846 / 360));
+  c->width = rp->width;
+  c->height = rp->height;
+  c->aspect = (double)rp->width / rp->height;
+}
+
+/* The unit direction through the centre of pixel (i, j), row 0 on top. */
+static oc_vec3 ray_dir(const camera *c, int i, int j) {
+  double x = (2 * (i + 0.5) / c->width - 1) * c->th * c->aspect;
+  double y = (1 - 2 * (j + 0.5) / c->height) * c->th;
+  oc_vec3 d = oc_add(c->w, oc_add(oc_mul(c->right, x), oc_mul(c->up, y)));
+  return oc_mul(d, 1 / oc_len(d));
+}
+
+static double resolve_T(const oc_program *prog, const oc_render_params *rp) {
+  return rp->threshold != 0 ? rp->threshold : oc_program_threshold(prog);
+}
+
+static void tracer_for(oc_tracer *tr, const oc_program *prog,
+                       const oc_render_params *rp, const camera *c) {
+  double pixel = 2 * c->th / c->height;
+  oc_tracer_init(tr, prog, resolve_T(prog, rp), rp->tracer, EPS_PIXEL * pixel,
+                 1e-7 * c->scale);
+}
+
+/* Rays end where the scene's box ends, or at max_distance; an unbounded
+** scene needs a finite end, or a ray grazing a half-space would march
+** for ever. */
+static double far_for(const oc_program *prog, const oc_render_params *rp,
+                      const camera *c) {
+  if (rp->max_distance > 0) return rp->max_distance;
+  oc_aabb b = oc_program_bounds(prog);
+  if (oc_vfinite(b.lo) && oc_vfinite(b.hi)) return INFINITY;
+  return 1000 * c->scale;
+}
+
+/* ---- tiles ---------------------------------------------------------------
+ */
+
+typedef void (*tile_fn)(const void *ctx, int x0, int y0, int x1, int y1);
+
+/* Runs fn over every tile in parallel; progress in [base, base + span]
+** from the calling thread only. Returns OC_ECANCEL when cancelled. */
+static int run_tiles(int w, int h, tile_fn fn, const void *ctx,
+                     const oc_progress *pg, double base, double span) {
+  int ntx = (w + TILE - 1) / TILE, nty = (h + TILE - 1) / TILE;
+  int n = ntx * nty, stop = 0, done = 0;
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int k = 0; k < n; k++) {
+    int halt;
+#pragma omp atomic read
+    halt = stop;
+    if (halt) continue;
+    int x0 = (k % ntx) * TILE, y0 = (k / ntx) * TILE;
+    fn(ctx, x0, y0, x0 + TILE < w ? x0 + TILE : w,
+       y0 + TILE < h ? y0 + TILE : h);
+    int d;
+#pragma omp atomic capture
+    d = ++done;
+    if (pg->fn && omp_get_thread_num() == 0 &&
+        pg->fn(pg->ud, base + span * d / n)) {
+#pragma omp atomic write
+      stop = 1;
+    }
+  }
+  if (stop || (pg->fn && pg->fn(pg->ud, base + span))) return OC_ECANCEL;
+  return OC_OK;
+}
+
+/* ---- geometry ------------------------------------------------------------
+ */
+
+typedef struct gctx {
+  const oc_program *prog;
+  camera cam;
+  oc_tracer tr;
+  double far;
+  float *px;
+} gctx;
+
+static void geom_pixel(const gctx *g, int i, int j, float *out) {
+  oc_vec3 u = ray_dir(&g->cam, i, j);
+  double t, ev = 0;
+  memset(out, 0, OC_RG_COUNT * sizeof *out);
+  if (!oc_trace(&g->tr, g->cam.eye, u, 0, g->far, 0, &t, &ev)) {
+    out[OC_RG_Z] = INFINITY;
+    out[OC_RG_EVALS] = (float)ev;
+    return;
+  }
+  oc_vec3 p = oc_add(g->cam.eye, oc_mul(u, t)), gr;
+  oc_program_gradient(g->prog, p, &gr);
+  ev += 1;
+  double gl = oc_len(gr);
+  oc_vec3 n = gl > 0 && isfinite(gl) ? oc_mul(gr, -1 / gl) : oc_mul(u, -1);
+  out[OC_RG_HIT] = 1;
+  out[OC_RG_Z] = (float)t;
+  out[OC_RG_NX] = (float)n.x;
+  out[OC_RG_NX + 1] = (float)n.y;
+  out[OC_RG_NX + 2] = (float)n.z;
+  out[OC_RG_PX] = (float)p.x;
+  out[OC_RG_PX + 1] = (float)p.y;
+  out[OC_RG_PX + 2] = (float)p.z;
+  out[OC_RG_EVALS] = (float)ev;
+}
+
+static void geom_tile(const void *ctx, int x0, int y0, int x1, int y1) {
+  const gctx *g = ctx;
+  for (int j = y0; j < y1; j++)
+    for (int i = x0; i < x1; i++)
+      geom_pixel(g, i, j, g->px + ((size_t)j * g->cam.width + i) * OC_RG_COUNT);
+}
+
+static oc_image *geometry(const oc_program *prog, const oc_render_params *rp,
+                          double base, double span, oc_error *err) {
+  if (oc_render_check_geometry(prog, rp, err)) return NULL;
+  oc_image *img = oc_image_new(rp->width, rp->height, OC_RG_COUNT, err);
+  if (!img) return NULL;
+  for (int c = 0; c < OC_RG_COUNT; c++)
+    oc_image_set_channel_name(img, c, geom_names[c], NULL);
+  gctx g;
+  camera_init(&g.cam, rp);
+  g.prog = prog;
+  tracer_for(&g.tr, prog, rp, &g.cam);
+  g.far = far_for(prog, rp, &g.cam);
+  g.px = oc_image_data(img);
+  if (run_tiles(rp->width, rp->height, geom_tile, &g, &rp->progress, base,
+                span)) {
+    oc_image_free(img);
+    oc_seterr(err, OC_ECANCEL, "rendering cancelled");
+    return NULL;
+  }
+  return img;
+}
+
+oc_image *oc_render_geometry(const oc_program *prog, const oc_render_params *rp,
+                             oc_error *err) {
+  return geometry(prog, rp, 0, 1, err);
+}
+
+/* ---- shading -------------------------------------------------------------
+ */
+
+typedef struct sctx {
+  oc_shader sh;
+  camera cam;
+  const float *geo;
+  const float *albedo;
+  float *px;
+  int nch;
+} sctx;
+
+static void shade_pixel(const sctx *s, int i, int j) {
+  size_t k = (size_t)j * s->cam.width + i;
+  const float *g = s->geo + k * OC_RG_COUNT;
+  float *out = s->px + k * s->nch;
+  double ev = g[OC_RG_EVALS], rgba[4];
+  if (g[OC_RG_HIT] > 0) {
+    oc_vec3 p = oc_v3(g[OC_RG_PX], g[OC_RG_PX + 1], g[OC_RG_PX + 2]);
+    oc_vec3 n = oc_v3(g[OC_RG_NX], g[OC_RG_NX + 1], g[OC_RG_NX + 2]);
+    double alb[3];
+    if (s->albedo)
+      for (int c = 0; c < 3; c++)
+        alb[c] = s->albedo[k * 3 + c];
+    else
+      oc_albedo(&s->sh, p, n, alb, &ev);
+    oc_texture(&s->sh, p, n, alb);
+    oc_light(&s->sh, p, n, g[OC_RG_Z], alb, rgba, &ev);
+    rgba[3] = 1;
+  } else {
+    oc_sky(&s->sh, ray_dir(&s->cam, i, j), rgba);
+  }
+  for (int c = 0; c < 4; c++)
+    out[c] = (float)rgba[c];
+  if (s->nch > 4) {
+    memcpy(out + 4, g + OC_RG_Z, 7 * sizeof *out);
+    out[11] = (float)ev;
+  }
+}
+
+static void shade_tile(const void *ctx, int x0, int y0, int x1, int y1) {
+  for (int j = y0; j < y1; j++)
+    for (int i = x0; i < x1; i++)
+      shade_pixel(ctx, i, j);
+}
+
+/* Rule levels from the altitudes of the visible surface, unless given. */
+static void resolve_levels(oc_shader *sh, const oc_render_params *rp,
+                           const float *geo, size_t npx) {
+  const oc_render_rules *ru = &rp->rules;
+  double z0 = INFINITY, z1 = -INFINITY;
+  for (size_t k = 0; k < npx; k++) {
+    const float *g = geo + k * OC_RG_COUNT;
+    if (g[OC_RG_HIT] > 0) {
+      z0 = fmin(z0, g[OC_RG_PX + 2]);
+      z1 = fmax(z1, g[OC_RG_PX + 2]);
+    }
+  }
+  if (!(z0 <= z1)) z0 = z1 = 0;
+  double relief = z1 - z0;
+  if (ru->levels) {
+    sh->sea = ru->sea_level;
+    sh->snow = ru->snow_line;
+    sh->beach = ru->beach;
+  } else {
+    sh->sea = z0 + 0.04 * relief;
+    sh->snow = z0 + 0.75 * relief;
+    sh->beach = ru->beach > 0 ? ru->beach : 0.015 * relief;
+  }
+}
+
+static oc_image *shade(const oc_program *prog, const oc_render_params *rp,
+                       const oc_image *geo, const float *albedo, double base,
+                       double span, oc_error *err) {
+  if (oc_render_check_geometry(prog, rp, err)) return NULL;
+  if (oc_render_check_shade(rp, err)) return NULL;
+  if (!geo) {
+    oc_seterr(err, OC_EINVAL, "'geometry' is NULL");
+    return NULL;
+  }
+  if (oc_image_channels(geo) != OC_RG_COUNT ||
+      oc_image_width(geo) != rp->width || oc_image_height(geo) != rp->height) {
+    oc_seterr(err, OC_EINVAL,
+              "'geometry' must be a %d x %d image from oc_render_geometry "
+              "(got %d x %d x %d)",
+              rp->width, rp->height, oc_image_width(geo), oc_image_height(geo),
+              oc_image_channels(geo));
+    return NULL;
+  }
+  int nch = rp->aov ? 4 + NAOV : 4;
+  oc_image *img = oc_image_new(rp->width, rp->height, nch, err);
+  if (!img) return NULL;
+  for (int c = 4; c < nch; c++)
+    oc_image_set_channel_name(img, c, aov_names[c - 4], NULL);
+  /* linear light: the writers encode sRGB for integer formats */
+  oc_image_set_meta(img, "outcrop:colorspace", "linear", NULL);
+  sctx s;
+  camera_init(&s.cam, rp);
+  s.geo = oc_image_cdata(geo);
+  s.albedo = albedo;
+  s.px = oc_image_data(img);
+  s.nch = nch;
+  oc_shader *sh = &s.sh;
+  sh->rp = rp;
+  sh->prog = prog;
+  tracer_for(&sh->tracer, prog, rp, &s.cam);
+  sh->tracer.refine = 0; /* shadow rays need no exact distance */
+  sh->T = sh->tracer.T;
+  sh->sun = oc_mul(rp->sun_direction, 1 / oc_len(rp->sun_direction));
+  sh->far = far_for(prog, rp, &s.cam);
+  sh->ao_step = rp->ao_distance > 0 ? rp->ao_distance : s.cam.scale / 150;
+  sh->tex_scale = rp->texture_scale > 0 ? rp->texture_scale : s.cam.scale / 12;
+  resolve_levels(sh, rp, s.geo, (size_t)rp->width * rp->height);
+  if (run_tiles(rp->width, rp->height, shade_tile, &s, &rp->progress, base,
+                span)) {
+    oc_image_free(img);
+    oc_seterr(err, OC_ECANCEL, "rendering cancelled");
+    return NULL;
+  }
+  return img;
+}
+
+oc_image *oc_render_shade(const oc_program *prog, const oc_render_params *rp,
+                          const oc_image *geometry, const float *albedo,
+                          oc_error *err) {
+  return shade(prog, rp, geometry, albedo, 0, 1, err);
+}
+
+oc_image *oc_render(const oc_program *prog, const oc_render_params *rp,
+                    oc_error *err) {
+  /* checked before any tracing: a bad colour should not cost a render */
+  if (oc_render_check_geometry(prog, rp, err) || oc_render_check_shade(rp, err))
+    return NULL;
+  oc_image *geo = geometry(prog, rp, 0, GEOM_SHARE, err);
+  if (!geo) return NULL;
+  oc_image *img = shade(prog, rp, geo, NULL, GEOM_SHARE, 1 - GEOM_SHARE, err);
+  oc_image_free(geo);
+  return img;
+}

@@ -1,0 +1,48 @@
+/*
+** analysis.h — what the terrain analysis files share: the 8-neighbourhood
+** in a fixed order (the order every sum over neighbours runs in, which is
+** part of what makes results byte-identical), a progress relay that maps
+** the fraction of one phase into the whole call, and the result grid.
+*/
+#ifndef OC_TERRAIN_ANALYSIS_H
+#define OC_TERRAIN_ANALYSIS_H
+
+#include <float.h>
+#include <stddef.h>
+
+#include "outcrop.h"
+
+/* Neighbour k of sample (i, j) is (i + oc_hf_di[k], j + oc_hf_dj[k]);
+** even k are the four axis neighbours, odd k the diagonals. */
+extern const int oc_hf_di[8], oc_hf_dj[8];
+/* Distance to neighbour k in cells. */
+extern const double oc_hf_dist[8];
+
+/* A phase of a longer call: reports lo + span * f through the caller's
+** callback. Returns non-zero when the caller asks to stop. */
+typedef struct oc_hf_phase {
+  oc_progress cb;
+  double lo, span;
+} oc_hf_phase;
+
+static inline int oc_hf_report(const oc_hf_phase *ph, double f) {
+  return ph->cb.fn && ph->cb.fn(ph->cb.ud, ph->lo + ph->span * f);
+}
+
+/* A new grid with the geometry of hf (samples at 0, for the caller to
+** write before it shares the grid). */
+oc_heightfield *oc_hf_like(const oc_heightfield *hf, oc_error *err);
+
+/* A finite float for a double result (slopes of absurd grids overflow). */
+static inline float oc_hf_float(double v) {
+  return v > FLT_MAX ? FLT_MAX : v < -FLT_MAX ? -FLT_MAX : (float)v;
+}
+
+/* Priority-Flood+epsilon into z (nx ny samples, modified in place). */
+int oc_hf_fill_samples(float *z, int nx, int ny, const oc_hf_phase *ph,
+                       oc_error *err);
+/* |grad z| by central differences (one-sided on the border) into out. */
+void oc_hf_slope_samples(const float *z, int nx, int ny, double cell,
+                         float *out);
+
+#endif

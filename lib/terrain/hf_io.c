@@ -1,0 +1,379 @@
+/*
+** hf_io.c — heightfields to and from image files: oc_heightfield_load and
+** oc_heightfield_save.
+**
+** Files hold one channel, north up (the top row is the grid's last row).
+** Integer files hold counts q with elevation = q scale + offset; the
+** cell, origin, scale and offset travel as metadata written with 17
+** significant digits, so that a saved grid loads back to exactly the
+** quantized elevations and a float file to exactly its floats.
+*/
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "core/error.h"
+#include "io/atomic.h"
+#include "io/oiio.h"
+#include "io/oiio_hf.h"
+#include "outcrop.h"
+
+/* The metadata keys, in the order of the load parameters they fill. */
+enum { M_CELL, M_X0, M_Y0, M_SCALE, M_OFFSET, NKEYS };
+static const char *const keys[NKEYS] = {"outcrop:cell", "outcrop:x0",
+                                        "outcrop:y0", "outcrop:scale",
+                                        "outcrop:offset"};
+
+/* ---- loading ----------------------------------------------------------- */
+
+typedef struct loader {
+  const char *path;
+  oc_hf_load_params p; /* what the caller gave */
+  double meta[NKEYS];  /* values found in the file */
+  int found[NKEYS];
+  oc_heightfield *hf;
+} loader;
+
+/* A whole string holding one finite number. */
+static int parse_number(const char *s, double *out) {
+  char *end;
+  double v = strtod(s, &end);
+  while (*end == ' ' || *end == '\t')
+    end++;
+  if (end == s || *end != '\0' || !isfinite(v)) return 0;
+  *out = v;
+  return 1;
+}
+
+static void take(loader *ld, const char *key, size_t keylen,
+                 const char *value) {
+  for (int k = 0; k < NKEYS; k++)
+    if (strlen(keys[k]) == keylen && strncasecmp(key, keys[k], keylen) == 0) {
+      double v;
+      if (parse_number(value, &v)) {
+        ld->meta[k] = v;
+        ld->found[k] = 1;
+      }
+    }
+}
+
+/* TIFF keeps keys it has no tag for as "key=value" lines of its
+** ImageDescription (see bindings/oiio/oiio.cpp); other formats keep them
+** as attributes of their own. */
+static void on_attr(void *ud, const char *key, const char *value) {
+  loader *ld = ud;
+  if (strcasecmp(key, "ImageDescription") != 0) {
+    take(ld, key, strlen(key), value);
+    return;
+  }
+  char line[256];
+  while (*value) {
+    size_t n = strcspn(value, "\n");
+    const char *eq = memchr(value, '=', n);
+    if (eq && n < sizeof line) {
+      memcpy(line, value, n);
+      line[n] = '\0';
+      take(ld, value, (size_t)(eq - value), line + (eq - value) + 1);
+    }
+    value += n;
+    if (*value) value++;
+  }
+}
+
+static double pick(const loader *ld, unsigned bit, double given, int k,
+                   double def) {
+  if (ld->p.given & bit) return given;
+  return ld->found[k] ? ld->meta[k] : def;
+}
+
+static float *on_begin(void *ud, int w, int h, int channels, const char *type,
+                       oc_error *err) {
+  loader *ld = ud;
+  (void)channels, (void)type;
+  if (w < 2 || h < 2) {
+    oc_seterr(err, OC_EINVAL,
+              "cannot load '%s': it is %d x %d pixels, a heightfield needs "
+              "at least 2 x 2",
+              ld->path, w, h);
+    return NULL;
+  }
+  double cell = pick(ld, OC_HF_GIVE_CELL, ld->p.cell, M_CELL, 1);
+  double x0 = pick(ld, OC_HF_GIVE_ORIGIN, ld->p.x0, M_X0, 0);
+  double y0 = pick(ld, OC_HF_GIVE_ORIGIN, ld->p.y0, M_Y0, 0);
+  oc_error e = {OC_OK, ""};
+  ld->hf = oc_heightfield_new(w, h, cell, x0, y0, NULL, &e);
+  if (!ld->hf) {
+    oc_seterr(err, e.code, "cannot load '%s': %s", ld->path, e.msg);
+    return NULL;
+  }
+  return oc_heightfield_samples_mut(ld->hf);
+}
+
+/* Turns the image rows (top first, raw values) into grid rows (j = 0 at
+** the bottom, elevations). */
+static int finish_load(loader *ld, oc_error *err) {
+  oc_heightfield *hf = ld->hf;
+  int nx = oc_heightfield_nx(hf), ny = oc_heightfield_ny(hf);
+  float *z = oc_heightfield_samples_mut(hf);
+  for (int a = 0, b = ny - 1; a < b; a++, b--) {
+    float *ra = z + (size_t)a * nx, *rb = z + (size_t)b * nx;
+    for (int i = 0; i < nx; i++) {
+      float t = ra[i];
+      ra[i] = rb[i];
+      rb[i] = t;
+    }
+  }
+  double scale = pick(ld, OC_HF_GIVE_SCALE, ld->p.scale, M_SCALE, 1);
+  double offset = pick(ld, OC_HF_GIVE_OFFSET, ld->p.offset, M_OFFSET, 0);
+  if (!isfinite(scale) || !isfinite(offset))
+    return oc_seterr(err, OC_EINVAL,
+                     "cannot load '%s': 'scale' and 'offset' must be finite",
+                     ld->path);
+  /* scale 1 and offset 0 copy the values as they are, -0.0 included. */
+  int identity = scale == 1 && offset == 0;
+  size_t n = (size_t)nx * (size_t)ny;
+  for (size_t k = 0; k < n; k++) {
+    float v = identity ? z[k] : (float)(z[k] * scale + offset);
+    if (!isfinite(v))
+      return oc_seterr(err, OC_EINVAL,
+                       "cannot load '%s': the elevation of sample (%zu, %zu) "
+                       "is not finite (%g)",
+                       ld->path, k % (size_t)nx, k / (size_t)nx, (double)v);
+    z[k] = v;
+  }
+  return OC_OK;
+}
+
+oc_heightfield *oc_heightfield_load(const char *path,
+                                    const oc_hf_load_params *p, oc_error *err) {
+  if (!path || !*path) {
+    oc_seterr(err, OC_EINVAL, "'path' must be a non-empty file name");
+    return NULL;
+  }
+  loader ld;
+  memset(&ld, 0, sizeof ld);
+  ld.path = path;
+  if (p) ld.p = *p;
+  if ((ld.p.given & OC_HF_GIVE_CELL) &&
+      (!(ld.p.cell > 0) || !isfinite(ld.p.cell))) {
+    oc_seterr(err, OC_EINVAL, "'cell' must be > 0 (got %g)", ld.p.cell);
+    return NULL;
+  }
+  oc_oiio_raw r = {on_attr, on_begin, &ld};
+  int rc = oc_oiio_read_raw(path, &r, err);
+  if (rc == OC_OK) rc = finish_load(&ld, err);
+  if (rc != OC_OK) {
+    oc_heightfield_release(ld.hf);
+    return NULL;
+  }
+  return ld.hf;
+}
+
+/* ---- saving ------------------------------------------------------------ */
+
+typedef enum kind { PNG, TIFF, EXR } kind;
+
+static const struct {
+  const char *ext;
+  kind kind;
+} extensions[] = {
+    {".png", PNG}, {".tif", TIFF}, {".tiff", TIFF}, {".exr", EXR}};
+
+static const char *const oiio_names[] = {"png", "tiff", "openexr"};
+
+static int file_kind(const char *path) {
+  const char *slash = strrchr(path, '/');
+  const char *base = slash ? slash + 1 : path;
+  const char *dot = strrchr(base, '.');
+  if (!dot || dot == base) return -1;
+  for (size_t i = 0; i < sizeof extensions / sizeof *extensions; i++)
+    if (strcasecmp(dot, extensions[i].ext) == 0) return (int)extensions[i].kind;
+  return -1;
+}
+
+/* Sample type for `bits`, or -1 when the format cannot hold it. */
+static int sample_type(kind k, int bits) {
+  switch (k) {
+  case PNG:
+    return bits == 0 || bits == 16 ? OC_OIIO_U16 : bits == 8 ? OC_OIIO_U8 : -1;
+  case TIFF:
+    return bits == 0 || bits == 32 ? OC_OIIO_F32
+           : bits == 16            ? OC_OIIO_U16
+                                   : -1;
+  case EXR:
+    return bits == 0 || bits == 32 ? OC_OIIO_F32
+           : bits == 16            ? OC_OIIO_HALF
+                                   : -1;
+  }
+  return -1;
+}
+
+static const char *const bits_allowed[] = {"8 or 16", "16 or 32",
+                                           "16 (half) or 32 (float)"};
+
+/* The counts of an integer file, in image order (top row first). */
+static void *quantize(const oc_heightfield *hf, int type, double scale,
+                      double offset, int fixed, const char *path,
+                      oc_error *err) {
+  int nx = oc_heightfield_nx(hf), ny = oc_heightfield_ny(hf);
+  const float *z = oc_heightfield_samples(hf);
+  double qmax = type == OC_OIIO_U8 ? 255 : 65535;
+  size_t size = type == OC_OIIO_U8 ? 1 : 2;
+  unsigned char *buf = malloc((size_t)nx * (size_t)ny * size);
+  if (!buf) {
+    oc_seterr(err, OC_ENOMEM, "cannot write '%s': out of memory", path);
+    return NULL;
+  }
+  for (int r = 0; r < ny; r++) {
+    const float *row = z + (size_t)(ny - 1 - r) * (size_t)nx;
+    for (int i = 0; i < nx; i++) {
+      double q = floor((row[i] - offset) / scale + 0.5);
+      if (!(q >= 0 && q <= qmax)) {
+        if (fixed) {
+          oc_seterr(err, OC_EINVAL,
+                    "cannot write '%s': elevation %g at sample (%d, %d) is "
+                    "outside [offset, offset + %.0f scale] = [%g, %g]",
+                    path, (double)row[i], i, ny - 1 - r, qmax, offset,
+                    offset + qmax * scale);
+          free(buf);
+          return NULL;
+        }
+        q = q < 0 ? 0 : qmax; /* fitted: a rounding step outside at most */
+      }
+      size_t k = (size_t)r * (size_t)nx + (size_t)i;
+      if (size == 1)
+        buf[k] = (unsigned char)q;
+      else
+        ((uint16_t *)buf)[k] = (uint16_t)q;
+    }
+  }
+  return buf;
+}
+
+/* The floats in image order. */
+static float *flipped(const oc_heightfield *hf, const char *path,
+                      oc_error *err) {
+  int nx = oc_heightfield_nx(hf), ny = oc_heightfield_ny(hf);
+  float *buf = malloc((size_t)nx * (size_t)ny * sizeof *buf);
+  if (!buf) {
+    oc_seterr(err, OC_ENOMEM, "cannot write '%s': out of memory", path);
+    return NULL;
+  }
+  for (int r = 0; r < ny; r++)
+    memcpy(buf + (size_t)r * nx,
+           oc_heightfield_samples(hf) + (size_t)(ny - 1 - r) * nx,
+           (size_t)nx * sizeof *buf);
+  return buf;
+}
+
+static int is_ours(const char *key) {
+  for (int k = 0; k < NKEYS; k++)
+    if (strcasecmp(key, keys[k]) == 0) return 1;
+  return 0;
+}
+
+static int write_atomic(const char *path, const oc_oiio_out *out,
+                        oc_error *err) {
+  char why[OC_ERRMSG] = "";
+  oc_atomic a;
+  int rc = oc_atomic_begin(&a, path, err);
+  if (rc != OC_OK) return rc;
+  if (oc_oiio_write(a.tmp, out, why, sizeof why) != OC_OK) {
+    oc_atomic_abort(&a);
+    return oc_seterr(err, OC_EIO, "cannot write '%s': %s", path, why);
+  }
+  return oc_atomic_commit(&a, err);
+}
+
+int oc_heightfield_save(const oc_heightfield *hf, const char *path,
+                        const oc_hf_save_params *p, double used[2],
+                        oc_error *err) {
+  static const oc_hf_save_params defaults = {0, 0, 1, 0, NULL, 0};
+  if (!hf) return oc_seterr(err, OC_EINVAL, "the heightfield is NULL");
+  if (!path || !*path)
+    return oc_seterr(err, OC_EINVAL, "'path' must be a non-empty file name");
+  if (!p) p = &defaults;
+  int k = file_kind(path);
+  if (k < 0)
+    return oc_seterr(err, OC_EINVAL,
+                     "cannot write '%s': unknown heightfield format (use "
+                     ".png, .tif, .tiff or .exr)",
+                     path);
+  int type = sample_type((kind)k, p->bits);
+  if (type < 0)
+    return oc_seterr(err, OC_EINVAL, "'bits' must be %s for %s (got %d)",
+                     bits_allowed[k], oiio_names[k], p->bits);
+  int integer = type == OC_OIIO_U8 || type == OC_OIIO_U16;
+  double scale = 1, offset = 0;
+  if (p->fixed) {
+    if (!integer)
+      return oc_seterr(err, OC_EINVAL,
+                       "'scale' and 'offset' apply to 8- and 16-bit files "
+                       "only (floats are stored as they are)");
+    if (!(p->scale > 0) || !isfinite(p->scale))
+      return oc_seterr(err, OC_EINVAL, "'scale' must be > 0 (got %g)",
+                       p->scale);
+    if (!isfinite(p->offset))
+      return oc_seterr(err, OC_EINVAL, "'offset' must be finite (got %g)",
+                       p->offset);
+    scale = p->scale;
+    offset = p->offset;
+  } else if (integer) {
+    double lo, hi;
+    oc_heightfield_minmax(hf, &lo, &hi);
+    offset = lo;
+    scale = (hi - lo) / (type == OC_OIIO_U8 ? 255.0 : 65535.0);
+    if (!(scale > 0) || !isfinite(scale)) scale = 1;
+  }
+
+  void *px = integer ? quantize(hf, type, scale, offset, p->fixed, path, err)
+                     : (void *)flipped(hf, path, err);
+  if (!px) return err ? err->code : OC_ENOMEM;
+
+  double x0, y0;
+  oc_heightfield_origin(hf, &x0, &y0);
+  double vals[NKEYS] = {oc_heightfield_cell(hf), x0, y0, scale, offset};
+  char text[NKEYS][32];
+  size_t nmeta = NKEYS;
+  const char **meta = malloc((2 * (NKEYS + p->nmeta)) * sizeof *meta);
+  if (!meta) {
+    free(px);
+    return oc_seterr(err, OC_ENOMEM, "cannot write '%s': out of memory", path);
+  }
+  for (int m = 0; m < NKEYS; m++) {
+    snprintf(text[m], sizeof text[m], "%.17g", vals[m]);
+    meta[2 * m] = keys[m];
+    meta[2 * m + 1] = text[m];
+  }
+  for (size_t m = 0; m < p->nmeta; m++) {
+    const char *key = p->meta[2 * m], *value = p->meta[2 * m + 1];
+    if (!key || !value || is_ours(key)) continue;
+    meta[2 * nmeta] = key;
+    meta[2 * nmeta + 1] = value;
+    nmeta++;
+  }
+  const char *names[1] = {"Y"};
+  oc_oiio_out out = {
+      .format = oiio_names[k],
+      .width = oc_heightfield_nx(hf),
+      .height = oc_heightfield_ny(hf),
+      .channels = 1,
+      .type = (oc_oiio_type)type,
+      .pixels = px,
+      .alpha = -1,
+      .channel_names = names,
+      .meta = meta,
+      .nmeta = nmeta,
+  };
+  int rc = write_atomic(path, &out, err);
+  free(meta);
+  free(px);
+  if (rc == OC_OK && used) {
+    used[0] = scale;
+    used[1] = offset;
+  }
+  return rc;
+}

@@ -1,0 +1,330 @@
+/*
+** terrain.c — the terrain primitive (seed 000 section 5.1): an elevation
+** source h over a domain Omega made a 3D field f = min(f_T, f_P), with
+** f_T = sigma(v), v = h(x, y) - z (z - h when inverted), and
+** f_P = 2T g(d / R), d the distance to the prism (Omega shrunk by R) x
+** [zlo, zhi]. Constructor, value, gradient, support, Lipschitz bounds and
+** column spans.
+**
+** sigma is the paper's piecewise odd cubic around (0, T): sigma(0) = T,
+** sigma(+-W) = 2T or 0, flat beyond. With s = sigma'(0) W / T = k, on
+** u = |v| / W in [0, 1]: sigma = T +- T (k u + (3 - 2k) u^2 + (k - 2) u^3).
+** The paper takes sigma'(0) = 1 (k = W / T); past k = 3 that cubic
+** overshoots 2T and stops being monotone, so k is capped at 3.
+*/
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "core/falloff.h"
+#include "field/node.h"
+#include "terrain/terrain.h"
+
+/* g(x) = 1/2: where f_P = 2T g crosses T. sqrt(1 - 2^(-1/3)). */
+#define X_HALF 0.45020879914569640
+#define DEFAULT_W 1.0
+
+/* ---- sigma ------------------------------------------------------------ */
+
+void oc_terrain_sigma(double T, double W, double par[OC_TPAR_N]) {
+  double k = fmin(W / T, 3.0);
+  /* s'(u) = k + 2 (3 - 2k) u + 3 (k - 2) u^2 on [0, 1]: its largest value
+  ** is at u = 0 or at the vertex */
+  double m = k;
+  if (k != 2) {
+    double u = (2 * k - 3) / (3 * (k - 2));
+    if (u > 0 && u < 1)
+      m = fmax(m, k + u * (2 * (3 - 2 * k) + 3 * (k - 2) * u));
+  }
+  par[OC_TPAR_T] = T;
+  par[OC_TPAR_W] = W;
+  par[OC_TPAR_K] = k;
+  par[OC_TPAR_DS] = T / W * m * (1 + 1e-12);
+}
+
+static double sigma(const double *par, double v, double *ds) {
+  double T = par[OC_TPAR_T], W = par[OC_TPAR_W], k = par[OC_TPAR_K];
+  double u = v / W;
+  if (u >= 1) {
+    *ds = 0;
+    return 2 * T;
+  }
+  if (u <= -1) {
+    *ds = 0;
+    return 0;
+  }
+  double a = fabs(u);
+  double s = a * (k + a * ((3 - 2 * k) + a * (k - 2)));
+  *ds = T / W * (k + a * (2 * (3 - 2 * k) + 3 * (k - 2) * a));
+  return u >= 0 ? T + T * s : T - T * s;
+}
+
+/* ---- the prism ---------------------------------------------------------- */
+
+/* Distance to the prism; its gradient in *g when g is not NULL (0 where
+** the distance is 0). INFINITY off a mask's grid. */
+static double prism_dist(const oc_tdata *t, oc_vec3 p, oc_vec3 *g) {
+  double dz = 0, sz = 0;
+  if (p.z < t->zlo) {
+    dz = t->zlo - p.z;
+    sz = -1;
+  } else if (p.z > t->zhi) {
+    dz = p.z - t->zhi;
+    sz = 1;
+  }
+  double gx = 0, gy = 0, d2;
+  if (t->dist) {
+    double gh[2];
+    double dh = oc_terrain_mask_dist(t, p.x, p.y, g ? gh : NULL);
+    d2 = dh * dh + dz * dz;
+    if (g && d2 > 0 && d2 < INFINITY) {
+      gx = dh * gh[0];
+      gy = dh * gh[1];
+    }
+  } else {
+    double ax = 0, ay = 0;
+    if (p.x < t->ix0)
+      ax = p.x - t->ix0;
+    else if (p.x > t->ix1)
+      ax = p.x - t->ix1;
+    if (p.y < t->iy0)
+      ay = p.y - t->iy0;
+    else if (p.y > t->iy1)
+      ay = p.y - t->iy1;
+    d2 = ax * ax + ay * ay + dz * dz;
+    gx = ax;
+    gy = ay;
+  }
+  double d = sqrt(d2);
+  if (g)
+    *g = d > 0 && d < INFINITY ? (oc_vec3){gx / d, gy / d, dz * sz / d}
+                               : (oc_vec3){0, 0, 0};
+  return d;
+}
+
+/* ---- value and gradient ------------------------------------------------- */
+
+double oc_terrain_eval(const oc_tdata *t, const double *par, oc_vec3 p,
+                       oc_vec3 *g) {
+  double T2 = 2 * par[OC_TPAR_T], W = par[OC_TPAR_W];
+  if (g) *g = (oc_vec3){0, 0, 0};
+  /* f_T is 0 beyond the elevation range: no need to look h up */
+  if (t->invert ? p.z <= t->zlo - W : p.z >= t->zhi + W) return 0;
+  oc_vec3 gd;
+  double d = prism_dist(t, p, g ? &gd : NULL);
+  if (!(d < t->R)) return 0;
+  double x = d / t->R;
+  double fp = T2 * oc_falloff(x);
+  double gh[2];
+  double h = t->src.height(t->src.ud, p.x, p.y, g ? gh : NULL);
+  double v = t->invert ? p.z - h : h - p.z, ds;
+  double ft = sigma(par, v, &ds);
+  if (ft <= fp || isnan(ft)) {
+    if (g) {
+      double s = t->invert ? -ds : ds;
+      *g = (oc_vec3){s * gh[0], s * gh[1], -s};
+    }
+    return ft;
+  }
+  if (g) {
+    double k = T2 * oc_falloff_d(x) / t->R;
+    *g = (oc_vec3){k * gd.x, k * gd.y, k * gd.z};
+  }
+  return fp;
+}
+
+double oc_terrain_column_value(const oc_tdata *t, const double *par, double h,
+                               double z) {
+  double ds, dz = z < t->zlo ? t->zlo - z : z > t->zhi ? z - t->zhi : 0;
+  double fp = 2 * par[OC_TPAR_T] * oc_falloff(dz / t->R);
+  double ft = sigma(par, t->invert ? z - h : h - z, &ds);
+  return ft < fp ? ft : fp;
+}
+
+double oc_terrain_cap_z(const oc_tdata *t) {
+  return t->invert ? t->zhi + X_HALF * t->R : t->zlo - X_HALF * t->R;
+}
+
+/* ---- bounds ---------------------------------------------------------------
+ */
+
+oc_aabb oc_terrain_box(const oc_tdata *t) {
+  double zl = t->invert ? t->zlo - t->W : t->zlo - t->R;
+  double zh = t->invert ? t->zhi + t->R : t->zhi + t->W;
+  return (oc_aabb){{t->sx0, t->sy0, zl}, {t->sx1, t->sy1, zh}};
+}
+
+static double lip_prism(const oc_tdata *t, const double *par) {
+  /* |grad d| <= max(|grad d_h|, 1): sqrt 2 for the bilinear mask
+  ** distance (with a margin for its single-precision nodes), 1 else */
+  double ld = t->dist ? sqrt(2.0) * (1 + 1e-6) : 1;
+  return 2 * par[OC_TPAR_T] * OC_FALLOFF_LIPSCHITZ / t->R * ld;
+}
+
+static double lip_surface(const double *par, double slope) {
+  return par[OC_TPAR_DS] * sqrt(1 + slope * slope);
+}
+
+double oc_terrain_lipschitz(const oc_tdata *t, const double *par) {
+  return fmax(lip_surface(par, t->slope), lip_prism(t, par));
+}
+
+/* Whether f_P is 2T over the whole footprint between zlo and zhi (the
+** prism's interior), and whether it is 0 over the whole footprint. */
+static void foot_prism(const oc_tdata *t, double x0, double y0, double x1,
+                       double y1, int *inside, int *outside) {
+  if (t->dist) {
+    double lo, hi;
+    oc_terrain_mask_range(t, x0, y0, x1, y1, &lo, &hi);
+    *inside = hi == 0;
+    *outside = lo >= t->R;
+    return;
+  }
+  *inside = x0 >= t->ix0 && x1 <= t->ix1 && y0 >= t->iy0 && y1 <= t->iy1;
+  *outside = x1 <= t->sx0 || x0 >= t->sx1 || y1 <= t->sy0 || y0 >= t->sy1;
+}
+
+double oc_terrain_lipschitz_in(const oc_tdata *t, const double *par,
+                               const oc_aabb *b) {
+  double W = par[OC_TPAR_W];
+  int inside, outside;
+  foot_prism(t, b->lo.x, b->lo.y, b->hi.x, b->hi.y, &inside, &outside);
+  if (outside) return 0;
+  double hlo, hhi;
+  t->src.range(t->src.ud, b->lo.x, b->lo.y, b->hi.x, b->hi.y, &hlo, &hhi);
+  /* f_T is 0 on the whole box: so is f */
+  if (t->invert ? b->hi.z <= hlo - W : b->lo.z >= hhi + W) return 0;
+  double lt = 0, lp = 0;
+  if (b->hi.z > hlo - W && b->lo.z < hhi + W)
+    lt = lip_surface(
+        par, t->src.slope(t->src.ud, b->lo.x, b->lo.y, b->hi.x, b->hi.y));
+  if (!(inside && b->lo.z >= t->zlo && b->hi.z <= t->zhi))
+    lp = lip_prism(t, par);
+  return fmax(lt, lp);
+}
+
+int oc_terrain_spans(const oc_tdata *t, const double *par, double x0, double y0,
+                     double x1, double y1, void (*add)(void *, double, double),
+                     void *S) {
+  double W = par[OC_TPAR_W], R = t->R;
+  int inside, outside;
+  foot_prism(t, x0, y0, x1, y1, &inside, &outside);
+  if (outside) return 0;
+  double hlo, hhi;
+  t->src.range(t->src.ud, x0, y0, x1, y1, &hlo, &hhi);
+  /* margin for the rounding of v = h - z and of u = v / W */
+  double pad = 1e-9 * (fabs(hlo) + fabs(hhi) + W + R);
+  double alo = hlo - W - pad, ahi = hhi + W + pad;
+  add(S, alo, ahi);
+  /* where f_P varies, clipped to where f_T > 0 (elsewhere f = 0) */
+  oc_zspan b[2] = {{t->zlo - R - pad, t->zlo + pad},
+                   {t->zhi - pad, t->zhi + R + pad}};
+  if (!inside) {
+    b[0].hi = b[1].hi;
+    b[1].lo = 1, b[1].hi = 0;
+  }
+  for (int k = 0; k < 2; k++) {
+    if (t->invert)
+      b[k].lo = fmax(b[k].lo, alo);
+    else
+      b[k].hi = fmin(b[k].hi, ahi);
+    if (b[k].lo <= b[k].hi) add(S, b[k].lo, b[k].hi);
+  }
+  return inside;
+}
+
+/* ---- construction ----------------------------------------------------- */
+
+void oc_tdata_free(oc_tdata *t) {
+  if (!t) return;
+  if (t->src.release) t->src.release(t->src.ud);
+  free(t->dist);
+  free(t);
+}
+
+static int check_source(const oc_elevation *s, oc_error *err) {
+  if (!s || !s->height || !s->range || !s->slope)
+    return oc_seterr(err, OC_EINVAL,
+                     "the elevation source needs height, range and slope");
+  if (!isfinite(s->x0) || !isfinite(s->y0) || !isfinite(s->x1) ||
+      !isfinite(s->y1) || !(s->x0 < s->x1) || !(s->y0 < s->y1))
+    return oc_seterr(err, OC_EINVAL,
+                     "the elevation source's domain must be finite and "
+                     "non-empty (got %g %g to %g %g)",
+                     s->x0, s->y0, s->x1, s->y1);
+  return 0;
+}
+
+oc_node *oc_terrain(const oc_elevation *src, const oc_terrain_params *tp,
+                    oc_error *err) {
+  if (check_source(src, err)) return NULL;
+  if (!tp) {
+    oc_seterr(err, OC_EINVAL, "terrain parameters missing");
+    return NULL;
+  }
+  double R = tp->falloff, W = tp->transition == 0 ? DEFAULT_W : tp->transition;
+  if (!oc_check_positive(R, "falloff", err) ||
+      !oc_check_positive(W, "transition", err))
+    return NULL;
+  if (!(tp->thickness >= 0) || !isfinite(tp->thickness)) {
+    oc_seterr(err, OC_EINVAL, "'thickness' must be a number >= 0 (got %g)",
+              tp->thickness);
+    return NULL;
+  }
+  double wx = src->x1 - src->x0, wy = src->y1 - src->y0;
+  if (!tp->mask && !(2 * R < wx && 2 * R < wy)) {
+    oc_seterr(err, OC_EINVAL,
+              "'falloff' %g must be less than half the domain's width "
+              "(%g x %g)",
+              R, wx, wy);
+    return NULL;
+  }
+  double lo, hi;
+  src->range(src->ud, src->x0, src->y0, src->x1, src->y1, &lo, &hi);
+  double slope = src->slope(src->ud, src->x0, src->y0, src->x1, src->y1);
+  if (!isfinite(lo) || !isfinite(hi) || !(lo <= hi) || !(slope >= 0) ||
+      !isfinite(slope)) {
+    oc_seterr(err, OC_EINVAL,
+              "the elevation source reports a range %g .. %g and slope %g: "
+              "they must be finite",
+              lo, hi, slope);
+    return NULL;
+  }
+  oc_tdata *t = calloc(1, sizeof *t);
+  if (!t) {
+    oc_seterr(err, OC_ENOMEM, "out of memory");
+    return NULL;
+  }
+  t->src = *src;
+  t->src.retain = t->src.release = NULL; /* until retained below */
+  t->R = R;
+  t->W = W;
+  t->invert = tp->invert != 0;
+  t->zlo = t->invert ? lo : lo - tp->thickness;
+  t->zhi = t->invert ? hi + tp->thickness : hi;
+  t->slope = slope;
+  t->ix0 = src->x0 + R;
+  t->iy0 = src->y0 + R;
+  t->ix1 = src->x1 - R;
+  t->iy1 = src->y1 - R;
+  t->sx0 = src->x0;
+  t->sy0 = src->y0;
+  t->sx1 = src->x1;
+  t->sy1 = src->y1;
+  if (tp->mask && oc_terrain_mask(t, tp->mask, err)) {
+    oc_tdata_free(t);
+    return NULL;
+  }
+  oc_node *n = oc_node_alloc(OC_K_TERRAIN, NULL, 0, err);
+  if (!n) {
+    oc_tdata_free(t);
+    return NULL;
+  }
+  if (src->retain) src->retain(src->ud);
+  t->src.retain = src->retain;
+  t->src.release = src->release;
+  n->terrain = t;
+  n->par[OC_P_R] = R;
+  return n;
+}

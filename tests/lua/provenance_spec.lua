@@ -1,0 +1,175 @@
+-- provenance_spec.lua — every image written from Lua carries its
+-- provenance (scene, --set parameters, seed, version) as metadata, read
+-- back here with OpenImageIO's own `oiiotool --info -v`; and the options
+-- of image:write (bits, meta).
+local oc = require "outcrop"
+local Fs = require "helpers.files"
+local read_file = Fs.read_file
+local info = Fs.image_info
+local R = require "helpers.ref"
+
+local F = "provenance_spec.lua"
+local reg = debug.getregistry()
+local node = oc.point{center = {0, 0, 0}, radius = 1}
+
+
+
+-- The "key=value" lines folded into a TIFF or JPEG ImageDescription.
+local function description_lines(text)
+  local d = text:match('ImageDescription: "(.-)"\n%s+%w')
+  local t = {}
+  for line in (d or ""):gmatch("[^\n]+") do
+    local k, v = line:match("^([^=]+)=(.*)$")
+    if k then t[k] = v end
+  end
+  return t
+end
+
+describe("provenance", function()
+  local dir
+  before_each(function() dir = R.tmpdir() end)
+  after_each(function()
+    R.rmdir(dir)
+    reg["outcrop.params"], reg["outcrop.seed"], reg["outcrop.scene"] = nil, nil, nil
+  end)
+
+  it("under stock lua5.4: the script's file, no parameters, seed 1", function()
+    -- a script run by lua5.4 itself, as a user would (busted's own main
+    -- chunk is not a scene)
+    local script = dir .. "/scene.lua"
+    local f = assert(io.open(script, "w"))
+    f:write([[
+local oc = require "outcrop"
+local function out(name)
+  return oc.slice(oc.point{center = {0, 0, 0}, radius = 1}, {size = {4, 4}})
+    :write(name)
+end
+assert(out(arg[1]))
+]])
+    f:close()
+    assert.is_true(os.execute("cd '" .. dir .. "' && lua5.4 scene.lua a.png"))
+    local a = info(dir .. "/a.png")
+    assert.are.equal("outcrop " .. oc.version, a.Software)
+    assert.are.equal(oc.version, a["outcrop:version"])
+    assert.are.equal("scene.lua", a["outcrop:scene"])
+    assert.are.equal("1", a["outcrop:seed"])
+    assert.are.equal("(none)", a["outcrop:params"])
+  end)
+
+  it("records the interpreter's scene, sorted parameters and seed", function()
+    reg["outcrop.scene"] = "scenes/arch.lua"
+    reg["outcrop.seed"] = 42
+    reg["outcrop.params"] = {zeta = "1", alpha = "two words", b = 'q"x',
+      c = "tab\there", ["d e"] = "f", eq = "x=y"}
+    local img = oc.slice(node, {size = {4, 4}})
+    local want = '"alpha=two words" "b=q\\"x" "c=tab\\there" "d e=f" eq=x=y zeta=1'
+    for _, ext in ipairs{"png", "exr"} do
+      local path = dir .. "/p." .. ext
+      assert.is_true(img:write(path))
+      local a = info(path)
+      assert.are.equal("scenes/arch.lua", a["outcrop:scene"], ext)
+      assert.are.equal("42", a["outcrop:seed"], ext)
+      assert.are.equal(want, a["outcrop:params"], ext)
+      assert.are.equal(oc.version, a["outcrop:version"], ext)
+    end
+    -- TIFF and JPEG have no free text fields: the keys become lines of
+    -- the ImageDescription
+    for _, ext in ipairs{"tif", "jpg"} do
+      local path = dir .. "/p." .. ext
+      assert.is_true(img:write(path))
+      local _, text = info(path)
+      local d = description_lines(text)
+      assert.are.equal("scenes/arch.lua", d["outcrop:scene"], ext)
+      assert.are.equal("42", d["outcrop:seed"], ext)
+      assert.are.equal(want, d["outcrop:params"], ext)
+    end
+  end)
+
+  it("is byte-identical whatever order the parameters were set in", function()
+    local names = {}
+    for i = 1, 40 do names[i] = "p" .. i end
+    local function write(path, order)
+      local t = {}
+      for _, i in ipairs(order) do t[names[i]] = tostring(i) end
+      reg["outcrop.params"] = t
+      assert.is_true(oc.slice(node, {size = {4, 4}}):write(path))
+    end
+    local fwd, back = {}, {}
+    for i = 1, 40 do fwd[i], back[i] = i, 41 - i end
+    write(dir .. "/f.png", fwd)
+    write(dir .. "/b.png", back)
+    assert.are.equal(read_file(dir .. "/f.png"), read_file(dir .. "/b.png"))
+    local a = info(dir .. "/f.png")
+    assert.is_truthy(a["outcrop:params"]:find("^p1=1 p10=10 p11=11 "))
+  end)
+
+  it("cuts an enormous parameter list with a marker", function()
+    reg["outcrop.params"] = {a = string.rep("x", 40000), b = string.rep("y", 40000)}
+    local path = dir .. "/big.exr"
+    assert.is_true(oc.slice(node, {size = {2, 2}}):write(path))
+    local v = info(path)["outcrop:params"]
+    -- (compared by length and ends: a failure must not print 40 kB)
+    assert.are.equal(40006, #v)
+    assert.are.equal("a=xxx", v:sub(1, 5))
+    assert.are.equal("x ...", v:sub(-5))
+  end)
+
+  it("stamps again on each write (values follow the registry)", function()
+    local img = oc.slice(node, {size = {2, 2}})
+    reg["outcrop.seed"] = 5
+    assert.is_true(img:write(dir .. "/s5.png"))
+    reg["outcrop.seed"] = 6
+    assert.is_true(img:write(dir .. "/s6.png"))
+    assert.are.equal("5", info(dir .. "/s5.png")["outcrop:seed"])
+    assert.are.equal("6", info(dir .. "/s6.png")["outcrop:seed"])
+  end)
+end)
+
+describe("image:write options", function()
+  local dir
+  local img = oc.slice(node, {size = {3, 2}})
+  before_each(function() dir = R.tmpdir() end)
+  after_each(function() R.rmdir(dir) end)
+
+  it("adds the caller's metadata, sorted, beside the provenance", function()
+    assert.is_true(img:write(dir .. "/m.exr", {meta = {note = "hello", n = 3}}))
+    local a = info(dir .. "/m.exr")
+    assert.are.equal("hello", a.note)
+    assert.are.equal("3", a.n)
+    assert.are.equal(oc.version, a["outcrop:version"])
+  end)
+
+  it("checks meta", function()
+    local p = dir .. "/x.png"
+    R.check_error(function() img:write(p, {meta = 5}) end, F, "image:write", "'meta' must be a table")
+    R.check_error(function() img:write(p, {meta = {[1] = "a"}}) end, F, "image:write", "'meta' keys must be strings")
+    R.check_error(function() img:write(p, {meta = {k = {}}}) end, F, "image:write", "'meta.k' must be a string or a number")
+    R.check_error(function() img:write(p, {meta = {["outcrop:seed"] = "9"}}) end, F, "image:write", "'meta.outcrop:seed' is provenance")
+    R.check_error(function() img:write(p, {meta = {Software = "x"}}) end, F, "image:write", "'meta.Software' is provenance")
+    R.check_error(function() img:write(p, {meta = {compression = "none"}}) end, F, "image:write", "'meta.compression'", "reserved")
+    R.check_error(function() img:write(p, {meta = {["a b"] = "x"}}) end, F, "image:write", "'meta.a b'", "may hold only")
+    assert.is_nil(read_file(p))
+  end)
+
+  it("writes float TIFF and EXR with bits = 32, refuses it for PNG", function()
+    assert.is_true(img:write(dir .. "/f.tif", {bits = 32}))
+    assert.is_true(img:write(dir .. "/f.exr", {bits = 32}))
+    local _, t = info(dir .. "/f.tif")
+    assert.is_truthy(t:find("float tiff", 1, true))
+    local _, e = info(dir .. "/f.exr")
+    assert.is_truthy(e:find("float openexr", 1, true))
+    local _, h = info((img:write(dir .. "/h.exr") and dir .. "/h.exr"))
+    assert.is_truthy(h:find("half openexr", 1, true))
+    R.check_error(function() img:write(dir .. "/f.png", {bits = 32}) end, F, "image:write", "'bits' must be 8 or 16 for PNG")
+    R.check_error(function() img:write(dir .. "/f.jpg", {bits = 16}) end, F, "image:write", "'bits' must be 8 for JPEG")
+    R.check_error(function() img:write(dir .. "/f.png", {bits = 12}) end, F, "image:write", "'bits' must be 8 or 16", "(got 12)")
+    assert.is_nil(read_file(dir .. "/f.png"))
+  end)
+
+  it("writes 16-bit PNG and JPEG", function()
+    assert.is_true(img:write(dir .. "/b.png", {bits = 16}))
+    assert.are.equal(16, read_file(dir .. "/b.png"):byte(25))
+    assert.is_true(img:write(dir .. "/c.jpg"))
+    assert.are.equal("\255\216", read_file(dir .. "/c.jpg"):sub(1, 2))
+  end)
+end)
