@@ -253,4 +253,9 @@ void oclua_open_gen(lua_State *L) {
   lua_setfield(L, -2, "__index");
   lua_pop(L, 1);
   luaL_setfuncs(L, sample_funcs, 0);
+  lua_createtable(L, 0, 4);
+  luaL_setfuncs(L, oclua_gen_sea, 0);
+  luaL_setfuncs(L, oclua_gen_karst, 0);
+  luaL_setfuncs(L, oclua_gen_hoodoos, 0);
+  lua_setfield(L, -2, "generate");
 }
