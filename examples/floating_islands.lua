@@ -1,7 +1,8 @@
 -- floating_islands.lua — islands in the sky (seed 000 figures 1 and 21):
 -- each island is the intersection of a terrain (its top: solid below a
 -- heightfield) and an inverted terrain (its underside: solid above a
--- second heightfield), cut to an island shape by a mask.
+-- second heightfield), cut to an island shape by a mask, then eroded
+-- through folded strata so that soft beds recede into ledges.
 --
 --   outcrop run examples/floating_islands.lua [--set cell=1.5] [--out DIR]
 
@@ -51,14 +52,25 @@ island(-60, -40, 70, 120, 3)
 island(90, 70, 55, 150, 7)
 island(100, -110, 40, 95, 11)
 
-local sky = oc.union(islands)
+-- The rock: folded strata with a soft bed; erosion eats (1 - resistance)
+-- of `depth` everywhere, so hard beds stand out as ledges on the flanks.
+local G = oc.geology
+local rock = G.fold(G.strata{wavelength = 7, amplitude = 0.8, offset = 0.1,
+                             seed = 4}
+                    + G.layer{origin = {0, 0, 100}, normal = {0, 0.2, 1},
+                              radius = 3, resistance = -0.4},
+                    {wavelength = 60, amplitude = 6, seed = 9})
+local sky = oc.erosion(oc.union(islands), rock, {depth = 0.45})
 local mesh = oc.polygonize(sky, {box = {-half, -half, 20, half, half, 200},
                                  cell = cell})
 mesh:write("floating_islands.ply")
 local st = mesh:stats()
 print(string.format("floating_islands: %d triangles in %.2f s", st.triangles,
                     st.seconds))
-oc.render(sky, {camera = {eye = {-250, -230, 200}, target = {20, -10, 105},
+oc.render(sky, {camera = {eye = {-190, -185, 165}, target = {-20, -25, 100},
                           fov = 40},
-                size = {960, 540}}):write("floating_islands.png")
+                size = {800, 450},
+                color = rock,
+                palette = {{0, {0.13, 0.07, 0.04}}, {0.5, {0.30, 0.20, 0.12}},
+                           {1, {0.55, 0.47, 0.36}}}}):write("floating_islands.png")
 print("floating_islands: wrote floating_islands.ply, floating_islands.png")

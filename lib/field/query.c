@@ -447,6 +447,11 @@ static double op_lip(const oc_program *P, uint32_t i, const oc_aabb *b,
   }
 }
 
+double oc_op_lipschitz_in(const oc_program *P, uint32_t op, const oc_aabb *b) {
+  if (oc_aabb_is_empty(*b)) return 0;
+  return op_lip(P, op, b, 0);
+}
+
 double oc_program_lipschitz_in(const oc_program *P, oc_aabb box) {
   if (oc_aabb_is_empty(box)) return 0;
   return op_lip(P, P->root, &box, 0);

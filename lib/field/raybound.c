@@ -13,7 +13,6 @@
 #include "field/prim.h"
 #include "field/program.h"
 #include "field/raybound.h"
-#include "terrain/terrain.h"
 
 #define BVH_STACK 64
 #define IV_CAP 64
@@ -269,25 +268,19 @@ static void op_db(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
       *lo -= k;
     return;
   }
-  case OC_K_TERRAIN: {
-    /* the terrain's local bound over the segment's box: 0 where the
-    ** segment runs wholly above the elevations under it (so rays over a
-    ** heightfield take long steps), else from the local slope of h */
-    oc_vec3 a = oc_add(r->o, oc_mul(r->u, t0)),
-            b = oc_add(r->o, oc_mul(r->u, t1));
-    oc_aabb box = {{fmin(a.x, b.x), fmin(a.y, b.y), fmin(a.z, b.z)},
-                   {fmax(a.x, b.x), fmax(a.y, b.y), fmax(a.z, b.z)}};
-    double k =
-        fmin(oc_terrain_lipschitz_in(P->terr[o->kid], par, &box) * (1 + REL),
-             o->lip);
+  default: {
+    /* terrains, geology, erosion, perturb, warp, smooth operators: the
+    ** op's local bound over the segment's box (a terrain's is 0 where the
+    ** segment runs wholly above the elevations under it, so rays over a
+    ** heightfield take long steps) */
+    oc_vec3 a = oc_add(r->o, oc_mul(r->u, t0));
+    oc_vec3 b = oc_add(r->o, oc_mul(r->u, t1));
+    oc_aabb box = {oc_vmin(a, b), oc_vmax(a, b)};
+    double k = fmin(oc_op_lipschitz_in(P, i, &box) * (1 + REL), o->lip);
     *lo -= k;
     *hi += k;
     return;
   }
-  default: /* other primitives, perturb, warp, smooth operators */
-    *lo -= o->lip;
-    *hi += o->lip;
-    return;
   }
 }
 
