@@ -19,7 +19,7 @@
 
 /* Largest node count scanned by a range query before it answers the
 ** trivial bounds. */
-#define RANGE_SCAN 4096
+#define RANGE_SCAN 256
 
 /* Squared distance transform of one line: d[q] = min_p (q - p)^2 + f[p]
 ** over the sites p with finite f. v, z: scratch of n and n + 1. */
@@ -211,7 +211,18 @@ void oc_terrain_mask_range(const oc_tdata *t, double x0, double y0, double x1,
     return;
   }
   int i0 = (int)u0, i1 = (int)ceil(u1), j0 = (int)v0, j1 = (int)ceil(v1);
-  if ((double)(i1 - i0 + 1) * (j1 - j0 + 1) > RANGE_SCAN) return;
+  if ((double)(i1 - i0 + 1) * (j1 - j0 + 1) > RANGE_SCAN) {
+    /* too many nodes to scan (long ray segments): the interpolated
+    ** distance is sqrt(2)-Lipschitz, so the centre bounds the rest */
+    double cx = t->mx0 + 0.5 * (u0 + u1) * t->mcell;
+    double cy = t->my0 + 0.5 * (v0 + v1) * t->mcell;
+    double r = 0.5 * t->mcell * hypot(u1 - u0, v1 - v0);
+    double c = oc_terrain_mask_dist(t, cx, cy, NULL);
+    double m = sqrt(2.0) * (1 + 1e-6) * r + 1e-9 * (c + r);
+    *lo = fmax(0, c - m);
+    *hi = off ? INFINITY : c + m;
+    return;
+  }
   double a = INFINITY, b = 0;
   for (int j = j0; j <= j1; j++)
     for (int i = i0; i <= i1; i++) {
