@@ -562,6 +562,12 @@ typedef struct oc_hf_save_params {
   double scale, offset;
   const char *const *meta; /* extra metadata: key0, value0, key1, ... */
   size_t nmeta;            /* number of (key, value) pairs */
+  /* With nstops > 0: a picture instead of the elevations, for looking at
+  ** analysis results: 8-bit RGB (PNG or TIFF), each sample's value
+  ** through the palette (stops (value, r, g, b), as oc_mesh_color_by_field
+  ** takes them); bits, fixed, scale and offset do not apply. */
+  const double *stops;
+  int nstops;
 } oc_hf_save_params;
 
 /* Writes the grid by extension (.png, .tif, .tiff, .exr) as one channel

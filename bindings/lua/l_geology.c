@@ -24,7 +24,6 @@
 #include "l_geology.h"
 #include "l_image.h"
 
-#define MAX_STOPS 256
 #define DEFAULT_SLICE_SIZE 256
 #define MAX_SLICE_SIZE 16384
 
@@ -300,61 +299,12 @@ static const double default_stops[] = {0.00, 0.22, 0.13, 0.08, 0.35, 0.45,
                                        1.00, 0.95, 0.91, 0.82};
 
 static const double *read_palette(const oclua_fields *f, int *nstops) {
-  lua_State *L = f->L;
-  static const char *const rgb[3] = {"r", "g", "b"};
   if (oclua_field_push(f, "palette") == LUA_TNIL) {
-    lua_pop(L, 1);
+    lua_pop(f->L, 1);
     *nstops = 4;
     return default_stops;
   }
-  int pal = lua_gettop(L);
-  lua_Integer n = lua_istable(L, pal) ? (lua_Integer)lua_rawlen(L, pal) : 0;
-  if (n < 1 || n > MAX_STOPS)
-    oclua_error(L, f->fname,
-                "'palette' must be an array of 1..%d {value, {r, g, b}} "
-                "(got %s)",
-                MAX_STOPS, oclua_got(L, pal));
-  double *stops = lua_newuserdatauv(L, (size_t)n * 4 * sizeof *stops, 0);
-  for (lua_Integer k = 1; k <= n; k++) {
-    double *s = stops + 4 * (k - 1);
-    lua_geti(L, pal, k);
-    if (!lua_istable(L, -1) || lua_rawlen(L, -1) != 2)
-      oclua_error(L, f->fname,
-                  "'palette[%I]' must be {value, {r, g, b}} (got "
-                  "%s)",
-                  (LUAI_UACINT)k, oclua_got(L, -1));
-    if (lua_geti(L, -1, 1) != LUA_TNUMBER || !isfinite(lua_tonumber(L, -1)))
-      oclua_error(L, f->fname,
-                  "'palette[%I]' value must be a finite number "
-                  "(got %s)",
-                  (LUAI_UACINT)k, oclua_got(L, -1));
-    s[0] = lua_tonumber(L, -1);
-    lua_pop(L, 1);
-    if (k > 1 && s[0] < s[-4])
-      oclua_error(L, f->fname,
-                  "'palette' values must be in ascending order (item %I: %f "
-                  "after %f)",
-                  (LUAI_UACINT)k, (LUAI_UACNUMBER)s[0], (LUAI_UACNUMBER)s[-4]);
-    if (lua_geti(L, -1, 2) != LUA_TTABLE || lua_rawlen(L, -1) != 3)
-      oclua_error(L, f->fname,
-                  "'palette[%I]' colour must be {r, g, b} (got "
-                  "%s)",
-                  (LUAI_UACINT)k, oclua_got(L, -1));
-    for (int j = 0; j < 3; j++) {
-      int t = lua_geti(L, -1, j + 1);
-      double x = lua_tonumber(L, -1);
-      if (t != LUA_TNUMBER || !(x >= 0 && x <= 1))
-        oclua_error(L, f->fname,
-                    "'palette[%I]' colour components must be in [0, 1] "
-                    "(got %s = %s)",
-                    (LUAI_UACINT)k, rgb[j], oclua_got(L, -1));
-      s[1 + j] = x;
-      lua_pop(L, 1);
-    }
-    lua_pop(L, 2);
-  }
-  *nstops = (int)n;
-  return stops;
+  return oclua_read_palette(f->L, -1, f->fname, "palette", nstops);
 }
 
 /* Linear between stops, clamped at the ends; NaN reads as the first. */

@@ -498,7 +498,8 @@ static const char **provenance(lua_State *L, size_t *n) {
 }
 
 static int hf_save(lua_State *L) {
-  static const char *const known[] = {"bits", "scale", "offset", NULL};
+  static const char *const known[] = {"bits", "scale", "offset", "palette",
+                                      NULL};
   const char *fname = "heightfield:save";
   oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
   oclua_fields f;
@@ -509,9 +510,33 @@ static int hf_save(lua_State *L) {
   if (lua_type(L, 2) != LUA_TSTRING)
     oclua_error(L, fname, "the path must be a string (got %s)",
                 oclua_got(L, 2));
-  oclua_checkargs(L, 3, fname, "(path [, {bits =, scale =, offset =}])");
+  oclua_checkargs(L, 3, fname,
+                  "(path [, {bits =, scale =, offset =, palette =}])");
   opt_table(L, 3);
   oclua_fields_open(&f, L, 3, fname, NULL, known, 0);
+  int pt = oclua_field_push(&f, "palette");
+  if (pt == LUA_TBOOLEAN && lua_toboolean(L, -1)) {
+    /* the default: dark blue-green lows to pale highs over the grid */
+    static const double ramp[5][4] = {{0, 0.10, 0.20, 0.35},
+                                      {0.25, 0.15, 0.45, 0.45},
+                                      {0.5, 0.55, 0.65, 0.30},
+                                      {0.75, 0.75, 0.55, 0.30},
+                                      {1, 0.97, 0.95, 0.90}};
+    double lo, hi;
+    oc_heightfield_minmax(hf, &lo, &hi);
+    double *st = lua_newuserdatauv(L, sizeof ramp, 0);
+    for (int k = 0; k < 5; k++) {
+      st[4 * k] = lo + ramp[k][0] * (hi - lo);
+      for (int c = 1; c < 4; c++)
+        st[4 * k + c] = ramp[k][c];
+    }
+    p.stops = st;
+    p.nstops = 5;
+  } else if (pt != LUA_TNIL && pt != LUA_TBOOLEAN) {
+    p.stops = oclua_read_palette(L, -1, fname, "palette", &p.nstops);
+  } else if (pt == LUA_TBOOLEAN) {
+    /* palette = false: the elevations, as without it */
+  }
   p.bits = (int)oclua_field_optint(&f, "bits", 8, 32, 0);
   p.fixed = oclua_field_push(&f, "scale") != LUA_TNIL;
   p.fixed |= oclua_field_push(&f, "offset") != LUA_TNIL;

@@ -32,7 +32,6 @@
 
 #define FNAME "outcrop.render"
 #define MAX_SIDE 16384
-#define MAX_STOPS 256
 #define DEFAULT_FOV 40.0
 #define MAX_FOV 179.0
 /* Default view: from the south-west, 30 degrees above the horizon. */
@@ -257,54 +256,6 @@ static void read_rules(const oclua_fields *f, oc_render_params *rp) {
   close_sub(L);
 }
 
-/* Reads a palette at stack index pal into a Lua-owned array of stops
-** (value, r, g, b), pushed on the stack. `label` names the field. */
-static const double *read_palette(lua_State *L, int pal, const char *label,
-                                  int *nstops) {
-  lua_Integer n = lua_istable(L, pal) ? (lua_Integer)lua_rawlen(L, pal) : 0;
-  if (n < 1 || n > MAX_STOPS)
-    oclua_error(L, FNAME,
-                "'%s' must be an array of 1..%d {value, {r, g, b}} "
-                "(got %s)",
-                label, MAX_STOPS, oclua_got(L, pal));
-  double *stops = lua_newuserdatauv(L, (size_t)n * 4 * sizeof *stops, 0);
-  for (lua_Integer k = 1; k <= n; k++) {
-    double *s = stops + 4 * (k - 1);
-    lua_geti(L, pal, k);
-    if (!lua_istable(L, -1) || lua_rawlen(L, -1) != 2)
-      oclua_error(L, FNAME, "'%s[%I]' must be {value, {r, g, b}} (got %s)",
-                  label, (LUAI_UACINT)k, oclua_got(L, -1));
-    if (lua_geti(L, -1, 1) != LUA_TNUMBER || !isfinite(lua_tonumber(L, -1)))
-      oclua_error(L, FNAME, "'%s[%I]' value must be a finite number (got %s)",
-                  label, (LUAI_UACINT)k, oclua_got(L, -1));
-    s[0] = lua_tonumber(L, -1);
-    lua_pop(L, 1);
-    if (k > 1 && s[0] < s[-4])
-      oclua_error(L, FNAME,
-                  "'%s' values must be in ascending order (item %I: %f "
-                  "after %f)",
-                  label, (LUAI_UACINT)k, (LUAI_UACNUMBER)s[0],
-                  (LUAI_UACNUMBER)s[-4]);
-    if (lua_geti(L, -1, 2) != LUA_TTABLE || lua_rawlen(L, -1) != 3)
-      oclua_error(L, FNAME, "'%s[%I]' colour must be {r, g, b} (got %s)", label,
-                  (LUAI_UACINT)k, oclua_got(L, -1));
-    for (int j = 0; j < 3; j++) {
-      int t = lua_geti(L, -1, j + 1);
-      double x = lua_tonumber(L, -1);
-      if (t != LUA_TNUMBER || !(x >= 0 && x <= 1))
-        oclua_error(L, FNAME,
-                    "'%s[%I]' colour components must be in [0, 1] (got "
-                    "%s = %s)",
-                    label, (LUAI_UACINT)k, rgb_names[j], oclua_got(L, -1));
-      s[1 + j] = x;
-      lua_pop(L, 1);
-    }
-    lua_pop(L, 2);
-  }
-  *nstops = (int)n;
-  return stops;
-}
-
 enum { SRC_RULES, SRC_FIELD, SRC_FUNCTION };
 
 /* What `color` asked for; the node or function stays on the stack at idx
@@ -346,7 +297,8 @@ static void read_color(const oclua_fields *f, oc_render_params *rp,
     rp->color = OC_COLOR_FIELD;
     if (has_palette) {
       oclua_field_push(f, "palette");
-      rp->stops = read_palette(L, lua_gettop(L), "palette", &rp->nstops);
+      rp->stops =
+          oclua_read_palette(L, lua_gettop(L), FNAME, "palette", &rp->nstops);
     }
     return;
   }
@@ -361,7 +313,8 @@ static void read_color(const oclua_fields *f, oc_render_params *rp,
     src->idx = lua_gettop(L);
     rp->color = OC_COLOR_FIELD;
     if (oclua_field_push(&c, "palette") != LUA_TNIL)
-      rp->stops = read_palette(L, lua_gettop(L), "color.palette", &rp->nstops);
+      rp->stops = oclua_read_palette(L, lua_gettop(L), FNAME, "color.palette",
+                                     &rp->nstops);
     return;
   }
   oclua_field_error(f, "color", -1,

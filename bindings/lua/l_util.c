@@ -440,3 +440,50 @@ int oclua_field_numbers(const oclua_fields *f, const char *name, int n,
   lua_pop(L, 1);
   return 1;
 }
+
+const double *oclua_read_palette(lua_State *L, int idx, const char *fname,
+                                 const char *label, int *nstops) {
+  static const char *const rgb[3] = {"r", "g", "b"};
+  idx = lua_absindex(L, idx);
+  lua_Integer n = lua_istable(L, idx) ? (lua_Integer)lua_rawlen(L, idx) : 0;
+  if (n < 1 || n > OCLUA_MAX_STOPS)
+    oclua_error(L, fname,
+                "'%s' must be an array of 1..%d {value, {r, g, b}} (got %s)",
+                label, OCLUA_MAX_STOPS, oclua_got(L, idx));
+  double *stops = lua_newuserdatauv(L, (size_t)n * 4 * sizeof *stops, 0);
+  for (lua_Integer k = 1; k <= n; k++) {
+    double *s = stops + 4 * (k - 1);
+    lua_geti(L, idx, k);
+    if (!lua_istable(L, -1) || lua_rawlen(L, -1) != 2)
+      oclua_error(L, fname, "'%s[%I]' must be {value, {r, g, b}} (got %s)",
+                  label, (LUAI_UACINT)k, oclua_got(L, -1));
+    if (lua_geti(L, -1, 1) != LUA_TNUMBER || !isfinite(lua_tonumber(L, -1)))
+      oclua_error(L, fname, "'%s[%I]' value must be a finite number (got %s)",
+                  label, (LUAI_UACINT)k, oclua_got(L, -1));
+    s[0] = lua_tonumber(L, -1);
+    lua_pop(L, 1);
+    if (k > 1 && s[0] < s[-4])
+      oclua_error(L, fname,
+                  "'%s' values must be in ascending order (item %I: %f "
+                  "after %f)",
+                  label, (LUAI_UACINT)k, (LUAI_UACNUMBER)s[0],
+                  (LUAI_UACNUMBER)s[-4]);
+    if (lua_geti(L, -1, 2) != LUA_TTABLE || lua_rawlen(L, -1) != 3)
+      oclua_error(L, fname, "'%s[%I]' colour must be {r, g, b} (got %s)", label,
+                  (LUAI_UACINT)k, oclua_got(L, -1));
+    for (int j = 0; j < 3; j++) {
+      int t = lua_geti(L, -1, j + 1);
+      double x = lua_tonumber(L, -1);
+      if (t != LUA_TNUMBER || !(x >= 0 && x <= 1))
+        oclua_error(L, fname,
+                    "'%s[%I]' colour components must be in [0, 1] (got "
+                    "%s = %s)",
+                    label, (LUAI_UACINT)k, rgb[j], oclua_got(L, -1));
+      s[1 + j] = x;
+      lua_pop(L, 1);
+    }
+    lua_pop(L, 2);
+  }
+  *nstops = (int)n;
+  return stops;
+}

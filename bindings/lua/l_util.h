@@ -90,4 +90,12 @@ lua_Integer oclua_scene_seed(lua_State *L);
 /* Raises unless the call has at most `n` arguments. */
 void oclua_checkargs(lua_State *L, int n, const char *fname, const char *usage);
 
+/* Reads the palette at stack index idx (an array of {value, {r, g, b}},
+** values ascending, components in [0, 1]) into a Lua-owned array of stops
+** (value, r, g, b), pushed on the stack; `label` names the field in the
+** messages ("palette", "colors.palette"). At most OCLUA_MAX_STOPS. */
+#define OCLUA_MAX_STOPS 65536
+const double *oclua_read_palette(lua_State *L, int idx, const char *fname,
+                                 const char *label, int *nstops);
+
 #endif

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/palette.h"
 #include "mesh/mesh.h"
 
 /* Array of n groups of three `size`-byte items; NULL when n == 0 (the
@@ -127,62 +128,11 @@ int oc_mesh_set_colors(oc_mesh *mesh, const float *rgb, oc_error *err) {
   return OC_OK;
 }
 
-static int check_stops(const double *stops, int n, oc_error *err) {
-  if (n < 1)
-    return oc_seterr(err, OC_EINVAL,
-                     "'stops' must hold at least 1 stop "
-                     "(got %d)",
-                     n);
-  if (!stops) return oc_seterr(err, OC_EINVAL, "'stops' is NULL");
-  for (int k = 0; k < n; k++) {
-    const double *s = stops + 4 * k;
-    if (!isfinite(s[0]))
-      return oc_seterr(err, OC_EINVAL,
-                       "'stops' value of stop %d must be finite (got %g)",
-                       k + 1, s[0]);
-    if (k > 0 && s[0] < s[-4])
-      return oc_seterr(err, OC_EINVAL,
-                       "'stops' must be sorted by value (stop %d: %g after "
-                       "%g)",
-                       k + 1, s[0], s[-4]);
-    for (int c = 1; c <= 3; c++)
-      if (!(s[c] >= 0 && s[c] <= 1))
-        return oc_seterr(err, OC_EINVAL,
-                         "'stops' colour of stop %d must be in [0, 1] "
-                         "(got %g)",
-                         k + 1, s[c]);
-  }
-  return OC_OK;
-}
-
-/* Palette lookup: linear between the two stops around v, the end colours
-** beyond them. Where stops share a value the colour steps (the later stop
-** wins from that value on). NaN takes the first stop's colour. */
-static void palette(const double *stops, int n, double v, float *rgb) {
-  const double *s = stops;
-  if (!(v >= stops[0]) || n == 1) {
-    s = stops;
-  } else if (v >= stops[4 * (n - 1)]) {
-    s = stops + 4 * (n - 1);
-  } else {
-    int k = 0;
-    while (v >= stops[4 * (k + 1)])
-      k++; /* stops[4k] <= v < stops[4k+4] */
-    const double *a = stops + 4 * k, *b = a + 4;
-    double t = (v - a[0]) / (b[0] - a[0]);
-    for (int c = 1; c <= 3; c++)
-      rgb[c - 1] = clamp01(a[c] + t * (b[c] - a[c]));
-    return;
-  }
-  for (int c = 1; c <= 3; c++)
-    rgb[c - 1] = (float)s[c];
-}
-
 int oc_mesh_color_by_field(oc_mesh *mesh, const oc_program *field,
                            const double *stops, int n, oc_error *err) {
   if (!mesh) return oc_seterr(err, OC_EINVAL, "'mesh' is NULL");
   if (!field) return oc_seterr(err, OC_EINVAL, "'field' is NULL");
-  int rc = check_stops(stops, n, err);
+  int rc = oc_palette_check(stops, n, err);
   if (rc) return rc;
   float *c = color_array(mesh, err);
   if (!c) return OC_ENOMEM;
@@ -192,7 +142,10 @@ int oc_mesh_color_by_field(oc_mesh *mesh, const oc_program *field,
 #pragma omp parallel for schedule(static)
   for (ptrdiff_t i = 0; i < nv; i++) {
     oc_vec3 p = {P[3 * i], P[3 * i + 1], P[3 * i + 2]};
-    palette(stops, n, oc_program_eval(field, p), c + 3 * i);
+    double rgb[3];
+    oc_palette_eval(stops, n, oc_program_eval(field, p), rgb);
+    for (int k = 0; k < 3; k++)
+      c[3 * i + k] = (float)rgb[k];
   }
   mesh->col = c;
   return OC_OK;

@@ -6,6 +6,7 @@
 */
 #include <math.h>
 
+#include "core/palette.h"
 #include "core/noise.h"
 #include "render/shade.h"
 
@@ -48,31 +49,13 @@ static void rules(const oc_shader *sh, oc_vec3 p, oc_vec3 n, double c[3]) {
   mix(c, SNOW, snow);
 }
 
-static void palette(const double *st, int n, double v, double c[3]) {
-  if (!(v > st[0])) { /* also NaN */
-    c[0] = st[1], c[1] = st[2], c[2] = st[3];
-    return;
-  }
-  for (int i = 1; i < n; i++) {
-    const double *a = st + 4 * (i - 1), *b = st + 4 * i;
-    if (v <= b[0]) {
-      double w = b[0] > a[0] ? (v - a[0]) / (b[0] - a[0]) : 1;
-      for (int k = 0; k < 3; k++)
-        c[k] = a[k + 1] + (b[k + 1] - a[k + 1]) * w;
-      return;
-    }
-  }
-  const double *z = st + 4 * (n - 1);
-  c[0] = z[1], c[1] = z[2], c[2] = z[3];
-}
-
 void oc_albedo(const oc_shader *sh, oc_vec3 p, oc_vec3 n, double rgb[3],
                double *evals) {
   const oc_render_params *rp = sh->rp;
   if (rp->color == OC_COLOR_FIELD) {
     double v = oc_program_eval(rp->color_field, p);
     *evals += 1;
-    palette(rp->stops, rp->nstops, v, rgb);
+    oc_palette_eval(rp->stops, rp->nstops, v, rgb);
   } else {
     rules(sh, p, n, rgb);
   }

@@ -16,6 +16,7 @@
 #include <strings.h>
 
 #include "core/error.h"
+#include "core/palette.h"
 #include "io/atomic.h"
 #include "io/oiio.h"
 #include "io/oiio_hf.h"
@@ -288,10 +289,53 @@ static int write_atomic(const char *path, const oc_oiio_out *out,
   return oc_atomic_commit(&a, err);
 }
 
+/* The colour picture of the grid through a palette: 8-bit RGB, north up,
+** with the caller's metadata only (it is no heightfield file). */
+static int save_colors(const oc_heightfield *hf, const char *path, int k,
+                       const oc_hf_save_params *p, oc_error *err) {
+  if (k != PNG && k != TIFF)
+    return oc_seterr(err, OC_EINVAL,
+                     "cannot write '%s': a palette picture must be .png or "
+                     ".tif",
+                     path);
+  int rc = oc_palette_check(p->stops, p->nstops, err);
+  if (rc != OC_OK) return rc;
+  int nx = oc_heightfield_nx(hf), ny = oc_heightfield_ny(hf);
+  unsigned char *px = malloc((size_t)nx * (size_t)ny * 3);
+  if (!px)
+    return oc_seterr(err, OC_ENOMEM, "cannot write '%s': out of memory", path);
+  const float *z = oc_heightfield_samples(hf);
+  for (int r = 0; r < ny; r++)
+    for (int i = 0; i < nx; i++) {
+      double rgb[3];
+      oc_palette_eval(p->stops, p->nstops,
+                      z[(size_t)(ny - 1 - r) * (size_t)nx + (size_t)i], rgb);
+      unsigned char *o = px + 3 * ((size_t)r * (size_t)nx + (size_t)i);
+      for (int c = 0; c < 3; c++)
+        o[c] = (unsigned char)lround(rgb[c] * 255);
+    }
+  const char *names[3] = {"R", "G", "B"};
+  oc_oiio_out out = {
+      .format = oiio_names[k],
+      .width = nx,
+      .height = ny,
+      .channels = 3,
+      .type = OC_OIIO_U8,
+      .pixels = px,
+      .alpha = -1,
+      .channel_names = names,
+      .meta = p->meta,
+      .nmeta = p->nmeta,
+  };
+  rc = write_atomic(path, &out, err);
+  free(px);
+  return rc;
+}
+
 int oc_heightfield_save(const oc_heightfield *hf, const char *path,
                         const oc_hf_save_params *p, double used[2],
                         oc_error *err) {
-  static const oc_hf_save_params defaults = {0, 0, 1, 0, NULL, 0};
+  static const oc_hf_save_params defaults = {0, 0, 1, 0, NULL, 0, NULL, 0};
   if (!hf) return oc_seterr(err, OC_EINVAL, "the heightfield is NULL");
   if (!path || !*path)
     return oc_seterr(err, OC_EINVAL, "'path' must be a non-empty file name");
@@ -302,6 +346,11 @@ int oc_heightfield_save(const oc_heightfield *hf, const char *path,
                      "cannot write '%s': unknown heightfield format (use "
                      ".png, .tif, .tiff or .exr)",
                      path);
+  if (p->nstops > 0) {
+    int rc = save_colors(hf, path, k, p, err);
+    if (rc == OC_OK && used) used[0] = 1, used[1] = 0;
+    return rc;
+  }
   int type = sample_type((kind)k, p->bits);
   if (type < 0)
     return oc_seterr(err, OC_EINVAL, "'bits' must be %s for %s (got %d)",

@@ -192,6 +192,29 @@ describe("files", function()
     assert.are.equal(read_file(path), read_file(dir .. "/h2.png"))
   end)
 
+  it("palette pictures: each sample's value through the stops, north up", function()
+    -- v = i + 10 j on a 5 x 4 grid, stops 0 -> black, 40 -> white
+    local g = HF.from(function(x, y) return x + 10 * y end, {size = {5, 4}})
+    local path = dir .. "/p.png"
+    g:save(path, {palette = {{0, {0, 0, 0}}, {40, {1, 1, 1}}}})
+    local attrs, _, channels = Fs.image_info(path)
+    assert.are.equal("R, G, B", channels)
+    assert.truthy(attrs["outcrop:version"])
+    -- read back the red channel as raw counts (north up: flipped in and out)
+    local back = HF.load(path)
+    for i, j in each_sample(g) do
+      assert.are.equal(math.floor(g:get(i, j) / 40 * 255 + 0.5), back:get(i, j))
+    end
+    -- palette = true: the default ramp from the grid's min to max
+    g:save(dir .. "/d.png", {palette = true})
+    local d = HF.load(dir .. "/d.png")
+    assert.is_true(d:get(1, 1) < d:get(5, 4))
+    check(function() g:save(dir .. "/e.png", {palette = {{1, {0, 0, 2}}}}) end,
+          "heightfield:save", "'palette[1]' colour components must be in [0, 1] (got b = 2)")
+    check(function() g:save(dir .. "/e.exr", {palette = true}) end,
+          "heightfield:save", "a palette picture must be .png or .tif")
+  end)
+
   it("EXR and float TIFF: exact floats", function()
     for _, ext in ipairs({"exr", "tif", "tiff"}) do
       local path = dir .. "/h." .. ext
