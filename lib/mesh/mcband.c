@@ -45,6 +45,9 @@ static void span_ranges(const oc_mcgrid *g, double zl, double zh,
   s->hi = clampi(floor(b - 0.5 + 1e-6), 0, nz - 1);
   if (g->open && a <= 1e-6) s->lo = -1;
   if (g->open && b >= nz - 1e-6) s->hi = nz;
+  /* a span between two samples still separates the gaps below and above
+  ** it, whose constant values differ: its sample just above varies */
+  if (s->lo > s->hi) s->hi = s->lo;
 }
 
 /* Cube ranges (rows ja .. jb - 1) and varying sample ranges (rows ja ..

@@ -569,6 +569,33 @@ static int same_mesh(const oc_mesh *a, const oc_mesh *b) {
                  3 * nt * sizeof(uint32_t));
 }
 
+START_TEST(thin_span_between_samples) {
+  /* a tilted half-space whose field varies over a slab thinner than a
+  ** cell (falloff 0.3, cell 1), often between two sample layers: the
+  ** gap below it (inside) and the gap above it (outside) must not merge
+  ** into one constant (regression: coarse cells on thin terrains) */
+  oc_error e;
+  oc_program *pr = oct_compile(
+      OCT_OK(oc_plane(oct_v(0, 0, 4.9), oct_v(0.05, 0.02, 1), 0.3, 1, &e)), 0,
+      0);
+  oc_aabb box = box3(0, 0, 0, 24, 24, 10);
+  oc_polygonize_params pp = params(box, 1);
+  oc_mesh *mb = mesh_ok(pr, &pp);
+  pp.full_grid = 1;
+  oc_mesh *mf = mesh_ok(pr, &pp);
+  meshinfo ib = check_mesh(mb, 1, box);
+  ck_assert_int_eq(ib.euler, 2);
+  tri9 *tb = canonical(mb), *tf = canonical(mf);
+  ck_assert_uint_eq(oc_mesh_triangle_count(mb), oc_mesh_triangle_count(mf));
+  ck_assert(!memcmp(tb, tf, oc_mesh_triangle_count(mb) * sizeof *tb));
+  free(tb);
+  free(tf);
+  oc_mesh_free(mb);
+  oc_mesh_free(mf);
+  oc_program_free(pr);
+}
+END_TEST
+
 START_TEST(tiny_grids) {
   /* 1 to 9 cells per axis, slabs of every size, a surface crossing the
   ** box or not: closed, and the same with and without bounds */
@@ -934,6 +961,7 @@ static Suite *suite(void) {
   tcase_set_timeout(t, 120);
   tcase_add_test(t, bounds_match_full_grid);
   tcase_add_test(t, threads_byte_identical);
+  tcase_add_test(t, thin_span_between_samples);
   tcase_add_test(t, tiny_grids);
   tcase_add_test(t, wide_grid_streams);
   tcase_add_test(t, far_from_origin);
