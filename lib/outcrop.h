@@ -830,6 +830,188 @@ oc_node *oc_fault(oc_node *child, const oc_fault_domain *dom, oc_vec3 offset,
 oc_node *oc_erosion(oc_node *terrain, oc_node *geology, oc_node *control,
                     double depth, oc_error *err);
 
+/* ---- generators: karst (gen/karst.c) ---------------------------------- */
+
+/* Karst networks by invasion percolation (seed 000 section 6.2). From the
+** sinks, a priority queue of candidate points ordered by resistance rho
+** (the geology, clamped to [0, 1]) plus epsilon times a uniform draw: the
+** least resistant candidate is popped; where rho < rho0 a negative point
+** primitive carves there, and `branches` new candidates are tried at
+** `step` from it in uniform random directions of the lower hemisphere
+** (dz <= 0), each kept only when it lies inside the heightfield's domain
+** (shrunk by radius), between `floor` and `cover` below the surface h(x,
+** y) of the heightfield, and at least `spacing` from every point queued
+** so far (Poisson spheres, through a grid hash). Stops when no candidate
+** can have rho < rho0, or at max_primitives cavities. Ties pop the older
+** candidate first; the draws of a candidate come from the stream (seed,
+** its index): the same parameters give the same cavities, sequentially
+** (the process is), on any number of threads. */
+typedef struct oc_karst_cavity {
+  oc_vec3 center;
+  double radius, energy; /* energy < 0: carves */
+  double rho;            /* clamped resistance at the centre */
+  int64_t parent;        /* cavity it grew from (distance `step`), or -1
+                         ** for one at a sink */
+} oc_karst_cavity;
+
+typedef struct oc_gen_karst_params {
+  oc_heightfield *heightfield; /* required: the surface and the sinks */
+  oc_node *terrain;    /* blended with the cavities; NULL: cavities alone */
+  oc_node *geology;    /* resistance; NULL: strata of wavelength 8 radius
+                       ** (oc_strata, 3 octaves, the seed below) */
+  const oc_vec3 *sinks; /* nsinks starting points; NULL: oc_hf_sinks of the
+                        ** heightfield. A sink higher than `cover` below the
+                        ** surface is lowered to it. */
+  size_t nsinks;
+  uint64_t seed;
+  double radius;  /* R of the point primitives > 0; 0: 2 cells */
+  double step;    /* distance to new candidates > 0; 0: radius */
+  double spacing; /* Poisson-sphere radius > 0; 0: radius / 2 */
+  double cover;   /* least depth of a centre under h >= 0; NAN: R / 4 */
+  double floor;   /* lowest centre z; NAN: lowest sample + radius */
+  double epsilon; /* perturbation range >= 0 (0.1) */
+  double rho0;    /* carve where rho < rho0, in (0, 1] (0.5) */
+  double energy;  /* E > 0: a cavity's energy is -E (beta + (1 - beta)
+                  ** (1 - rho)), e(rho, sigma = 1) of section 6.1 (1.5) */
+  double beta;    /* in [0, 1] (0.5) */
+  int branches;   /* candidates tried per cavity, 1 .. 64 (6) */
+  size_t max_primitives; /* budget, 1 .. OC_KARST_MAX (100000) */
+  oc_progress progress;
+} oc_gen_karst_params;
+
+#define OC_KARST_MAX 20000000
+
+typedef struct oc_gen_karst_stats {
+  size_t primitives; /* cavities carved */
+  size_t candidates; /* points queued, sinks included */
+  size_t sinks;      /* sinks queued */
+  double seconds;
+} oc_gen_karst_stats;
+
+/* The defaults above (heightfield, terrain, geology, sinks NULL). */
+void oc_gen_karst_defaults(oc_gen_karst_params *p);
+
+/* Runs the percolation: the cavities in carving order go to a new array
+** *out (free() it; NULL when none), their count to *n. st may be NULL.
+** OC_OK, or OC_EINVAL naming the parameter, OC_ENOMEM, OC_ECANCEL. */
+int oc_karst_cavities(const oc_gen_karst_params *p, oc_karst_cavity **out,
+                      size_t *n, oc_gen_karst_stats *st, oc_error *err);
+
+/* The blend of the terrain (when given) and one oc_point per cavity (so a
+** compiled program stores them inline). NULL with err when the
+** percolation fails, or when no terrain is given and nothing was carved. */
+oc_node *oc_generate_karst(const oc_gen_karst_params *p,
+                           oc_gen_karst_stats *st, oc_error *err);
+
+/* ---- generators: hoodoos (gen/hoodoos.c, gen/grammar.c) ---------------- */
+
+/* Hoodoos and goblins (seed 000 section 6.3). Placement: the maximal
+** Poisson disk set of spacing `radius` over the heightfield (shrunk by
+** `margin`) is thinned with the probability
+**   P = probability * exp(-((s - slope) / slope_spread)^2) / (1 + A /
+**       drainage) * mask
+** (clamped to [0, 1]; s = oc_hf_slope, A = oc_hf_drainage: hoodoos favour
+** talus and cliffs, medium slope and low drainage). Each kept sample is an
+** axiom of the grammar of figure 20, derived upwards from the surface:
+**   A -> B;  B -> b B (p_B) | b C (1 - p_B);
+**   C -> c B (p_C / 2) | c (p_C / 2) | d (1 - p_C),
+** p_B = clamp(p_block (0.5 + rho)), p_C = clamp(p_cone (1.5 - rho)), rho
+** the clamped geology at the centre of the symbol being produced. A
+** symbol of size s at base p is followed at p + s z with size shrink * s;
+** its half-width is width shrink^k (0.5 + rho) (hard rock: wide caps,
+** soft rock: necks). At most max_depth symbols: a derivation is steered
+** to a terminal (b C, then c or d) when the budget runs out. Terminals:
+** b a block (an ellipsoid), c a cone (a spire), d a box (a caprock 1.3
+** times wider); each with a random turn about z, a tilt of up to `tilt`
+** radians, and a perturbed surface (oc_perturb, amplitude roughness). The
+** first symbol's base sinks below the surface by 0.15 H + |grad h| width
+** (at most half its size), so every hoodoo is attached to the ground; H,
+** drawn in [height_lo, height_hi], is how far a derivation reaching
+** max_depth rises above the surface. Draws come from the stream (seed,
+** axiom index): the same parameters give the same symbols on any number
+** of threads. */
+typedef enum oc_hoodoo_kind {
+  OC_HOODOO_BLOCK = 'b',
+  OC_HOODOO_CONE = 'c',
+  OC_HOODOO_BOX = 'd'
+} oc_hoodoo_kind;
+
+typedef struct oc_hoodoo_symbol {
+  char kind;       /* an oc_hoodoo_kind */
+  uint32_t hoodoo; /* index of its axiom (hoodoo) */
+  int depth;       /* 0 for the base symbol */
+  oc_vec3 base;    /* centre of its base; its axis is the local z */
+  double size;     /* height s */
+  double width;    /* half-width */
+  double rho;      /* clamped resistance at its centre */
+  double turn;     /* rotation about z, radians */
+  double tilt;     /* tilt from the vertical, radians */
+  double tilt_dir; /* azimuth of the tilt axis, radians */
+  double aspect;   /* x / y half-width ratio (>= 1 / 1.3, <= 1.3) */
+  uint64_t noise;  /* seed of its perturbation */
+} oc_hoodoo_symbol;
+
+typedef struct oc_gen_hoodoos_params {
+  oc_heightfield *heightfield; /* required: placement and ground level */
+  oc_node *terrain; /* blended with the hoodoos; NULL: hoodoos alone */
+  oc_node *geology; /* resistance; NULL: rho = 0.5 everywhere */
+  const oc_heightfield *mask; /* NULL, or a factor of P (clamped [0, 1]) */
+  /* NULL, or a factor of P in [0, 1], called from the calling thread once
+  ** per sample of the maximal set (anything else fails, NaN to abort). */
+  double (*mask_fn)(void *ud, double x, double y);
+  void *mask_ud;
+  uint64_t seed;
+  double radius;               /* Poisson spacing > 0 (5 cells) */
+  double height_lo, height_hi; /* 0 < lo <= hi (4 and 10 cells) */
+  double width;        /* half-width of the base symbol > 0 (0.3 radius) */
+  double margin;       /* >= 0: kept from the grid's edges (4 cells) */
+  int max_depth;       /* symbols per hoodoo, 2 .. OC_HOODOO_MAX_DEPTH (6) */
+  double p_block;      /* in [0, 1] (0.5) */
+  double p_cone;       /* in [0, 1] (0.5) */
+  double shrink;       /* lambda in (0, 1] (0.85) */
+  double tilt;         /* radians in [0, 0.5] (0.1) */
+  double roughness;    /* perturbation, fraction of the falloff, [0, 1]
+                       ** (0.3) */
+  double probability;  /* in [0, 1] (1) */
+  double slope;        /* favoured slope, rise over run >= 0 (0.6) */
+  double slope_spread; /* > 0 (0.4) */
+  double drainage;     /* A0 in m^2 > 0 (20 cells^2) */
+  double threshold;    /* T; 0: OC_DEFAULT_THRESHOLD */
+  oc_progress progress;
+} oc_gen_hoodoos_params;
+
+#define OC_HOODOO_MAX_DEPTH 64
+#define OC_HOODOO_MAX_SYMBOLS 4000000
+
+typedef struct oc_gen_hoodoos_stats {
+  size_t hoodoos;    /* axioms kept */
+  size_t primitives; /* symbols made, one primitive each */
+  size_t blocks, cones, boxes;
+  double seconds;
+} oc_gen_hoodoos_stats;
+
+/* The defaults above for hf (cell-relative sizes); hf may be NULL (cell
+** 1). terrain, geology and masks NULL, seed 0. */
+void oc_gen_hoodoos_defaults(oc_gen_hoodoos_params *p, oc_heightfield *hf);
+
+/* Places and derives the hoodoos: their symbols, hoodoo after hoodoo
+** (base first), go to a new array *out (free() it; NULL when none), the
+** count to *n. st may be NULL. OC_OK, or OC_EINVAL naming the parameter,
+** OC_ENOMEM, OC_ECANCEL. */
+int oc_hoodoo_symbols(const oc_gen_hoodoos_params *p, oc_hoodoo_symbol **out,
+                      size_t *n, oc_gen_hoodoos_stats *st, oc_error *err);
+
+/* The solid of one symbol: a transformed, perturbed primitive of energy
+** 2T (T = threshold, 0 for the default). */
+oc_node *oc_hoodoo_symbol_node(const oc_hoodoo_symbol *s, double roughness,
+                               double threshold, oc_error *err);
+
+/* The blend of the terrain (when given) and one primitive per symbol.
+** NULL with err when placement fails, or when no terrain is given and no
+** hoodoo was placed. */
+oc_node *oc_generate_hoodoos(const oc_gen_hoodoos_params *p,
+                             oc_gen_hoodoos_stats *st, oc_error *err);
+
 #ifdef __cplusplus
 }
 #endif
