@@ -1012,6 +1012,103 @@ oc_node *oc_hoodoo_symbol_node(const oc_hoodoo_symbol *s, double roughness,
 oc_node *oc_generate_hoodoos(const oc_gen_hoodoos_params *p,
                              oc_gen_hoodoos_stats *st, oc_error *err);
 
+/* ---- generators: sea and river (gen/sea.c, gen/river.c, gen/stress.c) -- */
+
+/* Shallow erosion (seed 000 section 6.1). Both make negative point
+** primitives of radius `radius` and energy -strength e(rho, sigma), with
+** e(rho, sigma) = sigma (1 - rho)(1 - beta) + sigma beta, rho the geology
+** at the sample clamped to [0, 1], and drop those with e < cutoff. Samples
+** are the points where horizontal rays, cast from Poisson disk columns
+** (radius `spacing`, sampled on the tiles of the footprint that hold
+** candidates and merged in tile order, still `spacing` apart) at a height
+** drawn per step, enter the current tree:
+** step k marches the terrain blended with the primitives of steps < k, so
+** each step bites further into what earlier ones carved (into soft rock
+** most). Each returns blend(terrain, primitives...), the terrain first
+** (NULL terrain: oc_terrain of the heightfield, falloff 4 cells), or with
+** `no_terrain` the blend of the primitives alone (the rays still march the
+** terrain; OC_EINVAL when nothing was carved). Draws
+** are keyed by (seed, step, column): the same primitives for any thread
+** count. OC_EINVAL naming the parameter, OC_ENOMEM, OC_ECANCEL. */
+typedef struct oc_gen_sea_stats {
+  size_t columns;    /* Poisson columns kept as candidates */
+  size_t samples;    /* rays that found the surface, over all steps */
+  size_t primitives; /* primitives made */
+} oc_gen_sea_stats;
+
+typedef struct oc_gen_sea_params {
+  oc_heightfield *heightfield; /* required */
+  oc_node *terrain;            /* or NULL (see above) */
+  int no_terrain;              /* 1: return the primitives alone */
+  oc_node *geology;            /* resistance; NULL: 0.5 everywhere */
+  uint64_t seed;
+  double sea_level; /* finite (0) */
+  double range;     /* > 0: sigma falls off as g(|z - sea_level| / range);
+                    ** columns lower than sea_level - range are not
+                    ** sampled (8, the paper's figure 11) */
+  double radius;    /* > 0 (0: range) */
+  double spacing;   /* Poisson radius > 0 (0: radius / 2) */
+  double reach;     /* > 0: columns above sea_level + range are candidates
+                    ** within this horizontal distance of the band, their
+                    ** ray cast at a height drawn in the band (steep cliff
+                    ** faces) (0: 2 radius) */
+  double beta;      /* in [0, 1] (0.2) */
+  double strength;  /* > 0 (4) */
+  double cutoff;    /* >= 0 (0.05) */
+  int steps;        /* 1 .. 64 (3) */
+  int rays;         /* accessibility rays per column, 0 .. 4096; 0: alpha
+                    ** = 1 (16) */
+  double threshold; /* T; 0: OC_DEFAULT_THRESHOLD */
+  oc_progress progress;
+} oc_gen_sea_params;
+
+/* Sea erosion: candidate columns within `range` of sea level (the
+** heightfield's surface z = h is in [sea_level - range, sea_level +
+** range]) cast their ray landward (up the slope) at z = h; cliff columns
+** (above the band, within `reach` of it) at z drawn in the band, landward
+** along the gradient of the distance to the band. sigma = w alpha, w the
+** falloff above, alpha the column's accessibility (Miller 1994): the
+** fraction of `rays` directions over the upper hemisphere (uniform in
+** solid angle) along which the heightfield stays below the ray within 8
+** radius, the rays leaving 1.5 cells seaward of where the column's ray
+** first met the surface (a vertical cliff face sees about half the sky).
+** It is measured once per column and kept for later steps, since from
+** inside a cave the heightfield sees only the cliff above. */
+void oc_gen_sea_defaults(oc_gen_sea_params *p);
+oc_node *oc_generate_sea(const oc_gen_sea_params *p, oc_gen_sea_stats *st,
+                         oc_error *err);
+
+typedef struct oc_gen_river_params {
+  oc_heightfield *heightfield; /* required */
+  oc_node *terrain;            /* or NULL (see above) */
+  int no_terrain;              /* 1: return the primitives alone */
+  oc_node *geology;            /* resistance; NULL: 0.5 everywhere */
+  uint64_t seed;
+  double power;    /* stream power A^(1/2) s above which a sample is
+                   ** riverbed, > 0; 0: the 95th percentile of the grid */
+  int banks;       /* widening of the bed in cells, 0 .. 64 (3) */
+  double depth;    /* > 0: bank rays are cast at z drawn in [h - depth, h]
+                   ** (0: 3 radius) */
+  double radius;   /* > 0 (0: 1.5 cells) */
+  double spacing;  /* Poisson radius > 0 (0: radius / 2) */
+  double beta;     /* in [0, 1] (0.2) */
+  double strength; /* > 0 (2) */
+  double cutoff;   /* >= 0 (0.05) */
+  int steps;       /* 1 .. 64 (2) */
+  double threshold; /* T; 0: OC_DEFAULT_THRESHOLD */
+  oc_progress progress;
+} oc_gen_river_params;
+
+/* River erosion: sigma per sample is 1 on the riverbed (stream power >=
+** power) and falls off linearly to 0 at `banks` + 1 cells from it (a small
+** max-convolution of the bed with a tent). Bed columns (slope < 0.05)
+** carve at z = h; bank columns cast their ray away from the river (up the
+** slope) at z drawn in [h - depth, h], so walls are undercut where the
+** rock is soft. oc_gen_sea_stats counts as for the sea. */
+void oc_gen_river_defaults(oc_gen_river_params *p);
+oc_node *oc_generate_river(const oc_gen_river_params *p, oc_gen_sea_stats *st,
+                           oc_error *err);
+
 #ifdef __cplusplus
 }
 #endif

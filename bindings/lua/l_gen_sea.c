@@ -1,6 +1,184 @@
 /*
-** l_gen_sea.c — sea and river erosion: outcrop.generate.sea, outcrop.generate.river.
+** l_gen_sea.c — sea and river erosion (seed 000 section 6.1):
+** outcrop.generate.sea{...} and outcrop.generate.river{...}.
+**
+**   field (both)   | default
+**   ---------------+--------------------------------------------------------
+**   heightfield    | required: the footprint, slopes, stream power
+**   terrain        | outcrop.terrain(heightfield): the tree the rays march
+**                  | and the primitives are blended with; false: the
+**                  | rays march that default, the primitives come alone
+**   geology        | none: resistance 0.5 everywhere
+**   seed           | the scene seed
+**   radius         | sea: range; river: 1.5 cells (negative point radius)
+**   spacing        | radius / 2: Poisson disk radius of the columns
+**   beta           | 0.2: e(1, 1), the bite on the hardest rock
+**   strength       | sea 4, river 2: energy = -strength e(rho, sigma)
+**   cutoff         | 0.05: samples with a smaller e make no primitive
+**   steps          | sea 3, river 2: rounds on the updated tree
+**
+**   sea only       |
+**   sea_level      | 0 when the heightfield spans it, else its lowest
+**                  | sample plus a quarter of its relief
+**   range          | 8 (metres): sigma falls off over range from sea level
+**   reach          | 2 radius: cliff columns sampled this far from the band
+**   rays           | 16: accessibility rays per sample (0: alpha = 1)
+**
+**   river only     |
+**   power          | the 95th percentile of hf:stream_power(): riverbed
+**   banks          | 3 (cells): widening of the bed to the banks
+**   depth          | 3 radius: bank rays are cast down to this below h
+**
+** Each returns the node (blend of the terrain and the primitives) and a
+** table {columns=, samples=, primitives=}.
 */
+#include "l_field.h"
 #include "l_gen.h"
+#include "l_heightfield.h"
+#include "l_progress.h"
 
-const luaL_Reg oclua_gen_sea[] = {{NULL, NULL}};
+typedef struct common {
+  oc_heightfield *hf;
+  oc_node *terrain, *geology;
+  uint64_t seed;
+  double radius, spacing, beta, strength, cutoff, threshold;
+  int steps, no_terrain;
+} common;
+
+/* A node or nil; false sets *nofalse when nofalse is not NULL. */
+static oc_node *optnode(oclua_fields *f, const char *name, int *nofalse) {
+  oc_node *n = NULL;
+  int t = oclua_field_push(f, name);
+  if (nofalse && t == LUA_TBOOLEAN && !lua_toboolean(f->L, -1))
+    *nofalse = 1;
+  else if (t != LUA_TNIL) {
+    oclua_node *u = oclua_testnode(f->L, -1);
+    if (!u)
+      oclua_field_error(f, name, -1,
+                        nofalse ? "must be a node or false" : "must be a node");
+    n = u->node;
+  }
+  lua_pop(f->L, 1); /* the table keeps the node alive */
+  return n;
+}
+
+static void read_common(oclua_fields *f, common *c, int steps,
+                        double strength) {
+  if (oclua_field_push(f, "heightfield") == LUA_TNIL)
+    oclua_field_missing(f, "heightfield", "a heightfield");
+  c->hf = oclua_testheightfield(f->L, -1);
+  if (!c->hf) oclua_field_error(f, "heightfield", -1, "must be a heightfield");
+  lua_pop(f->L, 1);
+  c->no_terrain = 0;
+  c->terrain = optnode(f, "terrain", &c->no_terrain);
+  c->geology = optnode(f, "geology", NULL);
+  c->seed = oclua_field_seed(f, "seed");
+  c->radius = oclua_field_optnumber(f, "radius", OCLUA_POSITIVE, 0);
+  c->spacing = oclua_field_optnumber(f, "spacing", OCLUA_POSITIVE, 0);
+  c->beta = oclua_field_optnumber(f, "beta", OCLUA_FINITE, 0.2);
+  if (!(c->beta >= 0 && c->beta <= 1))
+    oclua_error(f->L, f->fname, "'beta' must be in [0, 1] (got %f)", c->beta);
+  c->strength = oclua_field_optnumber(f, "strength", OCLUA_POSITIVE, strength);
+  c->cutoff = oclua_field_optnumber(f, "cutoff", OCLUA_FINITE, 0.05);
+  if (c->cutoff < 0)
+    oclua_error(f->L, f->fname, "'cutoff' must be >= 0 (got %f)", c->cutoff);
+  c->steps = (int)oclua_field_optint(f, "steps", 1, 64, steps);
+  c->threshold = oclua_threshold(f->L, f->fname);
+}
+
+static int finish(lua_State *L, const char *fname, oclua_node *u, oc_node *n,
+                  const oc_error *err, const oc_gen_sea_stats *st) {
+  if (!n && err->code == OC_ECANCEL) return luaL_error(L, "interrupted");
+  oclua_setnode(L, u, n, err, fname);
+  lua_createtable(L, 0, 3);
+  lua_pushinteger(L, (lua_Integer)st->columns);
+  lua_setfield(L, -2, "columns");
+  lua_pushinteger(L, (lua_Integer)st->samples);
+  lua_setfield(L, -2, "samples");
+  lua_pushinteger(L, (lua_Integer)st->primitives);
+  lua_setfield(L, -2, "primitives");
+  return 2;
+}
+
+static int l_sea(lua_State *L) {
+  static const char *const known[] = {
+      "heightfield", "terrain", "geology",  "seed",   "radius",
+      "spacing",     "beta",    "strength", "cutoff", "steps",
+      "sea_level",   "range",   "reach",    "rays",   NULL};
+  const char *fname = "outcrop.generate.sea";
+  oclua_fields f;
+  common c;
+  oc_gen_sea_params p;
+  oclua_checkargs(L, 1, fname, "{heightfield =, sea_level =, range =, ...}");
+  oclua_fields_open(&f, L, 1, fname, NULL, known, 0);
+  oc_gen_sea_defaults(&p);
+  read_common(&f, &c, p.steps, p.strength);
+  double lo, hi;
+  oc_heightfield_minmax(c.hf, &lo, &hi);
+  p.sea_level =
+      oclua_field_optnumber(&f, "sea_level", OCLUA_FINITE,
+                            lo < 0 && hi > 0 ? 0 : lo + 0.25 * (hi - lo));
+  p.range = oclua_field_optnumber(&f, "range", OCLUA_POSITIVE, p.range);
+  p.reach = oclua_field_optnumber(&f, "reach", OCLUA_POSITIVE, 0);
+  p.rays = (int)oclua_field_optint(&f, "rays", 0, 4096, p.rays);
+  p.heightfield = c.hf;
+  p.terrain = c.terrain;
+  p.no_terrain = c.no_terrain;
+  p.geology = c.geology;
+  p.seed = c.seed;
+  p.radius = c.radius;
+  p.spacing = c.spacing;
+  p.beta = c.beta;
+  p.strength = c.strength;
+  p.cutoff = c.cutoff;
+  p.steps = c.steps;
+  p.threshold = c.threshold;
+  oclua_node *u = oclua_newnode(L);
+  oclua_progress pl;
+  oc_gen_sea_stats st = {0, 0, 0};
+  oc_error err = {OC_OK, ""};
+  p.progress = oclua_progress_start(L, &pl, fname);
+  oc_node *n = oc_generate_sea(&p, &st, &err);
+  oclua_progress_end(&pl);
+  return finish(L, fname, u, n, &err, &st);
+}
+
+static int l_river(lua_State *L) {
+  static const char *const known[] = {
+      "heightfield", "terrain", "geology", "seed",  "radius", "spacing", "beta",
+      "strength",    "cutoff",  "steps",   "power", "banks",  "depth",   NULL};
+  const char *fname = "outcrop.generate.river";
+  oclua_fields f;
+  common c;
+  oc_gen_river_params p;
+  oclua_checkargs(L, 1, fname, "{heightfield =, power =, banks =, ...}");
+  oclua_fields_open(&f, L, 1, fname, NULL, known, 0);
+  oc_gen_river_defaults(&p);
+  read_common(&f, &c, p.steps, p.strength);
+  p.power = oclua_field_optnumber(&f, "power", OCLUA_POSITIVE, 0);
+  p.banks = (int)oclua_field_optint(&f, "banks", 0, 64, p.banks);
+  p.depth = oclua_field_optnumber(&f, "depth", OCLUA_POSITIVE, 0);
+  p.heightfield = c.hf;
+  p.terrain = c.terrain;
+  p.no_terrain = c.no_terrain;
+  p.geology = c.geology;
+  p.seed = c.seed;
+  p.radius = c.radius;
+  p.spacing = c.spacing;
+  p.beta = c.beta;
+  p.strength = c.strength;
+  p.cutoff = c.cutoff;
+  p.steps = c.steps;
+  p.threshold = c.threshold;
+  oclua_node *u = oclua_newnode(L);
+  oclua_progress pl;
+  oc_gen_sea_stats st = {0, 0, 0};
+  oc_error err = {OC_OK, ""};
+  p.progress = oclua_progress_start(L, &pl, fname);
+  oc_node *n = oc_generate_river(&p, &st, &err);
+  oclua_progress_end(&pl);
+  return finish(L, fname, u, n, &err, &st);
+}
+
+const luaL_Reg oclua_gen_sea[] = {
+    {"sea", l_sea}, {"river", l_river}, {NULL, NULL}};

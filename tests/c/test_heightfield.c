@@ -261,7 +261,7 @@ START_TEST(png16_exact_lattice) {
   oc_heightfield *h1 = load_ok(p, NULL);
   ck_assert(same_samples(hf, h1));
   /* fixed scale and offset give the same file */
-  oc_hf_save_params sp = {16, 1, 0.25, 100, NULL, 0};
+  oc_hf_save_params sp = {16, 1, 0.25, 100, NULL, 0, NULL, 0};
   const char *q = oct_in_dir(dir, "fixed.png");
   save_ok(hf, q, &sp, used);
   ck_assert(same_file(p, q));
@@ -304,7 +304,7 @@ END_TEST
 
 START_TEST(tiff16_and_half) {
   oc_heightfield *hf = wavy(33, 21, 1, 10);
-  oc_hf_save_params sp = {16, 0, 0, 0, NULL, 0};
+  oc_hf_save_params sp = {16, 0, 0, 0, NULL, 0, NULL, 0};
   double used[2];
   save_ok(hf, oct_in_dir(dir, "h16.tif"), &sp, used);
   oc_heightfield *a = load_ok(oct_in_dir(dir, "h16.tif"), NULL);
@@ -473,7 +473,7 @@ START_TEST(metadata_and_overrides) {
   ck_assert(hi == (float)(65535 * 2 + used[1]));
   /* provenance-style pairs land in the file next to ours */
   const char *meta[] = {"outcrop:seed", "42", "outcrop:scale", "999"};
-  oc_hf_save_params sp = {0, 0, 0, 0, meta, 2};
+  oc_hf_save_params sp = {0, 0, 0, 0, meta, 2, NULL, 0};
   save_ok(hf, oct_in_dir(dir, "n.exr"), &sp, used);
   oc_error e = {0};
   oc_image *img = oc_oiio_read(oct_in_dir(dir, "n.exr"), &e);
@@ -549,17 +549,18 @@ START_TEST(file_errors) {
       oc_heightfield_save(hf, oct_in_dir(dir, "h.jpg"), NULL, NULL, &e),
       OC_EINVAL);
   ck_assert_ptr_nonnull(strstr(e.msg, ".png"));
-  oc_hf_save_params sp = {12, 0, 0, 0, NULL, 0};
+  oc_hf_save_params sp = {12, 0, 0, 0, NULL, 0, NULL, 0};
   ck_assert_int_eq(
       oc_heightfield_save(hf, oct_in_dir(dir, "h.png"), &sp, NULL, &e),
       OC_EINVAL);
   ck_assert_ptr_nonnull(strstr(e.msg, "'bits'"));
-  sp = (oc_hf_save_params){16, 1, 1, 0, NULL, 0}; /* 1e30 does not fit */
+  sp = (oc_hf_save_params){16,   1, 1,    0,
+                           NULL, 0, NULL, 0}; /* 1e30 does not fit */
   ck_assert_int_eq(
       oc_heightfield_save(hf, oct_in_dir(dir, "h.png"), &sp, NULL, &e),
       OC_EINVAL);
   ck_assert_ptr_nonnull(strstr(e.msg, "outside"));
-  sp = (oc_hf_save_params){0, 1, 1, 0, NULL, 0};
+  sp = (oc_hf_save_params){0, 1, 1, 0, NULL, 0, NULL, 0};
   ck_assert_int_eq(
       oc_heightfield_save(hf, oct_in_dir(dir, "h.exr"), &sp, NULL, &e),
       OC_EINVAL);

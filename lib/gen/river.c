@@ -1,0 +1,206 @@
+/*
+** river.c — river erosion (seed 000 section 6.1, figure 15): canyons
+** whose walls are undercut where the strata are soft.
+**
+** The stress is the stream power A^(1/2) s of the heightfield: samples
+** above `power` are the riverbed (sigma = 1), and a small max-convolution
+** with a tent of `banks` + 1 cells widens it to the banks, sigma falling
+** linearly to 0 (the paper's flooding). Bed columns carve straight down at
+** the surface; bank columns cast horizontal rays away from the river (up
+** the slope) at heights drawn below their surface, so they reach the
+** canyon wall at every level of it and carve most into soft layers.
+*/
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "gen/erode.h"
+
+/* Below this slope a column is riverbed floor: carve at z = h. */
+#define FLAT 0.05
+
+void oc_gen_river_defaults(oc_gen_river_params *p) {
+  memset(p, 0, sizeof *p);
+  p->banks = 3;
+  p->beta = 0.2;
+  p->strength = 2;
+  p->cutoff = 0.05;
+  p->steps = 2;
+}
+
+static int cmpf(const void *a, const void *b) {
+  float x = *(const float *)a, y = *(const float *)b;
+  return (x > y) - (x < y);
+}
+
+/* The q-quantile of the grid's samples (sorted copy). */
+static int quantile(const float *v, size_t n, double q, double *out,
+                    oc_error *err) {
+  float *c = malloc(n * sizeof *c);
+  if (!c) return oc_seterr(err, OC_ENOMEM, "out of memory");
+  memcpy(c, v, n * sizeof *c);
+  qsort(c, n, sizeof *c, cmpf);
+  *out = c[(size_t)(q * (double)(n - 1))];
+  free(c);
+  return OC_OK;
+}
+
+/* sigma: 1 on the bed, 1 - d / (banks + 1) at d cells from it. */
+static void widen(const float *pw, float *sig, int nx, int ny, double thr,
+                  int banks) {
+  int r = banks + 1;
+#pragma omp parallel for schedule(static)
+  for (int j = 0; j < ny; j++)
+    for (int i = 0; i < nx; i++) {
+      double best = 0;
+      for (int dj = -banks; dj <= banks; dj++) {
+        int jj = j + dj;
+        if (jj < 0 || jj >= ny) continue;
+        for (int di = -banks; di <= banks; di++) {
+          int ii = i + di;
+          if (ii < 0 || ii >= nx) continue;
+          double w = 1 - sqrt((double)(di * di + dj * dj)) / r;
+          if (w > best && pw[(size_t)jj * nx + ii] >= thr) best = w;
+        }
+      }
+      sig[(size_t)j * nx + i] = (float)best;
+    }
+}
+
+typedef struct bed {
+  const oc_heightfield *sig;
+  double x0, y0, cell;
+  int nx, ny;
+} bed;
+
+/* sigma at the nearest sample. */
+static double sigma_at(const bed *B, double x, double y) {
+  int i = (int)lround((x - B->x0) / B->cell);
+  int j = (int)lround((y - B->y0) / B->cell);
+  i = i < 0 ? 0 : i >= B->nx ? B->nx - 1 : i;
+  j = j < 0 ? 0 : j >= B->ny ? B->ny - 1 : j;
+  return oc_heightfield_samples(B->sig)[(size_t)j * B->nx + i];
+}
+
+static int keep_column(void *ud, double x, double y) {
+  return sigma_at(ud, x, y) > 0;
+}
+
+static int check(const oc_gen_river_params *p, oc_gen_river_params *q,
+                 oc_error *err) {
+  *q = *p;
+  if (!p->heightfield)
+    return oc_seterr(err, OC_EINVAL, "'heightfield' is required");
+  double cell = oc_heightfield_cell(p->heightfield);
+  if (!(p->power >= 0 && isfinite(p->power)))
+    return oc_seterr(err, OC_EINVAL, "'power' must be > 0 (got %g)", p->power);
+  if (p->banks < 0 || p->banks > 64)
+    return oc_seterr(err, OC_EINVAL, "'banks' must be in 0..64 (got %d)",
+                     p->banks);
+  if (q->radius == 0) q->radius = 1.5 * cell;
+  if (q->spacing == 0) q->spacing = q->radius / 2;
+  if (q->depth == 0) q->depth = 3 * q->radius;
+  if (oc_erode_check(q->radius, q->spacing, q->beta, q->strength, q->cutoff,
+                     q->steps, q->threshold, err))
+    return err ? err->code : OC_EINVAL;
+  if (!(q->depth > 0 && isfinite(q->depth)))
+    return oc_seterr(err, OC_EINVAL, "'depth' must be > 0 (got %g)", q->depth);
+  return OC_OK;
+}
+
+oc_node *oc_generate_river(const oc_gen_river_params *pin, oc_gen_sea_stats *st,
+                           oc_error *err) {
+  oc_gen_river_params p;
+  if (check(pin, &p, err)) return NULL;
+  oc_heightfield *hf = p.heightfield, *pw = NULL, *sig = NULL;
+  int nx = oc_heightfield_nx(hf), ny = oc_heightfield_ny(hf);
+  double x0, y0, cell = oc_heightfield_cell(hf), *xy = NULL;
+  oc_heightfield_origin(hf, &x0, &y0);
+  oc_erode_cand *cand = NULL;
+  unsigned char *mask = NULL;
+  oc_node *base = NULL, *out = NULL;
+  size_t ncol = 0, nc = 0, samples = 0, prims = 0;
+  double thr = p.power;
+
+  if (!(base = oc_erode_base(hf, p.terrain, err))) return NULL;
+  oc_hf_flow_params fp = {0, 0, p.progress};
+  if (!(pw = oc_hf_stream_power(hf, &fp, err))) goto done;
+  if (thr == 0 &&
+      quantile(oc_heightfield_samples(pw), (size_t)nx * ny, 0.95, &thr, err))
+    goto done;
+  if (!(thr > 0)) thr = 1e-30; /* a flat grid: anything that flows */
+  if (!(sig = oc_heightfield_new(nx, ny, cell, x0, y0, NULL, err))) goto done;
+  widen(oc_heightfield_samples(pw), oc_heightfield_samples_mut(sig), nx, ny,
+        thr, p.banks);
+  bed B = {sig, x0, y0, cell, nx, ny};
+  size_t ns = (size_t)nx * ny;
+  if (!(mask = malloc(ns))) {
+    oc_seterr(err, OC_ENOMEM, "out of memory for the riverbed mask");
+    goto done;
+  }
+  for (size_t k = 0; k < ns; k++)
+    mask[k] = oc_heightfield_samples(sig)[k] > 0;
+  xy = oc_erode_columns(hf, mask, p.spacing, p.seed, keep_column, &B, &ncol,
+                        err);
+  if (!xy) goto done;
+  cand = malloc((ncol ? ncol : 1) * sizeof *cand);
+  if (!cand) {
+    oc_seterr(err, OC_ENOMEM, "out of memory for %zu columns", ncol);
+    goto done;
+  }
+  for (size_t i = 0; i < ncol; i++) {
+    oc_erode_cand *c = &cand[nc++];
+    double g[2], x = xy[2 * i], y = xy[2 * i + 1];
+    double h = oc_heightfield_height(hf, x, y, g), s = hypot(g[0], g[1]);
+    c->x = x;
+    c->y = y;
+    c->stress = sigma_at(&B, x, y);
+    c->fwd = p.steps * p.radius + cell;
+    if (s < FLAT) { /* the bed floor */
+      c->zlo = c->zhi = h;
+      c->ux = c->uy = 0;
+      c->back = 0;
+      continue;
+    }
+    c->ux = g[0] / s;
+    c->uy = g[1] / s;
+    c->zlo = h - p.depth;
+    c->zhi = h;
+    double back = p.depth / s;
+    if (back > 4 * p.depth) back = 4 * p.depth;
+    c->back = back + p.radius + cell;
+  }
+
+  oc_erode_params ep;
+  memset(&ep, 0, sizeof ep);
+  ep.base = base;
+  ep.omit_base = p.no_terrain;
+  ep.geology = p.geology;
+  ep.rho = 0.5;
+  ep.threshold = p.threshold > 0 ? p.threshold : OC_DEFAULT_THRESHOLD;
+  ep.radius = p.radius;
+  ep.strength = p.strength;
+  ep.beta = p.beta;
+  ep.cutoff = p.cutoff;
+  ep.step = 0.5 * (cell < p.radius ? cell : p.radius);
+  ep.steps = p.steps;
+  ep.seed = p.seed;
+  ep.progress = p.progress;
+  ep.pbase = 0.3;
+  ep.pspan = 0.7;
+  out = oc_erode_run(&ep, cand, nc, &samples, &prims, err);
+  if (out && st) {
+    st->columns = nc;
+    st->samples = samples;
+    st->primitives = prims;
+  }
+done:
+  oc_node_release(base);
+  oc_heightfield_release(pw);
+  oc_heightfield_release(sig);
+  free(xy);
+  free(cand);
+  free(mask);
+  return out;
+}
