@@ -62,21 +62,6 @@ static double mask_fn(void *ud, double x, double y) {
   return v; /* the library reports a value out of [0, 1] */
 }
 
-static oc_node *default_terrain(lua_State *L, oc_heightfield *hf) {
-  oc_error err = {OC_OK, ""};
-  oc_terrain_params tp = {0};
-  tp.falloff = 4 * oc_heightfield_cell(hf);
-  tp.transition = 1;
-  oc_elevation src;
-  oc_node *t = NULL;
-  if (oc_heightfield_elevation(hf, &src, &err) == OC_OK) {
-    t = oc_terrain(&src, &tp, &err);
-    src.release(src.ud);
-  }
-  if (!t) oclua_liberror(L, FNAME, &err);
-  return t;
-}
-
 static oc_node *optnode(oclua_fields *f, const char *name, int *off) {
   lua_State *L = f->L;
   oc_node *n = NULL;
@@ -170,8 +155,9 @@ static int l_hoodoos(lua_State *L) {
   oclua_node *u = oclua_newnode(L);
   oclua_progress pl;
   oc_gen_hoodoos_stats st = {0};
-  oc_node *terrain =
-      !p.terrain && !no_terrain ? default_terrain(L, p.heightfield) : NULL;
+  oc_node *terrain = !p.terrain && !no_terrain
+                         ? oclua_gen_default_terrain(L, p.heightfield, FNAME)
+                         : NULL;
   if (terrain) p.terrain = terrain;
   p.progress = oclua_progress_start(L, &pl, FNAME);
   oc_node *n = oc_generate_hoodoos(&p, &st, &err);

@@ -60,21 +60,6 @@ static oc_vec3 *read_sinks(oclua_fields *f, size_t *n) {
   return v;
 }
 
-static oc_node *default_terrain(lua_State *L, oc_heightfield *hf) {
-  oc_error err = {OC_OK, ""};
-  oc_terrain_params tp = {0};
-  tp.falloff = 4 * oc_heightfield_cell(hf);
-  tp.transition = 1;
-  oc_elevation src;
-  oc_node *t = NULL;
-  if (oc_heightfield_elevation(hf, &src, &err) == OC_OK) {
-    t = oc_terrain(&src, &tp, &err);
-    src.release(src.ud);
-  }
-  if (!t) oclua_liberror(L, FNAME, &err);
-  return t;
-}
-
 static int l_karst(lua_State *L) {
   static const char *const known[] = {
       "heightfield",    "terrain", "geology", "sinks", "seed",
@@ -127,7 +112,8 @@ static int l_karst(lua_State *L) {
   oclua_node *u = oclua_newnode(L);
   oclua_progress pl;
   oc_gen_karst_stats st = {0};
-  oc_node *terrain = own_terrain ? default_terrain(L, p.heightfield) : NULL;
+  oc_node *terrain =
+      own_terrain ? oclua_gen_default_terrain(L, p.heightfield, FNAME) : NULL;
   if (terrain) p.terrain = terrain;
   p.progress = oclua_progress_start(L, &pl, FNAME);
   oc_node *n = oc_generate_karst(&p, &st, &err);
