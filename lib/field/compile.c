@@ -515,6 +515,30 @@ static uint32_t make_group(comp *c, oc_kind kind, const leaf *lv, size_t nl) {
     lo = fmax(lo, 0);
     hi = fmax(hi, 0);
   }
+  /* A bounded child spanning most of the group (a terrain under scattered
+  ** features) would sit in every BVH path and every query would descend
+  ** to its leaf: evaluate it always, as the unbounded ones. */
+  if (nent > 2 * OC_BVH_LEAF) {
+    size_t keep = 0;
+    for (size_t i = 0; i < nent; i++) {
+      int wide = 0;
+      for (int a = 0; a < 2; a++) {
+        double ga = a ? all.hi.y - all.lo.y : all.hi.x - all.lo.x;
+        double ca = a ? box[i].hi.y - box[i].lo.y : box[i].hi.x - box[i].lo.x;
+        wide += ca > 0.5 * ga;
+      }
+      if (wide == 2 && ent[i].ref != OC_NONE) {
+        unb[nunb++] = ent[i].ref;
+        lipunb += lip[i];
+        continue;
+      }
+      box[keep] = box[i];
+      ent[keep] = ent[i];
+      lip[keep] = lip[i];
+      keep++;
+    }
+    nent = keep;
+  }
   /* BVH over bounded entries (also used for the Lipschitz bound) */
   size_t nnodes = 0;
   if (nent) {
