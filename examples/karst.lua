@@ -6,8 +6,9 @@
 --
 --   outcrop run examples/karst.lua [--set cell=2] [--seed N] [--out DIR]
 --
--- Writes karst.ply (the cut scene's mesh), karst.png (a render of it) and
--- karst_xz.png (a slice through the plateau: the tunnels in cross-section).
+-- Writes karst.ply (the cut scene's mesh), karst.png (a render of it),
+-- karst_xz.png (a slice through the plateau: the tunnels in cross-section)
+-- and karst_network.png (the cavities alone, drawn as a solid).
 
 local oc = require "outcrop"
 
@@ -23,13 +24,20 @@ local hf = oc.heightfield.from(function(x, y)
   return 10 + 70 * s + rough:height(x, y) * (0.3 + 0.7 * s)
 end, {size = {n, n}, cell = h})
 
--- Strata: beds of soft limestone (dark) between harder ones.
-local geology = oc.geology.strata{wavelength = 22, octaves = 3, amplitude = 2,
-                                  offset = -0.5, seed = 4}
+-- The rock: hard strata, two soft beds (z = 30 and 50) and two soft
+-- vertical fractures crossing under the plateau; water sinks down the
+-- fractures from the pits of the top and spreads along the soft beds.
+local G = oc.geology
+local geology = G.strata{wavelength = 30, octaves = 2, amplitude = 0.5,
+                         offset = 0.45, seed = 4}
+  + G.layer{origin = {0, 0, 50}, normal = {0, 0, 1}, radius = 2, resistance = -0.6}
+  + G.layer{origin = {0, 0, 30}, normal = {0, 0, 1}, radius = 2, resistance = -0.6}
+  + G.layer{origin = {c, c, 0}, normal = {1, 0.4, 0}, radius = 2, resistance = -0.6}
+  + G.layer{origin = {c, c, 0}, normal = {-0.3, 1, 0}, radius = 2, resistance = -0.6}
 local ground = oc.terrain(hf, {falloff = 8, transition = 1})
-local karst, info = oc.generate.karst{heightfield = hf, terrain = ground,
-                                      geology = geology, radius = 3.5,
-                                      rho0 = 0.7, max_primitives = 12000}
+local options = {heightfield = hf, terrain = ground, geology = geology,
+                 radius = 2.5, rho0 = 0.5, max_primitives = 20000}
+local karst, info = oc.generate.karst(options)
 print(string.format("karst: %d sinks, %d cavities in %.2f s", info.sinks,
                     info.primitives, info.seconds))
 
@@ -44,4 +52,10 @@ oc.render(cut, {camera = {eye = {150, -120, 150}, target = {200, 200, 35}, fov =
                 size = {800, 450}, color = geology}):write("karst.png")
 oc.slice(karst, {plane = "xz", at = c, box = {0, 0, 400, 100},
                  size = {800, 200}}):write("karst_xz.png")
-print("karst: wrote karst.png, karst_xz.png")
+-- The network alone, as a solid: the cavities negated.
+options.terrain = false
+local cavities = oc.generate.karst(options)
+oc.render(-cavities, {camera = {eye = {10, -60, 150}, target = {200, 200, 35},
+                                fov = 30},
+                      size = {800, 450}}):write("karst_network.png")
+print("karst: wrote karst.png, karst_xz.png, karst_network.png")
