@@ -46,6 +46,11 @@ const oc_program *oclua_program_at(lua_State *L, int idx, const char *fname,
 /* Each adds its functions to the module table at the stack top. */
 void oclua_open_field(lua_State *L);
 void oclua_open_prim(lua_State *L);
+
+/* The curve of the table f (points, radius, bezier) with its energy read
+** from field `energy` (default 1 when optional), pushed as a new node
+** userdata; returns 1. Shared by outcrop.curve and outcrop.geology.curve. */
+int oclua_make_curve(oclua_fields *f, const char *energy, int optional);
 void oclua_open_ops(lua_State *L);
 /* Operator metamethods (__add, __sub, __unm, __bor, __band). */
 extern const luaL_Reg oclua_node_operators[];

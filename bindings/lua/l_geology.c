@@ -24,9 +24,6 @@
 #include "l_geology.h"
 #include "l_image.h"
 
-#define DEFAULT_SLICE_SIZE 256
-#define MAX_SLICE_SIZE 16384
-
 static void begin(oclua_fields *f, lua_State *L, const char *fname,
                   const char *const *known) {
   oclua_checkargs(L, 1, fname, "a table of named fields");
@@ -121,35 +118,8 @@ static int l_curve(lua_State *L) {
   static const char *const known[] = {"points", "radius", "resistance",
                                       "bezier", NULL};
   oclua_fields f;
-  oc_error err = {OC_OK, ""};
   begin(&f, L, "outcrop.geology.curve", known);
-  if (oclua_field_push(&f, "points") == LUA_TNIL)
-    oclua_field_missing(&f, "points", "an array of {x, y, z} points");
-  if (!lua_istable(L, -1))
-    oclua_field_error(&f, "points", -1, "must be an array of {x, y, z} points");
-  lua_Integer n = (lua_Integer)lua_rawlen(L, -1);
-  if (n < 2)
-    oclua_error(L, f.fname, "'points' must hold at least 2 points (got %I)",
-                (LUAI_UACINT)n);
-  if ((size_t)n > ((size_t)-1) / sizeof(oc_vec3) / 2)
-    oclua_error(L, f.fname, "'points' is too long");
-  oc_vec3 *pts = lua_newuserdatauv(L, (size_t)n * sizeof *pts, 0);
-  for (lua_Integer i = 1; i <= n; i++) {
-    lua_geti(L, -2, i);
-    pts[i - 1] = oclua_tovec(L, -1, f.fname, "points", i);
-    lua_pop(L, 1);
-  }
-  double r = oclua_field_number(&f, "radius", OCLUA_POSITIVE);
-  double e = oclua_field_number(&f, "resistance", OCLUA_FINITE);
-  int bezier = oclua_field_optbool(&f, "bezier", 0);
-  if (bezier && (n - 1) % 3 != 0)
-    oclua_error(L, f.fname,
-                "'points' of a bezier curve must number 3k+1 (4, 7, 10, ...; "
-                "got %I)",
-                (LUAI_UACINT)n);
-  oclua_node *u = oclua_newnode(L);
-  return oclua_setnode(L, u, oc_curve(pts, (size_t)n, bezier, r, e, &err), &err,
-                       f.fname);
+  return oclua_make_curve(&f, "resistance", 0);
 }
 
 /* ---- operators ------------------------------------------------------- */
@@ -298,97 +268,10 @@ static const double default_stops[] = {0.00, 0.22, 0.13, 0.08, 0.35, 0.45,
                                        0.30, 0.18, 0.65, 0.72, 0.58, 0.40,
                                        1.00, 0.95, 0.91, 0.82};
 
-static const double *read_palette(const oclua_fields *f, int *nstops) {
-  if (oclua_field_push(f, "palette") == LUA_TNIL) {
-    lua_pop(f->L, 1);
-    *nstops = 4;
-    return default_stops;
-  }
-  return oclua_read_palette(f->L, -1, f->fname, "palette", nstops);
-}
-
-/* Linear between stops, clamped at the ends; NaN reads as the first. */
-static void palette(const double *s, int n, double v, float rgb[3]) {
-  int k = 0;
-  if (!(v > s[0])) {
-    k = 0;
-  } else if (v >= s[4 * (n - 1)]) {
-    k = n - 1;
-  } else {
-    while (k + 1 < n && s[4 * (k + 1)] <= v)
-      k++;
-    double a = s[4 * k], b = s[4 * (k + 1)];
-    double t = b > a ? (v - a) / (b - a) : 0;
-    for (int j = 0; j < 3; j++)
-      rgb[j] = (float)(s[4 * k + 1 + j] +
-                       t * (s[4 * (k + 1) + 1 + j] - s[4 * k + 1 + j]));
-    return;
-  }
-  for (int j = 0; j < 3; j++)
-    rgb[j] = (float)s[4 * k + 1 + j];
-}
-
+/* outcrop.slice with a resistance palette by default. */
 static int l_slice(lua_State *L) {
-  static const char *const known[] = {"plane", "at",      "box",
-                                      "size",  "palette", NULL};
-  static const char *const planes[] = {"xy", "xz", "yz", NULL};
-  const char *fname = "outcrop.geology.slice";
-  oclua_fields f;
-  oc_error err = {OC_OK, ""};
-  oc_slice_params sp;
-  double box[4], size[2] = {DEFAULT_SLICE_SIZE, DEFAULT_SLICE_SIZE};
-  int nstops;
-  node_and_options(L, &f, fname,
-                   "{plane =, at =, box = {u0, v0, u1, v1}, size =, palette =}",
-                   known, 1);
-  int plane = oclua_field_optoption(&f, "plane", planes, 1);
-  sp.plane = plane == 0 ? OC_PLANE_XY : plane == 1 ? OC_PLANE_XZ : OC_PLANE_YZ;
-  sp.at = oclua_field_optnumber(&f, "at", OCLUA_FINITE, 0.0);
-  oclua_field_numbers(&f, "size", 2, size, "must be {width, height}");
-  for (int k = 0; k < 2; k++)
-    if (size[k] != floor(size[k]) || size[k] < 1 || size[k] > MAX_SLICE_SIZE)
-      oclua_error(L, fname,
-                  "'size' must be {width, height} with integers in 1..%d "
-                  "(got %f)",
-                  MAX_SLICE_SIZE, (LUAI_UACNUMBER)size[k]);
-  sp.width = (int)size[0];
-  sp.height = (int)size[1];
-  int given =
-      oclua_field_numbers(&f, "box", 4, box, "must be {u0, v0, u1, v1}");
-  const double *stops = read_palette(&f, &nstops);
-  const oc_program *prog = oclua_program(L, 1, fname);
-  if (!given) {
-    oc_aabb b = oc_program_bounds(prog);
-    double lo[3] = {b.lo.x, b.lo.y, b.lo.z}, hi[3] = {b.hi.x, b.hi.y, b.hi.z};
-    int u = sp.plane == OC_PLANE_YZ ? 1 : 0;
-    int v = sp.plane == OC_PLANE_XY ? 1 : 2;
-    box[0] = lo[u], box[1] = lo[v], box[2] = hi[u], box[3] = hi[v];
-    if (!(isfinite(box[0]) && isfinite(box[1]) && isfinite(box[2]) &&
-          isfinite(box[3])))
-      oclua_error(L, fname,
-                  "the tree's bounds are infinite: give 'box' = "
-                  "{u0, v0, u1, v1}");
-  }
-  if (!(box[0] < box[2] && box[1] < box[3]))
-    oclua_error(L, fname,
-                "'box' = {u0, v0, u1, v1} needs u0 < u1 and v0 < v1 (got "
-                "{%f, %f, %f, %f})",
-                box[0], box[1], box[2], box[3]);
-  sp.u0 = box[0], sp.v0 = box[1], sp.u1 = box[2], sp.v1 = box[3];
-  oclua_image *u = oclua_newimage(L);
-  u->img = oc_slice(prog, &sp, &err);
-  if (u->img == NULL) oclua_liberror(L, fname, &err);
-  /* the slice's own colours give way to the palette; the "field" channel
-  ** keeps the raw resistance */
-  float *px = oc_image_data(u->img);
-  int nc = oc_image_channels(u->img);
-  size_t npx = (size_t)sp.width * (size_t)sp.height;
-  for (size_t i = 0; i < npx; i++) {
-    float *q = px + i * (size_t)nc;
-    palette(stops, nstops, q[4], q);
-    q[3] = 1;
-  }
-  return 1;
+  return oclua_slice(L, "outcrop.geology.slice", default_stops,
+                     (int)(sizeof default_stops / sizeof default_stops[0] / 4));
 }
 
 static const luaL_Reg geology_funcs[] = {

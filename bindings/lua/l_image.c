@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "l_field.h"
+#include "core/palette.h"
 #include "l_image.h"
 #include "l_provenance.h"
 
@@ -186,15 +187,17 @@ static int image_tostring(lua_State *L) {
 
 /* ---- outcrop.slice --------------------------------------------------- */
 
-static int l_slice(lua_State *L) {
-  static const char *const known[] = {"plane", "at", "box", "size", NULL};
+int oclua_slice(lua_State *L, const char *fname, const double *stops,
+                int nstops) {
+  static const char *const known[] = {"plane", "at",      "box",
+                                      "size",  "palette", NULL};
   static const char *const planes[] = {"xy", "xz", "yz", NULL};
-  const char *fname = "outcrop.slice";
   oclua_fields f;
   oc_error err = {OC_OK, ""};
   oc_slice_params sp;
   double box[4], size[2] = {DEFAULT_SLICE_SIZE, DEFAULT_SLICE_SIZE};
-  oclua_checkargs(L, 2, fname, "(node, {plane =, at =, box =, size =})");
+  oclua_checkargs(L, 2, fname,
+                  "(node, {plane =, at =, box =, size =, palette =})");
   oclua_checknode(L, 1, fname, "argument #1");
   if (lua_isnoneornil(L, 2)) { /* no options: an empty table at index 2 */
     lua_settop(L, 1);
@@ -220,6 +223,8 @@ static int l_slice(lua_State *L) {
   sp.height = (int)size[1];
   int given =
       oclua_field_numbers(&f, "box", 4, box, "must be {u0, v0, u1, v1}");
+  if (oclua_field_push(&f, "palette") != LUA_TNIL)
+    stops = oclua_read_palette(L, -1, fname, "palette", &nstops);
   const oc_program *prog = oclua_program(L, 1, fname);
   if (!given) {
     oc_aabb b = oc_program_bounds(prog);
@@ -243,7 +248,25 @@ static int l_slice(lua_State *L) {
   oclua_image *u = oclua_newimage(L);
   u->img = oc_slice(prog, &sp, &err);
   if (u->img == NULL) oclua_liberror(L, fname, &err);
+  if (stops) {
+    /* the colours follow the palette; the "field" channel keeps the raw
+    ** value */
+    float *px = oc_image_data(u->img);
+    int nc = oc_image_channels(u->img);
+    size_t npx = (size_t)sp.width * (size_t)sp.height;
+    for (size_t i = 0; i < npx; i++) {
+      float *q = px + i * (size_t)nc;
+      double rgb[3];
+      oc_palette_eval(stops, nstops, q[4], rgb);
+      q[0] = (float)rgb[0], q[1] = (float)rgb[1], q[2] = (float)rgb[2];
+      q[3] = 1;
+    }
+  }
   return 1;
+}
+
+static int l_slice(lua_State *L) {
+  return oclua_slice(L, "outcrop.slice", NULL, 0);
 }
 
 static const luaL_Reg image_methods[] = {{"write", image_write},

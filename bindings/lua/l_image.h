@@ -19,6 +19,13 @@ oclua_image *oclua_newimage(lua_State *L);
 /* Raises unless idx is an open image. */
 oc_image *oclua_checkimage(lua_State *L, int idx, const char *fname);
 
+/* outcrop.slice(node, {plane =, at =, box =, size =, palette =}) under
+** the name fname, pushing the image: with a palette (given, or `stops`
+** when the option is absent and stops is not NULL) the colour channels
+** are the field value through it. */
+int oclua_slice(lua_State *L, const char *fname, const double *stops,
+                int nstops);
+
 /* Adds outcrop.slice to the module table at the stack top and sets up
 ** the image metatable. */
 void oclua_open_image(lua_State *L);

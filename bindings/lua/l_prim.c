@@ -86,42 +86,46 @@ static int l_segment(lua_State *L) {
   return oclua_setnode(L, u, oc_segment(a, b, r, e, &err), &err, f.fname);
 }
 
-static int l_curve(lua_State *L) {
-  static const char *const known[] = {"points", "radius", "energy", "bezier",
-                                      NULL};
-  oclua_fields f;
+int oclua_make_curve(oclua_fields *f, const char *energy, int optional) {
+  lua_State *L = f->L;
   oc_error err = {OC_OK, ""};
-  lua_Integer n;
-  oc_vec3 *pts;
-  begin(&f, L, "outcrop.curve", known);
-  if (oclua_field_push(&f, "points") == LUA_TNIL)
-    oclua_field_missing(&f, "points", "an array of {x, y, z} points");
+  if (oclua_field_push(f, "points") == LUA_TNIL)
+    oclua_field_missing(f, "points", "an array of {x, y, z} points");
   if (!lua_istable(L, -1))
-    oclua_field_error(&f, "points", -1, "must be an array of {x, y, z} points");
-  n = (lua_Integer)lua_rawlen(L, -1);
+    oclua_field_error(f, "points", -1, "must be an array of {x, y, z} points");
+  lua_Integer n = (lua_Integer)lua_rawlen(L, -1);
   if (n < 2)
-    oclua_error(L, f.fname, "'points' must hold at least 2 points (got %I)",
+    oclua_error(L, f->fname, "'points' must hold at least 2 points (got %I)",
                 (LUAI_UACINT)n);
-  if ((size_t)n > ((size_t)-1) / sizeof *pts / 2)
-    oclua_error(L, f.fname, "'points' is too long");
+  if ((size_t)n > ((size_t)-1) / sizeof(oc_vec3) / 2)
+    oclua_error(L, f->fname, "'points' is too long");
   /* Scratch space owned by Lua: freed by the collector even on error. */
-  pts = lua_newuserdatauv(L, (size_t)n * sizeof *pts, 0);
+  oc_vec3 *pts = lua_newuserdatauv(L, (size_t)n * sizeof *pts, 0);
   for (lua_Integer i = 1; i <= n; i++) {
     lua_geti(L, -2, i);
-    pts[i - 1] = oclua_tovec(L, -1, f.fname, "points", i);
+    pts[i - 1] = oclua_tovec(L, -1, f->fname, "points", i);
     lua_pop(L, 1);
   }
-  double r = oclua_field_number(&f, "radius", OCLUA_POSITIVE);
-  double e = oclua_field_optnumber(&f, "energy", OCLUA_FINITE, 1.0);
-  int bezier = oclua_field_optbool(&f, "bezier", 0);
+  double r = oclua_field_number(f, "radius", OCLUA_POSITIVE);
+  double e = optional ? oclua_field_optnumber(f, energy, OCLUA_FINITE, 1.0)
+                      : oclua_field_number(f, energy, OCLUA_FINITE);
+  int bezier = oclua_field_optbool(f, "bezier", 0);
   if (bezier && (n - 1) % 3 != 0)
-    oclua_error(L, f.fname,
+    oclua_error(L, f->fname,
                 "'points' of a bezier curve must number 3k+1 "
                 "(4, 7, 10, ...; got %I)",
                 (LUAI_UACINT)n);
   oclua_node *u = oclua_newnode(L);
   return oclua_setnode(L, u, oc_curve(pts, (size_t)n, bezier, r, e, &err), &err,
-                       f.fname);
+                       f->fname);
+}
+
+static int l_curve(lua_State *L) {
+  static const char *const known[] = {"points", "radius", "energy", "bezier",
+                                      NULL};
+  oclua_fields f;
+  begin(&f, L, "outcrop.curve", known);
+  return oclua_make_curve(&f, "energy", 1);
 }
 
 static int l_cone(lua_State *L) {

@@ -8,6 +8,7 @@
 #include <math.h>
 
 #include "core/falloff.h"
+#include "core/spanset.h"
 #include "core/noise.h"
 #include "core/vec.h"
 #include "geology/geology.h"
@@ -29,57 +30,15 @@ typedef struct spans {
                ** governing its column alone where nothing else is met */
 } spans;
 
-/* Keeps spans sorted and disjoint; past the capacity, merges the two
-** neighbours with the smallest gap (still a cover, just looser). */
-static void span_add(spans *S, double lo, double hi);
-static void span_add_v(void *S, double lo, double hi) {
-  span_add(S, lo, hi);
-}
-
 static void span_add(spans *S, double lo, double hi) {
   if (S->all || !(lo <= hi)) return;
-  if (isinf(lo) && isinf(hi)) {
+  if (isinf(lo) && isinf(hi))
     S->all = 1;
-    return;
-  }
-  int i = 0;
-  while (i < S->n && S->s[i].hi < lo)
-    i++;
-  /* merge every span overlapping [lo, hi] */
-  int j = i;
-  while (j < S->n && S->s[j].lo <= hi) {
-    lo = fmin(lo, S->s[j].lo);
-    hi = fmax(hi, S->s[j].hi);
-    j++;
-  }
-  int removed = j - i;
-  if (removed == 0) {
-    if (S->n == SPAN_CAP) {
-      /* merge the closest pair to make room */
-      int best = 0;
-      double gap = INFINITY;
-      for (int k = 0; k + 1 < S->n; k++)
-        if (S->s[k + 1].lo - S->s[k].hi < gap) {
-          gap = S->s[k + 1].lo - S->s[k].hi;
-          best = k;
-        }
-      S->s[best].hi = S->s[best + 1].hi;
-      for (int k = best + 1; k + 1 < S->n; k++)
-        S->s[k] = S->s[k + 1];
-      S->n--;
-      span_add(S, lo, hi);
-      return;
-    }
-    for (int k = S->n; k > i; k--)
-      S->s[k] = S->s[k - 1];
-    S->n++;
-  } else if (removed > 1) {
-    for (int k = i + 1; k + removed - 1 < S->n; k++)
-      S->s[k] = S->s[k + removed - 1];
-    S->n -= removed - 1;
-  }
-  S->s[i].lo = lo;
-  S->s[i].hi = hi;
+  else
+    oc_spanset_add(S->s, &S->n, SPAN_CAP, lo, hi);
+}
+static void span_add_v(void *S, double lo, double hi) {
+  span_add(S, lo, hi);
 }
 
 typedef struct foot {

@@ -9,6 +9,7 @@
 #include <math.h>
 
 #include "core/falloff.h"
+#include "core/spanset.h"
 #include "core/vec.h"
 #include "field/prim.h"
 #include "field/program.h"
@@ -304,44 +305,7 @@ typedef struct ivset {
 static void iv_add(ivset *S, double lo, double hi) {
   if (!(lo <= hi)) return;
   double pad = REL * 1e-3 * (fabs(lo) + fabs(hi) + 1);
-  lo -= pad;
-  hi += pad;
-  int i = 0;
-  while (i < S->n && S->s[i].hi < lo)
-    i++;
-  int j = i;
-  while (j < S->n && S->s[j].lo <= hi) {
-    lo = fmin(lo, S->s[j].lo);
-    hi = fmax(hi, S->s[j].hi);
-    j++;
-  }
-  int removed = j - i;
-  if (removed == 0) {
-    if (S->n == IV_CAP) {
-      int best = 0;
-      double gap = INFINITY;
-      for (int k = 0; k + 1 < S->n; k++)
-        if (S->s[k + 1].lo - S->s[k].hi < gap) {
-          gap = S->s[k + 1].lo - S->s[k].hi;
-          best = k;
-        }
-      S->s[best].hi = S->s[best + 1].hi;
-      for (int k = best + 1; k + 1 < S->n; k++)
-        S->s[k] = S->s[k + 1];
-      S->n--;
-      iv_add(S, lo, hi);
-      return;
-    }
-    for (int k = S->n; k > i; k--)
-      S->s[k] = S->s[k - 1];
-    S->n++;
-  } else if (removed > 1) {
-    for (int k = i + 1; k + removed - 1 < S->n; k++)
-      S->s[k] = S->s[k + removed - 1];
-    S->n -= removed - 1;
-  }
-  S->s[i].lo = lo;
-  S->s[i].hi = hi;
+  oc_spanset_add(S->s, &S->n, IV_CAP, lo - pad, hi + pad);
 }
 
 static void op_sup(const oc_program *P, uint32_t i, const oc_ray *r, double t0,

@@ -26,6 +26,7 @@
 #include <unistd.h>
 
 #include "core/rng.h"
+#include "meshcmp.h"
 #include "outcrop.h"
 
 static oc_node *must(oc_node *n, const oc_error *err) {
@@ -125,36 +126,6 @@ static oc_mesh *mesh(const oc_program *p, oc_aabb box, double cell, int full,
   return m;
 }
 
-/* Triangles as sorted position triples, to compare meshes up to vertex
-** order. */
-typedef struct tri9 {
-  float v[9];
-} tri9;
-static int cmp3(const float *a, const float *b) {
-  for (int i = 0; i < 3; i++)
-    if (a[i] != b[i]) return a[i] < b[i] ? -1 : 1;
-  return 0;
-}
-static int cmp9(const void *x, const void *y) {
-  return memcmp(x, y, sizeof(tri9)) < 0 ? -1 : memcmp(x, y, sizeof(tri9)) > 0;
-}
-static tri9 *canon(const oc_mesh *m, size_t *n) {
-  *n = oc_mesh_triangle_count(m);
-  const float *P = oc_mesh_positions(m);
-  const uint32_t *I = oc_mesh_indices(m);
-  tri9 *t = malloc((*n ? *n : 1) * sizeof *t);
-  for (size_t i = 0; i < *n; i++) {
-    /* rotate so the smallest vertex comes first (keeps orientation) */
-    int s = 0;
-    for (int k = 1; k < 3; k++)
-      if (cmp3(P + 3 * I[3 * i + k], P + 3 * I[3 * i + s]) < 0) s = k;
-    for (int k = 0; k < 3; k++)
-      memcpy(t[i].v + 3 * k, P + 3 * I[3 * i + (s + k) % 3], 3 * sizeof(float));
-  }
-  qsort(t, *n, sizeof *t, cmp9);
-  return t;
-}
-
 static void terrain_speedup(void) {
   oc_error err;
   double w = 400;
@@ -178,9 +149,7 @@ static void terrain_speedup(void) {
   oc_mesh_stats stb, stf;
   oc_mesh_get_stats(mb, &stb);
   oc_mesh_get_stats(mf, &stf);
-  size_t nb, nf;
-  tri9 *tb = canon(mb, &nb), *tf = canon(mf, &nf);
-  int same = nb == nf && !memcmp(tb, tf, nb * sizeof *tb);
+  int same = same_mesh(mb, mf);
   printf("# terrain %g x %g m (implicitized fBm ground), cell 1 m, box z "
          "-64..64 (%g M cells): %zu triangles; root finding everywhere: "
          "full grid %.2f s, bounded %.2f s; meshes %s\n",
@@ -192,8 +161,6 @@ static void terrain_speedup(void) {
   printf("mesh.bounds_speedup: %.1f x\n", sf / sb);
   printf("mesh.field_call_ratio: %.1f x\n",
          (double)stf.field_calls / (double)stb.field_calls);
-  free(tb);
-  free(tf);
   oc_mesh_free(mb);
   oc_mesh_free(mf);
   oc_program_free(p);
