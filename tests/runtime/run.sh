@@ -373,10 +373,11 @@ else
   set -m # with job control, background jobs keep default signals
 fi
 
-# interrupt NAME [HOW]: Ctrl-C half a second into loop.lua HOW
-interrupt() {
-  begin "$1"
-  (cd "$W" && exec "${DEFSIG[@]}" "$OUTCROP" "$S/loop.lua" --out "$W/o" ${2:-}) \
+# ctrl_c SCENE [HOW]: runs SCENE HOW, presses Ctrl-C half a second after
+# it wrote started.txt, and checks that it stopped cleanly (status 130,
+# "interrupted", nothing after the interruption)
+ctrl_c() {
+  (cd "$W" && exec "${DEFSIG[@]}" "$OUTCROP" "$S/$1" --out "$W/o" ${2:-}) \
     >"$OUT" 2>"$ERR" </dev/null &
   pid=$!
   for _ in $(seq 200); do # up to 20 s for a slow (sanitized) start
@@ -398,6 +399,12 @@ interrupt() {
   sanitizer_check
   [ -e "$W/o/started.txt" ] || because "the scene never started"
   status_is 130; err_has "outcrop: interrupted"; no_file "$W/o/after.txt"
+}
+
+# interrupt NAME [HOW]: Ctrl-C half a second into loop.lua HOW
+interrupt() {
+  begin "$1"
+  ctrl_c loop.lua "${2:-}"
   no_file "$W/o/mesh.ply"
   end
 }
@@ -413,28 +420,7 @@ interrupt interrupt-polygonize mesh
 # interrupt_render NAME [HOW]: Ctrl-C half a second into render_loop.lua HOW
 interrupt_render() {
   begin "$1"
-  (cd "$W" && exec "${DEFSIG[@]}" "$OUTCROP" "$S/render_loop.lua" --out "$W/o" ${2:-}) \
-    >"$OUT" 2>"$ERR" </dev/null &
-  pid=$!
-  for _ in $(seq 200); do
-    [ -e "$W/o/started.txt" ] && break
-    sleep 0.1
-  done
-  sleep 0.5
-  kill -INT "$pid" 2>/dev/null
-  for _ in $(seq 100); do
-    kill -0 "$pid" 2>/dev/null || break
-    sleep 0.1
-  done
-  if kill -0 "$pid" 2>/dev/null; then
-    because "still running 10 s after SIGINT"
-    kill -KILL "$pid" 2>/dev/null
-  fi
-  wait "$pid"
-  rc=$?
-  sanitizer_check
-  [ -e "$W/o/started.txt" ] || because "the scene never started"
-  status_is 130; err_has "outcrop: interrupted"; no_file "$W/o/after.txt"
+  ctrl_c render_loop.lua "${2:-}"
   no_file "$W/o/render.png"
   [ -z "$(ls "$W/o" | grep -v '^started.txt$')" ] || because "files left in the output folder: $(ls "$W/o")"
   end
