@@ -80,6 +80,11 @@ int oc_hfsurf_level_spans(const oc_hfsurf *s, double x0, double y0, double x1,
       hi = fmax(hi, e[k]);
     }
   }
+  return oc_hfsurf_elev_spans(s, lo, hi, out);
+}
+
+int oc_hfsurf_elev_spans(const oc_hfsurf *s, double lo, double hi,
+                         oc_zspan out[2]) {
   /* rounding of the elevation and of the range: far below a cell */
   double m = 1e-9 * (fabs(lo) + fabs(hi) + 1);
   oc_zspan a = {lo - m, hi + m};

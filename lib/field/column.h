@@ -42,6 +42,10 @@ double oc_hfsurf_value(const oc_hfsurf *s, double e, double z);
 ** [y0, y1]: the range of the elevation there, and a terrain's flat cap. */
 int oc_hfsurf_level_spans(const oc_hfsurf *s, double x0, double y0, double x1,
                           double y1, oc_zspan out[2]);
+/* The same for a column, or a group of columns, whose elevations range
+** over [lo, hi]. */
+int oc_hfsurf_elev_spans(const oc_hfsurf *s, double lo, double hi,
+                         oc_zspan out[2]);
 /* The crossing of f = T between za < zb in a column whose surface is at
 ** e, given that f - T changes sign there: e, or a terrain's flat cap
 ** (*cap set to 1 then: its normal is vertical). */

@@ -30,17 +30,17 @@ static int32_t clampi(double v, int32_t lo, int32_t hi) {
 /* ---- 1. the band ------------------------------------------------------- */
 
 /* Cube and sample k-ranges of the z-span [zl, zh]: the cubes meeting it,
-** grown by one cube (seed 000's dilation), and the samples in it, with a
+** grown by `grow` cubes (1: seed 000's dilation), and the samples in it, with a
 ** margin far above the rounding of this arithmetic (a sample outside is
 ** in a gap, where the field is exactly constant along the column). The
 ** padding samples of open meshes lie on the faces: they vary when the
 ** span reaches the face. */
-static void span_ranges(const oc_mcgrid *g, double zl, double zh,
+static void span_ranges(const oc_mcgrid *g, double zl, double zh, int grow,
                         oc_mc_irange *c, oc_mc_irange *s) {
   int nz = g->n[2];
   double a = (zl - g->lo[2]) / g->h[2], b = (zh - g->lo[2]) / g->h[2];
-  c->lo = clampi(ceil(a - 1.5) - 1, -1, nz - 1);
-  c->hi = clampi(floor(b - 0.5) + 1, -1, nz - 1);
+  c->lo = clampi(ceil(a - 1.5) - grow, -1, nz - 1);
+  c->hi = clampi(floor(b - 0.5) + grow, -1, nz - 1);
   s->lo = clampi(ceil(a - 0.5 - 1e-6), 0, nz - 1);
   s->hi = clampi(floor(b - 0.5 + 1e-6), 0, nz - 1);
   if (g->open && a <= 1e-6) s->lo = -1;
@@ -48,6 +48,63 @@ static void span_ranges(const oc_mcgrid *g, double zl, double zh,
   /* a span between two samples still separates the gaps below and above
   ** it, whose constant values differ: its sample just above varies */
   if (s->lo > s->hi) s->hi = s->lo;
+}
+
+/* Direct blocks: per block of B x B cube columns (aligned as the culling
+** blocks), the direct surface that governs the block's whole footprint,
+** grown by one cube, alone, or NULL. Rows ja .. jr of the slab; the
+** decision depends on the block only, so slabs sharing a sample row agree
+** on it. */
+static int direct_blocks(const oc_mcgrid *g, int ja, int jr, oc_mcwork *w) {
+  int nx = g->n[0], ny = g->n[1];
+  int nbu = (nx + 1 + B - 1) / B, bv0 = (ja + 1) / B, bv1 = (jr + 1) / B;
+  size_t nb = (size_t)(bv1 - bv0 + 1) * (size_t)nbu;
+  if (oc_mc_grow(&w->bsurf, &w->capbsurf, nb, sizeof *w->bsurf)) return -1;
+  oc_zspan sp[MAXSPANS];
+  size_t q = 0;
+  for (int bv = bv0; bv <= bv1; bv++) {
+    int j0 = bv * B - 1, j1 = j0 + B - 1 < ny - 1 ? j0 + B - 1 : ny - 1;
+    for (int bu = 0; bu < nbu; bu++, q++) {
+      int i0 = bu * B - 1, i1 = i0 + B - 1 < nx - 1 ? i0 + B - 1 : nx - 1;
+      uint32_t hf = OC_MC_NONE;
+      int ns = oc_program_column_query(
+          g->prog, oc_mc_coord(g, 0, i0 - 1), oc_mc_coord(g, 1, j0 - 1),
+          oc_mc_coord(g, 0, i1 + 2), oc_mc_coord(g, 1, j1 + 2), sp, MAXSPANS,
+          &hf);
+      const struct oc_hfsurf *hs =
+          ns >= 0 && hf != OC_MC_NONE ? oc_mc_surface(g, hf) : NULL;
+      w->bsurf[q] = hs && oc_mc_direct_kind(hs) ? hs : NULL;
+    }
+  }
+  return 0;
+}
+
+/* Cube ranges of cube column (i, j) inside a direct block: exactly the
+** cubes the surface crosses, from the elevations of its four sample
+** columns (no dilation: every sample of them is on the surface's side
+** given by its elevation, so no other cube holds a crossing); closed
+** meshes add the cap cubes. 1 done, 0 when an elevation is not finite,
+** -1 out of memory. */
+static int exact_cubes(const oc_mcgrid *g, oc_mcwork *w,
+                       const struct oc_hfsurf *hs, int i, int j, size_t fc) {
+  double lo = INFINITY, hi = -INFINITY;
+  for (int q = 0; q < 4; q++) {
+    double e = oc_mc_elevation(g, w, hs, i + (q & 1), j + (q >> 1))[0];
+    lo = fmin(lo, e);
+    hi = fmax(hi, e);
+  }
+  if (!(isfinite(lo) && isfinite(hi))) return 0;
+  int nz = g->n[2];
+  oc_zspan sp[2];
+  int n = oc_hfsurf_elev_spans(hs, lo, hi, sp);
+  if (!g->open && oc_mc_rlist_add(&w->cube, fc, -1, -1)) return -1;
+  for (int s = 0; s < n; s++) {
+    oc_mc_irange cr, sr;
+    span_ranges(g, sp[s].lo, sp[s].hi, 0, &cr, &sr);
+    if (oc_mc_rlist_add(&w->cube, fc, cr.lo, cr.hi)) return -1;
+  }
+  if (!g->open && oc_mc_rlist_add(&w->cube, fc, nz - 1, nz - 1)) return -1;
+  return 1;
 }
 
 /* Cube ranges (rows ja .. jb - 1) and varying sample ranges (rows ja ..
@@ -59,20 +116,41 @@ int oc_mc_band(const oc_mcgrid *g, int ja, int jb, int jr, oc_mcwork *w) {
     return -1;
   /* direct sample columns: sample column (i, j) is direct when the
   ** footprint of cube column (i, j), which covers its four edges, is
-  ** governed by one heightfield-like op alone (mcdirect.c) */
+  ** governed by one heightfield-like op alone (mcdirect.c): its block's
+  ** footprint, or else its own */
   size_t nsc = (size_t)(jb - ja + 1) * (size_t)(nx + 2);
+  int nbu = (nx + 1 + B - 1) / B, bv0 = (ja + 1) / B;
   if (g->direct) {
     if (oc_mc_grow(&w->dsurf, &w->capdsurf, nsc, sizeof *w->dsurf) ||
-        oc_mc_grow(&w->delev, &w->capdelev, 3 * nsc, sizeof *w->delev))
+        oc_mc_grow(&w->esurf, &w->capesurf, nsc, sizeof *w->esurf) ||
+        oc_mc_grow(&w->delev, &w->capdelev, 3 * nsc, sizeof *w->delev) ||
+        direct_blocks(g, ja, jr, w))
       return -1;
     for (size_t q = 0; q < nsc; q++)
-      w->dsurf[q] = NULL;
+      w->dsurf[q] = w->esurf[q] = NULL;
   }
   oc_zspan sp[MAXSPANS], lsp[2];
   size_t c = 0;
   for (int j = ja; j <= jr; j++) {
     for (int i = -1; i < nx; i++, c++) {
       size_t fc = w->cube.n, fv = w->var.n;
+      int side = i == -1 || i == nx - 1 || j == -1 || j == ny - 1;
+      const struct oc_hfsurf *bs =
+          g->direct && !side ? w->bsurf[(size_t)((j + 1) / B - bv0) * nbu +
+                                        (size_t)((i + 1) / B)]
+                             : NULL;
+      if (bs) {
+        /* a direct block: no column query, and exact cubes (all of the
+        ** column when full, or should an elevation not be finite) */
+        int rc = 0;
+        if (j < jb && (g->full || !(rc = exact_cubes(g, w, bs, i, j, fc))))
+          rc = oc_mc_rlist_add(&w->cube, fc, -1, nz - 1) ? -1 : 1;
+        if (rc < 0) return -1;
+        w->dsurf[(size_t)(j - ja) * (nx + 2) + (size_t)(i + 1)] = bs;
+        w->cube.at[c + 1] = w->cube.n;
+        w->var.at[c + 1] = w->var.n; /* direct: no varying samples */
+        continue;
+      }
       int ns = -1;
       uint32_t hf = OC_MC_NONE;
       double fx0 = oc_mc_coord(g, 0, i - 1), fy0 = oc_mc_coord(g, 1, j - 1);
@@ -94,7 +172,6 @@ int oc_mc_band(const oc_mcgrid *g, int ja, int jb, int jr, oc_mcwork *w) {
         ncs = oc_hfsurf_level_spans(hs, fx0, fy0, fx1, fy1, lsp);
         csp = lsp;
       }
-      int side = i == -1 || i == nx - 1 || j == -1 || j == ny - 1;
       int whole = ns < 0 || (side && !g->open);
       if (j < jb) {
         if (whole) {
@@ -104,7 +181,7 @@ int oc_mc_band(const oc_mcgrid *g, int ja, int jb, int jr, oc_mcwork *w) {
           for (int s = 0; s < ncs; s++) {
             oc_mc_irange cr, sr;
             if (!(csp[s].lo <= csp[s].hi)) continue;
-            span_ranges(g, csp[s].lo, csp[s].hi, &cr, &sr);
+            span_ranges(g, csp[s].lo, csp[s].hi, 1, &cr, &sr);
             if (oc_mc_rlist_add(&w->cube, fc, cr.lo, cr.hi)) return -1;
           }
           if (!g->open && oc_mc_rlist_add(&w->cube, fc, nz - 1, nz - 1))
@@ -117,7 +194,7 @@ int oc_mc_band(const oc_mcgrid *g, int ja, int jb, int jr, oc_mcwork *w) {
         for (int s = 0; s < ns; s++) {
           oc_mc_irange cr, sr;
           if (!(sp[s].lo <= sp[s].hi)) continue;
-          span_ranges(g, sp[s].lo, sp[s].hi, &cr, &sr);
+          span_ranges(g, sp[s].lo, sp[s].hi, 1, &cr, &sr);
           if (oc_mc_rlist_add(&w->var, fv, sr.lo, sr.hi)) return -1;
         }
       }

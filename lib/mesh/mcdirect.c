@@ -90,13 +90,22 @@ const oc_hfsurf *oc_mc_surface(const oc_mcgrid *g, uint32_t op) {
   return a < g->nsurf && g->surf[a].op == op ? &g->surf[a] : NULL;
 }
 
+const double *oc_mc_elevation(const oc_mcgrid *g, oc_mcwork *w,
+                              const oc_hfsurf *hs, int i, int j) {
+  size_t c = (size_t)(j - w->ja) * ((size_t)g->n[0] + 2) + (size_t)(i + 1);
+  double *el = w->delev + 3 * c;
+  if (w->esurf[c] != hs) {
+    el[0] = oc_hfsurf_height(hs, oc_mc_coord(g, 0, i), oc_mc_coord(g, 1, j),
+                             el + 1);
+    w->esurf[c] = hs;
+  }
+  return el;
+}
+
 void oc_mc_direct_column(const oc_mcgrid *g, int i, int j, size_t c,
                          const oc_mc_srange *s, size_t ns, oc_mcwork *w) {
   const oc_hfsurf *hs = w->dsurf[c];
-  double *el = w->delev + 3 * c;
-  double e =
-      oc_hfsurf_height(hs, oc_mc_coord(g, 0, i), oc_mc_coord(g, 1, j), el + 1);
-  el[0] = e;
+  double e = oc_mc_elevation(g, w, hs, i, j)[0];
   int nz = g->n[2];
   for (size_t r = 0; r < ns; r++)
     for (int32_t k = s[r].lo; k <= s[r].hi; k++)

@@ -64,6 +64,8 @@ void oc_mcwork_free(oc_mcwork *w) {
   free(w->flat);
   free(w->dsurf);
   free(w->delev);
+  free(w->esurf);
+  free(w->bsurf);
   free(w);
 }
 

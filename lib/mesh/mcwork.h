@@ -48,6 +48,11 @@ struct oc_mcwork {
   const struct oc_hfsurf **dsurf;
   double *delev;
   size_t capdsurf, capdelev;
+  /* the surface whose elevation delev holds, per sample column (NULL:
+  ** none yet), and per block of the slab's cube columns the direct
+  ** surface governing the block's whole footprint alone, or NULL */
+  const struct oc_hfsurf **esurf, **bsurf;
+  size_t capesurf, capbsurf;
   int ja;                  /* first row of the slab being meshed */
   size_t last_nv, last_nt; /* output sizes of the previous slab */
 };
@@ -83,6 +88,10 @@ void oc_mc_samples(const oc_mcgrid *g, int ja, int jb, oc_mcwork *w,
 ** stores in w->delev). */
 void oc_mc_direct_column(const oc_mcgrid *g, int i, int j, size_t c,
                          const oc_mc_srange *s, size_t ns, oc_mcwork *w);
+/* Elevation and gradient (3 doubles) of surface hs at sample column
+** (i, j) of the slab (rows ja .. jb), computed once per slab. */
+const double *oc_mc_elevation(const oc_mcgrid *g, oc_mcwork *w,
+                              const struct oc_hfsurf *hs, int i, int j);
 /* Places the vertex of a crossing edge from the elevation when the edge
 ** lies in direct columns (one, or two under the same surface): 1 done, 0
 ** when the caller must find the root on the field. */
