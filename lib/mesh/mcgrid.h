@@ -80,9 +80,12 @@ typedef struct oc_mcwork oc_mcwork; /* per-thread scratch, reused */
 oc_mcwork *oc_mcwork_new(void);
 void oc_mcwork_free(oc_mcwork *w);
 void oc_mcout_clear(oc_mcout *out);
+/* Empties out but keeps its arrays, for another slab. */
+void oc_mcout_reset(oc_mcout *out);
 
 /* Meshes the cube rows ja .. jb - 1 (ja >= -1, jb <= n[1]) into *out,
-** which must be zeroed. Returns OC_OK, or OC_ENOMEM with err filled (out
+** whose counts must be 0 (its arrays may be those of an earlier slab,
+** reused). Returns OC_OK, or OC_ENOMEM with err filled (out
 ** is then to be cleared by the caller). */
 int oc_mc_slab(const oc_mcgrid *g, int ja, int jb, oc_mcwork *w, oc_mcout *out,
                oc_error *err);

@@ -212,14 +212,17 @@ static int nomem(oc_error *err) {
   return oc_seterr(err, OC_ENOMEM, "out of memory while meshing");
 }
 
-/* Sizes the output like the previous slab's, so it rarely grows. */
+/* Sizes the output like the previous slab's, so it rarely grows (a
+** recycled output may be large enough already). */
 static int presize(oc_mcout *o, const oc_mcwork *w) {
   size_t v = w->last_nv + w->last_nv / 4, t = w->last_nt + w->last_nt / 4;
-  size_t c1 = 0, c2 = 0;
-  if (v && (oc_mc_grow(&o->pos, &c1, v, 3 * sizeof(float)) ||
-            oc_mc_grow(&o->nrm, &c2, v, 3 * sizeof(float))))
-    return -1;
-  o->capv = c1;
+  if (v > o->capv) {
+    size_t c1 = o->capv, c2 = o->capv;
+    if (oc_mc_grow(&o->pos, &c1, v, 3 * sizeof(float)) ||
+        oc_mc_grow(&o->nrm, &c2, v, 3 * sizeof(float)))
+      return -1;
+    o->capv = c1;
+  }
   if (t && oc_mc_grow(&o->tri, &o->capt, t, 3 * sizeof(uint32_t))) return -1;
   return 0;
 }

@@ -78,6 +78,11 @@ void oc_mcout_clear(oc_mcout *o) {
   memset(o, 0, sizeof *o);
 }
 
+void oc_mcout_reset(oc_mcout *o) {
+  o->nv = o->nt = o->nk = o->nb = 0;
+  o->calls = o->cells = 0;
+}
+
 void oc_mc_sort_ranges(oc_mc_irange *t, size_t n) {
   for (size_t i = 1; i < n; i++) {
     oc_mc_irange x = t[i];

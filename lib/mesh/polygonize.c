@@ -156,7 +156,30 @@ typedef struct merger {
   uint32_t *prev, *cur; /* local -> global of slabs next - 1 and next */
   size_t capprev, capcur;
   size_t calls, cells;
+  int nslab;
+  /* outputs of merged slabs, emptied, for slabs still to mesh: their
+  ** memory is warm, where fresh memory would fault at every page */
+  oc_mcout *pool;
+  int npool;
 } merger;
+
+/* Grows a merged array to hold `need` items after slab s of nslab: to
+** what the slabs so far project for the whole mesh, a quarter more, so
+** that realloc copies it once or twice rather than at every doubling
+** (untouched capacity costs no memory). */
+static int reserve(void *pp, size_t *cap, size_t need, int s, int nslab,
+                   size_t elem) {
+  if (need <= *cap) return 0;
+  double want = (double)need * nslab / (s + 1) * 1.25;
+  double most = (double)SIZE_MAX / 2 / elem;
+  size_t c = want < most ? (size_t)want : need;
+  if (c < need) c = need;
+  void *p = realloc(*(void **)pp, c * elem);
+  if (!p) return -1;
+  *(void **)pp = p;
+  *cap = c;
+  return 0;
+}
 
 static int merge_one(merger *M, int s, oc_error *err) {
   oc_mcout *o = &M->outs[s];
@@ -170,9 +193,10 @@ static int merge_one(merger *M, int s, oc_error *err) {
                      "mesh too large: more than %lu vertices (indices are "
                      "32-bit); use a larger 'cell' or a smaller 'box'",
                      (unsigned long)UINT32_MAX - 1);
-  if (oc_mc_grow(&M->pos, &M->capv, nv, 3 * sizeof(float)) ||
-      oc_mc_grow(&M->nrm, &M->capn, nv, 3 * sizeof(float)) ||
-      oc_mc_grow(&M->tri, &M->capt, M->nt + o->nt, 3 * sizeof(uint32_t)))
+  size_t nt = M->nt + o->nt;
+  if (reserve(&M->pos, &M->capv, nv, s, M->nslab, 3 * sizeof(float)) ||
+      reserve(&M->nrm, &M->capn, nv, s, M->nslab, 3 * sizeof(float)) ||
+      reserve(&M->tri, &M->capt, nt, s, M->nslab, 3 * sizeof(uint32_t)))
     goto nomem;
   for (size_t v = 0; v < o->nv; v++) {
     if (M->cur[v] != OC_MC_NONE) continue;
@@ -190,7 +214,11 @@ static int merge_one(merger *M, int s, oc_error *err) {
   size_t c = M->capprev;
   M->prev = M->cur, M->capprev = M->capcur;
   M->cur = x, M->capcur = c;
-  if (s) oc_mcout_clear(&M->outs[s - 1]);
+  if (s) {
+    oc_mcout_reset(&M->outs[s - 1]);
+    M->pool[M->npool++] = M->outs[s - 1];
+    memset(&M->outs[s - 1], 0, sizeof M->outs[s - 1]);
+  }
   return 0;
 nomem:
   return oc_seterr(err, OC_ENOMEM, "out of memory while assembling the mesh");
@@ -199,6 +227,9 @@ nomem:
 static void merger_free(merger *M, int nslab) {
   for (int s = 0; s < nslab; s++)
     oc_mcout_clear(&M->outs[s]);
+  for (int k = 0; k < M->npool; k++)
+    oc_mcout_clear(&M->pool[k]);
+  free(M->pool);
   free(M->outs);
   free(M->ready);
   free(M->pos);
@@ -249,9 +280,11 @@ oc_mesh *oc_polygonize(const oc_program *prog, const oc_polygonize_params *pp,
   int nslab = (g.n[1] + 1 + rows - 1) / rows;
   merger M;
   memset(&M, 0, sizeof M);
+  M.nslab = nslab;
   M.outs = calloc((size_t)nslab, sizeof *M.outs);
+  M.pool = calloc((size_t)nslab, sizeof *M.pool);
   M.ready = calloc((size_t)nslab, 1);
-  if (!M.outs || !M.ready) {
+  if (!M.outs || !M.pool || !M.ready) {
     merger_free(&M, 0);
     oc_mc_surfaces_free(&g);
     oc_seterr(err, OC_ENOMEM, "out of memory");
@@ -271,6 +304,8 @@ oc_mesh *oc_polygonize(const oc_program *prog, const oc_polygonize_params *pp,
       if (halt) continue;
       int ja = -1 + s * rows, jb = ja + rows < g.n[1] ? ja + rows : g.n[1];
       oc_error e = {OC_OK, ""};
+#pragma omp critical(oc_polygonize_merge)
+      if (M.npool) M.outs[s] = M.pool[--M.npool];
       int rc = w ? oc_mc_slab(&g, ja, jb, w, &M.outs[s], &e)
                  : oc_seterr(&e, OC_ENOMEM, "out of memory while meshing");
       if (!rc) {
