@@ -75,6 +75,10 @@ static inline double rho_max(const oc_op *o, const double *par) {
   return par[OC_P_R] + fmax(0, nz[1]) * oc_turb3_max((int)nz[3]);
 }
 
+double oc_perturb_reach(const oc_op *o, const double *par) {
+  return rho_max(o, par);
+}
+
 static double perturb(const oc_op *o, const double *par, oc_vec3 p) {
   double E = par[OC_P_E], R = par[OC_P_R];
   noisep nz = unpack_noise(par + o->nkid);
@@ -88,6 +92,51 @@ static double perturb(const oc_op *o, const double *par, oc_vec3 p) {
   double rho =
       R + nz.amp * oc_turb3(nz.seed, nz.oct, oc_mul(v, 1 / nz.wl), NULL);
   return E * oc_falloff(d / rho);
+}
+
+/* Value and gradient of perturb, analytically: with u = (p - s) / d,
+** v = s + R u and rho = R + A t(v / wl),
+**   grad f = E g'(d / rho) (u / rho - d grad rho / rho^2),
+**   grad rho = (A / wl) Jv^T grad t, Jv = S + (R / d) (I - u u^T)(I - S),
+** S = ds/dp from the projection (symmetric). 0 when the primitive's kind
+** has no such Jacobian. */
+static int perturb_grad(const oc_op *o, const double *par, oc_vec3 p,
+                        oc_vec3 *g, double *val) {
+  double E = par[OC_P_E], R = par[OC_P_R];
+  noisep nz = unpack_noise(par + o->nkid);
+  oc_vec3 s;
+  double d, J[9];
+  double rmax = rho_max(o, par);
+  if (!oc_prim_project_jac((oc_kind)o->sub, par, p, &s, rmax, &d, J)) return 0;
+  *g = oc_v3(0, 0, 0);
+  if (!(d > 0)) {
+    *val = d == 0 ? E : d; /* NaN propagates */
+    return 1;
+  }
+  if (d >= rmax) {
+    *val = 0;
+    return 1;
+  }
+  oc_vec3 u = oc_mul(oc_sub(p, s), 1 / d);
+  oc_vec3 v = oc_add(s, oc_mul(u, R));
+  oc_vec3 gt;
+  double rho =
+      R + nz.amp * oc_turb3(nz.seed, nz.oct, oc_mul(v, 1 / nz.wl), &gt);
+  double x = d / rho;
+  *val = E * oc_falloff(x);
+  /* Jv^T w = S w + (R / d) (I - S)(w - u (u.w)), w = grad t */
+  oc_vec3 w = oc_sub(gt, oc_mul(u, oc_dot(u, gt)));
+  oc_vec3 Sg = oc_v3(J[0] * gt.x + J[1] * gt.y + J[2] * gt.z,
+                     J[3] * gt.x + J[4] * gt.y + J[5] * gt.z,
+                     J[6] * gt.x + J[7] * gt.y + J[8] * gt.z);
+  oc_vec3 Sw = oc_v3(J[0] * w.x + J[1] * w.y + J[2] * w.z,
+                     J[3] * w.x + J[4] * w.y + J[5] * w.z,
+                     J[6] * w.x + J[7] * w.y + J[8] * w.z);
+  oc_vec3 jt = oc_add(Sg, oc_mul(oc_sub(w, Sw), R / d));
+  oc_vec3 grho = oc_mul(jt, nz.amp / nz.wl);
+  double k = E * oc_falloff_d(x);
+  *g = oc_mul(oc_sub(oc_mul(u, 1 / rho), oc_mul(grho, d / (rho * rho))), k);
+  return 1;
 }
 
 /* ---- groups ------------------------------------------------------------ */
@@ -428,10 +477,12 @@ static double evg(const oc_program *P, uint32_t i, oc_vec3 p, oc_vec3 *g) {
     return v;
   }
   case OC_K_PERTURB: {
-    /* The projection's Jacobian differs per skeleton and is not continuous
-    ** on medial axes; central differences are robust and cheap here. */
+    /* Analytic for every kind but cones, whose projection's Jacobian
+    ** takes central differences. */
+    double v;
+    if (perturb_grad(o, par, p, g, &v)) return v;
     double h = 1e-6 * fmax(par[OC_P_R], 1e-3);
-    double v = perturb(o, par, p);
+    v = perturb(o, par, p);
     double gx = perturb(o, par, oc_v3(p.x + h, p.y, p.z)) -
                 perturb(o, par, oc_v3(p.x - h, p.y, p.z));
     double gy = perturb(o, par, oc_v3(p.x, p.y + h, p.z)) -

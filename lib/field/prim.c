@@ -218,6 +218,12 @@ static size_t nchunks(size_t npts) {
   return npts > 1 ? (npts - 2) / CHUNK + 1 : 0;
 }
 
+const double *oc_prim_curve_boxes(const double *par, size_t *n) {
+  size_t np = (size_t)par[2];
+  *n = nchunks(np);
+  return par + 3 + 3 * np;
+}
+
 size_t oc_prim_npar(const oc_node *n) {
   return n->kind == OC_K_CURVE ? 3 + 3 * n->npts + 6 * nchunks(n->npts) : 9;
 }
@@ -253,6 +259,59 @@ static double seg_project(oc_vec3 a, oc_vec3 b, oc_vec3 p, oc_vec3 *s) {
   t = t < 0 ? 0 : t > 1 ? 1 : t;
   *s = oc_add(a, oc_mul(ab, t));
   return oc_len(oc_sub(p, *s));
+}
+
+/* seg_project, and in *tan the unit direction of the segment when the
+** closest point is inside it (where it slides along the segment as p
+** moves), else 0. */
+static double seg_project_tan(oc_vec3 a, oc_vec3 b, oc_vec3 p, oc_vec3 *s,
+                              oc_vec3 *tan) {
+  oc_vec3 ab = oc_sub(b, a), ap = oc_sub(p, a);
+  double l2 = oc_dot(ab, ab);
+  double t = l2 > 0 ? oc_dot(ap, ab) / l2 : 0;
+  int in = t > 0 && t < 1;
+  t = t < 0 ? 0 : t > 1 ? 1 : t;
+  *s = oc_add(a, oc_mul(ab, t));
+  *tan = in ? oc_mul(ab, 1 / sqrt(l2)) : oc_v3(0, 0, 0);
+  return oc_len(oc_sub(p, *s));
+}
+
+/* The closest point of a curve's polyline, skipping the chunks whose box
+** is farther than the best distance so far; its tangent as
+** seg_project_tan's when tan is not NULL. */
+static double curve_project(const double *par, oc_vec3 p, oc_vec3 *s,
+                            double cutoff, oc_vec3 *tan) {
+  size_t n = (size_t)par[2];
+  if (tan) *tan = oc_v3(0, 0, 0);
+  if (n == 1) {
+    *s = get(par, 3);
+    return oc_len(oc_sub(p, *s));
+  }
+  const double *box = par + 3 + 3 * n;
+  double best = cutoff, best2 = cutoff * cutoff;
+  *s = p;
+  for (size_t c = 0; c < nchunks(n); c++, box += 6) {
+    /* squared distance from p to the chunk's box (plain comparisons:
+    ** fmax is a library call at -O2) */
+    double dx = p.x < box[0] ? box[0] - p.x : p.x > box[3] ? p.x - box[3] : 0;
+    double dy = p.y < box[1] ? box[1] - p.y : p.y > box[4] ? p.y - box[4] : 0;
+    double dz = p.z < box[2] ? box[2] - p.z : p.z > box[5] ? p.z - box[5] : 0;
+    if (dx * dx + dy * dy + dz * dz >= best2) continue;
+    size_t end = (c + 1) * CHUNK < n - 1 ? (c + 1) * CHUNK : n - 1;
+    for (size_t i = c * CHUNK; i < end; i++) {
+      const double *v = par + 3 + 3 * i;
+      oc_vec3 q, tq;
+      double d = tan ? seg_project_tan(get(v, 0), get(v, 3), p, &q, &tq)
+                     : seg_project(get(v, 0), get(v, 3), p, &q);
+      if (d < best) {
+        best = d;
+        best2 = d * d;
+        *s = q;
+        if (tan) *tan = tq;
+      }
+    }
+  }
+  return best;
 }
 
 /* Closest point on 2D segment (ax, ay)-(bx, by) to (x, y). */
@@ -320,36 +379,8 @@ double oc_prim_project(oc_kind kind, const double *par, oc_vec3 p, oc_vec3 *s,
   }
   case OC_K_SEGMENT:
     return seg_project(get(par, OC_P_A), get(par, OC_P_B), p, s);
-  case OC_K_CURVE: {
-    size_t n = (size_t)par[2];
-    if (n == 1) {
-      *s = get(par, 3);
-      return oc_len(oc_sub(p, *s));
-    }
-    const double *box = par + 3 + 3 * n;
-    double best = cutoff, best2 = cutoff * cutoff;
-    *s = p;
-    for (size_t c = 0; c < nchunks(n); c++, box += 6) {
-      /* squared distance from p to the chunk's box (plain comparisons:
-      ** fmax is a library call at -O2) */
-      double dx = p.x < box[0] ? box[0] - p.x : p.x > box[3] ? p.x - box[3] : 0;
-      double dy = p.y < box[1] ? box[1] - p.y : p.y > box[4] ? p.y - box[4] : 0;
-      double dz = p.z < box[2] ? box[2] - p.z : p.z > box[5] ? p.z - box[5] : 0;
-      if (dx * dx + dy * dy + dz * dz >= best2) continue;
-      size_t end = (c + 1) * CHUNK < n - 1 ? (c + 1) * CHUNK : n - 1;
-      for (size_t i = c * CHUNK; i < end; i++) {
-        const double *v = par + 3 + 3 * i;
-        oc_vec3 q;
-        double d = seg_project(get(v, 0), get(v, 3), p, &q);
-        if (d < best) {
-          best = d;
-          best2 = d * d;
-          *s = q;
-        }
-      }
-    }
-    return best;
-  }
+  case OC_K_CURVE:
+    return curve_project(par, p, s, cutoff, NULL);
   case OC_K_CONE:
     return cone_project(par, p, s);
   case OC_K_PLANE: {
@@ -365,6 +396,62 @@ double oc_prim_project(oc_kind kind, const double *par, oc_vec3 p, oc_vec3 *s,
   default:
     *s = p;
     return INFINITY;
+  }
+}
+
+static void set_outer(double J[9], oc_vec3 a, double k) {
+  const double v[3] = {a.x, a.y, a.z};
+  for (int r = 0; r < 3; r++)
+    for (int c = 0; c < 3; c++)
+      J[3 * r + c] = k * v[r] * v[c];
+}
+
+static void set_diag(double J[9], double x, double y, double z) {
+  for (int k = 0; k < 9; k++)
+    J[k] = 0;
+  J[0] = x, J[4] = y, J[8] = z;
+}
+
+int oc_prim_project_jac(oc_kind kind, const double *par, oc_vec3 p, oc_vec3 *s,
+                        double cutoff, double *d, double J[9]) {
+  switch (kind) {
+  case OC_K_POINT:
+    *d = oc_prim_project(kind, par, p, s, cutoff);
+    set_diag(J, 0, 0, 0);
+    return 1;
+  case OC_K_SEGMENT:
+  case OC_K_CURVE: {
+    oc_vec3 t;
+    *d = kind == OC_K_CURVE
+             ? curve_project(par, p, s, cutoff, &t)
+             : seg_project_tan(get(par, OC_P_A), get(par, OC_P_B), p, s, &t);
+    set_outer(J, t, 1); /* 0 at an end: the closest point stays there */
+    return 1;
+  }
+  case OC_K_SPHERE: {
+    *d = oc_prim_project(kind, par, p, s, cutoff);
+    oc_vec3 cp = oc_sub(p, get(par, OC_P_C));
+    double l = oc_len(cp);
+    if (!(*d > 0)) {
+      set_diag(J, 1, 1, 1);
+      return 1;
+    }
+    /* s = c + r u: dS = (r / l) (I - u u^T) */
+    oc_vec3 u = oc_mul(cp, 1 / l);
+    double k = par[OC_P_RAD] / l;
+    set_outer(J, u, -k);
+    J[0] += k, J[4] += k, J[8] += k;
+    return 1;
+  }
+  case OC_K_BOX: {
+    *d = oc_prim_project(kind, par, p, s, cutoff);
+    oc_vec3 lo = get(par, OC_P_LO), hi = get(par, OC_P_HI);
+    set_diag(J, p.x > lo.x && p.x<hi.x, p.y> lo.y && p.y<hi.y, p.z> lo.z &&
+                    p.z < hi.z);
+    return 1;
+  }
+  default:
+    return 0;
   }
 }
 

@@ -62,6 +62,23 @@ static void ball_span(const foot *f, double cx, double cy, double cz, double R,
   add(S, cz - h, cz + h);
 }
 
+/* A curve's field varies within R of its segments: over the footprint,
+** within the z-ranges (grown by R) of the chunks whose boxes, grown by R,
+** meet it. An arch's top column then spans the top only, not the legs. */
+static void curve_spans(const double *par, double R, const foot *f, spans *S) {
+  size_t n;
+  const double *b = oc_prim_curve_boxes(par, &n);
+  if (!n) { /* a single point */
+    ball_span(f, par[3], par[4], par[5], R * (1 + 1e-9), span_add_v, S);
+    return;
+  }
+  double m = R * (1 + 1e-9);
+  for (size_t c = 0; c < n; c++, b += 6)
+    if (b[0] - m <= f->x1 && b[3] + m >= f->x0 && b[1] - m <= f->y1 &&
+        b[4] + m >= f->y0)
+      span_add(S, b[2] - m, b[5] + m);
+}
+
 static int foot_meets(const float *lo, const float *hi, const foot *f) {
   return lo[0] <= f->x1 && hi[0] >= f->x0 && lo[1] <= f->y1 && hi[1] >= f->y0;
 }
@@ -235,6 +252,16 @@ static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
       span_add(S, o->lo[2], o->hi[2]);
     return;
   }
+  case OC_K_CURVE:
+    curve_spans(par, par[OC_P_R], f, S);
+    return;
+  case OC_K_PERTURB:
+    if (o->sub == OC_K_CURVE) {
+      curve_spans(par, oc_perturb_reach(o, par), f, S);
+      return;
+    }
+    span_add(S, o->lo[2], o->hi[2]);
+    return;
   case OC_K_POINT:
   case OC_K_SPHERE: {
     double R = par[OC_P_R] + (o->kind == OC_K_SPHERE ? par[OC_P_RAD] : 0);

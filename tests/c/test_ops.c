@@ -970,6 +970,36 @@ START_TEST(perturb_queries) {
 }
 END_TEST
 
+/* The analytic gradient of perturbed curves (segment interiors and vertex
+** regions; the other kinds: perturb_queries) against central
+** differences, and its value against eval. */
+START_TEST(perturb_gradient_curves) {
+  oct_rng r = oct_rng_new(150);
+  oc_noise nz = {1.1, 0.6, 0, 3, 43};
+  oc_error e;
+  oc_vec3 pts[5] = {
+      {-2, 0, 0}, {0, 1.5, 0}, {2, 0, 0.5}, {3, 2, 0}, {1, 3, -1}};
+  oc_node *k[2] = {
+      OCT_OK(oc_curve(pts, 5, 0, 1.3, 1, &e)),
+      OCT_OK(oc_curve(pts, 4, 1, 1.3, -0.8, &e))}; /* a flattened Bezier */
+  for (int i = 0; i < 2; i++) {
+    oc_program *pp = oct_compile(OCT_OK(oc_perturb(k[i], &nz, &e)), 0, 0);
+    oc_node_release(k[i]);
+    double L = oc_program_lipschitz(pp);
+    int checked = 0;
+    for (int n = 0; n < 2000; n++) {
+      oc_vec3 p = oct_in_box(&r, oct_v(-4, -3, -3), oct_v(5, 5, 3));
+      double f = oc_program_eval(pp, p);
+      if (f == 0 || fabs(f) == 1 || f == -0.8) continue;
+      oct_check_grad(pp, p, 1e-6, 1e-7 * L);
+      checked++;
+    }
+    ck_assert_int_gt(checked, 200);
+    oc_program_free(pp);
+  }
+}
+END_TEST
+
 /* Curves and cones: the perturbed radius stays within [rho_min, rho_max],
 ** so g(d / rho_min) <= f <= g(d / rho_max) (E = 1), d recovered from the
 ** unperturbed field. */
@@ -1239,6 +1269,7 @@ int main(void) {
   tcase_add_test(tc, perturb_amplitude_zero);
   tcase_add_loop_test(tc, perturb_star_shaped, 0, 2);
   tcase_add_loop_test(tc, perturb_queries, 0, 8);
+  tcase_add_test(tc, perturb_gradient_curves);
   tcase_add_test(tc, perturb_bracket);
   tcase_add_test(tc, perturb_rejects_non_primitives);
   tcase_add_test(tc, dag_instancing);

@@ -89,6 +89,38 @@ START_TEST(spans_cover_variation) {
 }
 END_TEST
 
+/* Curves, plain and perturbed (an arch): spans per chunk of segments keep
+** the contract, and a column under the arch's top spans the top only, not
+** the legs. */
+START_TEST(spans_of_curves_follow_them) {
+  oc_error err;
+  oc_vec3 spine[4] = {{-20, 0, -2}, {-22, 0, 28}, {22, 0, 28}, {20, 0, -2}};
+  oc_vec3 zig[5] = {
+      {0, -30, 0}, {10, -25, 12}, {20, -30, 0}, {30, -25, 9}, {40, -30, 1}};
+  oc_noise nz = {6, 1.5, 0, 3, 9};
+  oc_node *arch = OCT_OK(oc_curve(spine, 4, 1, 6, 1, &err));
+  oc_node *k[2] = {OCT_OK(oc_perturb(arch, &nz, &err)),
+                   OCT_OK(oc_curve(zig, 5, 0, 2, 1, &err))};
+  oc_node_release(arch);
+  oc_node *b = OCT_OK(oc_blend(k, 2, &err));
+  oc_node_release(k[0]);
+  oc_node_release(k[1]);
+  oc_program *pr = oct_compile(b, 0, 0);
+  oct_rng r = oct_rng_new(19);
+  for (int c = 0; c < 300; c++) {
+    double x = oct_unif(&r, -35, 45), y = oct_unif(&r, -40, 12);
+    double w = oct_unif(&r, 0.2, 4);
+    check_gaps(pr, &r, x, y, x + w, y + w);
+  }
+  /* above the middle of the arch: its top is near z = 20.5 */
+  oc_zspan s[8];
+  int n = oc_program_column_spans(pr, -1, -1, 1, 1, s, 8);
+  ck_assert_int_ge(n, 1);
+  ck_assert_msg(s[0].lo > 0, "arch top column spans from %g", s[0].lo);
+  oc_program_free(pr);
+}
+END_TEST
+
 START_TEST(spans_of_plane_are_thin) {
   oc_error err;
   oc_node *pl = OCT_OK(oc_plane(oct_v(0, 0, 5), oct_v(0, 0, 1), 2, 1, &err));
@@ -175,6 +207,7 @@ int main(void) {
   TCase *tc = tcase_create("query");
   tcase_set_timeout(tc, 60);
   tcase_add_test(tc, spans_cover_variation);
+  tcase_add_test(tc, spans_of_curves_follow_them);
   tcase_add_test(tc, spans_of_plane_are_thin);
   tcase_add_test(tc, spans_merge_to_max);
   tcase_add_test(tc, local_lipschitz_holds);
