@@ -83,27 +83,34 @@ static int direct_blocks(const oc_mcgrid *g, int ja, int jr, oc_mcwork *w) {
 ** cubes the surface crosses, from the elevations of its four sample
 ** columns (no dilation: every sample of them is on the surface's side
 ** given by its elevation, so no other cube holds a crossing); closed
-** meshes add the cap cubes. 1 done, 0 when an elevation is not finite,
+** meshes add the cap cubes that hold one. 1 done, 0 when an elevation is not finite,
 ** -1 out of memory. */
 static int exact_cubes(const oc_mcgrid *g, oc_mcwork *w,
                        const struct oc_hfsurf *hs, int i, int j, size_t fc) {
+  int nz = g->n[2];
   double lo = INFINITY, hi = -INFINITY;
+  int bottom = 0, top = 0; /* a sample of the bottom/top layer inside */
+  double z0 = oc_mc_coord(g, 2, 0), z1 = oc_mc_coord(g, 2, nz - 1);
   for (int q = 0; q < 4; q++) {
     double e = oc_mc_elevation(g, w, hs, i + (q & 1), j + (q >> 1))[0];
     lo = fmin(lo, e);
     hi = fmax(hi, e);
+    bottom |= oc_hfsurf_value(hs, e, z0) > g->T;
+    top |= oc_hfsurf_value(hs, e, z1) > g->T;
   }
   if (!(isfinite(lo) && isfinite(hi))) return 0;
-  int nz = g->n[2];
   oc_zspan sp[2];
   int n = oc_hfsurf_elev_spans(hs, lo, hi, sp);
-  if (!g->open && oc_mc_rlist_add(&w->cube, fc, -1, -1)) return -1;
+  /* the cap cubes against the padding (outside) hold a crossing only
+  ** where a sample next to it is inside */
+  if (!g->open && bottom && oc_mc_rlist_add(&w->cube, fc, -1, -1)) return -1;
   for (int s = 0; s < n; s++) {
     oc_mc_irange cr, sr;
     span_ranges(g, sp[s].lo, sp[s].hi, 0, &cr, &sr);
     if (oc_mc_rlist_add(&w->cube, fc, cr.lo, cr.hi)) return -1;
   }
-  if (!g->open && oc_mc_rlist_add(&w->cube, fc, nz - 1, nz - 1)) return -1;
+  if (!g->open && top && oc_mc_rlist_add(&w->cube, fc, nz - 1, nz - 1))
+    return -1;
   return 1;
 }
 

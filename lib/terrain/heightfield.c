@@ -171,20 +171,36 @@ double oc_heightfield_height(const oc_heightfield *hf, double x, double y,
   cr_weights(tu, wu, dwu);
   cr_weights(tv, wv, dwv);
   double h = 0, hu = 0, hv = 0;
-  for (int b = 0; b < 4; b++) {
-    int jj = j - 1 + b;
-    jj = jj < 0 ? 0 : jj >= hf->ny ? hf->ny - 1 : jj;
-    const float *row = hf->z + (size_t)jj * (size_t)hf->nx;
-    double r = 0, dr = 0;
-    for (int a = 0; a < 4; a++) {
-      int ii = i - 1 + a;
-      ii = ii < 0 ? 0 : ii >= hf->nx ? hf->nx - 1 : ii;
-      r += wu[a] * row[ii];
-      dr += dwu[a] * row[ii];
+  if (i >= 1 && i + 2 < hf->nx && j >= 1 && j + 2 < hf->ny) {
+    /* inside: no clamping; the same sums in the same order */
+    const float *row = hf->z + (size_t)(j - 1) * (size_t)hf->nx + (i - 1);
+    for (int b = 0; b < 4; b++, row += hf->nx) {
+      double r = wu[0] * row[0] + wu[1] * row[1] + wu[2] * row[2] +
+                 wu[3] * row[3];
+      h += wv[b] * r;
+      if (grad) {
+        double dr = dwu[0] * row[0] + dwu[1] * row[1] + dwu[2] * row[2] +
+                    dwu[3] * row[3];
+        hu += wv[b] * dr;
+        hv += dwv[b] * r;
+      }
     }
-    h += wv[b] * r;
-    hu += wv[b] * dr;
-    hv += dwv[b] * r;
+  } else {
+    for (int b = 0; b < 4; b++) {
+      int jj = j - 1 + b;
+      jj = jj < 0 ? 0 : jj >= hf->ny ? hf->ny - 1 : jj;
+      const float *row = hf->z + (size_t)jj * (size_t)hf->nx;
+      double r = 0, dr = 0;
+      for (int a = 0; a < 4; a++) {
+        int ii = i - 1 + a;
+        ii = ii < 0 ? 0 : ii >= hf->nx ? hf->nx - 1 : ii;
+        r += wu[a] * row[ii];
+        dr += dwu[a] * row[ii];
+      }
+      h += wv[b] * r;
+      hu += wv[b] * dr;
+      hv += dwv[b] * r;
+    }
   }
   if (grad) {
     grad[0] = inu ? hu / hf->cell : 0;
