@@ -23,7 +23,7 @@
 #define MAX_CUBES ((double)(1ull << 40))
 #define DEFAULT_STEPS 6
 #define MAX_STEPS 64
-#define SLAB_ROWS 32
+#define SLAB_ROWS 16
 /* Samples of one slab's band: 20 bytes each with their edge slots, so
 ** at most 640 MiB per thread. */
 #define MAX_SLAB_SAMPLES ((size_t)1 << 25)
