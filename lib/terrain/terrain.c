@@ -22,7 +22,7 @@
 #include "terrain/terrain.h"
 
 /* g(x) = 1/2: where f_P = 2T g crosses T. sqrt(1 - 2^(-1/3)). */
-#define X_HALF 0.45020879914569640
+#define X_HALF 0.45420201894740647
 #define DEFAULT_W 1.0
 
 /* ---- sigma ------------------------------------------------------------ */

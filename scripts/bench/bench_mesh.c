@@ -3,10 +3,12 @@
 **
 ** 1. A terrain-like scene: an implicitized fBm heightfield as the ground,
 **    with about 2 % of its area covered by 3D features (carved spheres,
-**    boulders, a perturbed arch), meshed over the same box and cell with
-**    surface bounds and on the full grid, both by root finding everywhere
-**    (no direct extraction); the meshes must be the same up to vertex
-**    order.
+**    boulders, a perturbed arch), meshed over the same box and cell on
+**    the full grid (root finding on every edge) and with surface bounds
+**    and direct elevation extraction (seed 000's t0 and t); the meshes
+**    must have the same triangles on the same grid edges. Surface bounds
+**    with root finding everywhere, for context, must give the full grid's
+**    mesh to the bit.
 ** 2. The same kind of scene over 2000 x 2000 columns, a band 64 cells
 **    thick, 2 threads: seconds and peak memory (in a child process, so the
 **    peak is that run's own).
@@ -126,6 +128,67 @@ static oc_mesh *mesh(const oc_program *p, oc_aabb box, double cell, int full,
   return m;
 }
 
+/* The best of `reps` runs (the mesh of the last). */
+static oc_mesh *mesh_best(const oc_program *p, oc_aabb box, double cell,
+                          int full, int no_direct, int reps, double *sec) {
+  oc_mesh *m = NULL;
+  *sec = INFINITY;
+  for (int r = 0; r < reps; r++) {
+    double s;
+    oc_mesh_free(m);
+    m = mesh(p, box, cell, full, no_direct, &s);
+    *sec = fmin(*sec, s);
+  }
+  return m;
+}
+
+/* One cell size of the speedup scene: the full grid (standard marching
+** cubes, root finding on every edge) against surface bounds with direct
+** elevation extraction (seed 000's optimized polygonization: Table 1's
+** t0 / t), and against surface bounds alone (root finding everywhere,
+** the same mesh to the bit). Returns 0 when a mesh differs. */
+static int speedup_at(const oc_program *p, oc_aabb box, double cell,
+                      int figures) {
+  double sf, sb, sr;
+  omp_set_num_threads(2);
+  oc_mesh *mf = mesh_best(p, box, cell, 1, 1, 2, &sf);
+  oc_mesh *mb = mesh_best(p, box, cell, 0, 0, 3, &sb);
+  oc_mesh *mr = mesh_best(p, box, cell, 0, 1, 3, &sr);
+  oc_mesh_stats stf, stb, str;
+  oc_mesh_get_stats(mf, &stf);
+  oc_mesh_get_stats(mb, &stb);
+  oc_mesh_get_stats(mr, &str);
+  double lo[3] = {box.lo.x, box.lo.y, box.lo.z}, h[3], dev;
+  double ext[3] = {box.hi.x - box.lo.x, box.hi.y - box.lo.y,
+                   box.hi.z - box.lo.z};
+  for (int a = 0; a < 3; a++)
+    h[a] = ext[a] / ceil(ext[a] / cell * (1 - 1e-12));
+  int same_bits = same_mesh(mr, mf);
+  int same = same_edges(mb, mf, lo, h, &dev);
+  printf("# cell %g m (%.0f x %.0f x %.0f cells): %zu triangles; full grid "
+         "%.2f s (%zu field calls); surface bounds + direct extraction %.3f "
+         "s (%zu calls, %zu cells visited): %.1f x, %s (vertices within "
+         "%.1e m); surface bounds, root finding everywhere %.3f s: %.1f x, "
+         "%s\n",
+         cell, ext[0] / h[0], ext[1] / h[1], ext[2] / h[2], stf.triangles, sf,
+         stf.field_calls, sb, stb.field_calls, stb.cells_visited, sf / sb,
+         same ? "same triangles on the same edges" : "DIFFERENT TRIANGLES", dev,
+         sr, sf / sr, same_bits ? "same mesh to the bit" : "DIFFERENT MESH");
+  if (figures) {
+    printf("mesh.bounds_speedup: %.1f x\n", sf / sb);
+    printf("mesh.field_call_ratio: %.1f x\n",
+           (double)stf.field_calls / (double)stb.field_calls);
+  }
+  oc_mesh_free(mf);
+  oc_mesh_free(mb);
+  oc_mesh_free(mr);
+  return same && same_bits && dev < 1e-2 * cell;
+}
+
+/* The issue's scene: a 400 m wide implicitized fBm ground with features on
+** 2 % of it, in a box 128 m high. The figure is at cell 0.5 m (800 x 800
+** x 256 cells, the proportions of seed 000 Table 1's karst scene, whose
+** 3D coverage is also 2 %: 1520 x 1520 x 447); 1 m for context. */
 static void terrain_speedup(void) {
   oc_error err;
   double w = 400;
@@ -139,34 +202,14 @@ static void terrain_speedup(void) {
     exit(1);
   }
   oc_aabb box = {{0, 0, -64}, {w, w, 64}};
-  double sb, sf, sd, sfd;
-  omp_set_num_threads(2);
-  oc_mesh *mb = mesh(p, box, 1.0, 0, 1, &sb);
-  oc_mesh *mf = mesh(p, box, 1.0, 1, 1, &sf);
-  /* the same with direct extraction, for context */
-  oc_mesh_free(mesh(p, box, 1.0, 0, 0, &sd));
-  oc_mesh_free(mesh(p, box, 1.0, 1, 0, &sfd));
-  oc_mesh_stats stb, stf;
-  oc_mesh_get_stats(mb, &stb);
-  oc_mesh_get_stats(mf, &stf);
-  int same = same_mesh(mb, mf);
-  printf("# terrain %g x %g m (implicitized fBm ground), cell 1 m, box z "
-         "-64..64 (%g M cells): %zu triangles; root finding everywhere: "
-         "full grid %.2f s, bounded %.2f s; meshes %s\n",
-         w, w, w * w * 128 / 1e6, stb.triangles, sf, sb,
-         same ? "identical up to vertex order" : "DIFFER");
-  printf("# with direct elevation extraction: full grid %.2f s, bounded "
-         "%.2f s (%.1f x); full grid without over bounded with: %.1f x\n",
-         sfd, sd, sfd / sd, sf / sd);
-  printf("mesh.bounds_speedup: %.1f x\n", sf / sb);
-  printf("mesh.field_call_ratio: %.1f x\n",
-         (double)stf.field_calls / (double)stb.field_calls);
-  oc_mesh_free(mb);
-  oc_mesh_free(mf);
+  printf("# terrain %g x %g m (implicitized fBm ground, features on 2 %% of "
+         "it), box z -64..64, 2 threads:\n",
+         w, w);
+  int ok = speedup_at(p, box, 0.5, 1) & speedup_at(p, box, 1.0, 0);
   oc_program_free(p);
   oc_node_release(t);
   oc_heightfield_release(hf);
-  if (!same) exit(1);
+  if (!ok) exit(1);
 }
 
 /* Issue 5: a 2048 x 2048 DEM, implicitized, meshed at its cell over its
