@@ -6,12 +6,16 @@
 ** evaluates value and gradient together (one call), shrinks the bracket,
 ** and takes a Newton step along the edge, falling back to false position
 ** and then bisection when Newton leaves the bracket. The gradient of the
-** last step gives the normal. `steps` bounds the iterations and sets the
-** accuracy: iteration stops once a Newton step moves the vertex by less
-** than 10^(-steps/3) of the edge, after which the error is about the
-** square of that (the default 6 stops below 1e-2, leaving ~1e-4 of a cell
-** or less, and most vertices cost one or two calls; 20 reaches double
-** precision). The edge parameter is finally kept 1e-3 (or a few float ulps,
+** last step gives the normal. `steps` sets the accuracy and the usual
+** number of iterations: iteration stops once a Newton step moves the
+** vertex by less than tol = 10^(-steps/3) of the edge, after which the
+** error is about the square of that (the default 6 stops below 1e-2,
+** leaving ~1e-4 of a cell or less, and most vertices cost one or two
+** calls; 20 reaches double precision). Past `steps` iterations, it goes
+** on only while the bracket is wider than tol^2, which happens where the
+** field is flat over most of the edge (a transition narrower than a
+** cell), so that no vertex stays far from the surface. The edge parameter is
+*finally kept 1e-3 (or a few float ulps,
 ** far from the origin) away from the samples, so that no vertex coincides
 ** with a grid point even once rounded to float: distinct edges give
 ** distinct vertices and no triangle degenerates.
@@ -25,6 +29,7 @@
 #include "mesh/mcgrid.h"
 
 #define BRACKET_TOL 1e-7
+#define MAX_ITERS 64
 
 static void unit_or_flag(const oc_vec3 *gr, float nrm[3], int *flat,
                          double fallback_sign, int axis) {
@@ -75,7 +80,11 @@ int oc_mc_vertex(const oc_mcgrid *g, const int s[3], int axis, double va,
   oc_vec3 gr = {0, 0, 0};
   int calls = 0, fallbacks = 0;
   const double tol = g->newton_tol;
-  for (int it = 0; it < g->steps; it++) {
+  /* past the budget, only while the bracket is wider than tol^2: where
+  ** the field is flat (a narrow transition in a long edge) Newton has
+  ** nothing to go on, and the fallbacks need more steps */
+  const double wide = fmax(tol * tol, BRACKET_TOL);
+  for (int it = 0; it < g->steps || (it < MAX_ITERS && hi - lo > wide); it++) {
     p[axis] = co + t * d;
     double f = oc_program_gradient(g->prog, (oc_vec3){p[0], p[1], p[2]}, &gr);
     calls++;

@@ -19,20 +19,20 @@ typedef struct tri9 {
   float v[9];
 } tri9;
 
-static int cmp3(const float *a, const float *b) {
+static inline int cmp3(const float *a, const float *b) {
   for (int i = 0; i < 3; i++)
     if (a[i] != b[i]) return a[i] < b[i] ? -1 : 1;
   return 0;
 }
 
-static int cmp9(const void *x, const void *y) {
+static inline int cmp9(const void *x, const void *y) {
   int c = memcmp(x, y, sizeof(tri9));
   return (c > 0) - (c < 0);
 }
 
 /* Triangles as position triples, each rotated so its smallest vertex
 ** comes first (orientation kept), sorted. */
-static tri9 *canon(const oc_mesh *m, size_t *n) {
+static inline tri9 *canon(const oc_mesh *m, size_t *n) {
   *n = oc_mesh_triangle_count(m);
   const float *P = oc_mesh_positions(m);
   const uint32_t *I = oc_mesh_indices(m);
@@ -49,7 +49,7 @@ static tri9 *canon(const oc_mesh *m, size_t *n) {
 }
 
 /* 1 when a and b hold the same triangles up to vertex order. */
-static int same_mesh(const oc_mesh *a, const oc_mesh *b) {
+static inline int same_mesh(const oc_mesh *a, const oc_mesh *b) {
   size_t na, nb;
   tri9 *ta = canon(a, &na), *tb = canon(b, &nb);
   int same = na == nb && !memcmp(ta, tb, na * sizeof *ta);
@@ -61,8 +61,8 @@ static int same_mesh(const oc_mesh *a, const oc_mesh *b) {
 /* The sampling-grid edge a vertex lies on (samples at lo + (i + 1/2) h,
 ** padding at the box faces): the two coordinates on the grid, and the
 ** lower sample along the third, the one farthest from any grid plane. */
-static uint64_t edge_key(const float *p, const double lo[3],
-                         const double h[3]) {
+static inline uint64_t edge_key(const float *p, const double lo[3],
+                                const double h[3]) {
   double u[3], r[3];
   int ax = 0;
   for (int a = 0; a < 3; a++) {
@@ -83,12 +83,12 @@ typedef struct keyidx {
   uint32_t v;
 } keyidx;
 
-static int cmp_key(const void *x, const void *y) {
+static inline int cmp_key(const void *x, const void *y) {
   uint64_t a = ((const keyidx *)x)->key, b = ((const keyidx *)y)->key;
   return (a > b) - (a < b);
 }
 
-static int cmp_tri3(const void *x, const void *y) {
+static inline int cmp_tri3(const void *x, const void *y) {
   const uint32_t *a = x, *b = y;
   for (int k = 0; k < 3; k++)
     if (a[k] != b[k]) return a[k] < b[k] ? -1 : 1;
@@ -98,8 +98,8 @@ static int cmp_tri3(const void *x, const void *y) {
 /* Triangles of m as triples of vertex ranks in edge-key order, each
 ** rotated to start at its smallest (orientation kept), sorted; the keys
 ** sorted in *ks. NULL when two vertices share an edge. */
-static uint32_t *canon_edges(const oc_mesh *m, const double lo[3],
-                             const double h[3], keyidx **ks) {
+static inline uint32_t *canon_edges(const oc_mesh *m, const double lo[3],
+                                    const double h[3], keyidx **ks) {
   size_t nv = oc_mesh_vertex_count(m), nt = oc_mesh_triangle_count(m);
   const float *P = oc_mesh_positions(m);
   const uint32_t *I = oc_mesh_indices(m);
@@ -133,8 +133,9 @@ static uint32_t *canon_edges(const oc_mesh *m, const double lo[3],
 /* 1 when a and b have the same triangles on the same grid edges (box lo,
 ** sample spacing h), whatever the vertex order; *dev gets the largest
 ** distance between the two vertices of an edge. */
-static int same_edges(const oc_mesh *a, const oc_mesh *b, const double lo[3],
-                      const double h[3], double *dev) {
+static inline int same_edges(const oc_mesh *a, const oc_mesh *b,
+                             const double lo[3], const double h[3],
+                             double *dev) {
   size_t nv = oc_mesh_vertex_count(a), nt = oc_mesh_triangle_count(a);
   *dev = INFINITY;
   if (nv != oc_mesh_vertex_count(b) || nt != oc_mesh_triangle_count(b))

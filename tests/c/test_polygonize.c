@@ -337,6 +337,36 @@ START_TEST(capped_half_space) {
 }
 END_TEST
 
+/* A transition far narrower than a cell (a tilted plane of falloff
+** 0.03 meshed at cell 0.4): the field is flat at both samples of most
+** crossing edges, so Newton has nothing to go on and the fallbacks need
+** more than the default step budget; every vertex must still end on the
+** surface. */
+START_TEST(narrow_transition_vertices) {
+  oc_error e;
+  oc_vec3 n = oct_v(0.3, 0.2, 1);
+  n = oct_mul(n, 1 / oct_len(n));
+  const double R = 0.03;
+  oc_program *pr =
+      oct_compile(OCT_OK(oc_plane(oct_v(0, 0, 0), n, R, 1, &e)), 0, 0);
+  oc_aabb box = box3(-3, -3, -2, 3, 3, 2);
+  oc_polygonize_params pp = params(box, 0.4);
+  oc_mesh *m = mesh_ok(pr, &pp);
+  meshinfo in = check_mesh(m, 1, box);
+  ck_assert_int_eq(in.euler, 2);
+  double ds = iso_radius(R, 1, 0.5), worst = 0;
+  const float *P = oc_mesh_positions(m);
+  for (size_t v = 0; v < in.nv; v++) {
+    if (on_box_face(box, P + 3 * v)) continue;
+    double d = P[3 * v] * n.x + P[3 * v + 1] * n.y + P[3 * v + 2] * n.z;
+    worst = fmax(worst, fabs(d - ds));
+  }
+  ck_assert_msg(worst < 1e-3 * 0.4, "a vertex %g from the surface", worst);
+  oc_mesh_free(m);
+  oc_program_free(pr);
+}
+END_TEST
+
 START_TEST(sphere_crossing_box) {
   const double R = 1.5;
   oc_program *pr = point_prog(oct_v(1.9, 0.1, -0.05), R, 1);
@@ -946,6 +976,7 @@ static Suite *suite(void) {
   tcase_add_test(t, ring_euler_zero);
   tcase_add_test(t, box_euler_two);
   tcase_add_test(t, capped_half_space);
+  tcase_add_test(t, narrow_transition_vertices);
   tcase_add_test(t, sphere_crossing_box);
   tcase_add_test(t, open_surface);
   tcase_add_test(t, resolution_and_threshold);
