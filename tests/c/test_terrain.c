@@ -615,7 +615,10 @@ START_TEST(dem_meshed_closed) {
   oc_aabb inner = {oct_v(10, 10, b.lo.z - 1), oct_v(80, 70, b.hi.z + 1)};
   oc_mesh *mo = polygonize(pr, inner, 0.7, 0, 0, 1);
   check_file(mo, dir, 0, 0);
+  oc_mesh *mof = polygonize(pr, inner, 0.7, 1, 0, 1);
+  ck_assert(same_triangles(mo, mof));
   oc_mesh_free(mo);
+  oc_mesh_free(mof);
   oc_mesh_free(m1);
   oc_mesh_free(m2);
   oc_mesh_free(m3);
@@ -681,7 +684,10 @@ START_TEST(sculpted_terrain_seamless) {
   ck_assert(oc_program_eval(pr, oct_v(40, 40, h2 - 0.1)) < 0.5);
   oc_mesh *mi = polygonize(pr, box, 0.6, 0, 0, 0);
   check_file(mi, dir, 1, 2);
+  oc_mesh *mif = polygonize(pr, box, 0.6, 1, 0, 0);
+  ck_assert(same_triangles(mi, mif));
   oc_mesh_free(mi);
+  oc_mesh_free(mif);
   oc_program_free(pr);
   oc_heightfield_release(flip);
   oc_heightfield_release(hf);
