@@ -30,9 +30,10 @@ static int32_t clampi(double v, int32_t lo, int32_t hi) {
 /* ---- 1. the band ------------------------------------------------------- */
 
 /* Cube and sample k-ranges of the z-span [zl, zh]: the cubes meeting it,
-** grown by `grow` cubes (1: seed 000's dilation), and the samples in it, with a
-** margin far above the rounding of this arithmetic (a sample outside is
-** in a gap, where the field is exactly constant along the column). The
+** grown by `grow` cubes (1: seed 000's dilation), and the samples in it,
+** with a margin far above the rounding of this arithmetic (a sample
+** outside is in a gap, where the field is exactly constant along the
+** column). The
 ** padding samples of open meshes lie on the faces: they vary when the
 ** span reaches the face. */
 static void span_ranges(const oc_mcgrid *g, double zl, double zh, int grow,
@@ -83,8 +84,8 @@ static int direct_blocks(const oc_mcgrid *g, int ja, int jr, oc_mcwork *w) {
 ** cubes the surface crosses, from the elevations of its four sample
 ** columns (no dilation: every sample of them is on the surface's side
 ** given by its elevation, so no other cube holds a crossing); closed
-** meshes add the cap cubes that hold one. 1 done, 0 when an elevation is not finite,
-** -1 out of memory. */
+** meshes add the cap cubes that hold one. 1 done, 0 when an elevation is
+** not finite, -1 out of memory. */
 static int exact_cubes(const oc_mcgrid *g, oc_mcwork *w,
                        const struct oc_hfsurf *hs, int i, int j, size_t fc) {
   int nz = g->n[2];

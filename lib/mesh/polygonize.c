@@ -175,6 +175,8 @@ static int reserve(void *pp, size_t *cap, size_t need, int s, int nslab,
   size_t c = want < most ? (size_t)want : need;
   if (c < need) c = need;
   void *p = realloc(*(void **)pp, c * elem);
+  if (!p && c > need) /* the projection overshot what the system gives */
+    p = realloc(*(void **)pp, (c = need) * elem);
   if (!p) return -1;
   *(void **)pp = p;
   *cap = c;
