@@ -664,6 +664,18 @@ START_TEST(sculpted_terrain_seamless) {
   oc_mesh_free(ms);
   oc_mesh_free(mf);
   oc_program_free(pr);
+  /* a round island cut by a mask: direct blocks inside the disc, the
+  ** mask's walls root-found; the same with or without bounds, closed */
+  oc_heightfield *disc = disc_mask(81, 1, 0, 0, 40, 40, 30);
+  pr = oct_compile(terrain_of(hf, 3, 1, 0, disc), 0, 0);
+  oc_mesh *mm = polygonize(pr, box, 0.6, 0, 0, 0);
+  check_file(mm, dir, 1, 2);
+  oc_mesh *mmf = polygonize(pr, box, 0.6, 1, 0, 0);
+  ck_assert(same_triangles(mm, mmf));
+  oc_mesh_free(mm);
+  oc_mesh_free(mmf);
+  oc_program_free(pr);
+  oc_heightfield_release(disc);
   /* floating island: below h, above h2 = -h / 2 - 8 (inverted) */
   oc_heightfield *flip = grid(81, 81, 1, 0, 0, 3, 12);
   float *z = oc_heightfield_samples_mut(flip);
