@@ -18,6 +18,15 @@
 int oc_program_column_query(const oc_program *P, double x0, double y0,
                             double x1, double y1, oc_zspan *out, int max,
                             uint32_t *hf);
+/* The same, and in zout (*nz of them, at most max; -1 with the whole
+** column) the z-spans outside which the field is constant along every
+** column of the footprint: those are the samples a column must evaluate
+** one by one. A subset of the spans' union: near a terrain's walls the
+** field varies across the footprint at every z, but along a column only
+** near the floor and the surface. */
+int oc_program_column_query_z(const oc_program *P, double x0, double y0,
+                              double x1, double y1, oc_zspan *out, int max,
+                              uint32_t *hf, oc_zspan *zout, int *nz);
 
 /* The surface f = T of such an op, for one threshold T. */
 typedef struct oc_hfsurf {

@@ -24,6 +24,11 @@
 typedef struct spans {
   oc_zspan s[SPAN_CAP];
   int n;
+  /* when wz, terrains keep theirs apart: where they may vary (t), and
+  ** where they may vary along a column (z); the others' are in s alone,
+  ** the same for both */
+  oc_zspan t[SPAN_CAP], z[SPAN_CAP];
+  int nt, nz, wz;
   int all;     /* the whole column */
   int nleaf;   /* ops met other than blends and unions */
   uint32_t hf; /* a heightfield-like op met through blends and unions only,
@@ -32,13 +37,23 @@ typedef struct spans {
 
 static void span_add(spans *S, double lo, double hi) {
   if (S->all || !(lo <= hi)) return;
-  if (isinf(lo) && isinf(hi))
+  if (isinf(lo) && isinf(hi)) {
     S->all = 1;
-  else
-    oc_spanset_add(S->s, &S->n, SPAN_CAP, lo, hi);
+    return;
+  }
+  oc_spanset_add(S->s, &S->n, SPAN_CAP, lo, hi);
 }
 static void span_add_v(void *S, double lo, double hi) {
   span_add(S, lo, hi);
+}
+/* A terrain's, when wz. */
+static void span_add_t(void *v, double lo, double hi) {
+  spans *S = v;
+  if (!S->all && lo <= hi) oc_spanset_add(S->t, &S->nt, SPAN_CAP, lo, hi);
+}
+static void span_add_z(void *v, double lo, double hi) {
+  spans *S = v;
+  if (!S->all && lo <= hi) oc_spanset_add(S->z, &S->nz, SPAN_CAP, lo, hi);
 }
 
 typedef struct foot {
@@ -167,12 +182,16 @@ static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
     plane_spans(par, f, S);
     if (direct) S->hf = i;
     return;
-  case OC_K_TERRAIN:
-    if (oc_terrain_spans(P->terr[o->kid], par, f->x0, f->y0, f->x1, f->y1,
-                         span_add_v, S) &&
+  case OC_K_TERRAIN: {
+    const oc_tdata *t = P->terr[o->kid];
+    if (oc_terrain_spans(t, par, f->x0, f->y0, f->x1, f->y1, 0,
+                         S->wz ? span_add_t : span_add_v, S) &&
         direct)
       S->hf = i;
+    if (S->wz)
+      oc_terrain_spans(t, par, f->x0, f->y0, f->x1, f->y1, 1, span_add_z, S);
     return;
+  }
   case OC_K_TURB:
     S->all = 1;
     return;
@@ -278,33 +297,58 @@ static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
   }
 }
 
-int oc_program_column_query(const oc_program *P, double x0, double y0,
-                            double x1, double y1, oc_zspan *out, int max,
-                            uint32_t *hf) {
+/* Closes the smallest gaps of set s (n spans) until at most max remain,
+** and copies it to out. */
+static int reduce(oc_zspan *s, int n, oc_zspan *out, int max) {
+  while (n > max) {
+    int best = 0;
+    double gap = INFINITY;
+    for (int k = 0; k + 1 < n; k++)
+      if (s[k + 1].lo - s[k].hi < gap) {
+        gap = s[k + 1].lo - s[k].hi;
+        best = k;
+      }
+    s[best].hi = s[best + 1].hi;
+    for (int k = best + 1; k + 1 < n; k++)
+      s[k] = s[k + 1];
+    n--;
+  }
+  for (int k = 0; k < n; k++)
+    out[k] = s[k];
+  return n;
+}
+
+int oc_program_column_query_z(const oc_program *P, double x0, double y0,
+                              double x1, double y1, oc_zspan *out, int max,
+                              uint32_t *hf, oc_zspan *zout, int *nz) {
   if (hf) *hf = OC_NONE;
+  if (nz) *nz = -1;
   if (!(x0 <= x1 && y0 <= y1) || max < 1) return -1;
   foot f = {x0, y0, x1, y1};
-  spans S = {.n = 0, .all = 0, .nleaf = 0, .hf = OC_NONE};
+  spans S = {.n = 0,
+             .nt = 0,
+             .nz = 0,
+             .wz = zout != NULL,
+             .all = 0,
+             .nleaf = 0,
+             .hf = OC_NONE};
   op_spans(P, P->root, &f, &S, 0, 1);
   if (S.all) return -1;
   if (hf && S.nleaf == 1) *hf = S.hf;
-  /* reduce to max spans by closing the smallest gaps */
-  while (S.n > max) {
-    int best = 0;
-    double gap = INFINITY;
-    for (int k = 0; k + 1 < S.n; k++)
-      if (S.s[k + 1].lo - S.s[k].hi < gap) {
-        gap = S.s[k + 1].lo - S.s[k].hi;
-        best = k;
-      }
-    S.s[best].hi = S.s[best + 1].hi;
-    for (int k = best + 1; k + 1 < S.n; k++)
-      S.s[k] = S.s[k + 1];
-    S.n--;
+  if (zout) {
+    for (int k = 0; k < S.n; k++)
+      oc_spanset_add(S.z, &S.nz, SPAN_CAP, S.s[k].lo, S.s[k].hi);
+    for (int k = 0; k < S.nt; k++)
+      oc_spanset_add(S.s, &S.n, SPAN_CAP, S.t[k].lo, S.t[k].hi);
+    *nz = reduce(S.z, S.nz, zout, max);
   }
-  for (int k = 0; k < S.n; k++)
-    out[k] = S.s[k];
-  return S.n;
+  return reduce(S.s, S.n, out, max);
+}
+
+int oc_program_column_query(const oc_program *P, double x0, double y0,
+                            double x1, double y1, oc_zspan *out, int max,
+                            uint32_t *hf) {
+  return oc_program_column_query_z(P, x0, y0, x1, y1, out, max, hf, NULL, NULL);
 }
 
 int oc_program_column_spans(const oc_program *P, double x0, double y0,

@@ -137,7 +137,7 @@ int oc_mc_band(const oc_mcgrid *g, int ja, int jb, int jr, oc_mcwork *w) {
     for (size_t q = 0; q < nsc; q++)
       w->dsurf[q] = w->esurf[q] = NULL;
   }
-  oc_zspan sp[MAXSPANS], lsp[2];
+  oc_zspan sp[MAXSPANS], zsp[MAXSPANS], lsp[2];
   size_t c = 0;
   for (int j = ja; j <= jr; j++) {
     for (int i = -1; i < nx; i++, c++) {
@@ -163,10 +163,12 @@ int oc_mc_band(const oc_mcgrid *g, int ja, int jb, int jr, oc_mcwork *w) {
       uint32_t hf = OC_MC_NONE;
       double fx0 = oc_mc_coord(g, 0, i - 1), fy0 = oc_mc_coord(g, 1, j - 1);
       double fx1 = oc_mc_coord(g, 0, i + 2), fy1 = oc_mc_coord(g, 1, j + 2);
+      int nzs = -1;
       if (!g->full || g->direct)
-        ns = oc_program_column_query(g->prog, fx0, fy0, fx1, fy1, sp, MAXSPANS,
-                                     g->nsurf ? &hf : NULL);
-      if (g->full) ns = -1;
+        ns =
+            oc_program_column_query_z(g->prog, fx0, fy0, fx1, fy1, sp, MAXSPANS,
+                                      g->nsurf ? &hf : NULL, zsp, &nzs);
+      if (g->full) ns = nzs = -1;
       const struct oc_hfsurf *hs =
           hf != OC_MC_NONE ? oc_mc_surface(g, hf) : NULL;
       if (g->direct && i >= 0 && j >= 0 && hs && oc_mc_direct_kind(hs))
@@ -196,13 +198,15 @@ int oc_mc_band(const oc_mcgrid *g, int ja, int jb, int jr, oc_mcwork *w) {
             return -1;
         }
       }
-      if (ns < 0) {
+      /* samples evaluated one by one: where the field varies along the
+      ** column (the others share their gap's value) */
+      if (nzs < 0) {
         if (oc_mc_rlist_add(&w->var, fv, -g->open, nz - 1 + g->open)) return -1;
       } else {
-        for (int s = 0; s < ns; s++) {
+        for (int s = 0; s < nzs; s++) {
           oc_mc_irange cr, sr;
-          if (!(sp[s].lo <= sp[s].hi)) continue;
-          span_ranges(g, sp[s].lo, sp[s].hi, 1, &cr, &sr);
+          if (!(zsp[s].lo <= zsp[s].hi)) continue;
+          span_ranges(g, zsp[s].lo, zsp[s].hi, 1, &cr, &sr);
           if (oc_mc_rlist_add(&w->var, fv, sr.lo, sr.hi)) return -1;
         }
       }

@@ -205,8 +205,8 @@ double oc_terrain_lipschitz_in(const oc_tdata *t, const double *par,
 }
 
 int oc_terrain_spans(const oc_tdata *t, const double *par, double x0, double y0,
-                     double x1, double y1, void (*add)(void *, double, double),
-                     void *S) {
+                     double x1, double y1, int zvar,
+                     void (*add)(void *, double, double), void *S) {
   double W = par[OC_TPAR_W], R = t->R;
   int inside, outside;
   foot_prism(t, x0, y0, x1, y1, &inside, &outside);
@@ -217,10 +217,11 @@ int oc_terrain_spans(const oc_tdata *t, const double *par, double x0, double y0,
   double pad = 1e-9 * (fabs(hlo) + fabs(hhi) + W + R);
   double alo = hlo - W - pad, ahi = hhi + W + pad;
   add(S, alo, ahi);
-  /* where f_P varies, clipped to where f_T > 0 (elsewhere f = 0) */
+  /* where f_P varies, clipped to where f_T > 0 (elsewhere f = 0); along
+  ** a column, f_P depends on z only below zlo and above zhi */
   oc_zspan b[2] = {{t->zlo - R - pad, t->zlo + pad},
                    {t->zhi - pad, t->zhi + R + pad}};
-  if (!inside) {
+  if (!inside && !zvar) {
     b[0].hi = b[1].hi;
     b[1].lo = 1, b[1].hi = 0;
   }

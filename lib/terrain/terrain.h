@@ -38,13 +38,16 @@ oc_aabb oc_terrain_box(const oc_tdata *t);
 double oc_terrain_lipschitz(const oc_tdata *t, const double *par);
 double oc_terrain_lipschitz_in(const oc_tdata *t, const double *par,
                                const oc_aabb *b);
-/* Adds the z-spans where the terrain may vary over the footprint; returns
-** 1 when the footprint lies where f_P depends on z alone (inside Omega
-** shrunk by R), so that f = min(sigma(v), f_P(z)) along every column of
-** it: the case of direct elevation extraction. */
+/* Adds the z-spans where the terrain may vary over the footprint (zvar =
+** 0), or only those where it may vary along z, column by column (zvar =
+** 1: near the prism's walls f_P changes across the footprint at every
+** z, but along a column only near its floor and top); returns 1 when the
+** footprint lies where f_P depends on z alone (inside Omega shrunk by
+** R), so that f = min(sigma(v), f_P(z)) along every column of it: the
+** case of direct elevation extraction. */
 int oc_terrain_spans(const oc_tdata *t, const double *par, double x0, double y0,
-                     double x1, double y1, void (*add)(void *, double, double),
-                     void *S);
+                     double x1, double y1, int zvar,
+                     void (*add)(void *, double, double), void *S);
 
 /* Along a column of that case, with elevation h there: the field at z,
 ** and the z of the prism's cap (the bottom, or the top when inverted). */

@@ -9,6 +9,7 @@
 */
 #include <stdlib.h>
 
+#include "field/column.h"
 #include "ocheck.h"
 
 /* A terrain-like scene: a ground plane (optionally tilted), carved and
@@ -121,6 +122,83 @@ START_TEST(spans_of_curves_follow_them) {
 }
 END_TEST
 
+/* Spans along columns (what the mesher evaluates one by one): outside
+** them the field is constant along every column of the footprint, they
+** lie within the spans, and near a terrain's walls, where the field
+** varies across the footprint at every height, they keep only the floor
+** and the surface. */
+START_TEST(column_z_spans) {
+  enum { N = 41 };
+  float *z = malloc(N * N * sizeof *z);
+  for (int j = 0; j < N; j++)
+    for (int i = 0; i < N; i++)
+      z[j * N + i] = (float)(4 * sin(0.3 * i) * cos(0.2 * j));
+  oc_error e;
+  oc_heightfield *hf = oc_heightfield_new(N, N, 1, 0, 0, z, &e);
+  free(z);
+  ck_assert(hf != NULL);
+  oc_elevation src;
+  ck_assert_int_eq(oc_heightfield_elevation(hf, &src, &e), OC_OK);
+  oc_terrain_params tp = {4, 1, 0, 0, NULL};
+  oc_node *k[3];
+  k[0] = OCT_OK(oc_terrain(&src, &tp, &e));
+  tp.invert = 1;
+  tp.thickness = 10;
+  k[1] = OCT_OK(oc_terrain(&src, &tp, &e)); /* ground above: a roof */
+  src.release(src.ud);
+  k[2] = OCT_OK(oc_sphere(oct_v(20, 20, 0), 3, 2, -1, &e));
+  oc_node *b = OCT_OK(oc_blend(k, 3, &e));
+  for (int i = 0; i < 3; i++)
+    oc_node_release(k[i]);
+  oc_program *pr = oct_compile(b, 0, 0);
+  oct_rng r = oct_rng_new(23);
+  int tighter = 0;
+  for (int c = 0; c < 300; c++) {
+    double x = oct_unif(&r, -3, 43), y = oct_unif(&r, -3, 43);
+    double w = oct_unif(&r, 0.2, 3);
+    oc_zspan s[8], zs[8];
+    int nz;
+    int n =
+        oc_program_column_query_z(pr, x, y, x + w, y + w, s, 8, NULL, zs, &nz);
+    if (n < 0) {
+      ck_assert_int_lt(nz, 0);
+      continue;
+    }
+    ck_assert_int_ge(nz, 0);
+    double zlen = 0, slen = 0;
+    for (int q = 0; q < nz; q++) {
+      int in = 0;
+      for (int p = 0; p < n; p++)
+        in |= zs[q].lo >= s[p].lo && zs[q].hi <= s[p].hi;
+      ck_assert_msg(in, "z-span %g..%g outside the spans", zs[q].lo, zs[q].hi);
+      zlen += zs[q].hi - zs[q].lo;
+    }
+    for (int p = 0; p < n; p++)
+      slen += s[p].hi - s[p].lo;
+    tighter += zlen < 0.5 * slen;
+    /* gaps of zs: f constant along each column */
+    for (int g = 0; g <= nz; g++) {
+      double lo = g == 0 ? -40 : zs[g - 1].hi, hi = g == nz ? 40 : zs[g].lo;
+      if (!(hi > lo)) continue;
+      for (int t = 0; t < 6; t++) {
+        double px = oct_unif(&r, x, x + w), py = oct_unif(&r, y, y + w);
+        double za = oct_unif(&r, lo, hi), zb = oct_unif(&r, lo, hi);
+        if (za <= lo || za >= hi || zb <= lo || zb >= hi) continue;
+        double fa = oc_program_eval(pr, oct_v(px, py, za));
+        double fb = oc_program_eval(pr, oct_v(px, py, zb));
+        ck_assert_msg(fabs(fa - fb) <= 1e-12,
+                      "varies along the column at %g %g in gap %g..%g: "
+                      "%.17g at %g, %.17g at %g",
+                      px, py, lo, hi, fa, za, fb, zb);
+      }
+    }
+  }
+  ck_assert_int_gt(tighter, 10); /* the walls' columns */
+  oc_program_free(pr);
+  oc_heightfield_release(hf);
+}
+END_TEST
+
 START_TEST(spans_of_plane_are_thin) {
   oc_error err;
   oc_node *pl = OCT_OK(oc_plane(oct_v(0, 0, 5), oct_v(0, 0, 1), 2, 1, &err));
@@ -208,6 +286,7 @@ int main(void) {
   tcase_set_timeout(tc, 60);
   tcase_add_test(tc, spans_cover_variation);
   tcase_add_test(tc, spans_of_curves_follow_them);
+  tcase_add_test(tc, column_z_spans);
   tcase_add_test(tc, spans_of_plane_are_thin);
   tcase_add_test(tc, spans_merge_to_max);
   tcase_add_test(tc, local_lipschitz_holds);
