@@ -536,6 +536,19 @@ static int same_triangles(const oc_mesh *a, const oc_mesh *b) {
   return same;
 }
 
+/* Meshed with surface bounds (and direct extraction), the file checked
+** (closed with that Euler characteristic, or open), and the same
+** triangles as on the full grid. */
+static void check_bounded(const oc_program *pr, oc_aabb box, double cell,
+                          int open, const char *dir, long euler) {
+  oc_mesh *m = polygonize(pr, box, cell, 0, 0, open);
+  check_file(m, dir, !open, euler);
+  oc_mesh *mf = polygonize(pr, box, cell, 1, 0, open);
+  ck_assert(same_triangles(m, mf));
+  oc_mesh_free(m);
+  oc_mesh_free(mf);
+}
+
 START_TEST(dem_meshed_closed) {
   oc_heightfield *hf = grid(97, 81, 1, 0, 0, 6, 8);
   const double R = 5;
@@ -613,12 +626,7 @@ START_TEST(dem_meshed_closed) {
                 "%zu vertices off the surface, by up to %g", noff, off);
   /* open: the surface reaches the box and stops there */
   oc_aabb inner = {oct_v(10, 10, b.lo.z - 1), oct_v(80, 70, b.hi.z + 1)};
-  oc_mesh *mo = polygonize(pr, inner, 0.7, 0, 0, 1);
-  check_file(mo, dir, 0, 0);
-  oc_mesh *mof = polygonize(pr, inner, 0.7, 1, 0, 1);
-  ck_assert(same_triangles(mo, mof));
-  oc_mesh_free(mo);
-  oc_mesh_free(mof);
+  check_bounded(pr, inner, 0.7, 1, dir, 0);
   oc_mesh_free(m1);
   oc_mesh_free(m2);
   oc_mesh_free(m3);
@@ -668,12 +676,7 @@ START_TEST(sculpted_terrain_seamless) {
   ** mask's walls root-found; the same with or without bounds, closed */
   oc_heightfield *disc = disc_mask(81, 1, 0, 0, 40, 40, 30);
   pr = oct_compile(terrain_of(hf, 3, 1, 0, disc), 0, 0);
-  oc_mesh *mm = polygonize(pr, box, 0.6, 0, 0, 0);
-  check_file(mm, dir, 1, 2);
-  oc_mesh *mmf = polygonize(pr, box, 0.6, 1, 0, 0);
-  ck_assert(same_triangles(mm, mmf));
-  oc_mesh_free(mm);
-  oc_mesh_free(mmf);
+  check_bounded(pr, box, 0.6, 0, dir, 2);
   oc_program_free(pr);
   oc_heightfield_release(disc);
   /* floating island: below h, above h2 = -h / 2 - 8 (inverted) */
@@ -694,12 +697,7 @@ START_TEST(sculpted_terrain_seamless) {
   ck_assert(oc_program_eval(pr, oct_v(40, 40, h1 + 0.1)) < 0.5);
   ck_assert(oc_program_eval(pr, oct_v(40, 40, h2 + 0.1)) > 0.5);
   ck_assert(oc_program_eval(pr, oct_v(40, 40, h2 - 0.1)) < 0.5);
-  oc_mesh *mi = polygonize(pr, box, 0.6, 0, 0, 0);
-  check_file(mi, dir, 1, 2);
-  oc_mesh *mif = polygonize(pr, box, 0.6, 1, 0, 0);
-  ck_assert(same_triangles(mi, mif));
-  oc_mesh_free(mi);
-  oc_mesh_free(mif);
+  check_bounded(pr, box, 0.6, 0, dir, 2);
   oc_program_free(pr);
   oc_heightfield_release(flip);
   oc_heightfield_release(hf);
