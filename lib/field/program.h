@@ -77,6 +77,8 @@ size_t oc_bvh_build(const oc_aabb *boxes, size_t n, oc_bvhnode *nodes,
 /* The local Lipschitz bound of op `op` inside box b (query.c): what
 ** oc_program_lipschitz_in answers for the root. */
 double oc_op_lipschitz_in(const oc_program *P, uint32_t op, const oc_aabb *b);
+/* 1 when op is 0 all over box b, as far as supports tell (query.c). */
+int oc_op_zero_in(const oc_program *P, uint32_t op, const oc_aabb *b);
 /* The largest distance from its skeleton at which a perturb op is non-zero
 ** (eval.c). */
 double oc_perturb_reach(const oc_op *o, const double *par);

@@ -477,6 +477,48 @@ static double op_lip(const oc_program *P, uint32_t i, const oc_aabb *b,
   }
 }
 
+/* 1 when op i is 0 all over box b: its support misses b, or it is a
+** blend or union whose every child's does (0 otherwise, also when it
+** cannot tell). */
+static int op_zero(const oc_program *P, uint32_t i, const oc_aabb *b,
+                   int depth) {
+  const oc_op *o = &P->ops[i];
+  if (!box_meets(o->lo, o->hi, b)) return 1;
+  if (depth > OC_MAX_DEPTH + 8 ||
+      (o->kind != OC_K_BLEND && o->kind != OC_K_UNION))
+    return 0;
+  for (uint32_t k = 0; k < o->nkid; k++)
+    if (!op_zero(P, P->kids[o->kid + k], b, depth + 1)) return 0;
+  if (!o->nent) return 1;
+  uint32_t stack[BVH_STACK];
+  int sp = 0;
+  stack[sp++] = o->bvh;
+  while (sp) {
+    const oc_bvhnode *nd = &P->bvh[stack[--sp]];
+    if (!box_meets(nd->lo, nd->hi, b)) continue;
+    if (!nd->count) {
+      if (sp + 2 > BVH_STACK) return 0;
+      stack[sp++] = nd->first + 1;
+      stack[sp++] = nd->first;
+      continue;
+    }
+    for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
+      const oc_ent *e = &P->ent[j];
+      if (e->ref != OC_NONE) {
+        if (!op_zero(P, e->ref, b, depth + 1)) return 0;
+        continue;
+      }
+      double Rp = 1.0 / sqrt((double)e->ir2) * (1 + 1e-6);
+      if (box_d2(b, e->c[0], e->c[1], e->c[2]) < Rp * Rp) return 0;
+    }
+  }
+  return 1;
+}
+
+int oc_op_zero_in(const oc_program *P, uint32_t op, const oc_aabb *b) {
+  return oc_aabb_is_empty(*b) || op_zero(P, op, b, 0);
+}
+
 double oc_op_lipschitz_in(const oc_program *P, uint32_t op, const oc_aabb *b) {
   if (oc_aabb_is_empty(*b)) return 0;
   return op_lip(P, op, b, 0);

@@ -486,6 +486,9 @@ double oc_geo_lipschitz_in(const oc_program *P, const oc_op *o,
     return lip(P, ch, &m, ud);
   }
   case OC_K_EROSION: {
+    /* where f <= 0 the erosion is f itself: 0 where f's support misses
+    ** the box (as between islands under one erosion) */
+    if (oc_op_zero_in(P, ch, b)) return 0;
     /* L_f, plus depth (L_control + L_rho) where f_D may be non-zero */
     double L = lip(P, ch, b, ud);
     int hasctl = par[OC_GP_HASCTL] != 0;

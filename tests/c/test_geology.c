@@ -423,6 +423,48 @@ START_TEST(erosion_local_queries) {
 }
 END_TEST
 
+/* Erosion over two separate rocks: between them, where neither rock's
+** support reaches, the local bound is 0 (rays between islands take long
+** steps), and every local bound holds for point pairs. */
+START_TEST(erosion_zero_between_rocks) {
+  oc_error err;
+  oc_node *k[2] = {
+      OCT_OK(oc_box(oct_v(-40, -10, -10), oct_v(-20, 10, 10), 3, 1, &err)),
+      OCT_OK(oc_sphere(oct_v(30, 0, 0), 8, 3, 1, &err))};
+  oc_node *u = OCT_OK(oc_union(k, 2, &err));
+  oc_noise nz = noise(5, 1, 0, 3, 8);
+  oc_node *g = OCT_OK(oc_strata(&nz, &err));
+  oc_node *n = OCT_OK(oc_erosion(u, g, NULL, 0.6, &err));
+  for (int i = 0; i < 2; i++)
+    oc_node_release(k[i]);
+  oc_node_release(u);
+  oc_node_release(g);
+  oc_program *pr = oct_compile(n, 0, 0);
+  oct_rng r = oct_rng_new(29);
+  int zero = 0;
+  for (int i = 0; i < 400; i++) {
+    oc_vec3 lo = oct_in_box(&r, oct_v(-50, -20, -20), oct_v(45, 15, 15));
+    double w = oct_unif(&r, 0.5, 8);
+    oc_aabb box = {lo, oct_add(lo, oct_v(w, w, w))};
+    double Lb = oc_program_lipschitz_in(pr, box);
+    zero += Lb == 0;
+    for (int t = 0; t < 60; t++) {
+      oc_vec3 p = oct_in_box(&r, box.lo, box.hi);
+      oc_vec3 q = oct_in_box(&r, box.lo, box.hi);
+      double d = fabs(oc_program_eval(pr, p) - oc_program_eval(pr, q));
+      ck_assert_msg(d <= Lb * oct_len(oct_sub(p, q)) * (1 + 1e-9) + 1e-14,
+                    "local bound %g exceeded in a box at %g %g %g", Lb, lo.x,
+                    lo.y, lo.z);
+    }
+  }
+  ck_assert_int_gt(zero, 60);
+  /* a box between the rocks, inside the union's box */
+  oc_aabb mid = {oct_v(-10, -5, -5), oct_v(10, 5, 5)};
+  ck_assert(oc_program_lipschitz_in(pr, mid) == 0);
+  oc_program_free(pr);
+}
+END_TEST
+
 /* An eroded cliff meshes to the same bytes with 1 and 2 threads, and
 ** erosion removes volume: fewer inside samples than the plain box. */
 START_TEST(erosion_mesh_deterministic) {
@@ -527,6 +569,7 @@ int main(void) {
   tcase_add_test(tc, fault_discontinuous_exactly_on_boundary);
   tcase_add_loop_test(tc, erosion_formula, 0, 2);
   tcase_add_test(tc, erosion_local_queries);
+  tcase_add_test(tc, erosion_zero_between_rocks);
   tcase_add_test(tc, erosion_mesh_deterministic);
   tcase_add_test(tc, parameter_errors);
   suite_add_tcase(s, tc);
