@@ -241,6 +241,7 @@ void oc_tdata_free(oc_tdata *t) {
   if (!t) return;
   if (t->src.release) t->src.release(t->src.ud);
   free(t->dist);
+  free(t->mpyr);
   free(t);
 }
 

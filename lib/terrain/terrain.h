@@ -13,6 +13,8 @@
 
 #include "outcrop.h"
 
+#define OC_TMASK_LEVELS 32
+
 typedef struct oc_tdata {
   oc_elevation src; /* retained */
   double R, W;      /* prism falloff, half-width of sigma */
@@ -24,6 +26,11 @@ typedef struct oc_tdata {
   float *dist;               /* mask: distance to Omega shrunk by R */
   int mnx, mny;              /* mask grid */
   double mcell, mx0, my0;
+  /* min/max pyramid of dist: level k (1 .. mlev) holds, for blocks of
+  ** 2^k x 2^k nodes, (min, max) pairs at mpyr + moff[k], mw[k] per row */
+  float *mpyr;
+  int mlev, mw[OC_TMASK_LEVELS], mh[OC_TMASK_LEVELS];
+  size_t moff[OC_TMASK_LEVELS];
 } oc_tdata;
 
 /* par of a terrain op: T, W, k = sigma'(0) W / T, and max sigma'. */

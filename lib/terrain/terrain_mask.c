@@ -17,9 +17,9 @@
 #include "core/error.h"
 #include "terrain/terrain.h"
 
-/* Largest node count scanned by a range query before it answers the
-** trivial bounds. */
-#define RANGE_SCAN 256
+/* Largest node count a range query scans exactly; larger footprints read
+** the pyramid, at most 4 x 4 blocks. */
+#define RANGE_SCAN 64
 
 /* Squared distance transform of one line: d[q] = min_p (q - p)^2 + f[p]
 ** over the sites p with finite f. v, z: scratch of n and n + 1. */
@@ -90,6 +90,42 @@ static int edt(const unsigned char *site, int nx, int ny, float *out) {
     free(v);
   }
   return fail ? -1 : 0;
+}
+
+/* The min/max pyramid of t->dist (levels of 2 x 2 blocks, the last
+** block of a row or column possibly narrower). 0, or -1 out of memory. */
+static int mask_pyramid(oc_tdata *t) {
+  int w = t->mnx, h = t->mny, k = 0;
+  size_t total = 0;
+  while ((w > 1 || h > 1) && k + 1 < OC_TMASK_LEVELS) {
+    w = (w + 1) / 2, h = (h + 1) / 2, k++;
+    t->mw[k] = w, t->mh[k] = h, t->moff[k] = total;
+    total += 2 * (size_t)w * (size_t)h;
+  }
+  t->mlev = k;
+  t->mpyr = total ? malloc(total * sizeof *t->mpyr) : NULL;
+  if (total && !t->mpyr) return -1;
+  for (int l = 1; l <= k; l++) {
+    float *out = t->mpyr + t->moff[l];
+    int pw = l > 1 ? t->mw[l - 1] : t->mnx, ph = l > 1 ? t->mh[l - 1] : t->mny;
+    for (int b = 0; b < t->mh[l]; b++)
+      for (int a = 0; a < t->mw[l]; a++) {
+        float lo = INFINITY, hi = 0;
+        for (int q = 0; q < 4; q++) {
+          int i = 2 * a + (q & 1), j = 2 * b + (q >> 1);
+          if (i >= pw || j >= ph) continue;
+          size_t c = (size_t)j * (size_t)pw + (size_t)i;
+          float cl = l > 1 ? t->mpyr[t->moff[l - 1] + 2 * c] : t->dist[c];
+          float ch = l > 1 ? t->mpyr[t->moff[l - 1] + 2 * c + 1] : t->dist[c];
+          lo = cl < lo ? cl : lo;
+          hi = ch > hi ? ch : hi;
+        }
+        size_t o = 2 * ((size_t)b * (size_t)t->mw[l] + (size_t)a);
+        out[o] = lo;
+        out[o + 1] = hi;
+      }
+  }
+  return 0;
 }
 
 int oc_terrain_mask(oc_tdata *t, const oc_heightfield *mask, oc_error *err) {
@@ -166,6 +202,7 @@ int oc_terrain_mask(oc_tdata *t, const oc_heightfield *mask, oc_error *err) {
   t->mx0 = x0;
   t->my0 = y0;
   d = NULL;
+  if (mask_pyramid(t)) goto nomem;
   goto done;
 nomem:
   rc = oc_seterr(err, OC_ENOMEM, "out of memory for a %d x %d mask", nx, ny);
@@ -211,16 +248,23 @@ void oc_terrain_mask_range(const oc_tdata *t, double x0, double y0, double x1,
     return;
   }
   int i0 = (int)u0, i1 = (int)ceil(u1), j0 = (int)v0, j1 = (int)ceil(v1);
-  if ((double)(i1 - i0 + 1) * (j1 - j0 + 1) > RANGE_SCAN) {
-    /* too many nodes to scan (long ray segments): the interpolated
-    ** distance is sqrt(2)-Lipschitz, so the centre bounds the rest */
-    double cx = t->mx0 + 0.5 * (u0 + u1) * t->mcell;
-    double cy = t->my0 + 0.5 * (v0 + v1) * t->mcell;
-    double r = 0.5 * t->mcell * hypot(u1 - u0, v1 - v0);
-    double c = oc_terrain_mask_dist(t, cx, cy, NULL);
-    double m = sqrt(2.0) * (1 + 1e-6) * r + 1e-9 * (c + r);
-    *lo = fmax(0, c - m);
-    *hi = off ? INFINITY : c + m;
+  if (t->mlev >= 1 && (double)(i1 - i0 + 1) * (j1 - j0 + 1) > RANGE_SCAN) {
+    /* the coarsest blocks that cover the nodes 4 x 4 at most: a range
+    ** over a superset of them */
+    int k = 1;
+    while (k < t->mlev &&
+           ((i1 >> k) - (i0 >> k) >= 4 || (j1 >> k) - (j0 >> k) >= 4))
+      k++;
+    const float *lv = t->mpyr + t->moff[k];
+    double a = INFINITY, b = 0;
+    for (int j = j0 >> k; j <= j1 >> k; j++)
+      for (int i = i0 >> k; i <= i1 >> k; i++) {
+        size_t o = 2 * ((size_t)j * (size_t)t->mw[k] + (size_t)i);
+        a = fmin(a, lv[o]);
+        b = fmax(b, lv[o + 1]);
+      }
+    *lo = a;
+    *hi = off ? INFINITY : b;
     return;
   }
   double a = INFINITY, b = 0;

@@ -22,6 +22,7 @@
 
 #include "meshread.h"
 #include "ocheck.h"
+#include "terrain/terrain.h"
 #include "outcrop.h"
 
 /* ---- grids and an independent interpolation ------------------------------ */
@@ -256,6 +257,56 @@ START_TEST(gradient_lipschitz_support) {
   }
   oc_heightfield_release(mask);
   oc_heightfield_release(hf);
+}
+END_TEST
+
+/* The mask's distance range over a footprint: exact over few nodes, and
+** from the min/max pyramid over many, always a superset of the nodes'
+** range (lo below their minimum, hi above their maximum). */
+START_TEST(mask_range_pyramid) {
+  oc_heightfield *mask = disc_mask(203, 0.5, -3, 2, 45, 50, 38);
+  oc_tdata *t = calloc(1, sizeof *t);
+  t->R = 4;
+  t->src.x0 = t->src.y0 = -1e9;
+  t->src.x1 = t->src.y1 = 1e9;
+  oc_error e;
+  ck_assert_int_eq(oc_terrain_mask(t, mask, &e), OC_OK);
+  ck_assert_int_ge(t->mlev, 7);
+  oct_rng r = oct_rng_new(31);
+  int exact = 0, coarse = 0;
+  for (int k = 0; k < 3000; k++) {
+    double w = k % 3 ? oct_unif(&r, 0, 3) : oct_unif(&r, 3, 90);
+    double x0 = oct_unif(&r, -3, 98 - w), y0 = oct_unif(&r, 2, 103 - w);
+    double x1 = x0 + w, y1 = y0 + oct_unif(&r, 0, w);
+    double lo, hi;
+    oc_terrain_mask_range(t, x0, y0, x1, y1, &lo, &hi);
+    /* the nodes of the footprint, as the query takes them */
+    int i0 = (int)((x0 + 3) / 0.5), i1 = (int)ceil((x1 + 3) / 0.5);
+    int j0 = (int)((y0 - 2) / 0.5), j1 = (int)ceil((y1 - 2) / 0.5);
+    double a = INFINITY, b = 0;
+    for (int j = j0; j <= j1 && j < 203; j++)
+      for (int i = i0; i <= i1 && i < 203; i++) {
+        a = fmin(a, t->dist[(size_t)j * 203 + i]);
+        b = fmax(b, t->dist[(size_t)j * 203 + i]);
+      }
+    ck_assert_msg(lo <= a && hi >= b, "range [%g, %g] misses [%g, %g]", lo, hi,
+                  a, b);
+    if ((i1 - i0 + 1) * (j1 - j0 + 1) <= 64) {
+      ck_assert(lo == a && hi == b);
+      exact++;
+    } else {
+      coarse++;
+    }
+    /* and the interpolated distance anywhere inside lies in it */
+    for (int q = 0; q < 4; q++) {
+      double d = oc_terrain_mask_dist(t, oct_unif(&r, x0, x1),
+                                      oct_unif(&r, y0, y1), NULL);
+      ck_assert(d >= lo - 1e-6 && d <= hi + 1e-6);
+    }
+  }
+  ck_assert(exact > 500 && coarse > 500);
+  oc_tdata_free(t);
+  oc_heightfield_release(mask);
 }
 END_TEST
 
@@ -764,6 +815,7 @@ static Suite *suite(void) {
   tcase_add_test(t, embeds_heightfield);
   tcase_add_test(t, gradient_lipschitz_support);
   tcase_add_test(t, mask_shapes_domain);
+  tcase_add_test(t, mask_range_pyramid);
   tcase_add_test(t, source_ranges_and_slopes);
   tcase_add_test(t, column_spans_cover_and_tight);
   tcase_add_test(t, bad_input);
