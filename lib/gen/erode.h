@@ -72,11 +72,25 @@ typedef struct oc_erode_params {
 /* Runs the steps; returns the blend of base and every primitive made (base
 ** first, then the primitives in step and candidate order; without base
 ** when omit_base, and then NULL with OC_EINVAL when nothing was carved),
-** or NULL with err. *samples gets the number of rays that found the surface,
-**prims the
-** number of primitives (either pointer may be NULL). */
+** or NULL with err. st (or NULL) gets the candidates, the rays that found
+** the surface and the primitives made. */
 oc_node *oc_erode_run(const oc_erode_params *ep, const oc_erode_cand *cand,
-                      size_t n, size_t *samples, size_t *prims, oc_error *err);
+                      size_t n, oc_gen_sea_stats *st, oc_error *err);
+
+/* The parameters of the sea and river generators that oc_erode_params
+** takes as they are. */
+typedef struct oc_erode_common {
+  double radius, strength, beta, cutoff;
+  int steps;
+  uint64_t seed;
+} oc_erode_common;
+
+/* Fills *ep from those, the rest zero: resistance 0.5 without geology,
+** the default threshold for 0, and a marching step of half the smaller
+** of the grid's cell and the radius. */
+void oc_erode_shared(oc_erode_params *ep, oc_node *base, int omit_base,
+                     oc_node *geology, double threshold, double cell,
+                     const oc_erode_common *c, oc_progress progress);
 
 /* Candidate columns: maximal Poisson disk sets of radius `spacing` on
 ** square tiles of the heightfield's extent, only on the tiles that hold a

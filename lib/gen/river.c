@@ -120,7 +120,7 @@ oc_node *oc_generate_river(const oc_gen_river_params *pin, oc_gen_sea_stats *st,
   oc_erode_cand *cand = NULL;
   unsigned char *mask = NULL;
   oc_node *base = NULL, *out = NULL;
-  size_t ncol = 0, nc = 0, samples = 0, prims = 0;
+  size_t ncol = 0, nc = 0;
   double thr = p.power;
 
   if (!(base = oc_erode_base(hf, p.terrain, err))) return NULL;
@@ -173,28 +173,13 @@ oc_node *oc_generate_river(const oc_gen_river_params *pin, oc_gen_sea_stats *st,
   }
 
   oc_erode_params ep;
-  memset(&ep, 0, sizeof ep);
-  ep.base = base;
-  ep.omit_base = p.no_terrain;
-  ep.geology = p.geology;
-  ep.rho = 0.5;
-  ep.threshold = p.threshold > 0 ? p.threshold : OC_DEFAULT_THRESHOLD;
-  ep.radius = p.radius;
-  ep.strength = p.strength;
-  ep.beta = p.beta;
-  ep.cutoff = p.cutoff;
-  ep.step = 0.5 * (cell < p.radius ? cell : p.radius);
-  ep.steps = p.steps;
-  ep.seed = p.seed;
-  ep.progress = p.progress;
+  oc_erode_common com = {p.radius, p.strength, p.beta,
+                         p.cutoff, p.steps,    p.seed};
+  oc_erode_shared(&ep, base, p.no_terrain, p.geology, p.threshold, cell, &com,
+                  p.progress);
   ep.pbase = 0.3;
   ep.pspan = 0.7;
-  out = oc_erode_run(&ep, cand, nc, &samples, &prims, err);
-  if (out && st) {
-    st->columns = nc;
-    st->samples = samples;
-    st->primitives = prims;
-  }
+  out = oc_erode_run(&ep, cand, nc, st, err);
 done:
   oc_node_release(base);
   oc_heightfield_release(pw);

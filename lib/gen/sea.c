@@ -122,7 +122,7 @@ oc_node *oc_generate_sea(const oc_gen_sea_params *pin, oc_gen_sea_stats *st,
   double cell = oc_heightfield_cell(hf), *xy = NULL;
   oc_erode_cand *cand = NULL;
   oc_node *base = NULL, *out = NULL;
-  size_t ncol = 0, nc = 0, samples = 0, prims = 0;
+  size_t ncol = 0, nc = 0;
   double T = p.threshold > 0 ? p.threshold : OC_DEFAULT_THRESHOLD;
   coast C = {hf, NULL, p.sea_level - p.range, p.sea_level + p.range, p.reach};
   oc_error e2 = {OC_OK, ""};
@@ -152,33 +152,18 @@ oc_node *oc_generate_sea(const oc_gen_sea_params *pin, oc_gen_sea_stats *st,
     nc += make_cand(&C, &p, cell, xy[2 * i], xy[2 * i + 1], &cand[nc]);
 
   oc_erode_params ep;
-  memset(&ep, 0, sizeof ep);
-  ep.base = base;
-  ep.omit_base = p.no_terrain;
-  ep.geology = p.geology;
-  ep.rho = 0.5;
-  ep.threshold = T;
+  oc_erode_common com = {p.radius, p.strength, p.beta,
+                         p.cutoff, p.steps,    p.seed};
+  oc_erode_shared(&ep, base, p.no_terrain, p.geology, T, cell, &com,
+                  p.progress);
   ep.sea_level = p.sea_level;
   ep.range = p.range;
   ep.alpha = p.rays > 0 ? hf : NULL;
   ep.rays = p.rays;
   ep.reach = 8 * p.radius;
-  ep.radius = p.radius;
-  ep.strength = p.strength;
-  ep.beta = p.beta;
-  ep.cutoff = p.cutoff;
-  ep.step = 0.5 * (cell < p.radius ? cell : p.radius);
-  ep.steps = p.steps;
-  ep.seed = p.seed;
-  ep.progress = p.progress;
   ep.pbase = 0.1;
   ep.pspan = 0.9;
-  out = oc_erode_run(&ep, cand, nc, &samples, &prims, err);
-  if (out && st) {
-    st->columns = nc;
-    st->samples = samples;
-    st->primitives = prims;
-  }
+  out = oc_erode_run(&ep, cand, nc, st, err);
 done:
   oc_node_release(base);
   oc_heightfield_release(dist);

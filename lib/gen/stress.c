@@ -308,8 +308,7 @@ static int prims_push(prims *P, oc_node *nd, oc_error *err) {
 }
 
 oc_node *oc_erode_run(const oc_erode_params *ep, const oc_erode_cand *cand,
-                      size_t n, size_t *samples, size_t *nprims,
-                      oc_error *err) {
+                      size_t n, oc_gen_sea_stats *st, oc_error *err) {
   prims P = {NULL, 0, 0};
   oc_program *geo = NULL, *tree = NULL;
   oc_node *out = NULL;
@@ -371,8 +370,11 @@ oc_node *oc_erode_run(const oc_erode_params *ep, const oc_erode_cand *cand,
     out = oc_blend(P.v + 1, P.n - 1, err);
   else
     out = oc_blend(P.v, P.n, err);
-  if (samples) *samples = found;
-  if (nprims) *nprims = P.n - 1;
+  if (out && st) {
+    st->columns = n;
+    st->samples = found;
+    st->primitives = P.n - 1;
+  }
 done:
   oc_program_free(tree);
   oc_program_free(geo);
@@ -398,6 +400,25 @@ oc_node *oc_erode_base(oc_heightfield *hf, oc_node *terrain, oc_error *err) {
   oc_node *t = oc_terrain(&src, &tp, err);
   src.release(src.ud);
   return t;
+}
+
+void oc_erode_shared(oc_erode_params *ep, oc_node *base, int omit_base,
+                     oc_node *geology, double threshold, double cell,
+                     const oc_erode_common *c, oc_progress progress) {
+  memset(ep, 0, sizeof *ep);
+  ep->base = base;
+  ep->omit_base = omit_base;
+  ep->geology = geology;
+  ep->rho = 0.5;
+  ep->threshold = threshold > 0 ? threshold : OC_DEFAULT_THRESHOLD;
+  ep->radius = c->radius;
+  ep->strength = c->strength;
+  ep->beta = c->beta;
+  ep->cutoff = c->cutoff;
+  ep->step = 0.5 * (cell < c->radius ? cell : c->radius);
+  ep->steps = c->steps;
+  ep->seed = c->seed;
+  ep->progress = progress;
 }
 
 int oc_erode_check(double radius, double spacing, double beta, double strength,
