@@ -100,6 +100,30 @@ static int finish(lua_State *L, const char *fname, oclua_node *u, oc_node *n,
   return 2;
 }
 
+/* Copies the common fields into the generator's params p: the sea's and
+** the river's share their names. */
+#define SET_COMMON(p, c)                                                       \
+  ((p).heightfield = (c).hf, (p).terrain = (c).terrain,                        \
+   (p).no_terrain = (c).no_terrain, (p).geology = (c).geology,                 \
+   (p).seed = (c).seed, (p).radius = (c).radius, (p).spacing = (c).spacing,    \
+   (p).beta = (c).beta, (p).strength = (c).strength, (p).cutoff = (c).cutoff,  \
+   (p).steps = (c).steps, (p).threshold = (c).threshold)
+
+/* Runs the sea (sea = 1) or river generator on params (whose progress
+** field is prog) with progress, and returns finish's results. */
+static int run(lua_State *L, const char *fname, int sea, void *params,
+               oc_progress *prog) {
+  oclua_node *u = oclua_newnode(L);
+  oclua_progress pl;
+  oc_gen_sea_stats st = {0, 0, 0};
+  oc_error err = {OC_OK, ""};
+  *prog = oclua_progress_start(L, &pl, fname);
+  oc_node *n = sea ? oc_generate_sea(params, &st, &err)
+                   : oc_generate_river(params, &st, &err);
+  oclua_progress_end(&pl);
+  return finish(L, fname, u, n, &err, &st);
+}
+
 static int l_sea(lua_State *L) {
   static const char *const known[] = {
       "heightfield", "terrain", "geology",  "seed",   "radius",
@@ -121,26 +145,8 @@ static int l_sea(lua_State *L) {
   p.range = oclua_field_optnumber(&f, "range", OCLUA_POSITIVE, p.range);
   p.reach = oclua_field_optnumber(&f, "reach", OCLUA_POSITIVE, 0);
   p.rays = (int)oclua_field_optint(&f, "rays", 0, 4096, p.rays);
-  p.heightfield = c.hf;
-  p.terrain = c.terrain;
-  p.no_terrain = c.no_terrain;
-  p.geology = c.geology;
-  p.seed = c.seed;
-  p.radius = c.radius;
-  p.spacing = c.spacing;
-  p.beta = c.beta;
-  p.strength = c.strength;
-  p.cutoff = c.cutoff;
-  p.steps = c.steps;
-  p.threshold = c.threshold;
-  oclua_node *u = oclua_newnode(L);
-  oclua_progress pl;
-  oc_gen_sea_stats st = {0, 0, 0};
-  oc_error err = {OC_OK, ""};
-  p.progress = oclua_progress_start(L, &pl, fname);
-  oc_node *n = oc_generate_sea(&p, &st, &err);
-  oclua_progress_end(&pl);
-  return finish(L, fname, u, n, &err, &st);
+  SET_COMMON(p, c);
+  return run(L, fname, 1, &p, &p.progress);
 }
 
 static int l_river(lua_State *L) {
@@ -158,26 +164,8 @@ static int l_river(lua_State *L) {
   p.power = oclua_field_optnumber(&f, "power", OCLUA_POSITIVE, 0);
   p.banks = (int)oclua_field_optint(&f, "banks", 0, 64, p.banks);
   p.depth = oclua_field_optnumber(&f, "depth", OCLUA_POSITIVE, 0);
-  p.heightfield = c.hf;
-  p.terrain = c.terrain;
-  p.no_terrain = c.no_terrain;
-  p.geology = c.geology;
-  p.seed = c.seed;
-  p.radius = c.radius;
-  p.spacing = c.spacing;
-  p.beta = c.beta;
-  p.strength = c.strength;
-  p.cutoff = c.cutoff;
-  p.steps = c.steps;
-  p.threshold = c.threshold;
-  oclua_node *u = oclua_newnode(L);
-  oclua_progress pl;
-  oc_gen_sea_stats st = {0, 0, 0};
-  oc_error err = {OC_OK, ""};
-  p.progress = oclua_progress_start(L, &pl, fname);
-  oc_node *n = oc_generate_river(&p, &st, &err);
-  oclua_progress_end(&pl);
-  return finish(L, fname, u, n, &err, &st);
+  SET_COMMON(p, c);
+  return run(L, fname, 0, &p, &p.progress);
 }
 
 const luaL_Reg oclua_gen_sea[] = {
