@@ -56,11 +56,7 @@ static int l_strata(lua_State *L) {
   oc_error err = {OC_OK, ""};
   oc_noise nz;
   begin(&f, L, "outcrop.geology.strata", known);
-  nz.wavelength = oclua_field_number(&f, "wavelength", OCLUA_POSITIVE);
-  nz.amplitude = oclua_field_optnumber(&f, "amplitude", OCLUA_FINITE, 1.0);
-  nz.octaves = (int)oclua_field_optint(&f, "octaves", 1, 16, 4);
-  nz.offset = oclua_field_optnumber(&f, "offset", OCLUA_FINITE, 0.0);
-  nz.seed = oclua_field_seed(&f, "seed");
+  oclua_field_noise(&f, &nz, 1.0, 4, 1);
   oclua_node *u = oclua_newnode(L);
   return oclua_setnode(L, u, oc_strata(&nz, &err), &err, f.fname);
 }
@@ -87,11 +83,7 @@ static int l_layer(lua_State *L) {
       oclua_field_error(&f, "noise", -1,
                         "must be a table {wavelength =, amplitude =, ...}");
     oclua_fields_open(&nf, L, lua_gettop(L), f.fname, "noise.", nknown, 0);
-    nz.wavelength = oclua_field_number(&nf, "wavelength", OCLUA_POSITIVE);
-    nz.amplitude = oclua_field_optnumber(&nf, "amplitude", OCLUA_FINITE, 1.0);
-    nz.octaves = (int)oclua_field_optint(&nf, "octaves", 1, 16, 4);
-    nz.offset = oclua_field_optnumber(&nf, "offset", OCLUA_FINITE, 0.0);
-    nz.seed = oclua_field_seed(&nf, "seed");
+    oclua_field_noise(&nf, &nz, 1.0, 4, 1);
     pn = &nz;
   }
   lua_pop(L, 1);
@@ -133,11 +125,7 @@ static int l_fold(lua_State *L) {
   oc_noise nz;
   oc_node *g = node_and_options(
       L, &f, fname, "{wavelength =, amplitude =, octaves =, seed =}", known, 0);
-  nz.wavelength = oclua_field_number(&f, "wavelength", OCLUA_POSITIVE);
-  nz.amplitude = oclua_field_number(&f, "amplitude", OCLUA_FINITE);
-  nz.octaves = (int)oclua_field_optint(&f, "octaves", 1, 16, 3);
-  nz.offset = 0;
-  nz.seed = oclua_field_seed(&f, "seed");
+  oclua_field_noise(&f, &nz, NAN, 3, 0);
   oclua_node *u = oclua_newnode(L);
   return oclua_setnode(L, u, oc_warp(g, &nz, NULL, &err), &err, fname);
 }

@@ -165,11 +165,7 @@ static int l_fbm(lua_State *L) {
                   "octaves =, seed =, offset =}");
   oclua_fields_open(&f, L, 1, fname, NULL, known, 0);
   oc_hf_grid g = field_grid(&f);
-  nz.amplitude = oclua_field_number(&f, "amplitude", OCLUA_FINITE);
-  nz.wavelength = oclua_field_number(&f, "wavelength", OCLUA_POSITIVE);
-  nz.octaves = (int)oclua_field_optint(&f, "octaves", 1, 16, DEFAULT_OCTAVES);
-  nz.seed = oclua_field_seed(&f, "seed");
-  nz.offset = oclua_field_optnumber(&f, "offset", OCLUA_FINITE, 0);
+  oclua_field_noise(&f, &nz, NAN, DEFAULT_OCTAVES, 1);
   oc_progress pr = oclua_progress_start(L, &pl, fname);
   oclua_heightfield *u = oclua_newheightfield(L);
   oc_heightfield *hf = oc_heightfield_fbm(&g, &nz, pr, &err);

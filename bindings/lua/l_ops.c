@@ -108,14 +108,6 @@ static int l_smooth_intersection(lua_State *L) {
 
 /* ---- noise-driven operators ----------------------------------------- */
 
-static void check_noise(const oclua_fields *f, oc_noise *nz) {
-  nz->wavelength = oclua_field_number(f, "wavelength", OCLUA_POSITIVE);
-  nz->amplitude = oclua_field_number(f, "amplitude", OCLUA_FINITE);
-  nz->octaves = (int)oclua_field_optint(f, "octaves", 1, 16, 3);
-  nz->offset = 0;
-  nz->seed = oclua_field_seed(f, "seed");
-}
-
 static int l_warp(lua_State *L) {
   static const char *const known[] = {"wavelength", "amplitude", "octaves",
                                       "seed",       "control",   NULL};
@@ -127,7 +119,7 @@ static int l_warp(lua_State *L) {
   oclua_checkargs(L, 2, fname, "(node, {wavelength =, amplitude =, ...})");
   oc_node *child = oclua_checknode(L, 1, fname, "argument #1");
   oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
-  check_noise(&f, &nz);
+  oclua_field_noise(&f, &nz, NAN, 3, 0);
   /* The control node stays on the stack until oc_warp has retained it:
   ** it may come from an __index metamethod and have no other owner. */
   if (oclua_field_push(&f, "control") != LUA_TNIL) {
@@ -150,7 +142,7 @@ static int l_perturb(lua_State *L) {
   oclua_checkargs(L, 2, fname, "(node, {wavelength =, amplitude =, ...})");
   oc_node *child = oclua_checknode(L, 1, fname, "argument #1");
   oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
-  check_noise(&f, &nz);
+  oclua_field_noise(&f, &nz, NAN, 3, 0);
   oclua_node *u = oclua_newnode(L);
   return oclua_setnode(L, u, oc_perturb(child, &nz, &err), &err, fname);
 }

@@ -169,11 +169,7 @@ static int l_turbulence(lua_State *L) {
   oc_error err = {OC_OK, ""};
   oc_noise nz;
   begin(&f, L, "outcrop.turbulence", known);
-  nz.wavelength = oclua_field_number(&f, "wavelength", OCLUA_POSITIVE);
-  nz.amplitude = oclua_field_optnumber(&f, "amplitude", OCLUA_FINITE, 1.0);
-  nz.octaves = (int)oclua_field_optint(&f, "octaves", 1, 16, 4);
-  nz.offset = oclua_field_optnumber(&f, "offset", OCLUA_FINITE, 0.0);
-  nz.seed = oclua_field_seed(&f, "seed");
+  oclua_field_noise(&f, &nz, 1.0, 4, 1);
   oclua_node *u = oclua_newnode(L);
   return oclua_setnode(L, u, oc_turbulence(&nz, &err), &err, f.fname);
 }

@@ -313,6 +313,18 @@ uint64_t oclua_field_seed(const oclua_fields *f, const char *name) {
   return (uint64_t)v;
 }
 
+void oclua_field_noise(const oclua_fields *f, oc_noise *nz, double amp,
+                       int octaves, int offset) {
+  nz->wavelength = oclua_field_number(f, "wavelength", OCLUA_POSITIVE);
+  nz->amplitude =
+      isnan(amp) ? oclua_field_number(f, "amplitude", OCLUA_FINITE)
+                 : oclua_field_optnumber(f, "amplitude", OCLUA_FINITE, amp);
+  nz->octaves = (int)oclua_field_optint(f, "octaves", 1, 16, octaves);
+  nz->offset =
+      offset ? oclua_field_optnumber(f, "offset", OCLUA_FINITE, 0.0) : 0;
+  nz->seed = oclua_field_seed(f, "seed");
+}
+
 /* ---- vectors --------------------------------------------------------- */
 
 enum { VEC_OK, VEC_NOTTABLE, VEC_ELEMENT, VEC_LONG, VEC_NAN };

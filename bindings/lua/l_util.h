@@ -75,6 +75,13 @@ int oclua_field_optoption(const oclua_fields *f, const char *name,
 /* An integer >= 0; absent: the scene seed. */
 uint64_t oclua_field_seed(const oclua_fields *f, const char *name);
 
+/* The noise fields of a table: wavelength (> 0, required), amplitude
+** (required when amp is NaN, else amp by default), octaves (1 .. 16,
+** `octaves` by default), offset (when `offset`, 0 by default; else 0)
+** and seed, read in that order. */
+void oclua_field_noise(const oclua_fields *f, oc_noise *nz, double amp,
+                       int octaves, int offset);
+
 /* A vector is {x, y, z} or {x = , y = , z = }, with finite numbers. */
 oc_vec3 oclua_field_vec(const oclua_fields *f, const char *name);
 /* Returns 0 and leaves *v alone when the field is absent. */
