@@ -79,51 +79,41 @@ double oc_perturb_reach(const oc_op *o, const double *par) {
   return rho_max(o, par);
 }
 
-static double perturb(const oc_op *o, const double *par, oc_vec3 p) {
-  double E = par[OC_P_E], R = par[OC_P_R];
-  noisep nz = unpack_noise(par + o->nkid);
-  oc_vec3 s;
-  double rmax = rho_max(o, par);
-  double d = oc_prim_project((oc_kind)o->sub, par, p, &s, rmax);
-  if (!(d > 0)) return d == 0 ? E : d; /* NaN propagates */
-  if (d >= rmax) return 0;             /* beyond any perturbed radius */
-  oc_vec3 u = oc_mul(oc_sub(p, s), 1 / d);
-  oc_vec3 v = oc_add(s, oc_mul(u, R));
-  double rho =
-      R + nz.amp * oc_turb3(nz.seed, nz.oct, oc_mul(v, 1 / nz.wl), NULL);
-  return E * oc_falloff(d / rho);
-}
-
-/* Value and gradient of perturb, analytically: with u = (p - s) / d,
-** v = s + R u and rho = R + A t(v / wl),
+/* The perturbed primitive's value in *val; with g, its gradient too,
+** analytically: with u = (p - s) / d, v = s + R u and
+** rho = R + A t(v / wl),
 **   grad f = E g'(d / rho) (u / rho - d grad rho / rho^2),
 **   grad rho = (A / wl) Jv^T grad t, Jv = S + (R / d) (I - u u^T)(I - S),
-** S = ds/dp from the projection (symmetric). 0 when the primitive's kind
-** has no such Jacobian. */
-static int perturb_grad(const oc_op *o, const double *par, oc_vec3 p,
-                        oc_vec3 *g, double *val) {
+** S = ds/dp from the projection (symmetric). Returns 0 (and nothing)
+** when g is asked for a kind without that Jacobian. */
+static int perturb_at(const oc_op *o, const double *par, oc_vec3 p, double *val,
+                      oc_vec3 *g) {
   double E = par[OC_P_E], R = par[OC_P_R];
   noisep nz = unpack_noise(par + o->nkid);
   oc_vec3 s;
   double d, J[9];
   double rmax = rho_max(o, par);
-  if (!oc_prim_project_jac((oc_kind)o->sub, par, p, &s, rmax, &d, J)) return 0;
-  *g = oc_v3(0, 0, 0);
+  if (!g)
+    d = oc_prim_project((oc_kind)o->sub, par, p, &s, rmax);
+  else if (!oc_prim_project_jac((oc_kind)o->sub, par, p, &s, rmax, &d, J))
+    return 0;
+  if (g) *g = oc_v3(0, 0, 0);
   if (!(d > 0)) {
     *val = d == 0 ? E : d; /* NaN propagates */
     return 1;
   }
-  if (d >= rmax) {
+  if (d >= rmax) { /* beyond any perturbed radius */
     *val = 0;
     return 1;
   }
   oc_vec3 u = oc_mul(oc_sub(p, s), 1 / d);
   oc_vec3 v = oc_add(s, oc_mul(u, R));
   oc_vec3 gt;
-  double rho =
-      R + nz.amp * oc_turb3(nz.seed, nz.oct, oc_mul(v, 1 / nz.wl), &gt);
+  double rho = R + nz.amp * oc_turb3(nz.seed, nz.oct, oc_mul(v, 1 / nz.wl),
+                                     g ? &gt : NULL);
   double x = d / rho;
   *val = E * oc_falloff(x);
+  if (!g) return 1;
   /* Jv^T w = S w + (R / d) (I - S)(w - u (u.w)), w = grad t */
   oc_vec3 w = oc_sub(gt, oc_mul(u, oc_dot(u, gt)));
   oc_vec3 Sg = oc_v3(J[0] * gt.x + J[1] * gt.y + J[2] * gt.z,
@@ -137,6 +127,12 @@ static int perturb_grad(const oc_op *o, const double *par, oc_vec3 p,
   double k = E * oc_falloff_d(x);
   *g = oc_mul(oc_sub(oc_mul(u, 1 / rho), oc_mul(grho, d / (rho * rho))), k);
   return 1;
+}
+
+static double perturb(const oc_op *o, const double *par, oc_vec3 p) {
+  double v;
+  perturb_at(o, par, p, &v, NULL);
+  return v;
 }
 
 /* ---- groups ------------------------------------------------------------ */
@@ -480,7 +476,7 @@ static double evg(const oc_program *P, uint32_t i, oc_vec3 p, oc_vec3 *g) {
     /* Analytic for every kind but cones, whose projection's Jacobian
     ** takes central differences. */
     double v;
-    if (perturb_grad(o, par, p, g, &v)) return v;
+    if (perturb_at(o, par, p, &v, g)) return v;
     double h = 1e-6 * fmax(par[OC_P_R], 1e-3);
     v = perturb(o, par, p);
     double gx = perturb(o, par, oc_v3(p.x + h, p.y, p.z)) -

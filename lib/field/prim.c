@@ -261,28 +261,21 @@ static double seg_project(oc_vec3 a, oc_vec3 b, oc_vec3 p, oc_vec3 *s) {
   return oc_len(oc_sub(p, *s));
 }
 
-/* seg_project, and in *tan the unit direction of the segment when the
-** closest point is inside it (where it slides along the segment as p
-** moves), else 0. */
-static double seg_project_tan(oc_vec3 a, oc_vec3 b, oc_vec3 p, oc_vec3 *s,
-                              oc_vec3 *tan) {
-  oc_vec3 ab = oc_sub(b, a), ap = oc_sub(p, a);
-  double l2 = oc_dot(ab, ab);
-  double t = l2 > 0 ? oc_dot(ap, ab) / l2 : 0;
-  int in = t > 0 && t < 1;
-  t = t < 0 ? 0 : t > 1 ? 1 : t;
-  *s = oc_add(a, oc_mul(ab, t));
-  *tan = in ? oc_mul(ab, 1 / sqrt(l2)) : oc_v3(0, 0, 0);
-  return oc_len(oc_sub(p, *s));
+/* The unit direction of segment ab when the closest point of p lies
+** inside it (where it slides along the segment as p moves), else 0. */
+static oc_vec3 seg_tangent(oc_vec3 a, oc_vec3 b, oc_vec3 p) {
+  oc_vec3 ab = oc_sub(b, a);
+  double l2 = oc_dot(ab, ab), t = l2 > 0 ? oc_dot(oc_sub(p, a), ab) / l2 : 0;
+  return t > 0 && t < 1 ? oc_mul(ab, 1 / sqrt(l2)) : oc_v3(0, 0, 0);
 }
 
 /* The closest point of a curve's polyline, skipping the chunks whose box
-** is farther than the best distance so far; its tangent as
-** seg_project_tan's when tan is not NULL. */
+** is farther than the best distance so far; *seg (when not NULL) gets the
+** index of its segment, or SIZE_MAX. */
 static double curve_project(const double *par, oc_vec3 p, oc_vec3 *s,
-                            double cutoff, oc_vec3 *tan) {
+                            double cutoff, size_t *seg) {
   size_t n = (size_t)par[2];
-  if (tan) *tan = oc_v3(0, 0, 0);
+  if (seg) *seg = SIZE_MAX;
   if (n == 1) {
     *s = get(par, 3);
     return oc_len(oc_sub(p, *s));
@@ -300,14 +293,13 @@ static double curve_project(const double *par, oc_vec3 p, oc_vec3 *s,
     size_t end = (c + 1) * CHUNK < n - 1 ? (c + 1) * CHUNK : n - 1;
     for (size_t i = c * CHUNK; i < end; i++) {
       const double *v = par + 3 + 3 * i;
-      oc_vec3 q, tq;
-      double d = tan ? seg_project_tan(get(v, 0), get(v, 3), p, &q, &tq)
-                     : seg_project(get(v, 0), get(v, 3), p, &q);
+      oc_vec3 q;
+      double d = seg_project(get(v, 0), get(v, 3), p, &q);
       if (d < best) {
         best = d;
         best2 = d * d;
         *s = q;
-        if (tan) *tan = tq;
+        if (seg) *seg = i;
       }
     }
   }
@@ -419,13 +411,19 @@ int oc_prim_project_jac(oc_kind kind, const double *par, oc_vec3 p, oc_vec3 *s,
     *d = oc_prim_project(kind, par, p, s, cutoff);
     set_diag(J, 0, 0, 0);
     return 1;
-  case OC_K_SEGMENT:
+  case OC_K_SEGMENT: {
+    oc_vec3 a = get(par, OC_P_A), b = get(par, OC_P_B);
+    *d = seg_project(a, b, p, s);
+    set_outer(J, seg_tangent(a, b, p), 1); /* 0 at an end: s stays */
+    return 1;
+  }
   case OC_K_CURVE: {
-    oc_vec3 t;
-    *d = kind == OC_K_CURVE
-             ? curve_project(par, p, s, cutoff, &t)
-             : seg_project_tan(get(par, OC_P_A), get(par, OC_P_B), p, s, &t);
-    set_outer(J, t, 1); /* 0 at an end: the closest point stays there */
+    size_t i;
+    *d = curve_project(par, p, s, cutoff, &i);
+    oc_vec3 t = oc_v3(0, 0, 0);
+    if (i != SIZE_MAX)
+      t = seg_tangent(get(par, 3 + 3 * (int)i), get(par, 6 + 3 * (int)i), p);
+    set_outer(J, t, 1);
     return 1;
   }
   case OC_K_SPHERE: {

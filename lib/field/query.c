@@ -228,7 +228,9 @@ static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
     ** largest displacement */
     double A = fabs(par[1]) * oc_turb3_max((int)par[3]) / 2;
     foot g = {f->x0 - A, f->y0 - A, f->x1 + A, f->y1 + A};
-    spans C = {.n = 0, .all = 0};
+    spans C;
+    C.n = C.nt = C.nz = C.wz = C.all = C.nleaf = 0;
+    C.hf = OC_NONE;
     op_spans(P, P->kids[o->kid], &g, &C, depth + 1, 0);
     if (C.all) {
       S->all = 1;
@@ -253,7 +255,9 @@ static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
           g.y0 = fmin(g.y0, v);
           g.y1 = fmax(g.y1, v);
         }
-      spans C = {.n = 0, .all = 0};
+      spans C;
+      C.n = C.nt = C.nz = C.wz = C.all = C.nleaf = 0;
+      C.hf = OC_NONE;
       op_spans(P, P->kids[o->kid], &g, &C, depth + 1, 0);
       if (C.all) {
         S->all = 1;
@@ -325,13 +329,10 @@ int oc_program_column_query_z(const oc_program *P, double x0, double y0,
   if (nz) *nz = -1;
   if (!(x0 <= x1 && y0 <= y1) || max < 1) return -1;
   foot f = {x0, y0, x1, y1};
-  spans S = {.n = 0,
-             .nt = 0,
-             .nz = 0,
-             .wz = zout != NULL,
-             .all = 0,
-             .nleaf = 0,
-             .hf = OC_NONE};
+  spans S; /* the span arrays are filled as needed, not cleared */
+  S.n = S.nt = S.nz = S.all = S.nleaf = 0;
+  S.wz = zout != NULL;
+  S.hf = OC_NONE;
   op_spans(P, P->root, &f, &S, 0, 1);
   if (S.all) return -1;
   if (hf && S.nleaf == 1) *hf = S.hf;
