@@ -107,12 +107,7 @@ int main(int argc, char **argv) {
   oc_mesh *mf = mesh(prog, box, mcell, 1, 1, &sf);
   oc_mesh *mb = mesh(prog, box, mcell, 0, 0, &sb);
   oc_mesh *mr = mesh(prog, box, mcell, 0, 1, &sr);
-  double blo[3] = {box.lo.x, box.lo.y, box.lo.z}, h[3];
-  double ext[3] = {box.hi.x - box.lo.x, box.hi.y - box.lo.y,
-                   box.hi.z - box.lo.z};
-  for (int a = 0; a < 3; a++)
-    h[a] = ext[a] / ceil(ext[a] / mcell * (1 - 1e-12));
-  int same = same_edges(mb, mf, blo, h, &dev) && dev < 1e-2 * mcell;
+  int same = same_edges(mb, mf, box, mcell, &dev) && dev < 1e-2 * mcell;
   int same_bits = same_mesh(mr, mf);
   printf("# mesh at cell %g m: %zu triangles; full grid %.2f s; surface "
          "bounds + direct extraction %.2f s, %s (vertices within %.1e m); "

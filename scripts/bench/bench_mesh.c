@@ -158,20 +158,17 @@ static int speedup_at(const oc_program *p, oc_aabb box, double cell,
   oc_mesh_get_stats(mf, &stf);
   oc_mesh_get_stats(mb, &stb);
   oc_mesh_get_stats(mr, &str);
-  double lo[3] = {box.lo.x, box.lo.y, box.lo.z}, h[3], dev;
-  double ext[3] = {box.hi.x - box.lo.x, box.hi.y - box.lo.y,
-                   box.hi.z - box.lo.z};
-  for (int a = 0; a < 3; a++)
-    h[a] = ext[a] / ceil(ext[a] / cell * (1 - 1e-12));
+  double n[3], dev;
+  grid_cells(box, cell, n);
   int same_bits = same_mesh(mr, mf);
-  int same = same_edges(mb, mf, lo, h, &dev);
+  int same = same_edges(mb, mf, box, cell, &dev);
   printf("# cell %g m (%.0f x %.0f x %.0f cells): %zu triangles; full grid "
          "%.2f s (%zu field calls); surface bounds + direct extraction %.3f "
          "s (%zu calls, %zu cells visited): %.1f x, %s (vertices within "
          "%.1e m); surface bounds, root finding everywhere %.3f s: %.1f x, "
          "%s\n",
-         cell, ext[0] / h[0], ext[1] / h[1], ext[2] / h[2], stf.triangles, sf,
-         stf.field_calls, sb, stb.field_calls, stb.cells_visited, sf / sb,
+         cell, n[0], n[1], n[2], stf.triangles, sf, stf.field_calls, sb,
+         stb.field_calls, stb.cells_visited, sf / sb,
          same ? "same triangles on the same edges" : "DIFFERENT TRIANGLES", dev,
          sr, sf / sr, same_bits ? "same mesh to the bit" : "DIFFERENT MESH");
   if (figures) {

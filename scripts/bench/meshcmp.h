@@ -58,6 +58,15 @@ static inline int same_mesh(const oc_mesh *a, const oc_mesh *b) {
   return same;
 }
 
+/* Cells per axis of the polygonizer's grid for box and cell (the rule of
+** polygonize.c). */
+static inline void grid_cells(oc_aabb box, double cell, double n[3]) {
+  double ext[3] = {box.hi.x - box.lo.x, box.hi.y - box.lo.y,
+                   box.hi.z - box.lo.z};
+  for (int a = 0; a < 3; a++)
+    n[a] = ceil(ext[a] / cell * (1 - 1e-12));
+}
+
 /* The sampling-grid edge a vertex lies on (samples at lo + (i + 1/2) h,
 ** padding at the box faces): the two coordinates on the grid, and the
 ** lower sample along the third, the one farthest from any grid plane. */
@@ -130,12 +139,16 @@ static inline uint32_t *canon_edges(const oc_mesh *m, const double lo[3],
   return t;
 }
 
-/* 1 when a and b have the same triangles on the same grid edges (box lo,
-** sample spacing h), whatever the vertex order; *dev gets the largest
+/* 1 when a and b, meshed over box at cell, have the same triangles on
+** the same grid edges, whatever the vertex order; *dev gets the largest
 ** distance between the two vertices of an edge. */
-static inline int same_edges(const oc_mesh *a, const oc_mesh *b,
-                             const double lo[3], const double h[3],
-                             double *dev) {
+static inline int same_edges(const oc_mesh *a, const oc_mesh *b, oc_aabb box,
+                             double cell, double *dev) {
+  double lo[3] = {box.lo.x, box.lo.y, box.lo.z}, h[3], n[3];
+  grid_cells(box, cell, n);
+  h[0] = (box.hi.x - box.lo.x) / n[0];
+  h[1] = (box.hi.y - box.lo.y) / n[1];
+  h[2] = (box.hi.z - box.lo.z) / n[2];
   size_t nv = oc_mesh_vertex_count(a), nt = oc_mesh_triangle_count(a);
   *dev = INFINITY;
   if (nv != oc_mesh_vertex_count(b) || nt != oc_mesh_triangle_count(b))
