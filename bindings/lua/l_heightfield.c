@@ -49,9 +49,8 @@ oc_heightfield *oclua_checkheightfield(lua_State *L, int idx,
   return u->hf;
 }
 
-/* Stores a new grid in the userdata on the stack top, or raises. */
-static int sethf(lua_State *L, oclua_heightfield *u, oc_heightfield *hf,
-                 const oc_error *err, const char *fname) {
+int oclua_sethf(lua_State *L, oclua_heightfield *u, oc_heightfield *hf,
+                const oc_error *err, const char *fname) {
   if (hf == NULL) {
     if (err->code == OC_ECANCEL) return luaL_error(L, "interrupted");
     oclua_liberror(L, fname, err);
@@ -145,8 +144,8 @@ static int l_load(lua_State *L) {
     p.y0 = o[1];
   }
   oclua_heightfield *u = oclua_newheightfield(L);
-  return sethf(L, u, oc_heightfield_load(lua_tostring(L, 1), &p, &err), &err,
-               fname);
+  return oclua_sethf(L, u, oc_heightfield_load(lua_tostring(L, 1), &p, &err),
+                     &err, fname);
 }
 
 /* ---- outcrop.heightfield.fbm ------------------------------------------ */
@@ -170,7 +169,7 @@ static int l_fbm(lua_State *L) {
   oclua_heightfield *u = oclua_newheightfield(L);
   oc_heightfield *hf = oc_heightfield_fbm(&g, &nz, pr, &err);
   oclua_progress_end(&pl);
-  return sethf(L, u, hf, &err, fname);
+  return oclua_sethf(L, u, hf, &err, fname);
 }
 
 /* ---- outcrop.heightfield.from ----------------------------------------- */
@@ -254,7 +253,7 @@ static int l_from(lua_State *L) {
   oc_heightfield *hf =
       oc_heightfield_from_program(prog, &g, zr[0], zr[1], t, pr, &err);
   oclua_progress_end(&pl);
-  return sethf(L, u, hf, &err, fname);
+  return oclua_sethf(L, u, hf, &err, fname);
 }
 
 /* ---- queries ------------------------------------------------------------ */
@@ -417,7 +416,7 @@ static int hf_resample(lua_State *L) {
   oclua_heightfield *u = oclua_newheightfield(L);
   oc_heightfield *out = oc_heightfield_resample(hf, &g, pr, &err);
   oclua_progress_end(&pl);
-  return sethf(L, u, out, &err, fname);
+  return oclua_sethf(L, u, out, &err, fname);
 }
 
 /* crop{i0, j0, i1, j1}: 1-based inclusive sample indices; or
@@ -469,8 +468,9 @@ static int hf_crop(lua_State *L) {
     }
   }
   oclua_heightfield *u = oclua_newheightfield(L);
-  return sethf(L, u, oc_heightfield_crop(hf, ij[0], ij[1], ij[2], ij[3], &err),
-               &err, fname);
+  return oclua_sethf(L, u,
+                     oc_heightfield_crop(hf, ij[0], ij[1], ij[2], ij[3], &err),
+                     &err, fname);
 }
 
 /* ---- save -------------------------------------------------------------- */

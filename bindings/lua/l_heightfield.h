@@ -20,6 +20,11 @@ oclua_heightfield *oclua_newheightfield(lua_State *L);
 /* Raises unless idx is a heightfield (names fname in the message). */
 oc_heightfield *oclua_checkheightfield(lua_State *L, int idx,
                                        const char *fname);
+/* Stores hf, just made, in u (the userdata made before the work, so an
+** error cannot leak) and returns 1; raises when hf is NULL ("interrupted"
+** on cancel, else fname and err's message). */
+int oclua_sethf(lua_State *L, oclua_heightfield *u, oc_heightfield *hf,
+                const oc_error *err, const char *fname);
 /* The grid at idx, or NULL when idx is not a heightfield. */
 oc_heightfield *oclua_testheightfield(lua_State *L, int idx);
 

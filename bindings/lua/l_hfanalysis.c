@@ -25,18 +25,6 @@
 
 /* ---- helpers ------------------------------------------------------------ */
 
-/* Stores the result in a userdata pushed BEFORE the work (so nothing can
-** leak), or raises. */
-static int push_result(lua_State *L, oclua_heightfield *u, oc_heightfield *hf,
-                       const oc_error *err, const char *fname) {
-  if (hf == NULL) {
-    if (err->code == OC_ECANCEL) return luaL_error(L, "interrupted");
-    oclua_liberror(L, fname, err);
-  }
-  u->hf = hf;
-  return 1;
-}
-
 /* Opens the optional options table at 2 (nil or absent: none given). */
 static void open_options(lua_State *L, oclua_fields *f, const char *fname,
                          const char *const *known, const char *usage) {
@@ -56,7 +44,7 @@ static int hf_slope(lua_State *L) {
   oc_error err = {OC_OK, ""};
   oclua_checkargs(L, 1, fname, "()");
   oclua_heightfield *u = oclua_newheightfield(L);
-  return push_result(L, u, oc_hf_slope(hf, &err), &err, fname);
+  return oclua_sethf(L, u, oc_hf_slope(hf, &err), &err, fname);
 }
 
 static int hf_filled(lua_State *L) {
@@ -69,7 +57,7 @@ static int hf_filled(lua_State *L) {
   oc_progress pr = oclua_progress_start(L, &pl, fname);
   oc_heightfield *r = oc_hf_fill(hf, pr, &err);
   oclua_progress_end(&pl);
-  return push_result(L, u, r, &err, fname);
+  return oclua_sethf(L, u, r, &err, fname);
 }
 
 /* drainage and stream_power: {exponent = } */
@@ -89,7 +77,7 @@ static int flow(lua_State *L, const char *fname, int power) {
   oc_heightfield *r =
       power ? oc_hf_stream_power(hf, &fp, &err) : oc_hf_drainage(hf, &fp, &err);
   oclua_progress_end(&pl);
-  return push_result(L, u, r, &err, fname);
+  return oclua_sethf(L, u, r, &err, fname);
 }
 
 static int hf_drainage(lua_State *L) {
@@ -161,7 +149,7 @@ static int hf_accessibility(lua_State *L) {
   ap.progress = oclua_progress_start(L, &pl, fname);
   oc_heightfield *r = oc_hf_accessibility(hf, &ap, &err);
   oclua_progress_end(&pl);
-  return push_result(L, u, r, &err, fname);
+  return oclua_sethf(L, u, r, &err, fname);
 }
 
 static int hf_distance_to_level(lua_State *L) {
@@ -173,7 +161,7 @@ static int hf_distance_to_level(lua_State *L) {
     oclua_error(L, fname, "'z' must be a number (got %s)", oclua_got(L, 2));
   oclua_checkargs(L, 2, fname, "(z)");
   oclua_heightfield *u = oclua_newheightfield(L);
-  return push_result(L, u, oc_hf_distance_to_level(hf, z, &err), &err, fname);
+  return oclua_sethf(L, u, oc_hf_distance_to_level(hf, z, &err), &err, fname);
 }
 
 const luaL_Reg oclua_heightfield_analysis[] = {

@@ -17,6 +17,7 @@
 
 #include <strings.h>
 
+#include "oiio_util.hpp"
 #include "io/oiio.h"
 
 extern "C" {
@@ -38,15 +39,6 @@ int say(char *why, size_t n, int code, const char *fmt, ...) {
     va_end(ap);
   }
   return code;
-}
-
-/* OpenImageIO messages may span lines; ours are one line. */
-std::string oneline(std::string s) {
-  for (char &c : s)
-    if (c == '\n' || c == '\r') c = ' ';
-  while (!s.empty() && s.back() == ' ')
-    s.pop_back();
-  return s.empty() ? std::string("unknown OpenImageIO error") : s;
 }
 
 /* String attributes the TIFF and JPEG writers store in a tag of their
@@ -118,7 +110,8 @@ int write_file(const char *path, const oc_oiio_out *im, char *why, size_t n) {
     return say(why, n, OC_EIO, "unknown sample type %d", (int)im->type);
   }
   auto out = ImageOutput::create(im->format);
-  if (!out) return say(why, n, OC_EIO, "%s", oneline(OIIO::geterror()).c_str());
+  if (!out)
+    return say(why, n, OC_EIO, "%s", oc_oiio_oneline(OIIO::geterror()).c_str());
   ImageSpec spec(im->width, im->height, im->channels, file);
   for (int c = 0; c < im->channels; c++)
     spec.channelnames[c] = im->channel_names[c];
@@ -127,13 +120,13 @@ int write_file(const char *path, const oc_oiio_out *im, char *why, size_t n) {
   if (im->alpha >= 0) spec.attribute("oiio:UnassociatedAlpha", 1);
   describe(im->format, im, spec);
   if (!out->open(path, spec))
-    return say(why, n, OC_EIO, "%s", oneline(out->geterror()).c_str());
+    return say(why, n, OC_EIO, "%s", oc_oiio_oneline(out->geterror()).c_str());
   bool ok = out->write_image(mem, im->pixels);
   std::string e = ok ? std::string() : out->geterror();
   ok = out->close() && ok;
   if (!ok) {
     if (e.empty()) e = out->geterror();
-    return say(why, n, OC_EIO, "%s", oneline(e).c_str());
+    return say(why, n, OC_EIO, "%s", oc_oiio_oneline(e).c_str());
   }
   return OC_OK;
 }
@@ -148,7 +141,7 @@ oc_image *read_file(const char *path, oc_error *err) {
   auto in = ImageInput::open(path, &config);
   if (!in) {
     oc_seterr(err, OC_EIO, "cannot read '%s': %s", path,
-              oneline(OIIO::geterror()).c_str());
+              oc_oiio_oneline(OIIO::geterror()).c_str());
     return nullptr;
   }
   const ImageSpec &spec = in->spec();
@@ -169,7 +162,7 @@ oc_image *read_file(const char *path, oc_error *err) {
   if (!in->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT,
                       oc_image_data(img.get()))) {
     oc_seterr(err, OC_EIO, "cannot read '%s': %s", path,
-              oneline(in->geterror()).c_str());
+              oc_oiio_oneline(in->geterror()).c_str());
     return nullptr;
   }
   /* Names and attributes the image model refuses (odd characters,
@@ -178,14 +171,7 @@ oc_image *read_file(const char *path, oc_error *err) {
     oc_image_set_channel_name(img.get(), c, spec.channelnames[c].c_str(),
                               nullptr);
   for (const auto &p : spec.extra_attribs) {
-    /* Strings whole; arrays of numbers capped, they are not provenance. */
-    std::string v;
-    if (p.type() == TypeDesc::STRING) {
-      const char *s = *(const char *const *)p.data();
-      v = s ? s : "";
-    } else {
-      v = p.get_string(64);
-    }
+    std::string v = oc_oiio_attr_text(p);
     oc_image_set_meta(img.get(), p.name().c_str(), v.c_str(), nullptr);
   }
   in->close();

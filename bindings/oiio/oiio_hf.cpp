@@ -13,6 +13,7 @@
 #include <new>
 #include <string>
 
+#include "oiio_util.hpp"
 #include "io/oiio_hf.h"
 
 extern "C" {
@@ -24,15 +25,6 @@ using OIIO::ImageSpec;
 using OIIO::TypeDesc;
 
 namespace {
-
-/* OpenImageIO messages may span lines; ours are one line. */
-std::string oneline(std::string s) {
-  for (char &c : s)
-    if (c == '\n' || c == '\r') c = ' ';
-  while (!s.empty() && s.back() == ' ')
-    s.pop_back();
-  return s.empty() ? std::string("unknown OpenImageIO error") : s;
-}
 
 /* Integer samples are read as they are stored into the front of the float
 ** buffer, then widened in place from the last one down: sample k's float
@@ -53,7 +45,7 @@ int read_raw(const char *path, const oc_oiio_raw *r, oc_error *err) {
   auto in = ImageInput::open(path, &config);
   if (!in)
     return oc_seterr(err, OC_EIO, "cannot read '%s': %s", path,
-                     oneline(OIIO::geterror()).c_str());
+                     oc_oiio_oneline(OIIO::geterror()).c_str());
   const ImageSpec &spec = in->spec();
   if (spec.deep || spec.depth > 1 || spec.nchannels < 1)
     return oc_seterr(err, OC_EUNSUPPORTED,
@@ -61,13 +53,7 @@ int read_raw(const char *path, const oc_oiio_raw *r, oc_error *err) {
                      "images are not heightfields",
                      path);
   for (const auto &p : spec.extra_attribs) {
-    std::string v;
-    if (p.type() == TypeDesc::STRING) {
-      const char *s = *(const char *const *)p.data();
-      v = s ? s : "";
-    } else {
-      v = p.get_string(64);
-    }
+    std::string v = oc_oiio_attr_text(p);
     if (r->attr) r->attr(r->ud, p.name().c_str(), v.c_str());
   }
   TypeDesc type = spec.channelformat(0);
@@ -90,7 +76,7 @@ int read_raw(const char *path, const oc_oiio_raw *r, oc_error *err) {
   }
   if (!in->read_image(0, 0, 0, 1, mem, dst))
     return oc_seterr(err, OC_EIO, "cannot read '%s': %s", path,
-                     oneline(in->geterror()).c_str());
+                     oc_oiio_oneline(in->geterror()).c_str());
   switch (mem.basetype) {
   case TypeDesc::UINT8:
     widen<uint8_t>(dst, n);

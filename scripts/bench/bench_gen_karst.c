@@ -44,21 +44,6 @@ static oc_heightfield *plateau(void) {
   return hf;
 }
 
-static oc_mesh *mesh(const oc_program *p, oc_aabb box, double cell, int full,
-                     int no_direct, double *sec) {
-  oc_error err;
-  oc_polygonize_params pp = {0};
-  pp.box = box;
-  pp.cell = cell;
-  pp.full_grid = full;
-  pp.no_direct = no_direct;
-  double t0 = omp_get_wtime();
-  oc_mesh *m = oc_polygonize(p, &pp, &err);
-  *sec = omp_get_wtime() - t0;
-  if (!m) die(&err);
-  return m;
-}
-
 int main(int argc, char **argv) {
   oc_error err;
   double mcell = argc > 1 ? atof(argv[1]) : 6;
@@ -104,9 +89,9 @@ int main(int argc, char **argv) {
   ** surface bounds with direct elevation extraction; and surface bounds
   ** alone, which must give the full grid's mesh to the bit */
   double sb, sf, sr, dev;
-  oc_mesh *mf = mesh(prog, box, mcell, 1, 1, &sf);
-  oc_mesh *mb = mesh(prog, box, mcell, 0, 0, &sb);
-  oc_mesh *mr = mesh(prog, box, mcell, 0, 1, &sr);
+  oc_mesh *mf = timed_mesh("bench_gen_karst", prog, box, mcell, 1, 1, &sf);
+  oc_mesh *mb = timed_mesh("bench_gen_karst", prog, box, mcell, 0, 0, &sb);
+  oc_mesh *mr = timed_mesh("bench_gen_karst", prog, box, mcell, 0, 1, &sr);
   int same = same_edges(mb, mf, box, mcell, &dev) && dev < 1e-2 * mcell;
   int same_bits = same_mesh(mr, mf);
   printf("# mesh at cell %g m: %zu triangles; full grid %.2f s; surface "

@@ -110,24 +110,6 @@ static oc_node *terrain(double w, uint64_t seed, oc_node *ground,
   return b;
 }
 
-static oc_mesh *mesh(const oc_program *p, oc_aabb box, double cell, int full,
-                     int no_direct, double *sec) {
-  oc_error err;
-  oc_polygonize_params pp = {0};
-  pp.box = box;
-  pp.cell = cell;
-  pp.full_grid = full;
-  pp.no_direct = no_direct;
-  double t0 = omp_get_wtime();
-  oc_mesh *m = oc_polygonize(p, &pp, &err);
-  *sec = omp_get_wtime() - t0;
-  if (!m) {
-    fprintf(stderr, "bench_mesh: %s\n", err.msg);
-    exit(1);
-  }
-  return m;
-}
-
 /* The best of `reps` runs (the mesh of the last). */
 static oc_mesh *mesh_best(const oc_program *p, oc_aabb box, double cell,
                           int full, int no_direct, int reps, double *sec) {
@@ -136,7 +118,7 @@ static oc_mesh *mesh_best(const oc_program *p, oc_aabb box, double cell,
   for (int r = 0; r < reps; r++) {
     double s;
     oc_mesh_free(m);
-    m = mesh(p, box, cell, full, no_direct, &s);
+    m = timed_mesh("bench_mesh", p, box, cell, full, no_direct, &s);
     *sec = fmin(*sec, s);
   }
   return m;
@@ -226,10 +208,10 @@ static void direct_speedup(void) {
   for (int rep = 0; rep < 2; rep++) { /* best of 2 */
     double s;
     oc_mesh_free(md);
-    md = mesh(p, box, 1.0, 0, 0, &s);
+    md = timed_mesh("bench_mesh", p, box, 1.0, 0, 0, &s);
     sd = fmin(sd, s);
     oc_mesh_free(mr);
-    mr = mesh(p, box, 1.0, 0, 1, &s);
+    mr = timed_mesh("bench_mesh", p, box, 1.0, 0, 1, &s);
     sr = fmin(sr, s);
   }
   oc_mesh_stats std, str;
@@ -276,7 +258,7 @@ static void band_run(void) {
   oc_aabb box = {{0, 0, -32}, {w, w, 32}};
   double s;
   omp_set_num_threads(2);
-  oc_mesh *m = mesh(p, box, 1.0, 0, 0, &s);
+  oc_mesh *m = timed_mesh("bench_mesh", p, box, 1.0, 0, 0, &s);
   oc_mesh_stats st;
   oc_mesh_get_stats(m, &st);
   printf("# band: %g x %g columns, 64 cells thick, cell 1 m: %zu triangles, "
@@ -306,9 +288,9 @@ static void spheres1000(void) {
   oc_aabb box = {{-13.75, -13.75, -5}, {113.75, 113.75, 122.5}};
   double s1, s2;
   omp_set_num_threads(1);
-  oc_mesh *m1 = mesh(p, box, 0.25, 0, 0, &s1);
+  oc_mesh *m1 = timed_mesh("bench_mesh", p, box, 0.25, 0, 0, &s1);
   omp_set_num_threads(2);
-  oc_mesh *m2 = mesh(p, box, 0.25, 0, 0, &s2);
+  oc_mesh *m2 = timed_mesh("bench_mesh", p, box, 0.25, 0, 0, &s2);
   oc_mesh_stats st;
   oc_mesh_get_stats(m2, &st);
   int same = oc_mesh_vertex_count(m1) == oc_mesh_vertex_count(m2) &&

@@ -1,6 +1,6 @@
 /*
-** meshcmp.h — comparing two meshes up to vertex order, for the benchmarks
-** that check a faster path gives the same mesh (bench_mesh.c,
+** meshcmp.h — timing meshes, and comparing two up to vertex order, for the
+** benchmarks that check a faster path gives the same mesh (bench_mesh.c,
 ** bench_gen_karst.c): to the bit, or as the same triangles on the same
 ** grid edges with vertices placed differently along their edges (root
 ** finding against direct elevation extraction).
@@ -13,7 +13,31 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <omp.h>
+#include <stdio.h>
+
 #include "outcrop.h"
+
+/* Meshes box at cell (full grid and/or root finding everywhere when
+** asked), its seconds in *sec; exits naming `who` on error. */
+static inline oc_mesh *timed_mesh(const char *who, const oc_program *p,
+                                  oc_aabb box, double cell, int full,
+                                  int no_direct, double *sec) {
+  oc_error err;
+  oc_polygonize_params pp = {0};
+  pp.box = box;
+  pp.cell = cell;
+  pp.full_grid = full;
+  pp.no_direct = no_direct;
+  double t0 = omp_get_wtime();
+  oc_mesh *m = oc_polygonize(p, &pp, &err);
+  *sec = omp_get_wtime() - t0;
+  if (!m) {
+    fprintf(stderr, "%s: %s\n", who, err.msg);
+    exit(1);
+  }
+  return m;
+}
 
 typedef struct tri9 {
   float v[9];
