@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include <lauxlib.h>
 
@@ -45,7 +46,8 @@ static const char usage_text[] =
     "                    512M, 2G); 0 for no limit (default: half of the\n"
     "                    physical memory; no limit with --unsafe)\n"
     "  --timeout SECONDS stop the scene after this wall-clock time (decimals\n"
-    "                    allowed; default and 0: no limit)\n"
+    "                    allowed; default and 0: no limit); one stuck in C\n"
+    "                    code is ended 10 s later\n"
     "  --unsafe          lift the sandbox: allow os.execute, io.popen,\n"
     "                    C modules, binary chunks, writes outside --out, the\n"
     "                    debug library\n"
@@ -62,7 +64,6 @@ static const char usage_text[] =
     "os.tmpname and io.tmpfile raise an error and os.setlocale is absent.\n"
     "With --unsafe, io.open and os.* take paths as plain Lua does (relative\n"
     "to the current folder); outcrop's own writers always use --out.\n"
-    "\n"
     "\n"
     "Ctrl-C, SIGTERM and SIGHUP stop the scene (long engine work included)\n"
     "without leaving partial outputs; a second one kills the process. After\n"
@@ -105,7 +106,7 @@ static int parse_int(const char *s, long long lo, long long hi,
 }
 
 /* Parses SIZE for --max-memory: digits, then optionally one of K, M, G, T
-** (binary multiples, either case, "iB" or "B" may follow); "none" is 0.
+** (binary multiples; "iB" or "B" may follow; any case); "none" is 0.
 ** At most 2^50 bytes, so no product overflows. */
 static int parse_size(const char *s, long long *out) {
   static const char units[] = "KMGT";
@@ -126,7 +127,7 @@ static int parse_size(const char *s, long long *out) {
     u = strchr(units, *s >= 'a' ? *s - 'a' + 'A' : *s);
     if (u == NULL || *u == '\0') return 0;
     s++;
-    if (strcmp(s, "") != 0 && strcmp(s, "B") != 0 && strcmp(s, "iB") != 0)
+    if (*s != '\0' && strcasecmp(s, "B") != 0 && strcasecmp(s, "iB") != 0)
       return 0;
     for (n = 0; n <= (size_t)(u - units); n++) {
       if (v > (1LL << 50) / 1024) return 0;

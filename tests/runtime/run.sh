@@ -513,6 +513,10 @@ end
 begin max-memory-none
 run --max-memory 0 "$S/hello.lua" x
 status_is 0; out_has "args	1	x"
+for v in none 1G 512MiB 65536k 2gb; do
+  run --max-memory "$v" "$S/hello.lua"
+  [ "$rc" -eq 0 ] || because "--max-memory '$v' gave status $rc"
+done
 end
 
 begin timeout-lua-loop
@@ -529,6 +533,14 @@ run --timeout=1.5 "$S/loop.lua" mesh --out "$W/o"
 status_is 124; err_has "outcrop: timeout (--timeout 1.5 s)"
 [ $((SECONDS - started)) -le 8 ] || because "took $((SECONDS - started)) s"
 only_started
+end
+
+# stuck in C, where no hook runs: ended GRACE (10 s) after the timeout
+begin timeout-stuck-in-c
+started=$SECONDS
+run --timeout 0.5 "$S/loop.lua" c --out "$W/o"
+status_is 124; err_has "outcrop: timeout (--timeout 0.5 s), still running 10 s later: killed"
+[ $((SECONDS - started)) -le 15 ] || because "took $((SECONDS - started)) s"
 end
 
 begin timeout-finalizer
