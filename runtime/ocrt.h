@@ -15,7 +15,8 @@ enum {
   OCRT_ESCRIPT = 1,    /* the scene failed: syntax or runtime error */
   OCRT_EUSAGE = 2,     /* bad command line, unreadable scene, bad --out */
   OCRT_ETIMEOUT = 124, /* --timeout reached, as timeout(1) reports it */
-  OCRT_ESIGNAL = 128   /* stopped by signal N (SIGINT, SIGTERM, SIGHUP):
+  OCRT_ESIGNAL = 128   /* stopped by signal N (SIGINT, SIGTERM, SIGHUP,
+                       ** SIGPIPE):
                        ** 128 + N, as shells report a death by signal */
 };
 
@@ -59,16 +60,16 @@ void ocrt_sandbox(lua_State *L);
 
 /* Stopping a running scene (stop.c). ocrt_stop_open prepares L (once,
 ** before the scene runs: wraps coroutine.resume, .wrap, .close, xpcall and
-** setmetatable); ocrt_stop_arm makes Ctrl-C, SIGTERM, SIGHUP and, when
-** `timeout` > 0, a timer after that many seconds (written `timeout_text`
-** on the command line) stop the scene running in
-** L (by raising an error from a count hook, and again at every Lua
-** instruction until control is back in C); ocrt_stop_finish, once the
-** scene returned, makes sure no script code runs after a stop (not even
-** finalizers in lua_close); ocrt_stop_release, after lua_close, restores
-** the signals and cancels the timer. ocrt_stop_request does the same as a
-** signal from inside the state (os.exit in the sandbox) with the exit
-** status to report. */
+** setmetatable); ocrt_stop_arm makes Ctrl-C, SIGTERM, SIGHUP, SIGPIPE and,
+** when `timeout` > 0, a timer after that many seconds (written
+** `timeout_text` on the command line) stop the scene running in L (by
+** raising an error from a count hook, and again at every Lua instruction
+** until control is back in C); ocrt_stop_finish, once the scene returned,
+** makes sure no script code runs after a stop (not even finalizers in
+** lua_close); ocrt_stop_release, after lua_close, restores the signals
+** and cancels the timer. ocrt_stop_request does the same as a signal
+** from inside the state (os.exit in the sandbox) with the exit status to
+** report. */
 void ocrt_stop_open(lua_State *L);
 void ocrt_stop_arm(lua_State *L, double timeout, const char *timeout_text);
 void ocrt_stop_finish(lua_State *L);
@@ -80,6 +81,8 @@ int ocrt_stop_status(lua_State *L);
 ** OCRT_STOP_TIMEOUT. */
 enum { OCRT_STOP_TIMEOUT = -1 };
 int ocrt_stop_cause(void);
+/* The message for a cause: "interrupted", "terminated", "timeout"... */
+const char *ocrt_stop_text(int cause);
 /* Non-zero once any stop began (signal, timeout, os.exit). */
 int ocrt_stopping(void);
 

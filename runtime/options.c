@@ -65,14 +65,16 @@ static const char usage_text[] =
     "With --unsafe, io.open and os.* take paths as plain Lua does (relative\n"
     "to the current folder); outcrop's own writers always use --out.\n"
     "\n"
-    "Ctrl-C, SIGTERM and SIGHUP stop the scene (long engine work included)\n"
-    "without leaving partial outputs; a second one kills the process. After\n"
-    "a stop no script code runs any more (no finalizer either). Running out\n"
-    "of --max-memory is an error the scene may catch with pcall.\n"
+    "Ctrl-C, SIGTERM, SIGHUP and SIGPIPE stop the scene (long engine work\n"
+    "included) without leaving partial outputs; a second one kills the\n"
+    "process. After a stop no script code runs any more (no finalizer\n"
+    "either). Running out of --max-memory is an error the scene may catch\n"
+    "with pcall.\n"
     "\n"
     "exit status: 0 success, 1 error in the scene (memory limit included),\n"
     "2 usage error (binary scene included), 124 --timeout reached,\n"
-    "128 + N stopped by signal N: 130 Ctrl-C, 143 SIGTERM, 129 SIGHUP;\n"
+    "128 + N stopped by signal N: 130 Ctrl-C, 143 SIGTERM, 129 SIGHUP,\n"
+    "141 SIGPIPE;\n"
     "os.exit(n) in a scene exits with n.\n";
 
 static int usage_error(const char *fmt, ...)

@@ -123,9 +123,7 @@ static int report_stop(const run *r, int cause) {
     report(msg);
     return OCRT_ETIMEOUT;
   }
-  report(cause == SIGTERM  ? "terminated"
-         : cause == SIGHUP ? "hangup"
-                           : "interrupted");
+  report(ocrt_stop_text(cause));
   return OCRT_ESIGNAL + cause;
 }
 

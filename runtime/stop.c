@@ -1,6 +1,7 @@
 /*
 ** stop.c — stopping a running scene cleanly: Ctrl-C, SIGTERM, SIGHUP,
-** --timeout, and os.exit in the sandbox.
+** SIGPIPE (print to a closed pipe: stock Lua dies of it, here the scene
+** stops cleanly), --timeout, and os.exit in the sandbox.
 **
 ** All of them work the same way: an error is raised inside the scene and a
 ** count hook raises it again before every Lua instruction, so a scene that
@@ -55,7 +56,7 @@
 #define GRACE 10 /* seconds a timed-out scene has to unwind */
 
 /* the signals that stop a scene; SIGALRM is the --timeout timer */
-static const int stop_signals[] = {SIGINT, SIGTERM, SIGHUP, SIGALRM};
+static const int stop_signals[] = {SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGALRM};
 #define NSIGNALS (int)(sizeof stop_signals / sizeof stop_signals[0])
 
 static lua_State *volatile running; /* main thread of the scene */
@@ -83,26 +84,27 @@ static void clear_finalizers(lua_State *L) {
   lua_pop(L, 1);
 }
 
+const char *ocrt_stop_text(int why) {
+  switch (why) {
+  case 0:
+    return "scene stopped by os.exit";
+  case SIGTERM:
+    return "terminated";
+  case SIGHUP:
+    return "hangup";
+  case SIGPIPE:
+    return "broken pipe";
+  case OCRT_STOP_TIMEOUT:
+    return "timeout";
+  default:
+    return "interrupted";
+  }
+}
+
 static void stop_hook(lua_State *L, lua_Debug *ar) {
   (void)ar;
   clear_finalizers(L);
-  switch (cause) {
-  case 0:
-    lua_pushliteral(L, "scene stopped by os.exit");
-    break;
-  case SIGTERM:
-    lua_pushliteral(L, "terminated");
-    break;
-  case SIGHUP:
-    lua_pushliteral(L, "hangup");
-    break;
-  case OCRT_STOP_TIMEOUT:
-    lua_pushliteral(L, "timeout");
-    break;
-  default:
-    lua_pushliteral(L, "interrupted");
-    break;
-  }
+  lua_pushstring(L, ocrt_stop_text(cause));
   lua_error(L);
 }
 

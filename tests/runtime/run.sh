@@ -475,6 +475,17 @@ stop_with HUP loop.lua xpcall
 status_is 129; err_has "outcrop: hangup"; only_started
 end
 
+# print to a closed pipe: stock Lua dies of SIGPIPE, outcrop stops cleanly
+begin sigpipe
+mkdir -p "$W/o"
+(cd "$W" && exec "$OUTCROP" "$S/loop.lua" print --out "$W/o") 2>"$ERR" \
+  </dev/null | head -n 1 >"$OUT"
+rc=${PIPESTATUS[0]}
+sanitizer_check
+status_is 141; err_has "outcrop: broken pipe"; out_has "line"
+no_file "$W/o/after.txt"
+end
+
 # ---- resource limits ---------------------------------------------------------
 
 begin help-limits

@@ -4,7 +4,7 @@
 -- coroutine.wrap function (wrap-close), in an xpcall
 -- message handler called for an error raised by the stop itself (xpcall),
 -- with a finalizer pending that would write after.txt (finalizer), or
--- loops in the standard library's C code (c), or
+-- loops in the standard library's C code (c), prints for ever (print), or
 -- meshes for a long time in C (HOW: mesh); Ctrl-C must still stop it
 -- before after.txt (or the mesh) is written.
 local function spin()
@@ -42,6 +42,14 @@ elseif how == "wrap-close" then
     local _ <close> = setmetatable({}, {__close = spin})
     spin()
   end)()
+elseif how == "print" then
+  -- prints for ever, swallowing errors, with a finalizer pending
+  pending = setmetatable({}, {__gc = function()
+    local out = io.open("after.txt", "w")
+    out:write("finalizer ran after the stop\n")
+    out:close()
+  end})
+  while true do pcall(print, "line") end
 elseif how == "c" then
   -- a C loop over 2^63 absent slots: no hook can run in it
   table.move({}, 1, math.maxinteger, 1, {})
