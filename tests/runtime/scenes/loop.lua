@@ -13,6 +13,15 @@ local function spin()
   end
 end
 
+-- an object kept until the end whose finalizer would write after.txt
+local function pend_finalizer()
+  pending = setmetatable({}, {__gc = function()
+    local out = io.open("after.txt", "w")
+    out:write("finalizer ran after the stop\n")
+    out:close()
+  end})
+end
+
 local f = assert(io.open("started.txt", "w"))
 f:close()
 local how = arg[1]
@@ -44,11 +53,7 @@ elseif how == "wrap-close" then
   end)()
 elseif how == "print" then
   -- prints for ever, swallowing errors, with a finalizer pending
-  pending = setmetatable({}, {__gc = function()
-    local out = io.open("after.txt", "w")
-    out:write("finalizer ran after the stop\n")
-    out:close()
-  end})
+  pend_finalizer()
   while true do pcall(print, "line") end
 elseif how == "c" then
   -- a C loop over 2^63 absent slots: no hook can run in it
@@ -59,11 +64,7 @@ elseif how == "xpcall" then
   local function handler() while true do end end
   while true do xpcall(function() while true do end end, handler) end
 elseif how == "finalizer" then
-  pending = setmetatable({}, {__gc = function()
-    local out = io.open("after.txt", "w")
-    out:write("finalizer ran after the stop\n")
-    out:close()
-  end})
+  pend_finalizer()
   spin()
 elseif how == "nested" then
   coroutine.wrap(function()
