@@ -95,8 +95,14 @@ $(LIBSO): $(LIB_OBJ)
 $(MODULE): $(LUA_OBJ) $(LIB_OBJ)
 	$(CXX) -shared -o $@ $^ $(OIIO_LIBS) $(LDLIBS) $(OPT)
 
+# The interpreter counts the allocations of the engine and the bindings
+# for --max-memory (runtime/memory.c): --wrap sends their calls, and only
+# theirs, to counting wrappers.
+RT_WRAP := -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free \
+           -Wl,--wrap=strdup,--wrap=realpath
+
 $(BIN): $(RT_OBJ) $(LUA_OBJ) $(LIB_OBJ)
-	$(CXX) -o $@ $^ $(LUA_LIBS) $(OIIO_LIBS) $(LDLIBS) $(OPT)
+	$(CXX) -o $@ $^ $(RT_WRAP) $(LUA_LIBS) $(OIIO_LIBS) $(LDLIBS) $(OPT)
 
 $(B)/tests/%: tests/c/%.c $(CTEST_SUPPORT_OBJ) $(LIBA)
 	@mkdir -p $(dir $@)

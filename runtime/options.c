@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include <lauxlib.h>
 
@@ -40,8 +41,16 @@ static const char usage_text[] =
     "  --out DIR         folder for outputs; relative output paths resolve\n"
     "                    against it (default: the current folder; created\n"
     "                    if missing)\n"
+    "  --max-memory SIZE memory for the scene, Lua and engine together, in\n"
+    "                    bytes or with a suffix K, M, G, T (powers of 1024:\n"
+    "                    512M, 2G); 0 for no limit (default: half of the\n"
+    "                    physical memory; no limit with --unsafe)\n"
+    "  --timeout SECONDS stop the scene after this wall-clock time (decimals\n"
+    "                    allowed; default and 0: no limit); one stuck in C\n"
+    "                    code is ended 10 s later\n"
     "  --unsafe          lift the sandbox: allow os.execute, io.popen,\n"
-    "                    C modules, writes outside --out, the debug library\n"
+    "                    C modules, binary chunks, writes outside --out, the\n"
+    "                    debug library\n"
     "  -h, --help        print this help and exit\n"
     "  --version         print the version and exit\n"
     "  --                end of options\n"
@@ -50,14 +59,23 @@ static const char usage_text[] =
     "(io.open for writing, io.output, os.remove, os.rename; relative paths\n"
     "resolve against --out, while relative paths opened for reading resolve\n"
     "against the current folder), cannot run programs or load C code or\n"
-    "binary chunks, and has only debug.traceback of the debug library;\n"
-    "os.exit ends the scene cleanly, os.tmpname raises an error and\n"
-    "os.setlocale is absent.\n"
+    "binary chunks (the scene itself included), and has only\n"
+    "debug.traceback of the debug library; os.exit ends the scene cleanly,\n"
+    "os.tmpname and io.tmpfile raise an error and os.setlocale is absent.\n"
     "With --unsafe, io.open and os.* take paths as plain Lua does (relative\n"
     "to the current folder); outcrop's own writers always use --out.\n"
     "\n"
-    "exit status: 0 success, 1 error in the scene, 2 usage error,\n"
-    "130 interrupted (Ctrl-C); os.exit(n) in a scene exits with n.\n";
+    "Ctrl-C, SIGTERM, SIGHUP and SIGPIPE stop the scene (long engine work\n"
+    "included) without leaving partial outputs; a second one kills the\n"
+    "process. After a stop no script code runs any more (no finalizer\n"
+    "either). Running out of --max-memory is an error the scene may catch\n"
+    "with pcall.\n"
+    "\n"
+    "exit status: 0 success, 1 error in the scene (memory limit included),\n"
+    "2 usage error (binary scene included), 124 --timeout reached,\n"
+    "128 + N stopped by signal N: 130 Ctrl-C, 143 SIGTERM, 129 SIGHUP,\n"
+    "141 SIGPIPE;\n"
+    "os.exit(n) in a scene exits with n.\n";
 
 static int usage_error(const char *fmt, ...)
     __attribute__((format(printf, 1, 2)));
@@ -85,6 +103,51 @@ static int parse_int(const char *s, long long lo, long long hi,
     v = v * 10 + (*s - '0');
   }
   if (v < lo) return 0;
+  *out = v;
+  return 1;
+}
+
+/* Parses SIZE for --max-memory: digits, then optionally one of K, M, G, T
+** (binary multiples; "iB" or "B" may follow; any case); "none" is 0.
+** At most 2^50 bytes, so no product overflows. */
+static int parse_size(const char *s, long long *out) {
+  static const char units[] = "KMGT";
+  const char *u;
+  long long v;
+  char num[24];
+  size_t n = strspn(s, "0123456789");
+  if (strcmp(s, "none") == 0) {
+    *out = 0;
+    return 1;
+  }
+  if (n == 0 || n >= sizeof num) return 0;
+  memcpy(num, s, n);
+  num[n] = '\0';
+  if (!parse_int(num, 0, 1LL << 50, &v)) return 0;
+  s += n;
+  if (*s != '\0') {
+    u = strchr(units, *s >= 'a' ? *s - 'a' + 'A' : *s);
+    if (u == NULL || *u == '\0') return 0;
+    s++;
+    if (*s != '\0' && strcasecmp(s, "B") != 0 && strcasecmp(s, "iB") != 0)
+      return 0;
+    for (n = 0; n <= (size_t)(u - units); n++) {
+      if (v > (1LL << 50) / 1024) return 0;
+      v *= 1024;
+    }
+  }
+  *out = v;
+  return 1;
+}
+
+/* Parses SECONDS for --timeout: a plain decimal number (no sign, no
+** exponent, no hexadecimal), at most ten million seconds. */
+static int parse_seconds(const char *s, double *out) {
+  char *end;
+  double v;
+  if (s[0] == '\0' || strspn(s, "0123456789.") != strlen(s)) return 0;
+  v = strtod(s, &end);
+  if (*end != '\0' || !(v >= 0 && v <= 1e7)) return 0;
   *out = v;
   return 1;
 }
@@ -118,7 +181,8 @@ void ocrt_options_free(ocrt_options *o) {
 
 /* Handles one option word at argv[*i]; returns OCRT_RUN to go on. */
 static int option(ocrt_options *o, int argc, char **argv, int *i) {
-  static const char *const valued[] = {"--set", "--seed", "--threads", "--out",
+  static const char *const valued[] = {"--set", "--seed",       "--threads",
+                                       "--out", "--max-memory", "--timeout",
                                        NULL};
   const char *arg = argv[*i];
   const char *val = NULL;
@@ -165,6 +229,20 @@ static int option(ocrt_options *o, int argc, char **argv, int *i) {
     if (val[0] == '\0') return usage_error("--out expects a folder name");
     o->outdir = val;
     return OCRT_RUN;
+  case 4: /* --max-memory */
+    if (!parse_size(val, &v))
+      return usage_error("--max-memory expects a size such as 512M or 2G, "
+                         "or 0 for no limit (got '%s')",
+                         val);
+    o->max_memory = v;
+    return OCRT_RUN;
+  case 5: /* --timeout */
+    if (!parse_seconds(val, &o->timeout))
+      return usage_error("--timeout expects seconds, a number from 0 (no "
+                         "limit) to 10000000 (got '%s')",
+                         val);
+    o->timeout_text = val;
+    return OCRT_RUN;
   default:
     return usage_error("unknown option '%s'", arg);
   }
@@ -174,6 +252,7 @@ int ocrt_parse(ocrt_options *o, int argc, char **argv) {
   int i, status, options = 1, command = 0;
   memset(o, 0, sizeof *o);
   o->seed = 1;
+  o->max_memory = -1;
   /* at most one entry per word, so argc entries always suffice */
   o->params = malloc(sizeof *o->params * (size_t)(argc + 1));
   o->args = malloc(sizeof *o->args * (size_t)(argc + 1));

@@ -7,6 +7,7 @@
 ** even a memory error while setting up is reported instead of aborting.
 */
 #include <omp.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,7 +22,26 @@ typedef struct run {
   const ocrt_options *opt;
   int status;   /* exit status, set by pmain */
   char *outdir; /* malloc'ed; freed after lua_close, so errors cannot leak */
+  long long max_memory;   /* the limit in force, 0 for none */
+  int warn_on, warn_cont; /* warn(): "@on" seen; a message continues */
 } run;
+
+/* Warnings as stock lua5.4 shows them: off until warn("@on"). */
+static void on_warning(void *ud, const char *msg, int tocont) {
+  run *r = ud;
+  if (!r->warn_cont && !tocont && msg[0] == '@') { /* a control message */
+    if (strcmp(msg, "@on") == 0) r->warn_on = 1;
+    if (strcmp(msg, "@off") == 0) r->warn_on = 0;
+    return;
+  }
+  if (r->warn_on) {
+    if (!r->warn_cont) fputs("Lua warning: ", stderr);
+    fputs(msg, stderr);
+    if (!tocont) fputs("\n", stderr);
+    fflush(stderr);
+  }
+  r->warn_cont = tocont;
+}
 
 static void report(const char *msg) {
   fprintf(stderr, "outcrop: %s\n",
@@ -33,7 +53,9 @@ static void report(const char *msg) {
 static int msghandler(lua_State *L) {
   const char *msg = lua_tostring(L, 1);
   if (msg == NULL) {
-    if (luaL_callmeta(L, 1, "__tostring") && lua_type(L, -1) == LUA_TSTRING)
+    /* no script code after a stop, be it a __tostring */
+    if (!ocrt_stopping() && luaL_callmeta(L, 1, "__tostring") &&
+        lua_type(L, -1) == LUA_TSTRING)
       return 1;
     msg =
         lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
@@ -93,6 +115,43 @@ static int push_args(lua_State *L, const ocrt_options *o) {
   return o->nargs;
 }
 
+/* Reports a stop by a signal or the timer; returns the exit status. */
+static int report_stop(const run *r, int cause) {
+  char msg[160];
+  if (cause == OCRT_STOP_TIMEOUT) {
+    snprintf(msg, sizeof msg, "timeout (--timeout %s s)", r->opt->timeout_text);
+    report(msg);
+    return OCRT_ETIMEOUT;
+  }
+  report(ocrt_stop_text(cause));
+  return OCRT_ESIGNAL + cause;
+}
+
+/* Reports the scene's error (at the top), saying so when it came from
+** the memory limit. */
+static void report_error(lua_State *L, const run *r) {
+  const char *msg = lua_tostring(L, -1), *at = NULL;
+  char limit[48], note[80];
+  if (msg && r->max_memory > 0 && ocrt_memory_exhausted()) {
+    ocrt_memory_text(r->max_memory, limit, sizeof limit);
+    snprintf(note, sizeof note, " (--max-memory %s reached)", limit);
+    if ((at = strstr(msg, "not enough memory")) != NULL)
+      at += strlen("not enough memory");
+    else if ((at = strstr(msg, "out of memory")) != NULL)
+      at += strlen("out of memory");
+    if (at) {
+      lua_pushlstring(L, msg, (size_t)(at - msg));
+      lua_pushstring(L, note);
+      lua_pushstring(L, at);
+      lua_concat(L, 3);
+      msg = lua_tostring(L, -1);
+    }
+  }
+  report(msg);
+  if (msg && r->max_memory > 0 && ocrt_memory_exhausted() && at == NULL)
+    fprintf(stderr, "outcrop: (--max-memory %s was reached)\n", limit);
+}
+
 /* Runs the loaded chunk (at the top) and sets r->status. */
 static void run_scene(lua_State *L, run *r) {
   int nargs = push_args(L, r->opt);
@@ -100,22 +159,41 @@ static void run_scene(lua_State *L, run *r) {
   int st, stop;
   lua_pushcfunction(L, msghandler);
   lua_insert(L, base);
-  ocrt_stop_arm(L);
+  ocrt_stop_arm(L, r->opt->timeout, r->opt->timeout_text);
   st = lua_pcall(L, nargs, 0, base);
-  ocrt_stop_disarm(L);
+  ocrt_stop_finish(L);
   stop = ocrt_stop_status(L);
   if (stop != OCRT_RUN) {
     r->status = stop; /* os.exit: a chosen status, nothing to report */
+  } else if (ocrt_stop_cause() != 0) {
+    r->status = report_stop(r, ocrt_stop_cause());
   } else if (st == LUA_OK) {
     r->status = OCRT_OK;
-  } else if (ocrt_interrupted()) {
-    report("interrupted");
-    r->status = OCRT_EINTR;
   } else {
-    report(lua_tostring(L, -1));
+    report_error(L, r);
     r->status = OCRT_ESCRIPT;
   }
   lua_settop(L, base - 1);
+}
+
+/* Loads the scene file (text only in the sandbox: Lua bytecode can be
+** crafted to break out of the VM, and the scene is the first chunk an
+** attacker controls). Returns a load status; a refused binary chunk is
+** reported as LUA_ERRFILE, a usage error rather than a bug in the scene.
+** The chunk name is "@" .. path, so messages read "scene.lua:3: ...". */
+static int load_scene(lua_State *L, const ocrt_options *o) {
+  int st = luaL_loadfilex(L, strcmp(o->scene, "-") == 0 ? NULL : o->scene,
+                          o->unsafe ? NULL : "t");
+  if (st == LUA_ERRSYNTAX && !o->unsafe &&
+      strstr(lua_tostring(L, -1), "attempt to load a binary chunk")) {
+    lua_pop(L, 1);
+    lua_pushfstring(L,
+                    "%s: is a binary chunk (precompiled Lua); scenes must be "
+                    "Lua source unless --unsafe is given",
+                    strcmp(o->scene, "-") == 0 ? "stdin" : o->scene);
+    return LUA_ERRFILE;
+  }
+  return st;
 }
 
 static int pmain(lua_State *L) {
@@ -126,12 +204,11 @@ static int pmain(lua_State *L) {
   luaL_checkversion(L);
   lua_gc(L, LUA_GCSTOP);
   luaL_openlibs(L);
-  /* the chunk name is "@" .. path, so messages read "scene.lua:3: ..." */
-  st = luaL_loadfile(L, strcmp(o->scene, "-") == 0 ? NULL : o->scene);
+  st = load_scene(L, o);
   if (st == LUA_ERRMEM) return lua_error(L);
   if (st != LUA_OK) {
     report(lua_tostring(L, -1));
-    r->status = st == LUA_ERRFILE ? OCRT_EUSAGE : OCRT_ESCRIPT;
+    r->status = st == LUA_ERRSYNTAX ? OCRT_ESCRIPT : OCRT_EUSAGE;
     return 0;
   }
   r->outdir = ocrt_outdir(o->outdir, msg, sizeof msg);
@@ -150,15 +227,24 @@ static int pmain(lua_State *L) {
   return 0;
 }
 
+static int panic(lua_State *L) {
+  report(lua_tostring(L, -1));
+  return 0; /* Lua then aborts */
+}
+
 int ocrt_run(const ocrt_options *o) {
-  run r = {o, OCRT_ESCRIPT, NULL};
+  run r = {o, OCRT_ESCRIPT, NULL, o->max_memory, 0, 0};
   lua_State *L;
   if (o->threads > 0) omp_set_num_threads(o->threads);
-  L = luaL_newstate();
+  if (r.max_memory < 0) r.max_memory = o->unsafe ? 0 : ocrt_memory_default();
+  ocrt_memory_limit(r.max_memory);
+  L = lua_newstate(ocrt_lua_alloc, NULL);
   if (L == NULL) {
     report("cannot create the Lua state: not enough memory");
     return OCRT_ESCRIPT;
   }
+  lua_atpanic(L, panic);
+  lua_setwarnf(L, on_warning, &r);
   lua_pushcfunction(L, pmain);
   lua_pushlightuserdata(L, &r);
   if (lua_pcall(L, 1, 0, 0) != LUA_OK) {
@@ -166,6 +252,10 @@ int ocrt_run(const ocrt_options *o) {
     r.status = OCRT_ESCRIPT;
   }
   lua_close(L);
+  ocrt_stop_release();
+  if (r.status == OCRT_OK && ocrt_stop_cause() != 0) /* while closing */
+    r.status = report_stop(&r, ocrt_stop_cause());
+  ocrt_memory_limit(0);
   free(r.outdir);
   return r.status;
 }

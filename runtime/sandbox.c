@@ -6,19 +6,29 @@
 **  - os.execute, io.popen and package.loadlib are removed; package.searchers
 **    keeps the preload and Lua searchers only (no C modules), and the Lua
 **    searcher, load, loadfile and dofile accept text chunks only, since
-**    Lua bytecode can be crafted to break out of the VM;
+**    Lua bytecode can be crafted to break out of the VM (run.c loads the
+**    scene itself, or standard input, as text too);
 **  - io.open for writing ("w", "a", any "+"), io.output(name), os.remove
 **    and os.rename take paths through oclua_output_path: relative paths
 **    land in the output folder and anything outside it is an error.
 **    Reading is not restricted and relative read paths resolve against the
 **    current folder, as in plain Lua;
-**  - os.tmpname raises an error (it creates a file in /tmp); os.setlocale
-**    is removed (outputs must not depend on the C locale);
+**  - os.tmpname and io.tmpfile raise an error (they create files in /tmp,
+**    outside --out and without limit); os.setlocale is removed (outputs
+**    must not depend on the C locale);
 **  - os.exit ends the scene through the interpreter, which closes the state
 **    first, so outputs are flushed and closed;
 **  - of the debug library only debug.traceback remains: the rest could
 **    read the registry (and turn the sandbox off) or the upvalues holding
 **    the original functions, or remove the Ctrl-C hook.
+** What stays is harmless by itself or bounded elsewhere: reading any file
+** the user can read (io.open, io.lines, io.read, dofile, require through
+** package.path), os.getenv, os.clock, os.time, os.date, os.difftime,
+** string.dump (its output cannot be loaded back), collectgarbage; reading
+** special files such as /dev/zero or huge strings is bounded by
+** --max-memory, blocking reads (a FIFO) and long loops by --timeout and
+** Ctrl-C (see stop.c for what else the stop wraps: coroutine.resume, .wrap,
+** .close, xpcall, setmetatable).
 ** The tables are changed in place, so package.loaded sees the same thing.
 */
 #include <stdlib.h>
@@ -70,6 +80,11 @@ static int sb_os_rename(lua_State *L) {
 
 static int sb_os_tmpname(lua_State *L) {
   return luaL_error(L, "os.tmpname is not allowed in scenes; "
+                       "write under the output folder instead");
+}
+
+static int sb_io_tmpfile(lua_State *L) {
+  return luaL_error(L, "io.tmpfile is not allowed in scenes; "
                        "write under the output folder instead");
 }
 
@@ -167,6 +182,7 @@ static void sandbox_io(lua_State *L) {
   luaL_getsubtable(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
   lua_getfield(L, -1, LUA_IOLIBNAME);
   remove_field(L, "popen");
+  set_function(L, "tmpfile", sb_io_tmpfile);
   wrap(L, "open", sb_io_open);
   wrap(L, "output", sb_io_output);
   lua_pop(L, 1);

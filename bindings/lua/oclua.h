@@ -26,8 +26,9 @@ int luaopen_outcrop(lua_State *L);
 #define OCLUA_SCENE "outcrop.scene"
 
 /* light userdata: address of a `volatile sig_atomic_t` the interpreter sets
-** to non-zero on Ctrl-C; long work polls it through its progress callback
-** and stops (OC_ECANCEL), after which the binding raises "interrupted" */
+** to non-zero on Ctrl-C, SIGTERM, SIGHUP and --timeout; long work polls it
+** through its progress callback and stops (OC_ECANCEL), after which the
+** binding raises "interrupted" (the interpreter reports the real cause) */
 #define OCLUA_INTERRUPT "outcrop.interrupt"
 
 /* Resolves an output path given by a script: a relative path is joined to

@@ -352,6 +352,31 @@ run "$S/remove.lua" rename "$W/keep.txt" d.txt --out "$W/o"
 status_is 1; file_has "$W/keep.txt" keep
 end
 
+# a precompiled scene is Lua bytecode, which can be crafted to break out
+# of the VM: refused as a file and on standard input
+begin bytecode-scene
+printf 'print("bytecode ran")\n' >"$W/scene.lua"
+luac5.4 -o "$W/scene.luac" "$W/scene.lua"
+run "$W/scene.luac"
+status_is 2; err_has "binary chunk"; err_has "--unsafe"; out_lacks "bytecode ran"
+(cd "$W" && exec "$OUTCROP" - <"$W/scene.luac") >"$OUT" 2>"$ERR"
+rc=$?
+sanitizer_check
+status_is 2; err_has "binary chunk"; out_lacks "bytecode ran"
+run --unsafe "$W/scene.luac"
+status_is 0; out_has "bytecode ran"
+end
+
+# a closed standard output is not reused by the first file opened: print
+# fails (and the status says so) instead of writing into that file
+begin closed-stdout
+(cd "$W" && exec "$OUTCROP" "$S/closedout.lua") >&- 2>"$ERR" </dev/null
+rc=$?
+sanitizer_check
+status_is 1; err_has "writing standard output"
+[ "$(cat "$W/out.txt")" = written ] || because "out.txt holds '$(cat "$W/out.txt")'"
+end
+
 begin unsafe
 run "$S/unsafe.lua" --out "$W/o"
 status_is 1
@@ -373,11 +398,13 @@ else
   set -m # with job control, background jobs keep default signals
 fi
 
-# ctrl_c SCENE [HOW]: runs SCENE HOW, presses Ctrl-C half a second after
-# it wrote started.txt, and checks that it stopped cleanly (status 130,
-# "interrupted", nothing after the interruption)
-ctrl_c() {
-  (cd "$W" && exec "${DEFSIG[@]}" "$OUTCROP" "$S/$1" --out "$W/o" ${2:-}) \
+# stop_with SIG SCENE [HOW] [OPTIONS...]: runs SCENE HOW, sends SIG half a
+# second after it wrote started.txt, and waits for the end (10 s at most);
+# sets rc
+stop_with() {
+  local sig=$1 scene=$2 how=${3:-}
+  shift 3 2>/dev/null || shift $#
+  (cd "$W" && exec "${DEFSIG[@]}" "$OUTCROP" "$S/$scene" --out "$W/o" $how "$@") \
     >"$OUT" 2>"$ERR" </dev/null &
   pid=$!
   for _ in $(seq 200); do # up to 20 s for a slow (sanitized) start
@@ -385,20 +412,33 @@ ctrl_c() {
     sleep 0.1
   done
   sleep 0.5
-  kill -INT "$pid" 2>/dev/null
+  kill -"$sig" "$pid" 2>/dev/null
   for _ in $(seq 100); do
     kill -0 "$pid" 2>/dev/null || break
     sleep 0.1
   done
   if kill -0 "$pid" 2>/dev/null; then
-    because "still running 10 s after SIGINT"
+    because "still running 10 s after SIG$sig"
     kill -KILL "$pid" 2>/dev/null
   fi
   wait "$pid"
   rc=$?
   sanitizer_check
   [ -e "$W/o/started.txt" ] || because "the scene never started"
+}
+
+# ctrl_c SCENE [HOW]: Ctrl-C, and checks that it stopped cleanly (status
+# 130, "interrupted", nothing after the interruption)
+ctrl_c() {
+  stop_with INT "$@"
   status_is 130; err_has "outcrop: interrupted"; no_file "$W/o/after.txt"
+}
+
+# only_started: nothing but started.txt in the output folder (no output,
+# no temporary)
+only_started() {
+  [ -z "$(ls -A "$W/o" | grep -v '^started.txt$')" ] ||
+    because "files left in the output folder: $(ls -A "$W/o")"
 }
 
 # interrupt NAME [HOW]: Ctrl-C half a second into loop.lua HOW
@@ -414,6 +454,115 @@ interrupt interrupt-coroutine-wrap wrap
 interrupt interrupt-coroutine-resume resume
 interrupt interrupt-coroutine-nested nested
 interrupt interrupt-polygonize mesh
+interrupt interrupt-coroutine-close close
+interrupt interrupt-wrap-close wrap-close
+interrupt interrupt-xpcall-handler xpcall
+interrupt interrupt-finalizer finalizer
+
+# SIGTERM and SIGHUP stop the scene as Ctrl-C does, with 128 + signal
+begin sigterm-polygonize
+stop_with TERM loop.lua mesh
+status_is 143; err_has "outcrop: terminated"; only_started
+end
+
+begin sigterm-lua-loop
+stop_with TERM loop.lua finalizer
+status_is 143; err_has "outcrop: terminated"; only_started
+end
+
+begin sighup
+stop_with HUP loop.lua xpcall
+status_is 129; err_has "outcrop: hangup"; only_started
+end
+
+# print to a closed pipe: stock Lua dies of SIGPIPE, outcrop stops cleanly
+begin sigpipe
+mkdir -p "$W/o"
+(cd "$W" && exec "$OUTCROP" "$S/loop.lua" print --out "$W/o") 2>"$ERR" \
+  </dev/null | head -n 1 >"$OUT"
+rc=${PIPESTATUS[0]}
+sanitizer_check
+status_is 141; err_has "outcrop: broken pipe"; out_has "line"
+no_file "$W/o/after.txt"
+end
+
+# ---- resource limits ---------------------------------------------------------
+
+begin help-limits
+run --help
+out_has "--max-memory SIZE"; out_has "--timeout SECONDS"; out_has "124"
+end
+
+begin bad-limits
+for v in "" 0.5 -1M 12Q M 1e3 99999999999T; do
+  run --max-memory "$v" "$S/hello.lua"
+  [ "$rc" -eq 2 ] || because "--max-memory '$v' gave status $rc"
+done
+err_has "--max-memory expects"
+for v in "" -1 abc 1e400 nan inf; do
+  run --timeout "$v" "$S/hello.lua"
+  [ "$rc" -eq 2 ] || because "--timeout '$v' gave status $rc"
+done
+err_has "--timeout expects"
+end
+
+begin max-memory-lua
+run --max-memory 64M "$S/grow.lua"
+status_is 1; err_has "not enough memory (--max-memory 64 MiB reached)"
+out_lacks "not reached"
+end
+
+begin max-memory-engine
+run --max-memory=256M "$S/grow.lua" engine
+status_is 1; err_has "(--max-memory 256 MiB reached)"
+err_has "outcrop.heightfield.fbm"; out_lacks "heightfield made"
+run --max-memory 256M "$S/grow.lua" engine 512 --threads 2
+status_is 1; out_has "heightfield made	512	512"; out_lacks "not reached"
+err_has "grow.lua:13: not reached on purpose"
+end
+
+begin max-memory-none
+run --max-memory 0 "$S/hello.lua" x
+status_is 0; out_has "args	1	x"
+for v in none 1G 512MiB 65536k 2gb; do
+  run --max-memory "$v" "$S/hello.lua"
+  [ "$rc" -eq 0 ] || because "--max-memory '$v' gave status $rc"
+done
+end
+
+begin timeout-lua-loop
+started=$SECONDS
+run --timeout 1 "$S/loop.lua" --out "$W/o"
+status_is 124; err_has "outcrop: timeout (--timeout 1 s)"
+[ $((SECONDS - started)) -le 8 ] || because "took $((SECONDS - started)) s"
+no_file "$W/o/after.txt"
+end
+
+begin timeout-engine
+started=$SECONDS
+run --timeout=1.5 "$S/loop.lua" mesh --out "$W/o"
+status_is 124; err_has "outcrop: timeout (--timeout 1.5 s)"
+[ $((SECONDS - started)) -le 8 ] || because "took $((SECONDS - started)) s"
+only_started
+end
+
+# stuck in C, where no hook runs: ended GRACE (10 s) after the timeout
+begin timeout-stuck-in-c
+started=$SECONDS
+run --timeout 0.5 "$S/loop.lua" c --out "$W/o"
+status_is 124; err_has "outcrop: timeout (--timeout 0.5 s), still running 10 s later: killed"
+[ $((SECONDS - started)) -le 15 ] || because "took $((SECONDS - started)) s"
+end
+
+begin timeout-finalizer
+run --timeout 1 "$S/loop.lua" finalizer --out "$W/o"
+status_is 124; no_file "$W/o/after.txt"
+end
+
+begin timeout-not-reached
+run --timeout 30 "$S/hello.lua"
+status_is 0
+end
 
 # ---- rendering -------------------------------------------------
 
@@ -422,7 +571,7 @@ interrupt_render() {
   begin "$1"
   ctrl_c render_loop.lua "${2:-}"
   no_file "$W/o/render.png"
-  [ -z "$(ls "$W/o" | grep -v '^started.txt$')" ] || because "files left in the output folder: $(ls "$W/o")"
+  only_started
   end
 }
 

@@ -9,6 +9,9 @@ assert(debug.sethook == nil and debug.getregistry == nil
        and debug.getupvalue == nil, "debug library reduced")
 assert(type(debug.traceback) == "function", "debug.traceback kept")
 assert(not pcall(os.tmpname), "os.tmpname refused")
+-- io.tmpfile writes in /tmp, outside --out and without limit
+local tok, tmsg = pcall(io.tmpfile)
+assert(not tok and tmsg:find("io.tmpfile is not allowed", 1, true), tmsg)
 
 -- binary chunks are refused by load, loadfile and require
 local bytecode = string.dump(function() return 42 end)
