@@ -143,9 +143,12 @@ static int l_load(lua_State *L) {
     p.x0 = o[0];
     p.y0 = o[1];
   }
+  oclua_progress pl;
+  p.progress = oclua_progress_start(L, &pl, fname); /* Ctrl-C while reading */
   oclua_heightfield *u = oclua_newheightfield(L);
-  return oclua_sethf(L, u, oc_heightfield_load(lua_tostring(L, 1), &p, &err),
-                     &err, fname);
+  oc_heightfield *hf = oc_heightfield_load(lua_tostring(L, 1), &p, &err);
+  oclua_progress_end(&pl);
+  return oclua_sethf(L, u, hf, &err, fname);
 }
 
 /* ---- outcrop.heightfield.fbm ------------------------------------------ */
