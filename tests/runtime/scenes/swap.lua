@@ -24,6 +24,9 @@ else
   swap()
   local f
   f, msg = io.open(path, "w")
-  if f then ok = f:write("written\n") and f:close() end
+  if f then
+    f:write("written\n")
+    ok, msg = f:close()
+  end
 end
 if ok then print("wrote " .. path) else print("failed " .. path .. ": " .. tostring(msg)) end
