@@ -20,6 +20,7 @@
 #include "outcrop.h"
 
 #define SUPPORTED ".png, .jpg, .jpeg, .tif, .tiff or .exr"
+#define JPEG_MAX_SIDE 65500
 
 typedef enum kind { PNG, JPEG, TIFF, EXR } kind;
 
@@ -199,6 +200,14 @@ int oc_image_write_at(const oc_image *img, int dirfd, const char *path,
     int rc = check_names(img, err);
     if (rc) return rc;
   }
+  /* libjpeg's limit; past it, its error handler exits the process. */
+  if (k == JPEG && (oc_image_width(img) > JPEG_MAX_SIDE ||
+                    oc_image_height(img) > JPEG_MAX_SIDE))
+    return oc_seterr(err, OC_EINVAL,
+                     "cannot write '%s': JPEG holds at most %d pixels per "
+                     "side (the image is %d x %d; use .png, .tif or .exr)",
+                     path, JPEG_MAX_SIDE, oc_image_width(img),
+                     oc_image_height(img));
 
   int nch = written_channels((kind)k, oc_image_channels(img));
   const char *names[64];

@@ -637,6 +637,27 @@ START_TEST(metadata_cannot_forge_lines) {
 }
 END_TEST
 
+/* libjpeg exits the process on an image wider or taller than 65500: such
+** a write is refused before the encoder runs, and nothing is left. */
+START_TEST(jpeg_size_limit) {
+  oc_error e = {0};
+  oc_image *img = oc_image_new(65501, 2, 3, &e);
+  ck_assert_ptr_nonnull(img);
+  const char *p = oct_in_dir(dir, "wide.jpg");
+  ck_assert_int_eq(oc_image_write(img, p, 0, &e), OC_EINVAL);
+  ck_assert_msg(strstr(e.msg, "65500") && strstr(e.msg, "65501 x 2"), "%s",
+                e.msg);
+  ck_assert_int_eq(oct_count_entries(dir, NULL, 0), 0);
+  oc_image_free(img);
+  img = oc_image_new(2, 65501, 1, &e);
+  ck_assert_int_eq(oc_image_write(img, p, 0, &e), OC_EINVAL);
+  oc_image_free(img);
+  img = pattern(65500, 1, 3); /* the largest that JPEG holds */
+  write_ok(img, p, 0);
+  oc_image_free(img);
+}
+END_TEST
+
 /* A full disk: every format reports it, and leaves neither the file nor
 ** its temporary; once there is room, the same folder takes a small file.
 ** (The PNG writer used to report success and rename a truncated file into
@@ -691,6 +712,7 @@ static Suite *suite(void) {
   tcase_add_test(t, overwrite_is_atomic);
   tcase_add_test(t, read_errors);
   tcase_add_test(t, metadata_cannot_forge_lines);
+  tcase_add_test(t, jpeg_size_limit);
   tcase_add_test(t, disk_full);
   suite_add_tcase(s, t);
   return s;
