@@ -1,8 +1,9 @@
 /*
 ** atomic.h — atomic file output, shared by every writer in lib/.
 **
-** A file is written under a temporary name in the destination's own
-** folder (so the final rename never crosses file systems), flushed and
+** A file is written as a temporary file in the destination's own folder
+** (so the final rename never crosses file systems; anonymous where the
+** system allows, so that a killed process leaves nothing), flushed and
 ** synced to disk, then renamed over the final name: readers see the old
 ** file or the whole new one, never a part. Every byte goes through the
 ** stream a.fp, so every failed write, flush, sync or close is seen; on
@@ -29,7 +30,8 @@
 typedef struct oc_atomic {
   int dir;    /* the directory descriptor names are relative to */
   char *path; /* the final name (a copy) */
-  char *tmp;  /* the temporary name: ".<base>.tmp-<pid>-<n><ext>" */
+  char *tmp;  /* the temporary name ".<base>.tmp-<pid>-<n><ext>", or NULL
+              ** while the file is anonymous (O_TMPFILE) */
   FILE *fp;   /* open for writing on tmp, at offset 0 */
   int error;  /* errno of the first failed oc_atomic_write, or 0 */
 } oc_atomic;
