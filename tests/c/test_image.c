@@ -601,6 +601,10 @@ START_TEST(read_errors) {
   fclose(f);
   ck_assert_ptr_null(oc_oiio_read(oct_in_dir(dir, "junk.png"), &e));
   ck_assert_int_eq(e.code, OC_EIO);
+  ck_assert_msg(strstr(e.msg, "unrecognised image format"), "%s", e.msg);
+  /* not a regular file: refused at once, never probed by every reader */
+  ck_assert_ptr_null(oc_oiio_read("/dev/zero", &e));
+  ck_assert_msg(strstr(e.msg, "not a regular file"), "%s", e.msg);
 }
 END_TEST
 
