@@ -133,6 +133,7 @@ check-lua: $(MODULE)
 check-runtime: $(BIN)
 	@echo "== interpreter tests ($(B))"
 	@OUTCROP=$(abspath $(BIN)) bash tests/runtime/run.sh
+	@OUTCROP=$(abspath $(BIN)) bash tests/runtime/outpaths.sh
 
 # The sanitizer pass: C tests, Lua specs (stock lua5.4 with libasan
 # preloaded; leak checking off there because lua5.4 itself is not

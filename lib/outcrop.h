@@ -262,6 +262,15 @@ int oc_mesh_color_by_field(oc_mesh *mesh, const oc_program *field,
 ** colours when set), .obj (positions, normals), .glb (glTF 2.0 binary).
 ** Atomic (temporary name, then rename); on error no file is left. */
 int oc_mesh_write(const oc_mesh *mesh, const char *path, oc_error *err);
+/* The same, with `path` relative to the directory descriptor `dirfd`
+** (AT_FDCWD: the current folder), so a folder resolved once is written
+** without its path being looked up again. The temporary file is created
+** and renamed in path's parent; every write, the flush, fsync and close
+** are checked, and a failure ("cannot write 'path': No space left on
+** device") leaves neither the file nor a temporary. The same holds for
+** oc_image_write_at and oc_heightfield_save_at. */
+int oc_mesh_write_at(const oc_mesh *mesh, int dirfd, const char *path,
+                     oc_error *err);
 
 /* ---- images ---------------------------------------------------------- */
 
@@ -293,6 +302,10 @@ int oc_image_set_meta(oc_image *img, const char *key, const char *value,
 ** with their colour space (sRGB, or Linear for float formats). */
 int oc_image_write(const oc_image *img, const char *path, int bits,
                    oc_error *err);
+/* oc_image_write relative to a directory descriptor (see
+** oc_mesh_write_at). */
+int oc_image_write_at(const oc_image *img, int dirfd, const char *path,
+                      int bits, oc_error *err);
 
 /* ---- slices ---------------------------------------------------------- */
 
@@ -535,17 +548,21 @@ typedef struct oc_hf_load_params {
   double cell;          /* > 0 */
   double scale, offset; /* elevation = stored value * scale + offset */
   double x0, y0;        /* position of sample (0, 0) */
+  oc_progress progress; /* polled while reading; may be {NULL, NULL} */
 } oc_hf_load_params;
 
-/* Reads the first channel of an image file (PNG, TIFF, EXR or anything
-** else OpenImageIO reads) into a new grid. Integer samples are raw counts
-** (0..255 for 8 bits, 0..65535 for 16 bits: not normalized, so `scale` is
-** metres per count); half and float samples are taken as stored. North
-** up: the image's top row is the grid's last row (j = ny - 1), its left
-** column i = 0. p may be NULL. On error NULL and `err`: OC_EIO naming the
-** path for unreadable or corrupt files, OC_EINVAL for an image under
-** 2 x 2 pixels or a non-finite elevation, OC_ENOMEM (before allocating)
-** for images over the size limit of oc_heightfield_new. */
+/* Reads the first channel of an image file into a new grid. The format
+** (PNG, TIFF, EXR or JPEG) is told by the file's signature, not its name;
+** only regular files are read (FIFOs, devices and folders are refused
+** without blocking). Integer samples are raw counts (0..255 for 8 bits,
+** 0..65535 for 16 bits: not normalized, so `scale` is metres per count);
+** half and float samples are taken as stored. North up: the image's top
+** row is the grid's last row (j = ny - 1), its left column i = 0. p may
+** be NULL. On error NULL and `err`: OC_EIO naming the path for
+** unreadable, corrupt or unrecognised files, OC_EINVAL for an image
+** under 2 x 2 pixels, over 65535 per side or with a non-finite
+** elevation, OC_ENOMEM (before allocating) for images over the size
+** limit of oc_heightfield_new, OC_ECANCEL when p->progress stops it. */
 oc_heightfield *oc_heightfield_load(const char *path,
                                     const oc_hf_load_params *p, oc_error *err);
 
@@ -581,6 +598,11 @@ typedef struct oc_hf_save_params {
 int oc_heightfield_save(const oc_heightfield *hf, const char *path,
                         const oc_hf_save_params *p, double used[2],
                         oc_error *err);
+/* oc_heightfield_save relative to a directory descriptor (see
+** oc_mesh_write_at). */
+int oc_heightfield_save_at(const oc_heightfield *hf, int dirfd,
+                           const char *path, const oc_hf_save_params *p,
+                           double used[2], oc_error *err);
 
 /* -- procedural grids (terrain/hf_make.c) -- */
 

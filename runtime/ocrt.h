@@ -55,7 +55,7 @@ char *ocrt_outdir(const char *dir, char *msg, size_t msgsize);
 int ocrt_run(const ocrt_options *o);
 
 /* Restricts the standard libraries of L to the scene sandbox. The module
-** must already be loaded (writes go through oclua_output_path). */
+** must already be loaded (writes go through oclua_output_target). */
 void ocrt_sandbox(lua_State *L);
 
 /* Stopping a running scene (stop.c). ocrt_stop_open prepares L (once,

@@ -9,8 +9,11 @@
 **    Lua bytecode can be crafted to break out of the VM (run.c loads the
 **    scene itself, or standard input, as text too);
 **  - io.open for writing ("w", "a", any "+"), io.output(name), os.remove
-**    and os.rename take paths through oclua_output_path: relative paths
-**    land in the output folder and anything outside it is an error.
+**    and os.rename take paths through oclua_output_target: relative paths
+**    land in the output folder, anything outside it or through a symbolic
+**    link is an error, and the file is opened (or removed, renamed)
+**    relative to the output folder's descriptor, folder by folder, so
+**    nothing done meanwhile can lead it outside.
 **    Reading is not restricted and relative read paths resolve against the
 **    current folder, as in plain Lua;
 **  - os.tmpname and io.tmpfile raise an error (they create files in /tmp,
@@ -31,8 +34,12 @@
 ** .close, xpcall, setmetatable).
 ** The tables are changed in place, so package.loaded sees the same thing.
 */
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <lauxlib.h>
 #include <lualib.h>
@@ -49,33 +56,117 @@ static int call_original(lua_State *L) {
   return lua_gettop(L);
 }
 
-/* Replaces argument `arg` (a path) by its resolved output path. */
-static void output_arg(lua_State *L, int arg, const char *fname) {
-  oclua_output_path(L, fname, luaL_checkstring(L, arg));
-  lua_replace(L, arg);
+/* ---- writes: opened relative to the output folder's descriptor ---------- */
+
+/* The open(2) flags of a C fopen mode ([rwa]+?b*), or -1. */
+static int open_flags(const char *mode) {
+  int flags;
+  switch (*mode++) {
+  case 'r':
+    flags = 0;
+    break;
+  case 'w':
+    flags = O_CREAT | O_TRUNC;
+    break;
+  case 'a':
+    flags = O_CREAT | O_APPEND;
+    break;
+  default:
+    return -1;
+  }
+  int plus = *mode == '+';
+  if (plus) mode++;
+  mode += strspn(mode, "b");
+  if (*mode) return -1;
+  return flags | (plus ? O_RDWR : flags ? O_WRONLY : O_RDONLY);
+}
+
+static int close_stream(lua_State *L) {
+  luaL_Stream *p = luaL_checkudata(L, 1, LUA_FILEHANDLE);
+  errno = 0;
+  return luaL_fileresult(L, fclose(p->f) == 0, NULL);
+}
+
+/* Pushes a Lua file opened on `name` in the output folder, as io.open
+** would, or fail, a message and an errno. */
+static int open_output(lua_State *L, const char *fname, const char *path,
+                       const char *mode) {
+  oclua_target t;
+  int flags = open_flags(mode);
+  luaL_argcheck(L, flags >= 0, 2, "invalid mode");
+  int e = oclua_output_target(L, fname, path, OCLUA_TARGET_CREATE, &t);
+  int fd = -1;
+  if (!e) {
+    fd = openat(t.dir, t.name, flags | O_NOFOLLOW | O_CLOEXEC, 0666);
+    e = fd < 0 ? errno : 0;
+  }
+  oclua_target_close(L, &t);
+  lua_pop(L, 1);
+  /* created closed, as liolib does, so an error meanwhile leaks nothing */
+  luaL_Stream *p = lua_newuserdatauv(L, sizeof *p, 0);
+  p->closef = NULL;
+  luaL_setmetatable(L, LUA_FILEHANDLE);
+  if (!e) {
+    p->f = fdopen(fd, mode);
+    if (p->f == NULL) {
+      e = errno;
+      close(fd);
+    }
+  }
+  if (e) {
+    errno = e;
+    return luaL_fileresult(L, 0, path);
+  }
+  p->closef = close_stream;
+  return 1;
 }
 
 static int sb_io_open(lua_State *L) {
+  const char *path = luaL_checkstring(L, 1);
   const char *mode = luaL_optstring(L, 2, "r");
-  luaL_checkstring(L, 1);
-  if (mode[0] != 'r' || strchr(mode, '+') != NULL) output_arg(L, 1, "io.open");
-  return call_original(L);
+  if (mode[0] == 'r' && strchr(mode, '+') == NULL) return call_original(L);
+  return open_output(L, "io.open", path, mode);
 }
 
 static int sb_io_output(lua_State *L) {
-  if (lua_type(L, 1) == LUA_TSTRING) output_arg(L, 1, "io.output");
+  if (lua_type(L, 1) == LUA_TSTRING) {
+    const char *path = lua_tostring(L, 1);
+    if (open_output(L, "io.output", path, "w") != 1)
+      return luaL_error(L, "cannot open file '%s' (%s)", path,
+                        lua_tostring(L, -2));
+    lua_replace(L, 1);
+    lua_settop(L, 1);
+  }
   return call_original(L);
 }
 
 static int sb_os_remove(lua_State *L) {
-  output_arg(L, 1, "os.remove");
-  return call_original(L);
+  const char *path = luaL_checkstring(L, 1);
+  oclua_target t;
+  int e = oclua_output_target(L, "os.remove", path, OCLUA_TARGET_LINK, &t);
+  /* remove(3) removes empty folders too */
+  if (!e && unlinkat(t.dir, t.name, 0) != 0)
+    e = errno == EISDIR && unlinkat(t.dir, t.name, AT_REMOVEDIR) == 0 ? 0
+                                                                      : errno;
+  oclua_target_close(L, &t);
+  errno = e;
+  return luaL_fileresult(L, e == 0, path);
 }
 
 static int sb_os_rename(lua_State *L) {
-  output_arg(L, 1, "os.rename");
-  output_arg(L, 2, "os.rename");
-  return call_original(L);
+  const char *from = luaL_checkstring(L, 1);
+  const char *to = luaL_checkstring(L, 2);
+  oclua_target a, b;
+  int e = oclua_output_target(L, "os.rename", from, OCLUA_TARGET_LINK, &a);
+  if (!e)
+    e = oclua_output_target(L, "os.rename", to, OCLUA_TARGET_LINK, &b);
+  else
+    b.owner = NULL;
+  if (!e && renameat(a.dir, a.name, b.dir, b.name) != 0) e = errno;
+  oclua_target_close(L, &a);
+  oclua_target_close(L, &b);
+  errno = e;
+  return luaL_fileresult(L, e == 0, from);
 }
 
 static int sb_os_tmpname(lua_State *L) {
@@ -180,6 +271,8 @@ static void sandbox_base(lua_State *L) {
 
 static void sandbox_io(lua_State *L) {
   luaL_getsubtable(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
+  /* the output folder is resolved once, now, for the whole run */
+  oclua_outdir_fd(L, "outcrop");
   lua_getfield(L, -1, LUA_IOLIBNAME);
   remove_field(L, "popen");
   set_function(L, "tmpfile", sb_io_tmpfile);

@@ -143,9 +143,12 @@ static int l_load(lua_State *L) {
     p.x0 = o[0];
     p.y0 = o[1];
   }
+  oclua_progress pl;
+  p.progress = oclua_progress_start(L, &pl, fname); /* Ctrl-C while reading */
   oclua_heightfield *u = oclua_newheightfield(L);
-  return oclua_sethf(L, u, oc_heightfield_load(lua_tostring(L, 1), &p, &err),
-                     &err, fname);
+  oc_heightfield *hf = oc_heightfield_load(lua_tostring(L, 1), &p, &err);
+  oclua_progress_end(&pl);
+  return oclua_sethf(L, u, hf, &err, fname);
 }
 
 /* ---- outcrop.heightfield.fbm ------------------------------------------ */
@@ -539,15 +542,18 @@ static int hf_save(lua_State *L) {
   lua_pop(L, 2);
   p.scale = oclua_field_optnumber(&f, "scale", OCLUA_POSITIVE, 1);
   p.offset = oclua_field_optnumber(&f, "offset", OCLUA_FINITE, 0);
-  const char *path = oclua_output_path(L, fname, lua_tostring(L, 2));
   p.meta = provenance(L, &p.nmeta);
-  if (oc_heightfield_save(hf, path, &p, used, &err) != OC_OK) {
+  oclua_target t;
+  int e = oclua_output_target(L, fname, lua_tostring(L, 2), OCLUA_TARGET_CREATE,
+                              &t);
+  if (e) return oclua_output_fail(L, &t, strerror(e));
+  int rc = oc_heightfield_save_at(hf, t.dir, t.name, &p, used, &err);
+  oclua_target_close(L, &t);
+  if (rc != OC_OK) {
     /* A file that cannot be written is an expected failure, as io.open. */
-    if (err.code == OC_EIO) {
-      luaL_pushfail(L);
-      lua_pushstring(L, err.msg[0] ? err.msg : "cannot write the heightfield");
-      return 2;
-    }
+    if (err.code == OC_EIO)
+      return oclua_output_fail(
+          L, &t, err.msg[0] ? err.msg : "cannot write the heightfield");
     oclua_liberror(L, fname, &err);
   }
   lua_pushnumber(L, used[0]);

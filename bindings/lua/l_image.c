@@ -114,14 +114,17 @@ static int image_write(lua_State *L) {
                   bits);
     set_user_meta(&f, img);
   }
-  const char *path = oclua_output_path(L, fname, lua_tostring(L, 2));
-  if (oc_image_write(img, path, bits, &err) != OC_OK) {
+  oclua_target t;
+  int e = oclua_output_target(L, fname, lua_tostring(L, 2), OCLUA_TARGET_CREATE,
+                              &t);
+  if (e) return oclua_output_fail(L, &t, strerror(e));
+  int rc = oc_image_write_at(img, t.dir, t.name, bits, &err);
+  oclua_target_close(L, &t);
+  if (rc != OC_OK) {
     /* A file that cannot be written is an expected failure, as io.open. */
-    if (err.code == OC_EIO) {
-      luaL_pushfail(L);
-      lua_pushstring(L, err.msg[0] ? err.msg : "cannot write the image");
-      return 2;
-    }
+    if (err.code == OC_EIO)
+      return oclua_output_fail(L, &t,
+                               err.msg[0] ? err.msg : "cannot write the image");
     oclua_liberror(L, fname, &err);
   }
   lua_pushboolean(L, 1);

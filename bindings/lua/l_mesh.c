@@ -214,7 +214,6 @@ static int mesh_write(lua_State *L) {
   oclua_mesh *u = checkmesh(L, fname);
   oc_error err = {OC_OK, ""};
   colors c = {COLORS_NONE, 0, NULL, 0};
-  const char *path;
   if (lua_type(L, 2) != LUA_TSTRING)
     oclua_error(L, fname, "the path must be a string (got %s)",
                 oclua_got(L, 2));
@@ -225,15 +224,19 @@ static int mesh_write(lua_State *L) {
     oclua_fields_open(&f, L, 3, fname, NULL, known, 0);
     read_colors(&f, &c);
   }
-  path = oclua_output_path(L, fname, lua_tostring(L, 2));
   apply_colors(L, u, &c, fname);
-  if (oc_mesh_write(u->mesh, path, &err) != OC_OK) {
+  /* resolved after the colour callbacks, which may move folders */
+  oclua_target t;
+  int e = oclua_output_target(L, fname, lua_tostring(L, 2), OCLUA_TARGET_CREATE,
+                              &t);
+  if (e) return oclua_output_fail(L, &t, strerror(e));
+  int rc = oc_mesh_write_at(u->mesh, t.dir, t.name, &err);
+  oclua_target_close(L, &t);
+  if (rc != OC_OK) {
     /* A file that cannot be written is an expected failure, as io.open. */
-    if (err.code == OC_EIO) {
-      luaL_pushfail(L);
-      lua_pushstring(L, err.msg[0] ? err.msg : "cannot write the mesh");
-      return 2;
-    }
+    if (err.code == OC_EIO)
+      return oclua_output_fail(L, &t,
+                               err.msg[0] ? err.msg : "cannot write the mesh");
     oclua_liberror(L, fname, &err);
   }
   lua_pushboolean(L, 1);

@@ -5,6 +5,7 @@
 ** The only C++ in the project. Every entry point catches every exception:
 ** C callers get a status code and a message, never an unwinding stack.
 */
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <cstdarg>
@@ -14,10 +15,12 @@
 #include <memory>
 #include <new>
 #include <string>
+#include <vector>
 
 #include <strings.h>
 
 #include "oiio_util.hpp"
+#include "io/metatext.h"
 #include "io/oiio.h"
 
 extern "C" {
@@ -66,23 +69,42 @@ bool native_text(const char *format, const char *key) {
   return true;
 }
 
+/* The formats whose only free text is the ImageDescription. */
+bool folds(const char *format) {
+  return std::strcmp(format, "tiff") == 0 || std::strcmp(format, "jpeg") == 0;
+}
+
+/* A key that can start a "key=value" line. */
+bool line_key(const char *k) {
+  if (!*k) return false;
+  for (; *k; k++)
+    if ((unsigned char)*k < ' ' || *k == '=' || *k == 0x7f) return false;
+  return true;
+}
+
+/* Keys the format cannot hold become lines of the ImageDescription, each
+** value quoted (io/metatext.h) so that none can forge another line; a
+** description given by the caller becomes a line too, so that the whole
+** text is lines we wrote. */
 void describe(const char *format, const oc_oiio_out *im, ImageSpec &spec) {
   std::string folded;
   for (size_t i = 0; i < im->nmeta; i++) {
     const char *k = im->meta[2 * i], *v = im->meta[2 * i + 1];
-    if (native_text(format, k)) {
+    bool own_line = folds(format) && strcasecmp(k, "ImageDescription") == 0;
+    if (native_text(format, k) && !own_line) {
       spec.attribute(k, v);
-    } else {
+    } else if (line_key(k)) {
+      std::string q(oc_meta_quoted_size(v), '\0');
+      q.resize(oc_meta_quote(v, &q[0]));
       folded += k;
       folded += '=';
-      folded += v;
+      folded += q;
       folded += '\n';
     }
   }
   if (!folded.empty()) {
     folded.pop_back();
-    std::string d = spec.get_string_attribute("ImageDescription");
-    spec.attribute("ImageDescription", d.empty() ? folded : d + "\n" + folded);
+    spec.attribute("ImageDescription", folded);
   }
   /* The TIFF and EXR writers stamp the current time unless a DateTime is
   ** present; an empty one is written as nothing (TIFF) or an empty
@@ -90,7 +112,8 @@ void describe(const char *format, const oc_oiio_out *im, ImageSpec &spec) {
   if (!spec.find_attribute("DateTime")) spec.attribute("DateTime", "");
 }
 
-int write_file(const char *path, const oc_oiio_out *im, char *why, size_t n) {
+int encode(const oc_oiio_out *im, oc_oiio_sink sink, void *ud, char *why,
+           size_t n) {
   TypeDesc file, mem;
   switch (im->type) {
   case OC_OIIO_U8:
@@ -119,7 +142,17 @@ int write_file(const char *path, const oc_oiio_out *im, char *why, size_t n) {
   /* Values are written as given: no division by alpha on the way out. */
   if (im->alpha >= 0) spec.attribute("oiio:UnassociatedAlpha", 1);
   describe(im->format, im, spec);
-  if (!out->open(path, spec))
+  /* Encoded into memory: the disk is written by the caller, through one
+  ** path that checks every write (libjpeg, for one, would otherwise exit
+  ** the process on a failed write). The formats we write all take a
+  ** proxy; one that did not would write a file named "-", never ours. */
+  OIIO::Filesystem::IOVecOutput vec;
+  void *proxy = &vec;
+  if (!out->supports("ioproxy"))
+    return say(why, n, OC_EIO, "OpenImageIO cannot encode %s into memory",
+               im->format);
+  spec.attribute("oiio:ioproxy", TypeDesc::PTR, &proxy);
+  if (!out->open("-", spec))
     return say(why, n, OC_EIO, "%s", oc_oiio_oneline(out->geterror()).c_str());
   bool ok = out->write_image(mem, im->pixels);
   std::string e = ok ? std::string() : out->geterror();
@@ -128,7 +161,12 @@ int write_file(const char *path, const oc_oiio_out *im, char *why, size_t n) {
     if (e.empty()) e = out->geterror();
     return say(why, n, OC_EIO, "%s", oc_oiio_oneline(e).c_str());
   }
-  return OC_OK;
+  const std::vector<unsigned char> &bytes = vec.buffer();
+  return sink(ud, bytes.data(), bytes.size(), why, n);
+}
+
+void set_meta(void *img, const char *key, const char *value) {
+  oc_image_set_meta(static_cast<oc_image *>(img), key, value, nullptr);
 }
 
 struct image_deleter {
@@ -138,12 +176,9 @@ struct image_deleter {
 oc_image *read_file(const char *path, oc_error *err) {
   ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
-  auto in = ImageInput::open(path, &config);
-  if (!in) {
-    oc_seterr(err, OC_EIO, "cannot read '%s': %s", path,
-              oc_oiio_oneline(OIIO::geterror()).c_str());
-    return nullptr;
-  }
+  oc_oiio_input input;
+  if (!oc_oiio_open_input(input, path, config, err)) return nullptr;
+  ImageInput *in = input.in.get();
   const ImageSpec &spec = in->spec();
   if (spec.deep || spec.depth > 1) {
     oc_seterr(err, OC_EUNSUPPORTED,
@@ -174,16 +209,23 @@ oc_image *read_file(const char *path, oc_error *err) {
     std::string v = oc_oiio_attr_text(p);
     oc_image_set_meta(img.get(), p.name().c_str(), v.c_str(), nullptr);
   }
-  in->close();
+  /* The lines the writer folded into a TIFF or JPEG description come back
+  ** as the keys they were (only there: in other formats a description is
+  ** free text, not ours to parse). */
+  if (folds(in->format_name())) {
+    std::string d = spec.get_string_attribute("ImageDescription");
+    if (oc_meta_unfold(d.c_str(), set_meta, img.get()) != 0)
+      throw std::bad_alloc();
+  }
   return img.release();
 }
 
 } // namespace
 
-extern "C" int oc_oiio_write(const char *path, const oc_oiio_out *im, char *why,
-                             size_t whysize) {
+extern "C" int oc_oiio_encode(const oc_oiio_out *im, oc_oiio_sink sink,
+                              void *ud, char *why, size_t whysize) {
   try {
-    return write_file(path, im, why, whysize);
+    return encode(im, sink, ud, why, whysize);
   } catch (const std::bad_alloc &) {
     return say(why, whysize, OC_EIO, "out of memory");
   } catch (const std::exception &e) {

@@ -7,6 +7,7 @@
 */
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <exception>
@@ -38,25 +39,34 @@ template <typename T> void widen(float *dst, size_t n) {
   }
 }
 
+/* Rows read between two polls of the progress callback. */
+const int STRIP = 64;
+
 int read_raw(const char *path, const oc_oiio_raw *r, oc_error *err) {
   ImageSpec config;
   /* Values as stored: never multiplied by an alpha channel. */
   config.attribute("oiio:UnassociatedAlpha", 1);
-  auto in = ImageInput::open(path, &config);
-  if (!in)
-    return oc_seterr(err, OC_EIO, "cannot read '%s': %s", path,
-                     oc_oiio_oneline(OIIO::geterror()).c_str());
+  oc_oiio_input input;
+  if (!oc_oiio_open_input(input, path, config, err))
+    return err ? err->code : OC_EIO;
+  ImageInput *in = input.in.get();
   const ImageSpec &spec = in->spec();
   if (spec.deep || spec.depth > 1 || spec.nchannels < 1)
     return oc_seterr(err, OC_EUNSUPPORTED,
                      "cannot read '%s': deep, volume and channel-less "
                      "images are not heightfields",
                      path);
+  if (spec.width < 1 || spec.height < 1)
+    return oc_seterr(err, OC_EIO,
+                     "cannot read '%s': it declares %d x %d pixels", path,
+                     spec.width, spec.height);
   for (const auto &p : spec.extra_attribs) {
     std::string v = oc_oiio_attr_text(p);
     if (r->attr) r->attr(r->ud, p.name().c_str(), v.c_str());
   }
   TypeDesc type = spec.channelformat(0);
+  /* `begin` refuses sizes over the grid limit before anything is
+  ** allocated; the file's declared size is not trusted further. */
   float *dst = r->begin(r->ud, spec.width, spec.height, spec.nchannels,
                         type.c_str(), err);
   if (!dst) return err ? err->code : OC_EINVAL;
@@ -74,7 +84,20 @@ int read_raw(const char *path, const oc_oiio_raw *r, oc_error *err) {
   default: /* half, float exactly; the rest converted by OpenImageIO */
     break;
   }
-  if (!in->read_image(0, 0, 0, 1, mem, dst))
+  const oc_progress *pr = &r->progress;
+  /* Scanline files are read in strips, polling for cancellation between
+  ** them; tiled ones whole. Row y's samples go to (T *)dst + y * width. */
+  bool ok = true;
+  int strip = spec.tile_width ? spec.height : STRIP;
+  for (int y = spec.y; ok && y < spec.y + spec.height; y += strip) {
+    if (pr->fn && pr->fn(pr->ud, (double)(y - spec.y) / spec.height))
+      return oc_seterr(err, OC_ECANCEL, "loading '%s' cancelled", path);
+    int end = std::min(y + strip, spec.y + spec.height);
+    char *at = (char *)dst + (size_t)(y - spec.y) * spec.width * mem.size();
+    ok = spec.tile_width ? in->read_image(0, 0, 0, 1, mem, at)
+                         : in->read_scanlines(0, 0, y, end, 0, 0, 1, mem, at);
+  }
+  if (!ok)
     return oc_seterr(err, OC_EIO, "cannot read '%s': %s", path,
                      oc_oiio_oneline(in->geterror()).c_str());
   switch (mem.basetype) {
@@ -99,7 +122,6 @@ int read_raw(const char *path, const oc_oiio_raw *r, oc_error *err) {
   default:
     break;
   }
-  in->close();
   return OC_OK;
 }
 

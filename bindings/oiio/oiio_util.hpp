@@ -1,14 +1,22 @@
 /*
 ** oiio_util.hpp — what both OpenImageIO readers (oiio.cpp: images,
-** oiio_hf.cpp: heightfields) need alike: one-line error messages and
-** attributes as text (internal).
+** oiio_hf.cpp: heightfields) need alike: one-line error messages,
+** attributes as text, and opening a file that may be hostile (internal).
 */
 #ifndef OC_OIIO_UTIL_HPP
 #define OC_OIIO_UTIL_HPP
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include <cstdio>
+#include <memory>
 #include <string>
+
+extern "C" {
+#include "core/error.h"
+#include "io/infile.h"
+}
 
 /* OpenImageIO messages may span lines; ours are one line. */
 inline std::string oc_oiio_oneline(std::string s) {
@@ -27,6 +35,40 @@ inline std::string oc_oiio_attr_text(const OIIO::ParamValue &p) {
     return s ? s : "";
   }
   return p.get_string(64);
+}
+
+/* An image reader over a file we opened and checked ourselves. Members
+** are destroyed in reverse order: the reader, its proxy, then the file. */
+struct oc_oiio_input {
+  struct closer {
+    void operator()(FILE *f) const { std::fclose(f); }
+  };
+  std::unique_ptr<FILE, closer> file;
+  std::unique_ptr<OIIO::Filesystem::IOFile> proxy;
+  std::unique_ptr<OIIO::ImageInput> in;
+};
+
+/* Opens `path` through oc_infile_open (a regular file, the reader chosen
+** by its signature: no other reader probes it) and reads its header.
+** Returns false with `err` set (OC_EIO naming the path). */
+inline bool oc_oiio_open_input(oc_oiio_input &x, const char *path,
+                               const OIIO::ImageSpec &config, oc_error *err) {
+  FILE *fp;
+  const char *format;
+  if (oc_infile_open(path, &fp, &format, err) != OC_OK) return false;
+  x.file.reset(fp);
+  x.proxy.reset(
+      new OIIO::Filesystem::IOFile(fp, OIIO::Filesystem::IOProxy::Read));
+  x.in = OIIO::ImageInput::create(format);
+  OIIO::ImageSpec spec;
+  if (!x.in || !x.in->supports("ioproxy") ||
+      !x.in->set_ioproxy(x.proxy.get()) || !x.in->open(path, spec, config)) {
+    std::string e = x.in ? x.in->geterror() : OIIO::geterror();
+    oc_seterr(err, OC_EIO, "cannot read '%s': %s", path,
+              oc_oiio_oneline(e).c_str());
+    return false;
+  }
+  return true;
 }
 
 #endif

@@ -1,7 +1,15 @@
 /*
-** atomic.c — atomic file output: temporary name, fsync, rename (see
-** atomic.h for the protocol).
+** atomic.c — atomic file output: temporary file, checked writes, fsync,
+** rename, all relative to one directory descriptor (see atomic.h).
+**
+** Where the kernel and file system allow it the temporary file is
+** anonymous (O_TMPFILE) until the commit links it under its hidden name
+** just before the rename, so a process killed while writing (a second
+** Ctrl-C, SIGKILL) leaves nothing behind; elsewhere it is created under
+** its hidden name at once.
 */
+#define _GNU_SOURCE /* O_TMPFILE, linkat through /proc */
+
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
@@ -27,36 +35,91 @@ static char *copy(const char *s) {
   return c ? memcpy(c, s, n) : NULL;
 }
 
-/* Opens a new temporary file next to `path`: hidden, unique among
-** processes (pid) and threads (O_EXCL, trying the next n), ending in the
-** real extension. Returns the fd and the malloc'ed name in *name, or -1
-** with errno set. */
-static int make_temp(const char *path, char **name) {
+/* The malloc'ed name of temporary n next to `path`: hidden, unique among
+** processes (pid) and threads (n), ending in the real extension. */
+static char *temp_name(const char *path, unsigned n) {
   const char *slash = strrchr(path, '/');
   int dirlen = slash ? (int)(slash - path + 1) : 0;
-  const char *base = path + dirlen;
   const char *ext = extension(path);
   size_t size = strlen(path) + strlen(ext) + 64;
   char *tmp = malloc(size);
-  if (!tmp) {
-    errno = ENOMEM;
-    return -1;
-  }
-  for (unsigned n = 0; n < 1000; n++) {
-    snprintf(tmp, size, "%.*s.%s.tmp-%ld-%u%s", dirlen, path, base,
+  if (tmp)
+    snprintf(tmp, size, "%.*s.%s.tmp-%ld-%u%s", dirlen, path, path + dirlen,
              (long)getpid(), n, ext);
-    int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  else
+    errno = ENOMEM;
+  return tmp;
+}
+
+/* Creates the temporary file under a new name (O_EXCL, trying the next n
+** while one exists). Returns the fd and the name in *name, or -1 with
+** errno set. */
+static int make_temp(int dir, const char *path, char **name) {
+  for (unsigned n = 0; n < 1000; n++) {
+    char *tmp = temp_name(path, n);
+    if (!tmp) return -1;
+    int fd = openat(dir, tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd >= 0) {
       *name = tmp;
       return fd;
     }
-    if (errno != EEXIST) break;
+    int e = errno;
+    free(tmp);
+    errno = e;
+    if (e != EEXIST) break;
   }
-  int e = errno;
-  free(tmp);
-  errno = e;
   return -1;
 }
+
+#ifdef O_TMPFILE
+/* An anonymous file in path's folder, or -1 when the system cannot make
+** one or could not link it later (no /proc). */
+static int anonymous_temp(int dir, const char *path) {
+  const char *slash = strrchr(path, '/');
+  char *folder = slash ? strndup(path, (size_t)(slash - path + 1)) : NULL;
+  if (slash && !folder) return -1;
+  int fd = openat(dir, folder ? folder : ".", O_WRONLY | O_TMPFILE | O_CLOEXEC,
+                  0666);
+  free(folder);
+  char proc[64];
+  snprintf(proc, sizeof proc, "/proc/self/fd/%d", fd);
+  if (fd >= 0 && access(proc, F_OK) != 0) {
+    close(fd);
+    fd = -1;
+  }
+  return fd;
+}
+
+/* Gives the anonymous file its hidden name (see make_temp). */
+static int link_temp(oc_atomic *a) {
+  char proc[64];
+  snprintf(proc, sizeof proc, "/proc/self/fd/%d", fileno(a->fp));
+  for (unsigned n = 0; n < 1000; n++) {
+    char *tmp = temp_name(a->path, n);
+    if (!tmp) return -1;
+    if (linkat(AT_FDCWD, proc, a->dir, tmp, AT_SYMLINK_FOLLOW) == 0) {
+      a->tmp = tmp;
+      return 0;
+    }
+    int e = errno;
+    free(tmp);
+    errno = e;
+    if (e != EEXIST) break;
+  }
+  return -1;
+}
+#else
+static int anonymous_temp(int dir, const char *path) {
+  (void)dir, (void)path;
+  return -1;
+}
+
+static int link_temp(oc_atomic *a) {
+  (void)a;
+  errno = ENOTSUP;
+  return -1;
+}
+#endif
 
 static void finish(oc_atomic *a) {
   free(a->tmp);
@@ -65,14 +128,17 @@ static void finish(oc_atomic *a) {
   a->fp = NULL;
 }
 
-int oc_atomic_begin(oc_atomic *a, const char *path, oc_error *err) {
+int oc_atomic_begin_at(oc_atomic *a, int dirfd, const char *path,
+                       oc_error *err) {
+  a->dir = dirfd;
   a->tmp = NULL;
   a->fp = NULL;
   a->error = 0;
   a->path = copy(path);
   if (!a->path)
     return oc_seterr(err, OC_ENOMEM, "cannot write '%s': out of memory", path);
-  int fd = make_temp(path, &a->tmp);
+  int fd = anonymous_temp(dirfd, path);
+  if (fd < 0) fd = make_temp(dirfd, path, &a->tmp);
   if (fd < 0) {
     int rc = oc_seterr(err, errno == ENOMEM ? OC_ENOMEM : OC_EIO,
                        "cannot write '%s': %s", path, strerror(errno));
@@ -83,11 +149,15 @@ int oc_atomic_begin(oc_atomic *a, const char *path, oc_error *err) {
   if (!a->fp) {
     int e = errno;
     close(fd);
-    unlink(a->tmp);
+    if (a->tmp) unlinkat(dirfd, a->tmp, 0);
     finish(a);
     return oc_seterr(err, OC_EIO, "cannot write '%s': %s", path, strerror(e));
   }
   return OC_OK;
+}
+
+int oc_atomic_begin(oc_atomic *a, const char *path, oc_error *err) {
+  return oc_atomic_begin_at(a, AT_FDCWD, path, err);
 }
 
 int oc_atomic_write(oc_atomic *a, const void *p, size_t n) {
@@ -105,40 +175,24 @@ static int sync_fd(int fd) {
   return errno == EINVAL || errno == ENOTSUP ? 0 : -1;
 }
 
-/* Syncs the file now under the temporary name. A library given the name
-** may have replaced the file rather than rewritten it; then the data is
-** in another inode than our descriptor's, and that one is synced too. */
-static int sync_temp(oc_atomic *a) {
-  int fd = fileno(a->fp);
-  if (sync_fd(fd) != 0) return -1;
-  struct stat mine, named;
-  if (fstat(fd, &mine) != 0 || stat(a->tmp, &named) != 0) return -1;
-  if (mine.st_dev == named.st_dev && mine.st_ino == named.st_ino) return 0;
-  int other = open(a->tmp, O_RDONLY | O_CLOEXEC);
-  if (other < 0) return -1;
-  int rc = sync_fd(other);
-  int e = errno;
-  close(other);
-  errno = e;
-  return rc;
-}
-
 int oc_atomic_commit(oc_atomic *a, oc_error *err) {
   int e = 0;
   errno = 0;
   if (fflush(a->fp) != 0 || ferror(a->fp) || a->error)
     e = a->error ? a->error : errno ? errno : EIO;
-  else if (sync_temp(a) != 0)
+  else if (sync_fd(fileno(a->fp)) != 0)
+    e = errno ? errno : EIO;
+  else if (!a->tmp && link_temp(a) != 0)
     e = errno ? errno : EIO;
   /* Some file systems (NFS) report write errors only at close. */
   errno = 0;
   if (fclose(a->fp) != 0 && !e) e = errno ? errno : EIO;
-  if (!e && rename(a->tmp, a->path) != 0) e = errno;
+  if (!e && renameat(a->dir, a->tmp, a->dir, a->path) != 0) e = errno;
   if (!e) {
     finish(a);
     return OC_OK;
   }
-  unlink(a->tmp);
+  if (a->tmp) unlinkat(a->dir, a->tmp, 0);
   int rc =
       oc_seterr(err, OC_EIO, "cannot write '%s': %s", a->path, strerror(e));
   finish(a);
@@ -147,6 +201,6 @@ int oc_atomic_commit(oc_atomic *a, oc_error *err) {
 
 void oc_atomic_abort(oc_atomic *a) {
   if (a->fp) fclose(a->fp);
-  if (a->tmp) unlink(a->tmp);
+  if (a->tmp) unlinkat(a->dir, a->tmp, 0);
   finish(a);
 }

@@ -1,9 +1,12 @@
 /*
 ** image_write.c — oc_image_write: the format from the extension, samples
-** converted to what the format stores, and an atomic write (io/atomic.h:
-** temporary name in the same folder, then rename) so that no reader ever
-** sees a partial file under the final name.
+** converted to what the format stores, encoded in memory by the bridge,
+** and an atomic write (io/atomic.h: temporary name in the same folder,
+** every write checked, then rename) so that no reader ever sees a partial
+** file under the final name; oc_oiio_write_at, which heightfield saves
+** share.
 */
+#include <fcntl.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -17,6 +20,7 @@
 #include "outcrop.h"
 
 #define SUPPORTED ".png, .jpg, .jpeg, .tif, .tiff or .exr"
+#define JPEG_MAX_SIDE 65500
 
 typedef enum kind { PNG, JPEG, TIFF, EXR } kind;
 
@@ -149,8 +153,34 @@ static int check_names(const oc_image *img, oc_error *err) {
   return OC_OK;
 }
 
+/* The sink of oc_oiio_write_at: the encoded file into the atomic output. */
+static int to_atomic(void *ud, const void *bytes, size_t n, char *why,
+                     size_t whysize) {
+  (void)why, (void)whysize; /* a failed write is reported by the commit */
+  oc_atomic_write(ud, bytes, n);
+  return OC_OK;
+}
+
+int oc_oiio_write_at(int dirfd, const char *name, const oc_oiio_out *im,
+                     oc_error *err) {
+  char why[OC_ERRMSG] = "";
+  oc_atomic a;
+  int rc = oc_atomic_begin_at(&a, dirfd, name, err);
+  if (rc != OC_OK) return rc;
+  if (oc_oiio_encode(im, to_atomic, &a, why, sizeof why) != OC_OK) {
+    oc_atomic_abort(&a);
+    return oc_seterr(err, OC_EIO, "cannot write '%s': %s", name, why);
+  }
+  return oc_atomic_commit(&a, err);
+}
+
 int oc_image_write(const oc_image *img, const char *path, int bits,
                    oc_error *err) {
+  return oc_image_write_at(img, AT_FDCWD, path, bits, err);
+}
+
+int oc_image_write_at(const oc_image *img, int dirfd, const char *path,
+                      int bits, oc_error *err) {
   if (!img) return oc_seterr(err, OC_EINVAL, "'image' is NULL");
   if (!path || !*path)
     return oc_seterr(err, OC_EINVAL, "'path' must be a non-empty file name");
@@ -170,6 +200,14 @@ int oc_image_write(const oc_image *img, const char *path, int bits,
     int rc = check_names(img, err);
     if (rc) return rc;
   }
+  /* libjpeg's limit; past it, its error handler exits the process. */
+  if (k == JPEG && (oc_image_width(img) > JPEG_MAX_SIDE ||
+                    oc_image_height(img) > JPEG_MAX_SIDE))
+    return oc_seterr(err, OC_EINVAL,
+                     "cannot write '%s': JPEG holds at most %d pixels per "
+                     "side (the image is %d x %d; use .png, .tif or .exr)",
+                     path, JPEG_MAX_SIDE, oc_image_width(img),
+                     oc_image_height(img));
 
   int nch = written_channels((kind)k, oc_image_channels(img));
   const char *names[64];
@@ -207,18 +245,7 @@ int oc_image_write(const oc_image *img, const char *path, int bits,
       .nmeta = nmeta,
   };
 
-  char why[OC_ERRMSG] = "";
-  oc_atomic a;
-  int rc = oc_atomic_begin(&a, path, err);
-  if (rc == OC_OK) {
-    /* The bridge writes by name; the atomic helper syncs and renames. */
-    if (oc_oiio_write(a.tmp, &out, why, sizeof why) != OC_OK) {
-      oc_atomic_abort(&a);
-      rc = oc_seterr(err, OC_EIO, "cannot write '%s': %s", path, why);
-    } else {
-      rc = oc_atomic_commit(&a, err);
-    }
-  }
+  int rc = oc_oiio_write_at(dirfd, path, &out, err);
   free(owned);
   free(meta);
   return rc;

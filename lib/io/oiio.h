@@ -37,20 +37,37 @@ typedef struct oc_oiio_out {
   size_t nmeta;                     /* number of (key, value) pairs */
 } oc_oiio_out;
 
-/* Writes `im` to `path`, which must not be a name other threads use.
-** Every metadata pair becomes a string attribute; where the format has no
-** free text fields (TIFF) the keys it cannot hold are appended to the
-** ImageDescription as "key=value" lines. No timestamp is added, so equal
-** inputs give equal bytes. Returns OC_OK, or OC_EIO with the reason in
-** `why` (not naming the path: the caller knows which name to report). */
-int oc_oiio_write(const char *path, const oc_oiio_out *im, char *why,
-                  size_t whysize);
+/* Receives a whole encoded file; returns OC_OK or an error code with the
+** reason in `why`. */
+typedef int (*oc_oiio_sink)(void *ud, const void *bytes, size_t n, char *why,
+                            size_t whysize);
 
-/* Reads the first subimage of `path` into a new float image owned by the
-** caller (oc_image_free). Integer samples map to [0, 1]; alpha is left as
+/* Encodes `im` in memory and hands the bytes to `sink` (the bridge never
+** writes a file). Every metadata pair becomes a string attribute; where
+** the format has no free text fields (TIFF, JPEG) the keys it cannot
+** hold become "key=value" lines of the ImageDescription, each value
+** quoted by oc_meta_quote (io/metatext.h) so that no value can forge a
+** line. No timestamp is added, so equal inputs give equal bytes. Returns
+** what `sink` returned, or OC_EIO with the reason in `why`. */
+int oc_oiio_encode(const oc_oiio_out *im, oc_oiio_sink sink, void *ud,
+                   char *why, size_t whysize);
+
+/* Encodes `im` and writes it atomically (io/atomic.h) as `name` relative
+** to `dirfd` (AT_FDCWD: the current folder). OC_OK, or OC_EIO with a
+** message naming `name` ("cannot write 'x.png': No space left on
+** device"), and then neither the file nor a temporary exists. Defined in
+** io/image_write.c. */
+int oc_oiio_write_at(int dirfd, const char *name, const oc_oiio_out *im,
+                     oc_error *err);
+
+/* Reads the first subimage of `path` (opened with oc_infile_open: a
+** regular file, the reader chosen by its signature) into a new float
+** image owned by the caller (oc_image_free). Integer samples map to [0, 1];
+*alpha is left as
 ** stored (never premultiplied). Channel names are copied, and every file
 ** attribute that oc_image_set_meta accepts becomes metadata (numbers as
-** text). NULL on failure with `err` set: OC_EIO naming the path, or the
+** text); so do the "key=value" lines of a TIFF or JPEG description.
+** NULL on failure with `err` set: OC_EIO naming the path, or the
 ** error of oc_image_new for images too large. */
 oc_image *oc_oiio_read(const char *path, oc_error *err);
 

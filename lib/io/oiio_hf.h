@@ -27,9 +27,13 @@ typedef struct oc_oiio_raw {
   float *(*begin)(void *ud, int width, int height, int channels,
                   const char *type, oc_error *err);
   void *ud;
+  /* Polled between strips of rows; non-zero stops with OC_ECANCEL. */
+  oc_progress progress;
 } oc_oiio_raw;
 
-/* Reads the first channel of the first subimage of `path`. Integer samples
+/* Reads the first channel of the first subimage of `path`, opened with
+** oc_infile_open (io/infile.h): a regular file, the reader chosen by its
+** signature. Integer samples
 ** become their counts (uint16 65535 is 65535.0f; 32-bit integers are
 ** rounded to float), half and float samples are copied exactly, doubles
 ** rounded to float. Returns OC_OK, or an error code with `err`: OC_EIO

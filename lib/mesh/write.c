@@ -4,6 +4,7 @@
 ** into an atomic output, in the C locale so that numbers in text always
 ** use a decimal point whatever locale the host program set.
 */
+#include <fcntl.h>
 #include <locale.h>
 #include <math.h>
 #include <string.h>
@@ -56,6 +57,11 @@ static int check_mesh(const oc_mesh *m, const char *path, oc_error *err) {
 }
 
 int oc_mesh_write(const oc_mesh *mesh, const char *path, oc_error *err) {
+  return oc_mesh_write_at(mesh, AT_FDCWD, path, err);
+}
+
+int oc_mesh_write_at(const oc_mesh *mesh, int dirfd, const char *path,
+                     oc_error *err) {
   if (!mesh) return oc_seterr(err, OC_EINVAL, "'mesh' is NULL");
   if (!path || !*path)
     return oc_seterr(err, OC_EINVAL, "'path' must be a non-empty file name");
@@ -76,7 +82,7 @@ int oc_mesh_write(const oc_mesh *mesh, const char *path, oc_error *err) {
   if (c == (locale_t)0)
     return oc_seterr(err, OC_ENOMEM, "cannot write '%s': out of memory", path);
   oc_atomic a;
-  rc = oc_atomic_begin(&a, path, err);
+  rc = oc_atomic_begin_at(&a, dirfd, path, err);
   if (rc == OC_OK) {
     locale_t prev = uselocale(c); /* this thread only */
     rc = formats[k].write(mesh, &a, err);

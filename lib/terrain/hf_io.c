@@ -8,6 +8,7 @@
 ** significant digits, so that a saved grid loads back to exactly the
 ** quantized elevations and a float file to exactly its floats.
 */
+#include <fcntl.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -17,7 +18,7 @@
 
 #include "core/error.h"
 #include "core/palette.h"
-#include "io/atomic.h"
+#include "io/metatext.h"
 #include "io/oiio.h"
 #include "io/oiio_hf.h"
 #include "outcrop.h"
@@ -33,8 +34,11 @@ static const char *const keys[NKEYS] = {"outcrop:cell", "outcrop:x0",
 typedef struct loader {
   const char *path;
   oc_hf_load_params p; /* what the caller gave */
-  double meta[NKEYS];  /* values found in the file */
-  int found[NKEYS];
+  /* values found in the file: [0] as attributes of their own, [1] as
+  ** lines of the ImageDescription (TIFF), used only when [0] lacks them */
+  double meta[2][NKEYS];
+  int found[2][NKEYS];
+  int memory_failed; /* the description could not be parsed */
   oc_heightfield *hf;
 } loader;
 
@@ -49,51 +53,48 @@ static int parse_number(const char *s, double *out) {
   return 1;
 }
 
-static void take(loader *ld, const char *key, size_t keylen,
-                 const char *value) {
+static void take(loader *ld, int from, const char *key, const char *value) {
   for (int k = 0; k < NKEYS; k++)
-    if (strlen(keys[k]) == keylen && strncasecmp(key, keys[k], keylen) == 0) {
+    if (strcasecmp(key, keys[k]) == 0) {
       double v;
       if (parse_number(value, &v)) {
-        ld->meta[k] = v;
-        ld->found[k] = 1;
+        ld->meta[from][k] = v;
+        ld->found[from][k] = 1;
       }
     }
 }
 
+static void take_line(void *ud, const char *key, const char *value) {
+  take(ud, 1, key, value);
+}
+
 /* TIFF keeps keys it has no tag for as "key=value" lines of its
-** ImageDescription (see bindings/oiio/oiio.cpp); other formats keep them
-** as attributes of their own. */
+** ImageDescription, values quoted (see io/metatext.h); other formats keep
+** them as attributes of their own. */
 static void on_attr(void *ud, const char *key, const char *value) {
   loader *ld = ud;
-  if (strcasecmp(key, "ImageDescription") != 0) {
-    take(ld, key, strlen(key), value);
-    return;
-  }
-  char line[256];
-  while (*value) {
-    size_t n = strcspn(value, "\n");
-    const char *eq = memchr(value, '=', n);
-    if (eq && n < sizeof line) {
-      memcpy(line, value, n);
-      line[n] = '\0';
-      take(ld, value, (size_t)(eq - value), line + (eq - value) + 1);
-    }
-    value += n;
-    if (*value) value++;
-  }
+  if (strcasecmp(key, "ImageDescription") != 0)
+    take(ld, 0, key, value);
+  else if (oc_meta_unfold(value, take_line, ld) != 0)
+    ld->memory_failed = 1;
 }
 
 static double pick(const loader *ld, unsigned bit, double given, int k,
                    double def) {
   if (ld->p.given & bit) return given;
-  return ld->found[k] ? ld->meta[k] : def;
+  for (int from = 0; from < 2; from++)
+    if (ld->found[from][k]) return ld->meta[from][k];
+  return def;
 }
 
 static float *on_begin(void *ud, int w, int h, int channels, const char *type,
                        oc_error *err) {
   loader *ld = ud;
   (void)channels, (void)type;
+  if (ld->memory_failed) {
+    oc_seterr(err, OC_ENOMEM, "cannot load '%s': out of memory", ld->path);
+    return NULL;
+  }
   if (w < 2 || h < 2) {
     oc_seterr(err, OC_EINVAL,
               "cannot load '%s': it is %d x %d pixels, a heightfield needs "
@@ -163,7 +164,7 @@ oc_heightfield *oc_heightfield_load(const char *path,
     oc_seterr(err, OC_EINVAL, "'cell' must be > 0 (got %g)", ld.p.cell);
     return NULL;
   }
-  oc_oiio_raw r = {on_attr, on_begin, &ld};
+  oc_oiio_raw r = {on_attr, on_begin, &ld, ld.p.progress};
   int rc = oc_oiio_read_raw(path, &r, err);
   if (rc == OC_OK) rc = finish_load(&ld, err);
   if (rc != OC_OK) {
@@ -276,23 +277,10 @@ static int is_ours(const char *key) {
   return 0;
 }
 
-static int write_atomic(const char *path, const oc_oiio_out *out,
-                        oc_error *err) {
-  char why[OC_ERRMSG] = "";
-  oc_atomic a;
-  int rc = oc_atomic_begin(&a, path, err);
-  if (rc != OC_OK) return rc;
-  if (oc_oiio_write(a.tmp, out, why, sizeof why) != OC_OK) {
-    oc_atomic_abort(&a);
-    return oc_seterr(err, OC_EIO, "cannot write '%s': %s", path, why);
-  }
-  return oc_atomic_commit(&a, err);
-}
-
 /* The colour picture of the grid through a palette: 8-bit RGB, north up,
 ** with the caller's metadata only (it is no heightfield file). */
-static int save_colors(const oc_heightfield *hf, const char *path, int k,
-                       const oc_hf_save_params *p, oc_error *err) {
+static int save_colors(const oc_heightfield *hf, int dir, const char *path,
+                       int k, const oc_hf_save_params *p, oc_error *err) {
   if (k != PNG && k != TIFF)
     return oc_seterr(err, OC_EINVAL,
                      "cannot write '%s': a palette picture must be .png or "
@@ -327,7 +315,7 @@ static int save_colors(const oc_heightfield *hf, const char *path, int k,
       .meta = p->meta,
       .nmeta = p->nmeta,
   };
-  rc = write_atomic(path, &out, err);
+  rc = oc_oiio_write_at(dir, path, &out, err);
   free(px);
   return rc;
 }
@@ -335,6 +323,12 @@ static int save_colors(const oc_heightfield *hf, const char *path, int k,
 int oc_heightfield_save(const oc_heightfield *hf, const char *path,
                         const oc_hf_save_params *p, double used[2],
                         oc_error *err) {
+  return oc_heightfield_save_at(hf, AT_FDCWD, path, p, used, err);
+}
+
+int oc_heightfield_save_at(const oc_heightfield *hf, int dir, const char *path,
+                           const oc_hf_save_params *p, double used[2],
+                           oc_error *err) {
   static const oc_hf_save_params defaults = {0, 0, 1, 0, NULL, 0, NULL, 0};
   if (!hf) return oc_seterr(err, OC_EINVAL, "the heightfield is NULL");
   if (!path || !*path)
@@ -347,7 +341,7 @@ int oc_heightfield_save(const oc_heightfield *hf, const char *path,
                      ".png, .tif, .tiff or .exr)",
                      path);
   if (p->nstops > 0) {
-    int rc = save_colors(hf, path, k, p, err);
+    int rc = save_colors(hf, dir, path, k, p, err);
     if (rc == OC_OK && used) used[0] = 1, used[1] = 0;
     return rc;
   }
@@ -417,7 +411,7 @@ int oc_heightfield_save(const oc_heightfield *hf, const char *path,
       .meta = meta,
       .nmeta = nmeta,
   };
-  int rc = write_atomic(path, &out, err);
+  int rc = oc_oiio_write_at(dir, path, &out, err);
   free(meta);
   free(px);
   if (rc == OC_OK && used) {

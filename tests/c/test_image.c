@@ -16,6 +16,7 @@
 
 #include "io/oiio.h"
 #include "ocheck.h"
+#include "octmpfs.h"
 #include "outcrop.h"
 
 /* ---- helpers ------------------------------------------------------------ */
@@ -600,6 +601,96 @@ START_TEST(read_errors) {
   fclose(f);
   ck_assert_ptr_null(oc_oiio_read(oct_in_dir(dir, "junk.png"), &e));
   ck_assert_int_eq(e.code, OC_EIO);
+  ck_assert_msg(strstr(e.msg, "unrecognised image format"), "%s", e.msg);
+  /* not a regular file: refused at once, never probed by every reader */
+  ck_assert_ptr_null(oc_oiio_read("/dev/zero", &e));
+  ck_assert_msg(strstr(e.msg, "not a regular file"), "%s", e.msg);
+}
+END_TEST
+
+/* Values with line breaks cannot forge a line of a TIFF or JPEG
+** description: they come back whole, and the seed read back is the real
+** one. In PNG a free description is text, never parsed into keys. */
+START_TEST(metadata_cannot_forge_lines) {
+  const char *forged = "scene.lua\noutcrop:seed=99";
+  const char *tricky = "\"q\" \\ tab\t\x01 end";
+  oc_image *img = pattern(4, 4, 3);
+  oc_image_set_meta(img, "outcrop:seed", "42", NULL);
+  oc_image_set_meta(img, "outcrop:scene", forged, NULL);
+  oc_image_set_meta(img, "outcrop:params", tricky, NULL);
+  oc_image_set_meta(img, "ImageDescription", "x\noutcrop:seed=7", NULL);
+  const char *files[] = {"f.tif", "f.jpg", "f.png"};
+  for (int k = 0; k < 3; k++) {
+    write_ok(img, oct_in_dir(dir, files[k]), 8);
+    oc_image *back = read_ok(oct_in_dir(dir, files[k]));
+    const char *seed = oc_image_meta_get(back, "outcrop:seed");
+    const char *scene = oc_image_meta_get(back, "outcrop:scene");
+    const char *params = oc_image_meta_get(back, "outcrop:params");
+    const char *d = oc_image_meta_get(back, "ImageDescription");
+    ck_assert_msg(seed && strcmp(seed, "42") == 0, "%s: seed %s", files[k],
+                  seed ? seed : "(none)");
+    ck_assert_msg(scene && strcmp(scene, forged) == 0, "%s: scene %s", files[k],
+                  scene ? scene : "(none)");
+    ck_assert_msg(params && strcmp(params, tricky) == 0, "%s: params %s",
+                  files[k], params ? params : "(none)");
+    ck_assert_msg(d && strcmp(d, "x\noutcrop:seed=7") == 0,
+                  "%s: description %s", files[k], d ? d : "(none)");
+    oc_image_free(back);
+  }
+  oc_image_free(img);
+}
+END_TEST
+
+/* libjpeg exits the process on an image wider or taller than 65500: such
+** a write is refused before the encoder runs, and nothing is left. */
+START_TEST(jpeg_size_limit) {
+  oc_error e = {0};
+  oc_image *img = oc_image_new(65501, 2, 3, &e);
+  ck_assert_ptr_nonnull(img);
+  const char *p = oct_in_dir(dir, "wide.jpg");
+  ck_assert_int_eq(oc_image_write(img, p, 0, &e), OC_EINVAL);
+  ck_assert_msg(strstr(e.msg, "65500") && strstr(e.msg, "65501 x 2"), "%s",
+                e.msg);
+  ck_assert_int_eq(oct_count_entries(dir, NULL, 0), 0);
+  oc_image_free(img);
+  img = oc_image_new(2, 65501, 1, &e);
+  ck_assert_int_eq(oc_image_write(img, p, 0, &e), OC_EINVAL);
+  oc_image_free(img);
+  img = pattern(65500, 1, 3); /* the largest that JPEG holds */
+  write_ok(img, p, 0);
+  oc_image_free(img);
+}
+END_TEST
+
+/* A full disk: every format reports it, and leaves neither the file nor
+** its temporary; once there is room, the same folder takes a small file.
+** (The PNG writer used to report success and rename a truncated file into
+** place, and libjpeg to exit the process.) */
+START_TEST(disk_full) {
+  const char *fs = oct_tmpfs(64 * 1024, "image disk_full");
+  if (!fs) return;
+  oct_rng r = oct_rng_new(11);
+  oc_error e = {0};
+  oc_image *big = oc_image_new(512, 512, 4, &e), *small = pattern(4, 4, 4);
+  ck_assert_ptr_nonnull(big);
+  float *px = oc_image_data(big);
+  for (size_t i = 0; i < 512 * 512 * 4; i++) /* noise: no compression */
+    px[i] = (float)oct_unif(&r, 0, 1);
+  oc_image_set_meta(big, "outcrop:seed", "1", NULL);
+  const char *files[] = {"f.png", "f.tif", "f.jpg", "f.exr"};
+  for (int k = 0; k < 4; k++) {
+    const char *p = oct_in_dir(fs, files[k]);
+    int rc = oc_image_write(big, p, 0, &e);
+    oct_assert_full(rc, e.msg, p, fs);
+    write_ok(small, p, 0);
+    oc_image *back = read_ok(p);
+    ck_assert_int_eq(oc_image_width(back), 4);
+    oc_image_free(back);
+    ck_assert_int_eq(unlink(p), 0);
+  }
+  oc_image_free(big);
+  oc_image_free(small);
+  oct_tmpfs_done(fs);
 }
 END_TEST
 
@@ -624,6 +715,9 @@ static Suite *suite(void) {
   tcase_add_test(t, unwritable_paths);
   tcase_add_test(t, overwrite_is_atomic);
   tcase_add_test(t, read_errors);
+  tcase_add_test(t, metadata_cannot_forge_lines);
+  tcase_add_test(t, jpeg_size_limit);
+  tcase_add_test(t, disk_full);
   suite_add_tcase(s, t);
   return s;
 }

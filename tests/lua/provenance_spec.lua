@@ -14,13 +14,26 @@ local node = oc.point{center = {0, 0, 0}, radius = 1}
 
 
 
+-- A quoted value of a description line, as the README documents it.
+local function unquote(v)
+  if v:sub(1, 1) ~= '"' then return v end
+  assert(v:sub(-1) == '"' and #v >= 2, v)
+  local esc = {n = "\n", t = "\t", r = "\r", ['"'] = '"', ["\\"] = "\\"}
+  return (v:sub(2, -2):gsub("\\(%d%d%d)", function(d)
+    return string.char(tonumber(d, 8))
+  end):gsub("\\(.)", esc))
+end
+
 -- The "key=value" lines folded into a TIFF or JPEG ImageDescription.
 local function description_lines(text)
   local d = text:match('ImageDescription: "(.-)"\n%s+%w')
   local t = {}
   for line in (d or ""):gmatch("[^\n]+") do
     local k, v = line:match("^([^=]+)=(.*)$")
-    if k then t[k] = v end
+    if k then
+      assert(t[k] == nil, "line repeated: " .. k)
+      t[k] = unquote(v)
+    end
   end
   return t
 end
@@ -82,6 +95,29 @@ assert(out(arg[1]))
       assert.are.equal("scenes/arch.lua", d["outcrop:scene"], ext)
       assert.are.equal("42", d["outcrop:seed"], ext)
       assert.are.equal(want, d["outcrop:params"], ext)
+    end
+  end)
+
+  it("cannot be forged by a line break in a scene name or a parameter", function()
+    local forged = "scenes/a.lua\noutcrop:seed=99"
+    reg["outcrop.scene"] = forged
+    reg["outcrop.seed"] = 42
+    reg["outcrop.params"] = {p = "1\noutcrop:seed=99"}
+    local img = oc.slice(node, {size = {4, 4}})
+    for _, ext in ipairs{"tif", "jpg"} do
+      local path = dir .. "/forge." .. ext
+      assert.is_true(img:write(path))
+      local _, text = info(path)
+      local d = description_lines(text)
+      assert.are.equal("42", d["outcrop:seed"], ext)
+      assert.are.equal(forged, d["outcrop:scene"], ext)
+      assert.are.equal('"p=1\\noutcrop:seed=99"', d["outcrop:params"], ext)
+    end
+    for _, ext in ipairs{"png", "exr"} do
+      local path = dir .. "/forge." .. ext
+      assert.is_true(img:write(path))
+      local a = info(path)
+      assert.are.equal("42", a["outcrop:seed"], ext)
     end
   end)
 

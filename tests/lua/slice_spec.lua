@@ -1,5 +1,5 @@
 -- slice_spec.lua — outcrop.slice and the image userdata: sizes, pixel
--- positions, writing, and the output-folder sandbox of oclua_output_path.
+-- positions, writing, and the output-folder sandbox of oclua_output_target.
 local oc = require "outcrop"
 local Fs = require "helpers.files"
 local read_file = Fs.read_file
