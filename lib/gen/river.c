@@ -10,6 +10,7 @@
 ** the slope) at heights drawn below their surface, so they reach the
 ** canyon wall at every level of it and carve most into soft layers.
 */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -100,7 +101,7 @@ static int check(const oc_gen_river_params *p, oc_gen_river_params *q,
                      p->banks);
   if (q->radius == 0) q->radius = 1.5 * cell;
   if (q->spacing == 0) q->spacing = q->radius / 2;
-  if (q->depth == 0) q->depth = 3 * q->radius;
+  if (q->depth == 0) q->depth = fmin(3 * q->radius, DBL_MAX);
   if (oc_erode_check(q->radius, q->spacing, q->beta, q->strength, q->cutoff,
                      q->steps, q->threshold, err))
     return err ? err->code : OC_EINVAL;
@@ -175,7 +176,7 @@ oc_node *oc_generate_river(const oc_gen_river_params *pin, oc_gen_sea_stats *st,
   oc_erode_params ep;
   oc_erode_common com = {p.radius, p.strength, p.beta,
                          p.cutoff, p.steps,    p.seed};
-  oc_erode_shared(&ep, base, p.no_terrain, p.geology, p.threshold, cell, &com,
+  oc_erode_shared(&ep, base, p.no_terrain, p.geology, p.threshold, hf, &com,
                   p.progress);
   ep.pbase = 0.3;
   ep.pspan = 0.7;

@@ -1,0 +1,96 @@
+/*
+** test_limits.c — huge and odd numbers straight into the C API: every
+** size derived from them is checked before anything is allocated, so a
+** call returns an error naming the parameter (or a valid result), never
+** writes out of bounds (run under ASan), and work that would not end in
+** reasonable time is refused up front with the projected figure.
+*/
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ocheck.h"
+
+/* A valley along y sloping down to y = 0, 41 x 41 samples of 1 m. */
+static oc_heightfield *slope(void) {
+  oc_error err;
+  oc_heightfield *hf = oc_heightfield_new(41, 41, 1, 0, 0, NULL, &err);
+  ck_assert_ptr_nonnull(hf);
+  float *z = oc_heightfield_samples_mut(hf);
+  for (int j = 0; j < 41; j++)
+    for (int i = 0; i < 41; i++)
+      z[j * 41 + i] = (float)(0.2 * j + 0.6 * fabs(i - 20.0));
+  return hf;
+}
+
+/* Either a node, or an error whose message names `field`. */
+static void node_or_error(oc_node *n, const oc_error *err, const char *field) {
+  if (n) {
+    oc_node_release(n);
+    return;
+  }
+  ck_assert_msg(strstr(err->msg, field), "'%s' not in \"%s\"", field, err->msg);
+}
+
+/* Runs the river generator with these lengths (0: defaults); the result
+** must be a node or an error naming `field`. */
+static void river(oc_heightfield *hf, double spacing, double radius,
+                  double depth, const char *field) {
+  oc_error err = {OC_OK, ""};
+  oc_gen_sea_stats st;
+  oc_gen_river_params r;
+  oc_gen_river_defaults(&r);
+  r.heightfield = hf;
+  r.spacing = spacing;
+  r.radius = radius;
+  r.depth = depth;
+  node_or_error(oc_generate_river(&r, &st, &err), &err, field);
+}
+
+/* spacing = 1e308 made the candidate tiles' count 0, and the tile of a
+** masked sample was clamped to index -1: a write before the array. */
+START_TEST(erosion_huge_spacing) {
+  oc_heightfield *hf = slope();
+  static const double odd[] = {1e308, INFINITY, 1e300, 1e-308, 5e-324};
+  for (size_t k = 0; k < sizeof odd / sizeof *odd; k++) {
+    oc_error err = {OC_OK, ""};
+    oc_gen_sea_stats st;
+    river(hf, odd[k], 0, 0, "'spacing'");
+    oc_gen_sea_params s;
+    oc_gen_sea_defaults(&s);
+    s.heightfield = hf;
+    s.spacing = odd[k];
+    node_or_error(oc_generate_sea(&s, &st, &err), &err, "'spacing'");
+  }
+  oc_heightfield_release(hf);
+}
+END_TEST
+
+/* The river's bank rays ran `depth / slope` long (and radius lengthened
+** them too): depth = 1e7 marched for minutes without polling (1e6: 20 s),
+** radius = 1e5 as long; 1e9 overflowed the step count. They are cut
+** to the footprint now, so any depth costs what the grid allows. */
+START_TEST(river_long_rays) {
+  oc_heightfield *hf = slope();
+  static const double depth[] = {1e7, 1e9, 1e308, 0, 0.01, 0};
+  static const double radius[] = {0, 0, 0, 1e308, 1e5, 1e-300};
+  for (int k = 0; k < 6; k++) {
+    double t0 = omp_get_wtime();
+    river(hf, 1, radius[k], depth[k], "'radius'");
+    ck_assert_msg(omp_get_wtime() - t0 < 10, "case %d took %.1f s", k,
+                  omp_get_wtime() - t0);
+  }
+  oc_heightfield_release(hf);
+}
+END_TEST
+
+int main(void) {
+  Suite *s = suite_create("limits");
+  TCase *tc = tcase_create("limits");
+  tcase_set_timeout(tc, 120);
+  tcase_add_test(tc, erosion_huge_spacing);
+  tcase_add_test(tc, river_long_rays);
+  suite_add_tcase(s, tc);
+  return oct_run(s);
+}
