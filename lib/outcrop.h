@@ -223,8 +223,13 @@ typedef struct oc_polygonize_params {
   int no_direct;    /* 1: no direct elevation extraction: root finding on
                     ** the field even where one terrain or plane alone
                     ** governs a column (benchmarks, tests) */
+  size_t max_triangles; /* refuse when the projected mesh has more (an
+                        ** estimate from probes through the box, made
+                        ** before meshing); 0: OC_POLYGONIZE_MAX_TRIANGLES */
   oc_progress progress;
 } oc_polygonize_params;
+/* 2^27 triangles: about 3 GiB of mesh (positions, normals, indices). */
+#define OC_POLYGONIZE_MAX_TRIANGLES ((size_t)1 << 27)
 
 /* Marching cubes over the box with a topologically consistent case table:
 ** a closed, manifold, consistently oriented mesh (outward normals), capped

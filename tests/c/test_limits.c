@@ -85,12 +85,53 @@ START_TEST(river_long_rays) {
 }
 END_TEST
 
+static oc_program *plane(void) {
+  oc_error err;
+  oc_node *n = oc_plane(oct_v(0, 0, 0), oct_v(0, 0, 1), 1, 1, &err);
+  ck_assert_ptr_nonnull(n);
+  return oct_compile(n, 0, 0);
+}
+
+/* A plane over 500 x 500 km at 2 m cells would mesh until memory runs
+** out: refused before meshing, with the projected figure. */
+START_TEST(polygonize_projected_output) {
+  oc_program *p = plane();
+  oc_error err = {OC_OK, ""};
+  oc_polygonize_params pp;
+  memset(&pp, 0, sizeof pp);
+  pp.box = (oc_aabb){{-250000, -250000, -1}, {250000, 250000, 1}};
+  pp.cell = 2;
+  double t0 = omp_get_wtime();
+  ck_assert_ptr_null(oc_polygonize(p, &pp, &err));
+  ck_assert_int_eq(err.code, OC_ENOMEM);
+  ck_assert_msg(strstr(err.msg, "about 2.5e+11 triangles") &&
+                    strstr(err.msg, "'max_triangles' (134217728)"),
+                "%s", err.msg);
+  ck_assert(omp_get_wtime() - t0 < 1);
+  /* The estimate against the real count: a plane and its bottom cap
+  ** over 100 x 100 cells make 2 x 2 x 101^2 triangles and a few more. */
+  pp.box = (oc_aabb){{0, 0, -2}, {100, 100, 2}};
+  pp.cell = 1;
+  pp.max_triangles = 30000;
+  ck_assert_ptr_null(oc_polygonize(p, &pp, &err));
+  ck_assert_msg(strstr(err.msg, "about 4.08e+04 triangles"), "%s", err.msg);
+  pp.max_triangles = 50000;
+  oc_mesh *m = oc_polygonize(p, &pp, &err);
+  ck_assert_ptr_nonnull(m);
+  size_t nt = oc_mesh_triangle_count(m); /* the walls add a few more */
+  ck_assert(nt >= 40804 && nt < 1.05 * 40804);
+  oc_mesh_free(m);
+  oc_program_free(p);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("limits");
   TCase *tc = tcase_create("limits");
   tcase_set_timeout(tc, 120);
   tcase_add_test(tc, erosion_huge_spacing);
   tcase_add_test(tc, river_long_rays);
+  tcase_add_test(tc, polygonize_projected_output);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }
