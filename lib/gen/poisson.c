@@ -32,6 +32,8 @@
 #define COVER_MAX_2D 8
 #define COVER_MAX_3D 2
 #define COVER_DEPTH 2
+/* Sides of the box below this fraction of a cell are refused. */
+#define THIN 1e-3
 /* Key of the thinning stream, distinct from any tile's. */
 #define THIN_KEY 0x7468696e6e696e67ull
 
@@ -95,6 +97,18 @@ static int setup(const oc_poisson_params *pp, int d, oc_pgrid *g,
   g->h = r / sqrt((double)d);
   while (g->h * g->h * d > g->r2)
     g->h = nextafter(g->h, 0);
+  /* A box within one cell is that cell: darts thrown at a cell far larger
+  ** than the box (radius 1e308) would never land in it. */
+  double longest = fmax(len[0], fmax(len[1], len[2]));
+  if (g->h > longest) g->h = longest;
+  /* Gap filling splits the boxes of a cell until they are as thin as the
+  ** box: 2^(d-1) more at each level, too many below THIN of a cell. */
+  for (int a = 0; a < d; a++)
+    if (len[a] < THIN * g->h)
+      return oc_seterr(err, OC_EINVAL,
+                       "'box' is %g along %c, too thin for 'radius' %g "
+                       "(at least %g)",
+                       len[a], "xyz"[a], r, THIN * g -> h);
   g->tile = d == 2 ? TILE_2D : TILE_3D;
   g->seed = pp->seed;
   g->cover_max = d == 2 ? COVER_MAX_2D : COVER_MAX_3D;
