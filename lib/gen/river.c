@@ -12,6 +12,7 @@
 */
 #include <float.h>
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -47,12 +48,24 @@ static int quantile(const float *v, size_t n, double q, double *out,
   return OC_OK;
 }
 
-/* sigma: 1 on the bed, 1 - d / (banks + 1) at d cells from it. */
-static void widen(const float *pw, float *sig, int nx, int ny, double thr,
-                  int banks) {
-  int r = banks + 1;
-#pragma omp parallel for schedule(static)
-  for (int j = 0; j < ny; j++)
+/* sigma: 1 on the bed, 1 - d / (banks + 1) at d cells from it. Up to
+** (2 banks + 1)^2 reads per sample: long on a large grid, so the rows
+** poll for cancellation. Returns 0 or OC_ECANCEL. */
+static int widen(const float *pw, float *sig, int nx, int ny, double thr,
+                 int banks, oc_progress pr) {
+  int r = banks + 1, stop = 0;
+#pragma omp parallel for schedule(dynamic, 16)
+  for (int j = 0; j < ny; j++) {
+    int halt;
+#pragma omp atomic read
+    halt = stop;
+    if (halt) continue;
+    /* only the calling thread talks to the caller */
+    if (pr.fn && omp_get_thread_num() == 0 &&
+        pr.fn(pr.ud, 0.3 * (double)j / ny)) {
+#pragma omp atomic write
+      stop = 1;
+    }
     for (int i = 0; i < nx; i++) {
       double best = 0;
       for (int dj = -banks; dj <= banks; dj++) {
@@ -67,6 +80,8 @@ static void widen(const float *pw, float *sig, int nx, int ny, double thr,
       }
       sig[(size_t)j * nx + i] = (float)best;
     }
+  }
+  return stop ? OC_ECANCEL : OC_OK;
 }
 
 typedef struct bed {
@@ -132,8 +147,11 @@ oc_node *oc_generate_river(const oc_gen_river_params *pin, oc_gen_sea_stats *st,
     goto done;
   if (!(thr > 0)) thr = 1e-30; /* a flat grid: anything that flows */
   if (!(sig = oc_heightfield_new(nx, ny, cell, x0, y0, NULL, err))) goto done;
-  widen(oc_heightfield_samples(pw), oc_heightfield_samples_mut(sig), nx, ny,
-        thr, p.banks);
+  if (widen(oc_heightfield_samples(pw), oc_heightfield_samples_mut(sig), nx, ny,
+            thr, p.banks, p.progress)) {
+    oc_seterr(err, OC_ECANCEL, "river erosion cancelled");
+    goto done;
+  }
   bed B = {sig, x0, y0, cell, nx, ny};
   size_t ns = (size_t)nx * ny;
   if (!(mask = malloc(ns))) {
