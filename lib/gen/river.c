@@ -12,12 +12,12 @@
 */
 #include <float.h>
 #include <math.h>
-#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
 #include "gen/erode.h"
+#include "terrain/analysis.h"
 
 /* Below this slope a column is riverbed floor: carve at z = h. */
 #define FLAT 0.05
@@ -48,40 +48,33 @@ static int quantile(const float *v, size_t n, double q, double *out,
   return OC_OK;
 }
 
-/* sigma: 1 on the bed, 1 - d / (banks + 1) at d cells from it. Up to
-** (2 banks + 1)^2 reads per sample: long on a large grid, so the rows
-** poll for cancellation. Returns 0 or OC_ECANCEL. */
-static int widen(const float *pw, float *sig, int nx, int ny, double thr,
-                 int banks, oc_progress pr) {
-  int r = banks + 1, stop = 0;
-#pragma omp parallel for schedule(dynamic, 16)
-  for (int j = 0; j < ny; j++) {
-    int halt;
-#pragma omp atomic read
-    halt = stop;
-    if (halt) continue;
-    /* only the calling thread talks to the caller */
-    if (pr.fn && omp_get_thread_num() == 0 &&
-        pr.fn(pr.ud, 0.3 * (double)j / ny)) {
-#pragma omp atomic write
-      stop = 1;
-    }
-    for (int i = 0; i < nx; i++) {
-      double best = 0;
-      for (int dj = -banks; dj <= banks; dj++) {
-        int jj = j + dj;
-        if (jj < 0 || jj >= ny) continue;
-        for (int di = -banks; di <= banks; di++) {
-          int ii = i + di;
-          if (ii < 0 || ii >= nx) continue;
-          double w = 1 - sqrt((double)(di * di + dj * dj)) / r;
-          if (w > best && pw[(size_t)jj * nx + ii] >= thr) best = w;
-        }
+/* sigma: 1 on the bed, 1 - d / (banks + 1) at d cells from it; up to
+** (2 banks + 1)^2 reads per sample. */
+typedef struct widening {
+  const float *pw;
+  double thr;
+  int banks;
+} widening;
+
+static void widen_row(const void *ctx, oc_heightfield *sig, int j) {
+  const widening *W = ctx;
+  int nx = oc_heightfield_nx(sig), ny = oc_heightfield_ny(sig);
+  int banks = W->banks, r = banks + 1;
+  float *row = oc_heightfield_samples_mut(sig) + (size_t)j * nx;
+  for (int i = 0; i < nx; i++) {
+    double best = 0;
+    for (int dj = -banks; dj <= banks; dj++) {
+      int jj = j + dj;
+      if (jj < 0 || jj >= ny) continue;
+      for (int di = -banks; di <= banks; di++) {
+        int ii = i + di;
+        if (ii < 0 || ii >= nx) continue;
+        double w = 1 - sqrt((double)(di * di + dj * dj)) / r;
+        if (w > best && W->pw[(size_t)jj * nx + ii] >= W->thr) best = w;
       }
-      sig[(size_t)j * nx + i] = (float)best;
     }
+    row[i] = (float)best;
   }
-  return stop ? OC_ECANCEL : OC_OK;
 }
 
 typedef struct bed {
@@ -147,11 +140,9 @@ oc_node *oc_generate_river(const oc_gen_river_params *pin, oc_gen_sea_stats *st,
     goto done;
   if (!(thr > 0)) thr = 1e-30; /* a flat grid: anything that flows */
   if (!(sig = oc_heightfield_new(nx, ny, cell, x0, y0, NULL, err))) goto done;
-  if (widen(oc_heightfield_samples(pw), oc_heightfield_samples_mut(sig), nx, ny,
-            thr, p.banks, p.progress)) {
-    oc_seterr(err, OC_ECANCEL, "river erosion cancelled");
+  widening W = {oc_heightfield_samples(pw), thr, p.banks};
+  if (oc_hf_each_row(sig, widen_row, &W, p.progress, "river erosion", err))
     goto done;
-  }
   bed B = {sig, x0, y0, cell, nx, ny};
   size_t ns = (size_t)nx * ny;
   if (!(mask = malloc(ns))) {
