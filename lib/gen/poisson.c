@@ -77,7 +77,7 @@ static int setup(const oc_poisson_params *pp, int d, oc_pgrid *g,
     return oc_seterr(err, OC_EINVAL, "'radius' must be > 0 (got %g)", r);
   if (r < 1e-9 * big)
     return oc_seterr(err, OC_EINVAL,
-                     "'radius' %g is too small for coordinates up to %g "
+                     "'radius' %g is too small for 'box' coordinates up to %g "
                      "(double precision; move the box nearer the origin)",
                      r, big);
   double bound = count_bound(d, len, r);

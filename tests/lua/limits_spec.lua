@@ -86,3 +86,90 @@ describe("outcrop.polygonize", function()
     end
   end)
 end)
+
+-- One valid call per numeric field of the API, with the field replaced by
+-- each odd number: the call returns, or raises an error naming the
+-- function, the field (or the field derived from it: spacing = radius / 2)
+-- and this file's line; never a crash (ASan build).
+describe("odd numbers in every numeric field", function()
+  local sph = oc.sphere{center = {0, 0, 0}, radius = 5}
+  local hf = valley
+  local cases = {
+  {"outcrop.heightfield.fbm", "'size'", function(v) return H.fbm{size = {v, 10}, wavelength = 5, amplitude = 1} end},
+  {"outcrop.heightfield.fbm", "'cell'", function(v) return H.fbm{size = {10, 10}, cell = v, wavelength = 5, amplitude = 1} end},
+  {"outcrop.heightfield.fbm", "'wavelength'", function(v) return H.fbm{size = {10, 10}, wavelength = v, amplitude = 1} end},
+  {"outcrop.heightfield.fbm", "'amplitude'", function(v) return H.fbm{size = {10, 10}, wavelength = 5, amplitude = v} end},
+  {"outcrop.heightfield.fbm", "'octaves'", function(v) return H.fbm{size = {10, 10}, wavelength = 5, amplitude = 1, octaves = v} end},
+  {"outcrop.heightfield.fbm", "'origin'", function(v) return H.fbm{size = {10, 10}, wavelength = 5, amplitude = 1, origin = {v, 0}} end},
+  {"outcrop.heightfield.from", "'cell'", function(v) return H.from(function() return 0 end, {size = {10, 10}, cell = v}) end},
+  {"outcrop.heightfield.from", "'cell'", function(v) return H.from(sph, {size = {10, 10}, cell = v, origin = {-5, -5}}) end},
+  {"outcrop.heightfield.from", "'zrange'", function(v) return H.from(sph, {size = {10, 10}, zrange = {-1, v}}) end},
+  {"outcrop.heightfield.from", "'zrange'", function(v) return H.from(sph, {size = {10, 10}, zrange = {v, 1}}) end},
+  {"outcrop.heightfield.from", "'origin'", function(v) return H.from(sph, {size = {10, 10}, origin = {v, 1}}) end},
+  {"heightfield:resample", "'cell'", function(v) return hf:resample{cell = v} end},
+  {"heightfield:resample", "'size'", function(v) return hf:resample{size = {v, v}} end},
+  {"heightfield:crop", "item 3", function(v) return hf:crop{1, 1, v, 5} end},
+  {"heightfield:crop", "'box'", function(v) return hf:crop{box = {0, 0, v, 5}} end},
+  {"heightfield:crop", "'box'", function(v) return hf:crop{box = {v, 0, 30, 5}} end},
+  {"heightfield:accessibility", "'rays'", function(v) return hf:accessibility{rays = v} end},
+  {"heightfield:accessibility", "'distance'", function(v) return hf:accessibility{distance = v, rays = 4} end},
+  {"heightfield:drainage", "exponent", function(v) return hf:drainage{exponent = v} end},
+  {"heightfield:distance_to_level", "level", function(v) return hf:distance_to_level(v) end},
+  {"heightfield:", " must be", function(v) return hf:height(v, 3), hf:gradient(3, v) end},
+  {"heightfield:get", "i must", function(v) return hf:get(v, 1) end},
+  {"outcrop.terrain", "'falloff'", function(v) return oc.terrain(hf, {falloff = v}):eval{1,1,1} end},
+  {"outcrop.terrain", "'thickness'", function(v) return oc.terrain(hf, {thickness = v}):eval{1,1,1} end},
+  {"outcrop.terrain", "'transition'", function(v) return oc.terrain(hf, {transition = v}):eval{1,1,1} end},
+  {"outcrop.poisson2d", "'radius'", function(v) return oc.poisson2d{box = {0, 0, 10, 10}, radius = v} end},
+  {"outcrop.poisson2d", "'box'", function(v) return oc.poisson2d{box = {0, 0, v, 10}, radius = 1} end},
+  {"outcrop.poisson2d", "'box'", function(v) return oc.poisson2d{box = {v, 0, 10, 10}, radius = 1} end},
+  {"outcrop.poisson3d", "'radius'", function(v) return oc.poisson3d{box = {0, 0, 0, 10, 10, 10}, radius = v} end},
+  {"outcrop.poisson3d", "'box'", function(v) return oc.poisson3d{box = {0, 0, 0, 10, 10, v}, radius = 1} end},
+  {"outcrop.generate.sea", "'radius'|'spacing'", function(v) return oc.generate.sea{heightfield = hf, radius = v} end},
+  {"outcrop.generate.sea", "'range'|'spacing'", function(v) return oc.generate.sea{heightfield = hf, range = v} end},
+  {"outcrop.generate.sea", "'sea_level'", function(v) return oc.generate.sea{heightfield = hf, sea_level = v} end},
+  {"outcrop.generate.sea", "'reach'", function(v) return oc.generate.sea{heightfield = hf, reach = v} end},
+  {"outcrop.generate.sea", "'rays'", function(v) return oc.generate.sea{heightfield = hf, rays = v} end},
+  {"outcrop.generate.sea", "'steps'", function(v) return oc.generate.sea{heightfield = hf, steps = v} end},
+  {"outcrop.generate.sea", "'strength'", function(v) return oc.generate.sea{heightfield = hf, strength = v} end},
+  {"outcrop.generate.river", "'power'", function(v) return oc.generate.river{heightfield = hf, power = v} end},
+  {"outcrop.generate.river", "'banks'", function(v) return oc.generate.river{heightfield = hf, banks = v} end},
+  {"outcrop.generate.river", "'depth'", function(v) return oc.generate.river{heightfield = hf, depth = v} end},
+  {"outcrop.generate.river", "'spacing'", function(v) return oc.generate.river{heightfield = hf, spacing = v} end},
+  {"outcrop.generate.karst", "'spacing'", function(v) return oc.generate.karst{heightfield = hf, spacing = v} end},
+  {"outcrop.generate.karst", "'radius'|'spacing'", function(v) return oc.generate.karst{heightfield = hf, radius = v} end},
+  {"outcrop.generate.karst", "'max_primitives'", function(v) return oc.generate.karst{heightfield = hf, max_primitives = v} end},
+  {"outcrop.generate.hoodoos", "'radius'|'spacing'", function(v) return oc.generate.hoodoos{heightfield = hf, radius = v} end},
+  {"outcrop.generate.hoodoos", "'spacing'", function(v) return oc.generate.hoodoos{heightfield = hf, spacing = v} end},
+  {"outcrop.generate.hoodoos", "'max_depth'", function(v) return oc.generate.hoodoos{heightfield = hf, max_depth = v} end},
+  {"outcrop.slice", "'at'", function(v) return oc.slice(sph, {at = v, size = {8, 8}}) end},
+  {"outcrop.slice", "'size'", function(v) return oc.slice(sph, {size = {v, 8}}) end},
+  {"outcrop.slice", "'box'", function(v) return oc.slice(sph, {box = {-1, -1, v, 1}, size = {8, 8}}) end},
+  {"outcrop.render", "'size'", function(v) return oc.render(sph, {size = {v, 8}}) end},
+  {"outcrop.render", "'camera.fov'", function(v) return oc.render(sph, {size = {8, 8}, camera = {eye = {0, -20, 0}, target = {0, 0, 0}, fov = v}}) end},
+  {"outcrop.render", "'camera.eye'", function(v) return oc.render(sph, {size = {8, 8}, camera = {eye = {0, v, 0}, target = {0, 0, 0}}}) end},
+  {"outcrop.polygonize", "'cell'", function(v) return oc.polygonize(sph, {cell = v}) end},
+  {"outcrop.polygonize", "resolution", function(v) return oc.polygonize(sph, {resolution = {v, 4, 4}}) end},
+  {"outcrop.polygonize", "'box'", function(v) return oc.polygonize(sph, {box = {-1, -1, -1, v, 1, 1}, resolution = {4, 4, 4}}) end},
+  {"outcrop.polygonize", "'steps'", function(v) return oc.polygonize(sph, {steps = v}) end},
+  }
+  it("give a result or an error naming the function and the field", function()
+    local bad = {}
+    for _, c in ipairs(cases) do
+      local fname, field, call = c[1], c[2], c[3]
+      for _, v in ipairs(odd) do
+        local ok, err = pcall(call, v)
+        if not ok then
+          local where = F .. ":" .. debug.getinfo(call, "S").linedefined .. ": "
+          local named = false
+          for alt in field:gmatch("[^|]+") do named = named or err:find(alt, 1, true) end
+          if not (err:find(where .. fname, 1, true) and named) then
+            bad[#bad + 1] = string.format("%s with %s: %q lacks %q or %q", fname,
+                                          tostring(v), err, where .. fname, field)
+          end
+        end
+      end
+    end
+    assert.are.same({}, bad)
+  end)
+end)
