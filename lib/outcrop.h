@@ -223,9 +223,10 @@ typedef struct oc_polygonize_params {
   int no_direct;    /* 1: no direct elevation extraction: root finding on
                     ** the field even where one terrain or plane alone
                     ** governs a column (benchmarks, tests) */
-  size_t max_triangles; /* refuse when the projected mesh has more (an
-                        ** estimate from probes through the box, made
-                        ** before meshing); 0: OC_POLYGONIZE_MAX_TRIANGLES */
+  /* refuse when the projected mesh has more triangles (an estimate from
+  ** probes through the box, made before meshing); 0: the default,
+  ** OC_POLYGONIZE_MAX_TRIANGLES */
+  size_t max_triangles;
   oc_progress progress;
 } oc_polygonize_params;
 /* 2^27 triangles: about 3 GiB of mesh (positions, normals, indices). */
@@ -1035,6 +1036,11 @@ oc_node *oc_generate_hoodoos(const oc_gen_hoodoos_params *p,
 ** terrain; OC_EINVAL when nothing was carved). Draws
 ** are keyed by (seed, step, column): the same primitives for any thread
 ** count. OC_EINVAL naming the parameter, OC_ENOMEM, OC_ECANCEL. */
+/* Cap on columns x steps of sea and river erosion (each column makes at
+** most one point primitive per step), checked once the columns are
+** sampled, before any ray is cast. */
+#define OC_ERODE_MAX_PRIMITIVES 20000000
+
 typedef struct oc_gen_sea_stats {
   size_t columns;    /* Poisson columns kept as candidates */
   size_t samples;    /* rays that found the surface, over all steps */

@@ -320,6 +320,15 @@ static int prims_push(prims *P, oc_node *nd, oc_error *err) {
 
 oc_node *oc_erode_run(const oc_erode_params *ep, const oc_erode_cand *cand,
                       size_t n, oc_gen_sea_stats *st, oc_error *err) {
+  /* each column makes at most one primitive per step */
+  double most = (double)n * ep->steps;
+  if (most > OC_ERODE_MAX_PRIMITIVES) {
+    oc_seterr(err, OC_ENOMEM,
+              "%zu columns over %d 'steps' could make %.3g primitives (at "
+              "most %d million): use a larger 'spacing' or fewer 'steps'",
+              n, ep->steps, most, OC_ERODE_MAX_PRIMITIVES / 1000000);
+    return NULL;
+  }
   prims P = {NULL, 0, 0};
   oc_program *geo = NULL, *tree = NULL;
   oc_node *out = NULL;

@@ -158,6 +158,29 @@ START_TEST(poisson_odd_numbers) {
 }
 END_TEST
 
+/* Columns x steps beyond OC_ERODE_MAX_PRIMITIVES: refused once the
+** columns are known, before hours of rays, naming both fields. */
+START_TEST(erosion_primitive_budget) {
+  oc_heightfield *hf = slope();
+  oc_error err = {OC_OK, ""};
+  oc_gen_sea_stats st;
+  oc_gen_river_params r;
+  oc_gen_river_defaults(&r);
+  r.heightfield = hf;
+  r.banks = 64; /* the whole valley is bank */
+  r.spacing = 0.04;
+  r.steps = 64;
+  double t0 = omp_get_wtime();
+  ck_assert_ptr_null(oc_generate_river(&r, &st, &err));
+  ck_assert_int_eq(err.code, OC_ENOMEM);
+  ck_assert_msg(strstr(err.msg, "'spacing'") && strstr(err.msg, "'steps'") &&
+                    strstr(err.msg, "primitives (at most 20 million)"),
+                "%s", err.msg);
+  ck_assert(omp_get_wtime() - t0 < 20);
+  oc_heightfield_release(hf);
+}
+END_TEST
+
 /* Cancels at the n-th progress call. */
 static int cancel_at(void *ud, double fraction) {
   (void)fraction;
@@ -201,6 +224,7 @@ int main(void) {
   tcase_add_test(tc, polygonize_projected_output);
   tcase_add_test(tc, poisson_odd_numbers);
   tcase_add_test(tc, river_cancels_at_every_poll);
+  tcase_add_test(tc, erosion_primitive_budget);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }

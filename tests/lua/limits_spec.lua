@@ -38,6 +38,12 @@ describe("erosion generators", function()
     end
   end)
 
+  it("refuse more columns x steps than the primitive budget, with the figure", function()
+    local t = {heightfield = valley, banks = 64, spacing = 0.04, steps = 64}
+    check(function() oc.generate.river(t) end, "outcrop.generate.river", "'spacing'",
+          "'steps'", "primitives (at most 20 million)")
+  end)
+
   it("bound the bank rays by the grid: depth and radius cost no more", function()
     local t0 = os.clock()
     for _, t in ipairs{{depth = 1e7}, {depth = 1e308}, {radius = 1e5, depth = 0.01},
