@@ -312,7 +312,7 @@ typedef struct oc_slice_params {
   oc_plane_axis plane;
   double at;             /* coordinate on the remaining axis */
   double u0, v0, u1, v1; /* window on the plane's two axes */
-  int width, height;     /* pixels, each 1 .. 16384 */
+  int width, height;     /* pixels, each 1 .. 16384, 2^25 in all */
 } oc_slice_params;
 
 /* 5-channel image: R, G, B, A (colour map with the T iso-line in black,

@@ -181,6 +181,29 @@ START_TEST(erosion_primitive_budget) {
 }
 END_TEST
 
+/* A slice of 16384 x 16384 pixels of 5 floats is 5 GiB: refused with the
+** renderer's pixel limit before anything is allocated. */
+START_TEST(slice_pixel_limit) {
+  oc_program *p = plane();
+  oc_error err = {OC_OK, ""};
+  oc_slice_params sp;
+  memset(&sp, 0, sizeof sp);
+  sp.plane = OC_PLANE_XZ;
+  sp.u0 = sp.v0 = -1;
+  sp.u1 = sp.v1 = 1;
+  sp.width = sp.height = 16384;
+  ck_assert_ptr_null(oc_slice(p, &sp, &err));
+  ck_assert_int_eq(err.code, OC_ENOMEM);
+  ck_assert_msg(strstr(err.msg, "'size' 16384 x 16384 is 268435456 pixels"),
+                "%s", err.msg);
+  sp.width = sp.height = 64;
+  oc_image *img = oc_slice(p, &sp, &err);
+  ck_assert_ptr_nonnull(img);
+  oc_image_free(img);
+  oc_program_free(p);
+}
+END_TEST
+
 /* Cancels at the n-th progress call. */
 static int cancel_at(void *ud, double fraction) {
   (void)fraction;
@@ -225,6 +248,7 @@ int main(void) {
   tcase_add_test(tc, poisson_odd_numbers);
   tcase_add_test(tc, river_cancels_at_every_poll);
   tcase_add_test(tc, erosion_primitive_budget);
+  tcase_add_test(tc, slice_pixel_limit);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }

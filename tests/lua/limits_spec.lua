@@ -56,6 +56,15 @@ describe("erosion generators", function()
   end)
 end)
 
+describe("outcrop.slice", function()
+  it("refuses more pixels than the renderer's limit, with the figure", function()
+    local sph = oc.sphere{center = {0, 0, 0}, radius = 5}
+    local t = {size = {16384, 16384}}
+    check(function() oc.slice(sph, t) end, "outcrop.slice",
+          "'size' 16384 x 16384 is 268435456 pixels, over the limit of 33554432")
+  end)
+end)
+
 describe("outcrop.polygonize", function()
   local plane = oc.plane{origin = {0, 0, 0}, normal = {0, 0, 1}}
 
