@@ -498,6 +498,9 @@ const double *oc_samples_data(const oc_samples *s);
 ** oc_heightfield_samples_mut only while you hold the only reference. */
 typedef struct oc_heightfield oc_heightfield;
 
+/* Samples of a grid at most (1 GiB of floats). */
+#define OC_HF_MAX_SAMPLES (1ull << 28)
+
 /* nx, ny in 2 .. 65535 and nx ny <= 2^28; cell > 0; finite origin. `z`
 ** (nx ny floats, all finite) is copied, or the grid starts at 0 when NULL. */
 oc_heightfield *oc_heightfield_new(int nx, int ny, double cell, double x0,

@@ -56,6 +56,28 @@ describe("erosion generators", function()
   end)
 end)
 
+describe("heightfield sizes", function()
+  it("refuse more than 2^28 samples, with the figure", function()
+    local t = {size = {65535, 65535}, wavelength = 5, amplitude = 1}
+    check(function() H.fbm(t) end, "outcrop.heightfield.fbm",
+          "'size' 65535 x 65535 is 4294836225 samples (16383 MiB), over the limit of 268435456")
+    local sph = oc.sphere{center = {0, 0, 0}, radius = 5}
+    local u = {size = {20000, 20000}}
+    check(function() H.from(sph, u) end, "outcrop.heightfield.from", "'size' 20000 x 20000")
+    local v = {cell = 0.001}
+    check(function() valley:resample(v) end, "heightfield:resample",
+          "'cell' 0.001 gives 40001 x 40001 samples, over the limit of 268435456")
+  end)
+end)
+
+describe("Poisson sampling", function()
+  it("refuses a radius too small for the box, with the bound", function()
+    local t = {box = {0, 0, 1e6, 1e6}, radius = 0.01}
+    check(function() oc.poisson2d(t) end, "outcrop.poisson2d", "'radius' 0.01 is too small",
+          "samples could fit (at most 50 million")
+  end)
+end)
+
 describe("outcrop.slice", function()
   it("refuses more pixels than the renderer's limit, with the figure", function()
     local sph = oc.sphere{center = {0, 0, 0}, radius = 5}
