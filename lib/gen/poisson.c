@@ -11,11 +11,13 @@
 ** and on the samples within reach, which no other tile of its class can
 ** change: the result is the same to the bit for any thread count.
 */
+#include <limits.h>
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/checked.h"
 #include "core/error.h"
 #include "gen/poisson.h"
 
@@ -113,16 +115,21 @@ static int setup(const oc_poisson_params *pp, int d, oc_pgrid *g,
   g->seed = pp->seed;
   g->cover_max = d == 2 ? COVER_MAX_2D : COVER_MAX_3D;
   g->cover_depth = COVER_DEPTH;
-  double cells = 1;
+  size_t n[3], bytes;
   for (int a = 0; a < 3; a++) {
     g->lo[a] = lo[a];
     g->hi[a] = hi[a];
-    double n = a < d ? ceil(len[a] / g->h) : 1;
-    g->n[a] = n < 1 ? 1 : (int)n; /* n <= 2 bound^(1/d) + 2: fits */
+    /* n <= 2 bound^(1/d) + 2 fits, but checked all the same */
+    if (!oc_double_to_int(a < d ? fmax(1, ceil(len[a] / g->h)) : 1, 1,
+                          INT_MAX - g->tile, &g->n[a]))
+      return oc_seterr(err, OC_ENOMEM, "'radius' %g is too small for the box",
+                       r);
     g->nt[a] = (g->n[a] + g->tile - 1) / g->tile;
-    cells *= g->n[a];
+    n[a] = (size_t)g->n[a];
   }
-  g->ncell = (size_t)cells;
+  if (!oc_prod_size(n, 3, &g->ncell) ||
+      !oc_mul_size(g->ncell, (size_t)d * sizeof *g->pos, &bytes))
+    return oc_seterr(err, OC_ENOMEM, "'radius' %g is too small for the box", r);
   for (int z = 0; z < OC_PREACH; z++)
     for (int y = 0; y < OC_PREACH; y++)
       for (int x = 0; x < OC_PREACH; x++) {
@@ -134,11 +141,11 @@ static int setup(const oc_poisson_params *pp, int d, oc_pgrid *g,
         }
         g->reach[z][y][x] = (d == 3 || o[2] == 0) && gap2 < g->r2;
       }
-  g->pos = malloc(g->ncell * (size_t)d * sizeof *g->pos);
+  g->pos = malloc(bytes);
   if (!g->pos)
     return oc_seterr(err, OC_ENOMEM,
                      "out of memory for a grid of %zu cells (%zu MiB)",
-                     g->ncell, (g->ncell * (size_t)d * sizeof(double)) >> 20);
+                     g->ncell, bytes >> 20);
   const double nan = NAN;
   const long long nc = (long long)g->ncell * d;
 #pragma omp parallel for schedule(static)
