@@ -103,12 +103,13 @@ void oc_erode_shared(oc_erode_params *ep, oc_node *base, int omit_base,
 ** Tiles are sampled in parallel and merged in tile order, a column closer
 ** than `spacing` to one of an earlier tile being dropped, so the set is
 ** still `spacing` apart (slightly sparser along tile seams) and does not
-** depend on the thread count. Returns the positions (2 doubles each) in a
-** new array (free()), the count in *n; NULL with err. */
+** depend on the thread count. Polls pr between tiles, reporting the
+** fraction `at`. Returns the positions (2 doubles each) in a new array
+** (free()), the count in *n; NULL with err (OC_ECANCEL when cancelled). */
 double *oc_erode_columns(const oc_heightfield *hf, const unsigned char *mask,
                          double spacing, uint64_t seed,
                          int (*keep)(void *, double, double), void *ud,
-                         size_t *n, oc_error *err);
+                         oc_progress pr, double at, size_t *n, oc_error *err);
 
 /* A new reference to `terrain`, or when it is NULL to a terrain node of
 ** the heightfield (falloff 4 cells); NULL with err. */

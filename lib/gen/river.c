@@ -151,8 +151,8 @@ oc_node *oc_generate_river(const oc_gen_river_params *pin, oc_gen_sea_stats *st,
   }
   for (size_t k = 0; k < ns; k++)
     mask[k] = oc_heightfield_samples(sig)[k] > 0;
-  xy = oc_erode_columns(hf, mask, p.spacing, p.seed, keep_column, &B, &ncol,
-                        err);
+  xy = oc_erode_columns(hf, mask, p.spacing, p.seed, keep_column, &B,
+                        p.progress, 0.3, &ncol, err);
   if (!xy) goto done;
   cand = malloc((ncol ? ncol : 1) * sizeof *cand);
   if (!cand) {

@@ -137,8 +137,8 @@ oc_node *oc_generate_sea(const oc_gen_sea_params *pin, oc_gen_sea_stats *st,
   }
   C.dist = dist;
   if (!(mask = coast_mask(&C, err))) goto done;
-  xy = oc_erode_columns(hf, mask, p.spacing, p.seed, keep_column, &C, &ncol,
-                        err);
+  xy = oc_erode_columns(hf, mask, p.spacing, p.seed, keep_column, &C,
+                        p.progress, 0.05, &ncol, err);
   if (!xy) goto done;
   if (p.progress.fn && p.progress.fn(p.progress.ud, 0.1)) {
     oc_seterr(err, OC_ECANCEL, "sea erosion cancelled");

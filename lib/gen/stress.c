@@ -6,6 +6,7 @@
 */
 #include <limits.h>
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -75,7 +76,7 @@ static void hash_add(colhash *H, const double *xy, int64_t k) {
 double *oc_erode_columns(const oc_heightfield *hf, const unsigned char *mask,
                          double spacing, uint64_t seed,
                          int (*keep)(void *, double, double), void *ud,
-                         size_t *n, oc_error *err) {
+                         oc_progress pr, double at, size_t *n, oc_error *err) {
   int nx = oc_heightfield_nx(hf), ny = oc_heightfield_ny(hf);
   double x0, y0, c = oc_heightfield_cell(hf);
   oc_heightfield_origin(hf, &x0, &y0);
@@ -131,9 +132,13 @@ double *oc_erode_columns(const oc_heightfield *hf, const unsigned char *mask,
     goto done;
   }
   keeper K = {keep, ud};
+  int stop = 0;
 #pragma omp parallel for schedule(dynamic, 1)
   for (int k = 0; k < nact; k++) {
-    int t = list[k], a = t % tx, b = t / tx;
+    int t = list[k], a = t % tx, b = t / tx, halt;
+#pragma omp atomic read
+    halt = stop;
+    if (halt) continue;
     oc_poisson_params pp;
     memset(&pp, 0, sizeof pp);
     double bx1 = x0 + (a + 1) * side, by1 = y0 + (b + 1) * side;
@@ -150,6 +155,15 @@ double *oc_erode_columns(const oc_heightfield *hf, const unsigned char *mask,
 #pragma omp critical(oc_erode_columns)
       if (!failed++) ferr = e;
     }
+    /* only the calling thread talks to the caller */
+    if (pr.fn && omp_get_thread_num() == 0 && pr.fn(pr.ud, at)) {
+#pragma omp atomic write
+      stop = 1;
+    }
+  }
+  if (stop) {
+    oc_seterr(err, OC_ECANCEL, "erosion cancelled");
+    goto done;
   }
   if (failed) {
     oc_seterr(err, ferr.code, "%s", ferr.msg);

@@ -210,30 +210,39 @@ static int cancel_at(void *ud, double fraction) {
   return --*(int *)ud == 0;
 }
 
-/* Every progress poll of the river generator (stream power, widening the
-** bed, the rays) cancels cleanly: an error and nothing leaked, or the
-** node once the polls are used up. */
-START_TEST(river_cancels_at_every_poll) {
+/* Every progress poll of the sea and river generators (stream power,
+** widening the bed, the column tiles, the rays) cancels cleanly: an error
+** and nothing leaked, or the node once the polls are used up. */
+START_TEST(erosion_cancels_at_every_poll) {
   oc_heightfield *hf = slope();
-  int cancelled = 0;
-  for (int n = 1; n < 200; n++) {
-    int left = n;
-    oc_error err = {OC_OK, ""};
-    oc_gen_sea_stats st;
-    oc_gen_river_params r;
-    oc_gen_river_defaults(&r);
-    r.heightfield = hf;
-    r.banks = 64;
-    r.progress = (oc_progress){cancel_at, &left};
-    oc_node *nd = oc_generate_river(&r, &st, &err);
-    if (nd) {
-      oc_node_release(nd);
-      break;
+  for (int sea = 0; sea < 2; sea++) {
+    int cancelled = 0;
+    for (int n = 1; n < 400; n++) {
+      int left = n;
+      oc_error err = {OC_OK, ""};
+      oc_gen_sea_stats st;
+      oc_progress pr = {cancel_at, &left};
+      oc_gen_river_params r;
+      oc_gen_river_defaults(&r);
+      r.heightfield = hf;
+      r.banks = 64;
+      r.progress = pr;
+      oc_gen_sea_params q;
+      oc_gen_sea_defaults(&q);
+      q.heightfield = hf;
+      q.sea_level = 4;
+      q.progress = pr;
+      oc_node *nd = sea ? oc_generate_sea(&q, &st, &err)
+                        : oc_generate_river(&r, &st, &err);
+      if (nd) {
+        oc_node_release(nd);
+        break;
+      }
+      ck_assert_int_eq(err.code, OC_ECANCEL);
+      cancelled++;
     }
-    ck_assert_int_eq(err.code, OC_ECANCEL);
-    cancelled++;
+    ck_assert_int_ge(cancelled, 3);
   }
-  ck_assert_int_ge(cancelled, 3);
   oc_heightfield_release(hf);
 }
 END_TEST
@@ -246,7 +255,7 @@ int main(void) {
   tcase_add_test(tc, river_long_rays);
   tcase_add_test(tc, polygonize_projected_output);
   tcase_add_test(tc, poisson_odd_numbers);
-  tcase_add_test(tc, river_cancels_at_every_poll);
+  tcase_add_test(tc, erosion_cancels_at_every_poll);
   tcase_add_test(tc, erosion_primitive_budget);
   tcase_add_test(tc, slice_pixel_limit);
   suite_add_tcase(s, tc);
