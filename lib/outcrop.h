@@ -977,7 +977,7 @@ typedef struct oc_gen_hoodoos_params {
   int max_depth;       /* symbols per hoodoo, 2 .. OC_HOODOO_MAX_DEPTH (6) */
   double p_block;      /* in [0, 1] (0.5) */
   double p_cone;       /* in [0, 1] (0.5) */
-  double shrink;       /* lambda in (0, 1] (0.85) */
+  double shrink;       /* lambda in [0.1, 1] (0.85) */
   double tilt;         /* radians in [0, 0.5] (0.1) */
   double roughness;    /* perturbation, fraction of the falloff, [0, 1]
                        ** (0.3) */
