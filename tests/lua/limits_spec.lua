@@ -32,7 +32,7 @@ describe("erosion generators", function()
         local ok, err = pcall(oc.generate[name], {heightfield = valley, spacing = v})
         if not ok then
           assert.matches("outcrop.generate." .. name .. ": .*'spacing'", err)
-          assert.matches("^" .. F .. ":%d+:", err)
+          assert.matches(F .. ":%d+:", err)
         end
       end
     end
@@ -114,11 +114,11 @@ describe("outcrop.polygonize", function()
     for _, v in ipairs(odd) do
       local ok, err = pcall(oc.polygonize, plane, {box = {0, 0, -1, 4, 4, 1}, cell = v})
       if not ok then
-        assert.matches("^" .. F .. ":%d+: outcrop.polygonize: .*'cell'", err)
+        assert.matches(F .. ":%d+: outcrop.polygonize: .*'cell'", err)
       end
       ok, err = pcall(oc.polygonize, plane, {box = {0, 0, -1, v, 4, 1}})
       if not ok then
-        assert.matches("^" .. F .. ":%d+: outcrop.polygonize: .*'box'", err)
+        assert.matches(F .. ":%d+: outcrop.polygonize: .*'box'", err)
       end
     end
   end)
