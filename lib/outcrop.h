@@ -223,8 +223,14 @@ typedef struct oc_polygonize_params {
   int no_direct;    /* 1: no direct elevation extraction: root finding on
                     ** the field even where one terrain or plane alone
                     ** governs a column (benchmarks, tests) */
+  /* refuse when the projected mesh has more triangles (an estimate from
+  ** probes through the box, made before meshing); 0: the default,
+  ** OC_POLYGONIZE_MAX_TRIANGLES */
+  size_t max_triangles;
   oc_progress progress;
 } oc_polygonize_params;
+/* 2^27 triangles: about 3 GiB of mesh (positions, normals, indices). */
+#define OC_POLYGONIZE_MAX_TRIANGLES ((size_t)1 << 27)
 
 /* Marching cubes over the box with a topologically consistent case table:
 ** a closed, manifold, consistently oriented mesh (outward normals), capped
@@ -319,7 +325,7 @@ typedef struct oc_slice_params {
   oc_plane_axis plane;
   double at;             /* coordinate on the remaining axis */
   double u0, v0, u1, v1; /* window on the plane's two axes */
-  int width, height;     /* pixels, each 1 .. 16384 */
+  int width, height;     /* pixels, each 1 .. 16384, 2^25 in all */
 } oc_slice_params;
 
 /* 5-channel image: R, G, B, A (colour map with the T iso-line in black,
@@ -504,6 +510,9 @@ const double *oc_samples_data(const oc_samples *s);
 ** retains it. A grid is immutable once shared: write its samples through
 ** oc_heightfield_samples_mut only while you hold the only reference. */
 typedef struct oc_heightfield oc_heightfield;
+
+/* Samples of a grid at most (1 GiB of floats). */
+#define OC_HF_MAX_SAMPLES (1ull << 28)
 
 /* nx, ny in 2 .. 65535 and nx ny <= 2^28; cell > 0; finite origin. `z`
 ** (nx ny floats, all finite) is copied, or the grid starts at 0 when NULL. */
@@ -990,7 +999,7 @@ typedef struct oc_gen_hoodoos_params {
   int max_depth;       /* symbols per hoodoo, 2 .. OC_HOODOO_MAX_DEPTH (6) */
   double p_block;      /* in [0, 1] (0.5) */
   double p_cone;       /* in [0, 1] (0.5) */
-  double shrink;       /* lambda in (0, 1] (0.85) */
+  double shrink;       /* lambda in [0.1, 1] (0.85) */
   double tilt;         /* radians in [0, 0.5] (0.1) */
   double roughness;    /* perturbation, fraction of the falloff, [0, 1]
                        ** (0.3) */
@@ -1052,6 +1061,11 @@ oc_node *oc_generate_hoodoos(const oc_gen_hoodoos_params *p,
 ** terrain; OC_EINVAL when nothing was carved). Draws
 ** are keyed by (seed, step, column): the same primitives for any thread
 ** count. OC_EINVAL naming the parameter, OC_ENOMEM, OC_ECANCEL. */
+/* Cap on columns x steps of sea and river erosion (each column makes at
+** most one point primitive per step), checked once the columns are
+** sampled, before any ray is cast. */
+#define OC_ERODE_MAX_PRIMITIVES 20000000
+
 typedef struct oc_gen_sea_stats {
   size_t columns;    /* Poisson columns kept as candidates */
   size_t samples;    /* rays that found the surface, over all steps */

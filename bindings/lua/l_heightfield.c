@@ -411,6 +411,11 @@ static int hf_resample(lua_State *L) {
                   "'cell' %f gives %I x %I samples (at most %d per side)",
                   (LUAI_UACNUMBER)cell, (LUAI_UACINT)fmin(nx, 1e18),
                   (LUAI_UACINT)fmin(ny, 1e18), MAX_SIDE);
+    if (nx * ny > (double)OC_HF_MAX_SAMPLES)
+      oclua_error(L, fname,
+                  "'cell' %f gives %I x %I samples, over the limit of %I",
+                  (LUAI_UACNUMBER)cell, (LUAI_UACINT)nx, (LUAI_UACINT)ny,
+                  (LUAI_UACINT)OC_HF_MAX_SAMPLES);
     g.nx = (int)nx;
     g.ny = (int)ny;
     g.cell = cell;

@@ -5,7 +5,9 @@
 ** polygonize defaults: box = the node's bounds (an error when they are
 ** infinite or empty); when neither 'cell' nor 'resolution' is given,
 ** cubic cells of 1/64 of the box's longest side; threshold =
-** outcrop.threshold; open = false; steps = 6; full_grid = false. The node
+** outcrop.threshold; open = false; steps = 6; full_grid = false;
+** max_triangles = 2^27 (a mesh projected to have more, from probes
+** through the box before meshing, is refused with the figure). The node
 ** is compiled with the threshold it is meshed at, since difference and
 ** the smooth operators depend on T.
 **
@@ -354,9 +356,9 @@ static int field_resolution(const oclua_fields *f, int res[3]) {
 }
 
 static int l_polygonize(lua_State *L) {
-  static const char *const known[] = {"box",       "cell",   "resolution",
-                                      "threshold", "open",   "steps",
-                                      "full_grid", "colors", NULL};
+  static const char *const known[] = {
+      "box",   "cell",      "resolution", "threshold",     "open",
+      "steps", "full_grid", "colors",     "max_triangles", NULL};
   const char *fname = "outcrop.polygonize";
   oclua_fields f;
   oc_error err = {OC_OK, ""};
@@ -367,7 +369,8 @@ static int l_polygonize(lua_State *L) {
   int res[3] = {0, 0, 0}, hasbox, hasres, open, steps, full_grid;
   oclua_checkargs(L, 2, fname,
                   "(node, {box =, cell = or resolution =, threshold =, "
-                  "open =, steps =, full_grid =, colors =})");
+                  "open =, steps =, full_grid =, colors =, "
+                  "max_triangles =})");
   oclua_checknode(L, 1, fname, "argument #1");
   lua_settop(L, 2);
   if (lua_isnil(L, 2)) {
@@ -386,6 +389,9 @@ static int l_polygonize(lua_State *L) {
   open = oclua_field_optbool(&f, "open", 0);
   steps = (int)oclua_field_optint(&f, "steps", 1, MAX_STEPS, DEFAULT_STEPS);
   full_grid = oclua_field_optbool(&f, "full_grid", 0);
+  lua_Integer max_tri =
+      oclua_field_optint(&f, "max_triangles", 1, (lua_Integer)1 << 40,
+                         OC_POLYGONIZE_MAX_TRIANGLES);
   read_colors(&f, &c);
 
   const oc_program *prog = oclua_program_at(L, 1, fname, t);
@@ -428,6 +434,7 @@ static int l_polygonize(lua_State *L) {
   pp.open = open;
   pp.steps = steps;
   pp.full_grid = full_grid;
+  pp.max_triangles = (size_t)max_tri;
   pp.progress = oclua_progress_start(L, &pl, fname);
   /* The userdata first, so that nothing can leak once the mesh exists. */
   oclua_mesh *u = newmesh(L);

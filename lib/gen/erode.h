@@ -63,6 +63,8 @@ typedef struct oc_erode_params {
   double beta;
   double cutoff; /* samples with e < cutoff make no primitive */
   double step;   /* marching step along rays */
+  double span;   /* rays are cut to this each way (the footprint's diagonal
+                 ** plus a cell): depth and radius lengthen them no more */
   int steps;     /* >= 1 */
   uint64_t seed;
   oc_progress progress;
@@ -86,11 +88,13 @@ typedef struct oc_erode_common {
 } oc_erode_common;
 
 /* Fills *ep from those, the rest zero: resistance 0.5 without geology,
-** the default threshold for 0, and a marching step of half the smaller
-** of the grid's cell and the radius. */
+** the default threshold for 0, a marching step of half the smaller of
+** hf's cell and the radius (but at least 1/32 cell: a tinier radius only
+** makes the march longer) and rays cut to hf's extent. */
 void oc_erode_shared(oc_erode_params *ep, oc_node *base, int omit_base,
-                     oc_node *geology, double threshold, double cell,
-                     const oc_erode_common *c, oc_progress progress);
+                     oc_node *geology, double threshold,
+                     const oc_heightfield *hf, const oc_erode_common *c,
+                     oc_progress progress);
 
 /* Candidate columns: maximal Poisson disk sets of radius `spacing` on
 ** square tiles of the heightfield's extent, only on the tiles that hold a
@@ -99,12 +103,13 @@ void oc_erode_shared(oc_erode_params *ep, oc_node *base, int omit_base,
 ** Tiles are sampled in parallel and merged in tile order, a column closer
 ** than `spacing` to one of an earlier tile being dropped, so the set is
 ** still `spacing` apart (slightly sparser along tile seams) and does not
-** depend on the thread count. Returns the positions (2 doubles each) in a
-** new array (free()), the count in *n; NULL with err. */
+** depend on the thread count. Polls pr between tiles, reporting the
+** fraction `at`. Returns the positions (2 doubles each) in a new array
+** (free()), the count in *n; NULL with err (OC_ECANCEL when cancelled). */
 double *oc_erode_columns(const oc_heightfield *hf, const unsigned char *mask,
                          double spacing, uint64_t seed,
                          int (*keep)(void *, double, double), void *ud,
-                         size_t *n, oc_error *err);
+                         oc_progress pr, double at, size_t *n, oc_error *err);
 
 /* A new reference to `terrain`, or when it is NULL to a terrain node of
 ** the heightfield (falloff 4 cells); NULL with err. */

@@ -54,6 +54,21 @@ static int check(const oc_gen_hoodoos_params *p, oc_error *err) {
                      p->height_lo, p->height_hi);
   if (!(p->width > 0 && isfinite(p->width)))
     return oc_seterr(err, OC_EINVAL, "'width' must be > 0 (got %g)", p->width);
+  /* Symbols beyond the footprint's size (or, shrunk, below a millionth of
+  ** it) only make transforms that cannot be inverted in double. */
+  const oc_heightfield *hf = p->heightfield;
+  double ext = oc_heightfield_cell(hf) *
+               fmax(oc_heightfield_nx(hf), oc_heightfield_ny(hf));
+  if (!(p->width >= 1e-6 * ext && p->width <= ext))
+    return oc_seterr(err, OC_EINVAL,
+                     "'width' must be in [%g, %g] (a millionth of the "
+                     "heightfield's width, to its width; got %g)",
+                     1e-6 * ext, ext, p->width);
+  if (!(p->height_lo >= 1e-6 * ext && p->height_hi <= 100 * ext))
+    return oc_seterr(err, OC_EINVAL,
+                     "'height' must be in [%g, %g] (a millionth of the "
+                     "heightfield's width, to 100 times it; got {%g, %g})",
+                     1e-6 * ext, 100 * ext, p->height_lo, p->height_hi);
   if (!(p->margin >= 0 && isfinite(p->margin)))
     return oc_seterr(err, OC_EINVAL, "'margin' must be >= 0 (got %g)",
                      p->margin);
@@ -66,8 +81,8 @@ static int check(const oc_gen_hoodoos_params *p, oc_error *err) {
   if (!in01(p->p_cone))
     return oc_seterr(err, OC_EINVAL, "'p_cone' must be in [0, 1] (got %g)",
                      p->p_cone);
-  if (!(p->shrink > 0 && p->shrink <= 1))
-    return oc_seterr(err, OC_EINVAL, "'shrink' must be in (0, 1] (got %g)",
+  if (!(p->shrink >= 0.1 && p->shrink <= 1))
+    return oc_seterr(err, OC_EINVAL, "'shrink' must be in [0.1, 1] (got %g)",
                      p->shrink);
   if (!(p->tilt >= 0 && p->tilt <= 0.5))
     return oc_seterr(err, OC_EINVAL,

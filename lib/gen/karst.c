@@ -241,6 +241,10 @@ static int check(const oc_gen_karst_params *p, run *r, oc_error *err) {
   r->step = p->step == 0 ? r->R : p->step;
   if (!(r->step > 0) || !isfinite(r->step))
     return oc_seterr(err, OC_EINVAL, "'step' must be > 0 (got %g)", p->step);
+  if (!(r->step <= fmax(w, h)))
+    return oc_seterr(err, OC_EINVAL,
+                     "'step' %g is longer than the heightfield (%g x %g)",
+                     r->step, w, h);
   r->spacing = p->spacing == 0 ? r->R / 2 : p->spacing;
   if (!(r->spacing > 0) || !isfinite(r->spacing))
     return oc_seterr(err, OC_EINVAL, "'spacing' must be > 0 (got %g)",

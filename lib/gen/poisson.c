@@ -11,11 +11,13 @@
 ** and on the samples within reach, which no other tile of its class can
 ** change: the result is the same to the bit for any thread count.
 */
+#include <limits.h>
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/checked.h"
 #include "core/error.h"
 #include "gen/poisson.h"
 
@@ -32,6 +34,8 @@
 #define COVER_MAX_2D 8
 #define COVER_MAX_3D 2
 #define COVER_DEPTH 2
+/* Sides of the box below this fraction of a cell are refused. */
+#define THIN 1e-3
 /* Key of the thinning stream, distinct from any tile's. */
 #define THIN_KEY 0x7468696e6e696e67ull
 
@@ -75,7 +79,7 @@ static int setup(const oc_poisson_params *pp, int d, oc_pgrid *g,
     return oc_seterr(err, OC_EINVAL, "'radius' must be > 0 (got %g)", r);
   if (r < 1e-9 * big)
     return oc_seterr(err, OC_EINVAL,
-                     "'radius' %g is too small for coordinates up to %g "
+                     "'radius' %g is too small for 'box' coordinates up to %g "
                      "(double precision; move the box nearer the origin)",
                      r, big);
   double bound = count_bound(d, len, r);
@@ -95,20 +99,37 @@ static int setup(const oc_poisson_params *pp, int d, oc_pgrid *g,
   g->h = r / sqrt((double)d);
   while (g->h * g->h * d > g->r2)
     g->h = nextafter(g->h, 0);
+  /* A box within one cell is that cell: darts thrown at a cell far larger
+  ** than the box (radius 1e308) would never land in it. */
+  double longest = fmax(len[0], fmax(len[1], len[2]));
+  if (g->h > longest) g->h = longest;
+  /* Gap filling splits the boxes of a cell until they are as thin as the
+  ** box: 2^(d-1) more at each level, too many below THIN of a cell. */
+  for (int a = 0; a < d; a++)
+    if (len[a] < THIN * g->h)
+      return oc_seterr(err, OC_EINVAL,
+                       "'box' is %g along %c, too thin for 'radius' %g "
+                       "(at least %g)",
+                       len[a], "xyz"[a], r, THIN * g -> h);
   g->tile = d == 2 ? TILE_2D : TILE_3D;
   g->seed = pp->seed;
   g->cover_max = d == 2 ? COVER_MAX_2D : COVER_MAX_3D;
   g->cover_depth = COVER_DEPTH;
-  double cells = 1;
+  size_t n[3], bytes;
   for (int a = 0; a < 3; a++) {
     g->lo[a] = lo[a];
     g->hi[a] = hi[a];
-    double n = a < d ? ceil(len[a] / g->h) : 1;
-    g->n[a] = n < 1 ? 1 : (int)n; /* n <= 2 bound^(1/d) + 2: fits */
+    /* n <= 2 bound^(1/d) + 2 fits, but checked all the same */
+    if (!oc_double_to_int(a < d ? fmax(1, ceil(len[a] / g->h)) : 1, 1,
+                          INT_MAX - g->tile, &g->n[a]))
+      return oc_seterr(err, OC_ENOMEM, "'radius' %g is too small for the box",
+                       r);
     g->nt[a] = (g->n[a] + g->tile - 1) / g->tile;
-    cells *= g->n[a];
+    n[a] = (size_t)g->n[a];
   }
-  g->ncell = (size_t)cells;
+  if (!oc_prod_size(n, 3, &g->ncell) ||
+      !oc_mul_size(g->ncell, (size_t)d * sizeof *g->pos, &bytes))
+    return oc_seterr(err, OC_ENOMEM, "'radius' %g is too small for the box", r);
   for (int z = 0; z < OC_PREACH; z++)
     for (int y = 0; y < OC_PREACH; y++)
       for (int x = 0; x < OC_PREACH; x++) {
@@ -120,11 +141,11 @@ static int setup(const oc_poisson_params *pp, int d, oc_pgrid *g,
         }
         g->reach[z][y][x] = (d == 3 || o[2] == 0) && gap2 < g->r2;
       }
-  g->pos = malloc(g->ncell * (size_t)d * sizeof *g->pos);
+  g->pos = malloc(bytes);
   if (!g->pos)
     return oc_seterr(err, OC_ENOMEM,
                      "out of memory for a grid of %zu cells (%zu MiB)",
-                     g->ncell, (g->ncell * (size_t)d * sizeof(double)) >> 20);
+                     g->ncell, bytes >> 20);
   const double nan = NAN;
   const long long nc = (long long)g->ncell * d;
 #pragma omp parallel for schedule(static)

@@ -10,12 +10,14 @@
 ** the slope) at heights drawn below their surface, so they reach the
 ** canyon wall at every level of it and carve most into soft layers.
 */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
 #include "gen/erode.h"
+#include "terrain/analysis.h"
 
 /* Below this slope a column is riverbed floor: carve at z = h. */
 #define FLAT 0.05
@@ -46,26 +48,33 @@ static int quantile(const float *v, size_t n, double q, double *out,
   return OC_OK;
 }
 
-/* sigma: 1 on the bed, 1 - d / (banks + 1) at d cells from it. */
-static void widen(const float *pw, float *sig, int nx, int ny, double thr,
-                  int banks) {
-  int r = banks + 1;
-#pragma omp parallel for schedule(static)
-  for (int j = 0; j < ny; j++)
-    for (int i = 0; i < nx; i++) {
-      double best = 0;
-      for (int dj = -banks; dj <= banks; dj++) {
-        int jj = j + dj;
-        if (jj < 0 || jj >= ny) continue;
-        for (int di = -banks; di <= banks; di++) {
-          int ii = i + di;
-          if (ii < 0 || ii >= nx) continue;
-          double w = 1 - sqrt((double)(di * di + dj * dj)) / r;
-          if (w > best && pw[(size_t)jj * nx + ii] >= thr) best = w;
-        }
+/* sigma: 1 on the bed, 1 - d / (banks + 1) at d cells from it; up to
+** (2 banks + 1)^2 reads per sample. */
+typedef struct widening {
+  const float *pw;
+  double thr;
+  int banks;
+} widening;
+
+static void widen_row(const void *ctx, oc_heightfield *sig, int j) {
+  const widening *W = ctx;
+  int nx = oc_heightfield_nx(sig), ny = oc_heightfield_ny(sig);
+  int banks = W->banks, r = banks + 1;
+  float *row = oc_heightfield_samples_mut(sig) + (size_t)j * nx;
+  for (int i = 0; i < nx; i++) {
+    double best = 0;
+    for (int dj = -banks; dj <= banks; dj++) {
+      int jj = j + dj;
+      if (jj < 0 || jj >= ny) continue;
+      for (int di = -banks; di <= banks; di++) {
+        int ii = i + di;
+        if (ii < 0 || ii >= nx) continue;
+        double w = 1 - sqrt((double)(di * di + dj * dj)) / r;
+        if (w > best && W->pw[(size_t)jj * nx + ii] >= W->thr) best = w;
       }
-      sig[(size_t)j * nx + i] = (float)best;
     }
+    row[i] = (float)best;
+  }
 }
 
 typedef struct bed {
@@ -100,7 +109,7 @@ static int check(const oc_gen_river_params *p, oc_gen_river_params *q,
                      p->banks);
   if (q->radius == 0) q->radius = 1.5 * cell;
   if (q->spacing == 0) q->spacing = q->radius / 2;
-  if (q->depth == 0) q->depth = 3 * q->radius;
+  if (q->depth == 0) q->depth = fmin(3 * q->radius, DBL_MAX);
   if (oc_erode_check(q->radius, q->spacing, q->beta, q->strength, q->cutoff,
                      q->steps, q->threshold, err))
     return err ? err->code : OC_EINVAL;
@@ -131,8 +140,9 @@ oc_node *oc_generate_river(const oc_gen_river_params *pin, oc_gen_sea_stats *st,
     goto done;
   if (!(thr > 0)) thr = 1e-30; /* a flat grid: anything that flows */
   if (!(sig = oc_heightfield_new(nx, ny, cell, x0, y0, NULL, err))) goto done;
-  widen(oc_heightfield_samples(pw), oc_heightfield_samples_mut(sig), nx, ny,
-        thr, p.banks);
+  widening W = {oc_heightfield_samples(pw), thr, p.banks};
+  if (oc_hf_each_row(sig, widen_row, &W, p.progress, "river erosion", err))
+    goto done;
   bed B = {sig, x0, y0, cell, nx, ny};
   size_t ns = (size_t)nx * ny;
   if (!(mask = malloc(ns))) {
@@ -141,8 +151,8 @@ oc_node *oc_generate_river(const oc_gen_river_params *pin, oc_gen_sea_stats *st,
   }
   for (size_t k = 0; k < ns; k++)
     mask[k] = oc_heightfield_samples(sig)[k] > 0;
-  xy = oc_erode_columns(hf, mask, p.spacing, p.seed, keep_column, &B, &ncol,
-                        err);
+  xy = oc_erode_columns(hf, mask, p.spacing, p.seed, keep_column, &B,
+                        p.progress, 0.3, &ncol, err);
   if (!xy) goto done;
   cand = malloc((ncol ? ncol : 1) * sizeof *cand);
   if (!cand) {
@@ -175,7 +185,7 @@ oc_node *oc_generate_river(const oc_gen_river_params *pin, oc_gen_sea_stats *st,
   oc_erode_params ep;
   oc_erode_common com = {p.radius, p.strength, p.beta,
                          p.cutoff, p.steps,    p.seed};
-  oc_erode_shared(&ep, base, p.no_terrain, p.geology, p.threshold, cell, &com,
+  oc_erode_shared(&ep, base, p.no_terrain, p.geology, p.threshold, hf, &com,
                   p.progress);
   ep.pbase = 0.3;
   ep.pspan = 0.7;

@@ -11,6 +11,7 @@
 ** sea side). The rays run landward and stop where they enter the current
 ** tree, so later steps find the surface the earlier ones carved.
 */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -101,7 +102,7 @@ static int check(const oc_gen_sea_params *p, oc_gen_sea_params *q,
     return oc_seterr(err, OC_EINVAL, "'range' must be > 0 (got %g)", p->range);
   if (q->radius == 0) q->radius = q->range;
   if (q->spacing == 0) q->spacing = q->radius / 2;
-  if (q->reach == 0) q->reach = 2 * q->radius;
+  if (q->reach == 0) q->reach = fmin(2 * q->radius, DBL_MAX);
   if (oc_erode_check(q->radius, q->spacing, q->beta, q->strength, q->cutoff,
                      q->steps, q->threshold, err))
     return err ? err->code : OC_EINVAL;
@@ -136,8 +137,8 @@ oc_node *oc_generate_sea(const oc_gen_sea_params *pin, oc_gen_sea_stats *st,
   }
   C.dist = dist;
   if (!(mask = coast_mask(&C, err))) goto done;
-  xy = oc_erode_columns(hf, mask, p.spacing, p.seed, keep_column, &C, &ncol,
-                        err);
+  xy = oc_erode_columns(hf, mask, p.spacing, p.seed, keep_column, &C,
+                        p.progress, 0.05, &ncol, err);
   if (!xy) goto done;
   if (p.progress.fn && p.progress.fn(p.progress.ud, 0.1)) {
     oc_seterr(err, OC_ECANCEL, "sea erosion cancelled");
@@ -154,8 +155,7 @@ oc_node *oc_generate_sea(const oc_gen_sea_params *pin, oc_gen_sea_stats *st,
   oc_erode_params ep;
   oc_erode_common com = {p.radius, p.strength, p.beta,
                          p.cutoff, p.steps,    p.seed};
-  oc_erode_shared(&ep, base, p.no_terrain, p.geology, T, cell, &com,
-                  p.progress);
+  oc_erode_shared(&ep, base, p.no_terrain, p.geology, T, hf, &com, p.progress);
   ep.sea_level = p.sea_level;
   ep.range = p.range;
   ep.alpha = p.rays > 0 ? hf : NULL;

@@ -4,17 +4,23 @@
 ** surface, stress and resistance at the samples, and negative point
 ** primitives with energy -strength e(rho, sigma). See erode.h.
 */
+#include <limits.h>
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/checked.h"
 #include "core/error.h"
 #include "core/rng.h"
 #include "gen/erode.h"
 
 /* Candidates are processed in blocks: between blocks the calling thread
-** reports progress, inside a block both cores march rays. */
+** reports progress, inside a block both cores march rays. A block holds at
+** most BLOCK candidates and about BLOCK_EVALS field evaluations, so that
+** long rays (a large footprint) still poll for cancellation often. */
 #define BLOCK 4096
+#define BLOCK_EVALS (1 << 22)
 /* Bisection steps once a ray has entered the solid. */
 #define BISECT 14
 
@@ -70,22 +76,28 @@ static void hash_add(colhash *H, const double *xy, int64_t k) {
 double *oc_erode_columns(const oc_heightfield *hf, const unsigned char *mask,
                          double spacing, uint64_t seed,
                          int (*keep)(void *, double, double), void *ud,
-                         size_t *n, oc_error *err) {
+                         oc_progress pr, double at, size_t *n, oc_error *err) {
   int nx = oc_heightfield_nx(hf), ny = oc_heightfield_ny(hf);
   double x0, y0, c = oc_heightfield_cell(hf);
   oc_heightfield_origin(hf, &x0, &y0);
   double w = c * (nx - 1), h = c * (ny - 1);
   double side = 16 * spacing > 4 * c ? 16 * spacing : 4 * c;
-  double ntd = ceil(w / side), nty = ceil(h / side);
-  if (ntd * nty > 1e8) {
+  /* A tile wider than the footprint is the footprint: a huge spacing must
+  ** neither make the tile count 0 nor the tile boxes infinite. */
+  double ext = (w > h ? w : h) + c;
+  if (!(side <= ext)) side = ext;
+  int tx, ty;
+  size_t ntile;
+  if (!oc_double_to_int(fmax(1, ceil(w / side)), 1, INT_MAX, &tx) ||
+      !oc_double_to_int(fmax(1, ceil(h / side)), 1, INT_MAX, &ty) ||
+      !oc_mul_size((size_t)tx, (size_t)ty, &ntile) || ntile > 100000000) {
     oc_seterr(err, OC_ENOMEM, "'spacing' %g is too small for the extent",
               spacing);
     return NULL;
   }
-  int tx = (int)ntd, ty = (int)nty;
-  unsigned char *act = calloc((size_t)tx * ty, 1);
-  int *list = malloc((size_t)tx * ty * sizeof *list);
-  oc_samples **got = calloc((size_t)tx * ty, sizeof *got);
+  unsigned char *act = calloc(ntile, 1);
+  int *list = malloc(ntile * sizeof *list);
+  oc_samples **got = calloc(ntile, sizeof *got);
   double *xy = NULL;
   colhash H = {NULL, 0, x0, y0, 1 / spacing};
   int nact = 0, failed = 0;
@@ -110,8 +122,8 @@ double *oc_erode_columns(const oc_heightfield *hf, const unsigned char *mask,
   for (int t = 0; t < tx * ty; t++)
     if (act[t]) list[nact++] = t;
   /* The same bound as the sampler's, over all the tiles at once. */
-  double bound = nact * (side + spacing) * (side + spacing) /
-                 (0.785398 * spacing * spacing);
+  double q = side / spacing + 1; /* as a ratio: spacing^2 may overflow */
+  double bound = nact * q * q / 0.785398;
   if (!(bound <= OC_POISSON_MAX)) {
     oc_seterr(err, OC_ENOMEM,
               "'spacing' %g is too small: up to %.3g columns could fit "
@@ -120,9 +132,13 @@ double *oc_erode_columns(const oc_heightfield *hf, const unsigned char *mask,
     goto done;
   }
   keeper K = {keep, ud};
+  int stop = 0;
 #pragma omp parallel for schedule(dynamic, 1)
   for (int k = 0; k < nact; k++) {
-    int t = list[k], a = t % tx, b = t / tx;
+    int t = list[k], a = t % tx, b = t / tx, halt;
+#pragma omp atomic read
+    halt = stop;
+    if (halt) continue;
     oc_poisson_params pp;
     memset(&pp, 0, sizeof pp);
     double bx1 = x0 + (a + 1) * side, by1 = y0 + (b + 1) * side;
@@ -139,6 +155,15 @@ double *oc_erode_columns(const oc_heightfield *hf, const unsigned char *mask,
 #pragma omp critical(oc_erode_columns)
       if (!failed++) ferr = e;
     }
+    /* only the calling thread talks to the caller */
+    if (pr.fn && omp_get_thread_num() == 0 && pr.fn(pr.ud, at)) {
+#pragma omp atomic write
+      stop = 1;
+    }
+  }
+  if (stop) {
+    oc_seterr(err, OC_ECANCEL, "erosion cancelled");
+    goto done;
   }
   if (failed) {
     oc_seterr(err, ferr.code, "%s", ferr.msg);
@@ -259,9 +284,9 @@ static void sample_one(const oc_erode_params *ep, const oc_program *tree,
   if (c->ux == 0 && c->uy == 0) {
     *s = (oc_vec3){c->x, c->y, z};
   } else {
-    oc_vec3 a = {c->x - c->back * c->ux, c->y - c->back * c->uy, z};
-    if (!march(tree, ep->threshold, a, c->ux, c->uy, c->back + c->fwd, ep->step,
-               s))
+    double back = fmin(c->back, ep->span), fwd = fmin(c->fwd, ep->span);
+    oc_vec3 a = {c->x - back * c->ux, c->y - back * c->uy, z};
+    if (!march(tree, ep->threshold, a, c->ux, c->uy, back + fwd, ep->step, s))
       return;
   }
   double sigma = c->stress;
@@ -309,6 +334,15 @@ static int prims_push(prims *P, oc_node *nd, oc_error *err) {
 
 oc_node *oc_erode_run(const oc_erode_params *ep, const oc_erode_cand *cand,
                       size_t n, oc_gen_sea_stats *st, oc_error *err) {
+  /* each column makes at most one primitive per step */
+  double most = (double)n * ep->steps;
+  if (most > OC_ERODE_MAX_PRIMITIVES) {
+    oc_seterr(err, OC_ENOMEM,
+              "%zu columns over %d 'steps' could make %.3g primitives (at "
+              "most %d million): use a larger 'spacing' or fewer 'steps'",
+              n, ep->steps, most, OC_ERODE_MAX_PRIMITIVES / 1000000);
+    return NULL;
+  }
   prims P = {NULL, 0, 0};
   oc_program *geo = NULL, *tree = NULL;
   oc_node *out = NULL;
@@ -329,14 +363,19 @@ oc_node *oc_erode_run(const oc_erode_params *ep, const oc_erode_cand *cand,
     goto done;
   }
   if (ep->geology && !(geo = oc_compile(ep->geology, NULL, err))) goto done;
+  /* evaluations per candidate, at most: the ray both ways, bisection */
+  double evals = 2 * ep->span / ep->step + BISECT + 2;
+  size_t block = BLOCK;
+  if (evals * BLOCK > BLOCK_EVALS)
+    block = evals * 16 > BLOCK_EVALS ? 16 : (size_t)(BLOCK_EVALS / evals);
   for (int step = 0; step < ep->steps; step++) {
     oc_node *cur = oc_blend(P.v, P.n, err);
     if (!cur) goto done;
     tree = oc_compile(cur, &co, err);
     oc_node_release(cur);
     if (!tree) goto done;
-    for (size_t b0 = 0; b0 < n; b0 += BLOCK) {
-      long long b1 = (long long)(b0 + BLOCK < n ? b0 + BLOCK : n);
+    for (size_t b0 = 0; b0 < n; b0 += block) {
+      long long b1 = (long long)(b0 + block < n ? b0 + block : n);
 #pragma omp parallel for schedule(dynamic, 64)
       for (long long i = (long long)b0; i < b1; i++)
         sample_one(ep, tree, geo, &cand[i], (size_t)i, step, &s[i], &e[i],
@@ -403,8 +442,9 @@ oc_node *oc_erode_base(oc_heightfield *hf, oc_node *terrain, oc_error *err) {
 }
 
 void oc_erode_shared(oc_erode_params *ep, oc_node *base, int omit_base,
-                     oc_node *geology, double threshold, double cell,
-                     const oc_erode_common *c, oc_progress progress) {
+                     oc_node *geology, double threshold,
+                     const oc_heightfield *hf, const oc_erode_common *c,
+                     oc_progress progress) {
   memset(ep, 0, sizeof *ep);
   ep->base = base;
   ep->omit_base = omit_base;
@@ -415,7 +455,9 @@ void oc_erode_shared(oc_erode_params *ep, oc_node *base, int omit_base,
   ep->strength = c->strength;
   ep->beta = c->beta;
   ep->cutoff = c->cutoff;
-  ep->step = 0.5 * (cell < c->radius ? cell : c->radius);
+  double cell = oc_heightfield_cell(hf);
+  ep->step = fmax(0.5 * fmin(cell, c->radius), cell / 32);
+  ep->span = cell * (hypot(oc_heightfield_nx(hf), oc_heightfield_ny(hf)) + 1);
   ep->steps = c->steps;
   ep->seed = c->seed;
   ep->progress = progress;

@@ -112,4 +112,10 @@ int oc_mc_direct_kind(const struct oc_hfsurf *s);
 int oc_mc_surfaces(oc_mcgrid *g, int direct);
 void oc_mc_surfaces_free(oc_mcgrid *g);
 
+/* An estimate of the triangles the mesh of g will have, from a few
+** thousand field values (mcproject.c); low rather than high. A grid too
+** small to ever exceed `limit` is not probed: the result is then its
+** bound (at most limit). */
+double oc_mc_project_triangles(const oc_mcgrid *g, double limit);
+
 #endif

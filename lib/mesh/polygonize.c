@@ -28,6 +28,23 @@
 ** at most 640 MiB per thread. */
 #define MAX_SLAB_SAMPLES ((size_t)1 << 25)
 
+/* Refuses a mesh projected to exceed max_triangles, before any of it is
+** made. */
+static int check_output(const oc_mcgrid *g, const oc_polygonize_params *pp,
+                        oc_error *err) {
+  size_t most =
+      pp->max_triangles ? pp->max_triangles : OC_POLYGONIZE_MAX_TRIANGLES;
+  double t = oc_mc_project_triangles(g, (double)most);
+  if (t <= (double)most) return 0;
+  /* a triangle: 3 indices, and half a vertex of position and normal */
+  double gib = t * (3 * 4 + 0.5 * 6 * 4) / (1 << 30);
+  return oc_seterr(err, OC_ENOMEM,
+                   "the mesh would have about %.3g triangles (%.3g GiB), more "
+                   "than 'max_triangles' (%zu); use a larger 'cell' or a "
+                   "smaller 'box', or raise 'max_triangles'",
+                   t, gib, most);
+}
+
 static int setup(const oc_program *prog, const oc_polygonize_params *pp,
                  oc_mcgrid *g, oc_error *err) {
   if (!prog || !pp)
@@ -108,7 +125,7 @@ static int setup(const oc_program *prog, const oc_polygonize_params *pp,
                      "grid of %d x %d x %d cells is too large for "
                      "'full_grid' (a slab would hold %.3g samples)",
                      g->n[0], g->n[1], g->n[2], OC_MC_BLOCK * col);
-  return 0;
+  return check_output(g, pp, err);
 }
 
 /* Cube rows per slab: a multiple of the culling block, small enough that

@@ -5,14 +5,16 @@
 ** Two passes over rows: the field first (stored in the image's "field"
 ** channel), then colours, which need each pixel's four neighbours. Each
 ** pixel depends only on its own position, so the result is the same for
-** any thread count and schedule.
+** any thread count and schedule. Sizes are capped as the renderer's
+** (OC_RENDER_MAX_PIXELS): 2^25 pixels of 5 floats are 640 MiB already.
 */
 #include <math.h>
 
 #include "core/error.h"
 #include "outcrop.h"
+#include "render/render.h"
 
-#define MAX_SIDE 16384
+#define MAX_SIDE OC_RENDER_MAX_SIDE
 #define NCH 5 /* R, G, B, A, field */
 #define FIELD 4
 
@@ -30,6 +32,13 @@ static int check(const oc_program *prog, const oc_slice_params *sp,
   if (sp->height < 1 || sp->height > MAX_SIDE)
     return oc_seterr(err, OC_EINVAL, "'height' must be in 1..%d (got %d)",
                      MAX_SIDE, sp->height);
+  long long px = (long long)sp->width * sp->height;
+  if (px > OC_RENDER_MAX_PIXELS)
+    return oc_seterr(err, OC_ENOMEM,
+                     "'size' %d x %d is %lld pixels, over the limit of %lld "
+                     "(%lld MiB of %d float channels)",
+                     sp->width, sp->height, px, (long long)OC_RENDER_MAX_PIXELS,
+                     OC_RENDER_MAX_PIXELS * NCH * 4 >> 20, NCH);
   if (!isfinite(sp->at))
     return oc_seterr(err, OC_EINVAL, "'at' must be finite (got %g)", sp->at);
   /* The spans must be finite too, or pixel centres would be inf or NaN. */

@@ -33,6 +33,15 @@ static inline int oc_hf_report(const oc_hf_phase *ph, double f) {
 ** write before it shares the grid). */
 oc_heightfield *oc_hf_like(const oc_heightfield *hf, oc_error *err);
 
+/* Fills one row j of the grid being made. */
+typedef void (*oc_hf_row_fn)(const void *ctx, oc_heightfield *out, int j);
+
+/* Runs fn over every row of `out` on all cores. Only the calling thread
+** talks to the progress callback; a non-zero answer stops the remaining
+** rows and the work ends with OC_ECANCEL ("<what> cancelled"). */
+int oc_hf_each_row(oc_heightfield *out, oc_hf_row_fn fn, const void *ctx,
+                   oc_progress pr, const char *what, oc_error *err);
+
 /* A finite float for a double result (slopes of absurd grids overflow). */
 static inline float oc_hf_float(double v) {
   return v > FLT_MAX ? FLT_MAX : v < -FLT_MAX ? -FLT_MAX : (float)v;

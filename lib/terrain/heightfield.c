@@ -15,7 +15,6 @@
 #include "outcrop.h"
 
 #define MAX_SIDE 65535
-#define MAX_SAMPLES (1ull << 28) /* 1 GiB of floats */
 
 struct oc_heightfield {
   int refs;
@@ -33,11 +32,12 @@ oc_heightfield *oc_heightfield_new(int nx, int ny, double cell, double x0,
     return NULL;
   }
   unsigned long long n = (unsigned long long)nx * (unsigned long long)ny;
-  if (n > MAX_SAMPLES) {
+  if (n > OC_HF_MAX_SAMPLES) {
     oc_seterr(err, OC_ENOMEM,
-              "a %d x %d heightfield needs %llu MiB, over the %llu MiB limit",
-              nx, ny, (n * sizeof(float)) >> 20,
-              (MAX_SAMPLES * sizeof(float)) >> 20);
+              "'size' %d x %d is %llu samples (%llu MiB), over the limit of "
+              "%llu (%llu MiB)",
+              nx, ny, n, (n * sizeof(float)) >> 20, OC_HF_MAX_SAMPLES,
+              (OC_HF_MAX_SAMPLES * sizeof(float)) >> 20);
     return NULL;
   }
   if (!(cell > 0) || !isfinite(cell)) {
@@ -175,8 +175,8 @@ double oc_heightfield_height(const oc_heightfield *hf, double x, double y,
     /* inside: no clamping; the same sums in the same order */
     const float *row = hf->z + (size_t)(j - 1) * (size_t)hf->nx + (i - 1);
     for (int b = 0; b < 4; b++, row += hf->nx) {
-      double r = wu[0] * row[0] + wu[1] * row[1] + wu[2] * row[2] +
-                 wu[3] * row[3];
+      double r =
+          wu[0] * row[0] + wu[1] * row[1] + wu[2] * row[2] + wu[3] * row[3];
       h += wv[b] * r;
       if (grad) {
         double dr = dwu[0] * row[0] + dwu[1] * row[1] + dwu[2] * row[2] +

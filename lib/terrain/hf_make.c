@@ -15,35 +15,7 @@
 #include "core/noise.h"
 #include "field/node.h"
 #include "outcrop.h"
-
-/* Fills one row of the grid being made. */
-typedef void (*row_fn)(const void *ctx, oc_heightfield *out, int j);
-
-/* Runs fn over every row of `out` on all cores. Only the calling thread
-** talks to the progress callback; a non-zero answer stops the remaining
-** rows and the work ends with OC_ECANCEL. */
-static int each_row(oc_heightfield *out, row_fn fn, const void *ctx,
-                    oc_progress pr, const char *what, oc_error *err) {
-  int ny = oc_heightfield_ny(out), stop = 0, done = 0;
-#pragma omp parallel for schedule(dynamic, 1)
-  for (int j = 0; j < ny; j++) {
-    int halt;
-#pragma omp atomic read
-    halt = stop;
-    if (halt) continue;
-    fn(ctx, out, j);
-    int d;
-#pragma omp atomic capture
-    d = ++done;
-    if (pr.fn && omp_get_thread_num() == 0 && pr.fn(pr.ud, 0.99 * d / ny)) {
-#pragma omp atomic write
-      stop = 1;
-    }
-  }
-  if (stop || (pr.fn && pr.fn(pr.ud, 1.0)))
-    return oc_seterr(err, OC_ECANCEL, "%s cancelled", what);
-  return OC_OK;
-}
+#include "terrain/analysis.h"
 
 static oc_heightfield *new_grid(const oc_hf_grid *g, oc_error *err) {
   if (!g) {
@@ -53,9 +25,10 @@ static oc_heightfield *new_grid(const oc_hf_grid *g, oc_error *err) {
   return oc_heightfield_new(g->nx, g->ny, g->cell, g->x0, g->y0, NULL, err);
 }
 
-static oc_heightfield *run(oc_heightfield *out, row_fn fn, const void *ctx,
-                           oc_progress pr, const char *what, oc_error *err) {
-  if (out && each_row(out, fn, ctx, pr, what, err) != OC_OK) {
+static oc_heightfield *run(oc_heightfield *out, oc_hf_row_fn fn,
+                           const void *ctx, oc_progress pr, const char *what,
+                           oc_error *err) {
+  if (out && oc_hf_each_row(out, fn, ctx, pr, what, err) != OC_OK) {
     oc_heightfield_release(out);
     return NULL;
   }
