@@ -35,16 +35,26 @@
 #define MAX_STEPS 64
 #define MAX_STOPS 65536
 
+static void mesh_release(oclua_handle *h) {
+  oclua_mesh *u = (oclua_mesh *)h;
+  if (u->mesh) oc_mesh_free(u->mesh);
+  u->mesh = NULL;
+}
+
 static oclua_mesh *newmesh(lua_State *L) {
   oclua_mesh *u = lua_newuserdatauv(L, sizeof *u, 0);
+  oclua_handle_init(&u->h, "mesh", mesh_release);
   u->mesh = NULL;
   luaL_setmetatable(L, OCLUA_MESH);
   return u;
 }
 
-static oclua_mesh *checkmesh(lua_State *L, const char *fname) {
+/* The mesh at 1, open; pinned for the rest of the call when pin is set. */
+static oclua_mesh *checkmesh(lua_State *L, const char *fname, int pin) {
   oclua_mesh *u = luaL_checkudata(L, 1, OCLUA_MESH);
-  if (u->mesh == NULL) oclua_error(L, fname, "the mesh is closed");
+  oclua_handle_check(L, &u->h, fname);
+  if (u->mesh == NULL) oclua_error(L, fname, "the mesh is not made");
+  if (pin) oclua_pin(L, 1, &u->h, fname);
   return u;
 }
 
@@ -151,9 +161,9 @@ static void read_colors(const oclua_fields *f, colors *c) {
 }
 
 /* Calls the function at fn for every vertex. The function may do
-** anything, closing this very mesh included, so the mesh is looked up
-** again after each call; the colours gather in a Lua-owned buffer, so an
-** error raised in the function leaks nothing. */
+** anything, closing this very mesh included: the caller has pinned it, so
+** a close takes effect when the call returns. The colours gather in a
+** Lua-owned buffer, so an error raised in the function leaks nothing. */
 static void color_by_function(lua_State *L, oclua_mesh *u, int fn,
                               const char *fname) {
   oc_error err = {OC_OK, ""};
@@ -165,7 +175,6 @@ static void color_by_function(lua_State *L, oclua_mesh *u, int fn,
   luaL_checkstack(L, 8, NULL);
   for (size_t i = 0; i < nv; i++) {
     const float *p, *n;
-    if (u->mesh == NULL) break;
     p = oc_mesh_positions(u->mesh) + 3 * i;
     n = oc_mesh_normals(u->mesh) + 3 * i;
     lua_pushvalue(L, fn);
@@ -186,8 +195,6 @@ static void color_by_function(lua_State *L, oclua_mesh *u, int fn,
     }
     lua_pop(L, 3);
   }
-  if (u->mesh == NULL)
-    oclua_error(L, fname, "the mesh was closed by the colors function");
   if (oc_mesh_set_colors(u->mesh, rgb, &err) != OC_OK)
     oclua_liberror(L, fname, &err);
   lua_pop(L, 1);
@@ -211,7 +218,7 @@ static void apply_colors(lua_State *L, oclua_mesh *u, const colors *c,
 static int mesh_write(lua_State *L) {
   static const char *const known[] = {"colors", NULL};
   const char *fname = "mesh:write";
-  oclua_mesh *u = checkmesh(L, fname);
+  checkmesh(L, fname, 0);
   oc_error err = {OC_OK, ""};
   colors c = {COLORS_NONE, 0, NULL, 0};
   const char *path;
@@ -220,6 +227,7 @@ static int mesh_write(lua_State *L) {
                 oclua_got(L, 2));
   oclua_checkargs(L, 3, fname, "(path [, {colors = ...}])");
   lua_settop(L, 3);
+  oclua_mesh *u = checkmesh(L, fname, 1);
   if (!lua_isnil(L, 3)) {
     oclua_fields f;
     oclua_fields_open(&f, L, 3, fname, NULL, known, 0);
@@ -243,7 +251,7 @@ static int mesh_write(lua_State *L) {
 static int mesh_stats(lua_State *L) {
   oc_mesh_stats st;
   oclua_checkargs(L, 1, "mesh:stats", "()");
-  oc_mesh_get_stats(checkmesh(L, "mesh:stats")->mesh, &st);
+  oc_mesh_get_stats(checkmesh(L, "mesh:stats", 0)->mesh, &st);
   lua_createtable(L, 0, 5);
   lua_pushinteger(L, (lua_Integer)st.vertices);
   lua_setfield(L, -2, "vertices");
@@ -261,7 +269,7 @@ static int mesh_stats(lua_State *L) {
 static int mesh_counts(lua_State *L) {
   const oc_mesh *m;
   oclua_checkargs(L, 1, "mesh:counts", "()");
-  m = checkmesh(L, "mesh:counts")->mesh;
+  m = checkmesh(L, "mesh:counts", 0)->mesh;
   lua_pushinteger(L, (lua_Integer)oc_mesh_vertex_count(m));
   lua_pushinteger(L, (lua_Integer)oc_mesh_triangle_count(m));
   return 2;
@@ -286,7 +294,7 @@ static size_t checkindex(lua_State *L, const char *fname, const char *what,
 
 static int mesh_vertex(lua_State *L) {
   const char *fname = "mesh:vertex";
-  const oc_mesh *m = checkmesh(L, fname)->mesh;
+  const oc_mesh *m = checkmesh(L, fname, 0)->mesh;
   size_t i =
       checkindex(L, fname, "vertex", "vertices", oc_mesh_vertex_count(m));
   const float *p = oc_mesh_positions(m) + 3 * i;
@@ -300,7 +308,7 @@ static int mesh_vertex(lua_State *L) {
 
 static int mesh_triangle(lua_State *L) {
   const char *fname = "mesh:triangle";
-  const oc_mesh *m = checkmesh(L, fname)->mesh;
+  const oc_mesh *m = checkmesh(L, fname, 0)->mesh;
   size_t i =
       checkindex(L, fname, "triangle", "triangles", oc_mesh_triangle_count(m));
   const uint32_t *t = oc_mesh_indices(m) + 3 * i;
@@ -310,15 +318,13 @@ static int mesh_triangle(lua_State *L) {
 }
 
 static int mesh_gc(lua_State *L) {
-  oclua_mesh *u = luaL_checkudata(L, 1, OCLUA_MESH);
-  if (u->mesh) oc_mesh_free(u->mesh);
-  u->mesh = NULL;
+  oclua_handle_close(luaL_checkudata(L, 1, OCLUA_MESH));
   return 0;
 }
 
 static int mesh_tostring(lua_State *L) {
   oclua_mesh *u = luaL_checkudata(L, 1, OCLUA_MESH);
-  if (u->mesh == NULL)
+  if (u->mesh == NULL || u->h.closed)
     lua_pushliteral(L, OCLUA_MESH ": (closed)");
   else
     lua_pushfstring(L, OCLUA_MESH ": %I vertices, %I triangles",
@@ -448,17 +454,13 @@ static const luaL_Reg mesh_meta[] = {
     {"__gc", mesh_gc},
     {"__close", mesh_gc}, /* `local m <close>` frees the mesh early */
     {"__tostring", mesh_tostring},
-    {"__index", NULL},
     {NULL, NULL}};
 
 static const luaL_Reg mesh_funcs[] = {{"polygonize", l_polygonize},
                                       {NULL, NULL}};
 
 void oclua_open_mesh(lua_State *L) {
-  luaL_newmetatable(L, OCLUA_MESH);
-  luaL_setfuncs(L, mesh_meta, 0);
-  luaL_newlib(L, mesh_methods);
-  lua_setfield(L, -2, "__index");
+  oclua_newmeta(L, OCLUA_MESH, mesh_meta, mesh_methods);
   lua_pop(L, 1);
   luaL_setfuncs(L, mesh_funcs, 0);
 }
