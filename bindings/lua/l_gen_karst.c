@@ -52,7 +52,7 @@ static oc_vec3 *read_sinks(oclua_fields *f, size_t *n) {
   oc_vec3 *v = lua_newuserdatauv(L, (size_t)(len ? len : 1) * sizeof *v, 0);
   for (lua_Integer i = 1; i <= len; i++) {
     lua_geti(L, at, i);
-    v[i - 1] = oclua_tovec(L, -1, FNAME, "'sinks'", i);
+    v[i - 1] = oclua_tovec(L, -1, FNAME, "sinks", i);
     lua_pop(L, 1);
   }
   lua_replace(L, at); /* keep the array alive in the table's slot */

@@ -33,7 +33,6 @@
 #define MAX_CELLS (1 << 20)   /* per axis, as the lib allows */
 #define DEFAULT_STEPS 6
 #define MAX_STEPS 64
-#define MAX_STOPS 65536
 
 static void mesh_release(oclua_handle *h) {
   oclua_mesh *u = (oclua_mesh *)h;
@@ -76,58 +75,10 @@ static const char *const rgb_names[3] = {"r", "g", "b"};
 
 static void read_palette(const oclua_fields *cf, colors *c) {
   lua_State *L = cf->L;
-  const char *what = "must be an array of {value, {r, g, b}}";
-  double *stops;
-  lua_Integer n;
-  int pal;
   if (oclua_field_push(cf, "palette") == LUA_TNIL)
     oclua_field_missing(cf, "palette", "an array of {value, {r, g, b}}");
-  pal = lua_gettop(L);
-  n = lua_istable(L, pal) ? (lua_Integer)lua_rawlen(L, pal) : 0;
-  if (n < 1) oclua_field_error(cf, "palette", pal, what);
-  if (n > MAX_STOPS)
-    oclua_error(L, cf->fname, "'colors.palette' has %I stops (at most %d)",
-                (LUAI_UACINT)n, MAX_STOPS);
-  stops = lua_newuserdatauv(L, (size_t)n * 4 * sizeof *stops, 0);
-  for (lua_Integer k = 1; k <= n; k++) {
-    double *s = stops + 4 * (k - 1);
-    lua_geti(L, pal, k);
-    if (!lua_istable(L, -1) || lua_rawlen(L, -1) != 2)
-      oclua_error(L, cf->fname,
-                  "'colors.palette[%I]' must be {value, {r, g, b}} (got %s)",
-                  (LUAI_UACINT)k, oclua_got(L, -1));
-    if (lua_geti(L, -1, 1) != LUA_TNUMBER || !isfinite(lua_tonumber(L, -1)))
-      oclua_error(L, cf->fname,
-                  "'colors.palette[%I]' value must be a finite number "
-                  "(got %s)",
-                  (LUAI_UACINT)k, oclua_got(L, -1));
-    s[0] = lua_tonumber(L, -1);
-    lua_pop(L, 1);
-    if (k > 1 && s[0] < s[-4])
-      oclua_error(L, cf->fname,
-                  "'colors.palette' values must be in ascending order "
-                  "(item %I: %f after %f)",
-                  (LUAI_UACINT)k, (LUAI_UACNUMBER)s[0], (LUAI_UACNUMBER)s[-4]);
-    if (lua_geti(L, -1, 2) != LUA_TTABLE || lua_rawlen(L, -1) != 3)
-      oclua_error(L, cf->fname,
-                  "'colors.palette[%I]' colour must be {r, g, b} (got %s)",
-                  (LUAI_UACINT)k, oclua_got(L, -1));
-    for (int j = 0; j < 3; j++) {
-      double x;
-      int t = lua_geti(L, -1, j + 1);
-      x = lua_tonumber(L, -1);
-      if (t != LUA_TNUMBER || !(x >= 0 && x <= 1))
-        oclua_error(L, cf->fname,
-                    "'colors.palette[%I]' colour components must be in "
-                    "[0, 1] (got %s = %s)",
-                    (LUAI_UACINT)k, rgb_names[j], oclua_got(L, -1));
-      s[1 + j] = x;
-      lua_pop(L, 1);
-    }
-    lua_pop(L, 2);
-  }
-  c->stops = stops;
-  c->nstops = (int)n;
+  const char *label = lua_pushfstring(L, "%spalette", cf->prefix);
+  c->stops = oclua_read_palette(L, -2, cf->fname, label, &c->nstops);
 }
 
 /* Reads the optional `colors` field of f, leaving what it needs on the

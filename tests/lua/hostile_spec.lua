@@ -367,6 +367,27 @@ describe("hostile scripts", function()
     end)
   end)
 
+  describe("messages from nested options", function()
+    it("name the exact field path", function()
+      local pal = {{0, {0, 0, 0}}, {1, {2, 0, 0}}}
+      R.check_error(function() oc.render(ball, {size = {4, 4}, color = {field = ball, palette = pal}}) end,
+        F, "outcrop.render", "'color.palette[2]' colour components must be in [0, 1] (got r = 2)")
+      R.check_error(function() oc.polygonize(ball, {colors = {field = ball, palette = {pal[1], "x"}}}) end,
+        F, "outcrop.polygonize", "'colors.palette[2]' must be {value, {r, g, b}} (got string)")
+      R.check_error(function() oc.render(ball, {camera = {[true] = 1}}) end,
+        F, "outcrop.render", "unexpected key of type boolean of 'camera'")
+      R.check_error(function() oc.render(ball, {camera = {1, 2}}) end,
+        F, "outcrop.render", "unexpected array item [1] of 'camera'", "camera.eye = ...")
+      R.check_error(function() oc.transform(ball, {rotate = {1, 2, nil, 4}}) end,
+        F, "outcrop.transform", "the array part of 'rotate' must be a sequence")
+      R.check_error(function() oc.transform(ball, {rotate = {axis = {0, 0, "x"}, angle = 1}}) end,
+        F, "outcrop.transform", "'rotate.axis' must be a table of 3 numbers (item 3 is string)")
+      local hf = small_hf()
+      R.check_error(function() oc.generate.karst{heightfield = hf, sinks = {{1, 2, 3}, {1, "x", 3}}} end,
+        F, "outcrop.generate.karst", "'sinks[2]' must be a table of 3 numbers (item 2 is string)")
+    end)
+  end)
+
   describe("protected metatables", function()
     it("hide every metatable the module makes", function()
       local objs = {
