@@ -184,7 +184,58 @@ describe("hostile scripts", function()
     end)
   end)
 
+  describe("generators", function()
+    it("keep the grid and nodes their options drop or close", function()
+      local hf = oc.heightfield.fbm{size = {17, 17}, amplitude = 4, wavelength = 8, seed = 2}
+      local opts = {heightfield = hf, terrain = oc.terrain(hf, {falloff = 2}),
+                    geology = oc.geology.strata{wavelength = 5, seed = 9}}
+      setmetatable(opts, {__index = function(t)
+        rawset(t, "terrain", nil)
+        rawset(t, "geology", nil)
+        close(hf)
+        collectgarbage()
+      end})
+      local n, info = oc.generate.sea(opts)
+      assert.are.equal("blend", n:kind())
+      assert.is_true(info.columns > 0)
+      R.check_error(function() return hf:size() end, F, "heightfield:size", "the heightfield was closed")
+    end)
+  end)
+
   describe("callbacks that close things", function()
+    it("a finalizer run by collectgarbage() in a colour function", function()
+      local m = oc.polygonize(ball, {resolution = {6, 6, 6}})
+      local armed = true
+      local ok = m:write(dir .. "/g.ply", {colors = function()
+        if armed then
+          armed = false
+          setmetatable({}, {__gc = function() close(m) end})
+          collectgarbage()
+        end
+        return 1, 1, 1
+      end})
+      assert.is_true(ok)
+      assert.are.equal("outcrop.mesh: (closed)", tostring(m))
+    end)
+
+    it("a coroutine abandoned in an error keeps its pins until it goes", function()
+      local hf = small_hf()
+      local co = coroutine.create(function()
+        return hf:save(dir .. "/c.png", setmetatable({}, {__index = function()
+          error("stop here")
+        end}))
+      end)
+      local ok, err = coroutine.resume(co)
+      assert.is_false(ok)
+      assert.matches("stop here", err)
+      close(hf) -- deferred: the dead coroutine's stack still pins it
+      R.check_error(function() return hf:size() end, F, "heightfield:size", "the heightfield was closed")
+      assert.is_true(coroutine.close(co) == false) -- closes the pin, frees the grid
+      co = nil
+      collectgarbage()
+      assert.are.equal("outcrop.heightfield: (closed)", tostring(hf))
+    end)
+
     it("mesh:write with a colour function closing the mesh", function()
       local m = oc.polygonize(ball, {resolution = {6, 6, 6}})
       local n = 0

@@ -6,6 +6,7 @@ local Fs = require "helpers.files"
 local read_file = Fs.read_file
 local listdir = Fs.listdir
 local R = require "helpers.ref"
+require "helpers.gcstress" -- OUTCROP_GC_STRESS: eager collector
 
 local F = "mesh_spec.lua"
 local function check(f, fname, ...) return R.check_error(f, F, fname, ...) end
