@@ -126,9 +126,10 @@ check-lua: $(MODULE)
 
 # The specs that exercise lifetimes and callbacks once more with the
 # collector at its most aggressive (tests/lua/helpers/gcstress.lua), as
-# luv's CI does: a use after free shows at once.
-GC_SPECS := hostile_spec.lua gc_spec.lua mesh_spec.lua heightfield_spec.lua \
-  render_spec.lua
+# luv's CI does: a use after free shows at once. About 6 minutes under
+# the sanitizer; heightfield_spec passes too but adds 4 more (its
+# callbacks are in hostile_spec): GC_SPECS="..." to choose.
+GC_SPECS := hostile_spec.lua gc_spec.lua mesh_spec.lua render_spec.lua
 
 check-lua-gc: $(MODULE)
 	@echo "== busted specs, eager collector ($(B))"
