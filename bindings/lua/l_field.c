@@ -6,9 +6,29 @@
 #include <math.h>
 
 #include "l_field.h"
+#include "l_handle.h"
+
+#define PROGRAM_BOX "outcrop.program"
+
+/* A program box: the program, and the node userdata (its user value, so
+** that the node's memory outlives the box) whose cache it may be. */
+typedef struct program_box {
+  oc_program *prog;
+  oclua_node *owner;
+} program_box;
+
+static int box_gc(lua_State *L) {
+  program_box *b = luaL_checkudata(L, 1, PROGRAM_BOX);
+  if (b->prog) {
+    if (b->owner && b->owner->prog == b->prog) b->owner->prog = NULL;
+    oc_program_free(b->prog);
+  }
+  b->prog = NULL;
+  return 0;
+}
 
 oclua_node *oclua_newnode(lua_State *L) {
-  oclua_node *u = lua_newuserdatauv(L, sizeof *u, 0);
+  oclua_node *u = lua_newuserdatauv(L, sizeof *u, 1);
   u->node = NULL;
   u->prog = NULL;
   u->threshold = 0;
@@ -62,16 +82,30 @@ const oc_program *oclua_program_at(lua_State *L, int idx, const char *fname,
   oclua_node *u = luaL_checkudata(L, idx, OCLUA_NODE);
   oc_compile_options opts = {t, 0};
   oc_error err = {OC_OK, ""};
+  idx = lua_absindex(L, idx);
   if (u->node == NULL) oclua_error(L, fname, "the node was collected");
-  if (u->prog && u->threshold == t) return u->prog;
-  if (u->prog) {
-    oc_program_free(u->prog);
-    u->prog = NULL;
+  if (u->prog && u->threshold == t) {
+    lua_getiuservalue(L, idx, 1);
+    return u->prog;
   }
-  u->prog = oc_compile(u->node, &opts, &err);
-  if (u->prog == NULL) oclua_liberror(L, fname, &err);
+  /* The box before the program, so a raised error cannot leak it; its
+  ** allocation may run finalizers, which may recompile this node: the
+  ** cache is replaced only below. */
+  program_box *b = lua_newuserdatauv(L, sizeof *b, 1);
+  b->prog = NULL;
+  b->owner = NULL;
+  luaL_setmetatable(L, PROGRAM_BOX);
+  lua_pushvalue(L, idx);
+  lua_setiuservalue(L, -2, 1);
+  if (u->node == NULL) oclua_error(L, fname, "the node was collected");
+  b->prog = oc_compile(u->node, &opts, &err);
+  if (b->prog == NULL) oclua_liberror(L, fname, &err);
+  b->owner = u;
+  lua_pushvalue(L, -1);
+  lua_setiuservalue(L, idx, 1); /* the old box goes to the collector */
+  u->prog = b->prog;
   u->threshold = t;
-  return u->prog;
+  return b->prog;
 }
 
 /* ---- queries --------------------------------------------------------- */
@@ -172,8 +206,8 @@ static int node_kind(lua_State *L) {
 
 static int node_gc(lua_State *L) {
   oclua_node *u = luaL_checkudata(L, 1, OCLUA_NODE);
-  /* Cleared so a resurrected userdata reads as collected, not freed. */
-  if (u->prog) oc_program_free(u->prog);
+  /* Cleared so a resurrected userdata reads as collected, not freed; the
+  ** program is its box's to free (it holds its own node references). */
   if (u->node) oc_node_release(u->node);
   u->prog = NULL;
   u->node = NULL;
@@ -198,16 +232,13 @@ static const luaL_Reg node_methods[] = {{"eval", node_eval},
                                         {NULL, NULL}};
 
 static const luaL_Reg node_meta[] = {
-    {"__gc", node_gc},
-    {"__tostring", node_tostring},
-    {"__index", NULL}, /* placeholder, set to the method table */
-    {NULL, NULL}};
+    {"__gc", node_gc}, {"__tostring", node_tostring}, {NULL, NULL}};
 
 void oclua_open_field(lua_State *L) {
-  luaL_newmetatable(L, OCLUA_NODE);
-  luaL_setfuncs(L, node_meta, 0);
+  static const luaL_Reg box_meta[] = {{"__gc", box_gc}, {NULL, NULL}};
+  oclua_newmeta(L, PROGRAM_BOX, box_meta, NULL);
+  lua_pop(L, 1);
+  oclua_newmeta(L, OCLUA_NODE, node_meta, node_methods);
   luaL_setfuncs(L, oclua_node_operators, 0);
-  luaL_newlib(L, node_methods);
-  lua_setfield(L, -2, "__index");
   lua_pop(L, 1);
 }

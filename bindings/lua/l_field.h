@@ -7,6 +7,15 @@
 ** frees a node still in a tree. Queries compile the node lazily with the
 ** current outcrop.threshold and keep the program until the threshold
 ** changes or the userdata is collected.
+**
+** A node cannot be closed, only collected: a call keeps the nodes it uses
+** reachable from its stack (the argument, or a field value it leaves
+** pushed) until the library has retained them. A program lives in its own
+** userdata (a "program box", the node's user value while it is the
+** cache), which every caller of oclua_program_at keeps on its stack: a
+** callback or a finalizer that changes outcrop.threshold and recompiles
+** the node only replaces the cache, and the program in use is freed by
+** the collector once the call is over.
 */
 #ifndef L_FIELD_H
 #define L_FIELD_H
@@ -16,8 +25,8 @@
 #define OCLUA_NODE "outcrop.node"
 
 typedef struct oclua_node {
-  oc_node *node;    /* NULL only while a constructor is running */
-  oc_program *prog; /* compiled by the first query; NULL until then */
+  oc_node *node;    /* NULL while a constructor runs, and once collected */
+  oc_program *prog; /* the cached program (owned by its box), or NULL */
   double threshold; /* T that prog was compiled with */
 } oclua_node;
 
@@ -36,7 +45,9 @@ oc_node *oclua_checknode(lua_State *L, int idx, const char *fname,
 
 /* The current outcrop.threshold, checked to be a positive number. */
 double oclua_threshold(lua_State *L, const char *fname);
-/* The node at idx compiled with the current threshold (cached). */
+/* The node at idx compiled with the current threshold (cached). Pushes
+** the program's box, which keeps the program alive while it is on the
+** stack. */
 const oc_program *oclua_program(lua_State *L, int idx, const char *fname);
 /* The same with threshold t (t > 0); the cache then holds that program
 ** until a query with another threshold replaces it. */

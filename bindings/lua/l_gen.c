@@ -13,17 +13,29 @@
 #include <math.h>
 #include <string.h>
 
+#include "l_gen.h"
+#include "l_handle.h"
 #include "l_heightfield.h"
 #include "l_progress.h"
-#include "l_gen.h"
 
 typedef struct oclua_points {
-  oc_samples *s; /* NULL while being made, or once closed */
+  oclua_handle h; /* first: pins and closing (l_handle.h) */
+  oc_samples *s;  /* NULL while being made, or once freed */
 } oclua_points;
 
-static oclua_points *checkpoints(lua_State *L, const char *fname) {
+static void points_release(oclua_handle *h) {
+  oclua_points *u = (oclua_points *)h;
+  oc_samples_free(u->s);
+  u->s = NULL;
+}
+
+/* The point set at 1, open; pinned for the rest of the call when pin is
+** set. */
+static oclua_points *checkpoints(lua_State *L, const char *fname, int pin) {
   oclua_points *u = luaL_checkudata(L, 1, OCLUA_POINTS);
-  if (u->s == NULL) oclua_error(L, fname, "the point set is closed");
+  oclua_handle_check(L, &u->h, fname);
+  if (u->s == NULL) oclua_error(L, fname, "the point set is not made");
+  if (pin) oclua_pin(L, 1, &u->h, fname);
   return u;
 }
 
@@ -125,11 +137,11 @@ static int sample(lua_State *L, int d) {
       D.fn = lua_gettop(L);
       pp.density = density_fn;
     } else if (t != LUA_TNIL) {
-      D.hf = oclua_testheightfield(L, -1);
-      if (D.hf == NULL)
+      if (!oclua_isheightfield(L, -1))
         oclua_field_error(&f, "density", -1,
                           "must be a function (x, y) -> [0, 1] or a "
                           "heightfield");
+      D.hf = oclua_pinheightfield(L, -1, fname);
       pp.density = density_hf;
     }
     pp.density_ud = &D;
@@ -141,6 +153,7 @@ static int sample(lua_State *L, int d) {
   luaL_checkstack(L, 8, NULL);
   /* The userdata first, so that nothing can leak once the set exists. */
   oclua_points *u = lua_newuserdatauv(L, sizeof *u, 0);
+  oclua_handle_init(&u->h, "point set", points_release);
   u->s = NULL;
   luaL_setmetatable(L, OCLUA_POINTS);
   pp.progress = oclua_progress_start(L, &pl, fname);
@@ -175,25 +188,26 @@ static int l_poisson3d(lua_State *L) {
 static int points_count(lua_State *L) {
   oclua_checkargs(L, 1, "points:count", "()");
   lua_pushinteger(
-      L, (lua_Integer)oc_samples_count(checkpoints(L, "points:count")->s));
+      L, (lua_Integer)oc_samples_count(checkpoints(L, "points:count", 0)->s));
   return 1;
 }
 
 static int points_len(lua_State *L) {
   oclua_points *u = luaL_checkudata(L, 1, OCLUA_POINTS);
-  lua_pushinteger(L, u->s ? (lua_Integer)oc_samples_count(u->s) : 0);
+  lua_pushinteger(L, u->s && !u->h.closed ? (lua_Integer)oc_samples_count(u->s)
+                                          : 0);
   return 1;
 }
 
 static int points_dim(lua_State *L) {
   oclua_checkargs(L, 1, "points:dim", "()");
-  lua_pushinteger(L, oc_samples_dim(checkpoints(L, "points:dim")->s));
+  lua_pushinteger(L, oc_samples_dim(checkpoints(L, "points:dim", 0)->s));
   return 1;
 }
 
 static int points_get(lua_State *L) {
   const char *fname = "points:get";
-  const oc_samples *s = checkpoints(L, fname)->s;
+  const oc_samples *s = checkpoints(L, fname, 0)->s;
   size_t n = oc_samples_count(s);
   int isint, d = oc_samples_dim(s);
   lua_Integer i = lua_tointegerx(L, 2, &isint);
@@ -210,20 +224,18 @@ static int points_get(lua_State *L) {
 
 static int points_table(lua_State *L) {
   oclua_checkargs(L, 1, "points:table", "()");
-  push_table(L, checkpoints(L, "points:table")->s);
+  push_table(L, checkpoints(L, "points:table", 1)->s);
   return 1;
 }
 
 static int points_gc(lua_State *L) {
-  oclua_points *u = luaL_checkudata(L, 1, OCLUA_POINTS);
-  oc_samples_free(u->s);
-  u->s = NULL;
+  oclua_handle_close(luaL_checkudata(L, 1, OCLUA_POINTS));
   return 0;
 }
 
 static int points_tostring(lua_State *L) {
   oclua_points *u = luaL_checkudata(L, 1, OCLUA_POINTS);
-  if (u->s == NULL)
+  if (u->s == NULL || u->h.closed)
     lua_pushliteral(L, OCLUA_POINTS ": (closed)");
   else
     lua_pushfstring(L, OCLUA_POINTS ": %I points in %dD",
@@ -238,19 +250,18 @@ static const luaL_Reg points_methods[] = {{"count", points_count},
                                           {NULL, NULL}};
 
 static const luaL_Reg points_meta[] = {
-    {"__gc", points_gc},   {"__close", points_gc}, /* `local p <close>` frees
-                                                      the points early */
-    {"__len", points_len}, {"__tostring", points_tostring}, {"__index", NULL},
+    {"__gc", points_gc},
+    {"__close", points_gc}, /* `local p <close>` frees
+                               the points early */
+    {"__len", points_len},
+    {"__tostring", points_tostring},
     {NULL, NULL}};
 
 static const luaL_Reg sample_funcs[] = {
     {"poisson2d", l_poisson2d}, {"poisson3d", l_poisson3d}, {NULL, NULL}};
 
 void oclua_open_gen(lua_State *L) {
-  luaL_newmetatable(L, OCLUA_POINTS);
-  luaL_setfuncs(L, points_meta, 0);
-  luaL_newlib(L, points_methods);
-  lua_setfield(L, -2, "__index");
+  oclua_newmeta(L, OCLUA_POINTS, points_meta, points_methods);
   lua_pop(L, 1);
   luaL_setfuncs(L, sample_funcs, 0);
   lua_createtable(L, 0, 4);

@@ -75,7 +75,8 @@ static oc_node *optnode(oclua_fields *f, const char *name, int *off) {
                         off ? "must be a node or false" : "must be a node");
     n = u->node;
   }
-  lua_pop(L, 1); /* the table keeps the node alive */
+  /* The value stays on the stack until the generator has run: an __index
+  ** may have made it, or a finalizer drop it from the table. */
   return n;
 }
 
@@ -98,9 +99,10 @@ static int l_hoodoos(lua_State *L) {
   oclua_fields_open(&f, L, 1, FNAME, NULL, known, 0);
   if (oclua_field_push(&f, "heightfield") == LUA_TNIL)
     oclua_field_missing(&f, "heightfield", "a heightfield");
-  oc_heightfield *hf = oclua_testheightfield(L, -1);
-  if (!hf) oclua_field_error(&f, "heightfield", -1, "must be a heightfield");
-  lua_pop(L, 1);
+  if (!oclua_isheightfield(L, -1))
+    oclua_field_error(&f, "heightfield", -1, "must be a heightfield");
+  /* pinned, with the value, until the generator has run */
+  oc_heightfield *hf = oclua_pinheightfield(L, -1, FNAME);
   oc_gen_hoodoos_defaults(&p, hf);
   int no_terrain = 0;
   p.terrain = optnode(&f, "terrain", &no_terrain);
@@ -111,11 +113,11 @@ static int l_hoodoos(lua_State *L) {
     p.mask_fn = mask_fn;
     p.mask_ud = &M;
   } else if (t != LUA_TNIL) {
-    if (!(p.mask = oclua_testheightfield(L, -1)))
+    if (!oclua_isheightfield(L, -1))
       oclua_field_error(&f, "mask", -1,
                         "must be a heightfield or a function (x, y) -> "
                         "[0, 1]");
-    lua_pop(L, 1);
+    p.mask = oclua_pinheightfield(L, -1, FNAME);
   } else {
     lua_pop(L, 1);
   }

@@ -52,7 +52,7 @@ static oc_vec3 *read_sinks(oclua_fields *f, size_t *n) {
   oc_vec3 *v = lua_newuserdatauv(L, (size_t)(len ? len : 1) * sizeof *v, 0);
   for (lua_Integer i = 1; i <= len; i++) {
     lua_geti(L, at, i);
-    v[i - 1] = oclua_tovec(L, -1, FNAME, "'sinks'", i);
+    v[i - 1] = oclua_tovec(L, -1, FNAME, "sinks", i);
     lua_pop(L, 1);
   }
   lua_replace(L, at); /* keep the array alive in the table's slot */
@@ -74,10 +74,12 @@ static int l_karst(lua_State *L) {
   oc_gen_karst_defaults(&p);
   if (oclua_field_push(&f, "heightfield") == LUA_TNIL)
     oclua_field_missing(&f, "heightfield", "a heightfield");
-  p.heightfield = oclua_testheightfield(L, -1);
-  if (!p.heightfield)
+  if (!oclua_isheightfield(L, -1))
     oclua_field_error(&f, "heightfield", -1, "must be a heightfield");
-  lua_pop(L, 1);
+  /* Values read stay on the stack, and the grid pinned, until the
+  ** generator has run: an __index may have made them, or a finalizer
+  ** drop them from the table or close the grid. */
+  p.heightfield = oclua_pinheightfield(L, -1, FNAME);
   int own_terrain = 1;
   int t = oclua_field_push(&f, "terrain");
   if (t == LUA_TBOOLEAN && !lua_toboolean(L, -1))
@@ -88,13 +90,11 @@ static int l_karst(lua_State *L) {
     p.terrain = u->node;
     own_terrain = 0;
   }
-  lua_pop(L, 1);
   if (oclua_field_push(&f, "geology") != LUA_TNIL) {
     oclua_node *u = oclua_testnode(L, -1);
     if (!u) oclua_field_error(&f, "geology", -1, "must be a node");
     p.geology = u->node;
   }
-  lua_pop(L, 1);
   p.sinks = read_sinks(&f, &p.nsinks);
   p.seed = oclua_field_seed(&f, "seed");
   p.radius = oclua_field_optnumber(&f, "radius", OCLUA_POSITIVE, 0);

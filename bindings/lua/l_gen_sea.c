@@ -45,7 +45,9 @@ typedef struct common {
   int steps, no_terrain;
 } common;
 
-/* A node or nil; false sets *nofalse when nofalse is not NULL. */
+/* A node or nil; false sets *nofalse when nofalse is not NULL. The value
+** stays on the stack (an __index may have made it, or a finalizer drop
+** it from the table) until the generator has retained the node. */
 static oc_node *optnode(oclua_fields *f, const char *name, int *nofalse) {
   oc_node *n = NULL;
   int t = oclua_field_push(f, name);
@@ -58,7 +60,6 @@ static oc_node *optnode(oclua_fields *f, const char *name, int *nofalse) {
                         nofalse ? "must be a node or false" : "must be a node");
     n = u->node;
   }
-  lua_pop(f->L, 1); /* the table keeps the node alive */
   return n;
 }
 
@@ -66,9 +67,9 @@ static void read_common(oclua_fields *f, common *c, int steps,
                         double strength) {
   if (oclua_field_push(f, "heightfield") == LUA_TNIL)
     oclua_field_missing(f, "heightfield", "a heightfield");
-  c->hf = oclua_testheightfield(f->L, -1);
-  if (!c->hf) oclua_field_error(f, "heightfield", -1, "must be a heightfield");
-  lua_pop(f->L, 1);
+  if (!oclua_isheightfield(f->L, -1))
+    oclua_field_error(f, "heightfield", -1, "must be a heightfield");
+  c->hf = oclua_pinheightfield(f->L, -1, f->fname); /* value and pin stay */
   c->no_terrain = 0;
   c->terrain = optnode(f, "terrain", &c->no_terrain);
   c->geology = optnode(f, "geology", NULL);

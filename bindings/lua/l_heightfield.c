@@ -28,24 +28,41 @@
 #define MAX_SIDE 65535
 #define DEFAULT_OCTAVES 6
 
+static void hf_release(oclua_handle *h) {
+  oclua_heightfield *u = (oclua_heightfield *)h;
+  oc_heightfield_release(u->hf);
+  u->hf = NULL;
+}
+
 oclua_heightfield *oclua_newheightfield(lua_State *L) {
   oclua_heightfield *u = lua_newuserdatauv(L, sizeof *u, 0);
+  oclua_handle_init(&u->h, "heightfield", hf_release);
   u->hf = NULL;
   luaL_setmetatable(L, OCLUA_HEIGHTFIELD);
   return u;
 }
 
-oc_heightfield *oclua_testheightfield(lua_State *L, int idx) {
+int oclua_isheightfield(lua_State *L, int idx) {
+  return luaL_testudata(L, idx, OCLUA_HEIGHTFIELD) != NULL;
+}
+
+static oclua_heightfield *checkhf(lua_State *L, int idx, const char *fname) {
   oclua_heightfield *u = luaL_testudata(L, idx, OCLUA_HEIGHTFIELD);
-  return u ? u->hf : NULL;
+  if (u == NULL)
+    oclua_error(L, fname, "expected a heightfield (got %s)", oclua_got(L, idx));
+  oclua_handle_check(L, &u->h, fname);
+  if (u->hf == NULL) oclua_error(L, fname, "the heightfield is not made");
+  return u;
 }
 
 oc_heightfield *oclua_checkheightfield(lua_State *L, int idx,
                                        const char *fname) {
-  oclua_heightfield *u = luaL_testudata(L, idx, OCLUA_HEIGHTFIELD);
-  if (u == NULL)
-    oclua_error(L, fname, "expected a heightfield (got %s)", oclua_got(L, idx));
-  if (u->hf == NULL) oclua_error(L, fname, "the heightfield is closed");
+  return checkhf(L, idx, fname)->hf;
+}
+
+oc_heightfield *oclua_pinheightfield(lua_State *L, int idx, const char *fname) {
+  oclua_heightfield *u = checkhf(L, idx, fname);
+  oclua_pin(L, idx, &u->h, fname);
   return u->hf;
 }
 
@@ -379,6 +396,7 @@ static int hf_resample(lua_State *L) {
   oc_hf_grid g;
   oclua_progress pl;
   oclua_checkargs(L, 2, fname, "{cell = or size =}");
+  hf = oclua_pinheightfield(L, 1, fname);
   oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
   double c = oc_heightfield_cell(hf);
   double wx = (oc_heightfield_nx(hf) - 1) * c,
@@ -438,6 +456,7 @@ static int hf_crop(lua_State *L) {
   int nx = oc_heightfield_nx(hf), ny = oc_heightfield_ny(hf), ij[4];
   double box[4];
   oclua_checkargs(L, 2, fname, "{i0, j0, i1, j1} or {box = {x0, y0, x1, y1}}");
+  hf = oclua_pinheightfield(L, 1, fname);
   oclua_fields_open(&f, L, 2, fname, NULL, known, 1);
   int hasbox =
       oclua_field_numbers(&f, "box", 4, box, "must be {x0, y0, x1, y1}");
@@ -517,6 +536,7 @@ static int hf_save(lua_State *L) {
   oclua_checkargs(L, 3, fname,
                   "(path [, {bits =, scale =, offset =, palette =}])");
   opt_table(L, 3);
+  hf = oclua_pinheightfield(L, 1, fname);
   oclua_fields_open(&f, L, 3, fname, NULL, known, 0);
   int pt = oclua_field_push(&f, "palette");
   if (pt == LUA_TBOOLEAN && lua_toboolean(L, -1)) {
@@ -569,15 +589,13 @@ static int hf_save(lua_State *L) {
 /* ---- metamethods --------------------------------------------------------- */
 
 static int hf_gc(lua_State *L) {
-  oclua_heightfield *u = luaL_checkudata(L, 1, OCLUA_HEIGHTFIELD);
-  oc_heightfield_release(u->hf);
-  u->hf = NULL;
+  oclua_handle_close(luaL_checkudata(L, 1, OCLUA_HEIGHTFIELD));
   return 0;
 }
 
 static int hf_tostring(lua_State *L) {
   oclua_heightfield *u = luaL_checkudata(L, 1, OCLUA_HEIGHTFIELD);
-  if (u->hf == NULL) {
+  if (u->hf == NULL || u->h.closed) {
     lua_pushliteral(L, OCLUA_HEIGHTFIELD ": (closed)");
     return 1;
   }
@@ -606,19 +624,16 @@ static const luaL_Reg hf_meta[] = {
     {"__gc", hf_gc},
     {"__close", hf_gc}, /* `local hf <close>` frees the samples early */
     {"__tostring", hf_tostring},
-    {"__index", NULL},
     {NULL, NULL}};
 
 static const luaL_Reg hf_funcs[] = {
     {"load", l_load}, {"fbm", l_fbm}, {"from", l_from}, {NULL, NULL}};
 
 void oclua_open_heightfield(lua_State *L) {
-  luaL_newmetatable(L, OCLUA_HEIGHTFIELD);
-  luaL_setfuncs(L, hf_meta, 0);
-  luaL_newlib(L, hf_methods);
+  oclua_newmeta(L, OCLUA_HEIGHTFIELD, hf_meta, hf_methods);
+  lua_getfield(L, -1, "__index");
   luaL_setfuncs(L, oclua_heightfield_analysis, 0);
-  lua_setfield(L, -2, "__index");
-  lua_pop(L, 1);
+  lua_pop(L, 2);
   luaL_newlib(L, hf_funcs);
   lua_setfield(L, -2, "heightfield");
 }

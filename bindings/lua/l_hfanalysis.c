@@ -40,19 +40,21 @@ static void open_options(lua_State *L, oclua_fields *f, const char *fname,
 
 static int hf_slope(lua_State *L) {
   const char *fname = "heightfield:slope";
-  oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
+  oclua_checkheightfield(L, 1, fname); /* the message before the options */
   oc_error err = {OC_OK, ""};
   oclua_checkargs(L, 1, fname, "()");
+  oc_heightfield *hf = oclua_pinheightfield(L, 1, fname);
   oclua_heightfield *u = oclua_newheightfield(L);
   return oclua_sethf(L, u, oc_hf_slope(hf, &err), &err, fname);
 }
 
 static int hf_filled(lua_State *L) {
   const char *fname = "heightfield:filled";
-  oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
+  oclua_checkheightfield(L, 1, fname); /* the message before the options */
   oc_error err = {OC_OK, ""};
   oclua_progress pl;
   oclua_checkargs(L, 1, fname, "()");
+  oc_heightfield *hf = oclua_pinheightfield(L, 1, fname);
   oclua_heightfield *u = oclua_newheightfield(L);
   oc_progress pr = oclua_progress_start(L, &pl, fname);
   oc_heightfield *r = oc_hf_fill(hf, pr, &err);
@@ -63,13 +65,14 @@ static int hf_filled(lua_State *L) {
 /* drainage and stream_power: {exponent = } */
 static int flow(lua_State *L, const char *fname, int power) {
   static const char *const known[] = {"exponent", NULL};
-  oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
+  oclua_checkheightfield(L, 1, fname); /* the message before the options */
   oc_error err = {OC_OK, ""};
   oclua_fields f;
   oclua_progress pl;
   oc_hf_flow_params fp;
   memset(&fp, 0, sizeof fp);
   open_options(L, &f, fname, known, "([{exponent = 1.1}])");
+  oc_heightfield *hf = oclua_pinheightfield(L, 1, fname);
   fp.exponent = oclua_field_optnumber(&f, "exponent", OCLUA_POSITIVE,
                                       OC_HF_FREEMAN_EXPONENT);
   oclua_heightfield *u = oclua_newheightfield(L);
@@ -99,15 +102,18 @@ static int sinks_box_gc(lua_State *L) {
 
 static int hf_sinks(lua_State *L) {
   const char *fname = "heightfield:sinks";
-  oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
+  oclua_checkheightfield(L, 1, fname); /* the message before the options */
   oc_error err = {OC_OK, ""};
   size_t n = 0;
   oclua_checkargs(L, 1, fname, "()");
+  oc_heightfield *hf = oclua_pinheightfield(L, 1, fname);
   oc_vec3 **box = lua_newuserdatauv(L, sizeof *box, 0);
   *box = NULL;
   if (luaL_newmetatable(L, SINKS_BOX)) {
     lua_pushcfunction(L, sinks_box_gc);
     lua_setfield(L, -2, "__gc");
+    lua_pushliteral(L, "protected");
+    lua_setfield(L, -2, "__metatable");
   }
   lua_setmetatable(L, -2);
   if (oc_hf_sinks(hf, box, &n, &err) != OC_OK) oclua_liberror(L, fname, &err);
@@ -134,7 +140,7 @@ static int hf_sinks(lua_State *L) {
 static int hf_accessibility(lua_State *L) {
   static const char *const known[] = {"rays", "distance", "seed", NULL};
   const char *fname = "heightfield:accessibility";
-  oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
+  oclua_checkheightfield(L, 1, fname); /* the message before the options */
   oc_error err = {OC_OK, ""};
   oclua_fields f;
   oclua_progress pl;
@@ -142,6 +148,7 @@ static int hf_accessibility(lua_State *L) {
   memset(&ap, 0, sizeof ap);
   open_options(L, &f, fname, known,
                "([{rays = 64, distance = 50 cells, seed = }])");
+  oc_heightfield *hf = oclua_pinheightfield(L, 1, fname);
   ap.rays = (int)oclua_field_optint(&f, "rays", 1, MAX_RAYS, DEFAULT_RAYS);
   ap.distance = oclua_field_optnumber(&f, "distance", OCLUA_POSITIVE, 0);
   ap.seed = oclua_field_seed(&f, "seed");
@@ -154,12 +161,13 @@ static int hf_accessibility(lua_State *L) {
 
 static int hf_distance_to_level(lua_State *L) {
   const char *fname = "heightfield:distance_to_level";
-  oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
+  oclua_checkheightfield(L, 1, fname); /* the message before the options */
   oc_error err = {OC_OK, ""};
   double z = lua_tonumber(L, 2);
   if (lua_type(L, 2) != LUA_TNUMBER || isnan(z))
     oclua_error(L, fname, "'z' must be a number (got %s)", oclua_got(L, 2));
   oclua_checkargs(L, 2, fname, "(z)");
+  oc_heightfield *hf = oclua_pinheightfield(L, 1, fname);
   oclua_heightfield *u = oclua_newheightfield(L);
   return oclua_sethf(L, u, oc_hf_distance_to_level(hf, z, &err), &err, fname);
 }

@@ -21,16 +21,25 @@
 #define DEFAULT_SLICE_SIZE 256
 #define MAX_SLICE_SIZE 16384
 
+static void image_release(oclua_handle *h) {
+  oclua_image *u = (oclua_image *)h;
+  if (u->img) oc_image_free(u->img);
+  u->img = NULL;
+}
+
 oclua_image *oclua_newimage(lua_State *L) {
   oclua_image *u = lua_newuserdatauv(L, sizeof *u, 0);
+  oclua_handle_init(&u->h, "image", image_release);
   u->img = NULL;
   luaL_setmetatable(L, OCLUA_IMAGE);
   return u;
 }
 
-oc_image *oclua_checkimage(lua_State *L, int idx, const char *fname) {
+oc_image *oclua_checkimage(lua_State *L, int idx, const char *fname, int pin) {
   oclua_image *u = luaL_checkudata(L, idx, OCLUA_IMAGE);
-  if (u->img == NULL) oclua_error(L, fname, "the image is closed");
+  oclua_handle_check(L, &u->h, fname);
+  if (u->img == NULL) oclua_error(L, fname, "the image is not made");
+  if (pin) oclua_pin(L, idx, &u->h, fname);
   return u->img;
 }
 
@@ -95,7 +104,7 @@ static void set_user_meta(const oclua_fields *f, oc_image *img) {
 static int image_write(lua_State *L) {
   static const char *const known[] = {"bits", "meta", NULL};
   const char *fname = "image:write";
-  oc_image *img = oclua_checkimage(L, 1, fname);
+  oclua_checkimage(L, 1, fname, 0);
   oc_error err = {OC_OK, ""};
   int bits = 0;
   if (lua_type(L, 2) != LUA_TSTRING)
@@ -103,6 +112,7 @@ static int image_write(lua_State *L) {
                 oclua_got(L, 2));
   oclua_checkargs(L, 3, fname, "(path [, {bits = 8, 16 or 32, meta = {}}])");
   lua_settop(L, 3);
+  oc_image *img = oclua_checkimage(L, 1, fname, 1);
   oclua_stamp_provenance(L, img);
   if (!lua_isnil(L, 3)) {
     oclua_fields f;
@@ -132,22 +142,22 @@ static int image_write(lua_State *L) {
 }
 
 static int image_size(lua_State *L) {
-  oc_image *img = oclua_checkimage(L, 1, "image:size");
+  oc_image *img = oclua_checkimage(L, 1, "image:size", 0);
   lua_pushinteger(L, oc_image_width(img));
   lua_pushinteger(L, oc_image_height(img));
   return 2;
 }
 
 static int image_channels(lua_State *L) {
-  lua_pushinteger(L,
-                  oc_image_channels(oclua_checkimage(L, 1, "image:channels")));
+  lua_pushinteger(
+      L, oc_image_channels(oclua_checkimage(L, 1, "image:channels", 0)));
   return 1;
 }
 
 /* get(i, j): column i from the left, row j from the top, both 1-based. */
 static int image_get(lua_State *L) {
   const char *fname = "image:get";
-  const oc_image *img = oclua_checkimage(L, 1, fname);
+  const oc_image *img = oclua_checkimage(L, 1, fname, 0);
   int w = oc_image_width(img), h = oc_image_height(img);
   int nc = oc_image_channels(img);
   lua_Integer ij[2];
@@ -171,15 +181,13 @@ static int image_get(lua_State *L) {
 }
 
 static int image_gc(lua_State *L) {
-  oclua_image *u = luaL_checkudata(L, 1, OCLUA_IMAGE);
-  if (u->img) oc_image_free(u->img);
-  u->img = NULL;
+  oclua_handle_close(luaL_checkudata(L, 1, OCLUA_IMAGE));
   return 0;
 }
 
 static int image_tostring(lua_State *L) {
   oclua_image *u = luaL_checkudata(L, 1, OCLUA_IMAGE);
-  if (u->img == NULL)
+  if (u->img == NULL || u->h.closed)
     lua_pushliteral(L, OCLUA_IMAGE ": (closed)");
   else
     lua_pushfstring(L, OCLUA_IMAGE ": %dx%d, %d channels",
@@ -282,16 +290,12 @@ static const luaL_Reg image_meta[] = {
     {"__gc", image_gc},
     {"__close", image_gc}, /* `local img <close>` frees the pixels early */
     {"__tostring", image_tostring},
-    {"__index", NULL},
     {NULL, NULL}};
 
 static const luaL_Reg image_funcs[] = {{"slice", l_slice}, {NULL, NULL}};
 
 void oclua_open_image(lua_State *L) {
-  luaL_newmetatable(L, OCLUA_IMAGE);
-  luaL_setfuncs(L, image_meta, 0);
-  luaL_newlib(L, image_methods);
-  lua_setfield(L, -2, "__index");
+  oclua_newmeta(L, OCLUA_IMAGE, image_meta, image_methods);
   lua_pop(L, 1);
   luaL_setfuncs(L, image_funcs, 0);
 }

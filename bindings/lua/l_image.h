@@ -5,19 +5,21 @@
 #ifndef L_IMAGE_H
 #define L_IMAGE_H
 
-#include "l_util.h"
+#include "l_handle.h"
 
 #define OCLUA_IMAGE "outcrop.image"
 
 typedef struct oclua_image {
-  oc_image *img; /* NULL while being made, or once closed */
+  oclua_handle h; /* first: pins and closing (l_handle.h) */
+  oc_image *img;  /* NULL while being made, or once freed */
 } oclua_image;
 
 /* Pushes an image userdata owning nothing yet: create it BEFORE making
 ** the oc_image, then store the image in it, so an error cannot leak. */
 oclua_image *oclua_newimage(lua_State *L);
-/* Raises unless idx is an open image. */
-oc_image *oclua_checkimage(lua_State *L, int idx, const char *fname);
+/* Raises unless idx is an open image; with pin set, pins it for the rest
+** of the call (oclua_pin). */
+oc_image *oclua_checkimage(lua_State *L, int idx, const char *fname, int pin);
 
 /* outcrop.slice(node, {plane =, at =, box =, size =, palette =}) under
 ** the name fname, pushing the image: with a palette (given, or `stops`

@@ -35,18 +35,27 @@
 #define MAX_CELLS (1 << 20)   /* per axis, as the lib allows */
 #define DEFAULT_STEPS 6
 #define MAX_STEPS 64
-#define MAX_STOPS 65536
+
+static void mesh_release(oclua_handle *h) {
+  oclua_mesh *u = (oclua_mesh *)h;
+  if (u->mesh) oc_mesh_free(u->mesh);
+  u->mesh = NULL;
+}
 
 static oclua_mesh *newmesh(lua_State *L) {
   oclua_mesh *u = lua_newuserdatauv(L, sizeof *u, 0);
+  oclua_handle_init(&u->h, "mesh", mesh_release);
   u->mesh = NULL;
   luaL_setmetatable(L, OCLUA_MESH);
   return u;
 }
 
-static oclua_mesh *checkmesh(lua_State *L, const char *fname) {
+/* The mesh at 1, open; pinned for the rest of the call when pin is set. */
+static oclua_mesh *checkmesh(lua_State *L, const char *fname, int pin) {
   oclua_mesh *u = luaL_checkudata(L, 1, OCLUA_MESH);
-  if (u->mesh == NULL) oclua_error(L, fname, "the mesh is closed");
+  oclua_handle_check(L, &u->h, fname);
+  if (u->mesh == NULL) oclua_error(L, fname, "the mesh is not made");
+  if (pin) oclua_pin(L, 1, &u->h, fname);
   return u;
 }
 
@@ -68,58 +77,10 @@ static const char *const rgb_names[3] = {"r", "g", "b"};
 
 static void read_palette(const oclua_fields *cf, colors *c) {
   lua_State *L = cf->L;
-  const char *what = "must be an array of {value, {r, g, b}}";
-  double *stops;
-  lua_Integer n;
-  int pal;
   if (oclua_field_push(cf, "palette") == LUA_TNIL)
     oclua_field_missing(cf, "palette", "an array of {value, {r, g, b}}");
-  pal = lua_gettop(L);
-  n = lua_istable(L, pal) ? (lua_Integer)lua_rawlen(L, pal) : 0;
-  if (n < 1) oclua_field_error(cf, "palette", pal, what);
-  if (n > MAX_STOPS)
-    oclua_error(L, cf->fname, "'colors.palette' has %I stops (at most %d)",
-                (LUAI_UACINT)n, MAX_STOPS);
-  stops = lua_newuserdatauv(L, (size_t)n * 4 * sizeof *stops, 0);
-  for (lua_Integer k = 1; k <= n; k++) {
-    double *s = stops + 4 * (k - 1);
-    lua_geti(L, pal, k);
-    if (!lua_istable(L, -1) || lua_rawlen(L, -1) != 2)
-      oclua_error(L, cf->fname,
-                  "'colors.palette[%I]' must be {value, {r, g, b}} (got %s)",
-                  (LUAI_UACINT)k, oclua_got(L, -1));
-    if (lua_geti(L, -1, 1) != LUA_TNUMBER || !isfinite(lua_tonumber(L, -1)))
-      oclua_error(L, cf->fname,
-                  "'colors.palette[%I]' value must be a finite number "
-                  "(got %s)",
-                  (LUAI_UACINT)k, oclua_got(L, -1));
-    s[0] = lua_tonumber(L, -1);
-    lua_pop(L, 1);
-    if (k > 1 && s[0] < s[-4])
-      oclua_error(L, cf->fname,
-                  "'colors.palette' values must be in ascending order "
-                  "(item %I: %f after %f)",
-                  (LUAI_UACINT)k, (LUAI_UACNUMBER)s[0], (LUAI_UACNUMBER)s[-4]);
-    if (lua_geti(L, -1, 2) != LUA_TTABLE || lua_rawlen(L, -1) != 3)
-      oclua_error(L, cf->fname,
-                  "'colors.palette[%I]' colour must be {r, g, b} (got %s)",
-                  (LUAI_UACINT)k, oclua_got(L, -1));
-    for (int j = 0; j < 3; j++) {
-      double x;
-      int t = lua_geti(L, -1, j + 1);
-      x = lua_tonumber(L, -1);
-      if (t != LUA_TNUMBER || !(x >= 0 && x <= 1))
-        oclua_error(L, cf->fname,
-                    "'colors.palette[%I]' colour components must be in "
-                    "[0, 1] (got %s = %s)",
-                    (LUAI_UACINT)k, rgb_names[j], oclua_got(L, -1));
-      s[1 + j] = x;
-      lua_pop(L, 1);
-    }
-    lua_pop(L, 2);
-  }
-  c->stops = stops;
-  c->nstops = (int)n;
+  const char *label = lua_pushfstring(L, "%spalette", cf->prefix);
+  c->stops = oclua_read_palette(L, -2, cf->fname, label, &c->nstops);
 }
 
 /* Reads the optional `colors` field of f, leaving what it needs on the
@@ -153,9 +114,9 @@ static void read_colors(const oclua_fields *f, colors *c) {
 }
 
 /* Calls the function at fn for every vertex. The function may do
-** anything, closing this very mesh included, so the mesh is looked up
-** again after each call; the colours gather in a Lua-owned buffer, so an
-** error raised in the function leaks nothing. */
+** anything, closing this very mesh included: the caller has pinned it, so
+** a close takes effect when the call returns. The colours gather in a
+** Lua-owned buffer, so an error raised in the function leaks nothing. */
 static void color_by_function(lua_State *L, oclua_mesh *u, int fn,
                               const char *fname) {
   oc_error err = {OC_OK, ""};
@@ -167,7 +128,6 @@ static void color_by_function(lua_State *L, oclua_mesh *u, int fn,
   luaL_checkstack(L, 8, NULL);
   for (size_t i = 0; i < nv; i++) {
     const float *p, *n;
-    if (u->mesh == NULL) break;
     p = oc_mesh_positions(u->mesh) + 3 * i;
     n = oc_mesh_normals(u->mesh) + 3 * i;
     lua_pushvalue(L, fn);
@@ -188,8 +148,6 @@ static void color_by_function(lua_State *L, oclua_mesh *u, int fn,
     }
     lua_pop(L, 3);
   }
-  if (u->mesh == NULL)
-    oclua_error(L, fname, "the mesh was closed by the colors function");
   if (oc_mesh_set_colors(u->mesh, rgb, &err) != OC_OK)
     oclua_liberror(L, fname, &err);
   lua_pop(L, 1);
@@ -213,7 +171,7 @@ static void apply_colors(lua_State *L, oclua_mesh *u, const colors *c,
 static int mesh_write(lua_State *L) {
   static const char *const known[] = {"colors", NULL};
   const char *fname = "mesh:write";
-  oclua_mesh *u = checkmesh(L, fname);
+  checkmesh(L, fname, 0);
   oc_error err = {OC_OK, ""};
   colors c = {COLORS_NONE, 0, NULL, 0};
   if (lua_type(L, 2) != LUA_TSTRING)
@@ -221,6 +179,7 @@ static int mesh_write(lua_State *L) {
                 oclua_got(L, 2));
   oclua_checkargs(L, 3, fname, "(path [, {colors = ...}])");
   lua_settop(L, 3);
+  oclua_mesh *u = checkmesh(L, fname, 1);
   if (!lua_isnil(L, 3)) {
     oclua_fields f;
     oclua_fields_open(&f, L, 3, fname, NULL, known, 0);
@@ -248,7 +207,7 @@ static int mesh_write(lua_State *L) {
 static int mesh_stats(lua_State *L) {
   oc_mesh_stats st;
   oclua_checkargs(L, 1, "mesh:stats", "()");
-  oc_mesh_get_stats(checkmesh(L, "mesh:stats")->mesh, &st);
+  oc_mesh_get_stats(checkmesh(L, "mesh:stats", 0)->mesh, &st);
   lua_createtable(L, 0, 5);
   lua_pushinteger(L, (lua_Integer)st.vertices);
   lua_setfield(L, -2, "vertices");
@@ -266,7 +225,7 @@ static int mesh_stats(lua_State *L) {
 static int mesh_counts(lua_State *L) {
   const oc_mesh *m;
   oclua_checkargs(L, 1, "mesh:counts", "()");
-  m = checkmesh(L, "mesh:counts")->mesh;
+  m = checkmesh(L, "mesh:counts", 0)->mesh;
   lua_pushinteger(L, (lua_Integer)oc_mesh_vertex_count(m));
   lua_pushinteger(L, (lua_Integer)oc_mesh_triangle_count(m));
   return 2;
@@ -291,7 +250,7 @@ static size_t checkindex(lua_State *L, const char *fname, const char *what,
 
 static int mesh_vertex(lua_State *L) {
   const char *fname = "mesh:vertex";
-  const oc_mesh *m = checkmesh(L, fname)->mesh;
+  const oc_mesh *m = checkmesh(L, fname, 0)->mesh;
   size_t i =
       checkindex(L, fname, "vertex", "vertices", oc_mesh_vertex_count(m));
   const float *p = oc_mesh_positions(m) + 3 * i;
@@ -305,7 +264,7 @@ static int mesh_vertex(lua_State *L) {
 
 static int mesh_triangle(lua_State *L) {
   const char *fname = "mesh:triangle";
-  const oc_mesh *m = checkmesh(L, fname)->mesh;
+  const oc_mesh *m = checkmesh(L, fname, 0)->mesh;
   size_t i =
       checkindex(L, fname, "triangle", "triangles", oc_mesh_triangle_count(m));
   const uint32_t *t = oc_mesh_indices(m) + 3 * i;
@@ -315,15 +274,13 @@ static int mesh_triangle(lua_State *L) {
 }
 
 static int mesh_gc(lua_State *L) {
-  oclua_mesh *u = luaL_checkudata(L, 1, OCLUA_MESH);
-  if (u->mesh) oc_mesh_free(u->mesh);
-  u->mesh = NULL;
+  oclua_handle_close(luaL_checkudata(L, 1, OCLUA_MESH));
   return 0;
 }
 
 static int mesh_tostring(lua_State *L) {
   oclua_mesh *u = luaL_checkudata(L, 1, OCLUA_MESH);
-  if (u->mesh == NULL)
+  if (u->mesh == NULL || u->h.closed)
     lua_pushliteral(L, OCLUA_MESH ": (closed)");
   else
     lua_pushfstring(L, OCLUA_MESH ": %I vertices, %I triangles",
@@ -458,17 +415,13 @@ static const luaL_Reg mesh_meta[] = {
     {"__gc", mesh_gc},
     {"__close", mesh_gc}, /* `local m <close>` frees the mesh early */
     {"__tostring", mesh_tostring},
-    {"__index", NULL},
     {NULL, NULL}};
 
 static const luaL_Reg mesh_funcs[] = {{"polygonize", l_polygonize},
                                       {NULL, NULL}};
 
 void oclua_open_mesh(lua_State *L) {
-  luaL_newmetatable(L, OCLUA_MESH);
-  luaL_setfuncs(L, mesh_meta, 0);
-  luaL_newlib(L, mesh_methods);
-  lua_setfield(L, -2, "__index");
+  oclua_newmeta(L, OCLUA_MESH, mesh_meta, mesh_methods);
   lua_pop(L, 1);
   luaL_setfuncs(L, mesh_funcs, 0);
 }

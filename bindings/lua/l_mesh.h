@@ -4,12 +4,13 @@
 #ifndef L_MESH_H
 #define L_MESH_H
 
-#include "l_util.h"
+#include "l_handle.h"
 
 #define OCLUA_MESH "outcrop.mesh"
 
 typedef struct oclua_mesh {
-  oc_mesh *mesh; /* NULL while being made, or once closed */
+  oclua_handle h; /* first: pins and closing (l_handle.h) */
+  oc_mesh *mesh;  /* NULL while being made, or once freed */
 } oclua_mesh;
 
 /* Adds outcrop.polygonize to the module table at the stack top and sets

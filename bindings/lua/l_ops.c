@@ -20,22 +20,25 @@
 
 typedef oc_node *(*nary_fn)(oc_node *const *, size_t, oc_error *);
 
-/* Reads the children of {a, b, ...} into a Lua-owned scratch array. The
-** children stay alive while the table is on the stack. */
+/* Reads the children of {a, b, ...} into a Lua-owned scratch array,
+** pushed with a table of their userdata: the table may lose them (a
+** finalizer of the script's may run at the next allocation), the copy
+** keeps them alive until the operator has retained them. */
 static oc_node **children(lua_State *L, const oclua_fields *f, size_t *n) {
   oc_node **kids;
   *n = (size_t)f->narray;
   kids = lua_newuserdatauv(L, (*n ? *n : 1) * sizeof *kids, 0);
+  lua_createtable(L, (int)(*n < 65536 ? *n : 65536), 0);
   for (lua_Integer i = 1; i <= f->narray; i++) {
     oclua_node *u;
-    /* raw: no metamethod may run (and collect) while kids is filled */
+    /* raw: no metamethod may run while kids is filled */
     lua_rawgeti(L, f->t, i);
     u = oclua_testnode(L, -1);
     if (u == NULL)
       oclua_error(L, f->fname, "child #%I must be an outcrop node (got %s)",
                   (LUAI_UACINT)i, oclua_got(L, -1));
     kids[i - 1] = u->node;
-    lua_pop(L, 1);
+    lua_rawseti(L, -2, i);
   }
   return kids;
 }

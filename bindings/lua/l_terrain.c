@@ -61,7 +61,10 @@ static int l_terrain(lua_State *L) {
   oclua_checkargs(L, 2, fname,
                   "(heightfield [, {falloff=, transition=, "
                   "mask=, invert=}])");
-  oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
+  oclua_checkheightfield(L, 1, fname);
+  lua_settop(L, 2);
+  /* pinned: the options' metamethods and finalizers may close it */
+  oc_heightfield *hf = oclua_pinheightfield(L, 1, fname);
   oc_terrain_params tp = {0};
   tp.falloff = 4 * oc_heightfield_cell(hf);
   const char *mask_path = NULL;
@@ -76,12 +79,15 @@ static int l_terrain(lua_State *L) {
     if (tp.thickness < 0)
       oclua_error(L, fname, "'thickness' must be >= 0 (got %f)", tp.thickness);
     tp.invert = oclua_field_optbool(&f, "invert", 0);
+    /* The value stays on the stack (an __index may have made it) and a
+    ** grid is pinned until the node has retained it. */
     int t = oclua_field_push(&f, "mask");
     if (t == LUA_TSTRING)
       mask_path = lua_tostring(L, -1);
-    else if (t != LUA_TNIL && !(mask = oclua_testheightfield(L, -1)))
+    else if (t != LUA_TNIL && !oclua_isheightfield(L, -1))
       oclua_field_error(&f, "mask", -1, "must be a heightfield or a path");
-    lua_pop(L, 1); /* the string stays alive in the table */
+    else if (t != LUA_TNIL)
+      mask = oclua_pinheightfield(L, -1, fname);
   }
   oclua_node *u = oclua_newnode(L);
   oc_heightfield *own =

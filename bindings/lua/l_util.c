@@ -104,6 +104,14 @@ static int known_name(const char *name, const char *const *known) {
   return 0;
 }
 
+/* " of 'name'" for a nested table (prefix "name."), else "". Pushed. */
+static const char *in_field(const oclua_fields *f) {
+  size_t n = strlen(f->prefix);
+  if (n == 0) return "";
+  return lua_pushfstring(f->L, " of '%s'",
+                         lua_pushlstring(f->L, f->prefix, n - 1));
+}
+
 void oclua_fields_open(oclua_fields *f, lua_State *L, int idx,
                        const char *fname, const char *prefix,
                        const char *const *known, int array) {
@@ -142,21 +150,23 @@ void oclua_fields_open(oclua_fields *f, lua_State *L, int idx,
       count++;
       if (k > maxkey) maxkey = k;
     } else if (lua_isinteger(L, -1)) {
+      lua_Integer k = lua_tointeger(L, -1);
       oclua_error(L, fname,
-                  "unexpected array item [%I] (fields are named, "
+                  "unexpected array item [%I]%s (fields are named, "
                   "e.g. %s%s = ...)",
-                  (LUAI_UACINT)lua_tointeger(L, -1), f->prefix,
+                  (LUAI_UACINT)k, in_field(f), f->prefix,
                   known[0] ? known[0] : "name");
     } else {
-      oclua_error(L, fname, "unexpected key of type %s (fields are named)",
-                  luaL_typename(L, -1));
+      const char *type = luaL_typename(L, -1);
+      oclua_error(L, fname, "unexpected key of type %s%s (fields are named)",
+                  type, in_field(f));
     }
   }
   if (count != maxkey)
     oclua_error(L, fname,
-                "the array part must be a sequence 1..n without "
+                "the array part%s must be a sequence 1..n without "
                 "holes (%I items, largest index %I)",
-                (LUAI_UACINT)count, (LUAI_UACINT)maxkey);
+                in_field(f), (LUAI_UACINT)count, (LUAI_UACINT)maxkey);
   f->narray = count;
 }
 
@@ -444,8 +454,8 @@ int oclua_field_numbers(const oclua_fields *f, const char *name, int n,
     oclua_field_error(f, name, -1, what);
   for (int i = 0; i < n; i++) {
     if (lua_geti(L, -1, i + 1) != LUA_TNUMBER || !isfinite(lua_tonumber(L, -1)))
-      oclua_error(L, f->fname, "'%s' %s (item %d is %s)", name, what, i + 1,
-                  oclua_got(L, -1));
+      oclua_error(L, f->fname, "'%s%s' %s (item %d is %s)", f->prefix, name,
+                  what, i + 1, oclua_got(L, -1));
     out[i] = lua_tonumber(L, -1);
     lua_pop(L, 1);
   }

@@ -14,6 +14,7 @@
 
 #include "l_field.h"
 #include "l_geology.h"
+#include "l_handle.h"
 #include "l_heightfield.h"
 #include "l_image.h"
 #include "l_mesh.h"
@@ -79,6 +80,7 @@ int luaopen_outcrop(lua_State *L) {
   luaL_checkversion(L);
   lua_newtable(L);
   luaL_setfuncs(L, module_funcs, 0);
+  oclua_open_handle(L);
   oclua_open_field(L);
   oclua_open_prim(L);
   oclua_open_ops(L);

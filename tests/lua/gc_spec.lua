@@ -2,11 +2,9 @@
 -- parents keep children alive, deep chains neither recurse nor crash.
 local oc = require "outcrop"
 local R = require "helpers.ref"
+local G = require "helpers.gcstress" -- OUTCROP_GC_STRESS: eager collector
 
-local function restore_gc()
-  collectgarbage("incremental", 200, 100)
-  collectgarbage("restart")
-end
+local restore_gc = G.restore
 
 -- A random tree built from a tiny LCG so failures are reproducible.
 local function random_tree(seed, depth)

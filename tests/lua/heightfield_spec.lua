@@ -4,6 +4,7 @@
 -- provenance), resample and crop, every error with its script line, the
 -- same bytes for any thread count, and lifetimes under an eager collector.
 local oc = require "outcrop"
+local G = require "helpers.gcstress" -- OUTCROP_GC_STRESS: eager collector
 local Fs = require "helpers.files"
 local read_file = Fs.read_file
 local R = require "helpers.ref"
@@ -435,10 +436,7 @@ H.from(s, {size = {200, 150}, zrange = {-10, 80}}):save("surface.exr")
 end)
 
 describe("heightfield lifetimes", function()
-  after_each(function()
-    collectgarbage("incremental", 200, 100)
-    collectgarbage("restart")
-  end)
+  after_each(G.restore)
 
   it("survive an eager collector (setpause 0)", function()
     collectgarbage("setpause", 0)

@@ -10,6 +10,7 @@
 -- (e.g. `oiiotool golden.exr --colorconvert linear sRGB -o look.png`),
 -- and commit them with the change.
 local oc = require "outcrop"
+require "helpers.gcstress" -- OUTCROP_GC_STRESS: eager collector
 local Fs = require "helpers.files"
 local read_file = Fs.read_file
 local sh = Fs.sh
