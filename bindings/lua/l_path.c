@@ -10,6 +10,7 @@
 #define _XOPEN_SOURCE 700 /* realpath */
 
 #include <errno.h>
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -91,22 +92,22 @@ static char *resolve(lua_State *L, char *p, size_t *known) {
   char *slash = strrchr(p, '/');
   for (;;) {
     struct stat st;
-    char *prev, *real, *out;
+    char *prev, *out, real[PATH_MAX];
     if (slash == p) {
       *known = 0;
       return pushbuf(L, p);
     }
     *slash = '\0';
     if (stat(p, &st) == 0) {
-      real = realpath(p, NULL);
+      /* into a buffer of ours: pushing may raise a memory error */
+      char *ok = realpath(p, real);
       *slash = '/';
-      if (real == NULL) return NULL;
+      if (ok == NULL) return NULL;
       if (strcmp(real, "/") == 0) real[0] = '\0';
       *known = strlen(real);
       out = lua_newuserdatauv(L, *known + strlen(slash) + 2, 0);
       memcpy(out, real, *known);
       strcpy(out + *known, slash);
-      free(real);
       return out;
     }
     prev = slash;
@@ -129,18 +130,16 @@ static void sandboxed(lua_State *L, const char *fname, const char *outdir,
                       const char *path) {
   struct stat st;
   size_t known = 0;
-  char *real, *full;
+  char *real, *full, dir[PATH_MAX];
   const char *base;
   /* The output folder itself may not exist before the first write. */
   make_parents(pushbuf(L, outdir), 0);
   mkdir(outdir, 0777);
   lua_pop(L, 1);
-  real = realpath(outdir, NULL);
-  if (real == NULL)
+  if (realpath(outdir, dir) == NULL)
     oclua_error(L, fname, "the output folder '%s' is not usable: %s", outdir,
                 strerror(errno));
-  base = lua_pushstring(L, real);
-  free(real);
+  base = lua_pushstring(L, dir);
   full = resolve(L, absolute(L, base, path), &known);
   if (full == NULL || !is_under(full, base)) outside(L, fname, path, outdir);
   if (lstat(full, &st) == 0 && S_ISLNK(st.st_mode)) {
