@@ -19,6 +19,7 @@
 **   scene; -n N: only the cases failing allocation N)
 */
 #include <ctype.h>
+#include <malloc.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -45,13 +46,14 @@ enum { ENGINE, LUA_DATA, LUA_CALL };
 ** engine's allocations fail from fail_at on, and a Lua data allocation
 ** failing at fail_at fails again when Lua retries it after its emergency
 ** collection, so that Lua raises its memory error. Lua's allocations
-** never fail for good, and those for calls never twice: Lua skips a
-** finalizer it cannot call and frees its userdata without it, a leak of
-** Lua's making that would hide the engine's. */
+** never fail for good, and those for calls never: a finalizer that Lua
+** cannot call (inside a collection step Lua does not retry) is skipped
+** and its userdata freed without it, a leak of Lua's making that would
+** hide the engine's. */
 static int should_fail(int who) {
   if (!armed) return 0;
   long k = __atomic_add_fetch(&counter, 1, __ATOMIC_RELAXED);
-  int fail = k == fail_at;
+  int fail = k == fail_at && who != LUA_CALL;
   if (sticky && fail_at && k > fail_at)
     fail = who == ENGINE || (who == LUA_DATA && k == fail_at + 1);
   if (fail && who == ENGINE) failed++;
@@ -67,7 +69,9 @@ void *__wrap_calloc(size_t n, size_t size) {
 }
 
 void *__wrap_realloc(void *p, size_t n) {
-  if (n > 0 && should_fail(ENGINE)) return NULL;
+  /* shrinking never fails (trimming to size may ignore a failure) */
+  if (n > 0 && (p == NULL || n > malloc_usable_size(p)) && should_fail(ENGINE))
+    return NULL;
   return __real_realloc(p, n);
 }
 
@@ -77,9 +81,11 @@ void __wrap_free(void *p) {
 
 /* The Lua allocator: growth counts (and may fail) like engine calls;
 ** shrinking never fails, as Lua's own test allocator. Calls need a new
-** CallInfo (64 bytes on x86-64, Lua 5.4) or a grown stack (16-byte
-** slots); a few data allocations of such sizes are taken for them, which
-** only makes those fail once rather than twice. */
+** CallInfo or a larger stack: untyped blocks (osize 0 for a new block)
+** of 16-byte slots (Lua 5.4 on x86-64: a CallInfo is 64 bytes; 5.4.4
+** moves a growing stack to a new block, earlier versions reallocate it).
+** A few data allocations (array parts, buffers) of such sizes are taken
+** for them and never fail. */
 static void *lua_alloc(void *ud, void *p, size_t osize, size_t nsize) {
   (void)ud;
   if (nsize == 0) {
@@ -87,7 +93,7 @@ static void *lua_alloc(void *ud, void *p, size_t osize, size_t nsize) {
     return NULL;
   }
   if (nsize > osize) {
-    int call = p == NULL ? nsize == 64 : osize % 16 == 0 && nsize % 16 == 0;
+    int call = nsize % 16 == 0 && (p == NULL ? osize == 0 : osize % 16 == 0);
     if (should_fail(call ? LUA_CALL : LUA_DATA)) return NULL;
   }
   return __real_realloc(p, nsize);
@@ -200,6 +206,17 @@ static const scene scenes[] = {
      SMALL_HF
      "outcrop.generate.hoodoos{heightfield = h, radius = 6, margin = 1, "
      "mask = function(x, y) return 1 end}\n"},
+    {"terrain", 0,
+     SMALL_HF
+     "local t = outcrop.terrain(h, {falloff = 4}) - " SPHERE "\n"
+     "local m = outcrop.polygonize(t, {cell = 3})\n"
+     "assert(m:write('t.obj'))\n"
+     "outcrop.polygonize(t, {cell = 4, full_grid = true, open = true})\n"
+     "assert(outcrop.render(t, {size = {6, 4}, shadows = false})"
+     ":write('t.jpg'))\n"
+     "assert(h:save('h.tif', {bits = 16})); assert(h:save('p.png', "
+     "{palette = true}))\n"
+     "outcrop.heightfield.load(OUT .. '/h.tif')\n"},
     {"poisson", 0,
      "local p = outcrop.poisson2d{box = {0, 0, 20, 20}, radius = 3, "
      "density = function(x, y) return 0.5 end}\n"
