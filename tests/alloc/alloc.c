@@ -229,7 +229,7 @@ static const scene scenes[] = {
 /* At most this many failure points per scene: a stride beyond. */
 #define MAXCASES 700
 
-static char outdir[] = "/tmp/ocalloc.XXXXXX";
+static ocfz_dirs dirs;
 static int verbose;
 static long only; /* -n N: run case N alone */
 
@@ -251,9 +251,13 @@ static int run(const scene *sc, long n, int stick, char *msg, size_t msgsize) {
   sticky = stick;
   failed = 0;
   armed = sc->from_start;
-  st = ocfz_run(sc->code, strlen(sc->code), outdir, &lim, msg, msgsize);
+  st = ocfz_run(sc->code, strlen(sc->code), dirs.out, &lim, msg, msgsize);
   armed = 0;
-  ocfz_clean(outdir);
+  if (!ocfz_dirs_check(&dirs, msg, msgsize)) {
+    fprintf(stderr, "alloc: %s, allocation %ld%s failed: left '%s' behind\n",
+            sc->name, n, stick ? " and on" : "", msg);
+    exit(1);
+  }
   return st;
 }
 
@@ -304,8 +308,8 @@ int main(int argc, char **argv) {
   size_t i;
   long all = 0;
   int a, bad = 0;
-  if (mkdtemp(outdir) == NULL) {
-    perror("alloc: mkdtemp");
+  if (ocfz_dirs_open(&dirs, "ocalloc") != 0) {
+    perror("alloc: output folder");
     return 2;
   }
   for (a = 1; a < argc && argv[a][0] == '-'; a++) {
@@ -325,7 +329,7 @@ int main(int argc, char **argv) {
     else
       all += c;
   }
-  rmdir(outdir);
+  ocfz_dirs_close(&dirs);
   printf("alloc: %ld allocation-failure cases\n", all);
   return bad;
 }

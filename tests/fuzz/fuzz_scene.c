@@ -1,7 +1,8 @@
 /*
 ** fuzz_scene.c — the libFuzzer target: bytes to a scene (gen.c), run
 ** in-process in a sandboxed state with limits (runner.c), under ASan and
-** UBSan. Outputs go to a temporary folder emptied after every input.
+** UBSan. Outputs go to a temporary folder emptied after every input; a
+** temporary file left there, or a file beside it, is a finding (abort).
 ** OCFUZZ_SKIP leaves parts of the grammar out (see gen.h).
 */
 #include <stdio.h>
@@ -12,22 +13,21 @@
 #include "gen.h"
 #include "runner.h"
 
-static char outdir[] = "/tmp/ocfuzz.XXXXXX";
+static ocfz_dirs dirs;
 static int skip;
 
-static void remove_outdir(void) {
-  ocfz_clean(outdir);
-  rmdir(outdir);
+static void remove_dirs(void) {
+  ocfz_dirs_close(&dirs);
 }
 
 int LLVMFuzzerInitialize(int *argc, char ***argv) {
   (void)argc;
   (void)argv;
-  if (mkdtemp(outdir) == NULL) {
-    perror("fuzz_scene: mkdtemp");
+  if (ocfz_dirs_open(&dirs, "ocfuzz") != 0) {
+    perror("fuzz_scene: output folder");
     exit(2);
   }
-  atexit(remove_outdir);
+  atexit(remove_dirs);
   skip = ocfz_skip_from_env();
   return 0;
 }
@@ -38,8 +38,11 @@ int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size) {
   size_t len = 0;
   char *scene = ocfz_scene(data, size, skip, &len);
   if (scene == NULL) return 0;
-  ocfz_run(scene, len, outdir, &lim, msg, sizeof msg);
+  ocfz_run(scene, len, dirs.out, &lim, msg, sizeof msg);
   free(scene);
-  ocfz_clean(outdir);
+  if (!ocfz_dirs_check(&dirs, msg, sizeof msg)) {
+    fprintf(stderr, "fuzz_scene: the scene left '%s' behind\n", msg);
+    abort(); /* a finding */
+  }
   return 0;
 }

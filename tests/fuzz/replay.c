@@ -7,7 +7,8 @@
 **   replay [--show] [-v] FILE|DIR ...   (a DIR: its regular files)
 **
 ** Exit status 0 when every scene ran to its end or failed with a Lua
-** error; a sanitizer report ends the process with its own status.
+** error, and left no temporary file and nothing outside the output
+** folder; a sanitizer report ends the process with its own status.
 */
 #include <dirent.h>
 #include <stdio.h>
@@ -20,7 +21,7 @@
 #include "runner.h"
 
 static int show, verbose, count;
-static char outdir[] = "/tmp/ocreplay.XXXXXX";
+static ocfz_dirs dirs;
 
 static unsigned char *slurp(const char *path, size_t *n) {
   FILE *f = fopen(path, "rb");
@@ -52,9 +53,13 @@ static int one(const char *path) {
     fwrite(scene, 1, len, stdout);
   } else {
     if (verbose) fprintf(stderr, "replay: %s\n", path);
-    st = ocfz_run(scene, len, outdir, &lim, msg, sizeof msg);
+    st = ocfz_run(scene, len, dirs.out, &lim, msg, sizeof msg);
     if (verbose && st != 0) fprintf(stderr, "  error: %s\n", msg);
-    ocfz_clean(outdir);
+    if (!ocfz_dirs_check(&dirs, msg, sizeof msg)) {
+      fprintf(stderr, "replay: %s: the scene left '%s' behind\n", path, msg);
+      free(scene);
+      return 1;
+    }
     count++;
   }
   free(scene);
@@ -104,8 +109,8 @@ static int dir(const char *path) {
 int main(int argc, char **argv) {
   int i, bad = 0;
   struct stat sb;
-  if (mkdtemp(outdir) == NULL) {
-    perror("replay: mkdtemp");
+  if (ocfz_dirs_open(&dirs, "ocreplay") != 0) {
+    perror("replay: output folder");
     return 2;
   }
   for (i = 1; i < argc; i++) {
@@ -118,7 +123,7 @@ int main(int argc, char **argv) {
     else
       bad |= one(argv[i]);
   }
-  rmdir(outdir);
+  ocfz_dirs_close(&dirs);
   if (!show) fprintf(stderr, "replay: %d scenes replayed\n", count);
   return bad;
 }

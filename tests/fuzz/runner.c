@@ -1,16 +1,21 @@
 /*
 ** runner.c — one scene in one sandboxed Lua state, as the interpreter
-** runs it (runtime/run.c: module preloaded, sandbox applied, writes under
+** runs it (runtime/run.c: module loaded, sandbox applied, writes under
 ** the output folder), plus the limits a fuzzer needs so that no input can
 ** hang or exhaust the machine: a cap on the Lua heap and an instruction
 ** budget enforced by a count hook. Work done in C by the engine is kept
-** small by the generator instead.
+** small by the generator instead. Also the folders scenes write to, and
+** the check after each scene that no write left its temporary file or
+** landed beside the output folder.
 */
 #define _XOPEN_SOURCE 700
-#include <ftw.h>
+#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <lauxlib.h>
 #include <lualib.h>
@@ -118,14 +123,53 @@ int ocfz_run(const char *scene, size_t len, const char *outdir,
   return st;
 }
 
-static int remove_entry(const char *path, const struct stat *sb, int flag,
-                        struct FTW *ftw) {
-  (void)sb;
-  (void)flag;
-  if (ftw->level > 0) remove(path);
-  return 0;
+/* Removes what `dir` holds, depth first (not `dir` itself). Notes in msg
+** the first entry that is a temporary file, or (`only` non-NULL) the
+** first top-level entry not named `only`. Returns 1 when none was. */
+static int sweep(const char *dir, const char *only, char *msg, size_t msgsize) {
+  DIR *d = opendir(dir);
+  struct dirent *e;
+  int ok = 1;
+  if (d == NULL) return 1;
+  while ((e = readdir(d)) != NULL) {
+    char path[4096];
+    struct stat sb;
+    if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0) continue;
+    snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+    int bad = strstr(e->d_name, ".tmp-") != NULL ||
+              (only != NULL && strcmp(e->d_name, only) != 0);
+    if (bad && ok) snprintf(msg, msgsize, "%s", path);
+    ok &= !bad;
+    if (lstat(path, &sb) == 0 && S_ISDIR(sb.st_mode)) {
+      char sub[256];
+      if (!sweep(path, NULL, sub, sizeof sub) && ok) {
+        snprintf(msg, msgsize, "%s", sub);
+        ok = 0;
+      }
+      if (only == NULL || strcmp(e->d_name, only) != 0) rmdir(path);
+    } else {
+      unlink(path);
+    }
+  }
+  closedir(d);
+  return ok;
 }
 
-void ocfz_clean(const char *dir) {
-  nftw(dir, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+int ocfz_dirs_open(ocfz_dirs *d, const char *prefix) {
+  snprintf(d->base, sizeof d->base, "/tmp/%s.XXXXXX", prefix);
+  if (mkdtemp(d->base) == NULL) return -1;
+  snprintf(d->out, sizeof d->out, "%s/out", d->base);
+  return mkdir(d->out, 0777);
+}
+
+int ocfz_dirs_check(ocfz_dirs *d, char *msg, size_t msgsize) {
+  int ok = sweep(d->base, "out", msg, msgsize);
+  mkdir(d->out, 0777); /* in case the scene removed it */
+  return ok;
+}
+
+void ocfz_dirs_close(ocfz_dirs *d) {
+  char msg[8];
+  sweep(d->base, NULL, msg, sizeof msg);
+  rmdir(d->base);
 }

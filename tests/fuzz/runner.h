@@ -27,8 +27,25 @@ typedef struct ocfz_limits {
 int ocfz_run(const char *scene, size_t len, const char *outdir,
              const ocfz_limits *lim, char *msg, size_t msgsize);
 
-/* Removes everything under `dir` (not `dir` itself), so each scene starts
-** from an empty output folder. */
-void ocfz_clean(const char *dir);
+/* Where scenes write: a new temporary folder `base` holding the output
+** folder `out` (what the scene sees as OUT) and nothing else. */
+typedef struct ocfz_dirs {
+  char base[64];
+  char out[72];
+} ocfz_dirs;
+
+/* Creates the folders (base named after `prefix`). Returns 0, or -1 with
+** errno set. */
+int ocfz_dirs_open(ocfz_dirs *d, const char *prefix);
+
+/* Checks what the last scene left, then empties `out` and anything beside
+** it: a temporary file of an atomic write (".tmp-" in its name) is a
+** write that left its temporary behind, anything beside `out` a write
+** outside the output folder. Returns 1 when all was well, else 0 with
+** the first offending path in msg. */
+int ocfz_dirs_check(ocfz_dirs *d, char *msg, size_t msgsize);
+
+/* Removes the folders. */
+void ocfz_dirs_close(ocfz_dirs *d);
 
 #endif
