@@ -73,9 +73,7 @@ LIBSO := $(B)/liboutcrop.so
 MODULE := $(B)/outcrop.so
 BIN := $(B)/outcrop
 
-.PHONY: fuzz fuzz-smoke fuzz-pending fuzz-deps fuzz-bin check-corpus \
-        check-alloc \
-        bench-peer-deps all deps test check-c check-lua check-runtime check-asan demo bench \
+.PHONY: bench-peer-deps all deps test check-c check-lua check-runtime check-asan demo bench \
         clean format tests-bin
 .DEFAULT_GOAL := all
 
@@ -199,6 +197,8 @@ bench: deps
 	  bash scripts/bench/run.sh
 
 # ---- fuzzing (tests/fuzz, tests/corpus) ------------------------------
+.PHONY: fuzz fuzz-smoke fuzz-pending fuzz-deps fuzz-bin check-corpus \
+        check-alloc
 # One generator turns bytes into a Lua scene (tests/fuzz/gen.c); the
 # libFuzzer target (clang, FUZZ=1) and the corpus replayer (any build)
 # share it with the runner (a sandboxed state with a heap cap and an
