@@ -437,12 +437,15 @@ static void heightfield(gen *g) {
          GRID_ARGS, 4, 40, 1, 6);
     break;
   case 2:
+  from_function:
     emit(g,
          "%H = outcrop.heightfield.from(function(x, y) %[%m%] "
          "return x * %n + y end, %o)",
          F_GRID, GRID_ARGS);
     break;
   case 3:
+    /* its work grows with the node's Lipschitz bound, unbounded yet */
+    if (g->flags & OCFZ_NO_HUGE) goto from_function;
     emit(g, "%H = outcrop.heightfield.from(%N, %o)",
          F_GRID "%[, zrange = {%n, %n}%]", GRID_ARGS);
     break;

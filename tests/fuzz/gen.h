@@ -14,7 +14,8 @@
 enum {
   OCFZ_NO_CLOSE = 1, /* callbacks, finalizers and metamethods that close
                         or collect objects in use */
-  OCFZ_NO_HUGE = 2   /* odd numbers in fields that size the work */
+  OCFZ_NO_HUGE = 2   /* odd numbers in fields that size the work, and
+                        heightfield.from(node), whose work is unbounded */
 };
 
 /* Reads the OCFUZZ_SKIP environment variable ("close", "huge", both

@@ -46,7 +46,7 @@ static int one(const char *path) {
     fprintf(stderr, "replay: cannot read %s\n", path);
     return 1;
   }
-  scene = ocfz_scene(b, n, 0, &len);
+  scene = ocfz_scene(b, n, ocfz_skip_from_env(), &len);
   free(b);
   if (scene == NULL) return 1;
   if (show) {
