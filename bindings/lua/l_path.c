@@ -17,6 +17,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -154,14 +155,15 @@ int oclua_outdir_fd(lua_State *L, const char *fname) {
   lua_pop(L, 1);
   fd = new_handle(L, 2);
   *fd = open(outdir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  char *real = *fd >= 0 ? realpath(outdir, NULL) : NULL;
-  if (real == NULL)
+  /* real paths go into buffers of ours: pushing may raise a memory error,
+  ** which would leak realpath's own */
+  char real[PATH_MAX];
+  if (*fd < 0 || realpath(outdir, real) == NULL)
     oclua_error(L, fname, "the output folder '%s' is not usable: %s", outdir,
                 strerror(errno));
   lua_pushstring(L, outdir);
   lua_setiuservalue(L, -2, 1);
   lua_pushstring(L, real);
-  free(real);
   lua_setiuservalue(L, -2, 2);
   lua_setfield(L, LUA_REGISTRYINDEX, OUTDIR_FD);
   lua_pop(L, 1); /* OCLUA_OUTDIR */
@@ -190,11 +192,11 @@ static char *relative(lua_State *L, const char *fname, const char *path,
   char *slash = strrchr(p, '/');
   while (slash && slash != p) {
     *slash = '\0';
-    char *r = realpath(p, NULL);
+    char r[PATH_MAX];
+    char *ok = realpath(p, r);
     *slash = '/';
-    if (r) {
+    if (ok) {
       lua_pushfstring(L, "%s%s", r, slash);
-      free(r);
       char *c = pushbuf(L, lua_tostring(L, -1));
       lua_remove(L, -2);
       if (normalize(c) == 0 && is_under(c, real)) return c + strlen(real) + 1;

@@ -1010,7 +1010,10 @@ oc_program *oc_compile(oc_node *root, const oc_compile_options *opts,
     return NULL;
   }
   P->T = T;
-  uint32_t r = compile_node(&c, root);
+  /* an array even without parameters: every op reads P->par + offset
+  ** (NULL + 0 is undefined) */
+  uint32_t r = GROW(P->par, P->npar, c.cappar, 1) ? compile_node(&c, root)
+                                                  : (nomem(&c), OC_NONE);
   size_t nn, np;
   if (r == OC_NONE || !count_nodes(root, &nn, &np)) {
     if (r != OC_NONE) nomem(&c);

@@ -84,14 +84,24 @@ int oc_pgather(const oc_pgrid *g, int i, int j, int k, double *nb) {
 }
 
 /* A dart at box `lo` of side `side` in cell c: kept when it is inside the
-** box of the grid and free. */
-static void dart(oc_pgrid *g, size_t c, const double *lo, double side,
+** box of the grid and free. With `clip`
+** (gap filling) the dart is drawn in the part of the box inside the
+** domain: a box straddling a face of a domain much thinner than a cell
+** would otherwise almost never be hit, and its splits would double at
+** every level. (Those boxes get slightly denser darts than others; the
+** result stays maximal, and stays the same for any thread count.) */
+static void dart(oc_pgrid *g, size_t c, const double *lo, double side, int clip,
                  oc_rng *rng) {
   int d = g->d, ijk[3];
   double p[3];
   double *slot = g->pos + (size_t)d * c;
   for (int a = 0; a < d; a++) {
-    p[a] = lo[a] + side * oc_rng_uniform(rng);
+    double a0 = lo[a], len = side;
+    if (clip) {
+      a0 = fmax(lo[a], g->lo[a]);
+      len = fmin(lo[a] + side, g->hi[a]) - a0;
+    }
+    p[a] = a0 + len * oc_rng_uniform(rng);
     if (p[a] < g->lo[a] || p[a] > g->hi[a]) return;
   }
   if (!isnan(slot[0])) return;
@@ -122,7 +132,7 @@ void oc_ptile_darts(oc_pgrid *g, const int t[3], oc_rng *rng, size_t throws) {
     double lo[3] = {g->lo[0] + i * g->h, g->lo[1] + j * g->h,
                     g->lo[2] + k * g->h};
     if (!isnan(g->pos[(size_t)d * c])) continue;
-    dart(g, c, lo, g->h, rng);
+    dart(g, c, lo, g->h, 0, rng);
   }
 }
 
@@ -203,7 +213,7 @@ int oc_ptile_fill(oc_pgrid *g, const int t[3], oc_rng *rng, oc_pwork *w) {
     size_t throws = (size_t)ceil(FILL_DARTS * (double)ncur);
     for (size_t n = 0; n < throws; n++) {
       const oc_psub *s = &w->cur[pick(rng, ncur)];
-      dart(g, s->cell, s->lo, side, rng);
+      dart(g, s->cell, s->lo, side, 1, rng);
     }
     /* split the boxes whose cell is still empty */
     double half = 0.5 * side;

@@ -314,8 +314,9 @@ int oc_mc_cull(const oc_mcgrid *g, int ja, int jb, oc_mcwork *w,
   for (int j = ja; j < jb; j++) {
     for (int i = -1; i < nx; i++, c++) {
       size_t b = (size_t)((j - ja) / B) * nbu + (size_t)((i + 1) / B);
-      const oc_mc_irange *cu = w->cull.r + w->cull.at[b];
       size_t ncu = w->cull.at[b + 1] - w->cull.at[b], u = 0, first = w->kept.n;
+      /* NULL + 0 is undefined: with nothing culled the list may be NULL */
+      const oc_mc_irange *cu = ncu ? w->cull.r + w->cull.at[b] : NULL;
       for (size_t r = w->cube.at[c]; r < w->cube.at[c + 1]; r++) {
         int32_t lo = w->cube.r[r].lo, hi = w->cube.r[r].hi;
         while (lo <= hi) {

@@ -109,8 +109,8 @@ void oc_mc_samples(const oc_mcgrid *g, int ja, int jb, oc_mcwork *w,
   size_t c = 0;
   for (int j = ja; j <= jb; j++) {
     for (int i = -1; i <= nx; i++, c++) {
-      const oc_mc_srange *s = w->sr + w->srat[c];
       size_t ns = w->srat[c + 1] - w->srat[c];
+      const oc_mc_srange *s = ns ? w->sr + w->srat[c] : NULL; /* no NULL + 0 */
       if (!g->open && (i < 0 || i >= nx || j < 0 || j >= ny)) {
         for (size_t r = 0; r < ns; r++)
           for (int32_t k = s[r].lo; k <= s[r].hi; k++)

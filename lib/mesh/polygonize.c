@@ -223,9 +223,10 @@ static int merge_one(merger *M, int s, oc_error *err) {
     memcpy(M->nrm + 3 * M->nv, o->nrm + 3 * v, 3 * sizeof(float));
     M->cur[v] = (uint32_t)M->nv++;
   }
-  uint32_t *t = M->tri + 3 * M->nt;
+  /* indexed: with no triangle yet M->tri may be NULL (NULL + 0 is
+  ** undefined) */
   for (size_t k = 0; k < 3 * o->nt; k++)
-    t[k] = M->cur[o->tri[k]];
+    M->tri[3 * M->nt + k] = M->cur[o->tri[k]];
   M->nt += o->nt;
   M->calls += o->calls;
   M->cells += o->cells;
