@@ -226,8 +226,10 @@ bench: deps
 # instruction budget). scripts/fuzz-show FILE prints the scene of a file.
 
 FUZZ_SUPPORT := tests/fuzz/gen.c tests/fuzz/runner.c
+# (of the interpreter only the sandbox and the stop: memory.c's wrappers
+# need the interpreter's --wrap link)
 FUZZ_SUPPORT_OBJ := $(FUZZ_SUPPORT:%.c=$(B)/%.o) \
-  $(filter-out $(B)/runtime/main.o,$(RT_OBJ)) $(LUA_OBJ) $(LIB_OBJ)
+  $(B)/runtime/sandbox.o $(B)/runtime/stop.o $(LUA_OBJ) $(LIB_OBJ)
 FUZZ_LINK = $(LUA_LIBS) $(OIIO_LIBS) $(LDLIBS) $(OPT)
 
 $(B)/fuzz/fuzz_scene: $(B)/tests/fuzz/fuzz_scene.o $(FUZZ_SUPPORT_OBJ)
@@ -253,7 +255,7 @@ fuzz-bin:
 FUZZ_TIME ?= 3600
 FUZZ_OPTS = -max_len=512 -timeout=10 -rss_limit_mb=2048 -print_final_stats=1
 FUZZ_LONG_OPTS = -fork=1 -ignore_crashes=1 -ignore_timeouts=1
-FUZZ_SMOKE_SKIP ?= close,huge
+FUZZ_SMOKE_SKIP ?= huge
 # (libFuzzer reads corpus folders recursively: the seeds are copied, so
 # that tests/corpus/pending stays out.)
 fuzz-run = @mkdir -p $(3) build/fuzz/crashes && \
@@ -265,9 +267,10 @@ fuzz-run = @mkdir -p $(3) build/fuzz/crashes && \
 fuzz: fuzz-deps fuzz-bin
 	$(call fuzz-run,$(FUZZ_TIME),,build/fuzz/corpus,$(FUZZ_LONG_OPTS))
 
-# A short run from tests/corpus alone, with the parts of the grammar whose
-# defects are being fixed on other branches left out (FUZZ_SMOKE_SKIP,
-# see tests/fuzz/gen.h); it stops at the first finding.
+# A short run from tests/corpus alone, with the part of the grammar whose
+# known findings are still open (tests/corpus/pending: huge and subnormal
+# sizes that make work run long) left out (FUZZ_SMOKE_SKIP, see
+# tests/fuzz/gen.h); it stops at the first finding.
 fuzz-smoke: fuzz-bin
 	@rm -rf build/fuzz/smoke
 	$(call fuzz-run,100,OCFUZZ_SKIP=$(FUZZ_SMOKE_SKIP),build/fuzz/smoke,)

@@ -70,7 +70,8 @@ static void budget_hook(lua_State *L, lua_Debug *ar) {
 
 static int pmain(lua_State *L) {
   state *s = lua_touserdata(L, 1);
-  ocrt_stop_arm(L); /* inside the protected call: it allocates */
+  /* ocrt_stop_arm is not called: it would take over SIGALRM and SIGINT,
+  ** which libFuzzer uses for its own timeouts and stops */
   lua_gc(L, LUA_GCSTOP);
   luaL_openlibs(L);
   lua_newtable(L);
@@ -114,7 +115,7 @@ int ocfz_run(const char *scene, size_t len, const char *outdir,
   lua_pushlightuserdata(L, &s);
   st = lua_pcall(L, 1, 0, 0);
   if (lim->stop) lim->stop(lim->alloc_ud);
-  ocrt_stop_disarm(L);
+  ocrt_stop_finish(L);
   if (st != LUA_OK) {
     const char *m = lua_tostring(L, -1);
     snprintf(msg, msgsize, "%s", m ? m : "(error object is not a string)");
