@@ -9,9 +9,9 @@
 ** what would go over the limit: the engine then returns OC_ENOMEM, which
 ** the bindings raise as a Lua error. Lua's allocator (ocrt_lua_alloc)
 ** shares the count and the limit, so Lua tries an emergency collection
-** and then raises "not enough memory". Memory of other libraries (OpenImageIO,
-*the
-** C library's buffers, OpenMP) is not counted.
+** and then raises "not enough memory". Memory of other libraries
+** (OpenImageIO, the C library's buffers, OpenMP) is not counted, nor the
+** little that lib/ gets from libc functions not wrapped (strndup).
 **
 ** OpenMP threads allocate concurrently: the counter is atomic. Memory
 ** freed here but allocated elsewhere (a library returning malloc'ed
