@@ -236,6 +236,8 @@ static double access_at(const oc_erode_params *ep, const oc_erode_cand *cd,
     for (double t = dt; t <= ep->reach && !blocked;
          t += dt > 0.25 * t ? dt : 0.25 * t) {
       double x = s.x + t * dx, y = s.y + t * dy;
+      /* a step that no longer moves the point ends the ray (tiny cells) */
+      if (!(t > 0) || (x == s.x && y == s.y && t > dt)) break;
       if (x < x0 || x > x1 || y < y0 || y > y1) break;
       blocked = oc_heightfield_height(hf, x, y, NULL) > s.z + t * cz;
     }

@@ -7,6 +7,7 @@
 ** continuity of h, and its gradient must exist everywhere for Newton steps
 ** and shading.
 */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -40,8 +41,12 @@ oc_heightfield *oc_heightfield_new(int nx, int ny, double cell, double x0,
               (OC_HF_MAX_SAMPLES * sizeof(float)) >> 20);
     return NULL;
   }
-  if (!(cell > 0) || !isfinite(cell)) {
-    oc_seterr(err, OC_EINVAL, "'cell' must be > 0 (got %g)", cell);
+  /* a subnormal cell has no half (0.5 * 5e-324 == 0) and no finite
+  ** reciprocal: steps of a fraction of a cell would never advance */
+  if (!(cell >= DBL_MIN) || !isfinite(cell)) {
+    oc_seterr(err, OC_EINVAL,
+              "'cell' must be a positive normal number (>= %g; got %g)",
+              DBL_MIN, cell);
     return NULL;
   }
   if (!isfinite(x0) || !isfinite(y0)) {

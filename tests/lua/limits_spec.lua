@@ -68,6 +68,16 @@ describe("heightfield sizes", function()
     check(function() valley:resample(v) end, "heightfield:resample",
           "'cell' 0.001 gives 40001 x 40001 samples, over the limit of 268435456")
   end)
+
+  it("refuse subnormal cells (half a cell would be 0: erosion rays never advanced)", function()
+    local t = {size = {24, 24}, cell = 5e-324, wavelength = 8, amplitude = 0.25}
+    check(function() H.fbm(t) end, "outcrop.heightfield.fbm",
+          "'cell' must be a positive normal number")
+    t.cell = 1e-300 -- tiny but normal: the sea generator ends
+    local hf = H.fbm(t)
+    local ok = pcall(oc.generate.sea, {heightfield = hf, terrain = false, radius = 6})
+    assert.is_boolean(ok)
+  end)
 end)
 
 describe("Poisson sampling", function()
