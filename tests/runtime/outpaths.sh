@@ -17,7 +17,7 @@ fi
 S=$(cd "$(dirname "$0")" && pwd)/scenes
 T=$(mktemp -d "${TMPDIR:-/tmp}/outcrop-op.XXXXXX") || exit 2
 trap 'rm -rf "$T"' EXIT
-npass=0 nfail=0
+. "$(dirname "$0")/tally.sh"
 
 # begin NAME: a fresh case folder $W with an output folder $W/o, a folder
 # $W/elsewhere outside it, $W/o/trap, a link from inside to elsewhere, and
@@ -31,7 +31,6 @@ begin() {
   ln -s "$W/elsewhere" "$W/o/trap"
   ln -s "$W/elsewhere" "$W/o/x/sub"
 }
-because() { why="$why${why:+; }$*"; }
 # swap ARGS...: the swap.lua scene with --out $W/o
 swap() {
   (cd "$W" && exec "$OUTCROP" "$S/swap.lua" --out "$W/o" "$@") \
@@ -50,16 +49,7 @@ nothing_outside() {
 no_temporaries() {
   [ -z "$(find "$W/o" -name '.*.tmp-*')" ] || because "temporary left"
 }
-end() {
-  if [ -z "$why" ]; then
-    echo "ok   $name"
-    npass=$((npass + 1))
-  else
-    echo "FAIL $name: $why"
-    sed -e 's/^/     | /' "$T/stdout" "$T/stderr" | head -n 20
-    nfail=$((nfail + 1))
-  fi
-}
+end() { tally "$T/stdout" "$T/stderr"; }
 
 # The colour callback swaps the checked folder for a link leading out.
 for k in ply obj glb; do

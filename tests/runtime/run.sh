@@ -21,8 +21,7 @@ T=$(mktemp -d "${TMPDIR:-/tmp}/outcrop-rt.XXXXXX") || exit 2
 trap 'rm -rf "$T"' EXIT
 OUT=$T/stdout
 ERR=$T/stderr
-npass=0
-nfail=0
+. "$HERE/tally.sh"
 
 # begin NAME: a fresh folder $W, the current folder of the runs that follow
 begin() {
@@ -32,7 +31,6 @@ begin() {
   why=
 }
 
-because() { why="$why${why:+; }$*"; }
 
 sanitizer_check() {
   if grep -qE 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$ERR"; then
@@ -68,16 +66,7 @@ file_has() {
 }
 no_file() { [ ! -e "$1" ] || because "$1 exists"; }
 
-end() {
-  if [ -z "$why" ]; then
-    echo "ok   $name"
-    npass=$((npass + 1))
-  else
-    echo "FAIL $name: $why"
-    sed -e 's/^/     | /' "$ERR" | head -n 20
-    nfail=$((nfail + 1))
-  fi
-}
+end() { tally "$ERR"; }
 
 # ---- command line --------------------------------------------------------
 
