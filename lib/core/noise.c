@@ -54,6 +54,8 @@
 ** returns NaN, with a NaN gradient.
 */
 #include <math.h>
+#include <stdint.h>
+#include <string.h>
 
 #include "core/noise.h"
 #include "core/rng.h"
@@ -118,10 +120,24 @@ static inline int is_huge(oc_vec3 p) {
            fabs(p.z) <= REDUCE_PERIOD);
 }
 
-/* Huge finite coordinates modulo REDUCE_PERIOD (fmod is exact). */
+/* fmod(x, REDUCE_PERIOD), bit for bit, in constant time: glibc's fmod
+** loops over the exponent difference, about a thousand steps at 1e300,
+** which made a render of a warped node crawl (a fuzz finding). Past
+** 2^101 every double is m 2^e with e >= 49, and
+** m 2^e mod 3 2^48 = 2^48 ((m mod 3) (2^(e-48) mod 3) mod 3). */
+static double reduce1(double x) {
+  if (!(fabs(x) >= 0x1p101)) return fmod(x, REDUCE_PERIOD);
+  uint64_t b;
+  memcpy(&b, &x, sizeof b);
+  int e = (int)((b >> 52) & 0x7ff) - 1075; /* x = m 2^e, normal */
+  uint64_t m = (b & ((UINT64_C(1) << 52) - 1)) | (UINT64_C(1) << 52);
+  unsigned k = (unsigned)(m % 3) * ((e - 48) % 2 ? 2u : 1u) % 3;
+  return copysign(k * 0x1p48, x);
+}
+
+/* Huge finite coordinates modulo REDUCE_PERIOD (exact). */
 static oc_vec3 reduce(oc_vec3 p) {
-  oc_vec3 r = {fmod(p.x, REDUCE_PERIOD), fmod(p.y, REDUCE_PERIOD),
-               fmod(p.z, REDUCE_PERIOD)};
+  oc_vec3 r = {reduce1(p.x), reduce1(p.y), reduce1(p.z)};
   return r;
 }
 

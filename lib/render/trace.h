@@ -8,6 +8,9 @@
 
 #include "outcrop.h"
 
+/* Steps one ray may take before it counts as a miss (see trace.c). */
+#define OC_TRACE_MAX_STEPS 16384
+
 typedef struct oc_tracer {
   const oc_program *prog;
   double T; /* iso-value */
@@ -26,7 +29,7 @@ void oc_tracer_init(oc_tracer *tr, const oc_program *prog, double T,
 
 /* Traces o + t u (u unit) over [t0, t1]; d0 is the distance of o from the
 ** eye (for the tolerance). Returns 1 and the distance in *t on a hit, 0 on
-** a miss; adds the field evaluations made to *evals. Allocation-free. */
+** a miss (or after OC_TRACE_MAX_STEPS steps); adds the field evaluations made to *evals. Allocation-free. */
 int oc_trace(const oc_tracer *tr, oc_vec3 o, oc_vec3 u, double t0, double t1,
              double d0, double *t, double *evals);
 

@@ -927,6 +927,37 @@ START_TEST(surface_of_a_sphere) {
 }
 END_TEST
 
+/* A taper of huge factor makes the local Lipschitz bounds useless, so
+** every step shrank to (z1 - z0) 1e-5: 1e5 evaluations per sample (12 s
+** for this grid, beyond Check's timeout). Past a column's budget the
+** steps grow to (z1 - z0) / 1024. */
+START_TEST(loose_bounds_budget) {
+  oc_error e = {0};
+  oc_progress none = {NULL, NULL};
+  oc_noise nz = {2, 0.5, 0, 3, 1};
+  oc_taper_params tp = {.origin = oct_v(0, 0, 0),
+                        .axis = oct_v(0, 0, 1),
+                        .along = oct_v(1, 0, 0),
+                        .from = 0,
+                        .to = 5,
+                        .factor = 1e12,
+                        .height = 10};
+  oc_node *st = OCT_OK(oc_strata(&nz, &e));
+  oc_node *tn = OCT_OK(oc_taper(st, &tp, &e));
+  oc_node_release(st);
+  oc_program *pr = oct_compile(tn, 0, 0);
+  oc_hf_grid g = {24, 24, 1, 0, 0};
+  oc_heightfield *hf = oc_heightfield_from_program(pr, &g, -20, 20, 0, none, &e);
+  ck_assert_msg(hf != NULL, "%s", e.msg);
+  /* resistance stays below T = 1/2 in every column: z0 everywhere */
+  const float *z = oc_heightfield_samples(hf);
+  for (int k = 0; k < g.nx * g.ny; k++)
+    ck_assert(z[k] == -20.0f);
+  oc_heightfield_release(hf);
+  oc_program_free(pr);
+}
+END_TEST
+
 /* A horizontal plane with falloff: the surface lies at h + R ginv(T) for
 ** any T, with and without the column spans' help. */
 START_TEST(surface_of_a_plane) {
@@ -1028,6 +1059,7 @@ static Suite *suite(void) {
   tcase_add_test(t, same_bytes_for_any_thread_count);
   tcase_add_test(t, cancel_and_bad_parameters);
   tcase_add_test(t, surface_of_a_sphere);
+  tcase_add_test(t, loose_bounds_budget);
   tcase_add_test(t, surface_of_a_plane);
   tcase_add_test(t, resample_and_crop);
   suite_add_tcase(s, t);

@@ -809,6 +809,19 @@ START_TEST(noise_huge_coordinates) {
   double P = 3 * 0x1p48, x = 12345 * P + 0.25;
   ck_assert(oc_noise3(4, oc_v3(x, 1, 2), NULL) ==
             oc_noise3(4, oc_v3(fmod(x, P), 1, 2), NULL));
+  /* Past 2^101 the reduction is computed without fmod's loop: it must
+  ** still be fmod's, bit for bit, at every exponent and both signs. */
+  int differ = 0;
+  for (int e = 90; e <= 1023; e++)
+    for (int k = 0; k < 8; k++) {
+      double m = 1 + oc_rng_uniform(&r) * (1 - 0x1p-52);
+      double v = ldexp(k % 2 ? -m : m, e);
+      oc_vec3 a = oc_v3(v, -v / 3, 0.5), b;
+      b = oc_v3(fmod(a.x, P), fmod(a.y, P), fmod(a.z, P));
+      differ += oc_noise3(9, a, NULL) != oc_noise3(9, b, NULL) ||
+                oc_turb3(9, 4, a, NULL) != oc_turb3(9, 4, b, NULL);
+    }
+  ck_assert_int_eq(differ, 0);
   /* NaN and infinities give NaN, value and gradient. */
   const double odd[] = {NAN, INFINITY, -INFINITY};
   for (int i = 0; i < 3; i++) {

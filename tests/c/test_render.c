@@ -206,6 +206,31 @@ START_TEST(thin_wall_against_march) {
 }
 END_TEST
 
+/* A ray whose far end is 1e300 away (a scene's box grown by a huge warp)
+** with a pixel-sized tolerance would take millions of steps: both tracers
+** give up after OC_TRACE_MAX_STEPS, a miss. */
+START_TEST(ray_step_budget) {
+  oc_error e = {0};
+  /* a plane seen edge-on from above: f < T all along the ray, never a
+  ** hit, and no support interval ends the ray early */
+  oc_program *pr = oct_compile(
+      OCT_OK(oc_plane(oct_v(0, 0, 0), oct_v(0, 0, 1), 4, 1, &e)), 0, 0);
+  for (int mode = 0; mode < 2; mode++) {
+    oc_tracer tr;
+    oc_tracer_init(&tr, pr, oc_program_threshold(pr),
+                   mode ? OC_TRACE_SPHERE : OC_TRACE_SEGMENT, 1e-12, 1e-12);
+    double t, ev = 0;
+    oc_vec3 eye = oct_v(0, 0, 3), d = oct_v(1, 0, 0);
+    int hit = oc_trace(&tr, eye, d, 0, 1e300, 0, &t, &ev);
+    ck_assert_int_eq(hit, 0);
+    ck_assert_msg(ev <= OC_TRACE_MAX_STEPS + 1, "mode %d: %g evaluations",
+                  mode, ev);
+    if (mode) ck_assert(ev >= 1000); /* it did march */
+  }
+  oc_program_free(pr);
+}
+END_TEST
+
 /* Random pixels of a blob-and-plane view, both tracers, against the
 ** march. */
 START_TEST(image_against_march) {
@@ -587,6 +612,7 @@ static Suite *suite(void) {
   tcase_set_timeout(t, 300);
   tcase_add_test(t, sphere_silhouette_and_depth);
   tcase_add_test(t, thin_wall_against_march);
+  tcase_add_test(t, ray_step_budget);
   tcase_add_test(t, image_against_march);
   tcase_add_test(t, ray_bounds_hold);
   suite_add_tcase(s, t);

@@ -444,7 +444,8 @@ static void heightfield(gen *g) {
          F_GRID, GRID_ARGS);
     break;
   case 3:
-    /* its work grows with the node's Lipschitz bound, unbounded yet */
+    /* its work grows with the node's Lipschitz bound, up to a column
+    ** budget (lib/terrain/hf_make.c) */
     if (g->flags & OCFZ_NO_HUGE) goto from_function;
     emit(g, "%H = outcrop.heightfield.from(%N, %o)",
          F_GRID "%[, zrange = {%n, %n}%]", GRID_ARGS);
