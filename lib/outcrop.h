@@ -227,6 +227,9 @@ typedef struct oc_polygonize_params {
   ** probes through the box, made before meshing); 0: the default,
   ** OC_POLYGONIZE_MAX_TRIANGLES */
   size_t max_triangles;
+  /* drop the connected components of fewer vertices than this (loose
+  ** specks); 0 or 1 keep every component (the default) */
+  size_t min_component;
   oc_progress progress;
 } oc_polygonize_params;
 /* 2^27 triangles: about 3 GiB of mesh (positions, normals, indices). */
@@ -264,8 +267,38 @@ int oc_mesh_set_colors(oc_mesh *mesh, const float *rgb, oc_error *err);
 int oc_mesh_color_by_field(oc_mesh *mesh, const oc_program *field,
                            const double *stops, int n, oc_error *err);
 
+/* Connected components (triangles joined by shared edges and vertices):
+** (*sizes)[i] is the vertex count of component i, components numbered in
+** order of their lowest vertex index; a vertex no triangle uses is a
+** component of its own. *sizes is malloc'ed (free it), NULL when the mesh
+** has no vertices. */
+int oc_mesh_components(const oc_mesh *mesh, size_t **sizes, size_t *count,
+                       oc_error *err);
+/* Removes every component of fewer than min_vertices vertices (0 or 1:
+** nothing). Kept vertices and triangles keep their order and are
+** re-indexed; whole components go, so a closed manifold mesh stays so. */
+int oc_mesh_drop_components(oc_mesh *mesh, size_t min_vertices, oc_error *err);
+
+/* Metadata (provenance) carried by every later write: a PLY "comment
+** key=value" line and an OBJ "# key=value" line each (values quoted as
+** oc_meta_quote does, so no value can break or forge a line), and a
+** string member of the glTF asset.extras object. Keys: 1..64 letters,
+** digits, '_', '.', ':', '-', starting with a letter, compared exactly;
+** setting a key again replaces its value. Values up to 65535 bytes; at
+** most 64 keys. */
+int oc_mesh_set_meta(oc_mesh *mesh, const char *key, const char *value,
+                     oc_error *err);
+size_t oc_mesh_meta_count(const oc_mesh *mesh);
+const char *oc_mesh_meta_key(const oc_mesh *mesh, size_t i);   /* or NULL */
+const char *oc_mesh_meta_value(const oc_mesh *mesh, size_t i); /* or NULL */
+
 /* Writes by extension: .ply (binary little-endian: positions, normals,
 ** colours when set), .obj (positions, normals), .glb (glTF 2.0 binary).
+** Colours are linear: PLY stores them sRGB-encoded as bytes, GLB as
+** linear COLOR_0 floats with a default material that shows them. PLY and
+** OBJ keep the engine's Z-up axes; GLB is Y-up as glTF requires: engine
+** (x, y, z) is written as glTF (x, z, -y), positions and normals (a
+** rotation, so triangles stay counter-clockwise seen from outside).
 ** Atomic (temporary name, then rename); on error no file is left. */
 int oc_mesh_write(const oc_mesh *mesh, const char *path, oc_error *err);
 /* The same, with `path` relative to the directory descriptor `dirfd`
@@ -887,25 +920,25 @@ typedef struct oc_karst_cavity {
 
 typedef struct oc_gen_karst_params {
   oc_heightfield *heightfield; /* required: the surface and the sinks */
-  oc_node *terrain;    /* blended with the cavities; NULL: cavities alone */
-  oc_node *geology;    /* resistance; NULL: strata of wavelength 8 radius
-                       ** (oc_strata, 3 octaves, the seed below) */
+  oc_node *terrain;     /* blended with the cavities; NULL: cavities alone */
+  oc_node *geology;     /* resistance; NULL: strata of wavelength 8 radius
+                        ** (oc_strata, 3 octaves, the seed below) */
   const oc_vec3 *sinks; /* nsinks starting points; NULL: oc_hf_sinks of the
                         ** heightfield. A sink higher than `cover` below the
                         ** surface is lowered to it. */
   size_t nsinks;
   uint64_t seed;
-  double radius;  /* R of the point primitives > 0; 0: 2 cells */
-  double step;    /* distance to new candidates > 0; 0: radius */
-  double spacing; /* Poisson-sphere radius > 0; 0: radius / 2 */
-  double cover;   /* least depth of a centre under h >= 0; NAN: R / 4 */
-  double floor;   /* lowest centre z; NAN: lowest sample + radius */
-  double epsilon; /* perturbation range >= 0 (0.1) */
-  double rho0;    /* carve where rho < rho0, in (0, 1] (0.5) */
-  double energy;  /* E > 0: a cavity's energy is -E (beta + (1 - beta)
-                  ** (1 - rho)), e(rho, sigma = 1) of section 6.1 (1.5) */
-  double beta;    /* in [0, 1] (0.5) */
-  int branches;   /* candidates tried per cavity, 1 .. 64 (6) */
+  double radius;         /* R of the point primitives > 0; 0: 2 cells */
+  double step;           /* distance to new candidates > 0; 0: radius */
+  double spacing;        /* Poisson-sphere radius > 0; 0: radius / 2 */
+  double cover;          /* least depth of a centre under h >= 0; NAN: R / 4 */
+  double floor;          /* lowest centre z; NAN: lowest sample + radius */
+  double epsilon;        /* perturbation range >= 0 (0.1) */
+  double rho0;           /* carve where rho < rho0, in (0, 1] (0.5) */
+  double energy;         /* E > 0: a cavity's energy is -E (beta + (1 - beta)
+                         ** (1 - rho)), e(rho, sigma = 1) of section 6.1 (1.5) */
+  double beta;           /* in [0, 1] (0.5) */
+  int branches;          /* candidates tried per cavity, 1 .. 64 (6) */
   size_t max_primitives; /* budget, 1 .. OC_KARST_MAX (100000) */
   oc_progress progress;
 } oc_gen_karst_params;
@@ -931,8 +964,8 @@ int oc_karst_cavities(const oc_gen_karst_params *p, oc_karst_cavity **out,
 /* The blend of the terrain (when given) and one oc_point per cavity (so a
 ** compiled program stores them inline). NULL with err when the
 ** percolation fails, or when no terrain is given and nothing was carved. */
-oc_node *oc_generate_karst(const oc_gen_karst_params *p,
-                           oc_gen_karst_stats *st, oc_error *err);
+oc_node *oc_generate_karst(const oc_gen_karst_params *p, oc_gen_karst_stats *st,
+                           oc_error *err);
 
 /* ---- generators: hoodoos (gen/hoodoos.c, gen/grammar.c) ---------------- */
 
@@ -1120,17 +1153,17 @@ typedef struct oc_gen_river_params {
   int no_terrain;              /* 1: return the primitives alone */
   oc_node *geology;            /* resistance; NULL: 0.5 everywhere */
   uint64_t seed;
-  double power;    /* stream power A^(1/2) s above which a sample is
-                   ** riverbed, > 0; 0: the 95th percentile of the grid */
-  int banks;       /* widening of the bed in cells, 0 .. 64 (3) */
-  double depth;    /* > 0: bank rays are cast at z drawn in [h - depth, h]
-                   ** (0: 3 radius) */
-  double radius;   /* > 0 (0: 1.5 cells) */
-  double spacing;  /* Poisson radius > 0 (0: radius / 2) */
-  double beta;     /* in [0, 1] (0.2) */
-  double strength; /* > 0 (2) */
-  double cutoff;   /* >= 0 (0.05) */
-  int steps;       /* 1 .. 64 (2) */
+  double power;     /* stream power A^(1/2) s above which a sample is
+                    ** riverbed, > 0; 0: the 95th percentile of the grid */
+  int banks;        /* widening of the bed in cells, 0 .. 64 (3) */
+  double depth;     /* > 0: bank rays are cast at z drawn in [h - depth, h]
+                    ** (0: 3 radius) */
+  double radius;    /* > 0 (0: 1.5 cells) */
+  double spacing;   /* Poisson radius > 0 (0: radius / 2) */
+  double beta;      /* in [0, 1] (0.2) */
+  double strength;  /* > 0 (2) */
+  double cutoff;    /* >= 0 (0.05) */
+  int steps;        /* 1 .. 64 (2) */
   double threshold; /* T; 0: OC_DEFAULT_THRESHOLD */
   oc_progress progress;
 } oc_gen_river_params;
