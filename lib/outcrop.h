@@ -260,7 +260,8 @@ typedef struct oc_mesh_stats {
 } oc_mesh_stats;
 void oc_mesh_get_stats(const oc_mesh *mesh, oc_mesh_stats *st);
 
-/* Per-vertex colours: rgb has 3 floats per vertex in [0, 1] (copied). */
+/* Per-vertex colours, linear: rgb has 3 floats per vertex in [0, 1]
+** (copied). */
 int oc_mesh_set_colors(oc_mesh *mesh, const float *rgb, oc_error *err);
 /* Colours from a field through a palette: `n` stops (value, r, g, b)
 ** sorted by value, linearly interpolated, clamped at the ends. */
@@ -920,25 +921,25 @@ typedef struct oc_karst_cavity {
 
 typedef struct oc_gen_karst_params {
   oc_heightfield *heightfield; /* required: the surface and the sinks */
-  oc_node *terrain;     /* blended with the cavities; NULL: cavities alone */
-  oc_node *geology;     /* resistance; NULL: strata of wavelength 8 radius
-                        ** (oc_strata, 3 octaves, the seed below) */
+  oc_node *terrain;    /* blended with the cavities; NULL: cavities alone */
+  oc_node *geology;    /* resistance; NULL: strata of wavelength 8 radius
+                       ** (oc_strata, 3 octaves, the seed below) */
   const oc_vec3 *sinks; /* nsinks starting points; NULL: oc_hf_sinks of the
                         ** heightfield. A sink higher than `cover` below the
                         ** surface is lowered to it. */
   size_t nsinks;
   uint64_t seed;
-  double radius;         /* R of the point primitives > 0; 0: 2 cells */
-  double step;           /* distance to new candidates > 0; 0: radius */
-  double spacing;        /* Poisson-sphere radius > 0; 0: radius / 2 */
-  double cover;          /* least depth of a centre under h >= 0; NAN: R / 4 */
-  double floor;          /* lowest centre z; NAN: lowest sample + radius */
-  double epsilon;        /* perturbation range >= 0 (0.1) */
-  double rho0;           /* carve where rho < rho0, in (0, 1] (0.5) */
-  double energy;         /* E > 0: a cavity's energy is -E (beta + (1 - beta)
-                         ** (1 - rho)), e(rho, sigma = 1) of section 6.1 (1.5) */
-  double beta;           /* in [0, 1] (0.5) */
-  int branches;          /* candidates tried per cavity, 1 .. 64 (6) */
+  double radius;  /* R of the point primitives > 0; 0: 2 cells */
+  double step;    /* distance to new candidates > 0; 0: radius */
+  double spacing; /* Poisson-sphere radius > 0; 0: radius / 2 */
+  double cover;   /* least depth of a centre under h >= 0; NAN: R / 4 */
+  double floor;   /* lowest centre z; NAN: lowest sample + radius */
+  double epsilon; /* perturbation range >= 0 (0.1) */
+  double rho0;    /* carve where rho < rho0, in (0, 1] (0.5) */
+  double energy;  /* E > 0: a cavity's energy is -E (beta + (1 - beta)
+                  ** (1 - rho)), e(rho, sigma = 1) of section 6.1 (1.5) */
+  double beta;    /* in [0, 1] (0.5) */
+  int branches;   /* candidates tried per cavity, 1 .. 64 (6) */
   size_t max_primitives; /* budget, 1 .. OC_KARST_MAX (100000) */
   oc_progress progress;
 } oc_gen_karst_params;
@@ -964,8 +965,8 @@ int oc_karst_cavities(const oc_gen_karst_params *p, oc_karst_cavity **out,
 /* The blend of the terrain (when given) and one oc_point per cavity (so a
 ** compiled program stores them inline). NULL with err when the
 ** percolation fails, or when no terrain is given and nothing was carved. */
-oc_node *oc_generate_karst(const oc_gen_karst_params *p, oc_gen_karst_stats *st,
-                           oc_error *err);
+oc_node *oc_generate_karst(const oc_gen_karst_params *p,
+                           oc_gen_karst_stats *st, oc_error *err);
 
 /* ---- generators: hoodoos (gen/hoodoos.c, gen/grammar.c) ---------------- */
 
@@ -1153,17 +1154,17 @@ typedef struct oc_gen_river_params {
   int no_terrain;              /* 1: return the primitives alone */
   oc_node *geology;            /* resistance; NULL: 0.5 everywhere */
   uint64_t seed;
-  double power;     /* stream power A^(1/2) s above which a sample is
-                    ** riverbed, > 0; 0: the 95th percentile of the grid */
-  int banks;        /* widening of the bed in cells, 0 .. 64 (3) */
-  double depth;     /* > 0: bank rays are cast at z drawn in [h - depth, h]
-                    ** (0: 3 radius) */
-  double radius;    /* > 0 (0: 1.5 cells) */
-  double spacing;   /* Poisson radius > 0 (0: radius / 2) */
-  double beta;      /* in [0, 1] (0.2) */
-  double strength;  /* > 0 (2) */
-  double cutoff;    /* >= 0 (0.05) */
-  int steps;        /* 1 .. 64 (2) */
+  double power;    /* stream power A^(1/2) s above which a sample is
+                   ** riverbed, > 0; 0: the 95th percentile of the grid */
+  int banks;       /* widening of the bed in cells, 0 .. 64 (3) */
+  double depth;    /* > 0: bank rays are cast at z drawn in [h - depth, h]
+                   ** (0: 3 radius) */
+  double radius;   /* > 0 (0: 1.5 cells) */
+  double spacing;  /* Poisson radius > 0 (0: radius / 2) */
+  double beta;     /* in [0, 1] (0.2) */
+  double strength; /* > 0 (2) */
+  double cutoff;   /* >= 0 (0.05) */
+  int steps;       /* 1 .. 64 (2) */
   double threshold; /* T; 0: OC_DEFAULT_THRESHOLD */
   oc_progress progress;
 } oc_gen_river_params;
