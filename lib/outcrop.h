@@ -227,6 +227,9 @@ typedef struct oc_polygonize_params {
   ** probes through the box, made before meshing); 0: the default,
   ** OC_POLYGONIZE_MAX_TRIANGLES */
   size_t max_triangles;
+  /* drop the connected components of fewer vertices than this (loose
+  ** specks); 0 or 1 keep every component (the default) */
+  size_t min_component;
   oc_progress progress;
 } oc_polygonize_params;
 /* 2^27 triangles: about 3 GiB of mesh (positions, normals, indices). */
@@ -257,15 +260,46 @@ typedef struct oc_mesh_stats {
 } oc_mesh_stats;
 void oc_mesh_get_stats(const oc_mesh *mesh, oc_mesh_stats *st);
 
-/* Per-vertex colours: rgb has 3 floats per vertex in [0, 1] (copied). */
+/* Per-vertex colours, linear: rgb has 3 floats per vertex in [0, 1]
+** (copied). */
 int oc_mesh_set_colors(oc_mesh *mesh, const float *rgb, oc_error *err);
 /* Colours from a field through a palette: `n` stops (value, r, g, b)
 ** sorted by value, linearly interpolated, clamped at the ends. */
 int oc_mesh_color_by_field(oc_mesh *mesh, const oc_program *field,
                            const double *stops, int n, oc_error *err);
 
+/* Connected components (triangles joined by shared edges and vertices):
+** (*sizes)[i] is the vertex count of component i, components numbered in
+** order of their lowest vertex index; a vertex no triangle uses is a
+** component of its own. *sizes is malloc'ed (free it), NULL when the mesh
+** has no vertices. */
+int oc_mesh_components(const oc_mesh *mesh, size_t **sizes, size_t *count,
+                       oc_error *err);
+/* Removes every component of fewer than min_vertices vertices (0 or 1:
+** nothing). Kept vertices and triangles keep their order and are
+** re-indexed; whole components go, so a closed manifold mesh stays so. */
+int oc_mesh_drop_components(oc_mesh *mesh, size_t min_vertices, oc_error *err);
+
+/* Metadata (provenance) carried by every later write: a PLY "comment
+** key=value" line and an OBJ "# key=value" line each (values quoted as
+** oc_meta_quote does, so no value can break or forge a line), and a
+** string member of the glTF asset.extras object. Keys: 1..64 letters,
+** digits, '_', '.', ':', '-', starting with a letter, compared exactly;
+** setting a key again replaces its value. Values up to 65535 bytes; at
+** most 64 keys. */
+int oc_mesh_set_meta(oc_mesh *mesh, const char *key, const char *value,
+                     oc_error *err);
+size_t oc_mesh_meta_count(const oc_mesh *mesh);
+const char *oc_mesh_meta_key(const oc_mesh *mesh, size_t i);   /* or NULL */
+const char *oc_mesh_meta_value(const oc_mesh *mesh, size_t i); /* or NULL */
+
 /* Writes by extension: .ply (binary little-endian: positions, normals,
 ** colours when set), .obj (positions, normals), .glb (glTF 2.0 binary).
+** Colours are linear: PLY stores them sRGB-encoded as bytes, GLB as
+** linear COLOR_0 floats with a default material that shows them. PLY and
+** OBJ keep the engine's Z-up axes; GLB is Y-up as glTF requires: engine
+** (x, y, z) is written as glTF (x, z, -y), positions and normals (a
+** rotation, so triangles stay counter-clockwise seen from outside).
 ** Atomic (temporary name, then rename); on error no file is left. */
 int oc_mesh_write(const oc_mesh *mesh, const char *path, oc_error *err);
 /* The same, with `path` relative to the directory descriptor `dirfd`

@@ -1,13 +1,14 @@
 /*
 ** l_mesh.c — outcrop.polygonize and the mesh userdata (write, stats,
-** counts, vertex, triangle).
+** counts, vertex, triangle, components).
 **
 ** polygonize defaults: box = the node's bounds (an error when they are
 ** infinite or empty); when neither 'cell' nor 'resolution' is given,
 ** cubic cells of 1/64 of the box's longest side; threshold =
 ** outcrop.threshold; open = false; steps = 6; full_grid = false;
 ** max_triangles = 2^27 (a mesh projected to have more, from probes
-** through the box before meshing, is refused with the figure). The node
+** through the box before meshing, is refused with the figure);
+** min_component = 0 (keep every connected component). The node
 ** is compiled with the threshold it is meshed at, since difference and
 ** the smooth operators depend on T.
 **
@@ -18,11 +19,15 @@
 ** (the node evaluated at each vertex with outcrop.threshold, mapped
 ** through the palette: values ascending, linear between stops, clamped
 ** at the ends) or a function (x, y, z, nx, ny, nz) -> r, g, b called
-** once per vertex in index order. Components are in [0, 1].
+** once per vertex in index order. Components are linear, in [0, 1].
+**
+** Every write carries the provenance images get (l_provenance.h).
 */
+#include <limits.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
@@ -30,6 +35,7 @@
 #include "l_field.h"
 #include "l_mesh.h"
 #include "l_progress.h"
+#include "l_provenance.h"
 
 #define DEFAULT_RESOLUTION 64 /* cells along the longest side */
 #define MAX_CELLS (1 << 20)   /* per axis, as the lib allows */
@@ -186,6 +192,14 @@ static int mesh_write(lua_State *L) {
     read_colors(&f, &c);
   }
   apply_colors(L, u, &c, fname);
+  /* The same pairs as images, set anew for each write (a mesh may be
+  ** written again after a --set changes). */
+  const char *kv[2 * OCLUA_PROVENANCE_PAIRS];
+  oclua_push_provenance(L, kv);
+  for (int i = 0; i < OCLUA_PROVENANCE_PAIRS; i++)
+    if (oc_mesh_set_meta(u->mesh, kv[2 * i], kv[2 * i + 1], &err) != OC_OK)
+      oclua_liberror(L, fname, &err);
+  lua_pop(L, OCLUA_PROVENANCE_PAIRS);
   /* resolved after the colour callbacks, which may move folders */
   oclua_target t;
   int e = oclua_output_target(L, fname, lua_tostring(L, 2), OCLUA_TARGET_CREATE,
@@ -229,6 +243,42 @@ static int mesh_counts(lua_State *L) {
   lua_pushinteger(L, (lua_Integer)oc_mesh_vertex_count(m));
   lua_pushinteger(L, (lua_Integer)oc_mesh_triangle_count(m));
   return 2;
+}
+
+/* A C array owned by a Lua userdata: freed by its __gc, so that an
+** error raised while it is held leaks nothing. */
+#define SIZES_BOX "outcrop.mesh_sizes"
+
+static int sizes_gc(lua_State *L) {
+  size_t **box = luaL_checkudata(L, 1, SIZES_BOX);
+  free(*box);
+  *box = NULL;
+  return 0;
+}
+
+/* The vertex count of each connected component, in order of each
+** component's lowest vertex index. */
+static int mesh_components(lua_State *L) {
+  const char *fname = "mesh:components";
+  oc_error err = {OC_OK, ""};
+  size_t n;
+  oclua_checkargs(L, 1, fname, "()");
+  const oc_mesh *m = checkmesh(L, fname, 0)->mesh;
+  size_t **box = lua_newuserdatauv(L, sizeof *box, 0);
+  *box = NULL;
+  luaL_setmetatable(L, SIZES_BOX);
+  if (oc_mesh_components(m, box, &n, &err) != OC_OK)
+    oclua_liberror(L, fname, &err);
+  if (n > (size_t)INT_MAX)
+    oclua_error(L, fname, "too many components (%I)", (LUAI_UACINT)n);
+  lua_createtable(L, (int)n, 0);
+  for (size_t i = 0; i < n; i++) {
+    lua_pushinteger(L, (lua_Integer)(*box)[i]);
+    lua_rawseti(L, -2, (lua_Integer)i + 1);
+  }
+  free(*box);
+  *box = NULL;
+  return 1;
 }
 
 /* The 1-based index at argument 2, checked against 1..n; `what` names
@@ -314,8 +364,8 @@ static int field_resolution(const oclua_fields *f, int res[3]) {
 
 static int l_polygonize(lua_State *L) {
   static const char *const known[] = {
-      "box",   "cell",      "resolution", "threshold",     "open",
-      "steps", "full_grid", "colors",     "max_triangles", NULL};
+      "box",       "cell",   "resolution",    "threshold",     "open", "steps",
+      "full_grid", "colors", "max_triangles", "min_component", NULL};
   const char *fname = "outcrop.polygonize";
   oclua_fields f;
   oc_error err = {OC_OK, ""};
@@ -327,7 +377,7 @@ static int l_polygonize(lua_State *L) {
   oclua_checkargs(L, 2, fname,
                   "(node, {box =, cell = or resolution =, threshold =, "
                   "open =, steps =, full_grid =, colors =, "
-                  "max_triangles =})");
+                  "max_triangles =, min_component =})");
   oclua_checknode(L, 1, fname, "argument #1");
   lua_settop(L, 2);
   if (lua_isnil(L, 2)) {
@@ -349,6 +399,9 @@ static int l_polygonize(lua_State *L) {
   lua_Integer max_tri =
       oclua_field_optint(&f, "max_triangles", 1, (lua_Integer)1 << 40,
                          OC_POLYGONIZE_MAX_TRIANGLES);
+  /* above 2^32 vertices nothing is kept anyway (indices are 32-bit) */
+  lua_Integer min_comp =
+      oclua_field_optint(&f, "min_component", 0, (lua_Integer)1 << 40, 0);
   read_colors(&f, &c);
 
   const oc_program *prog = oclua_program_at(L, 1, fname, t);
@@ -392,6 +445,7 @@ static int l_polygonize(lua_State *L) {
   pp.steps = steps;
   pp.full_grid = full_grid;
   pp.max_triangles = (size_t)max_tri;
+  pp.min_component = (size_t)min_comp;
   pp.progress = oclua_progress_start(L, &pl, fname);
   /* The userdata first, so that nothing can leak once the mesh exists. */
   oclua_mesh *u = newmesh(L);
@@ -406,10 +460,13 @@ static int l_polygonize(lua_State *L) {
   return 1;
 }
 
-static const luaL_Reg mesh_methods[] = {
-    {"write", mesh_write},       {"stats", mesh_stats},
-    {"counts", mesh_counts},     {"vertex", mesh_vertex},
-    {"triangle", mesh_triangle}, {NULL, NULL}};
+static const luaL_Reg mesh_methods[] = {{"write", mesh_write},
+                                        {"stats", mesh_stats},
+                                        {"counts", mesh_counts},
+                                        {"vertex", mesh_vertex},
+                                        {"triangle", mesh_triangle},
+                                        {"components", mesh_components},
+                                        {NULL, NULL}};
 
 static const luaL_Reg mesh_meta[] = {
     {"__gc", mesh_gc},
@@ -422,6 +479,12 @@ static const luaL_Reg mesh_funcs[] = {{"polygonize", l_polygonize},
 
 void oclua_open_mesh(lua_State *L) {
   oclua_newmeta(L, OCLUA_MESH, mesh_meta, mesh_methods);
+  lua_pop(L, 1);
+  luaL_newmetatable(L, SIZES_BOX);
+  lua_pushcfunction(L, sizes_gc);
+  lua_setfield(L, -2, "__gc");
+  lua_pushliteral(L, "locked");
+  lua_setfield(L, -2, "__metatable");
   lua_pop(L, 1);
   luaL_setfuncs(L, mesh_funcs, 0);
 }

@@ -15,6 +15,7 @@
 #include <strings.h>
 
 #include "core/error.h"
+#include "core/srgb.h"
 #include "io/atomic.h"
 #include "io/oiio.h"
 #include "outcrop.h"
@@ -97,11 +98,6 @@ static int is_linear(const oc_image *img) {
   return v && strcasecmp(v, "linear") == 0;
 }
 
-/* The sRGB encoding (IEC 61966-2-1) of a linear value in [0, 1]. */
-static double srgb(double x) {
-  return x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1 / 2.4) - 0.055;
-}
-
 /* Number of leading colour channels: grey (+ alpha) or RGB (+ alpha). */
 static int colour_channels(int nch) {
   return nch >= 3 ? 3 : 1;
@@ -127,7 +123,7 @@ static const void *samples(const oc_image *img, int nch, oc_oiio_type t,
     for (int c = 0; c < nch; c++) {
       size_t i = p * nch + c;
       double v = unit(s[c]);
-      if (c < ncol) v = srgb(v);
+      if (c < ncol) v = oc_srgb_encode(v);
       if (t == OC_OIIO_U8)
         ((uint8_t *)buf)[i] = (uint8_t)(v * 255.0 + 0.5);
       else if (t == OC_OIIO_U16)

@@ -1,6 +1,7 @@
 /*
 ** mesh.c — the oc_mesh container: allocation, accessors, statistics and
-** per-vertex colours (given, or from a field through a palette).
+** per-vertex colours (given, or from a field through a palette),
+** metadata.
 */
 #include <math.h>
 #include <stddef.h>
@@ -62,6 +63,11 @@ void oc_mesh_free(oc_mesh *mesh) {
   free(mesh->nrm);
   free(mesh->col);
   free(mesh->tri);
+  for (size_t i = 0; i < mesh->nmeta; i++) {
+    free(mesh->meta[i].key);
+    free(mesh->meta[i].value);
+  }
+  free(mesh->meta);
   free(mesh);
 }
 
@@ -149,4 +155,101 @@ int oc_mesh_color_by_field(oc_mesh *mesh, const oc_program *field,
   }
   mesh->col = c;
   return OC_OK;
+}
+
+/* ---- metadata -------------------------------------------------------- */
+
+#define MAX_META_KEY 64
+#define MAX_META_VALUE 65535
+#define MAX_META 64
+
+/* Keys go into PLY and OBJ comment lines unquoted and into JSON as
+** member names, so they are kept to characters safe in all three. */
+static int check_key(const char *key, oc_error *err) {
+  size_t len = strlen(key);
+  if (len == 0 || len > MAX_META_KEY)
+    return oc_seterr(err, OC_EINVAL,
+                     "'key' must have 1..%d characters (got %zu)", MAX_META_KEY,
+                     len);
+  unsigned char c0 = (unsigned char)key[0];
+  if (!((c0 >= 'a' && c0 <= 'z') || (c0 >= 'A' && c0 <= 'Z')))
+    return oc_seterr(err, OC_EINVAL,
+                     "'key' must start with a letter (got '%s')", key);
+  for (size_t i = 0; i < len; i++) {
+    unsigned char c = (unsigned char)key[i];
+    int ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
+             (c >= '0' && c <= '9') || c == '_' || c == '.' || c == ':' ||
+             c == '-';
+    if (!ok)
+      return oc_seterr(err, OC_EINVAL,
+                       "'key' may hold only letters, digits, '_', '.', ':' and "
+                       "'-' (got '%s')",
+                       key);
+  }
+  return OC_OK;
+}
+
+static char *dupstr(const char *s) {
+  size_t n = strlen(s) + 1;
+  char *d = malloc(n);
+  if (d) memcpy(d, s, n);
+  return d;
+}
+
+int oc_mesh_set_meta(oc_mesh *mesh, const char *key, const char *value,
+                     oc_error *err) {
+  if (!mesh) return oc_seterr(err, OC_EINVAL, "'mesh' is NULL");
+  if (!key) return oc_seterr(err, OC_EINVAL, "'key' is NULL");
+  if (!value) return oc_seterr(err, OC_EINVAL, "'value' is NULL");
+  int rc = check_key(key, err);
+  if (rc) return rc;
+  size_t vlen = strlen(value);
+  if (vlen > MAX_META_VALUE)
+    return oc_seterr(err, OC_EINVAL,
+                     "'value' of '%s' is too long (%zu > %d bytes)", key, vlen,
+                     MAX_META_VALUE);
+  char *v = dupstr(value);
+  if (!v)
+    return oc_seterr(err, OC_ENOMEM, "out of memory for metadata '%s'", key);
+  /* Exact comparison: JSON member names are case-sensitive. */
+  for (size_t i = 0; i < mesh->nmeta; i++)
+    if (strcmp(mesh->meta[i].key, key) == 0) {
+      free(mesh->meta[i].value);
+      mesh->meta[i].value = v;
+      return OC_OK;
+    }
+  if (mesh->nmeta == MAX_META) {
+    free(v);
+    return oc_seterr(err, OC_EINVAL, "too many metadata entries (limit %d)",
+                     MAX_META);
+  }
+  if (mesh->nmeta == mesh->capmeta) {
+    size_t cap = mesh->capmeta ? 2 * mesh->capmeta : 8;
+    oc_mesh_meta *m = realloc(mesh->meta, cap * sizeof *m);
+    if (!m) {
+      free(v);
+      return oc_seterr(err, OC_ENOMEM, "out of memory for metadata '%s'", key);
+    }
+    mesh->meta = m;
+    mesh->capmeta = cap;
+  }
+  char *k = dupstr(key);
+  if (!k) {
+    free(v);
+    return oc_seterr(err, OC_ENOMEM, "out of memory for metadata '%s'", key);
+  }
+  mesh->meta[mesh->nmeta].key = k;
+  mesh->meta[mesh->nmeta].value = v;
+  mesh->nmeta++;
+  return OC_OK;
+}
+
+size_t oc_mesh_meta_count(const oc_mesh *mesh) {
+  return mesh->nmeta;
+}
+const char *oc_mesh_meta_key(const oc_mesh *mesh, size_t i) {
+  return i < mesh->nmeta ? mesh->meta[i].key : NULL;
+}
+const char *oc_mesh_meta_value(const oc_mesh *mesh, size_t i) {
+  return i < mesh->nmeta ? mesh->meta[i].value : NULL;
 }

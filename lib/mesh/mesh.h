@@ -3,12 +3,17 @@
 **
 ** Flat arrays, as the writers want them: positions and unit normals, three
 ** floats per vertex; optional colours, three floats per vertex in [0, 1];
-** triangles as three vertex indices, counter-clockwise seen from outside.
+** triangles as three vertex indices, counter-clockwise seen from outside;
+** metadata (provenance) as key/value strings, in the order first set.
 */
 #ifndef OC_MESH_H
 #define OC_MESH_H
 
 #include "outcrop.h"
+
+typedef struct oc_mesh_meta {
+  char *key, *value;
+} oc_mesh_meta;
 
 struct oc_mesh {
   float *pos;
@@ -18,6 +23,8 @@ struct oc_mesh {
   uint32_t *tri;
   size_t nt;
   oc_mesh_stats stats;
+  oc_mesh_meta *meta;
+  size_t nmeta, capmeta;
 };
 
 /* An empty mesh with room for exactly nv vertices and nt triangles (both

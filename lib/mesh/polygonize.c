@@ -367,6 +367,12 @@ oc_mesh *oc_polygonize(const oc_program *prog, const oc_polygonize_params *pp,
   else
     m = finish(&M, err);
   merger_free(&M, nslab);
+  /* After the ordered merge, on the whole mesh: serial, so the result is
+  ** the same for any thread count. */
+  if (m && oc_mesh_drop_components(m, pp->min_component, err) != OC_OK) {
+    oc_mesh_free(m);
+    m = NULL;
+  }
   oc_mc_surfaces_free(&g);
   if (m) m->stats.seconds = omp_get_wtime() - t0;
   return m;

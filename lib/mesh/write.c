@@ -7,10 +7,12 @@
 #include <fcntl.h>
 #include <locale.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 
 #include "core/error.h"
+#include "io/metatext.h"
 #include "mesh/write.h"
 
 static const struct {
@@ -52,6 +54,25 @@ static int check_mesh(const oc_mesh *m, const char *path, oc_error *err) {
                        "cannot write '%s': vertex %zu has a non-finite "
                        "normal",
                        path, i / 3);
+  }
+  return OC_OK;
+}
+
+int oc_mesh_write_meta_lines(const oc_mesh *m, oc_atomic *a, const char *prefix,
+                             oc_error *err) {
+  for (size_t i = 0; i < m->nmeta; i++) {
+    const oc_mesh_meta *e = &m->meta[i];
+    char *q = malloc(oc_meta_quoted_size(e->value));
+    if (!q)
+      return oc_seterr(err, OC_ENOMEM, "cannot write '%s': out of memory",
+                       a->path);
+    size_t n = oc_meta_quote(e->value, q);
+    oc_atomic_write(a, prefix, strlen(prefix));
+    oc_atomic_write(a, e->key, strlen(e->key));
+    oc_atomic_write(a, "=", 1);
+    oc_atomic_write(a, q, n);
+    oc_atomic_write(a, "\n", 1);
+    free(q);
   }
   return OC_OK;
 }

@@ -25,6 +25,13 @@ int oc_mesh_write_glb(const oc_mesh *m, oc_atomic *a, oc_error *err);
 ** called before anything is created, and before the arrays are read. */
 int oc_mesh_glb_fits(const oc_mesh *m, const char *path, oc_error *err);
 
+/* Writes one "<prefix>key=value\n" line per metadata pair of m, values
+** quoted by oc_meta_quote (io/metatext.h) so that no value holds a line
+** break: PLY ("comment ") and OBJ ("# ") share it. OC_ENOMEM with err
+** when a value cannot be quoted; write failures are left to the commit. */
+int oc_mesh_write_meta_lines(const oc_mesh *m, oc_atomic *a, const char *prefix,
+                             oc_error *err);
+
 /* Little-endian encoding, whatever the host's byte order. */
 static inline unsigned char *oc_put_u32(unsigned char *p, uint32_t v) {
   p[0] = (unsigned char)v;

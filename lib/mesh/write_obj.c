@@ -3,7 +3,7 @@
 ** (1-based; normal i belongs to vertex i). Numbers are %.9g, enough for
 ** every float to read back to the same float. Colours are not written:
 ** OBJ has no standard place for them. An empty mesh gives a file with
-** only the header comments.
+** only the header comments. Metadata follows them as "# key=value" lines.
 */
 #include <stdio.h>
 
@@ -36,13 +36,17 @@ static int vec3(chunk *c, const char *tag, const float *v) {
 }
 
 int oc_mesh_write_obj(const oc_mesh *m, oc_atomic *a, oc_error *err) {
-  (void)err; /* write failures are reported by the commit */
+  /* write failures are reported by the commit */
   chunk c, *ch = &c;
   ch->a = a;
   ch->n = (size_t)snprintf(ch->buf, sizeof ch->buf,
                            "# written by outcrop " OC_VERSION "\n"
                            "# %zu vertices, %zu triangles\n",
                            m->nv, m->nt);
+  oc_atomic_write(a, ch->buf, ch->n);
+  ch->n = 0;
+  int rc = oc_mesh_write_meta_lines(m, a, "# ", err);
+  if (rc) return rc;
   for (size_t i = 0; i < m->nv; i++)
     if (vec3(ch, "v", m->pos + 3 * i)) return OC_OK;
   for (size_t i = 0; i < m->nv; i++)

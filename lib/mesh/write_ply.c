@@ -2,21 +2,23 @@
 ** write_ply.c — binary little-endian PLY: float positions and normals,
 ** uchar colours when the mesh has them, triangles as uchar-counted lists
 ** of uint indices. An empty mesh gives a valid file with zero elements.
+**
+** Colours are linear in the engine; the bytes are their sRGB encoding,
+** which is how viewers read PLY colours. Metadata follows the first
+** comment as "comment key=value" lines.
 */
 #include <stdio.h>
 
+#include "core/srgb.h"
 #include "mesh/write.h"
 
-/* Round to nearest from [0, 1]; anything else (NaN too) is clamped. */
-static unsigned char quantize(float c) {
-  return c > 0.0f ? (c < 1.0f ? (unsigned char)(c * 255.0 + 0.5) : 255) : 0;
-}
+#define FIRST_LINES                                                            \
+  "ply\n"                                                                      \
+  "format binary_little_endian 1.0\n"                                          \
+  "comment written by outcrop " OC_VERSION "\n"
 
 static void header(const oc_mesh *m, char *buf, size_t size) {
   snprintf(buf, size,
-           "ply\n"
-           "format binary_little_endian 1.0\n"
-           "comment written by outcrop " OC_VERSION "\n"
            "element vertex %zu\n"
            "property float x\n"
            "property float y\n"
@@ -37,8 +39,11 @@ static void header(const oc_mesh *m, char *buf, size_t size) {
 }
 
 int oc_mesh_write_ply(const oc_mesh *m, oc_atomic *a, oc_error *err) {
-  (void)err; /* write failures are reported by the commit */
+  /* write failures are reported by the commit */
   unsigned char buf[OC_WRITE_CHUNK];
+  oc_atomic_write(a, FIRST_LINES, sizeof FIRST_LINES - 1);
+  int rc = oc_mesh_write_meta_lines(m, a, "comment ", err);
+  if (rc) return rc;
   header(m, (char *)buf, sizeof buf);
   oc_atomic_write(a, buf, strlen((char *)buf));
 
@@ -55,7 +60,7 @@ int oc_mesh_write_ply(const oc_mesh *m, oc_atomic *a, oc_error *err) {
       p = oc_put_f32(p, m->nrm[3 * i + c]);
     if (m->col)
       for (int c = 0; c < 3; c++)
-        *p++ = quantize(m->col[3 * i + c]);
+        *p++ = oc_srgb_byte(m->col[3 * i + c]);
   }
   for (size_t t = 0; t < m->nt; t++) {
     if ((size_t)(p - buf) + 13 > sizeof buf) {

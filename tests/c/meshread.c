@@ -538,6 +538,17 @@ static int ply_header(const unsigned char *d, size_t len, ply_elem *elems,
     if (!nl) return say(why, ws, "PLY: no end_header");
     char line[256];
     size_t n = (size_t)(nl - (d + pos));
+    /* Comments may be long (provenance): only the first is kept. */
+    if (n >= 8 && memcmp(d + pos, "comment ", 8) == 0 && line_no > 0) {
+      size_t k = n - 8 < gensize - 1 ? n - 8 : gensize - 1;
+      if (!gen[0]) {
+        memcpy(gen, d + pos + 8, k);
+        gen[k] = '\0';
+      }
+      pos = (size_t)(nl - d) + 1;
+      line_no++;
+      continue;
+    }
     if (n && d[pos + n - 1] == '\r') n--;
     if (n >= sizeof line) return say(why, ws, "PLY: header line too long");
     memcpy(line, d + pos, n);
@@ -794,6 +805,11 @@ static mr_mesh *read_obj(const unsigned char *d, size_t len, char *why,
     const unsigned char *nl = memchr(d + pos, '\n', len - pos);
     size_t n = nl ? (size_t)(nl - (d + pos)) : len - pos;
     line_no++;
+    /* Comments may be long (provenance): skipped unless first. */
+    if (n >= sizeof line && d[pos] == '#' && gen[0]) {
+      pos += n + 1;
+      continue;
+    }
     if (n >= sizeof line) {
       say(why, ws, "OBJ: line %zu too long", line_no);
       goto done;
@@ -1310,6 +1326,18 @@ static mr_mesh *read_glb(const unsigned char *d, size_t len, char *why,
 /* ======================================================================
 ** Dispatch
 ** ====================================================================== */
+
+void mr_gltf_to_engine(mr_mesh *m) {
+  for (size_t i = 0; i < m->nv; i++) {
+    float *v[2] = {m->pos + 3 * i, m->nrm ? m->nrm + 3 * i : NULL};
+    for (int k = 0; k < 2; k++) {
+      if (!v[k]) continue;
+      float Y = v[k][1], Z = v[k][2];
+      v[k][1] = -Z;
+      v[k][2] = Y;
+    }
+  }
+}
 
 mr_mesh *mr_read(const char *path, char *why, size_t whysize) {
   const char *dot = strrchr(path, '.');

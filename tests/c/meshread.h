@@ -83,6 +83,10 @@ typedef struct mr_mesh {
 ** the PLY and GLB magic must agree). NULL with the reason in `why`. */
 mr_mesh *mr_read(const char *path, char *why, size_t whysize);
 void mr_free(mr_mesh *m);
+/* Turns a GLB mesh's glTF axes (+Y up) back into outcrop's (+Z up):
+** glTF (X, Y, Z) is engine (X, -Z, Y), positions and normals. Exact (a
+** permutation and a negation), so the floats equal those written. */
+void mr_gltf_to_engine(mr_mesh *m);
 
 typedef struct mr_report {
   size_t vertices, triangles;

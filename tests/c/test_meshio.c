@@ -126,10 +126,23 @@ static void write_ok(const oc_mesh *m, const char *path) {
   ck_assert_msg(rc == OC_OK, "writing %s: %d %s", path, rc, e.msg);
 }
 
-static mr_mesh *read_ok(const char *path) {
+static double srgb_decode(double s) {
+  return s <= 0.04045 ? s / 12.92 : pow((s + 0.055) / 1.055, 2.4);
+}
+
+/* The file as written, in the file's own axes (glTF: +Y up). */
+static mr_mesh *read_raw(const char *path) {
   char why[300];
   mr_mesh *m = mr_read(path, why, sizeof why);
   ck_assert_msg(m != NULL, "reading back: %s", why);
+  return m;
+}
+
+/* The file in engine axes: a GLB's Y-up axes turned back to Z-up, so
+** that every format compares with the mesh bit for bit. */
+static mr_mesh *read_ok(const char *path) {
+  mr_mesh *m = read_raw(path);
+  if (m->format == MR_GLB) mr_gltf_to_engine(m);
   return m;
 }
 
@@ -422,14 +435,17 @@ START_TEST(ply_colors) {
   mr_mesh *back = read_ok(oct_in_dir(dir, "c.ply"));
   same_geometry(m, back, "c.ply");
   ck_assert_ptr_nonnull(back->col);
+  /* Bytes are the sRGB encoding of the linear colours, rounded half up. */
   for (int i = 0; i < 24; i++) {
     double v = fmin(fmax(rgb[i], 0), 1);
-    long want = lround(floor(v * 255 + 0.5));
+    double e = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1 / 2.4) - 0.055;
+    long want = lround(floor(e * 255 + 0.5));
     long got = lround(back->col[i] * 255);
     ck_assert_msg(got == want, "colour %d (%.9g): %ld, want %ld", i, rgb[i],
                   got, want);
   }
-  ck_assert_float_eq(back->col[2] * 255, 128); /* 0.5 rounds up */
+  ck_assert_float_eq(back->col[2] * 255, 188); /* linear 0.5: sRGB 0.735 */
+  ck_assert_float_eq(back->col[5] * 255, 13);  /* 1/255: sRGB 0.0497 */
   mr_free(back);
   /* GLB keeps the float colours (clamped). */
   back = read_ok(oct_in_dir(dir, "c.glb"));
@@ -515,11 +531,14 @@ START_TEST(glb_structure) {
     ck_assert_int_eq(jnum(mr_json_get(pa, "componentType")), 5126);
     ck_assert_str_eq(mr_json_str(mr_json_get(pa, "type")), "VEC3");
     ck_assert_int_eq(jnum(mr_json_get(pa, "count")), 301);
+    /* in glTF axes: X = x, Y = z, Z = -y */
     for (int c = 0; c < 3; c++) {
-      float lo = m->pos[c], hi = m->pos[c];
+      int ec = c == 0 ? 0 : c == 1 ? 2 : 1;
+      float sg = c == 2 ? -1.0f : 1.0f;
+      float lo = sg * m->pos[ec], hi = sg * m->pos[ec];
       for (int i = 1; i < 301; i++) {
-        lo = fminf(lo, m->pos[3 * i + c]);
-        hi = fmaxf(hi, m->pos[3 * i + c]);
+        lo = fminf(lo, sg * m->pos[3 * i + ec]);
+        hi = fmaxf(hi, sg * m->pos[3 * i + ec]);
       }
       ck_assert_float_eq((float)mr_json_at(mr_json_get(pa, "min"), c)->number,
                          lo);
@@ -1322,6 +1341,358 @@ START_TEST(polygonized_threads_identical) {
 }
 END_TEST
 
+/* ---- axes, colour space, components, metadata (issue 12) --------------- */
+
+/* A heightfield terrain (a hill over 6 x 8 units, about 1.5 high) written
+** as GLB stands on +Y: the engine's z extent is glTF Y, engine y is -Z,
+** and the triangles still wind counter-clockwise seen from outside. */
+START_TEST(glb_terrain_is_y_up) {
+  enum { NX = 25, NY = 33 };
+  float z[NX * NY];
+  for (int j = 0; j < NY; j++)
+    for (int i = 0; i < NX; i++) {
+      double x = i * 0.25 - 3, y = j * 0.25 - 4;
+      z[j * NX + i] = (float)(1.0 + 0.8 * exp(-(x * x + y * y) / 4));
+    }
+  oc_error e = {0};
+  oc_heightfield *hf = oc_heightfield_new(NX, NY, 0.25, -3, -4, z, &e);
+  ck_assert_msg(hf != NULL, "%s", e.msg);
+  oc_elevation src;
+  ck_assert_int_eq(oc_heightfield_elevation(hf, &src, &e), OC_OK);
+  oc_terrain_params tp = {0};
+  tp.falloff = 0.5;
+  tp.transition = 0.2;
+  oc_node *n = oc_terrain(&src, &tp, &e);
+  src.release(src.ud);
+  oc_heightfield_release(hf);
+  ck_assert_msg(n != NULL, "%s", e.msg);
+  oc_program *pr = oct_compile(n, 0, 0);
+  oc_polygonize_params pp = {0};
+  pp.box = (oc_aabb){oct_v(-3, -4, 0), oct_v(3, 4, 2.5)};
+  pp.cell = 0.1;
+  oc_mesh *m = oc_polygonize(pr, &pp, &e);
+  ck_assert_msg(m != NULL, "%s", e.msg);
+  oc_program_free(pr);
+  write_ok(m, oct_in_dir(dir, "hill.glb"));
+  mr_mesh *g = read_raw(oct_in_dir(dir, "hill.glb"));
+  const mr_json *accs = mr_json_get(g->gltf, "accessors");
+  const mr_json *pa = mr_json_at(accs, 0);
+  double lo[3], hi[3], elo[3], ehi[3];
+  for (int c = 0; c < 3; c++) {
+    lo[c] = mr_json_at(mr_json_get(pa, "min"), c)->number;
+    hi[c] = mr_json_at(mr_json_get(pa, "max"), c)->number;
+    elo[c] = ehi[c] = m->pos[c];
+    for (size_t i = 1; i < m->nv; i++) {
+      elo[c] = fmin(elo[c], m->pos[3 * i + c]);
+      ehi[c] = fmax(ehi[c], m->pos[3 * i + c]);
+    }
+  }
+  /* glTF X = x, Y = z, Z = -y (float values, compared exactly). */
+  ck_assert_double_eq((float)lo[0], (float)elo[0]);
+  ck_assert_double_eq((float)hi[0], (float)ehi[0]);
+  ck_assert_double_eq((float)lo[1], (float)elo[2]);
+  ck_assert_double_eq((float)hi[1], (float)ehi[2]);
+  ck_assert_double_eq((float)lo[2], (float)-ehi[1]);
+  ck_assert_double_eq((float)hi[2], (float)-elo[1]);
+  /* The height runs along glTF Y: 0 .. 1.8, narrower than X (6), Z (8). */
+  ck_assert_double_le(hi[1] - lo[1], 2.0);
+  ck_assert_double_ge(hi[2] - lo[2], 7);
+  ck_assert_double_ge(hi[0] - lo[0], 5);
+  /* Read in its own axes the file is a closed, outward solid whose
+  ** normals agree with the winding; the hill top's normal points +Y. */
+  mr_report r;
+  char buf[512];
+  mr_check(g, &r);
+  ck_assert_msg(r.closed && r.consistent && r.outward && r.volume > 0 &&
+                    r.normals_against * 100 < r.referenced,
+                "%s", mr_report_str(&r, buf, sizeof buf));
+  size_t top = 0;
+  for (size_t i = 1; i < g->nv; i++)
+    if (g->pos[3 * i + 1] > g->pos[3 * top + 1]) top = i;
+  ck_assert_double_gt(g->nrm[3 * top + 1], 0.9);
+  mr_free(g);
+  oc_mesh_free(m);
+}
+END_TEST
+
+/* One colour space: PLY bytes decoded from sRGB equal GLB's linear
+** floats within the 8-bit step; the GLB's material shows them. */
+START_TEST(colors_agree_ply_glb) {
+  oc_mesh *m = awkward(256, 5);
+  float *rgb = malloc(3 * 256 * sizeof *rgb);
+  for (int i = 0; i < 3 * 256; i++)
+    rgb[i] = (float)((i * 37) % 256) / 255.0f;
+  rgb[0] = 0.5f, rgb[1] = 0.002f, rgb[2] = 1;
+  ck_assert_int_eq(oc_mesh_set_colors(m, rgb, NULL), OC_OK);
+  free(rgb);
+  write_ok(m, oct_in_dir(dir, "c.ply"));
+  write_ok(m, oct_in_dir(dir, "c.glb"));
+  mr_mesh *p = read_ok(oct_in_dir(dir, "c.ply"));
+  mr_mesh *g = read_ok(oct_in_dir(dir, "c.glb"));
+  ck_assert_ptr_nonnull(p->col);
+  ck_assert_ptr_nonnull(g->col);
+  double worst = 0;
+  for (int i = 0; i < 3 * 256; i++) {
+    double lin = srgb_decode(p->col[i]); /* p->col = byte / 255 */
+    worst = fmax(worst, fabs(lin - g->col[i]));
+    /* Half an 8-bit step in sRGB, through the decoding's slope (<= 2.3). */
+    ck_assert_msg(fabs(lin - g->col[i]) <= 2.3 * 0.5 / 255 + 1e-6,
+                  "colour %d: PLY %g (linear %g), GLB %g", i, p->col[i] * 255,
+                  lin, g->col[i]);
+  }
+  ck_assert_double_gt(worst, 0); /* 8-bit, so not all exact */
+  /* Without the sRGB encoding, linear 0.5 would read back as 0.5 and
+  ** decode to 0.214. */
+  ck_assert_double_eq_tol(srgb_decode(p->col[0]), 0.5, 0.005);
+  const mr_json *prim = mr_json_at(
+      mr_json_get(mr_json_at(mr_json_get(g->gltf, "meshes"), 0), "primitives"),
+      0);
+  const mr_json *mat = mr_json_at(mr_json_get(g->gltf, "materials"),
+                                  (size_t)jnum(mr_json_get(prim, "material")));
+  const mr_json *pbr = mr_json_get(mat, "pbrMetallicRoughness");
+  ck_assert_ptr_nonnull(pbr);
+  for (int c = 0; c < 4; c++)
+    ck_assert_double_eq(
+        mr_json_at(mr_json_get(pbr, "baseColorFactor"), (size_t)c)->number, 1);
+  ck_assert_double_eq(mr_json_get(pbr, "metallicFactor")->number, 0);
+  ck_assert_double_eq_tol(mr_json_get(pbr, "roughnessFactor")->number, 0.9,
+                          1e-9);
+  mr_free(p);
+  mr_free(g);
+  oc_mesh_free(m);
+}
+END_TEST
+
+/* Two separate spheres, 1 and 0.5 in radius: two components, numbered
+** by lowest vertex, whose counts add up; a threshold between them keeps
+** the big one only, closed, with the same bytes for 1 and 2 threads. */
+static oc_mesh *two_spheres(size_t min_component) {
+  oc_node *a = OCT_OK(oc_point(oct_v(-1.5, 0, 0), 1.0, 1.0, NULL));
+  oc_node *b = OCT_OK(oc_point(oct_v(1.5, 0, 0), 0.5, 1.0, NULL));
+  oc_node *kids[2] = {a, b};
+  oc_node *u = OCT_OK(oc_union(kids, 2, NULL));
+  oc_node_release(a);
+  oc_node_release(b);
+  oc_program *pr = oct_compile(u, 0, 0);
+  oc_polygonize_params pp = {0};
+  pp.box = (oc_aabb){oct_v(-2.6, -1.1, -1.1), oct_v(2.6, 1.1, 1.1)};
+  pp.cell = 0.05;
+  pp.min_component = min_component;
+  oc_error e = {0};
+  oc_mesh *m = oc_polygonize(pr, &pp, &e);
+  ck_assert_msg(m != NULL, "%s", e.msg);
+  oc_program_free(pr);
+  return m;
+}
+
+START_TEST(components_two_spheres) {
+  oc_mesh *m = two_spheres(0);
+  size_t *sz, n;
+  oc_error e = {0};
+  ck_assert_int_eq(oc_mesh_components(m, &sz, &n, &e), OC_OK);
+  ck_assert_uint_eq(n, 2);
+  ck_assert_uint_eq(sz[0] + sz[1], m->nv);
+  size_t big = sz[0] > sz[1] ? sz[0] : sz[1];
+  size_t small = sz[0] > sz[1] ? sz[1] : sz[0];
+  /* Areas scale as R^2: the small sphere has about a quarter of the
+  ** vertices. */
+  ck_assert_msg(small * 3 < big && small * 6 > big, "%zu, %zu", big, small);
+  /* Vertex 0's sphere is component 0. */
+  ck_assert_uint_eq(sz[0], m->pos[0] < 0 ? big : small);
+  /* A ground truth independent of the union-find: count vertices by x. */
+  size_t left = 0;
+  for (size_t i = 0; i < m->nv; i++)
+    left += m->pos[3 * i] < 0;
+  ck_assert_uint_eq(left, big);
+  free(sz);
+  oc_mesh_free(m);
+
+  /* min_component between the two keeps only the big sphere. */
+  m = two_spheres(small + 1);
+  ck_assert_uint_eq(m->nv, big);
+  for (size_t i = 0; i < m->nv; i++)
+    ck_assert_float_lt(m->pos[3 * i], 0);
+  ck_assert_int_eq(oc_mesh_components(m, &sz, &n, &e), OC_OK);
+  ck_assert_uint_eq(n, 1);
+  ck_assert_uint_eq(sz[0], big);
+  free(sz);
+  write_ok(m, oct_in_dir(dir, "big.ply"));
+  mr_report r = report_of(oct_in_dir(dir, "big.ply"));
+  assert_solid(&r, 2, "the big sphere alone");
+  oc_mesh_free(m);
+  /* 0, 1 and small keep both. */
+  for (size_t k = 0; k <= 2; k++) {
+    m = two_spheres(k == 2 ? small : k);
+    ck_assert_uint_eq(m->nv, big + small);
+    oc_mesh_free(m);
+  }
+  /* Above both: nothing left, still a valid (empty) mesh. */
+  m = two_spheres(big + 1);
+  ck_assert_uint_eq(m->nv, 0);
+  ck_assert_uint_eq(m->nt, 0);
+  write_ok(m, oct_in_dir(dir, "none.glb"));
+  oc_mesh_free(m);
+
+  /* The same bytes for 1 and 2 threads. */
+  int threads = omp_get_max_threads();
+  for (int t = 1; t <= 2; t++) {
+    omp_set_num_threads(t);
+    m = two_spheres(small + 1);
+    write_ok(m, oct_in_dir(dir, t == 1 ? "c1.ply" : "c2.ply"));
+    oc_mesh_free(m);
+  }
+  omp_set_num_threads(threads);
+  ck_assert(
+      mr_same_bytes(oct_in_dir(dir, "c1.ply"), oct_in_dir(dir, "c2.ply")));
+}
+END_TEST
+
+/* Components of a hand-made mesh: order by lowest vertex, unused
+** vertices alone, colours moved with their vertices. */
+START_TEST(components_order) {
+  /* Tetra A on vertices 1, 3, 5, 7; tetra B on 0, 2, 4, 6; 8 unused. */
+  float pos[27];
+  for (int i = 0; i < 27; i++)
+    pos[i] = (float)i;
+  const uint32_t tri[24] = {1, 3, 5, 1, 5, 7, 1, 7, 3, 3, 7, 5,
+                            0, 2, 4, 0, 4, 6, 0, 6, 2, 2, 6, 4};
+  oc_mesh *m = build(pos, 9, tri, 8);
+  size_t *sz, n;
+  ck_assert_int_eq(oc_mesh_components(m, &sz, &n, NULL), OC_OK);
+  ck_assert_uint_eq(n, 3);
+  ck_assert_uint_eq(sz[0], 4); /* vertex 0's */
+  ck_assert_uint_eq(sz[1], 4); /* vertex 1's */
+  ck_assert_uint_eq(sz[2], 1); /* vertex 8 */
+  free(sz);
+  float rgb[27];
+  for (int i = 0; i < 27; i++)
+    rgb[i] = (float)i / 32;
+  oc_mesh_set_colors(m, rgb, NULL);
+  ck_assert_int_eq(oc_mesh_drop_components(m, 2, NULL), OC_OK);
+  ck_assert_uint_eq(m->nv, 8);
+  ck_assert_uint_eq(m->nt, 8);
+  for (size_t i = 0; i < 24; i++) {
+    ck_assert_float_eq(m->pos[i], (float)i);
+    ck_assert_float_eq(m->col[i], (float)i / 32);
+    ck_assert_uint_eq(m->tri[i], tri[i]);
+  }
+  ck_assert_int_eq(oc_mesh_components(m, &sz, &n, NULL), OC_OK);
+  ck_assert_uint_eq(n, 2);
+  free(sz);
+  oc_mesh_free(m);
+  /* An empty mesh has no component. */
+  m = oc_mesh_alloc(0, 0, NULL);
+  ck_assert_int_eq(oc_mesh_components(m, &sz, &n, NULL), OC_OK);
+  ck_assert_uint_eq(n, 0);
+  ck_assert_ptr_null(sz);
+  oc_mesh_free(m);
+}
+END_TEST
+
+/* The text of a PLY's header or an OBJ's leading comments. */
+static char *slurp_text(const char *path) {
+  size_t len;
+  char *d = (char *)mr_slurp(path, &len);
+  ck_assert_ptr_nonnull(d);
+  d = realloc(d, len + 1);
+  d[len] = '\0';
+  return d;
+}
+
+/* Metadata with quotes, newlines, a tab, a control byte, UTF-8 and a
+** byte that is not UTF-8: the GLB's JSON parses, is UTF-8, and gives the
+** value back (the bad byte as U+FFFD); PLY and OBJ comments hold one line
+** per pair that cannot forge another. */
+START_TEST(meta_in_every_format) {
+  const char *nasty = "a \"quoted\" \\ path\nend\tx\001 caf\xc3\xa9 \xff!";
+  const char *forge = "1\noutcrop:seed=99";
+  oc_mesh *m = tetra();
+  oc_error e = {0};
+  ck_assert_int_eq(oc_mesh_set_meta(m, "outcrop:scene", "old", &e), OC_OK);
+  ck_assert_int_eq(oc_mesh_set_meta(m, "outcrop:scene", nasty, &e), OC_OK);
+  ck_assert_int_eq(oc_mesh_set_meta(m, "outcrop:seed", forge, &e), OC_OK);
+  ck_assert_int_eq(oc_mesh_set_meta(m, "Software", "outcrop " OC_VERSION, &e),
+                   OC_OK);
+  ck_assert_uint_eq(oc_mesh_meta_count(m), 3);
+  ck_assert_int_eq(oc_mesh_set_meta(m, "bad key", "v", &e), OC_EINVAL);
+  ck_assert_int_eq(oc_mesh_set_meta(m, "a\nb", "v", &e), OC_EINVAL);
+  ck_assert_int_eq(oc_mesh_set_meta(m, "", "v", &e), OC_EINVAL);
+  ck_assert_int_eq(oc_mesh_set_meta(m, "k", NULL, &e), OC_EINVAL);
+  ck_assert_uint_eq(oc_mesh_meta_count(m), 3);
+
+  write_ok(m, oct_in_dir(dir, "p.glb"));
+  mr_mesh *g = read_raw(oct_in_dir(dir, "p.glb")); /* the JSON parses */
+  const mr_json *x = mr_json_get(mr_json_get(g->gltf, "asset"), "extras");
+  ck_assert_ptr_nonnull(x);
+  ck_assert_uint_eq(x->n, 3);
+  ck_assert_str_eq(
+      mr_json_str(mr_json_get(x, "outcrop:scene")),
+      "a \"quoted\" \\ path\nend\tx\001 caf\xc3\xa9 \xef\xbf\xbd!");
+  ck_assert_str_eq(mr_json_str(mr_json_get(x, "outcrop:seed")), forge);
+  ck_assert_str_eq(mr_json_str(mr_json_get(x, "Software")),
+                   "outcrop " OC_VERSION);
+  mr_free(g);
+  /* The JSON chunk is valid UTF-8. */
+  size_t len;
+  unsigned char *d = mr_slurp(oct_in_dir(dir, "p.glb"), &len);
+  size_t jl = d[12] | d[13] << 8 | d[14] << 16 | (size_t)d[15] << 24;
+  for (size_t i = 20; i < 20 + jl;) {
+    unsigned c = d[i];
+    size_t k = c < 0x80 ? 1 : (c >> 5) == 6 ? 2 : (c >> 4) == 14 ? 3 : 4;
+    ck_assert_msg(c < 0x80 || (c >= 0xC2 && c <= 0xF4), "byte %zu: %02x", i, c);
+    for (size_t j = 1; j < k; j++)
+      ck_assert_msg((d[i + j] & 0xC0) == 0x80, "byte %zu", i + j);
+    i += k;
+  }
+  free(d);
+
+  const char *want[2] = {"comment ", "# "};
+  const char *names[2] = {"p.ply", "p.obj"};
+  for (int f = 0; f < 2; f++) {
+    write_ok(m, oct_in_dir(dir, names[f]));
+    char *t = slurp_text(oct_in_dir(dir, names[f]));
+    char line[256];
+    snprintf(line, sizeof line,
+             "\n%soutcrop:scene=\"a \\\"quoted\\\" \\\\ path\\nend\\tx\\001 "
+             "caf\xc3\xa9 \xff!\"\n",
+             want[f]);
+    ck_assert_msg(strstr(t, line), "%s: no line %s in\n%.600s", names[f], line,
+                  t);
+    snprintf(line, sizeof line, "\n%soutcrop:seed=\"1\\noutcrop:seed=99\"\n",
+             want[f]);
+    ck_assert_msg(strstr(t, line), "%s: %.600s", names[f], t);
+    ck_assert_ptr_null(strstr(t, "\noutcrop:seed=99"));
+    free(t);
+    mr_mesh *b = read_ok(oct_in_dir(dir, names[f]));
+    same_geometry(m, b, names[f]);
+    ck_assert_str_eq(b->generator, "written by outcrop " OC_VERSION);
+    mr_free(b);
+  }
+  /* A value of 65535 bytes (the limit) of quotes still writes, in every
+  ** format. */
+  char *big = malloc(65536);
+  memset(big, '"', 65535);
+  big[65535] = '\0';
+  ck_assert_int_eq(oc_mesh_set_meta(m, "outcrop:params", big, &e), OC_OK);
+  big[0] = 'x';
+  for (int k = 0; k < 3; k++) {
+    char name[16];
+    snprintf(name, sizeof name, "big%s", exts[k]);
+    write_ok(m, oct_in_dir(dir, name));
+    mr_mesh *b = read_raw(oct_in_dir(dir, name));
+    if (k == 2)
+      ck_assert_uint_eq(
+          strlen(mr_json_str(
+              mr_json_get(mr_json_get(mr_json_get(b->gltf, "asset"), "extras"),
+                          "outcrop:params"))),
+          65535);
+    mr_free(b);
+  }
+  free(big);
+  oc_mesh_free(m);
+}
+END_TEST
+
 /* ---- suite -------------------------------------------------------------- */
 
 static Suite *suite(void) {
@@ -1366,6 +1737,11 @@ static Suite *suite(void) {
   tcase_add_test(t, polygonized_half_space);
   tcase_add_test(t, polygonized_sphere_crossing_box);
   tcase_add_test(t, polygonized_threads_identical);
+  tcase_add_test(t, glb_terrain_is_y_up);
+  tcase_add_test(t, colors_agree_ply_glb);
+  tcase_add_test(t, components_two_spheres);
+  tcase_add_test(t, components_order);
+  tcase_add_test(t, meta_in_every_format);
   suite_add_tcase(s, t);
   return s;
 }

@@ -18,6 +18,13 @@ local ball = oc.point{center = C, radius = RADIUS}
 -- g(r / R) = T  =>  r = R sqrt(1 - T^(1/3))
 local function iso_radius(T) return RADIUS * math.sqrt(1 - T ^ (1 / 3)) end
 
+-- Mesh colours are linear; PLY bytes are their sRGB encoding (IEC
+-- 61966-2-1), 255 * s unrounded here.
+local function srgb255(x)
+  x = math.max(0, math.min(1, x))
+  return 255 * (x <= 0.0031308 and 12.92 * x or 1.055 * x ^ (1 / 2.4) - 0.055)
+end
+
 
 
 local function vertices(m)
@@ -500,8 +507,8 @@ describe("colours", function()
       local v = calls[i]
       local c = rgb_of(ply, i)
       assert.are.equal(v[3] > C[3] and 255 or 0, c[1])
-      assert.is_true(math.abs(c[2] - 127.5) <= 0.5)
-      assert.is_true(math.abs(c[3] - 255 * (v[6] + 1) / 2) <= 0.51)
+      assert.are.equal(188, c[2]) -- linear 0.5 is sRGB 0.7354
+      assert.is_true(math.abs(c[3] - srgb255((v[6] + 1) / 2)) <= 0.51)
     end
   end)
 
@@ -533,16 +540,17 @@ describe("colours", function()
       local want
       if f < 0.5 then
         local t = f / 0.5
-        want = {0, 255 * t, 255 * (1 - t)}
+        want = {0, t, 1 - t}
         seen_lo = true
       else
         local t = math.min(1, (f - 0.5) / 0.5)
-        want = {255 * t, 255 * (1 - t), 0}
+        want = {t, 1 - t, 0}
         seen_hi = true
       end
       local c = rgb_of(ply, i)
       for k = 1, 3 do
-        assert.is_true(math.abs(c[k] - want[k]) <= 0.51, string.format("vertex %d: %s vs %s", i, c[k], want[k]))
+        local w = srgb255(want[k])
+        assert.is_true(math.abs(c[k] - w) <= 0.51, string.format("vertex %d: %s vs %s", i, c[k], w))
       end
     end
     assert.is_true(seen_lo and seen_hi) -- both palette segments in use
@@ -552,7 +560,8 @@ describe("colours", function()
     local m = oc.polygonize(ball, {cell = 0.5})
     assert.is_true(m:write(dir .. "/k.ply", {colors = {field = ball, palette = {{2, {0.2, 0.4, 0.6}}, {3, {1, 1, 1}}}}}))
     local ply = read_ply(read_file(dir .. "/k.ply"))
-    for i = 1, ply.nvertex do assert.are.same({51, 102, 153}, rgb_of(ply, i)) end
+    -- linear 0.2, 0.4, 0.6 are sRGB 124, 170, 203 (not 51, 102, 153)
+    for i = 1, ply.nvertex do assert.are.same({124, 170, 203}, rgb_of(ply, i)) end
   end)
 
   it("propagate an error raised in the function, with its line, and leave no file", function()
@@ -614,7 +623,121 @@ describe("colours", function()
     local v = {m:vertex(1)}
     local fa = oc.point{center = C, radius = 10}:eval(v[1], v[2], v[3])
     local want = math.min(fa, 1.4 - fa)
-    assert.is_true(math.abs(rgb_of(ply, 1)[1] - 255 * want) <= 0.51)
+    assert.is_true(math.abs(rgb_of(ply, 1)[1] - srgb255(want)) <= 0.51)
+  end)
+end)
+
+describe("components", function()
+  local dir
+  before_each(function() dir = R.tmpdir() end)
+  after_each(function()
+    R.rmdir(dir)
+    reg["outcrop.params"], reg["outcrop.seed"], reg["outcrop.scene"] = nil, nil, nil
+  end)
+
+  -- Two separate balls of radius 1 and 0.5 (iso radii 0.45 and 0.23).
+  local two = oc.union{oc.point{center = {-1.5, 0, 0}, radius = 1},
+                       oc.point{center = {1.5, 0, 0}, radius = 0.5}}
+  local box = {-2.6, -1.1, -1.1, 2.6, 1.1, 1.1}
+
+  it("counts the vertices of each connected component, by lowest vertex", function()
+    local m = oc.polygonize(two, {box = box, cell = 0.05})
+    local c = m:components()
+    assert.are.equal(2, #c)
+    assert.are.equal(m:counts(), c[1] + c[2])
+    local left = 0
+    for i = 1, m:counts() do if m:vertex(i) < 0 then left = left + 1 end end
+    local first_left = m:vertex(1) < 0
+    assert.are.equal(first_left and left or m:counts() - left, c[1])
+    assert.are.equal(math.type(c[1]), "integer")
+    local big, small = math.max(c[1], c[2]), math.min(c[1], c[2])
+    assert.is_true(small * 3 < big and small * 6 > big)
+    local one = oc.polygonize(ball, {cell = 0.5})
+    assert.are.same({(one:counts())}, one:components())
+    assert.are.same({}, oc.polygonize(oc.point{center = {0, 0, 0}, radius = 1}, {box = {5, 5, 5, 6, 6, 6}}):components())
+  end)
+
+  it("min_component drops the small ones, with the same bytes for 1 and 2 threads", function()
+    local all = oc.polygonize(two, {box = box, cell = 0.05})
+    local c = all:components()
+    local big, small = math.max(c[1], c[2]), math.min(c[1], c[2])
+    for _, k in ipairs{0, 1, small} do
+      assert.are.same(c, oc.polygonize(two, {box = box, cell = 0.05, min_component = k}):components())
+    end
+    local m = oc.polygonize(two, {box = box, cell = 0.05, min_component = small + 1})
+    assert.are.same({big}, m:components())
+    for i = 1, m:counts() do assert.is_true(m:vertex(i) < 0) end
+    local nt = select(2, m:counts())
+    for t = 1, nt do
+      local a, b, cc = m:triangle(t)
+      assert.is_true(a <= big and b <= big and cc <= big)
+    end
+    assert.are.same({0, 0}, {oc.polygonize(two, {box = box, cell = 0.05, min_component = big + 1}):counts()})
+    -- the interpreter's determinism: a child process per thread count
+    local build = os.getenv("OUTCROP_TEST_BUILD")
+    local script = dir .. "/t.lua"
+    local f = assert(io.open(script, "w"))
+    f:write(string.format([[
+local oc = require "outcrop"
+local two = oc.union{oc.point{center = {-1.5, 0, 0}, radius = 1},
+                     oc.point{center = {1.5, 0, 0}, radius = 0.5}}
+local m = oc.polygonize(two, {box = {-2.6, -1.1, -1.1, 2.6, 1.1, 1.1}, cell = 0.05, min_component = %d})
+assert(m:write(arg[1] .. ".ply")); assert(m:write(arg[1] .. ".glb"))
+]], small + 1))
+    f:close()
+    for t = 1, 2 do
+      assert.is_true(os.execute(string.format("cd '%s' && OMP_NUM_THREADS=%d LUA_CPATH='%s/?.so;;' lua5.4 t.lua t%d",
+        dir, t, build, t)))
+    end
+    for _, ext in ipairs{".ply", ".glb"} do
+      local a, b = read_file(dir .. "/t1" .. ext), read_file(dir .. "/t2" .. ext)
+      assert.truthy(a)
+      assert.are.equal(a, b)
+    end
+  end)
+
+  it("checks min_component and the arguments of components", function()
+    local P = "outcrop.polygonize"
+    check(function() oc.polygonize(ball, {min_component = -1}) end, P, "'min_component' must be an integer in 0..")
+    check(function() oc.polygonize(ball, {min_component = 2.5}) end, P, "'min_component'", "(got 2.5)")
+    check(function() oc.polygonize(ball, {min_component = "10"}) end, P, "'min_component'", "(got string)")
+    check(function() oc.polygonize(ball, {min_comp = 3}) end, P, "unknown field 'min_comp'")
+    local m = oc.polygonize(ball, {cell = 0.5})
+    check(function() m:components(1) end, "mesh:components", "too many arguments")
+  end)
+
+  it("mesh files carry the provenance images get, in every format", function()
+    reg["outcrop.scene"] = 'scenes/a "b"\nc.lua'
+    reg["outcrop.seed"] = 42
+    reg["outcrop.params"] = {height = "3", name = 'x "y"\nz'}
+    local m = oc.polygonize(ball, {cell = 0.5})
+    for _, ext in ipairs{".ply", ".obj", ".glb"} do assert.is_true(m:write(dir .. "/p" .. ext)) end
+    local ply = read_file(dir .. "/p.ply")
+    local head = ply:sub(1, select(2, ply:find("end_header\n", 1, true)))
+    assert.truthy(head:find('\ncomment outcrop:scene="scenes/a \\"b\\"\\nc.lua"\n', 1, true), head)
+    assert.truthy(head:find("\ncomment outcrop:seed=42\n", 1, true), head)
+    assert.truthy(head:find("\ncomment outcrop:version=" .. oc.version .. "\n", 1, true), head)
+    assert.truthy(head:find('\ncomment outcrop:params="height=3 \\"name=x \\\\\\"y\\\\\\"\\\\nz\\""\n', 1, true), head)
+    for line in head:gmatch("[^\n]+") do
+      assert.is_truthy(line:match("^comment ") or line:match("^ply$") or line:match("^format ")
+        or line:match("^element ") or line:match("^property ") or line:match("^end_header$"), line)
+    end
+    local obj = read_file(dir .. "/p.obj")
+    assert.truthy(obj:find("\n# outcrop:seed=42\n", 1, true))
+    assert.truthy(obj:find('\n# outcrop:scene="scenes/a \\"b\\"\\nc.lua"\n', 1, true))
+    local glb = read_file(dir .. "/p.glb")
+    local jlen = string.unpack("<I4", glb, 13)
+    local json = glb:sub(21, 20 + jlen)
+    assert.truthy(json:find('"extras":{', 1, true), json)
+    assert.truthy(json:find('"outcrop:scene":"scenes/a \\"b\\"\\nc.lua"', 1, true), json)
+    assert.truthy(json:find('"outcrop:seed":"42"', 1, true), json)
+    assert.truthy(json:find('"outcrop:version":"' .. oc.version .. '"', 1, true), json)
+    -- the GLB is otherwise unchanged by provenance: same bytes after the JSON
+    reg["outcrop.seed"] = 7
+    assert.is_true(m:write(dir .. "/q.glb"))
+    local glb2 = read_file(dir .. "/q.glb")
+    assert.truthy(glb2:find('"outcrop:seed":"7"', 1, true))
+    assert.are.equal(glb:sub(21 + jlen), glb2:sub(21 + string.unpack("<I4", glb2, 13)))
   end)
 end)
 
