@@ -228,6 +228,11 @@ typedef struct oc_polygonize_params {
   ** OC_POLYGONIZE_MAX_TRIANGLES */
   size_t max_triangles;
   oc_progress progress;
+  /* NULL, or where a warning goes (a sentence, "" when none) when the
+  ** mesh comes out empty for a reason the engine can tell, such as a
+  ** terrain whose solid is thinner than a cell */
+  char *warning;
+  size_t warning_size;
 } oc_polygonize_params;
 /* 2^27 triangles: about 3 GiB of mesh (positions, normals, indices). */
 #define OC_POLYGONIZE_MAX_TRIANGLES ((size_t)1 << 27)
@@ -783,13 +788,23 @@ typedef struct oc_terrain_params {
   ** the source's domain); f then falls off with the distance to the mask
   ** shrunk by R. Retained by nothing: the node keeps a distance grid. */
   const oc_heightfield *mask;
+  /* How the solid ends at the sides of the source's domain [x0, x1] x
+  ** [y0, y1]: OC_TERRAIN_OPEN (the default without a mask) cuts it at
+  ** those vertical sides, the surface z = h over the whole domain, border
+  ** included, and f = 0 exactly outside; OC_TERRAIN_SLAB is the paper's
+  ** prism, Omega shrunk by R with f falling off over R around it. A mask
+  ** always shapes its own slab (OC_TERRAIN_OPEN with a mask is refused). */
+  int edges;
 } oc_terrain_params;
+enum { OC_TERRAIN_EDGES_DEFAULT, OC_TERRAIN_OPEN, OC_TERRAIN_SLAB };
 
 /* The implicitization of seed 000 section 5.1: f = min(f_T, f_P) with
 ** f_T = sigma(h(x, y) - z) (inverted: sigma(z - h)), sigma the odd cubic
 ** of range [0, 2T], and f_P = 2T g(d(p, P) / R), P = (Omega shrunk by R)
-** x [min h, max h]. The surface f = T is z = h(x, y) wherever Omega
-** shrunk by R covers (x, y). The exact definition is in docs/fields.md.
+** x [min h, max h] (slab edges; open edges: d the vertical distance to
+** [min h, max h] inside the domain, f = 0 outside it). The surface f = T
+** is z = h(x, y) wherever Omega shrunk by R (open: the domain) covers
+** (x, y). The exact definition is in docs/fields.md.
 ** Retains the source (src is copied). New reference or NULL with err. */
 oc_node *oc_terrain(const oc_elevation *src, const oc_terrain_params *tp,
                     oc_error *err);
