@@ -580,6 +580,18 @@ typedef struct oc_hf_load_params {
 oc_heightfield *oc_heightfield_load(const char *path,
                                     const oc_hf_load_params *p, oc_error *err);
 
+/* A RAW 16-bit heightmap (.r16 / .raw, as Unity and Unreal read them):
+** nx x ny little-endian uint16, no header, rows in image order (the first
+** row is the grid's last, j = ny - 1, as in PNG), each row from i = 0.
+** nx = ny = 0: a square grid, its side from the file's size. Elevation =
+** count * scale + offset (scale 1, offset 0 unless given: a RAW keeps no
+** range); cell and origin from p as in oc_heightfield_load. Only regular
+** files are read. New grid or NULL with err (OC_EIO for unreadable files,
+** OC_EINVAL for a size that does not match the file's bytes). */
+oc_heightfield *oc_heightfield_load_raw(const char *path, int nx, int ny,
+                                        const oc_hf_load_params *p,
+                                        oc_error *err);
+
 typedef struct oc_hf_save_params {
   /* 0: the format's default: 16 for PNG, 32 (float) for TIFF and EXR.
   ** PNG takes 8 or 16, TIFF 16 or 32, EXR 16 (half) or 32. */
@@ -601,9 +613,11 @@ typedef struct oc_hf_save_params {
   int nstops;
 } oc_hf_save_params;
 
-/* Writes the grid by extension (.png, .tif, .tiff, .exr) as one channel
-** "Y", north up as oc_heightfield_load reads it, integer formats holding
-** round((z - offset) / scale). The cell, origin, scale and offset go into
+/* Writes the grid by extension (.png, .tif, .tiff, .exr; .r16 and .raw:
+** RAW 16-bit, as oc_heightfield_load_raw reads it, with no metadata) as
+** one channel "Y", north up as oc_heightfield_load reads it, integer
+** formats holding floor((z - offset) / scale + 0.5). The cell, origin, scale
+*and offset go into
 ** the file as metadata (numbers with 17 significant digits, so they read
 ** back exactly). used[0], used[1] (when used is not NULL) get the scale
 ** and offset (1 and 0 for float formats). Loading a saved 16-bit PNG gives
@@ -617,6 +631,38 @@ int oc_heightfield_save(const oc_heightfield *hf, const char *path,
 int oc_heightfield_save_at(const oc_heightfield *hf, int dirfd,
                            const char *path, const oc_hf_save_params *p,
                            double used[2], oc_error *err);
+
+/* -- grid arithmetic (terrain/hf_math.c) -- */
+
+/* Sample by sample: a + b, a - b, b - a, a * b. */
+typedef enum oc_hf_op { OC_HF_ADD, OC_HF_SUB, OC_HF_RSUB, OC_HF_MUL } oc_hf_op;
+
+/* a op b over two grids of the same layout (size, cell and origin equal,
+** else OC_EINVAL saying how they differ). A new grid (caller releases),
+** or NULL with err: also when a sample leaves float range, named. */
+oc_heightfield *oc_heightfield_combine(const oc_heightfield *a,
+                                       const oc_heightfield *b, oc_hf_op op,
+                                       oc_error *err);
+/* a op k, k finite (RSUB: k - a). New grid or NULL with err. */
+oc_heightfield *oc_heightfield_scalar(const oc_heightfield *a, double k,
+                                      oc_hf_op op, oc_error *err);
+/* Samples clamped to [lo, hi] (lo <= hi, no NaN; either may be infinite).
+** New grid or NULL with err. */
+oc_heightfield *oc_heightfield_clamp(const oc_heightfield *a, double lo,
+                                     double hi, oc_error *err);
+
+typedef struct oc_hf_mask_params {
+  int has_above, has_below;
+  double above, below; /* finite levels */
+  /* >= 0; 0: a 0/1 mask (1 where z >= above and z <= below), else a
+  ** linear ramp through 1/2 at each level, falloff wide */
+  double falloff;
+} oc_hf_mask_params;
+/* A mask grid of values in [0, 1] on the same layout: the product of
+** the ramps of the levels given; mask >= 0.5 where the hard mask is 1, as
+** oc_terrain_params.mask reads it. New grid or NULL with err. */
+oc_heightfield *oc_heightfield_mask(const oc_heightfield *a,
+                                    const oc_hf_mask_params *p, oc_error *err);
 
 /* -- procedural grids (terrain/hf_make.c) -- */
 
@@ -902,25 +948,25 @@ typedef struct oc_karst_cavity {
 
 typedef struct oc_gen_karst_params {
   oc_heightfield *heightfield; /* required: the surface and the sinks */
-  oc_node *terrain;    /* blended with the cavities; NULL: cavities alone */
-  oc_node *geology;    /* resistance; NULL: strata of wavelength 8 radius
-                       ** (oc_strata, 3 octaves, the seed below) */
+  oc_node *terrain;     /* blended with the cavities; NULL: cavities alone */
+  oc_node *geology;     /* resistance; NULL: strata of wavelength 8 radius
+                        ** (oc_strata, 3 octaves, the seed below) */
   const oc_vec3 *sinks; /* nsinks starting points; NULL: oc_hf_sinks of the
                         ** heightfield. A sink higher than `cover` below the
                         ** surface is lowered to it. */
   size_t nsinks;
   uint64_t seed;
-  double radius;  /* R of the point primitives > 0; 0: 2 cells */
-  double step;    /* distance to new candidates > 0; 0: radius */
-  double spacing; /* Poisson-sphere radius > 0; 0: radius / 2 */
-  double cover;   /* least depth of a centre under h >= 0; NAN: R / 4 */
-  double floor;   /* lowest centre z; NAN: lowest sample + radius */
-  double epsilon; /* perturbation range >= 0 (0.1) */
-  double rho0;    /* carve where rho < rho0, in (0, 1] (0.5) */
-  double energy;  /* E > 0: a cavity's energy is -E (beta + (1 - beta)
-                  ** (1 - rho)), e(rho, sigma = 1) of section 6.1 (1.5) */
-  double beta;    /* in [0, 1] (0.5) */
-  int branches;   /* candidates tried per cavity, 1 .. 64 (6) */
+  double radius;         /* R of the point primitives > 0; 0: 2 cells */
+  double step;           /* distance to new candidates > 0; 0: radius */
+  double spacing;        /* Poisson-sphere radius > 0; 0: radius / 2 */
+  double cover;          /* least depth of a centre under h >= 0; NAN: R / 4 */
+  double floor;          /* lowest centre z; NAN: lowest sample + radius */
+  double epsilon;        /* perturbation range >= 0 (0.1) */
+  double rho0;           /* carve where rho < rho0, in (0, 1] (0.5) */
+  double energy;         /* E > 0: a cavity's energy is -E (beta + (1 - beta)
+                         ** (1 - rho)), e(rho, sigma = 1) of section 6.1 (1.5) */
+  double beta;           /* in [0, 1] (0.5) */
+  int branches;          /* candidates tried per cavity, 1 .. 64 (6) */
   size_t max_primitives; /* budget, 1 .. OC_KARST_MAX (100000) */
   oc_progress progress;
 } oc_gen_karst_params;
@@ -946,8 +992,8 @@ int oc_karst_cavities(const oc_gen_karst_params *p, oc_karst_cavity **out,
 /* The blend of the terrain (when given) and one oc_point per cavity (so a
 ** compiled program stores them inline). NULL with err when the
 ** percolation fails, or when no terrain is given and nothing was carved. */
-oc_node *oc_generate_karst(const oc_gen_karst_params *p,
-                           oc_gen_karst_stats *st, oc_error *err);
+oc_node *oc_generate_karst(const oc_gen_karst_params *p, oc_gen_karst_stats *st,
+                           oc_error *err);
 
 /* ---- generators: hoodoos (gen/hoodoos.c, gen/grammar.c) ---------------- */
 
@@ -1135,17 +1181,17 @@ typedef struct oc_gen_river_params {
   int no_terrain;              /* 1: return the primitives alone */
   oc_node *geology;            /* resistance; NULL: 0.5 everywhere */
   uint64_t seed;
-  double power;    /* stream power A^(1/2) s above which a sample is
-                   ** riverbed, > 0; 0: the 95th percentile of the grid */
-  int banks;       /* widening of the bed in cells, 0 .. 64 (3) */
-  double depth;    /* > 0: bank rays are cast at z drawn in [h - depth, h]
-                   ** (0: 3 radius) */
-  double radius;   /* > 0 (0: 1.5 cells) */
-  double spacing;  /* Poisson radius > 0 (0: radius / 2) */
-  double beta;     /* in [0, 1] (0.2) */
-  double strength; /* > 0 (2) */
-  double cutoff;   /* >= 0 (0.05) */
-  int steps;       /* 1 .. 64 (2) */
+  double power;     /* stream power A^(1/2) s above which a sample is
+                    ** riverbed, > 0; 0: the 95th percentile of the grid */
+  int banks;        /* widening of the bed in cells, 0 .. 64 (3) */
+  double depth;     /* > 0: bank rays are cast at z drawn in [h - depth, h]
+                    ** (0: 3 radius) */
+  double radius;    /* > 0 (0: 1.5 cells) */
+  double spacing;   /* Poisson radius > 0 (0: radius / 2) */
+  double beta;      /* in [0, 1] (0.2) */
+  double strength;  /* > 0 (2) */
+  double cutoff;    /* >= 0 (0.05) */
+  int steps;        /* 1 .. 64 (2) */
   double threshold; /* T; 0: OC_DEFAULT_THRESHOLD */
   oc_progress progress;
 } oc_gen_river_params;
