@@ -231,6 +231,11 @@ typedef struct oc_polygonize_params {
   ** specks); 0 or 1 keep every component (the default) */
   size_t min_component;
   oc_progress progress;
+  /* NULL, or where a warning goes (a sentence, "" when none) when the
+  ** mesh comes out empty for a reason the engine can tell, such as a
+  ** terrain whose solid is thinner than a cell */
+  char *warning;
+  size_t warning_size;
 } oc_polygonize_params;
 /* 2^27 triangles: about 3 GiB of mesh (positions, normals, indices). */
 #define OC_POLYGONIZE_MAX_TRIANGLES ((size_t)1 << 27)
@@ -609,6 +614,18 @@ typedef struct oc_hf_load_params {
 oc_heightfield *oc_heightfield_load(const char *path,
                                     const oc_hf_load_params *p, oc_error *err);
 
+/* A RAW 16-bit heightmap (.r16 / .raw, as Unity and Unreal read them):
+** nx x ny little-endian uint16, no header, rows in image order (the first
+** row is the grid's last, j = ny - 1, as in PNG), each row from i = 0.
+** nx = ny = 0: a square grid, its side from the file's size. Elevation =
+** count * scale + offset (scale 1, offset 0 unless given: a RAW keeps no
+** range); cell and origin from p as in oc_heightfield_load. Only regular
+** files are read. New grid or NULL with err (OC_EIO for unreadable files,
+** OC_EINVAL for a size that does not match the file's bytes). */
+oc_heightfield *oc_heightfield_load_raw(const char *path, int nx, int ny,
+                                        const oc_hf_load_params *p,
+                                        oc_error *err);
+
 typedef struct oc_hf_save_params {
   /* 0: the format's default: 16 for PNG, 32 (float) for TIFF and EXR.
   ** PNG takes 8 or 16, TIFF 16 or 32, EXR 16 (half) or 32. */
@@ -630,9 +647,11 @@ typedef struct oc_hf_save_params {
   int nstops;
 } oc_hf_save_params;
 
-/* Writes the grid by extension (.png, .tif, .tiff, .exr) as one channel
-** "Y", north up as oc_heightfield_load reads it, integer formats holding
-** round((z - offset) / scale). The cell, origin, scale and offset go into
+/* Writes the grid by extension (.png, .tif, .tiff, .exr; .r16 and .raw:
+** RAW 16-bit, as oc_heightfield_load_raw reads it, with no metadata) as
+** one channel "Y", north up as oc_heightfield_load reads it, integer
+** formats holding floor((z - offset) / scale + 0.5). The cell, origin, scale
+*and offset go into
 ** the file as metadata (numbers with 17 significant digits, so they read
 ** back exactly). used[0], used[1] (when used is not NULL) get the scale
 ** and offset (1 and 0 for float formats). Loading a saved 16-bit PNG gives
@@ -646,6 +665,38 @@ int oc_heightfield_save(const oc_heightfield *hf, const char *path,
 int oc_heightfield_save_at(const oc_heightfield *hf, int dirfd,
                            const char *path, const oc_hf_save_params *p,
                            double used[2], oc_error *err);
+
+/* -- grid arithmetic (terrain/hf_math.c) -- */
+
+/* Sample by sample: a + b, a - b, b - a, a * b. */
+typedef enum oc_hf_op { OC_HF_ADD, OC_HF_SUB, OC_HF_RSUB, OC_HF_MUL } oc_hf_op;
+
+/* a op b over two grids of the same layout (size, cell and origin equal,
+** else OC_EINVAL saying how they differ). A new grid (caller releases),
+** or NULL with err: also when a sample leaves float range, named. */
+oc_heightfield *oc_heightfield_combine(const oc_heightfield *a,
+                                       const oc_heightfield *b, oc_hf_op op,
+                                       oc_error *err);
+/* a op k, k finite (RSUB: k - a). New grid or NULL with err. */
+oc_heightfield *oc_heightfield_scalar(const oc_heightfield *a, double k,
+                                      oc_hf_op op, oc_error *err);
+/* Samples clamped to [lo, hi] (lo <= hi, no NaN; either may be infinite).
+** New grid or NULL with err. */
+oc_heightfield *oc_heightfield_clamp(const oc_heightfield *a, double lo,
+                                     double hi, oc_error *err);
+
+typedef struct oc_hf_mask_params {
+  int has_above, has_below;
+  double above, below; /* finite levels */
+  /* >= 0; 0: a 0/1 mask (1 where z >= above and z <= below), else a
+  ** linear ramp through 1/2 at each level, falloff wide */
+  double falloff;
+} oc_hf_mask_params;
+/* A mask grid of values in [0, 1] on the same layout: the product of
+** the ramps of the levels given; mask >= 0.5 where the hard mask is 1, as
+** oc_terrain_params.mask reads it. New grid or NULL with err. */
+oc_heightfield *oc_heightfield_mask(const oc_heightfield *a,
+                                    const oc_hf_mask_params *p, oc_error *err);
 
 /* -- procedural grids (terrain/hf_make.c) -- */
 
@@ -819,13 +870,23 @@ typedef struct oc_terrain_params {
   ** the source's domain); f then falls off with the distance to the mask
   ** shrunk by R. Retained by nothing: the node keeps a distance grid. */
   const oc_heightfield *mask;
+  /* How the solid ends at the sides of the source's domain [x0, x1] x
+  ** [y0, y1]: OC_TERRAIN_OPEN (the default without a mask) cuts it at
+  ** those vertical sides, the surface z = h over the whole domain, border
+  ** included, and f = 0 exactly outside; OC_TERRAIN_SLAB is the paper's
+  ** prism, Omega shrunk by R with f falling off over R around it. A mask
+  ** always shapes its own slab (OC_TERRAIN_OPEN with a mask is refused). */
+  int edges;
 } oc_terrain_params;
+enum { OC_TERRAIN_EDGES_DEFAULT, OC_TERRAIN_OPEN, OC_TERRAIN_SLAB };
 
 /* The implicitization of seed 000 section 5.1: f = min(f_T, f_P) with
 ** f_T = sigma(h(x, y) - z) (inverted: sigma(z - h)), sigma the odd cubic
 ** of range [0, 2T], and f_P = 2T g(d(p, P) / R), P = (Omega shrunk by R)
-** x [min h, max h]. The surface f = T is z = h(x, y) wherever Omega
-** shrunk by R covers (x, y). The exact definition is in docs/fields.md.
+** x [min h, max h] (slab edges; open edges: d the vertical distance to
+** [min h, max h] inside the domain, f = 0 outside it). The surface f = T
+** is z = h(x, y) wherever Omega shrunk by R (open: the domain) covers
+** (x, y). The exact definition is in docs/fields.md.
 ** Retains the source (src is copied). New reference or NULL with err. */
 oc_node *oc_terrain(const oc_elevation *src, const oc_terrain_params *tp,
                     oc_error *err);
@@ -923,25 +984,25 @@ typedef struct oc_karst_cavity {
 
 typedef struct oc_gen_karst_params {
   oc_heightfield *heightfield; /* required: the surface and the sinks */
-  oc_node *terrain;    /* blended with the cavities; NULL: cavities alone */
-  oc_node *geology;    /* resistance; NULL: strata of wavelength 8 radius
-                       ** (oc_strata, 3 octaves, the seed below) */
+  oc_node *terrain;     /* blended with the cavities; NULL: cavities alone */
+  oc_node *geology;     /* resistance; NULL: strata of wavelength 8 radius
+                        ** (oc_strata, 3 octaves, the seed below) */
   const oc_vec3 *sinks; /* nsinks starting points; NULL: oc_hf_sinks of the
                         ** heightfield. A sink higher than `cover` below the
                         ** surface is lowered to it. */
   size_t nsinks;
   uint64_t seed;
-  double radius;  /* R of the point primitives > 0; 0: 2 cells */
-  double step;    /* distance to new candidates > 0; 0: radius */
-  double spacing; /* Poisson-sphere radius > 0; 0: radius / 2 */
-  double cover;   /* least depth of a centre under h >= 0; NAN: R / 4 */
-  double floor;   /* lowest centre z; NAN: lowest sample + radius */
-  double epsilon; /* perturbation range >= 0 (0.1) */
-  double rho0;    /* carve where rho < rho0, in (0, 1] (0.5) */
-  double energy;  /* E > 0: a cavity's energy is -E (beta + (1 - beta)
-                  ** (1 - rho)), e(rho, sigma = 1) of section 6.1 (1.5) */
-  double beta;    /* in [0, 1] (0.5) */
-  int branches;   /* candidates tried per cavity, 1 .. 64 (6) */
+  double radius;         /* R of the point primitives > 0; 0: 2 cells */
+  double step;           /* distance to new candidates > 0; 0: radius */
+  double spacing;        /* Poisson-sphere radius > 0; 0: radius / 2 */
+  double cover;          /* least depth of a centre under h >= 0; NAN: R / 4 */
+  double floor;          /* lowest centre z; NAN: lowest sample + radius */
+  double epsilon;        /* perturbation range >= 0 (0.1) */
+  double rho0;           /* carve where rho < rho0, in (0, 1] (0.5) */
+  double energy;         /* E > 0: a cavity's energy is -E (beta + (1 - beta)
+                         ** (1 - rho)), e(rho, sigma = 1) of section 6.1 (1.5) */
+  double beta;           /* in [0, 1] (0.5) */
+  int branches;          /* candidates tried per cavity, 1 .. 64 (6) */
   size_t max_primitives; /* budget, 1 .. OC_KARST_MAX (100000) */
   oc_progress progress;
 } oc_gen_karst_params;
@@ -967,8 +1028,8 @@ int oc_karst_cavities(const oc_gen_karst_params *p, oc_karst_cavity **out,
 /* The blend of the terrain (when given) and one oc_point per cavity (so a
 ** compiled program stores them inline). NULL with err when the
 ** percolation fails, or when no terrain is given and nothing was carved. */
-oc_node *oc_generate_karst(const oc_gen_karst_params *p,
-                           oc_gen_karst_stats *st, oc_error *err);
+oc_node *oc_generate_karst(const oc_gen_karst_params *p, oc_gen_karst_stats *st,
+                           oc_error *err);
 
 /* ---- generators: hoodoos (gen/hoodoos.c, gen/grammar.c) ---------------- */
 
@@ -1156,17 +1217,17 @@ typedef struct oc_gen_river_params {
   int no_terrain;              /* 1: return the primitives alone */
   oc_node *geology;            /* resistance; NULL: 0.5 everywhere */
   uint64_t seed;
-  double power;    /* stream power A^(1/2) s above which a sample is
-                   ** riverbed, > 0; 0: the 95th percentile of the grid */
-  int banks;       /* widening of the bed in cells, 0 .. 64 (3) */
-  double depth;    /* > 0: bank rays are cast at z drawn in [h - depth, h]
-                   ** (0: 3 radius) */
-  double radius;   /* > 0 (0: 1.5 cells) */
-  double spacing;  /* Poisson radius > 0 (0: radius / 2) */
-  double beta;     /* in [0, 1] (0.2) */
-  double strength; /* > 0 (2) */
-  double cutoff;   /* >= 0 (0.05) */
-  int steps;       /* 1 .. 64 (2) */
+  double power;     /* stream power A^(1/2) s above which a sample is
+                    ** riverbed, > 0; 0: the 95th percentile of the grid */
+  int banks;        /* widening of the bed in cells, 0 .. 64 (3) */
+  double depth;     /* > 0: bank rays are cast at z drawn in [h - depth, h]
+                    ** (0: 3 radius) */
+  double radius;    /* > 0 (0: 1.5 cells) */
+  double spacing;   /* Poisson radius > 0 (0: radius / 2) */
+  double beta;      /* in [0, 1] (0.2) */
+  double strength;  /* > 0 (2) */
+  double cutoff;    /* >= 0 (0.05) */
+  int steps;        /* 1 .. 64 (2) */
   double threshold; /* T; 0: OC_DEFAULT_THRESHOLD */
   oc_progress progress;
 } oc_gen_river_params;

@@ -1,7 +1,8 @@
 /*
 ** l_heightfield.c — the heightfield userdata and outcrop.heightfield:
 ** load, fbm, from; methods height, gradient, size, cell, bounds, get,
-** min, max, sum, resample, crop, save (the analysis methods come from
+** min, max, sum, resample, crop, save, clamp, mask, map, and the
+** operators + - * (the analysis methods come from
 ** l_hfanalysis.c and share the metatable).
 **
 ** Sample (i, j), 1-based in Lua, lies at (x0 + (i - 1) cell, y0 + (j - 1)
@@ -15,6 +16,7 @@
 #include <signal.h>
 #include <stdio.h>
 #include <string.h>
+#include <strings.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -130,9 +132,17 @@ static double check_coord(lua_State *L, int idx, const char *fname,
 
 /* ---- outcrop.heightfield.load ----------------------------------------- */
 
+/* Whether the path names a RAW 16-bit file (.r16, .raw): they have no
+** signature, so the name tells. */
+static int is_raw(const char *path) {
+  const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+  if (!dot || (slash && dot < slash)) return 0;
+  return !strcasecmp(dot, ".r16") || !strcasecmp(dot, ".raw");
+}
+
 static int l_load(lua_State *L) {
-  static const char *const known[] = {"cell", "scale", "offset", "origin",
-                                      NULL};
+  static const char *const known[] = {"cell",  "scale", "offset", "origin",
+                                      "range", "size",  NULL};
   const char *fname = "outcrop.heightfield.load";
   oclua_fields f;
   oc_error err = {OC_OK, ""};
@@ -143,9 +153,22 @@ static int l_load(lua_State *L) {
     oclua_error(L, fname, "the path must be a string (got %s)",
                 oclua_got(L, 1));
   oclua_checkargs(L, 2, fname,
-                  "(path [, {cell =, scale =, offset =, origin =}])");
+                  "(path [, {cell =, scale =, offset =, origin =, range =, "
+                  "size =}])");
   opt_table(L, 2);
   oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
+  int raw = is_raw(lua_tostring(L, 1));
+  double range[2];
+  int hasrange = oclua_field_numbers(&f, "range", 2, range, "must be {lo, hi}");
+  int hassize = oclua_field_push(&f, "size") != LUA_TNIL, nx = 0, ny = 0;
+  lua_pop(L, 1);
+  if ((hasrange || hassize) && !raw)
+    oclua_error(L, fname,
+                "'range' and 'size' apply to RAW files (.r16, .raw) only");
+  if (hassize) field_size(&f, &nx, &ny);
+  if (hasrange && !(range[0] <= range[1]))
+    oclua_error(L, fname, "'range' = {lo, hi} needs lo <= hi (got {%f, %f})",
+                (LUAI_UACNUMBER)range[0], (LUAI_UACNUMBER)range[1]);
   if (oclua_field_push(&f, "cell") != LUA_TNIL) p.given |= OC_HF_GIVE_CELL;
   lua_pop(L, 1);
   p.cell = oclua_field_optnumber(&f, "cell", OCLUA_POSITIVE, 1);
@@ -160,10 +183,19 @@ static int l_load(lua_State *L) {
     p.x0 = o[0];
     p.y0 = o[1];
   }
+  if (hasrange) {
+    if (p.given & (OC_HF_GIVE_SCALE | OC_HF_GIVE_OFFSET))
+      oclua_error(L, fname, "give either 'range' or 'scale' and 'offset'");
+    p.given |= OC_HF_GIVE_SCALE | OC_HF_GIVE_OFFSET;
+    p.scale = (range[1] - range[0]) / 65535.0;
+    p.offset = range[0];
+  }
   oclua_progress pl;
   p.progress = oclua_progress_start(L, &pl, fname); /* Ctrl-C while reading */
   oclua_heightfield *u = oclua_newheightfield(L);
-  oc_heightfield *hf = oc_heightfield_load(lua_tostring(L, 1), &p, &err);
+  oc_heightfield *hf =
+      raw ? oc_heightfield_load_raw(lua_tostring(L, 1), nx, ny, &p, &err)
+          : oc_heightfield_load(lua_tostring(L, 1), &p, &err);
   oclua_progress_end(&pl);
   return oclua_sethf(L, u, hf, &err, fname);
 }
@@ -521,8 +553,8 @@ static const char **provenance(lua_State *L, size_t *n) {
 }
 
 static int hf_save(lua_State *L) {
-  static const char *const known[] = {"bits", "scale", "offset", "palette",
-                                      NULL};
+  static const char *const known[] = {"bits",    "scale", "offset",
+                                      "palette", "range", NULL};
   const char *fname = "heightfield:save";
   oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
   oclua_fields f;
@@ -567,6 +599,17 @@ static int hf_save(lua_State *L) {
   lua_pop(L, 2);
   p.scale = oclua_field_optnumber(&f, "scale", OCLUA_POSITIVE, 1);
   p.offset = oclua_field_optnumber(&f, "offset", OCLUA_FINITE, 0);
+  double range[2];
+  if (oclua_field_numbers(&f, "range", 2, range, "must be {lo, hi}")) {
+    if (p.fixed)
+      oclua_error(L, fname, "give either 'range' or 'scale' and 'offset'");
+    if (!(range[0] < range[1]))
+      oclua_error(L, fname, "'range' = {lo, hi} needs lo < hi (got {%f, %f})",
+                  (LUAI_UACNUMBER)range[0], (LUAI_UACNUMBER)range[1]);
+    p.fixed = 1;
+    p.scale = (range[1] - range[0]) / (p.bits == 8 ? 255.0 : 65535.0);
+    p.offset = range[0];
+  }
   p.meta = provenance(L, &p.nmeta);
   oclua_target t;
   int e = oclua_output_target(L, fname, lua_tostring(L, 2), OCLUA_TARGET_CREATE,
@@ -581,9 +624,155 @@ static int hf_save(lua_State *L) {
           L, &t, err.msg[0] ? err.msg : "cannot write the heightfield");
     oclua_liberror(L, fname, &err);
   }
+  /* scale, offset, and the range the counts span (what a RAW file,
+  ** which keeps none, needs to be read back) */
   lua_pushnumber(L, used[0]);
   lua_pushnumber(L, used[1]);
-  return 2;
+  const char *dot = strrchr(lua_tostring(L, 2), '.');
+  int integer = p.bits == 8 || p.bits == 16 ||
+                (dot && (!strcasecmp(dot, ".png") || is_raw(dot)));
+  if (p.nstops > 0 || !integer) return 2;
+  lua_pushnumber(L, used[1]);
+  lua_pushnumber(L, used[1] + used[0] * (p.bits == 8 ? 255.0 : 65535.0));
+  return 4;
+}
+
+/* ---- arithmetic, clamp, mask, map --------------------------------------- */
+
+/* hf op hf2, hf op k, k op hf: a new grid. */
+static int hf_arith(lua_State *L, oc_hf_op op, const char *fname) {
+  int a = oclua_isheightfield(L, 1), b = oclua_isheightfield(L, 2);
+  oc_error err = {OC_OK, ""};
+  for (int k = 1; k <= 2; k++)
+    if (!oclua_isheightfield(L, k) && lua_type(L, k) != LUA_TNUMBER)
+      oclua_error(L, fname,
+                  "operand %d must be a heightfield or a number (got %s)", k,
+                  oclua_got(L, k));
+  /* pinned: making the result may run finalizers that close them */
+  oc_heightfield *ha = a ? oclua_pinheightfield(L, 1, fname) : NULL;
+  oc_heightfield *hb = b ? oclua_pinheightfield(L, 2, fname) : NULL;
+  double k = a && b ? 0 : check_coord(L, a ? 2 : 1, fname, "the number");
+  if (!a && op == OC_HF_SUB) op = OC_HF_RSUB;
+  oclua_heightfield *u = oclua_newheightfield(L);
+  oc_heightfield *out = a && b
+                            ? oc_heightfield_combine(ha, hb, op, &err)
+                            : oc_heightfield_scalar(a ? ha : hb, k, op, &err);
+  return oclua_sethf(L, u, out, &err, fname);
+}
+
+static int hf_add(lua_State *L) {
+  return hf_arith(L, OC_HF_ADD, "heightfield +");
+}
+static int hf_sub(lua_State *L) {
+  return hf_arith(L, OC_HF_SUB, "heightfield -");
+}
+static int hf_mul(lua_State *L) {
+  return hf_arith(L, OC_HF_MUL, "heightfield *");
+}
+static int hf_unm(lua_State *L) {
+  const char *fname = "heightfield unary -";
+  oc_error err = {OC_OK, ""};
+  oc_heightfield *hf = oclua_pinheightfield(L, 1, fname);
+  oclua_heightfield *u = oclua_newheightfield(L);
+  return oclua_sethf(L, u, oc_heightfield_scalar(hf, -1, OC_HF_MUL, &err), &err,
+                     fname);
+}
+
+/* clamp(lo, hi) or clamp{lo =, hi =}: either bound may be left out
+** (nil) in the table form. */
+static int hf_clamp(lua_State *L) {
+  static const char *const known[] = {"lo", "hi", NULL};
+  const char *fname = "heightfield:clamp";
+  oc_error err = {OC_OK, ""};
+  oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
+  double lo, hi;
+  if (lua_type(L, 2) == LUA_TTABLE) {
+    oclua_fields f;
+    oclua_checkargs(L, 2, fname, "(lo, hi) or {lo =, hi =}");
+    oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
+    lo = oclua_field_optnumber(&f, "lo", OCLUA_FINITE, -HUGE_VAL);
+    hi = oclua_field_optnumber(&f, "hi", OCLUA_FINITE, HUGE_VAL);
+  } else {
+    oclua_checkargs(L, 3, fname, "(lo, hi) or {lo =, hi =}");
+    lo = check_coord(L, 2, fname, "lo");
+    hi = check_coord(L, 3, fname, "hi");
+  }
+  if (!(lo <= hi))
+    oclua_error(L, fname, "needs lo <= hi (got %f, %f)", (LUAI_UACNUMBER)lo,
+                (LUAI_UACNUMBER)hi);
+  hf = oclua_pinheightfield(L, 1, fname);
+  oclua_heightfield *u = oclua_newheightfield(L);
+  return oclua_sethf(L, u, oc_heightfield_clamp(hf, lo, hi, &err), &err, fname);
+}
+
+static int hf_mask(lua_State *L) {
+  static const char *const known[] = {"above", "below", "falloff", NULL};
+  const char *fname = "heightfield:mask";
+  oc_error err = {OC_OK, ""};
+  oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
+  oclua_fields f;
+  oc_hf_mask_params mp;
+  memset(&mp, 0, sizeof mp);
+  oclua_checkargs(L, 2, fname, "{above =, below =, falloff =}");
+  oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
+  mp.has_above = oclua_field_push(&f, "above") != LUA_TNIL;
+  mp.has_below = oclua_field_push(&f, "below") != LUA_TNIL;
+  lua_pop(L, 2);
+  mp.above = oclua_field_optnumber(&f, "above", OCLUA_FINITE, 0);
+  mp.below = oclua_field_optnumber(&f, "below", OCLUA_FINITE, 0);
+  mp.falloff = oclua_field_optnumber(&f, "falloff", OCLUA_FINITE, 0);
+  if (mp.falloff < 0)
+    oclua_error(L, fname, "'falloff' must be >= 0 (got %f)",
+                (LUAI_UACNUMBER)mp.falloff);
+  if (!mp.has_above && !mp.has_below)
+    oclua_error(L, fname, "give 'above', 'below' or both");
+  hf = oclua_pinheightfield(L, 1, fname);
+  oclua_heightfield *u = oclua_newheightfield(L);
+  return oclua_sethf(L, u, oc_heightfield_mask(hf, &mp, &err), &err, fname);
+}
+
+/* map(fn): fn(z, x, y) for every sample, rows from j = 1 up, serially,
+** into a new grid. The source is pinned while fn runs (fn may close it
+** or drop every reference to it), and read through the pin. */
+static int hf_map(lua_State *L) {
+  const char *fname = "heightfield:map";
+  oc_error err = {OC_OK, ""};
+  oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
+  oclua_checkargs(L, 2, fname, "(function (z, x, y) -> z)");
+  if (lua_type(L, 2) != LUA_TFUNCTION)
+    oclua_error(L, fname, "argument #1 must be a function (got %s)",
+                oclua_got(L, 2));
+  hf = oclua_pinheightfield(L, 1, fname);
+  int nx = oc_heightfield_nx(hf), ny = oc_heightfield_ny(hf);
+  double x0, y0, cell = oc_heightfield_cell(hf);
+  oc_heightfield_origin(hf, &x0, &y0);
+  oclua_heightfield *u = oclua_newheightfield(L);
+  int ud = lua_gettop(L);
+  u->hf = oc_heightfield_new(nx, ny, cell, x0, y0, NULL, &err);
+  if (u->hf == NULL) oclua_liberror(L, fname, &err);
+  const float *zin = oc_heightfield_samples(hf);
+  float *z = oc_heightfield_samples_mut(u->hf);
+  for (int j = 0; j < ny; j++)
+    for (int i = 0; i < nx; i++) {
+      size_t k = (size_t)j * (size_t)nx + (size_t)i;
+      lua_pushvalue(L, 2);
+      lua_pushnumber(L, zin[k]);
+      lua_pushnumber(L, x0 + i * cell);
+      lua_pushnumber(L, y0 + j * cell);
+      lua_call(L, 3, 1);
+      double v = lua_tonumber(L, -1);
+      if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(v) || fabs(v) > 3.4e38)
+        oclua_error(L, fname,
+                    "the function must return a finite elevation (got %s at "
+                    "sample (%d, %d), x = %f, y = %f)",
+                    oclua_got(L, -1), i + 1, j + 1,
+                    (LUAI_UACNUMBER)(x0 + i * cell),
+                    (LUAI_UACNUMBER)(y0 + j * cell));
+      z[k] = (float)v;
+      lua_pop(L, 1);
+    }
+  lua_settop(L, ud);
+  return 1;
 }
 
 /* ---- metamethods --------------------------------------------------------- */
@@ -618,12 +807,17 @@ static const luaL_Reg hf_methods[] = {
     {"min", hf_min},       {"max", hf_max},
     {"sum", hf_sum},       {"resample", hf_resample},
     {"crop", hf_crop},     {"save", hf_save},
-    {NULL, NULL}};
+    {"clamp", hf_clamp},   {"mask", hf_mask},
+    {"map", hf_map},       {NULL, NULL}};
 
 static const luaL_Reg hf_meta[] = {
     {"__gc", hf_gc},
     {"__close", hf_gc}, /* `local hf <close>` frees the samples early */
     {"__tostring", hf_tostring},
+    {"__add", hf_add},
+    {"__sub", hf_sub},
+    {"__mul", hf_mul},
+    {"__unm", hf_unm},
     {NULL, NULL}};
 
 static const luaL_Reg hf_funcs[] = {

@@ -446,6 +446,9 @@ static int l_polygonize(lua_State *L) {
   pp.full_grid = full_grid;
   pp.max_triangles = (size_t)max_tri;
   pp.min_component = (size_t)min_comp;
+  char warning[300];
+  pp.warning = warning;
+  pp.warning_size = sizeof warning;
   pp.progress = oclua_progress_start(L, &pl, fname);
   /* The userdata first, so that nothing can leak once the mesh exists. */
   oclua_mesh *u = newmesh(L);
@@ -455,6 +458,7 @@ static int l_polygonize(lua_State *L) {
   if (u->mesh == NULL && err.code == OC_ECANCEL)
     return luaL_error(L, "interrupted");
   if (u->mesh == NULL) oclua_liberror(L, fname, &err);
+  if (warning[0]) oclua_warn(L, fname, "%s", warning);
   apply_colors(L, u, &c, fname);
   lua_pushvalue(L, midx);
   return 1;

@@ -13,6 +13,10 @@
 **   thickness  | 0: how much farther than the elevations the prism reaches
 **              | on the solid side (below; above when inverted)
 **   invert     | false: solid above the surface instead of below
+**   edges      | "open" (no mask): the solid is cut at the grid's vertical
+**              | sides, the surface the grid's up to its border samples;
+**              | "slab": the paper's prism, falling off over 'falloff'
+**              | inside the grid's sides (a mask always gives a slab)
 **
 ** The table is optional. Everything is checked before anything is made;
 ** the node keeps the grid alive.
@@ -55,12 +59,13 @@ static oc_heightfield *mask_from_path(lua_State *L, const char *fname,
 }
 
 static int l_terrain(lua_State *L) {
-  static const char *const known[] = {"falloff", "transition", "thickness",
-                                      "mask",    "invert",     NULL};
+  static const char *const known[] = {
+      "falloff", "transition", "thickness", "mask", "invert", "edges", NULL};
+  static const char *const edges[] = {"open", "slab", NULL};
   const char *fname = "outcrop.terrain";
   oclua_checkargs(L, 2, fname,
-                  "(heightfield [, {falloff=, transition=, "
-                  "mask=, invert=}])");
+                  "(heightfield [, {falloff=, transition=, thickness=, "
+                  "mask=, invert=, edges=}])");
   oclua_checkheightfield(L, 1, fname);
   lua_settop(L, 2);
   /* pinned: the options' metamethods and finalizers may close it */
@@ -79,6 +84,10 @@ static int l_terrain(lua_State *L) {
     if (tp.thickness < 0)
       oclua_error(L, fname, "'thickness' must be >= 0 (got %f)", tp.thickness);
     tp.invert = oclua_field_optbool(&f, "invert", 0);
+    int given = oclua_field_push(&f, "edges") != LUA_TNIL;
+    lua_pop(L, 1);
+    int e = oclua_field_optoption(&f, "edges", edges, 0);
+    if (given) tp.edges = e == 0 ? OC_TERRAIN_OPEN : OC_TERRAIN_SLAB;
     /* The value stays on the stack (an __index may have made it) and a
     ** grid is pinned until the node has retained it. */
     int t = oclua_field_push(&f, "mask");

@@ -7,6 +7,7 @@
 */
 #include <math.h>
 #include <stdarg.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "l_util.h"
@@ -37,6 +38,24 @@ int oclua_error(lua_State *L, const char *fname, const char *fmt, ...) {
   va_end(ap);
   lua_concat(L, 4);
   return lua_error(L);
+}
+
+/* Warnings go to stderr at once, whatever lua_setwarnf does (stock
+** lua5.4 shows none until warn("@on")): a script that made an empty mesh
+** should hear why. */
+void oclua_warn(lua_State *L, const char *fname, const char *fmt, ...) {
+  va_list ap;
+  luaL_checkstack(L, 4, NULL);
+  where(L);
+  lua_pushstring(L, fname);
+  lua_pushliteral(L, ": ");
+  va_start(ap, fmt);
+  lua_pushvfstring(L, fmt, ap);
+  va_end(ap);
+  lua_concat(L, 4);
+  fprintf(stderr, "outcrop: warning: %s\n", lua_tostring(L, -1));
+  fflush(stderr);
+  lua_pop(L, 1);
 }
 
 int oclua_liberror(lua_State *L, const char *fname, const oc_error *err) {

@@ -36,6 +36,8 @@ typedef struct oclua_fields {
 
 /* Raises "where: fname: message"; `fmt` as for lua_pushfstring. */
 int oclua_error(lua_State *L, const char *fname, const char *fmt, ...);
+/* "outcrop: warning: file:line: fname: message" on stderr. */
+void oclua_warn(lua_State *L, const char *fname, const char *fmt, ...);
 /* Raises with a library error message, prefixed with fname. */
 int oclua_liberror(lua_State *L, const char *fname, const oc_error *err);
 /* Pushes and returns a short description of a value for "(got ...)":

@@ -467,8 +467,12 @@ static double op_lip(const oc_program *P, uint32_t i, const oc_aabb *b,
     if (r > 0 && box_far2(b, cx, cy, cz) < r * r * (1 - 1e-9)) return 0;
     return o->lip;
   }
-  case OC_K_TERRAIN:
-    return fmin(oc_terrain_lipschitz_in(P->terr[o->kid], par, b), o->lip);
+  case OC_K_TERRAIN: {
+    /* infinite across the sides of open edges, where f jumps: the global
+    ** bound holds only off them */
+    double l = oc_terrain_lipschitz_in(P->terr[o->kid], par, b);
+    return isinf(l) ? l : fmin(l, o->lip);
+  }
   case OC_K_CLAMP:
   case OC_K_FAULT:
   case OC_K_EROSION:

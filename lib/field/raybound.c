@@ -277,7 +277,9 @@ static void op_db(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
     oc_vec3 a = oc_add(r->o, oc_mul(r->u, t0));
     oc_vec3 b = oc_add(r->o, oc_mul(r->u, t1));
     oc_aabb box = {oc_vmin(a, b), oc_vmax(a, b)};
-    double k = fmin(oc_op_lipschitz_in(P, i, &box) * (1 + REL), o->lip);
+    /* infinite across a jump (an open terrain's side): no step over it */
+    double l = oc_op_lipschitz_in(P, i, &box);
+    double k = isinf(l) ? l : fmin(l * (1 + REL), o->lip);
     *lo -= k;
     *hi += k;
     return;

@@ -18,6 +18,7 @@
 #include "mesh/mcgrid.h"
 #include "mesh/mcwork.h"
 #include "mesh/mesh.h"
+#include "terrain/terrain.h"
 
 #define MAX_AXIS (1 << 20)
 #define MAX_CUBES ((double)(1ull << 40))
@@ -375,5 +376,10 @@ oc_mesh *oc_polygonize(const oc_program *prog, const oc_polygonize_params *pp,
   }
   oc_mc_surfaces_free(&g);
   if (m) m->stats.seconds = omp_get_wtime() - t0;
+  if (pp->warning && pp->warning_size) {
+    pp->warning[0] = '\0';
+    if (m && oc_mesh_triangle_count(m) == 0)
+      oc_terrain_thin_reason(prog, g.h[2], pp->warning, pp->warning_size);
+  }
   return m;
 }

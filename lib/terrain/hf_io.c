@@ -8,7 +8,10 @@
 ** significant digits, so that a saved grid loads back to exactly the
 ** quantized elevations and a float file to exactly its floats.
 */
+#include <errno.h>
 #include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -18,6 +21,7 @@
 
 #include "core/error.h"
 #include "core/palette.h"
+#include "io/atomic.h"
 #include "io/metatext.h"
 #include "io/oiio.h"
 #include "io/oiio_hf.h"
@@ -174,17 +178,135 @@ oc_heightfield *oc_heightfield_load(const char *path,
   return ld.hf;
 }
 
+/* ---- RAW ----------------------------------------------------------------- */
+
+oc_heightfield *oc_heightfield_load_raw(const char *path, int nx, int ny,
+                                        const oc_hf_load_params *p,
+                                        oc_error *err) {
+  oc_hf_load_params d = {0, 1, 1, 0, 0, 0, {NULL, NULL}};
+  if (!p) p = &d;
+  if (!path || !*path) {
+    oc_seterr(err, OC_EINVAL, "'path' must be a non-empty file name");
+    return NULL;
+  }
+  double cell = p->given & OC_HF_GIVE_CELL ? p->cell : 1;
+  double scale = p->given & OC_HF_GIVE_SCALE ? p->scale : 1;
+  double offset = p->given & OC_HF_GIVE_OFFSET ? p->offset : 0;
+  double x0 = p->given & OC_HF_GIVE_ORIGIN ? p->x0 : 0;
+  double y0 = p->given & OC_HF_GIVE_ORIGIN ? p->y0 : 0;
+  if (!isfinite(scale) || !isfinite(offset)) {
+    oc_seterr(err, OC_EINVAL,
+              "cannot load '%s': 'scale' and 'offset' must be finite", path);
+    return NULL;
+  }
+  if ((nx != 0 || ny != 0) && (nx < 2 || ny < 2)) {
+    oc_seterr(err, OC_EINVAL,
+              "cannot load '%s': 'size' must be at least 2 x 2 (got %d x %d)",
+              path, nx, ny);
+    return NULL;
+  }
+  /* only a regular file: a FIFO or a device must not block or stream */
+  int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  struct stat st;
+  if (fd < 0 || fstat(fd, &st) != 0) {
+    oc_seterr(err, OC_EIO, "cannot load '%s': %s", path, strerror(errno));
+    if (fd >= 0) close(fd);
+    return NULL;
+  }
+  if (!S_ISREG(st.st_mode)) {
+    close(fd);
+    oc_seterr(err, OC_EIO, "cannot load '%s': not a regular file", path);
+    return NULL;
+  }
+  unsigned long long bytes = (unsigned long long)st.st_size;
+  if (nx == 0) {
+    /* square: 2 n^2 bytes */
+    unsigned long long n = bytes / 2, s = (unsigned long long)sqrt((double)n);
+    while (s * s > n)
+      s--;
+    while ((s + 1) * (s + 1) <= n)
+      s++;
+    if (bytes % 2 || s * s != n || s < 2 || s > 65535) {
+      close(fd);
+      oc_seterr(err, OC_EINVAL,
+                "cannot load '%s': %llu bytes are not a square grid of "
+                "16-bit samples: give 'size' = {nx, ny}",
+                path, bytes);
+      return NULL;
+    }
+    nx = ny = (int)s;
+  }
+  if (bytes != 2ull * (unsigned long long)nx * (unsigned long long)ny) {
+    close(fd);
+    oc_seterr(err, OC_EINVAL,
+              "cannot load '%s': it has %llu bytes, %d x %d 16-bit samples "
+              "need %llu",
+              path, bytes, nx, ny,
+              2ull * (unsigned long long)nx * (unsigned long long)ny);
+    return NULL;
+  }
+  oc_error e = {OC_OK, ""};
+  oc_heightfield *hf = oc_heightfield_new(nx, ny, cell, x0, y0, NULL, &e);
+  if (!hf) {
+    close(fd);
+    oc_seterr(err, e.code, "cannot load '%s': %s", path, e.msg);
+    return NULL;
+  }
+  float *z = oc_heightfield_samples_mut(hf);
+  unsigned char buf[8192];
+  size_t k = 0, n = (size_t)nx * (size_t)ny;
+  int bad = 0;
+  while (k < n && !bad) {
+    size_t want = (n - k) * 2 < sizeof buf ? (n - k) * 2 : sizeof buf;
+    ssize_t got = read(fd, buf, want);
+    if (got < 0 && errno == EINTR) continue;
+    if (got <= 0 || got % 2) {
+      /* a file that shrank, or an odd read: refuse rather than guess */
+      bad = 1;
+      break;
+    }
+    for (ssize_t b = 0; b < got; b += 2) {
+      size_t r = k / (size_t)nx, i = k % (size_t)nx;
+      /* image order: the first row is the grid's last (north up) */
+      size_t at = ((size_t)ny - 1 - r) * (size_t)nx + i;
+      double q = buf[b] | (unsigned)buf[b + 1] << 8;
+      z[at] = (float)(q * scale + offset);
+      if (!isfinite(z[at])) bad = 2;
+      k++;
+    }
+    if (p->progress.fn && p->progress.fn(p->progress.ud, (double)k / n)) {
+      close(fd);
+      oc_heightfield_release(hf);
+      oc_seterr(err, OC_ECANCEL, "loading '%s' cancelled", path);
+      return NULL;
+    }
+  }
+  close(fd);
+  if (bad) {
+    oc_heightfield_release(hf);
+    if (bad == 2)
+      oc_seterr(err, OC_EINVAL,
+                "cannot load '%s': 'scale' %g and 'offset' %g give "
+                "elevations beyond float range",
+                path, scale, offset);
+    else
+      oc_seterr(err, OC_EIO, "cannot load '%s': short read", path);
+    return NULL;
+  }
+  return hf;
+}
+
 /* ---- saving ------------------------------------------------------------ */
 
-typedef enum kind { PNG, TIFF, EXR } kind;
+typedef enum kind { PNG, TIFF, EXR, RAW } kind;
 
 static const struct {
   const char *ext;
   kind kind;
-} extensions[] = {
-    {".png", PNG}, {".tif", TIFF}, {".tiff", TIFF}, {".exr", EXR}};
+} extensions[] = {{".png", PNG}, {".tif", TIFF}, {".tiff", TIFF},
+                  {".exr", EXR}, {".r16", RAW},  {".raw", RAW}};
 
-static const char *const oiio_names[] = {"png", "tiff", "openexr"};
+static const char *const oiio_names[] = {"png", "tiff", "openexr", "raw"};
 
 static int file_kind(const char *path) {
   const char *slash = strrchr(path, '/');
@@ -209,12 +331,14 @@ static int sample_type(kind k, int bits) {
     return bits == 0 || bits == 32 ? OC_OIIO_F32
            : bits == 16            ? OC_OIIO_HALF
                                    : -1;
+  case RAW:
+    return bits == 0 || bits == 16 ? OC_OIIO_U16 : -1;
   }
   return -1;
 }
 
 static const char *const bits_allowed[] = {"8 or 16", "16 or 32",
-                                           "16 (half) or 32 (float)"};
+                                           "16 (half) or 32 (float)", "16"};
 
 /* The counts of an integer file, in image order (top row first). */
 static void *quantize(const oc_heightfield *hf, int type, double scale,
@@ -320,6 +444,26 @@ static int save_colors(const oc_heightfield *hf, int dir, const char *path,
   return rc;
 }
 
+/* RAW: the counts as little-endian uint16, image order, no header (the
+** layout of Unity's and Unreal's .r16 / .raw heightmaps). */
+static int write_raw(const uint16_t *q, size_t n, int dir, const char *path,
+                     oc_error *err) {
+  oc_atomic a;
+  int rc = oc_atomic_begin_at(&a, dir, path, err);
+  if (rc != OC_OK) return rc;
+  unsigned char buf[8192];
+  size_t used = 0;
+  for (size_t k = 0; k < n; k++) {
+    buf[used++] = (unsigned char)(q[k] & 0xff);
+    buf[used++] = (unsigned char)(q[k] >> 8);
+    if (used == sizeof buf || k + 1 == n) {
+      oc_atomic_write(&a, buf, used);
+      used = 0;
+    }
+  }
+  return oc_atomic_commit(&a, err);
+}
+
 int oc_heightfield_save(const oc_heightfield *hf, const char *path,
                         const oc_hf_save_params *p, double used[2],
                         oc_error *err) {
@@ -338,7 +482,7 @@ int oc_heightfield_save_at(const oc_heightfield *hf, int dir, const char *path,
   if (k < 0)
     return oc_seterr(err, OC_EINVAL,
                      "cannot write '%s': unknown heightfield format (use "
-                     ".png, .tif, .tiff or .exr)",
+                     ".png, .tif, .tiff, .exr, .r16 or .raw)",
                      path);
   if (p->nstops > 0) {
     int rc = save_colors(hf, dir, path, k, p, err);
@@ -375,6 +519,14 @@ int oc_heightfield_save_at(const oc_heightfield *hf, int dir, const char *path,
   void *px = integer ? quantize(hf, type, scale, offset, p->fixed, path, err)
                      : (void *)flipped(hf, path, err);
   if (!px) return err ? err->code : OC_ENOMEM;
+  if (k == RAW) {
+    int rc = write_raw(
+        px, (size_t)oc_heightfield_nx(hf) * (size_t)oc_heightfield_ny(hf), dir,
+        path, err);
+    free(px);
+    if (rc == OC_OK && used) used[0] = scale, used[1] = offset;
+    return rc;
+  }
 
   double x0, y0;
   oc_heightfield_origin(hf, &x0, &y0);

@@ -13,12 +13,14 @@
 ** overshoots 2T and stops being monotone, so k is capped at 3.
 */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
 #include "core/falloff.h"
 #include "field/node.h"
+#include "field/program.h"
 #include "terrain/terrain.h"
 
 /* g(x) = 1/2: where f_P = 2T g crosses T. sqrt(1 - 2^(-1/3)). */
@@ -82,6 +84,13 @@ static double prism_dist(const oc_tdata *t, oc_vec3 p, oc_vec3 *g) {
       gx = dh * gh[0];
       gy = dh * gh[1];
     }
+  } else if (t->open) {
+    /* inside the domain (sides included) f_P depends on z alone; off it
+    ** f = 0: an infinite distance */
+    if (!(p.x >= t->sx0 && p.x <= t->sx1 && p.y >= t->sy0 && p.y <= t->sy1))
+      d2 = INFINITY;
+    else
+      d2 = dz * dz;
   } else {
     double ax = 0, ay = 0;
     if (p.x < t->ix0)
@@ -157,7 +166,9 @@ oc_aabb oc_terrain_box(const oc_tdata *t) {
 
 static double lip_prism(const oc_tdata *t, const double *par) {
   /* |grad d| <= max(|grad d_h|, 1): sqrt 2 for the bilinear mask
-  ** distance (with a margin for its single-precision nodes), 1 else */
+  ** distance (with a margin for its single-precision nodes), 1 else (open
+  ** edges: d varies along z alone, and the jump at the sides is no
+  ** derivative: oc_terrain_lipschitz_in answers for boxes across them) */
   double ld = t->dist ? sqrt(2.0) * (1 + 1e-6) : 1;
   return 2 * par[OC_TPAR_T] * OC_FALLOFF_LIPSCHITZ / t->R * ld;
 }
@@ -182,7 +193,11 @@ static void foot_prism(const oc_tdata *t, double x0, double y0, double x1,
     return;
   }
   *inside = x0 >= t->ix0 && x1 <= t->ix1 && y0 >= t->iy0 && y1 <= t->iy1;
-  *outside = x1 <= t->sx0 || x0 >= t->sx1 || y1 <= t->sy0 || y0 >= t->sy1;
+  /* open edges: f != 0 on the sides themselves */
+  if (t->open)
+    *outside = x1 < t->sx0 || x0 > t->sx1 || y1 < t->sy0 || y0 > t->sy1;
+  else
+    *outside = x1 <= t->sx0 || x0 >= t->sx1 || y1 <= t->sy0 || y0 >= t->sy1;
 }
 
 double oc_terrain_lipschitz_in(const oc_tdata *t, const double *par,
@@ -195,6 +210,13 @@ double oc_terrain_lipschitz_in(const oc_tdata *t, const double *par,
   t->src.range(t->src.ud, b->lo.x, b->lo.y, b->hi.x, b->hi.y, &hlo, &hhi);
   /* f_T is 0 on the whole box: so is f */
   if (t->invert ? b->hi.z <= hlo - W : b->lo.z >= hhi + W) return 0;
+  /* open edges: across a side f jumps from 0 to up to 2T, which no
+  ** finite bound covers (callers then take small steps, or none) */
+  if (t->open && !inside) {
+    oc_aabb s = oc_terrain_box(t);
+    if (b->hi.z < s.lo.z || b->lo.z > s.hi.z) return 0;
+    return INFINITY;
+  }
   double lt = 0, lp = 0;
   if (b->hi.z > hlo - W && b->lo.z < hhi + W)
     lt = lip_surface(
@@ -233,6 +255,31 @@ int oc_terrain_spans(const oc_tdata *t, const double *par, double x0, double y0,
     if (b[k].lo <= b[k].hi) add(S, b[k].lo, b[k].hi);
   }
   return inside;
+}
+
+/* ---- empty meshes ------------------------------------------------------ */
+
+int oc_terrain_thin_reason(const struct oc_program *P, double cell, char *buf,
+                           size_t n) {
+  for (uint32_t i = 0; i < P->nops; i++) {
+    if (P->ops[i].kind != OC_K_TERRAIN) continue;
+    const oc_tdata *t = P->terr[P->ops[i].kid];
+    /* the solid ends at the cap, X_HALF R past [zlo, zhi] on its side:
+    ** thinnest under the lowest elevation (over the highest inverted) */
+    double lo, hi;
+    t->src.range(t->src.ud, t->sx0, t->sy0, t->sx1, t->sy1, &lo, &hi);
+    double solid =
+        t->invert ? oc_terrain_cap_z(t) - hi : lo - oc_terrain_cap_z(t);
+    if (solid < cell) {
+      snprintf(buf, n,
+               "the terrain's solid is %g thick where thinnest (%g x "
+               "'falloff' %g + 'thickness' %g), less than the cell %g: "
+               "give a larger 'falloff' or a 'thickness'",
+               solid, X_HALF, t->R, solid - X_HALF * t->R, cell);
+      return 1;
+    }
+  }
+  return 0;
 }
 
 /* ---- construction ----------------------------------------------------- */
@@ -274,8 +321,21 @@ oc_node *oc_terrain(const oc_elevation *src, const oc_terrain_params *tp,
               tp->thickness);
     return NULL;
   }
+  if (tp->edges != OC_TERRAIN_EDGES_DEFAULT && tp->edges != OC_TERRAIN_OPEN &&
+      tp->edges != OC_TERRAIN_SLAB) {
+    oc_seterr(err, OC_EINVAL, "'edges' must be open or slab (got %d)",
+              tp->edges);
+    return NULL;
+  }
+  if (tp->mask && tp->edges == OC_TERRAIN_OPEN) {
+    oc_seterr(err, OC_EINVAL,
+              "'edges' = open does not apply with a mask: the mask's "
+              "domain falls off over 'falloff' (use edges = slab or none)");
+    return NULL;
+  }
+  int open = !tp->mask && tp->edges != OC_TERRAIN_SLAB;
   double wx = src->x1 - src->x0, wy = src->y1 - src->y0;
-  if (!tp->mask && !(2 * R < wx && 2 * R < wy)) {
+  if (!open && !tp->mask && !(2 * R < wx && 2 * R < wy)) {
     oc_seterr(err, OC_EINVAL,
               "'falloff' %g must be less than half the domain's width "
               "(%g x %g)",
@@ -306,10 +366,12 @@ oc_node *oc_terrain(const oc_elevation *src, const oc_terrain_params *tp,
   t->zlo = t->invert ? lo : lo - tp->thickness;
   t->zhi = t->invert ? hi + tp->thickness : hi;
   t->slope = slope;
-  t->ix0 = src->x0 + R;
-  t->iy0 = src->y0 + R;
-  t->ix1 = src->x1 - R;
-  t->iy1 = src->y1 - R;
+  t->open = open;
+  double in = open ? 0 : R;
+  t->ix0 = src->x0 + in;
+  t->iy0 = src->y0 + in;
+  t->ix1 = src->x1 - in;
+  t->iy1 = src->y1 - in;
   t->sx0 = src->x0;
   t->sy0 = src->y0;
   t->sx1 = src->x1;

@@ -19,8 +19,9 @@ typedef struct oc_tdata {
   oc_elevation src; /* retained */
   double R, W;      /* prism falloff, half-width of sigma */
   int invert;
-  double zlo, zhi;           /* the prism's z-range: range of h */
-  double ix0, iy0, ix1, iy1; /* no mask: Omega shrunk by R */
+  int open;        /* open edges: f = 0 off the domain, no horizontal falloff */
+  double zlo, zhi; /* the prism's z-range: range of h */
+  double ix0, iy0, ix1, iy1; /* no mask: Omega shrunk by R (open: Omega) */
   double sx0, sy0, sx1, sy1; /* where f_P may be > 0 */
   double slope;              /* bound of |grad h| over the domain */
   float *dist;               /* mask: distance to Omega shrunk by R */
@@ -61,6 +62,12 @@ int oc_terrain_spans(const oc_tdata *t, const double *par, double x0, double y0,
 double oc_terrain_column_value(const oc_tdata *t, const double *par, double h,
                                double z);
 double oc_terrain_cap_z(const oc_tdata *t);
+
+/* When the terrains of P leave nothing to mesh at cells of size `cell`
+** (a solid thinner than a cell: a small falloff and no thickness), a
+** sentence saying so in buf and 1; else 0. */
+int oc_terrain_thin_reason(const struct oc_program *P, double cell, char *buf,
+                           size_t n);
 
 /* terrain_mask.c: the distance grid of a mask, and its queries. */
 int oc_terrain_mask(oc_tdata *t, const oc_heightfield *mask, oc_error *err);

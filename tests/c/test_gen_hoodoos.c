@@ -314,7 +314,7 @@ START_TEST(test_counts_match_tree) {
   oc_heightfield *hf = hills(101);
   oc_elevation src;
   ck_assert_int_eq(oc_heightfield_elevation(hf, &src, NULL), OC_OK);
-  oc_terrain_params tp = {4, 1, 0, 0, NULL};
+  oc_terrain_params tp = {4, 1, 0, 0, NULL, OC_TERRAIN_SLAB};
   oc_node *ter = oc_terrain(&src, &tp, NULL);
   src.release(src.ud);
   oc_gen_hoodoos_params p;

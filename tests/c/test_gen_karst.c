@@ -249,7 +249,7 @@ START_TEST(node_carves) {
   p.max_primitives = 400;
   oc_elevation src;
   ck_assert_int_eq(oc_heightfield_elevation(hf, &src, NULL), OC_OK);
-  oc_terrain_params tp = {8, 1, 0, 0, NULL};
+  oc_terrain_params tp = {8, 1, 0, 0, NULL, OC_TERRAIN_SLAB};
   oc_node *terr = OCT_OK(oc_terrain(&src, &tp, NULL));
   src.release(src.ud);
   p.terrain = terr;

@@ -740,6 +740,145 @@ START_TEST(hostile_files) {
 }
 END_TEST
 
+/* RAW 16-bit: little-endian counts, the grid's last row first, exactly
+** the PNG's counts; loads back with the range, a square inferred; a size
+** that does not fit, a FIFO and a folder are refused. */
+START_TEST(raw16_round_trip) {
+  const char *dir = oct_tmpdir("raw");
+  oc_heightfield *hf = wavy(37, 23, 2, 9);
+  double used[2], upng[2];
+  const char *raw = oct_in_dir(dir, "h.r16");
+  save_ok(hf, raw, NULL, used);
+  char png[4096];
+  snprintf(png, sizeof png, "%s", oct_in_dir(dir, "h.png"));
+  save_ok(hf, png, NULL, upng);
+  ck_assert(used[0] == upng[0] && used[1] == upng[1]);
+  size_t n;
+  unsigned char *b = (unsigned char *)slurp(raw, &n);
+  ck_assert_uint_eq(n, 2 * 37 * 23);
+  oc_heightfield *p16 = load_ok(png, NULL);
+  double lo, hi;
+  oc_heightfield_minmax(hf, &lo, &hi);
+  const float *z = oc_heightfield_samples(hf);
+  for (int r = 0; r < 23; r++)
+    for (int i = 0; i < 37; i++) {
+      unsigned q = b[2 * (r * 37 + i)] | (unsigned)b[2 * (r * 37 + i) + 1] << 8;
+      double zz = z[(22 - r) * 37 + i];
+      ck_assert_uint_eq(q, (unsigned)floor((zz - lo) / used[0] + 0.5));
+      /* the PNG holds the same counts: the same elevations once loaded */
+      ck_assert(fabs(q * used[0] + used[1] -
+                     oc_heightfield_samples(p16)[(22 - r) * 37 + i]) < 1e-3);
+    }
+  free(b);
+  oc_hf_load_params lp = {OC_HF_GIVE_SCALE | OC_HF_GIVE_OFFSET |
+                              OC_HF_GIVE_CELL,
+                          2,
+                          used[0],
+                          used[1],
+                          0,
+                          0,
+                          {NULL, NULL}};
+  oc_error e = {0};
+  oc_heightfield *back = oc_heightfield_load_raw(raw, 37, 23, &lp, &e);
+  ck_assert_msg(back != NULL, "%s", e.msg);
+  for (size_t k = 0; k < 37 * 23; k++)
+    ck_assert(fabs(oc_heightfield_samples(back)[k] - z[k]) <= used[0]);
+  /* saved again with the same range: the same bytes */
+  oc_hf_save_params fixed = {0, 1, used[0], used[1], NULL, 0, NULL, 0};
+  const char *raw2 = oct_in_dir(dir, "again.raw");
+  save_ok(back, raw2, &fixed, NULL);
+  size_t n1, n2;
+  char *b1 = slurp(raw, &n1), *b2 = slurp(raw2, &n2);
+  ck_assert(n1 == n2 && !memcmp(b1, b2, n1));
+  free(b1);
+  free(b2);
+  /* errors */
+  ck_assert(oc_heightfield_load_raw(raw, 0, 0, NULL, &e) == NULL);
+  ck_assert(e.code == OC_EINVAL && strstr(e.msg, "square"));
+  ck_assert(oc_heightfield_load_raw(raw, 23, 37 + 1, NULL, &e) == NULL);
+  ck_assert(e.code == OC_EINVAL && strstr(e.msg, "bytes"));
+  ck_assert(oc_heightfield_load_raw(dir, 0, 0, NULL, &e) == NULL);
+  ck_assert(e.code == OC_EIO && strstr(e.msg, "regular"));
+  lp.scale = NAN;
+  ck_assert(oc_heightfield_load_raw(raw, 37, 23, &lp, &e) == NULL);
+  ck_assert(e.code == OC_EINVAL && strstr(e.msg, "scale"));
+  oc_hf_save_params b8 = {8, 0, 1, 0, NULL, 0, NULL, 0};
+  ck_assert_int_eq(oc_heightfield_save(hf, raw2, &b8, NULL, &e), OC_EINVAL);
+  ck_assert(strstr(e.msg, "'bits'"));
+  /* a square: inferred */
+  oc_heightfield *sq = wavy(5, 5, 1, 2);
+  save_ok(sq, raw2, NULL, used);
+  oc_heightfield *sb = oc_heightfield_load_raw(raw2, 0, 0, NULL, &e);
+  ck_assert(sb && oc_heightfield_nx(sb) == 5 && oc_heightfield_ny(sb) == 5);
+  oc_heightfield_release(sb);
+  oc_heightfield_release(sq);
+  oc_heightfield_release(back);
+  oc_heightfield_release(p16);
+  oc_heightfield_release(hf);
+  oct_rm_tree(dir);
+}
+END_TEST
+
+/* Sums, differences, products, clamp and masks against the formulas;
+** mismatched grids, non-finite numbers and overflows refused by name. */
+START_TEST(grid_arithmetic) {
+  oc_heightfield *a = wavy(9, 7, 1.5, 3), *b = wavy(9, 7, 1.5, 4);
+  oc_error e = {0};
+  const float *za = oc_heightfield_samples(a), *zb = oc_heightfield_samples(b);
+  for (int op = OC_HF_ADD; op <= OC_HF_MUL; op++) {
+    oc_heightfield *c = oc_heightfield_combine(a, b, (oc_hf_op)op, &e);
+    oc_heightfield *d = oc_heightfield_scalar(a, 2.5, (oc_hf_op)op, &e);
+    ck_assert(c && d);
+    for (size_t k = 0; k < 63; k++) {
+      double x = za[k], y = zb[k];
+      double want[] = {x + y, x - y, y - x, x * y};
+      double wk[] = {x + 2.5, x - 2.5, 2.5 - x, x * 2.5};
+      ck_assert(oc_heightfield_samples(c)[k] == (float)want[op]);
+      ck_assert(oc_heightfield_samples(d)[k] == (float)wk[op]);
+    }
+    oc_heightfield_release(c);
+    oc_heightfield_release(d);
+  }
+  oc_heightfield *moved = grid_ok(9, 7, 1.5, 0, 0, NULL);
+  ck_assert(oc_heightfield_combine(a, moved, OC_HF_ADD, &e) == NULL);
+  ck_assert(e.code == OC_EINVAL && strstr(e.msg, "grids differ"));
+  ck_assert(oc_heightfield_scalar(a, INFINITY, OC_HF_MUL, &e) == NULL);
+  ck_assert(strstr(e.msg, "finite"));
+  ck_assert(oc_heightfield_scalar(a, 1e38, OC_HF_MUL, &e) == NULL);
+  ck_assert(strstr(e.msg, "sample (1, 1)"));
+  oc_heightfield *cl = oc_heightfield_clamp(a, 35, 45, &e);
+  for (size_t k = 0; k < 63; k++)
+    ck_assert(oc_heightfield_samples(cl)[k] ==
+              (float)fmin(fmax(za[k], 35), 45));
+  oc_heightfield_release(cl);
+  ck_assert(oc_heightfield_clamp(a, 5, 1, &e) == NULL);
+  ck_assert(oc_heightfield_clamp(a, NAN, 1, &e) == NULL);
+  oc_hf_mask_params mp = {1, 1, 38, 44, 0};
+  oc_heightfield *m = oc_heightfield_mask(a, &mp, &e);
+  for (size_t k = 0; k < 63; k++)
+    ck_assert(oc_heightfield_samples(m)[k] == (za[k] >= 38 && za[k] <= 44));
+  oc_heightfield_release(m);
+  mp.has_below = 0;
+  mp.falloff = 4;
+  m = oc_heightfield_mask(a, &mp, &e);
+  for (size_t k = 0; k < 63; k++)
+    ck_assert(fabs(oc_heightfield_samples(m)[k] -
+                   fmin(fmax((za[k] - 38) / 4 + 0.5, 0), 1)) < 1e-6);
+  oc_heightfield_release(m);
+  mp.above = NAN;
+  ck_assert(oc_heightfield_mask(a, &mp, &e) == NULL && strstr(e.msg, "above"));
+  mp.above = 1;
+  mp.falloff = -1;
+  ck_assert(oc_heightfield_mask(a, &mp, &e) == NULL &&
+            strstr(e.msg, "falloff"));
+  mp.has_above = 0;
+  ck_assert(oc_heightfield_mask(a, &mp, &e) == NULL);
+  oc_heightfield_release(moved);
+  oc_heightfield_release(a);
+  oc_heightfield_release(b);
+}
+END_TEST
+
 /* A full disk: every save (and the palette picture) reports it and leaves
 ** neither the file nor its temporary; a save that fits still works. */
 START_TEST(disk_full) {
@@ -753,14 +892,20 @@ START_TEST(disk_full) {
   oc_heightfield *small = wavy(4, 4, 1, 3);
   const double stops[] = {0, 0, 0, 0, 1000, 1, 1, 1};
   const oc_hf_save_params colours = {0, 0, 1, 0, NULL, 0, stops, 2};
-  const char *files[] = {"h.png", "h.tif", "h.exr", "c.png"};
-  for (int k = 0; k < 4; k++) {
+  const char *files[] = {"h.png", "h.tif", "h.exr", "c.png", "h.r16"};
+  for (int k = 0; k < 5; k++) {
     const char *p = oct_in_dir(fs, files[k]);
     const oc_hf_save_params *sp = k == 3 ? &colours : NULL;
+    /* 400 x 400 x 2 bytes: over the 64 KiB */
     oc_error e = {0};
     int rc = oc_heightfield_save(big, p, sp, NULL, &e);
     oct_assert_full(rc, e.msg, p, fs);
     save_ok(small, p, sp, NULL);
+    if (k == 4) {
+      oc_heightfield *back = oc_heightfield_load_raw(p, 0, 0, NULL, &e);
+      ck_assert(back && oc_heightfield_nx(back) == 4);
+      oc_heightfield_release(back);
+    }
     if (k < 3) {
       oc_heightfield *back = load_ok(p, NULL);
       ck_assert_int_eq(oc_heightfield_nx(back), 4);
@@ -1052,6 +1197,8 @@ static Suite *suite(void) {
   tcase_add_test(t, metadata_cannot_forge_lines);
   tcase_add_test(t, hostile_files);
   tcase_add_test(t, disk_full);
+  tcase_add_test(t, raw16_round_trip);
+  tcase_add_test(t, grid_arithmetic);
   suite_add_tcase(s, t);
   t = tcase_create("procedural");
   tcase_set_timeout(t, 60);

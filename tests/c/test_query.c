@@ -139,7 +139,7 @@ START_TEST(column_z_spans) {
   ck_assert(hf != NULL);
   oc_elevation src;
   ck_assert_int_eq(oc_heightfield_elevation(hf, &src, &e), OC_OK);
-  oc_terrain_params tp = {4, 1, 0, 0, NULL};
+  oc_terrain_params tp = {4, 1, 0, 0, NULL, OC_TERRAIN_SLAB};
   oc_node *k[3];
   k[0] = OCT_OK(oc_terrain(&src, &tp, &e));
   tp.invert = 1;

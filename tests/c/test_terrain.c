@@ -75,17 +75,24 @@ static double ref_height(const oc_heightfield *hf, double x, double y) {
   return cr1(row[0], row[1], row[2], row[3], v - j);
 }
 
-static oc_node *terrain_thick(oc_heightfield *hf, double R, double W,
-                              int invert, double thick,
-                              const oc_heightfield *mask) {
+static oc_node *terrain_e(oc_heightfield *hf, double R, double W, int invert,
+                          double thick, const oc_heightfield *mask, int edges) {
   oc_error e;
   oc_elevation src;
   ck_assert_int_eq(oc_heightfield_elevation(hf, &src, &e), OC_OK);
-  oc_terrain_params tp = {R, W, invert, thick, mask};
+  oc_terrain_params tp = {R, W, invert, thick, mask, edges};
   oc_node *n = oc_terrain(&src, &tp, &e);
   src.release(src.ud);
   ck_assert_msg(n != NULL, "oc_terrain: %s", e.msg);
   return n;
+}
+
+/* The paper's slab: most tests here check its prism. */
+static oc_node *terrain_thick(oc_heightfield *hf, double R, double W,
+                              int invert, double thick,
+                              const oc_heightfield *mask) {
+  return terrain_e(hf, R, W, invert, thick, mask,
+                   mask ? OC_TERRAIN_EDGES_DEFAULT : OC_TERRAIN_SLAB);
 }
 
 static oc_node *terrain_of(oc_heightfield *hf, double R, double W, int invert,
@@ -338,7 +345,7 @@ START_TEST(mask_shapes_domain) {
   oc_elevation src;
   oc_error e;
   ck_assert_int_eq(oc_heightfield_elevation(hf, &src, &e), OC_OK);
-  oc_terrain_params tp = {R, 1, 0, 0, tiny};
+  oc_terrain_params tp = {R, 1, 0, 0, tiny, 0};
   OCT_EINVAL(oc_terrain(&src, &tp, &e), e, "falloff");
   oc_heightfield *none = disc_mask(61, 1, 100, 100, 0, 0, 1);
   tp.mask = none;
@@ -689,6 +696,206 @@ START_TEST(dem_meshed_closed) {
 }
 END_TEST
 
+/* ---- open edges ---------------------------------------------------------- */
+
+/* Open edges: the surface is the grid's over its whole footprint, border
+** samples included, f = 0 just off it; bounds hold inside, local bounds
+** across a side are infinite (the jump), spans cover; heightfield.from on
+** the same grid gives the samples back; the mesh is closed and manifold,
+** its walls on the grid's sides, the same for any thread count. */
+START_TEST(open_edges) {
+  oc_error e;
+  oc_heightfield *hf = grid(61, 49, 1.5, 3, -2, 6, 21);
+  double x1 = 3 + 60 * 1.5, y1 = -2 + 48 * 1.5;
+  for (int inv = 0; inv < 2; inv++) {
+    oc_program *pr = oct_compile(
+        terrain_e(hf, 4.5, 0.8, inv, 0, NULL, OC_TERRAIN_EDGES_DEFAULT), 0, 0);
+    double T = oc_program_threshold(pr);
+    oc_aabb b = oc_program_bounds(pr);
+    ck_assert(b.lo.x == 3 && b.lo.y == -2 && b.hi.x == x1 && b.hi.y == y1);
+    /* on the border samples f = T at z = h; just off them f = 0 */
+    for (int k = 0; k < 4; k++) {
+      double x = k == 0 ? 3 : k == 1 ? x1 : 3 + 17 * 1.5;
+      double y = k == 2 ? -2 : k == 3 ? y1 : -2 + 9 * 1.5;
+      double h = ref_height(hf, x, y), sgn = inv ? -1 : 1;
+      ck_assert(fabs(oc_program_eval(pr, oct_v(x, y, h)) - T) < 1e-9);
+      ck_assert(oc_program_eval(pr, oct_v(x, y, h - sgn * 0.3)) > T);
+      double dx = k == 0 ? -1e-9 : k == 1 ? 1e-9 : 0;
+      double dy = k == 2 ? -1e-9 : k == 3 ? 1e-9 : 0;
+      ck_assert(oc_program_eval(pr, oct_v(x + dx, y + dy, h - sgn * 0.3)) == 0);
+    }
+    /* inside: gradients, the global bound, local bounds */
+    oc_vec3 lo = oct_v(b.lo.x, b.lo.y, b.lo.z - 3);
+    oc_vec3 hi = oct_v(b.hi.x, b.hi.y, b.hi.z + 3);
+    oct_rng r = oct_rng_new(70 + inv);
+    for (int n = 0; n < 2000; n++)
+      oct_check_grad(pr,
+                     oct_in_box(&r, oct_add(lo, oct_v(1e-4, 1e-4, 0)),
+                                oct_sub(hi, oct_v(1e-4, 1e-4, 0))),
+                     1e-6, 1e-6);
+    /* its pairs may reach a little beyond the box */
+    double worst =
+        oct_check_lipschitz(pr, oct_add(lo, oct_v(0.5, 0.5, 0)),
+                            oct_sub(hi, oct_v(0.5, 0.5, 0)), 20000, &r);
+    ck_assert(worst <= 1 && worst > 0.05);
+    int across = 0;
+    for (int n = 0; n < 400; n++) {
+      oc_vec3 c = oct_in_box(&r, oct_sub(lo, oct_v(4, 4, 0)), hi);
+      double sz = oct_unif(&r, 0.2, 6);
+      oc_aabb box = {c, oct_add(c, oct_v(sz, sz * 0.7, sz * 0.5))};
+      double L = oc_program_lipschitz_in(pr, box);
+      int cross = (box.lo.x < b.lo.x && box.hi.x >= b.lo.x) ||
+                  (box.lo.x <= x1 && box.hi.x > x1) ||
+                  (box.lo.y < b.lo.y && box.hi.y >= b.lo.y) ||
+                  (box.lo.y <= y1 && box.hi.y > y1);
+      /* across a side, finite only where f is 0 on both (over the
+      ** elevations, below the floor): the pairs check that */
+      if (cross && isinf(L)) {
+        across++;
+        continue;
+      }
+      for (int k = 0; k < 40; k++) {
+        oc_vec3 p = oct_in_box(&r, box.lo, box.hi),
+                q = oct_in_box(&r, box.lo, box.hi);
+        double df = fabs(oc_program_eval(pr, p) - oc_program_eval(pr, q));
+        ck_assert_msg(df <= L * oct_len(oct_sub(p, q)) * (1 + 1e-9) + 1e-15,
+                      "local bound %g broken: %g over %g", L, df,
+                      oct_len(oct_sub(p, q)));
+      }
+    }
+    ck_assert_int_gt(across, 20);
+    ck_assert_int_gt(oct_check_bounds(pr, oct_sub(lo, oct_v(3, 3, 0)),
+                                      oct_add(hi, oct_v(3, 3, 0)), 20000, &r),
+                     100);
+    /* spans: f does not vary over the footprint between them, also on
+    ** footprints across a side */
+    for (int n = 0; n < 300; n++) {
+      double fx = oct_unif(&r, 0, 97), fy = oct_unif(&r, -5, 72);
+      double sz = oct_unif(&r, 0.5, 3);
+      oc_zspan sp[16];
+      int ns = oc_program_column_spans(pr, fx, fy, fx + sz, fy + sz, sp, 16);
+      ck_assert_int_ge(ns, 0);
+      for (int g = 0; g <= ns; g++) {
+        double zl = g ? sp[g - 1].hi : -40, zh = g < ns ? sp[g].lo : 40;
+        if (!(zl < zh)) continue;
+        double f0 = NAN;
+        for (int k = 0; k < 40; k++) {
+          double f = oc_program_eval(pr, oct_v(fx + oct_unif(&r, 0, sz),
+                                               fy + oct_unif(&r, 0, sz),
+                                               oct_unif(&r, zl, zh)));
+          if (k == 0) f0 = f;
+          ck_assert_msg(f == f0, "f varies in a gap: %g vs %g", f, f0);
+        }
+      }
+    }
+    /* the grid back from the terrain, border samples included */
+    if (!inv) {
+      oc_hf_grid g = {61, 49, 1.5, 3, -2};
+      oc_heightfield *back = oc_heightfield_from_program(
+          pr, &g, b.lo.z, b.hi.z, 0, (oc_progress){0}, &e);
+      ck_assert_msg(back != NULL, "%s", e.msg);
+      const float *za = oc_heightfield_samples(hf),
+                  *zb = oc_heightfield_samples(back);
+      double off = 0;
+      for (size_t k = 0; k < 61 * 49; k++)
+        off = fmax(off, fabs(za[k] - zb[k]));
+      ck_assert_msg(off < 1e-5, "the grid back is %g off", off);
+      oc_heightfield_release(back);
+    }
+    /* meshes: walls on the sides (box = the bounds: caps; a wider box:
+    ** root finding across the jump) */
+    const char *dir = oct_tmpdir("open");
+    oc_aabb wide = {oct_v(b.lo.x - 2, b.lo.y - 2, b.lo.z - 1),
+                    oct_v(b.hi.x + 2, b.hi.y + 2, b.hi.z + 1)};
+    for (int wb = 0; wb < 2; wb++) {
+      oc_aabb box = wb ? wide : b;
+      int nt0 = omp_get_max_threads();
+      omp_set_num_threads(1);
+      oc_mesh *m1 = polygonize(pr, box, 0.7, 0, 0, 0);
+      omp_set_num_threads(2);
+      oc_mesh *m2 = polygonize(pr, box, 0.7, 0, 0, 0);
+      omp_set_num_threads(nt0);
+      ck_assert(same_mesh(m1, m2));
+      check_file(m1, dir, 1, 2);
+      oc_mesh *mf = polygonize(pr, box, 0.7, 1, 0, 0);
+      ck_assert(same_triangles(m1, mf));
+      /* the walls reach the grid's sides, and the top the elevation
+      ** up to the last half cell before them */
+      const float *P = oc_mesh_positions(m1);
+      double xmin = INFINITY, xmax = -INFINITY, worst = 0;
+      size_t top = 0;
+      for (size_t v = 0; v < oc_mesh_vertex_count(m1); v++) {
+        double x = P[3 * v], y = P[3 * v + 1], z = P[3 * v + 2];
+        xmin = fmin(xmin, x);
+        xmax = fmax(xmax, x);
+        if (x < 3 + 0.4 || x > x1 - 0.4 || y < -2 + 0.4 || y > y1 - 0.4)
+          continue;
+        double h = ref_height(hf, x, y);
+        if (fabs(z - h) < 0.5) {
+          worst = fmax(worst, fabs(z - h));
+          top++;
+        }
+      }
+      ck_assert_msg(fabs(xmin - 3) < 1e-4 && fabs(xmax - x1) < 1e-4,
+                    "walls at x = %g and %g, not 3 and %g", xmin, xmax, x1);
+      ck_assert(top > 3000);
+      ck_assert_msg(worst < 2e-3, "vertex %g from the elevation", worst);
+      oc_mesh_free(m1);
+      oc_mesh_free(m2);
+      oc_mesh_free(mf);
+    }
+    oct_rm_tree(dir);
+    oc_program_free(pr);
+  }
+  /* 'open' with a mask is refused; an unknown mode too */
+  oc_elevation src;
+  ck_assert_int_eq(oc_heightfield_elevation(hf, &src, &e), OC_OK);
+  oc_terrain_params tp = {4, 1, 0, 0, hf, OC_TERRAIN_OPEN};
+  OCT_EINVAL(oc_terrain(&src, &tp, &e), e, "edges");
+  tp.mask = NULL;
+  tp.edges = 7;
+  OCT_EINVAL(oc_terrain(&src, &tp, &e), e, "edges");
+  /* open edges take any falloff (the slab needs 2R < the width) */
+  tp.edges = OC_TERRAIN_OPEN;
+  tp.falloff = 500;
+  oc_node_release(OCT_OK(oc_terrain(&src, &tp, &e)));
+  src.release(src.ud);
+  oc_heightfield_release(hf);
+}
+END_TEST
+
+/* A solid thinner than a cell meshes to nothing, and says why. */
+START_TEST(thin_terrain_warns) {
+  oc_error e;
+  float z[16 * 16] = {0};
+  oc_heightfield *hf = oc_heightfield_new(16, 16, 1, 0, 0, z, &e);
+  for (int pass = 0; pass < 2; pass++) {
+    oc_program *pr = oct_compile(
+        terrain_e(hf, pass ? 4 : 0.01, 1, 0, 0, NULL, OC_TERRAIN_OPEN), 0, 0);
+    char warn[300] = "x";
+    oc_polygonize_params pp;
+    memset(&pp, 0, sizeof pp);
+    pp.box = (oc_aabb){oct_v(-1, -1, -2), oct_v(16, 16, 2)};
+    pp.cell = 0.5;
+    pp.warning = warn;
+    pp.warning_size = sizeof warn;
+    oc_mesh *m = oc_polygonize(pr, &pp, &e);
+    ck_assert_msg(m != NULL, "%s", e.msg);
+    if (pass == 0) {
+      ck_assert_int_eq(oc_mesh_triangle_count(m), 0);
+      ck_assert_msg(strstr(warn, "falloff") && strstr(warn, "thickness"),
+                    "warning: '%s'", warn);
+    } else {
+      ck_assert(oc_mesh_triangle_count(m) > 0);
+      ck_assert_str_eq(warn, "");
+    }
+    oc_mesh_free(m);
+    oc_program_free(pr);
+  }
+  oc_heightfield_release(hf);
+}
+END_TEST
+
 START_TEST(sculpted_terrain_seamless) {
   /* direct columns next to root-found ones: carved caves, a rock, an arch
   ** on an implicitized DEM; floating islands from a terrain and an
@@ -764,7 +971,7 @@ START_TEST(bad_input) {
   oc_elevation src;
   oc_error e;
   ck_assert_int_eq(oc_heightfield_elevation(hf, &src, &e), OC_OK);
-  oc_terrain_params tp = {2, 1, 0, 0, NULL};
+  oc_terrain_params tp = {2, 1, 0, 0, NULL, OC_TERRAIN_SLAB};
   tp.thickness = -1;
   OCT_EINVAL(oc_terrain(&src, &tp, &e), e, "thickness");
   tp.thickness = NAN;
@@ -824,6 +1031,8 @@ static Suite *suite(void) {
   tcase_set_timeout(t, 300);
   tcase_add_test(t, dem_meshed_closed);
   tcase_add_test(t, sculpted_terrain_seamless);
+  tcase_add_test(t, open_edges);
+  tcase_add_test(t, thin_terrain_warns);
   suite_add_tcase(s, t);
   return s;
 }

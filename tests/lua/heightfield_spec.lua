@@ -247,9 +247,131 @@ describe("files", function()
     assert.are.same({1, 2, -1, 1 + 64 * 7, 2 + 48 * 7, 509}, {moved:bounds()})
   end)
 
+  it("RAW 16-bit: little-endian, north row first, the range given back",
+     function()
+    local g = HF.from(function(x, y) return 10 + x + 100 * y end,
+                      {size = {3, 2}})
+    -- z from 10 (i = 1, j = 1) to 112 (i = 3, j = 2)
+    local s, o, lo, hi = g:save(dir .. "/g.r16")
+    assert.are.same({10, 112}, {lo, hi})
+    assert.are.equal(10, o)
+    assert.is_true(math.abs(s - 102 / 65535) < 1e-15)
+    local bytes = read_file(dir .. "/g.r16")
+    assert.are.equal(12, #bytes)
+    local q = {}
+    for k = 1, 6 do q[k] = string.unpack("<I2", bytes, 2 * k - 1) end
+    -- first row: j = 2 (y = 1): 110, 111, 112; then j = 1: 10, 11, 12
+    local function count(z) return math.floor((z - 10) / s + 0.5) end
+    assert.are.same({count(110), count(111), 65535, 0, count(11), count(12)}, q)
+    -- back with the range, and with size or without (a square is inferred)
+    local back = HF.load(dir .. "/g.r16", {size = {3, 2}, range = {lo, hi}})
+    for i, j in each_sample(g) do
+      assert.is_true(math.abs(back:get(i, j) - g:get(i, j)) <= s / 2 + 1e-9)
+    end
+    local sq = HF.from(function(x, y) return x * y end, {size = {4, 4}})
+    sq:save(dir .. "/sq.raw", {range = {0, 100}})
+    local b2 = HF.load(dir .. "/sq.raw", {range = {0, 100}})
+    assert.are.same({4, 4}, {b2:size()})
+    assert.is_true(math.abs(b2:get(4, 4) - 9) < 100 / 65535)
+    -- counts as they are without a range
+    assert.are.equal(65535, HF.load(dir .. "/g.r16", {size = {3, 2}}):get(3, 2))
+    -- errors: outside the range, a size that does not fit, options
+    local ok, msg = pcall(g.save, g, dir .. "/h.r16", {range = {0, 50}})
+    assert.is_false(ok)
+    assert.is_truthy(msg:find("outside", 1, true))
+    check(function() HF.load(dir .. "/g.r16") end, "outcrop.heightfield.load",
+          "square")
+    check(function() HF.load(dir .. "/g.r16", {size = {4, 2}}) end,
+          "outcrop.heightfield.load", "bytes")
+    check(function() HF.load(dir .. "/g.r16", {range = {1, 0 / 0}}) end,
+          "outcrop.heightfield.load", "'range'")
+    check(function() g:save(dir .. "/h.r16", {range = {5, 5}}) end,
+          "heightfield:save", "'range'")
+    check(function() g:save(dir .. "/h.r16", {bits = 8}) end,
+          "heightfield:save", "'bits'")
+    check(function() HF.load(dir .. "/h.png", {size = {3, 2}}) end,
+          "outcrop.heightfield.load", "RAW")
+    -- the same bytes for 1 and 2 threads is the writer's: no threads here
+  end)
+
+  it("arithmetic, clamp, mask and map", function()
+    local a = HF.from(function(x, y) return x + 2 * y end, {size = {4, 3}})
+    local b = HF.from(function(x, y) return x * y end, {size = {4, 3}})
+    for _, c in ipairs{{a + b, function(u, v) return u + v end},
+                       {a - b, function(u, v) return u - v end},
+                       {a * b, function(u, v) return u * v end},
+                       {a + 3, function(u) return u + 3 end},
+                       {3 - a, function(u) return 3 - u end},
+                       {a * 0.5, function(u) return u * 0.5 end},
+                       {2 * a, function(u) return 2 * u end},
+                       {-a, function(u) return -u end}} do
+      for i, j in each_sample(a) do
+        assert.are.equal(c[2](a:get(i, j), b:get(i, j)), c[1]:get(i, j))
+      end
+    end
+    local other = HF.from(function() return 0 end, {size = {4, 3}, cell = 2})
+    check(function() return a + other end, "heightfield +", "grids differ")
+    check(function() return a + {} end, "heightfield +", "operand 2")
+    check(function() return a * (1 / 0) end, "heightfield *", "finite")
+    check(function() return a * 1e38 * 1e10 end, "heightfield *", "sample")
+    -- clamp, both forms
+    local c1, c2 = a:clamp(2, 5), a:clamp{lo = 2, hi = 5}
+    for i, j in each_sample(a) do
+      local z = math.min(math.max(a:get(i, j), 2), 5)
+      assert.are.equal(z, c1:get(i, j))
+      assert.are.equal(z, c2:get(i, j))
+    end
+    assert.are.equal(a:max(), a:clamp{lo = 1}:max())
+    check(function() a:clamp(5, 2) end, "heightfield:clamp", "lo <= hi")
+    check(function() a:clamp(0 / 0, 2) end, "heightfield:clamp", "lo")
+    check(function() a:clamp{lo = 1, hi = 0 / 0} end, "heightfield:clamp", "'hi'")
+    -- masks: 0/1, a band, a ramp; terrain masks read them
+    local m = a:mask{above = 3}
+    for i, j in each_sample(a) do
+      assert.are.equal(a:get(i, j) >= 3 and 1 or 0, m:get(i, j))
+    end
+    local band = a:mask{above = 2, below = 4}
+    for i, j in each_sample(a) do
+      local z = a:get(i, j)
+      assert.are.equal((z >= 2 and z <= 4) and 1 or 0, band:get(i, j))
+    end
+    local soft = a:mask{above = 3, falloff = 2}
+    assert.are.equal(0.5, soft:get(4, 1)) -- z = 3
+    assert.are.equal(1, soft:get(3, 2)) -- z = 4: past the ramp
+    assert.are.equal(0.25, a:mask{above = 3, falloff = 4}:get(3, 1)) -- z = 2
+    check(function() a:mask{} end, "heightfield:mask", "'above', 'below'")
+    check(function() a:mask{above = 0 / 0} end, "heightfield:mask", "'above'")
+    check(function() a:mask{above = 1, falloff = -1} end, "heightfield:mask",
+          "'falloff'")
+    local big = HF.fbm{size = {33, 33}, cell = 1, amplitude = 4, wavelength = 9}
+    local t = oc.terrain(big, {mask = big:mask{above = 0}})
+    assert.are.equal("terrain", t:kind())
+    -- map: fn(z, x, y)
+    local mm = a:map(function(z, x, y) return z * 10 + x - y end)
+    for i, j in each_sample(a) do
+      local x, y = position(a, i, j)
+      assert.are.equal(a:get(i, j) * 10 + x - y, mm:get(i, j))
+    end
+    check(function() a:map(function() return "x" end) end, "heightfield:map",
+          "sample (1, 1)")
+    check(function() a:map(function(z) if z > 3 then return 0 / 0 end return z end) end,
+          "heightfield:map", "sample (")
+    check(function() a:map(3) end, "heightfield:map", "function")
+    -- the source may be closed and collected while fn runs
+    local victim = HF.from(function(x) return x end, {size = {5, 5}})
+    local out = victim:map(function(z)
+      do local c <close> = victim end
+      collectgarbage()
+      return z + 1
+    end)
+    check(function() victim:get(1, 1) end, "heightfield:get", "closed")
+    assert.are.equal(5, out:get(5, 5))
+  end)
+
   it("fixed scale and offset", function()
     local flat = HF.from(function(x) return 100 + x end, {size = {11, 3}})
-    assert.are.same({0.5, 90}, {flat:save(dir .. "/f.png", {scale = 0.5, offset = 90})})
+    assert.are.same({0.5, 90, 90, 90 + 0.5 * 65535},
+                    {flat:save(dir .. "/f.png", {scale = 0.5, offset = 90})})
     local back = HF.load(dir .. "/f.png")
     for i, j in each_sample(flat) do assert.are.equal(flat:get(i, j), back:get(i, j)) end
     local ok, msg = pcall(flat.save, flat, dir .. "/g.png", {scale = 0.001})

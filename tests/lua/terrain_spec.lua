@@ -115,8 +115,12 @@ describe("outcrop.terrain", function()
           "'falloff'")
     check(function() oc.terrain(hf, {falloff = 0 / 0}) end, "outcrop.terrain",
           "'falloff'")
-    check(function() oc.terrain(hf, {falloff = 1e9}) end, "outcrop.terrain",
-          "'falloff'")
+    check(function() oc.terrain(hf, {falloff = 1e9, edges = "slab"}) end,
+          "outcrop.terrain", "'falloff'")
+    check(function() oc.terrain(hf, {edges = "closed"}) end, "outcrop.terrain",
+          "'edges'")
+    check(function() oc.terrain(hf, {edges = "open", mask = hf}) end,
+          "outcrop.terrain", "'edges'")
     check(function() oc.terrain(hf, {transition = 0}) end, "outcrop.terrain",
           "'transition'")
     check(function() oc.terrain(hf, {thickness = -2}) end, "outcrop.terrain",
@@ -130,6 +134,63 @@ describe("outcrop.terrain", function()
     check(function() oc.terrain(hf, {fallof = 2}) end, "outcrop.terrain",
           "fallof")
     check(function() oc.terrain(hf, {}, 3) end, "outcrop.terrain")
+  end)
+
+  it("open edges (the default): the grid back from the terrain, border included",
+     function()
+    local t = oc.terrain(hf)
+    local x0, y0, z0, x1, y1, z1 = t:bounds()
+    local back = oc.heightfield.from(t, {size = {65, 49}, cell = 2,
+                                         zrange = {z0, z1}})
+    local worst = 0
+    for j = 1, 49 do
+      for i = 1, 65 do
+        worst = math.max(worst, math.abs(back:get(i, j) - hf:get(i, j)))
+      end
+    end
+    assert.is_true(worst < 1e-4, "off by " .. worst)
+    -- f = 0 just off the sides, the surface's on them
+    local h = hf:get(1, 10)
+    assert.is_true(t:eval(0, 18, h - 0.3) > 0.5)
+    assert.are.equal(0, t:eval(-1e-9, 18, h - 0.3))
+    -- a closed mesh, its walls on the grid's sides
+    local m = oc.polygonize(t, {cell = 1.5})
+    local v, tri = m:counts()
+    assert.are.equal(2, v - tri / 2) -- closed: V - E + T = 2
+    local xmin, xmax = math.huge, -math.huge
+    for k = 1, v do
+      local x = m:vertex(k)
+      xmin, xmax = math.min(xmin, x), math.max(xmax, x)
+    end
+    assert.is_true(math.abs(xmin) < 1e-4 and math.abs(xmax - X1) < 1e-4)
+    -- the slab, as before, ends 2.19 falloffs short of the sides
+    local s = oc.terrain(hf, {edges = "slab"})
+    assert.are.equal(0, s:eval(1, 18, h - 0.3) > 0.5 and 1 or 0)
+  end)
+
+  it("warns when a thin terrain meshes to nothing", function()
+    local flat = oc.heightfield.from(function() return 0 end,
+                                     {size = {16, 16}})
+    local t = oc.terrain(flat, {falloff = 0.01})
+    local name = os.tmpname()
+    local saved = io.stderr
+    -- the warning goes to the process's stderr: run in a child
+    local f = assert(io.popen("lua5.4 -e 'package.cpath=[[" .. package.cpath ..
+      "]] local oc = require \"outcrop\" " ..
+      "local hf = oc.heightfield.from(function() return 0 end, {size = {16, 16}}) " ..
+      "local m = oc.polygonize(oc.terrain(hf, {falloff = 0.01}), " ..
+      "{box = {-1, -1, -2, 16, 16, 2}, cell = 0.5}) " ..
+      "io.write(select(2, m:counts()))' 2>" .. name))
+    local out = f:read("a")
+    f:close()
+    local err = assert(io.open(name)):read("a")
+    os.remove(name)
+    assert.are.equal("0", out)
+    assert.is_truthy(err:find("outcrop: warning: ", 1, true))
+    assert.is_truthy(err:find("falloff", 1, true))
+    assert.is_truthy(err:find("thickness", 1, true))
+    assert.is_truthy(t)
+    assert.are.equal(saved, io.stderr)
   end)
 
   it("keeps its grid alive", function()
