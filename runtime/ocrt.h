@@ -27,10 +27,12 @@ typedef struct ocrt_options {
   int nparams;
   const char **args; /* positional arguments after the scene */
   int nargs;
-  lua_Integer seed;         /* --seed, default 1 */
+  lua_Integer seed;         /* --seed, -1 when not given (the scene seed
+                            ** is then 1 unless the scene configures it) */
   int threads;              /* --threads, 0 when not given */
   const char *outdir;       /* --out, NULL for the current folder */
   int unsafe;               /* --unsafe: no sandbox */
+  int list_params;          /* --list-params: list, write nothing */
   long long max_memory;     /* --max-memory in bytes; 0 none, -1 the default */
   double timeout;           /* --timeout in seconds, 0 for none */
   const char *timeout_text; /* --timeout as given, for the message */
@@ -49,6 +51,12 @@ void ocrt_options_free(ocrt_options *o);
 ** mkdir -p, and returns its canonical absolute path, malloc'ed. On failure
 ** returns NULL with a message in `msg`. */
 char *ocrt_outdir(const char *dir, char *msg, size_t msgsize);
+
+/* A new empty folder under $TMPDIR (else /tmp) for --list-params, as
+** ocrt_outdir returns it; ocrt_remove_tree removes it and all it holds
+** (symbolic links themselves, never what they point to). */
+char *ocrt_tmp_outdir(char *msg, size_t msgsize);
+void ocrt_remove_tree(const char *dir);
 
 /* Runs the scene described by `o` in a fresh Lua state; returns the exit
 ** status. */

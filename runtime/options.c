@@ -36,6 +36,11 @@ static const char usage_text[] =
     "(repeatable;\n"
     "                    the last value of a name wins)\n"
     "  --seed N          scene seed, an integer >= 0 (default 1)\n"
+    "  --list-params     run the scene with its outputs sent to a temporary\n"
+    "                    folder that is removed, its standard output\n"
+    "                    discarded, then print every parameter it reads:\n"
+    "                    NAME<tab>DEFAULT<tab>TYPE (sandboxed: not with\n"
+    "                    --unsafe)\n"
     "  --threads N       worker threads, 1 to 1024 (default: OpenMP's, all\n"
     "                    cores unless OMP_NUM_THREADS says otherwise)\n"
     "  --out DIR         folder for outputs; relative output paths resolve\n"
@@ -71,8 +76,12 @@ static const char usage_text[] =
     "either). Running out of --max-memory is an error the scene may catch\n"
     "with pcall.\n"
     "\n"
+    "A --set NAME that no outcrop.param call read by the end of the run is\n"
+    "an error (status 2) naming the closest name that was read.\n"
+    "\n"
     "exit status: 0 success, 1 error in the scene (memory limit included),\n"
-    "2 usage error (binary scene included), 124 --timeout reached,\n"
+    "2 usage error (binary scene and unread --set included), 124 --timeout\n"
+    "reached,\n"
     "128 + N stopped by signal N: 130 Ctrl-C, 143 SIGTERM, 129 SIGHUP,\n"
     "141 SIGPIPE;\n"
     "os.exit(n) in a scene exits with n.\n";
@@ -200,6 +209,10 @@ static int option(ocrt_options *o, int argc, char **argv, int *i) {
     o->unsafe = 1;
     return OCRT_RUN;
   }
+  if (strcmp(arg, "--list-params") == 0) {
+    o->list_params = 1;
+    return OCRT_RUN;
+  }
   for (k = 0; valued[k]; k++) {
     m = match(arg, valued[k], 1, argc, argv, i, &val);
     if (m < 0) return usage_error("option '%s' needs a value", valued[k]);
@@ -251,7 +264,7 @@ static int option(ocrt_options *o, int argc, char **argv, int *i) {
 int ocrt_parse(ocrt_options *o, int argc, char **argv) {
   int i, status, options = 1, command = 0;
   memset(o, 0, sizeof *o);
-  o->seed = 1;
+  o->seed = -1;
   o->max_memory = -1;
   /* at most one entry per word, so argc entries always suffice */
   o->params = malloc(sizeof *o->params * (size_t)(argc + 1));
@@ -282,6 +295,13 @@ int ocrt_parse(ocrt_options *o, int argc, char **argv) {
   if (o->scene == NULL) {
     ocrt_options_free(o);
     return usage_error("no scene given");
+  }
+  if (o->list_params && o->unsafe) {
+    ocrt_options_free(o);
+    /* its writes could land anywhere: the throw-away folder would not
+    ** hold them all */
+    return usage_error("--list-params runs the scene in the sandbox; it "
+                       "cannot be combined with --unsafe");
   }
   return OCRT_RUN;
 }

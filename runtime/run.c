@@ -5,25 +5,33 @@
 ** the sandbox, run the scene under a message handler that adds a
 ** traceback, report, close. All of it runs inside a protected call so that
 ** even a memory error while setting up is reported instead of aborting.
+** The scene's bytes are hashed as they are loaded (provenance), and the
+** command line reaches the module through oclua_configure, the path of
+** outcrop.configure.
 */
+#include <errno.h>
+#include <fcntl.h>
 #include <omp.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <lauxlib.h>
 #include <lualib.h>
 
 #include "../bindings/lua/oclua.h"
+#include "core/sha256.h"
 #include "ocrt.h"
 
 typedef struct run {
   const ocrt_options *opt;
   int status;   /* exit status, set by pmain */
   char *outdir; /* malloc'ed; freed after lua_close, so errors cannot leak */
-  long long max_memory;   /* the limit in force, 0 for none */
-  int warn_on, warn_cont; /* warn(): "@on" seen; a message continues */
+  long long max_memory;       /* the limit in force, 0 for none */
+  int warn_on, warn_cont;     /* warn(): "@on" seen; a message continues */
+  char sha256[OC_SHA256_HEX]; /* of the scene's bytes, once loaded */
 } run;
 
 /* Warnings as stock lua5.4 shows them: off until warn("@on"). */
@@ -64,27 +72,39 @@ static int msghandler(lua_State *L) {
   return 1;
 }
 
-/* Registry settings read by the module (see oclua.h). */
+/* Registry settings read by the module (see oclua.h): --seed, --set and
+** --out go through oclua_configure, as outcrop.configure would take them
+** (the seed only when given, so that a scene may configure its own), then
+** the sandbox flag, the scene and its hash. */
 static void set_registry(lua_State *L, const run *r) {
   const ocrt_options *o = r->opt;
   int i;
-  lua_createtable(L, 0, o->nparams);
-  for (i = 0; i < o->nparams; i++) {
-    const char *p = o->params[i];
-    const char *eq = strchr(p, '=');
-    lua_pushlstring(L, p, (size_t)(eq - p));
-    lua_pushstring(L, eq + 1);
-    lua_rawset(L, -3); /* a repeated name: the last value wins */
+  lua_createtable(L, 0, 3);
+  if (o->nparams > 0) {
+    lua_createtable(L, 0, o->nparams);
+    for (i = 0; i < o->nparams; i++) {
+      const char *p = o->params[i];
+      const char *eq = strchr(p, '=');
+      lua_pushlstring(L, p, (size_t)(eq - p));
+      lua_pushstring(L, eq + 1);
+      lua_rawset(L, -3); /* a repeated name: the last value wins */
+    }
+    lua_setfield(L, -2, "params");
   }
-  lua_setfield(L, LUA_REGISTRYINDEX, OCLUA_PARAMS);
+  if (o->seed >= 0) {
+    lua_pushinteger(L, o->seed);
+    lua_setfield(L, -2, "seed");
+  }
   lua_pushstring(L, r->outdir);
-  lua_setfield(L, LUA_REGISTRYINDEX, OCLUA_OUTDIR);
+  lua_setfield(L, -2, "out");
+  oclua_configure(L, -1, "outcrop");
+  lua_pop(L, 1);
   lua_pushboolean(L, !o->unsafe);
   lua_setfield(L, LUA_REGISTRYINDEX, OCLUA_SANDBOX);
-  lua_pushinteger(L, o->seed);
-  lua_setfield(L, LUA_REGISTRYINDEX, OCLUA_SEED);
   lua_pushstring(L, o->scene);
   lua_setfield(L, LUA_REGISTRYINDEX, OCLUA_SCENE);
+  lua_pushstring(L, r->sha256);
+  lua_setfield(L, LUA_REGISTRYINDEX, OCLUA_SCENE_SHA256);
 }
 
 /* package.preload.outcrop, package.loaded.outcrop and the global. */
@@ -176,24 +196,137 @@ static void run_scene(lua_State *L, run *r) {
   lua_settop(L, base - 1);
 }
 
+/* The scene as lua_load reads it, hashed on the way. As luaL_loadfilex
+** does, a UTF-8 byte order mark and a first line starting with '#' are
+** skipped (the newline stays, so line numbers hold; before a binary
+** chunk it goes too). */
+typedef struct scene_reader {
+  FILE *f;
+  oc_sha256 sha;
+  int state; /* 0 at the start, 1 in a first-line comment, 2 past it */
+  int err;   /* errno of a failed read */
+  char buf[BUFSIZ];
+} scene_reader;
+
+static const char *read_scene(lua_State *L, void *ud, size_t *size) {
+  scene_reader *r = ud;
+  (void)L;
+  for (;;) {
+    size_t n = fread(r->buf, 1, sizeof r->buf, r->f);
+    char *p = r->buf, *end = r->buf + n;
+    if (n == 0) {
+      if (ferror(r->f)) r->err = errno ? errno : EIO;
+      *size = 0;
+      return NULL;
+    }
+    oc_sha256_update(&r->sha, r->buf, n);
+    if (r->state == 0) {
+      if (n >= 3 && memcmp(p, "\xEF\xBB\xBF", 3) == 0) p += 3;
+      r->state = p < end && *p == '#' ? 1 : 2;
+    }
+    if (r->state == 1) {
+      char *nl = memchr(p, '\n', (size_t)(end - p));
+      if (nl == NULL) continue; /* all comment so far */
+      p = nl;
+      r->state = 2;
+      if (p + 1 < end && p[1] == LUA_SIGNATURE[0]) p++;
+    }
+    if (p < end) {
+      *size = (size_t)(end - p);
+      return p;
+    }
+  }
+}
+
 /* Loads the scene file (text only in the sandbox: Lua bytecode can be
 ** crafted to break out of the VM, and the scene is the first chunk an
-** attacker controls). Returns a load status; a refused binary chunk is
-** reported as LUA_ERRFILE, a usage error rather than a bug in the scene.
-** The chunk name is "@" .. path, so messages read "scene.lua:3: ...". */
-static int load_scene(lua_State *L, const ocrt_options *o) {
-  int st = luaL_loadfilex(L, strcmp(o->scene, "-") == 0 ? NULL : o->scene,
-                          o->unsafe ? NULL : "t");
+** attacker controls) and sets r->sha256. Returns a load status; a
+** refused binary chunk is reported as LUA_ERRFILE, a usage error rather
+** than a bug in the scene. The chunk name is "@" .. path, so messages
+** read "scene.lua:3: ...". */
+static int load_scene(lua_State *L, run *r) {
+  const ocrt_options *o = r->opt;
+  int from_stdin = strcmp(o->scene, "-") == 0;
+  const char *name = from_stdin ? "stdin" : o->scene;
+  scene_reader *sr = lua_newuserdatauv(L, sizeof *sr, 0);
+  const char *chunkname = from_stdin ? lua_pushliteral(L, "=stdin")
+                                     : lua_pushfstring(L, "@%s", name);
+  /* nothing raises between the open and the close */
+  sr->f = from_stdin ? stdin : fopen(o->scene, "r");
+  if (sr->f == NULL) {
+    lua_pushfstring(L, "cannot open %s: %s", name, strerror(errno));
+    return LUA_ERRFILE;
+  }
+  oc_sha256_init(&sr->sha);
+  sr->state = 0;
+  sr->err = 0;
+  int st = lua_load(L, read_scene, sr, chunkname, o->unsafe ? NULL : "t");
+  if (st == LUA_OK) { /* a binary chunk may end before the file */
+    size_t n;
+    while ((n = fread(sr->buf, 1, sizeof sr->buf, sr->f)) > 0)
+      oc_sha256_update(&sr->sha, sr->buf, n);
+    if (ferror(sr->f) && !sr->err) sr->err = errno ? errno : EIO;
+  }
+  if (!from_stdin) fclose(sr->f);
+  int err = sr->err;
+  if (st == LUA_OK && !err) {
+    unsigned char d[OC_SHA256_BYTES];
+    oc_sha256_final(&sr->sha, d);
+    oc_sha256_hex(d, r->sha256);
+  }
+  lua_replace(L, -3); /* the chunk or the message, in the userdata's slot */
+  lua_pop(L, 1);
+  if (err) {
+    lua_pop(L, 1);
+    lua_pushfstring(L, "cannot read %s: %s", name, strerror(err));
+    return LUA_ERRFILE;
+  }
   if (st == LUA_ERRSYNTAX && !o->unsafe &&
       strstr(lua_tostring(L, -1), "attempt to load a binary chunk")) {
     lua_pop(L, 1);
     lua_pushfstring(L,
                     "%s: is a binary chunk (precompiled Lua); scenes must be "
                     "Lua source unless --unsafe is given",
-                    strcmp(o->scene, "-") == 0 ? "stdin" : o->scene);
+                    name);
     return LUA_ERRFILE;
   }
   return st;
+}
+
+/* After a scene that ran to its end: a --set that nothing read is an
+** error (a typo would otherwise be silently ignored and recorded as if
+** applied). */
+static void check_params(lua_State *L, run *r) {
+  if (oclua_params_unread(L) > 0) {
+    const char *msg = lua_tostring(L, -1);
+    for (const char *nl; (nl = strchr(msg, '\n')) != NULL; msg = nl + 1)
+      fprintf(stderr, "outcrop: %.*s\n", (int)(nl - msg), msg);
+    fflush(stderr);
+    r->status = OCRT_EUSAGE;
+  }
+  lua_pop(L, 1);
+}
+
+/* --list-params: the scene's standard output goes to /dev/null (its
+** prints would mix with the list); returns the saved descriptor, or -1. */
+static int mute_stdout(void) {
+  fflush(stdout);
+  int saved = fcntl(1, F_DUPFD_CLOEXEC, 3);
+  int null = open("/dev/null", O_WRONLY | O_CLOEXEC);
+  if (saved < 0 || null < 0 || dup2(null, 1) < 0) {
+    if (saved >= 0) close(saved);
+    saved = -1;
+  }
+  if (null >= 0) close(null);
+  return saved;
+}
+
+static void unmute_stdout(int saved) {
+  fflush(stdout);
+  clearerr(stdout);
+  if (saved < 0) return;
+  dup2(saved, 1);
+  close(saved);
 }
 
 static int pmain(lua_State *L) {
@@ -204,14 +337,15 @@ static int pmain(lua_State *L) {
   luaL_checkversion(L);
   lua_gc(L, LUA_GCSTOP);
   luaL_openlibs(L);
-  st = load_scene(L, o);
+  st = load_scene(L, r);
   if (st == LUA_ERRMEM) return lua_error(L);
   if (st != LUA_OK) {
     report(lua_tostring(L, -1));
     r->status = st == LUA_ERRSYNTAX ? OCRT_ESCRIPT : OCRT_EUSAGE;
     return 0;
   }
-  r->outdir = ocrt_outdir(o->outdir, msg, sizeof msg);
+  r->outdir = o->list_params ? ocrt_tmp_outdir(msg, sizeof msg)
+                             : ocrt_outdir(o->outdir, msg, sizeof msg);
   if (r->outdir == NULL) {
     report(msg);
     r->status = OCRT_EUSAGE;
@@ -223,7 +357,25 @@ static int pmain(lua_State *L) {
   ocrt_stop_open(L);
   lua_gc(L, LUA_GCRESTART);
   lua_gc(L, LUA_GCGEN, 0, 0); /* as stock lua5.4 runs scripts */
-  run_scene(L, r);
+  if (o->list_params) {
+    int saved = mute_stdout();
+    run_scene(L, r);
+    unmute_stdout(saved);
+    if (saved < 0 && r->status == OCRT_OK) {
+      report("--list-params: cannot set standard output aside");
+      r->status = OCRT_ESCRIPT;
+    }
+  } else {
+    run_scene(L, r);
+  }
+  if (r->status == OCRT_OK && ocrt_stop_status(L) == OCRT_RUN) {
+    if (o->list_params) {
+      oclua_params_list(L);
+      fputs(lua_tostring(L, -1), stdout);
+      lua_pop(L, 1);
+    }
+    check_params(L, r);
+  }
   return 0;
 }
 
@@ -233,7 +385,7 @@ static int panic(lua_State *L) {
 }
 
 int ocrt_run(const ocrt_options *o) {
-  run r = {o, OCRT_ESCRIPT, NULL, o->max_memory, 0, 0};
+  run r = {o, OCRT_ESCRIPT, NULL, o->max_memory, 0, 0, "(none)"};
   lua_State *L;
   if (o->threads > 0) omp_set_num_threads(o->threads);
   if (r.max_memory < 0) r.max_memory = o->unsafe ? 0 : ocrt_memory_default();
@@ -256,6 +408,7 @@ int ocrt_run(const ocrt_options *o) {
   if (r.status == OCRT_OK && ocrt_stop_cause() != 0) /* while closing */
     r.status = report_stop(&r, ocrt_stop_cause());
   ocrt_memory_limit(0);
+  if (o->list_params && r.outdir) ocrt_remove_tree(r.outdir);
   free(r.outdir);
   return r.status;
 }

@@ -25,6 +25,7 @@
 #include "l_heightfield.h"
 #include "l_progress.h"
 #include "l_image.h"
+#include "l_config.h"
 #include "l_provenance.h"
 
 #define MAX_SIDE 65535
@@ -197,7 +198,10 @@ static int l_load(lua_State *L) {
       raw ? oc_heightfield_load_raw(lua_tostring(L, 1), nx, ny, &p, &err)
           : oc_heightfield_load(lua_tostring(L, 1), &p, &err);
   oclua_progress_end(&pl);
-  return oclua_sethf(L, u, hf, &err, fname);
+  oclua_sethf(L, u, hf, &err, fname);
+  /* once the grid is Lua's, so that a raise here leaks nothing */
+  oclua_record_input(L, lua_tostring(L, 1), fname);
+  return 1;
 }
 
 /* ---- outcrop.heightfield.fbm ------------------------------------------ */

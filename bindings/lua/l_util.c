@@ -315,6 +315,14 @@ int oclua_field_optoption(const oclua_fields *f, const char *name,
   }
 }
 
+void oclua_state(lua_State *L) {
+  if (lua_getfield(L, LUA_REGISTRYINDEX, OCLUA_STATE) == LUA_TTABLE) return;
+  lua_pop(L, 1);
+  lua_newtable(L);
+  lua_pushvalue(L, -1);
+  lua_setfield(L, LUA_REGISTRYINDEX, OCLUA_STATE);
+}
+
 lua_Integer oclua_scene_seed(lua_State *L) {
   lua_Integer seed = OCLUA_DEFAULT_SEED;
   int isint;
@@ -323,6 +331,10 @@ lua_Integer oclua_scene_seed(lua_State *L) {
     lua_Integer v = lua_tointegerx(L, -1, &isint);
     if (isint && v >= 0) seed = v;
   }
+  lua_pop(L, 1);
+  oclua_state(L);
+  lua_pushboolean(L, 1);
+  lua_setfield(L, -2, "seed_used");
   lua_pop(L, 1);
   return seed;
 }

@@ -93,8 +93,13 @@ int oclua_field_optvec(const oclua_fields *f, const char *name, oc_vec3 *v);
 oc_vec3 oclua_tovec(lua_State *L, int idx, const char *fname, const char *label,
                     lua_Integer elem);
 
-/* The scene seed: registry OCLUA_SEED when it is an integer >= 0, else 1. */
+/* The scene seed: registry OCLUA_SEED when it is an integer >= 0, else 1.
+** Notes in OCLUA_STATE that the seed was used, so that a later
+** outcrop.configure cannot change it. */
 lua_Integer oclua_scene_seed(lua_State *L);
+
+/* Pushes the table OCLUA_STATE (see oclua.h), created when missing. */
+void oclua_state(lua_State *L);
 
 /* Raises unless the call has at most `n` arguments. */
 void oclua_checkargs(lua_State *L, int n, const char *fname, const char *usage);

@@ -13,17 +13,46 @@
 
 int luaopen_outcrop(lua_State *L);
 
-/* table: name -> string value, from --set NAME=VALUE */
+/* table: name -> value (a --set string, or a Lua string, number or
+** boolean given to outcrop.configure) */
 #define OCLUA_PARAMS "outcrop.params"
-/* string: folder that relative output paths resolve against (--out) */
+/* string: folder that relative output paths resolve against (--out, or
+** outcrop.configure's out, made absolute) */
 #define OCLUA_OUTDIR "outcrop.outdir"
 /* boolean: true when writes must stay under OCLUA_OUTDIR (no --unsafe) */
 #define OCLUA_SANDBOX "outcrop.sandbox"
-/* integer: the scene seed (--seed), default 1; also outcrop.seed */
+/* integer: the scene seed (--seed or configure's seed), default 1; also
+** outcrop.seed */
 #define OCLUA_SEED "outcrop.seed"
 /* string: the scene file as given on the command line ("-" for standard
 ** input); written into image metadata as provenance */
 #define OCLUA_SCENE "outcrop.scene"
+/* string: the SHA-256 (hex) of the scene's bytes as the interpreter
+** loaded them; without it the file named by the scene is hashed */
+#define OCLUA_SCENE_SHA256 "outcrop.scene_sha256"
+/* table kept by the module (l_config.c): what configure fixed, what
+** outcrop.param read, the input files read, whether outputs were
+** written. Hosts leave it alone (tests reset it by setting it to nil). */
+#define OCLUA_STATE "outcrop.state"
+
+/* outcrop.configure{seed =, params =, out =} on the table at idx: checks
+** every field (raising errors prefixed with fname), refuses what
+** conflicts with the configuration so far, then stores the values under
+** OCLUA_SEED, OCLUA_PARAMS and OCLUA_OUTDIR. The interpreter configures
+** --seed, --set and --out through it, before the sandbox is applied. */
+void oclua_configure(lua_State *L, int idx, const char *fname);
+
+/* Pushes the lines (each ending in a newline) naming the configured
+** parameters no outcrop.param call read, with the closest name that was
+** read when one is close: "--set stpes: no outcrop.param reads it (did
+** you mean 'steps'?)". Returns their count (0: an empty string). */
+int oclua_params_unread(lua_State *L);
+
+/* Pushes one line per parameter outcrop.param read, in the order of the
+** first reads: "NAME<tab>DEFAULT<tab>TYPE", the default as --set would
+** spell it ("nil" when none) and its type (integer, number, string,
+** boolean, nil). */
+void oclua_params_list(lua_State *L);
 
 /* light userdata: address of a `volatile sig_atomic_t` the interpreter sets
 ** to non-zero on Ctrl-C, SIGTERM, SIGHUP and --timeout; long work polls it

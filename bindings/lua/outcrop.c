@@ -1,6 +1,6 @@
 /*
-** outcrop.c — luaopen_outcrop: the module table, outcrop.param and the
-** scene settings every script sees.
+** outcrop.c — luaopen_outcrop: the module table and the scene settings
+** every script sees (outcrop.param and outcrop.configure: l_config.c).
 **
 ** Module fields:
 **   outcrop.version    OC_VERSION
@@ -12,6 +12,7 @@
 */
 #include <string.h>
 
+#include "l_config.h"
 #include "l_field.h"
 #include "l_geology.h"
 #include "l_handle.h"
@@ -21,40 +22,6 @@
 #include "l_render.h"
 #include "l_terrain.h"
 #include "l_gen.h"
-
-/* outcrop.param(name, default): the --set value for name, as a number
-** when it reads as one ("3", "1e-2", "0x10"), a boolean for "true" and
-** "false", else the string; `default` when there is no such parameter. */
-static int l_param(lua_State *L) {
-  const char *fname = "outcrop.param";
-  if (lua_type(L, 1) != LUA_TSTRING)
-    oclua_error(L, fname, "the parameter name must be a string (got %s)",
-                oclua_got(L, 1));
-  oclua_checkargs(L, 2, fname, "(name [, default])");
-  lua_settop(L, 2);
-  if (lua_getfield(L, LUA_REGISTRYINDEX, OCLUA_PARAMS) != LUA_TTABLE) {
-    lua_settop(L, 2);
-    return 1;
-  }
-  lua_pushvalue(L, 1);
-  switch (lua_gettable(L, -2)) {
-  case LUA_TNIL:
-    lua_settop(L, 2);
-    return 1;
-  case LUA_TSTRING: {
-    const char *s = lua_tostring(L, -1);
-    if (strcmp(s, "true") == 0)
-      lua_pushboolean(L, 1);
-    else if (strcmp(s, "false") == 0)
-      lua_pushboolean(L, 0);
-    else
-      lua_stringtonumber(L, s); /* on failure the string stays on top */
-    return 1;
-  }
-  default: /* set by a host as a Lua value already */
-    return 1;
-  }
-}
 
 static int module_index(lua_State *L) {
   const char *key = lua_tostring(L, 2);
@@ -69,17 +36,16 @@ static int module_newindex(lua_State *L) {
   if (lua_type(L, 2) == LUA_TSTRING && strcmp(lua_tostring(L, 2), "seed") == 0)
     oclua_error(L, "outcrop",
                 "outcrop.seed is read-only (set the scene seed "
-                "with --seed, or pass seed = n to a constructor)");
+                "with --seed or outcrop.configure{seed = n}, or pass "
+                "seed = n to a constructor)");
   lua_rawset(L, 1);
   return 0;
 }
 
-static const luaL_Reg module_funcs[] = {{"param", l_param}, {NULL, NULL}};
-
 int luaopen_outcrop(lua_State *L) {
   luaL_checkversion(L);
   lua_newtable(L);
-  luaL_setfuncs(L, module_funcs, 0);
+  oclua_open_config(L); /* outcrop.param, outcrop.configure */
   oclua_open_handle(L);
   oclua_open_field(L);
   oclua_open_prim(L);

@@ -1,6 +1,6 @@
 /*
 ** infile.c — oc_infile_open: a regular file and its format from its
-** signature (see infile.h).
+** signature, and oc_infile_sha256 (see infile.h).
 */
 #include <errno.h>
 #include <fcntl.h>
@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "core/error.h"
+#include "core/sha256.h"
 #include "io/infile.h"
 
 static const struct {
@@ -47,15 +48,15 @@ static ssize_t read_full(int fd, unsigned char *p, size_t n) {
   return (ssize_t)got;
 }
 
-int oc_infile_open(const char *path, FILE **fp, const char **format,
-                   oc_error *err) {
-  *fp = NULL;
-  *format = NULL;
+/* Opens a regular file for reading, blocking reads; the descriptor, or
+** -1 with err set. */
+static int open_regular(const char *path, oc_error *err) {
   /* O_NONBLOCK: opening a FIFO must not wait for a writer. */
   int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
-  if (fd < 0)
-    return oc_seterr(err, OC_EIO, "cannot read '%s': %s", path,
-                     strerror(errno));
+  if (fd < 0) {
+    oc_seterr(err, OC_EIO, "cannot read '%s': %s", path, strerror(errno));
+    return -1;
+  }
   struct stat st;
   const char *why = NULL;
   int e = 0;
@@ -68,10 +69,42 @@ int oc_infile_open(const char *path, FILE **fp, const char **format,
   if (e || why) {
     close(fd);
     if (why)
-      return oc_seterr(err, OC_EIO, "cannot read '%s': not a regular file (%s)",
-                       path, why);
-    return oc_seterr(err, OC_EIO, "cannot read '%s': %s", path, strerror(e));
+      oc_seterr(err, OC_EIO, "cannot read '%s': not a regular file (%s)", path,
+                why);
+    else
+      oc_seterr(err, OC_EIO, "cannot read '%s': %s", path, strerror(e));
+    return -1;
   }
+  return fd;
+}
+
+int oc_infile_sha256(const char *path, char *hex, oc_error *err) {
+  int fd = open_regular(path, err);
+  if (fd < 0) return OC_EIO;
+  oc_sha256 s;
+  unsigned char buf[16384], d[OC_SHA256_BYTES];
+  ssize_t n;
+  oc_sha256_init(&s);
+  while ((n = read_full(fd, buf, sizeof buf)) > 0) {
+    oc_sha256_update(&s, buf, (size_t)n);
+    if ((size_t)n < sizeof buf) break;
+  }
+  int e = n < 0 ? errno : 0;
+  close(fd);
+  if (e)
+    return oc_seterr(err, OC_EIO, "cannot read '%s': %s", path, strerror(e));
+  oc_sha256_final(&s, d);
+  oc_sha256_hex(d, hex);
+  return OC_OK;
+}
+
+int oc_infile_open(const char *path, FILE **fp, const char **format,
+                   oc_error *err) {
+  *fp = NULL;
+  *format = NULL;
+  int fd = open_regular(path, err);
+  if (fd < 0) return OC_EIO;
+  int e;
   unsigned char head[8];
   ssize_t n = read_full(fd, head, sizeof head);
   if (n < 0 || lseek(fd, 0, SEEK_SET) != 0) {

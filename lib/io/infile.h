@@ -2,7 +2,8 @@
 ** infile.h — opening an image file that may be hostile: only a regular
 ** file (a FIFO, a device such as /dev/zero or a folder is refused without
 ** blocking), and its format told by its first bytes (signature), so that
-** no reader of another format ever probes it.
+** no reader of another format ever probes it; and the hash of such a
+** file, which provenance records.
 */
 #ifndef OC_INFILE_H
 #define OC_INFILE_H
@@ -23,6 +24,12 @@ extern "C" {
 ** "unrecognised image format (not PNG, TIFF, EXR or JPEG)". */
 int oc_infile_open(const char *path, FILE **fp, const char **format,
                    oc_error *err);
+
+/* The SHA-256 of the regular file `path` as lowercase hex (core/sha256.h)
+** in `hex` (OC_SHA256_HEX bytes), for provenance. Refuses what
+** oc_infile_open refuses (FIFOs, devices, folders) without blocking, but
+** takes any content. OC_OK, or OC_EIO with a message naming the path. */
+int oc_infile_sha256(const char *path, char *hex, oc_error *err);
 
 #ifdef __cplusplus
 }

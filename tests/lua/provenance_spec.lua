@@ -38,12 +38,27 @@ local function description_lines(text)
   return t
 end
 
+-- SHA-256 of a file by coreutils, independently of the engine.
+local function sha256sum(path)
+  local p = assert(io.popen("sha256sum '" .. path .. "'"))
+  local h = p:read("a"):match("^(%x+)")
+  p:close()
+  assert(h and #h == 64, "sha256sum failed on " .. path)
+  return h
+end
+
+local function write_text(path, text)
+  local f = assert(io.open(path, "w"))
+  f:write(text)
+  f:close()
+end
+
 describe("provenance", function()
   local dir
-  before_each(function() dir = R.tmpdir() end)
+  before_each(function() dir = R.tmpdir(); R.reset_config() end)
   after_each(function()
     R.rmdir(dir)
-    reg["outcrop.params"], reg["outcrop.seed"], reg["outcrop.scene"] = nil, nil, nil
+    R.reset_config()
   end)
 
   it("under stock lua5.4: the script's file, no parameters, seed 1", function()
@@ -65,8 +80,62 @@ assert(out(arg[1]))
     assert.are.equal("outcrop " .. oc.version, a.Software)
     assert.are.equal(oc.version, a["outcrop:version"])
     assert.are.equal("scene.lua", a["outcrop:scene"])
+    assert.are.equal(sha256sum(script), a["outcrop:scene_sha256"])
     assert.are.equal("1", a["outcrop:seed"])
     assert.are.equal("(none)", a["outcrop:params"])
+    assert.are.equal("(none)", a["outcrop:inputs"])
+  end)
+
+  it("under stock lua5.4 with outcrop.configure: seed, every parameter, the scene's and the inputs' hashes", function()
+    -- two input files, one read twice; a name with a space is quoted
+    assert(oc.heightfield.fbm{size = {8, 8}, wavelength = 4,
+      amplitude = 2, seed = 3}:save(dir .. "/in one.png"))
+    assert(oc.heightfield.fbm{size = {8, 8}, wavelength = 4,
+      amplitude = 2, seed = 4}:save(dir .. "/two.exr"))
+    local script = dir .. "/scene.lua"
+    write_text(script, [[
+local oc = require "outcrop"
+oc.configure{seed = 7, params = {steps = 6, name = "big arch", fast = true}}
+local steps, cell = oc.param("steps", 4), oc.param("cell", 0.8)
+assert(steps == 6 and cell == 0.8 and oc.param("fast") == true)
+assert(oc.param("rocks", 240) == 240 and oc.param("none") == nil)
+assert(oc.param("third", 1 / 3) == 1 / 3)
+assert(oc.seed == 7)
+oc.heightfield.load("two.exr")
+oc.heightfield.load("in one.png")
+oc.heightfield.load("two.exr")
+assert(oc.slice(oc.point{center = {0, 0, 0}, radius = 1}, {size = {4, 4}})
+  :write(arg[1]))
+]])
+    assert.is_true(os.execute("cd '" .. dir .. "' && lua5.4 scene.lua a.png"))
+    local a = info(dir .. "/a.png")
+    assert.are.equal("scene.lua", a["outcrop:scene"])
+    assert.are.equal(sha256sum(script), a["outcrop:scene_sha256"])
+    assert.are.equal("7", a["outcrop:seed"])
+    -- defaults included, as --set would spell them; "none" (no default,
+    -- not set) is left out; 1/3 keeps all its digits
+    assert.are.equal('cell=0.8 fast=true "name=big arch" rocks=240 '
+      .. "steps=6 third=0.33333333333333331", a["outcrop:params"])
+    assert.are.equal("two.exr=" .. sha256sum(dir .. "/two.exr") ..
+      ' "in one.png=' .. sha256sum(dir .. "/in one.png") .. '"',
+      a["outcrop:inputs"])
+  end)
+
+  it("records a changed input file again, with its new hash", function()
+    local hf = oc.heightfield.fbm{size = {8, 8}, wavelength = 4, amplitude = 2}
+    local path = dir .. "/in.png"
+    assert(hf:save(path))
+    local h1 = sha256sum(path)
+    oc.heightfield.load(path)
+    assert(oc.heightfield.fbm{size = {8, 8}, wavelength = 4,
+      amplitude = 2, seed = 99}:save(path))
+    local h2 = sha256sum(path)
+    assert.are_not.equal(h1, h2)
+    oc.heightfield.load(path)
+    oc.heightfield.load(path)
+    assert.is_true(oc.slice(node, {size = {2, 2}}):write(dir .. "/o.png"))
+    assert.are.equal(path .. "=" .. h1 .. " " .. path .. "=" .. h2,
+      info(dir .. "/o.png")["outcrop:inputs"])
   end)
 
   it("records the interpreter's scene, sorted parameters and seed", function()

@@ -1,6 +1,7 @@
 #!/bin/bash
 # run.sh — integration tests of the `outcrop` interpreter: command line,
-# exit statuses, error reports, parameters, seed, sandbox, Ctrl-C, threads.
+# exit statuses, error reports, parameters, seed, sandbox, Ctrl-C, threads,
+# --list-params, provenance by either front end.
 #
 #   OUTCROP=/abs/path/to/outcrop bash tests/runtime/run.sh
 #
@@ -597,6 +598,115 @@ cmp -s "$W/o/one.exr" "$W/o/two.exr" || because "1 and 2 threads give different 
 run --threads 1 "$S/render_meta.lua" --out "$W/o" one.png
 run --threads 2 "$S/render_meta.lua" --out "$W/o" two.png
 cmp -s "$W/o/one.png" "$W/o/two.png" || because "1 and 2 threads give different PNG files"
+end
+
+# ---- parameters: typos, --list-params, provenance by both front ends ------
+
+begin set-typo
+run "$S/steps.lua" --set stpes=6 --out "$W/o"
+status_is 2
+err_has "outcrop: --set stpes: no outcrop.param reads it (did you mean 'steps'?)"
+out_has "steps	4	0.8	plain	false" # the scene ran with the default
+run "$S/steps.lua" --set zzzzzz=1 --set steps=5 --set quik=true --out "$W/o"
+status_is 2
+err_has "--set quik: no outcrop.param reads it (did you mean 'quick'?)"
+err_has "--set zzzzzz: no outcrop.param reads it"
+grep -q "zzzzzz.*did you mean" "$ERR" && because "a far name got a suggestion"
+grep -q "steps: no" "$ERR" && because "steps was read"
+# a name read only at the very end of the scene counts
+run "$S/steps.lua" --set late=1 --set steps=5 --out "$W/o"
+status_is 0; out_has "steps	5	0.8	plain	false"
+end
+
+begin list-params
+mkdir -p "$W/tmp"
+(cd "$W" && TMPDIR="$W/tmp" exec "$OUTCROP" run "$S/steps.lua" --list-params \
+  --set steps=9 --out "$W/never") >"$OUT" 2>"$ERR" </dev/null
+rc=$?
+sanitizer_check
+status_is 0
+printf 'steps\t4\tinteger\ncell\t0.8\tnumber\nname\tplain\tstring\nquick\tfalse\tboolean\nlate\tnil\tnil\n' >"$W/want"
+cmp -s "$OUT" "$W/want" || because "the list differs from $(cat "$W/want")"
+out_lacks "steps	9" # the scene's own prints are discarded
+no_file "$W/never"; no_file "$W/steps.txt"; no_file "$W/sub"
+[ -z "$(ls -A "$W/tmp")" ] || because "the temporary output folder was left: $(ls -A "$W/tmp")"
+run "$S/steps.lua" --list-params --unsafe
+status_is 2; err_has "cannot be combined with --unsafe"
+# a typo is still an error after the list
+run "$S/steps.lua" --list-params --set stpes=1
+status_is 2; err_has "did you mean 'steps'?"; out_has "steps	4	integer"
+end
+
+# The module next to the binary, for stock lua5.4 (a sanitized module
+# needs its runtime preloaded, as the Makefile's check-asan does).
+MODDIR=$(dirname "$OUTCROP")
+stock_lua() {
+  local pre=
+  if ldd "$MODDIR/outcrop.so" 2>/dev/null | grep -q libasan; then
+    pre="$(gcc -print-file-name=libasan.so):$(gcc -print-file-name=libubsan.so)"
+  fi
+  (cd "$W" && ASAN_OPTIONS=detect_leaks=0 LD_PRELOAD=$pre exec lua5.4 "$@") \
+    >"$OUT" 2>"$ERR" </dev/null
+  rc=$?
+  sanitizer_check
+}
+
+begin routes-same-provenance
+cp "$HERE/../fixtures/heightmap16.png" "$W/in.png"
+cp "$S/routes.lua" "$W/routes.lua"
+mkdir -p "$W/o2"
+run routes.lua in.png --seed 7 --set steps=6 --out "$W/o1"
+status_is 0; out_has "routes	6	24"
+stock_lua -e "package.cpath = '$MODDIR/?.so;' .. package.cpath
+  require('outcrop').configure{seed = 7, params = {steps = '6'}, out = 'o2'}" \
+  routes.lua in.png
+status_is 0; out_has "routes	6	24"
+for f in bumps.png slice.png render.exr; do
+  cmp -s "$W/o1/$f" "$W/o2/$f" || because "$f differs between the two routes"
+done
+scene_sha=$(sha256sum "$W/routes.lua" | cut -c1-64)
+in_sha=$(sha256sum "$W/in.png" | cut -c1-64)
+for f in o1/slice.png o2/slice.png o1/render.exr o2/bumps.png; do
+  meta_has "$W/$f" outcrop:seed 7
+  meta_has "$W/$f" outcrop:params "size=24 steps=6"
+  meta_has "$W/$f" outcrop:scene routes.lua
+  meta_has "$W/$f" outcrop:scene_sha256 "$scene_sha"
+done
+meta_has "$W/o1/slice.png" outcrop:inputs "in.png=$in_sha"
+meta_has "$W/o2/render.exr" outcrop:inputs "in.png=$in_sha"
+# bumps.png was written before the load
+meta_has "$W/o1/bumps.png" outcrop:inputs "(none)"
+end
+
+begin stdin-scene-hash
+printf 'assert(outcrop.slice(outcrop.point{center = {0, 0, 0}, radius = 1},\n  {size = {2, 2}}):write("s.png"))\n' >"$W/s.lua"
+(cd "$W" && "$OUTCROP" - --out "$W/o" <"$W/s.lua") >"$OUT" 2>"$ERR"
+rc=$?
+status_is 0
+meta_has "$W/o/s.png" outcrop:scene -
+meta_has "$W/o/s.png" outcrop:scene_sha256 "$(sha256sum "$W/s.lua" | cut -c1-64)"
+# a first line starting with '#' is skipped but hashed
+printf '#!/usr/bin/env outcrop\n' | cat - "$W/s.lua" >"$W/shebang.lua"
+run shebang.lua --out "$W/o"
+status_is 0
+meta_has "$W/o/s.png" outcrop:scene_sha256 "$(sha256sum "$W/shebang.lua" | cut -c1-64)"
+end
+
+begin configure-in-scene
+# a scene configuring itself: the seed it asks for unless --seed says
+# otherwise, and then it is an error
+printf 'outcrop.configure{seed = 5, params = {steps = 2}}\nprint("seed", outcrop.seed, outcrop.param("steps", 4))\n' >"$W/c.lua"
+run c.lua
+status_is 0; out_has "seed	5	2"
+run c.lua --seed 5 --set steps=2
+status_is 0; out_has "seed	5	2"
+run c.lua --seed 6
+status_is 1; err_has "outcrop.configure: 'seed' is already configured as 6 (got 5)"
+printf 'outcrop.configure{out = "."}\n' >"$W/out.lua"
+run out.lua
+status_is 1; err_has "'out' cannot be set in the sandbox"
+run out.lua --unsafe --out "$W/elsewhere"
+status_is 1; err_has "'out' is already configured as"
 end
 
 set +m

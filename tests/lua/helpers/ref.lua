@@ -186,4 +186,15 @@ function M.rmdir(name)
   os.execute("rm -rf '" .. name .. "'")
 end
 
+-- Forgets the run's configuration (what outcrop.configure or the
+-- interpreter set, what outcrop.param read, the inputs, the written
+-- flag): busted runs every spec file in one Lua state.
+function M.reset_config()
+  local reg = debug.getregistry()
+  for _, k in ipairs{"outcrop.params", "outcrop.seed", "outcrop.scene",
+      "outcrop.scene_sha256", "outcrop.outdir", "outcrop.state"} do
+    reg[k] = nil
+  end
+end
+
 return M
