@@ -79,12 +79,9 @@ LIBA := $(B)/liboutcrop.a
 LIBSO := $(B)/liboutcrop.so
 MODULE := $(B)/outcrop.so
 BIN := $(B)/outcrop
+# (found next to the program or module holding lib/io, or one folder up:
+# the tests, benchmarks and fuzzers are built in sub-folders of $(B))
 GLUE := $(B)/liboutcrop_oiio.so
-# Where the loader's second search (after the folder of the object that
-# holds lib/io) finds the bridge: next to the program, or one folder up
-# for the tests, benchmarks and fuzzers built in sub-folders of $(B).
-RPATH_HERE := -Wl,-rpath,'$$ORIGIN'
-RPATH_UP := -Wl,-rpath,'$$ORIGIN/..'
 
 .PHONY: bench-peer-deps all deps test check-c check-lua check-lua-gc check-runtime check-asan demo bench \
         clean format tests-bin
@@ -123,11 +120,11 @@ $(GLUE): $(GLUE_OBJ) lib/io/oiio_glue.map
 	  $(OIIO_LIBS) $(LDLIBS) $(OPT)
 
 $(LIBSO): $(LIB_OBJ) | $(GLUE)
-	$(CC) -shared -o $@ $^ $(RPATH_HERE) $(LDLIBS) $(OPT)
+	$(CC) -shared -o $@ $^ $(LDLIBS) $(OPT)
 
 # The module is loaded into stock lua5.4, which provides the Lua symbols.
 $(MODULE): $(LUA_OBJ) $(LIB_OBJ) | $(GLUE)
-	$(CC) -shared -o $@ $^ $(RPATH_HERE) $(LDLIBS) $(OPT)
+	$(CC) -shared -o $@ $^ $(LDLIBS) $(OPT)
 
 # The interpreter counts the allocations of the engine and the bindings
 # for --max-memory (runtime/memory.c): --wrap sends their calls, and only
@@ -136,12 +133,12 @@ RT_WRAP := -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free \
            -Wl,--wrap=strdup,--wrap=realpath
 
 $(BIN): $(RT_OBJ) $(LUA_OBJ) $(LIB_OBJ) | $(GLUE)
-	$(CC) -o $@ $^ $(RT_WRAP) $(RPATH_HERE) $(LUA_LIBS) $(LDLIBS) $(OPT)
+	$(CC) -o $@ $^ $(RT_WRAP) $(LUA_LIBS) $(LDLIBS) $(OPT)
 
 $(B)/tests/%: tests/c/%.c $(CTEST_SUPPORT_OBJ) $(LIBA) | $(GLUE)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests/c -o $@ $< $(CTEST_SUPPORT_OBJ) $(LIBA) \
-	  $(RPATH_UP) $(CHECK_LIBS) $(LDLIBS)
+	  $(CHECK_LIBS) $(LDLIBS)
 
 tests-bin: $(CTEST_BIN)
 
@@ -213,7 +210,7 @@ BENCH_BIN := $(BENCH_SRC:scripts/bench/%.c=$(B)/bench/%)
 
 $(B)/bench/%: scripts/bench/%.c $(LIBA) | $(GLUE)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -o $@ $< $(LIBA) $(RPATH_UP) $(LDLIBS)
+	$(CC) $(CFLAGS) -o $@ $< $(LIBA) $(LDLIBS)
 
 # The peer comparison (OpenVDB's volumeToMesh) is optional: it is built only
 # when libopenvdb-dev is installed (`make bench-peer-deps` installs it).
@@ -225,7 +222,7 @@ PEER_BIN := $(PEER_SRC:scripts/bench/%.cpp=$(B)/bench/%)
 
 $(B)/bench/peer_%: scripts/bench/peer_%.cpp $(LIBA) | $(GLUE)
 	@mkdir -p $(dir $@)
-	$(CXX) $(CXXFLAGS) -o $@ $< $(LIBA) -lopenvdb -ltbb $(RPATH_UP) $(LDLIBS)
+	$(CXX) $(CXXFLAGS) -o $@ $< $(LIBA) -lopenvdb -ltbb $(LDLIBS)
 
 bench-peer-deps:
 	@$(MAKE) --no-print-directory deps PKGS="$(VDB_PKGS)"
@@ -248,7 +245,7 @@ FUZZ_SUPPORT := tests/fuzz/gen.c tests/fuzz/runner.c
 # need the interpreter's --wrap link)
 FUZZ_SUPPORT_OBJ := $(FUZZ_SUPPORT:%.c=$(B)/%.o) \
   $(B)/runtime/sandbox.o $(B)/runtime/stop.o $(LUA_OBJ) $(LIB_OBJ)
-FUZZ_LINK = $(RPATH_UP) $(LUA_LIBS) $(LDLIBS) $(OPT)
+FUZZ_LINK = $(LUA_LIBS) $(LDLIBS) $(OPT)
 
 $(B)/fuzz/fuzz_scene: $(B)/tests/fuzz/fuzz_scene.o $(FUZZ_SUPPORT_OBJ) | $(GLUE)
 	@mkdir -p $(dir $@)

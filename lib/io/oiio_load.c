@@ -8,10 +8,13 @@
 ** no image at all; now only the first image read or write pays for it.
 **
 ** The object is looked for next to the object this file is linked into
-** (the interpreter, the Lua module outcrop.so, liboutcrop.so), then by
-** the dynamic linker's search (a test program's $ORIGIN/.. run path,
-** LD_LIBRARY_PATH). It is never closed: OpenImageIO keeps threads and
-** caches until exit.
+** (the interpreter, the Lua module outcrop.so, liboutcrop.so), then one
+** folder up (the test, benchmark and fuzzing programs, built in
+** sub-folders of the build folder), then by the dynamic linker's search
+** for a bare name (LD_LIBRARY_PATH, the system's folders). Not by a run
+** path: dlopen searches the run path of its caller, and under the
+** sanitizers the caller is their interceptor. The object is never
+** closed: OpenImageIO keeps threads and caches until exit.
 */
 #define _GNU_SOURCE /* dladdr1, Dl_info, RTLD_DL_LINKMAP */
 #include <dlfcn.h>
@@ -64,15 +67,22 @@ static void own_folder(char *out, size_t n) {
   if (strlen(path) + 1 <= n) memcpy(out, path, strlen(path) + 1);
 }
 
+/* dlopen of `dir` `up` `name`; the first failure's reason kept in `why`
+** (it names the path looked at first). */
+static void *try_open(const char *dir, const char *up) {
+  char file[PATH_MAX + sizeof "../" OC_OIIO_GLUE_FILE];
+  snprintf(file, sizeof file, "%s%s%s", dir, up, OC_OIIO_GLUE_FILE);
+  void *h = dlopen(file, RTLD_NOW | RTLD_LOCAL);
+  if (!h && !why[0]) snprintf(why, sizeof why, "%s", dlerror());
+  return h;
+}
+
 static void load(void) {
-  char dir[PATH_MAX], file[PATH_MAX + sizeof OC_OIIO_GLUE_FILE];
+  char dir[PATH_MAX];
   void *h = NULL;
   own_folder(dir, sizeof dir);
-  if (dir[0]) {
-    snprintf(file, sizeof file, "%s%s", dir, OC_OIIO_GLUE_FILE);
-    h = dlopen(file, RTLD_NOW | RTLD_LOCAL);
-    if (!h) snprintf(why, sizeof why, "%s", dlerror());
-  }
+  if (dir[0]) h = try_open(dir, "");
+  if (dir[0] && !h) h = try_open(dir, "../");
   if (!h) {
     h = dlopen(OC_OIIO_GLUE_FILE, RTLD_NOW | RTLD_LOCAL);
     /* the first reason names the path looked at; keep it */
