@@ -72,7 +72,7 @@ static void own_folder(char *out, size_t n) {
 static void *try_open(const char *dir, const char *up) {
   char file[PATH_MAX + sizeof "../" OC_OIIO_GLUE_FILE];
   snprintf(file, sizeof file, "%s%s%s", dir, up, OC_OIIO_GLUE_FILE);
-  void *h = dlopen(file, RTLD_NOW | RTLD_LOCAL);
+  void *h = dlopen(file, RTLD_LAZY | RTLD_LOCAL);
   if (!h && !why[0]) snprintf(why, sizeof why, "%s", dlerror());
   return h;
 }
@@ -84,7 +84,7 @@ static void load(void) {
   if (dir[0]) h = try_open(dir, "");
   if (dir[0] && !h) h = try_open(dir, "../");
   if (!h) {
-    h = dlopen(OC_OIIO_GLUE_FILE, RTLD_NOW | RTLD_LOCAL);
+    h = dlopen(OC_OIIO_GLUE_FILE, RTLD_LAZY | RTLD_LOCAL);
     /* the first reason names the path looked at; keep it */
     if (!h && !why[0]) snprintf(why, sizeof why, "%s", dlerror());
   }
