@@ -53,16 +53,23 @@ CHECK_LIBS = $(shell $(PKGCONF) --libs check 2>/dev/null)
 COMMON := $(OPT) -fPIC -fopenmp -ffp-contract=off -Wall -Wextra -Ilib
 CFLAGS := -std=c17 -D_POSIX_C_SOURCE=200809L $(COMMON)
 CXXFLAGS := -std=c++17 $(COMMON)
-LDLIBS := -lm -fopenmp
+LDLIBS := -lm -fopenmp -ldl -lpthread
 
 LIB_SRC := $(shell find lib -name '*.c' | sort)
-OIIO_SRC := $(wildcard bindings/oiio/*.cpp)
+# The OpenImageIO bridge (the only C++) is a shared object of its own,
+# liboutcrop_oiio.so, that lib/io loads on the first image read or write
+# (lib/io/oiio_load.c): programs that touch no image start without
+# OpenImageIO's libraries. It carries private copies of two helpers that
+# allocate nothing (lib/io/oiio_glue.h).
+GLUE_SRC := $(wildcard lib/io/*.cpp)
+GLUE_OBJ := $(GLUE_SRC:%.cpp=$(B)/%.o) $(B)/lib/core/error.o \
+            $(B)/lib/io/infile.o
 LUA_SRC := $(wildcard bindings/lua/*.c)
 RT_SRC := $(wildcard runtime/*.c)
 CTEST_SRC := $(wildcard tests/c/test_*.c)
 CTEST_SUPPORT := $(filter-out $(CTEST_SRC),$(wildcard tests/c/*.c))
 
-LIB_OBJ := $(LIB_SRC:%.c=$(B)/%.o) $(OIIO_SRC:%.cpp=$(B)/%.o)
+LIB_OBJ := $(LIB_SRC:%.c=$(B)/%.o)
 LUA_OBJ := $(LUA_SRC:%.c=$(B)/%.o)
 RT_OBJ := $(RT_SRC:%.c=$(B)/%.o)
 CTEST_BIN := $(CTEST_SRC:tests/c/%.c=$(B)/tests/%)
@@ -72,12 +79,15 @@ LIBA := $(B)/liboutcrop.a
 LIBSO := $(B)/liboutcrop.so
 MODULE := $(B)/outcrop.so
 BIN := $(B)/outcrop
+# (found next to the program or module holding lib/io, or one folder up:
+# the tests, benchmarks and fuzzers are built in sub-folders of $(B))
+GLUE := $(B)/liboutcrop_oiio.so
 
 .PHONY: bench-peer-deps all deps test check-c check-lua check-lua-gc check-runtime check-asan demo bench \
         clean format tests-bin
 .DEFAULT_GOAL := all
 
-all: $(LIBA) $(LIBSO) $(MODULE) $(BIN)
+all: $(LIBA) $(LIBSO) $(MODULE) $(BIN) $(GLUE)
 	@ln -sf release/outcrop build/outcrop-bin 2>/dev/null || true
 
 deps:
@@ -104,12 +114,17 @@ $(LIBA): $(LIB_OBJ)
 	@rm -f $@
 	ar rcs $@ $^
 
-$(LIBSO): $(LIB_OBJ)
-	$(CXX) -shared -o $@ $^ $(OIIO_LIBS) $(LDLIBS) $(OPT)
+# The bridge exports only its entry (lib/io/oiio_glue.map).
+$(GLUE): $(GLUE_OBJ) lib/io/oiio_glue.map
+	$(CXX) -shared -o $@ $(GLUE_OBJ) -Wl,--version-script=lib/io/oiio_glue.map \
+	  $(OIIO_LIBS) $(LDLIBS) $(OPT)
+
+$(LIBSO): $(LIB_OBJ) | $(GLUE)
+	$(CC) -shared -o $@ $^ $(LDLIBS) $(OPT)
 
 # The module is loaded into stock lua5.4, which provides the Lua symbols.
-$(MODULE): $(LUA_OBJ) $(LIB_OBJ)
-	$(CXX) -shared -o $@ $^ $(OIIO_LIBS) $(LDLIBS) $(OPT)
+$(MODULE): $(LUA_OBJ) $(LIB_OBJ) | $(GLUE)
+	$(CC) -shared -o $@ $^ $(LDLIBS) $(OPT)
 
 # The interpreter counts the allocations of the engine and the bindings
 # for --max-memory (runtime/memory.c): --wrap sends their calls, and only
@@ -117,13 +132,13 @@ $(MODULE): $(LUA_OBJ) $(LIB_OBJ)
 RT_WRAP := -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free \
            -Wl,--wrap=strdup,--wrap=realpath
 
-$(BIN): $(RT_OBJ) $(LUA_OBJ) $(LIB_OBJ)
-	$(CXX) -o $@ $^ $(RT_WRAP) $(LUA_LIBS) $(OIIO_LIBS) $(LDLIBS) $(OPT)
+$(BIN): $(RT_OBJ) $(LUA_OBJ) $(LIB_OBJ) | $(GLUE)
+	$(CC) -o $@ $^ $(RT_WRAP) $(LUA_LIBS) $(LDLIBS) $(OPT)
 
-$(B)/tests/%: tests/c/%.c $(CTEST_SUPPORT_OBJ) $(LIBA)
+$(B)/tests/%: tests/c/%.c $(CTEST_SUPPORT_OBJ) $(LIBA) | $(GLUE)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests/c -o $@ $< $(CTEST_SUPPORT_OBJ) $(LIBA) \
-	  $(CHECK_LIBS) -Wl,--as-needed $(OIIO_LIBS) -lstdc++ $(LDLIBS)
+	  $(CHECK_LIBS) $(LDLIBS)
 
 tests-bin: $(CTEST_BIN)
 
@@ -132,11 +147,11 @@ tests-bin: $(CTEST_BIN)
 check-c: $(CTEST_BIN)
 	@set -e; for t in $(CTEST_BIN); do echo "== $$t"; CK_VERBOSITY=minimal $$t; done
 
-# gcc drops --as-needed when sanitizing, so every sanitized test binary
-# loads OpenImageIO's dependency tree, whose log4cplus starts a thread at
-# load time; a test forked by Check then hangs in exit() waiting for that
-# thread. The link line above restores --as-needed; CK_FORK=no in the
-# sanitizer pass is the second guard.
+# OpenImageIO's dependency tree (its log4cplus) starts a thread when it
+# is loaded; a test forked by Check after its parent had loaded it would
+# hang in exit() waiting for that thread. The tests link no OpenImageIO:
+# the bridge is loaded by the first image read or write, in the forked
+# child that does it; CK_FORK=no in the sanitizer pass is a second guard.
 
 LUA_SPEC_ENV = OUTCROP_TEST_BUILD=$(abspath $(B)) \
   LUA_CPATH="$(abspath $(B))/?.so;;" LUA_PATH="$(abspath tests/lua)/?.lua;;"
@@ -193,9 +208,9 @@ demo: deps
 BENCH_SRC := $(wildcard scripts/bench/bench_*.c)
 BENCH_BIN := $(BENCH_SRC:scripts/bench/%.c=$(B)/bench/%)
 
-$(B)/bench/%: scripts/bench/%.c $(LIBA)
+$(B)/bench/%: scripts/bench/%.c $(LIBA) | $(GLUE)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -o $@ $< $(LIBA) $(OIIO_LIBS) -lstdc++ $(LDLIBS)
+	$(CC) $(CFLAGS) -o $@ $< $(LIBA) $(LDLIBS)
 
 # The peer comparison (OpenVDB's volumeToMesh) is optional: it is built only
 # when libopenvdb-dev is installed (`make bench-peer-deps` installs it).
@@ -205,9 +220,9 @@ HAVE_VDB := $(shell for p in $(VDB_PKGS); do dpkg-query -W -f='$${Status}' $$p 2
 PEER_SRC := $(if $(HAVE_VDB),$(wildcard scripts/bench/peer_*.cpp))
 PEER_BIN := $(PEER_SRC:scripts/bench/%.cpp=$(B)/bench/%)
 
-$(B)/bench/peer_%: scripts/bench/peer_%.cpp $(LIBA)
+$(B)/bench/peer_%: scripts/bench/peer_%.cpp $(LIBA) | $(GLUE)
 	@mkdir -p $(dir $@)
-	$(CXX) $(CXXFLAGS) -o $@ $< $(LIBA) -lopenvdb -ltbb $(OIIO_LIBS) $(LDLIBS)
+	$(CXX) $(CXXFLAGS) -o $@ $< $(LIBA) -lopenvdb -ltbb $(LDLIBS)
 
 bench-peer-deps:
 	@$(MAKE) --no-print-directory deps PKGS="$(VDB_PKGS)"
@@ -230,13 +245,13 @@ FUZZ_SUPPORT := tests/fuzz/gen.c tests/fuzz/runner.c
 # need the interpreter's --wrap link)
 FUZZ_SUPPORT_OBJ := $(FUZZ_SUPPORT:%.c=$(B)/%.o) \
   $(B)/runtime/sandbox.o $(B)/runtime/stop.o $(LUA_OBJ) $(LIB_OBJ)
-FUZZ_LINK = $(LUA_LIBS) $(OIIO_LIBS) $(LDLIBS) $(OPT)
+FUZZ_LINK = $(LUA_LIBS) $(LDLIBS) $(OPT)
 
-$(B)/fuzz/fuzz_scene: $(B)/tests/fuzz/fuzz_scene.o $(FUZZ_SUPPORT_OBJ)
+$(B)/fuzz/fuzz_scene: $(B)/tests/fuzz/fuzz_scene.o $(FUZZ_SUPPORT_OBJ) | $(GLUE)
 	@mkdir -p $(dir $@)
 	$(CXX) -o $@ $^ -fsanitize=fuzzer $(FUZZ_LINK)
 
-$(B)/fuzz/replay: $(B)/tests/fuzz/replay.o $(FUZZ_SUPPORT_OBJ)
+$(B)/fuzz/replay: $(B)/tests/fuzz/replay.o $(FUZZ_SUPPORT_OBJ) | $(GLUE)
 	@mkdir -p $(dir $@)
 	$(CXX) -o $@ $^ $(FUZZ_LINK)
 
@@ -293,7 +308,7 @@ check-corpus: $(B)/fuzz/replay
 # is wrapped at link time so that the Nth call can fail.
 ALLOC_WRAP := -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free
 
-$(B)/alloc/alloc: $(B)/tests/alloc/alloc.o $(FUZZ_SUPPORT_OBJ)
+$(B)/alloc/alloc: $(B)/tests/alloc/alloc.o $(FUZZ_SUPPORT_OBJ) | $(GLUE)
 	@mkdir -p $(dir $@)
 	$(CXX) -o $@ $^ $(ALLOC_WRAP) $(FUZZ_LINK)
 
@@ -302,7 +317,7 @@ check-alloc: $(B)/alloc/alloc
 	@OMP_NUM_THREADS=1 $(B)/alloc/alloc
 
 format:
-	clang-format -i $$(find lib bindings runtime tests/c scripts -name '*.[ch]' -o -name '*.cpp')
+	clang-format -i $$(find lib bindings runtime tests/c scripts -name '*.[ch]' -o -name '*.cpp' -o -name '*.hpp')
 
 clean:
 	rm -rf build out

@@ -403,6 +403,14 @@ typedef enum oc_render_color {
   OC_COLOR_FIELD      /* a program (e.g. geology) through a palette */
 } oc_render_color;
 
+/* How linear colours become display values in 8/16-bit files (see
+** oc_render_shade). */
+typedef enum oc_render_tone {
+  OC_TONE_CLAMP = 0, /* clamp to [0, 1]: values over 1 are white */
+  OC_TONE_FILMIC     /* the ACES fit of Narkowicz (2015):
+                     ** x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14) */
+} oc_render_tone;
+
 /* Rule palette. Slopes are in degrees from the horizontal. When `levels`
 ** is 0, sea_level and snow_line are derived from the altitudes of the
 ** visible surface (z0 = lowest hit, z1 = highest): sea_level = z0 +
@@ -447,7 +455,11 @@ typedef struct oc_render_params {
   double max_distance;     /* farthest hit, metres; 0: auto (the scene's
                            ** box, or 1000 |target - eye| when unbounded) */
   oc_render_tracer tracer; /* OC_TRACE_SEGMENT by default */
-  int aov;                 /* 1: add the AOV channels (see oc_render) */
+  int aov;                 /* 1 (default): add the AOV channels (see
+                           ** oc_render_shade); 0: R, G, B, A only */
+  double exposure;         /* stops (EV) in [-20, 20]: colours are
+                           ** multiplied by 2^exposure (default 0) */
+  oc_render_tone tone;     /* OC_TONE_CLAMP by default */
   oc_progress progress;
 } oc_render_params;
 
@@ -455,7 +467,8 @@ typedef struct oc_render_params {
 ** (set the camera), sun from (-0.5, -0.4, 0.77) colour (1, 0.95, 0.86)
 ** intensity 2.2, sky (0.45, 0.6, 0.85), shadows and AO on, no fog (fog
 ** colour = sky), no background (sky), texture 0.3, rule colours with
-** derived levels, segment tracer, no AOV. */
+** derived levels, segment tracer, AOV channels on, exposure 0, tone
+** OC_TONE_CLAMP. */
 void oc_render_defaults(oc_render_params *rp);
 
 /* Channels of a geometry image (OC_RG_COUNT floats per pixel). */
@@ -484,9 +497,13 @@ oc_image *oc_render_geometry(const oc_program *prog, const oc_render_params *rp,
 ** NULL. Returns the final image: R, G, B, A, and when rp->aov also "Z",
 ** "N.x", "N.y", "N.z", "P.x", "P.y", "P.z", "evals" (evals includes the
 ** shadow, AO and colour evaluations). A is 1 on hits, the background's
-** alpha (1 for the sky) on misses. The image carries the metadata
-** outcrop:colorspace=linear, which makes oc_image_write encode its colour
-** channels as sRGB in 8/16-bit files (EXR keeps linear values). */
+** alpha (1 for the sky) on misses. R, G, B are linear and multiplied by
+** 2^rp->exposure (sky and background included). The image carries the
+** metadata outcrop:colorspace=linear, which makes oc_image_write encode
+** its colour channels as sRGB in 8/16-bit files (EXR and float TIFF keep
+** the linear values), and with OC_TONE_FILMIC outcrop:tone=filmic, which
+** makes it pass them through the filmic curve before the sRGB encoding
+** (again integer files only). */
 oc_image *oc_render_shade(const oc_program *prog, const oc_render_params *rp,
                           const oc_image *geometry, const float *albedo,
                           oc_error *err);

@@ -9,7 +9,9 @@
 ** camera.target is missing), up = {0, 0, 1}, fov = 40 degrees (vertical);
 ** sun, sky, shadows, AO and texture as the lib; no fog; the sky behind
 ** the surface; threshold = outcrop.threshold; rule colours by altitude
-** and slope.
+** and slope; the AOV channels (Z, N, P, evals) after R, G, B, A unless
+** aov = false; exposure 0 stops; tone "clamp" (the look of renders made
+** before the option existed), or "filmic".
 **
 ** `color` selects the albedo: nil (rules, tuned by `rules = {...}`), a
 ** node mapped through `palette` (a default palette of strata colours for
@@ -34,6 +36,7 @@
 #define MAX_SIDE 16384
 #define DEFAULT_FOV 40.0
 #define MAX_FOV 179.0
+#define MAX_EV 20.0 /* exposure, stops either way (lib/render/render.h) */
 /* Default view: from the south-west, 30 degrees above the horizon. */
 #define VIEW_AZIMUTH (-135.0)
 #define VIEW_ELEVATION 30.0
@@ -462,14 +465,13 @@ static const float *run_colour_function(lua_State *L, int fn, const oc_image *g,
 
 static int l_render(lua_State *L) {
   static const char *const known[] = {
-      "camera",      "size",          "sun",
-      "sky",         "shadows",       "ao",
-      "ao_distance", "fog",           "color",
-      "palette",     "rules",         "background",
-      "texture",     "texture_scale", "aov",
-      "threshold",   "max_distance",  "tracer",
+      "camera",    "size",         "sun",     "sky",           "shadows",
+      "ao",        "ao_distance",  "fog",     "color",         "palette",
+      "rules",     "background",   "texture", "texture_scale", "aov",
+      "threshold", "max_distance", "tracer",  "exposure",      "tone",
       NULL};
   static const char *const tracers[] = {"segment", "sphere", NULL};
+  static const char *const tones[] = {"clamp", "filmic", NULL};
   oclua_fields f;
   oc_error err = {OC_OK, ""};
   oc_render_params rp;
@@ -506,7 +508,10 @@ static int l_render(lua_State *L) {
   rp.texture = read_range(&f, "texture", 0, 1, rp.texture);
   rp.texture_scale = oclua_field_optnumber(&f, "texture_scale", OCLUA_POSITIVE,
                                            rp.texture_scale);
-  rp.aov = oclua_field_optbool(&f, "aov", 0);
+  rp.aov = oclua_field_optbool(&f, "aov", rp.aov);
+  rp.exposure = read_range(&f, "exposure", -MAX_EV, MAX_EV, rp.exposure);
+  rp.tone = oclua_field_optoption(&f, "tone", tones, 0) == 1 ? OC_TONE_FILMIC
+                                                             : OC_TONE_CLAMP;
   double t = oclua_field_optnumber(&f, "threshold", OCLUA_POSITIVE, 0);
   if (t == 0) t = oclua_threshold(L, FNAME);
   rp.threshold = t;

@@ -19,6 +19,7 @@
 #include "io/atomic.h"
 #include "io/oiio.h"
 #include "outcrop.h"
+#include "render/tone.h"
 
 #define SUPPORTED ".png, .jpg, .jpeg, .tif, .tiff or .exr"
 #define JPEG_MAX_SIDE 65500
@@ -89,7 +90,10 @@ static double unit(float x) {
 ** light (the renderer's output). Integer files are display-referred, so
 ** its colour channels go through the sRGB transfer function there and the
 ** file is tagged sRGB; float files (EXR, float TIFF) keep linear values
-** and are tagged linear. Alpha and any other channel stay as they are. */
+** and are tagged linear. Alpha and any other channel stay as they are.
+** A render made with a tone curve other than the clamp (render/tone.h)
+** has its colour channels go through that curve before the sRGB
+** encoding, in integer files only: float files stay scene-referred. */
 
 #define LINEAR_KEY "outcrop:colorspace"
 
@@ -118,11 +122,15 @@ static const void *samples(const oc_image *img, int nch, oc_oiio_type t,
   int ncol = is_linear(img) && (t == OC_OIIO_U8 || t == OC_OIIO_U16)
                  ? colour_channels(nch)
                  : 0;
+  oc_render_tone tone =
+      ncol ? oc_tone_from_name(oc_image_meta_get(img, OC_TONE_KEY))
+           : OC_TONE_CLAMP;
   for (size_t p = 0; p < npix; p++) {
     const float *s = src + p * stride;
     for (int c = 0; c < nch; c++) {
       size_t i = p * nch + c;
-      double v = unit(s[c]);
+      double v = c < ncol && tone != OC_TONE_CLAMP ? oc_tone_apply(tone, s[c])
+                                                   : unit(s[c]);
       if (c < ncol) v = oc_srgb_encode(v);
       if (t == OC_OIIO_U8)
         ((uint8_t *)buf)[i] = (uint8_t)(v * 255.0 + 0.5);

@@ -24,6 +24,7 @@ void oc_render_defaults(oc_render_params *rp) {
       .background = {0, 0, 0, 0},
       .texture = 0.3,
       .rules = {.rock_slope = 38, .snow_slope = 45},
+      .aov = 1,
   };
   *rp = d;
 }
@@ -177,6 +178,14 @@ int oc_render_check_shade(const oc_render_params *rp, oc_error *err) {
     return oc_seterr(err, OC_EINVAL,
                      "'texture_scale' must be finite and >= 0 (got %g)",
                      rp->texture_scale);
+  if (!(rp->exposure >= -OC_RENDER_MAX_EV && rp->exposure <= OC_RENDER_MAX_EV))
+    return oc_seterr(err, OC_EINVAL,
+                     "'exposure' must be in [%d, %d] stops (got %g)",
+                     -OC_RENDER_MAX_EV, OC_RENDER_MAX_EV, rp->exposure);
+  if (rp->tone != OC_TONE_CLAMP && rp->tone != OC_TONE_FILMIC)
+    return oc_seterr(err, OC_EINVAL,
+                     "'tone' must be \"clamp\" or \"filmic\" (got %d)",
+                     (int)rp->tone);
   if (rp->color == OC_COLOR_RULES) return check_rules(&rp->rules, err);
   if (rp->color == OC_COLOR_FIELD) {
     if (!rp->color_field)

@@ -16,6 +16,7 @@
 #include "core/vec.h"
 #include "render/render.h"
 #include "render/shade.h"
+#include "render/tone.h"
 #include "render/trace.h"
 
 #define TILE 16
@@ -194,6 +195,7 @@ typedef struct sctx {
   const float *albedo;
   float *px;
   int nch;
+  double gain; /* 2^exposure */
 } sctx;
 
 static void shade_pixel(const sctx *s, int i, int j) {
@@ -216,8 +218,10 @@ static void shade_pixel(const sctx *s, int i, int j) {
   } else {
     oc_sky(&s->sh, ray_dir(&s->cam, i, j), rgba);
   }
-  for (int c = 0; c < 4; c++)
-    out[c] = (float)rgba[c];
+  /* (a gain of exactly 1 leaves every value as it was) */
+  for (int c = 0; c < 3; c++)
+    out[c] = (float)(rgba[c] * s->gain);
+  out[3] = (float)rgba[3];
   if (s->nch > 4) {
     memcpy(out + 4, g + OC_RG_Z, 7 * sizeof *out);
     out[11] = (float)ev;
@@ -280,12 +284,17 @@ static oc_image *shade(const oc_program *prog, const oc_render_params *rp,
     oc_image_set_channel_name(img, c, aov_names[c - 4], NULL);
   /* linear light: the writers encode sRGB for integer formats */
   oc_image_set_meta(img, "outcrop:colorspace", "linear", NULL);
+  /* the clamp is the writers' default: only another curve is recorded, so
+  ** files of default renders are as they were */
+  if (rp->tone != OC_TONE_CLAMP)
+    oc_image_set_meta(img, OC_TONE_KEY, oc_tone_name(rp->tone), NULL);
   sctx s;
   camera_init(&s.cam, rp);
   s.geo = oc_image_cdata(geo);
   s.albedo = albedo;
   s.px = oc_image_data(img);
   s.nch = nch;
+  s.gain = exp2(rp->exposure);
   oc_shader *sh = &s.sh;
   sh->rp = rp;
   sh->prog = prog;

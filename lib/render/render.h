@@ -10,6 +10,7 @@
 #define OC_RENDER_MAX_SIDE 16384
 #define OC_RENDER_MAX_PIXELS (1ll << 25) /* 8K UHD fits */
 #define OC_RENDER_MAX_STOPS 256
+#define OC_RENDER_MAX_EV 20 /* exposure range, stops either way */
 
 int oc_render_check_geometry(const oc_program *prog, const oc_render_params *rp,
                              oc_error *err);

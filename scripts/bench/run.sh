@@ -9,6 +9,31 @@ for b in $BENCH_BIN; do
   echo "## $(basename "$b")"
   "$b"
 done
+
+# Start-up of the interpreter: the median wall time of 20 runs of a
+# one-line script, without images (OpenImageIO is loaded on first use,
+# lib/io/oiio_load.c) and with one tiny PNG written.
+startup_ms() {
+  local script=$1 dir times=() t0 t1
+  dir=$(mktemp -d)
+  for _ in $(seq 20); do
+    t0=$(date +%s%N)
+    "$OUTCROP" run "$script" --out "$dir" >/dev/null
+    t1=$(date +%s%N)
+    times+=($(( (t1 - t0) / 1000 )))
+  done
+  rm -rf "$dir"
+  printf '%s\n' "${times[@]}" | sort -n |
+    awk '{ v[NR] = $1 } END { printf "%.1f", (v[10] + v[11]) / 2 / 1000 }'
+}
+echo "## start-up"
+tmp=$(mktemp -d)
+echo 'print(1)' >"$tmp/print.lua"
+echo 'assert(outcrop.render(outcrop.point{center = {0, 0, 0}, radius = 1}, {size = {8, 8}}):write("tiny.png"))' >"$tmp/png.lua"
+echo "runtime.startup_ms: $(startup_ms "$tmp/print.lua") ms"
+echo "runtime.startup_ms_with_image: $(startup_ms "$tmp/png.lua") ms"
+rm -rf "$tmp"
+
 shopt -s nullglob
 for s in scripts/bench/*.lua; do
   echo "## $(basename "$s")"

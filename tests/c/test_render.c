@@ -16,6 +16,7 @@
 #include "io/oiio.h"
 #include "ocheck.h"
 #include "outcrop.h"
+#include "render/tone.h"
 #include "render/trace.h"
 
 #define PI 3.14159265358979323846
@@ -561,6 +562,10 @@ START_TEST(bad_params) {
        rp.nstops = 2),
       OC_EINVAL, "palette");
   BAD((rp.color = OC_COLOR_FIELD, rp.color_field = NULL), OC_EINVAL, "color");
+  BAD(rp.exposure = NAN, OC_EINVAL, "exposure");
+  BAD(rp.exposure = 20.5, OC_EINVAL, "exposure");
+  BAD(rp.exposure = -INFINITY, OC_EINVAL, "exposure");
+  BAD(rp.tone = (oc_render_tone)7, OC_EINVAL, "tone");
 #undef BAD
   /* a geometry image of the wrong size */
   oc_image *g = oc_render_geometry(pr, &ok, NULL);
@@ -606,6 +611,94 @@ START_TEST(srgb_on_write) {
 }
 END_TEST
 
+/* ---- exposure and tone --------------------------------------------------- */
+
+/* Narkowicz's (2015) fit as he gives it, in single steps. */
+static double aces_fit(double x) {
+  double a = 2.51, b = 0.03, c = 2.43, d = 0.59, e = 0.14;
+  double y = (x * (a * x + b)) / (x * (c * x + d) + e);
+  return y < 0 ? 0 : y > 1 ? 1 : y;
+}
+
+START_TEST(filmic_formula) {
+  static const double xs[] = {1e-6, 0.01, 0.05, 0.18, 0.5, 1, 2, 4, 10, 100};
+  for (size_t k = 0; k < sizeof xs / sizeof *xs; k++) {
+    double f = oc_tone_filmic(xs[k]);
+    ck_assert_msg(fabs(f - aces_fit(xs[k])) < 1e-15, "f(%g) = %.17g", xs[k], f);
+    if (k) ck_assert(f >= oc_tone_filmic(xs[k - 1])); /* monotonic */
+  }
+  /* a few values worked by hand: f(1) = 2.54 / 3.16, f(0.18) */
+  ck_assert(fabs(oc_tone_filmic(1) - 2.54 / 3.16) < 1e-15);
+  ck_assert(fabs(oc_tone_filmic(0.18) - 0.086724 / 0.324932) < 1e-6);
+  /* bright albedos no longer clip: 2 stays below white */
+  ck_assert(oc_tone_filmic(2) < 0.93);
+  ck_assert(oc_tone_filmic(0) == 0 && oc_tone_filmic(-1) == 0);
+  ck_assert(oc_tone_filmic(NAN) == 0);
+  ck_assert(oc_tone_filmic(INFINITY) == 1 && oc_tone_filmic(1e30) == 1);
+  /* the clamp is the writer's old rule */
+  ck_assert(oc_tone_apply(OC_TONE_CLAMP, 1.5) == 1);
+  ck_assert(oc_tone_apply(OC_TONE_CLAMP, 0.25) == 0.25);
+  ck_assert(oc_tone_apply(OC_TONE_CLAMP, NAN) == 0);
+  ck_assert(oc_tone_from_name(oc_tone_name(OC_TONE_FILMIC)) == OC_TONE_FILMIC);
+  ck_assert(oc_tone_from_name(NULL) == OC_TONE_CLAMP);
+}
+END_TEST
+
+START_TEST(exposure_and_tone) {
+  oc_program *pr = ball_over_ground();
+  oc_render_params rp = view(oct_v(10, -14, 9), oct_v(0, 0, 2), 45, 12, 9);
+  oc_render_params def = rp;
+  ck_assert(def.exposure == 0 && def.tone == OC_TONE_CLAMP && def.aov == 1);
+  oc_image *base = oc_render(pr, &rp, NULL);
+  rp.exposure = -1.25;
+  rp.tone = OC_TONE_FILMIC;
+  oc_image *img = oc_render(pr, &rp, NULL);
+  ck_assert_ptr_nonnull(base);
+  ck_assert_ptr_nonnull(img);
+  ck_assert_int_eq(oc_image_channels(img), 12);
+  ck_assert_str_eq(oc_image_meta_get(img, "outcrop:tone"), "filmic");
+  ck_assert_ptr_null(oc_image_meta_get(base, "outcrop:tone"));
+  const float *a = oc_image_cdata(base), *b = oc_image_cdata(img);
+  size_t n = 12 * 9;
+  for (size_t p = 0; p < n; p++)
+    for (int c = 0; c < 12; c++) {
+      double want = c < 3 ? (double)a[p * 12 + c] * exp2(-1.25) : a[p * 12 + c];
+      ck_assert_msg(fabs(b[p * 12 + c] - want) <= 1e-6 * fabs(want),
+                    "pixel %zu channel %d: %g, want %g", p, c, b[p * 12 + c],
+                    want);
+    }
+  /* PNG: the curve, then sRGB; EXR: the linear values as they are */
+  const char *dir = oct_tmpdir("tone");
+  ck_assert_int_eq(oc_image_write(img, oct_in_dir(dir, "f.png"), 16, NULL), 0);
+  ck_assert_int_eq(oc_image_write(img, oct_in_dir(dir, "f.exr"), 32, NULL), 0);
+  oc_image *png = oc_oiio_read(oct_in_dir(dir, "f.png"), NULL);
+  oc_image *exr = oc_oiio_read(oct_in_dir(dir, "f.exr"), NULL);
+  ck_assert_int_eq(oc_image_channels(png), 4);
+  ck_assert_int_eq(oc_image_channels(exr), 12);
+  const float *q = oc_image_cdata(png);
+  for (size_t p = 0; p < n; p++)
+    for (int c = 0; c < 3; c++) {
+      double v = aces_fit(b[p * 12 + c]);
+      v = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1 / 2.4) - 0.055;
+      ck_assert_msg(fabs(q[p * 4 + c] - v) <= 0.6 / 65535, "%g, want %g",
+                    q[p * 4 + c], v);
+    }
+  /* (the EXR stores channels in its own order: compare by name) */
+  for (int c = 0; c < 12; c++)
+    for (int k = 0; k < 12; k++)
+      if (strcmp(oc_image_channel_name(exr, k),
+                 oc_image_channel_name(img, c)) == 0)
+        for (size_t p = 0; p < n; p++)
+          ck_assert(oc_image_cdata(exr)[p * 12 + k] == b[p * 12 + c]);
+  oc_image_free(png);
+  oc_image_free(exr);
+  oc_image_free(img);
+  oc_image_free(base);
+  oct_rm_tree(dir);
+  oc_program_free(pr);
+}
+END_TEST
+
 static Suite *suite(void) {
   Suite *s = suite_create("render");
   TCase *t = tcase_create("tracing");
@@ -622,6 +715,8 @@ static Suite *suite(void) {
   tcase_add_test(t, two_phases_and_albedo);
   tcase_add_test(t, field_palette_and_fog);
   tcase_add_test(t, srgb_on_write);
+  tcase_add_test(t, filmic_formula);
+  tcase_add_test(t, exposure_and_tone);
   suite_add_tcase(s, t);
   t = tcase_create("running");
   tcase_set_timeout(t, 300);

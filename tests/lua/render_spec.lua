@@ -118,7 +118,8 @@ describe("outcrop.render", function()
     local w, h = img:size()
     assert.are.equal(33, w)
     assert.are.equal(25, h)
-    assert.are.equal(4, img:channels())
+    -- R, G, B, A and the AOVs by default
+    assert.are.equal(12, img:channels())
     -- the centre pixel sees the ball, the border sees nothing
     assert.are.equal(1, select(4, img:get(17, 13)))
     for i = 1, w do
@@ -208,6 +209,97 @@ describe("outcrop.render", function()
     end)
   end)
 
+  describe("AOVs by default", function()
+    local cam = {eye = {0, -25, 3}, target = {0, 0, 0}, fov = 25}
+    local plain = oc.render(sphere, {size = {20, 14}, camera = cam})
+    local rgba = oc.render(sphere, {size = {20, 14}, camera = cam, aov = false})
+    local with = oc.render(sphere, {size = {20, 14}, camera = cam, aov = true})
+
+    it("do not change the colours", function()
+      assert.are.equal(12, plain:channels())
+      assert.are.equal(4, rgba:channels())
+      for j = 1, 14 do
+        for i = 1, 20 do
+          local a, b, c = {plain:get(i, j)}, {rgba:get(i, j)}, {with:get(i, j)}
+          assert.are.same(b, {a[1], a[2], a[3], a[4]})
+          assert.are.same(c, a)
+        end
+      end
+    end)
+
+    it("go to EXR files unless aov = false", function()
+      local dir = R.tmpdir()
+      local function names(path)
+        local _, _, channels = info(path)
+        local t = {}
+        for c in channels:gmatch("[^, ]+") do t[#t + 1] = c end
+        table.sort(t)
+        return t
+      end
+      assert.is_true(plain:write(dir .. "/plain.exr"))
+      assert.are.same({"A", "B", "G", "N.x", "N.y", "N.z", "P.x", "P.y", "P.z", "R", "Z", "evals"},
+        names(dir .. "/plain.exr"))
+      assert.is_true(rgba:write(dir .. "/rgba.exr"))
+      assert.are.same({"A", "B", "G", "R"}, names(dir .. "/rgba.exr"))
+      -- the same file as aov = true makes
+      assert.is_true(with:write(dir .. "/with.exr"))
+      assert.are.equal(read_file(dir .. "/with.exr"), read_file(dir .. "/plain.exr"))
+      -- PNG and JPEG hold the colour only, the same bytes either way
+      for _, ext in ipairs{"png", "jpg"} do
+        assert.is_true(plain:write(dir .. "/plain." .. ext))
+        assert.is_true(rgba:write(dir .. "/rgba." .. ext))
+        assert.are.equal(read_file(dir .. "/rgba." .. ext), read_file(dir .. "/plain." .. ext))
+      end
+      R.rmdir(dir)
+    end)
+  end)
+
+  describe("exposure and tone", function()
+    local cam = {eye = {0, -25, 3}, target = {0, 0, 0}, fov = 25}
+    local size = {16, 12}
+
+    it("checks both fields", function()
+      R.check_error(function() oc.render(sphere, {exposure = "bright"}) end, F, "outcrop.render", "'exposure' must be a number in [-20")
+      R.check_error(function() oc.render(sphere, {exposure = 21}) end, F, "outcrop.render", "'exposure'")
+      R.check_error(function() oc.render(sphere, {exposure = 0 / 0}) end, F, "outcrop.render", "'exposure'")
+      R.check_error(function() oc.render(sphere, {tone = "aces"}) end, F, "outcrop.render", "'tone' must be one of", "\"filmic\"")
+      R.check_error(function() oc.render(sphere, {tone = 1}) end, F, "outcrop.render", "'tone'")
+    end)
+
+    it("multiplies the colours by 2^exposure, alpha and AOVs kept", function()
+      local base = oc.render(sphere, {size = size, camera = cam})
+      local up = oc.render(sphere, {size = size, camera = cam, exposure = 1.5})
+      local zero = oc.render(sphere, {size = size, camera = cam, exposure = 0, tone = "clamp"})
+      local k = 2 ^ 1.5
+      for j = 1, 12 do
+        for i = 1, 16 do
+          local a, b = {base:get(i, j)}, {up:get(i, j)}
+          for c = 1, 3 do R.close(b[c], a[c] * k, 1e-6 * (1 + a[c] * k)) end
+          for c = 4, 12 do assert.are.equal(a[c], b[c]) end
+          assert.are.same(a, {zero:get(i, j)})
+        end
+      end
+    end)
+
+    it("filmic: EXR keeps linear values, PNG goes through the curve", function()
+      local dir = R.tmpdir()
+      local img = oc.render(sphere, {size = size, camera = cam, exposure = 2, tone = "filmic"})
+      local clamp = oc.render(sphere, {size = size, camera = cam, exposure = 2})
+      -- the pixels are the same; only the written display values differ
+      assert.are.same({clamp:get(8, 6)}, {img:get(8, 6)})
+      assert.is_true(img:write(dir .. "/f.exr"))
+      assert.is_true(clamp:write(dir .. "/c.exr"))
+      local attrs = info(dir .. "/f.exr")
+      assert.are.equal("filmic", attrs["outcrop:tone"])
+      local mean = compare(dir .. "/f.exr", dir .. "/c.exr")
+      assert.are.equal(0, mean)
+      assert.is_true(img:write(dir .. "/f.png"))
+      assert.is_true(clamp:write(dir .. "/c.png"))
+      assert.are_not.equal(read_file(dir .. "/f.png"), read_file(dir .. "/c.png"))
+      R.rmdir(dir)
+    end)
+  end)
+
   describe("colours", function()
     local scene = ball({0, 0, 2}, 3) + oc.box{min = {-8, -8, -3}, max = {8, 8, -1}, falloff = 1}
     local cam = {eye = {14, -18, 10}, target = {0, 0, 0}}
@@ -272,7 +364,7 @@ describe("outcrop.render", function()
       end
       assert.is_true(hits > 50)
       -- the default palette for a resistance in [0, 1]
-      local strata = oc.render(scene, {size = {24, 18}, camera = cam, color = scene})
+      local strata = oc.render(scene, {size = {24, 18}, camera = cam, color = scene, aov = false})
       assert.are.equal(4, strata:channels())
     end)
 
@@ -285,7 +377,7 @@ describe("outcrop.render", function()
 
   it("applies background, fog and sky", function()
     local cam = {eye = {0, -30, 0}, target = {0, 0, 0}}
-    local img = oc.render(sphere, {size = {9, 9}, camera = cam, background = {0.25, 0.5, 0.75, 0.5}})
+    local img = oc.render(sphere, {size = {9, 9}, camera = cam, background = {0.25, 0.5, 0.75, 0.5}, aov = false})
     assert.are.same({0.25, 0.5, 0.75, 0.5}, {img:get(1, 1)})
     -- the sky behind: its colour, lightened towards the horizon
     local sky = oc.render(sphere, {size = {9, 9}, camera = cam, sky = {0.1, 0.2, 0.3}})
@@ -344,8 +436,10 @@ describe("outcrop.render", function()
     local scene = ball({0, 0, 2}, 4) + oc.box{min = {-10, -10, -4}, max = {10, 10, -1}, falloff = 1}
     local cam = {eye = {16, -20, 12}, target = {0, 0, 0}, fov = 40}
     local cases = {
-      {"sphere_plane", {size = {64, 48}, camera = cam}},
-      {"sphere_plane_function", {size = {64, 48}, camera = cam,
+      -- (the goldens hold R, G, B, A: made before the AOVs were on by
+      -- default; "AOVs by default" below checks that they are the same)
+      {"sphere_plane", {size = {64, 48}, camera = cam, aov = false}},
+      {"sphere_plane_function", {size = {64, 48}, camera = cam, aov = false,
         color = function(x, y, z, nx, ny, nz)
           -- bands of altitude, darker where steep
           local band = math.floor(z) % 2 == 0 and 0.8 or 0.4

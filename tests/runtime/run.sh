@@ -709,6 +709,50 @@ run out.lua --unsafe --out "$W/elsewhere"
 status_is 1; err_has "'out' is already configured as"
 end
 
+# ---- start-up: OpenImageIO is loaded on the first image read or write ------
+
+# (the scene prints the shared objects mapped into the process)
+begin image-library-lazy
+cat >"$W/maps.lua" <<'LUA'
+local oc = require "outcrop"
+local function mapped()
+  local f = assert(io.open("/proc/self/maps"))
+  local s = f:read("a"); f:close()
+  return s:find("libOpenImageIO", 1, true) ~= nil
+end
+print("before " .. tostring(mapped()))
+oc.polygonize(oc.point{center = {0, 0, 0}, radius = 1}, {cell = 0.5}):write("m.obj")
+print("mesh " .. tostring(mapped()))
+assert(oc.render(oc.point{center = {0, 0, 0}, radius = 1}, {size = {4, 4}}):write("r.png"))
+print("image " .. tostring(mapped()))
+LUA
+run "$W/maps.lua" --out "$W/o"
+status_is 0
+out_has "before false"
+out_has "mesh false"
+out_has "image true"
+end
+
+# A copy of the interpreter without liboutcrop_oiio.so beside it: scripts
+# without images run; an image write is an ordinary error naming the cause.
+begin image-library-missing
+mkdir -p "$W/lone"
+cp "$OUTCROP" "$W/lone/outcrop"
+echo 'print(1 + 1)' >"$W/p.lua"
+echo 'local oc = require "outcrop"
+assert(oc.render(oc.point{center = {0, 0, 0}, radius = 1}, {size = {4, 4}}):write("r.png"))' >"$W/w.lua"
+(cd "$W" && exec "$W/lone/outcrop" p.lua) >"$OUT" 2>"$ERR" </dev/null
+rc=$?
+status_is 0
+out_has 2
+(cd "$W" && LD_LIBRARY_PATH= exec "$W/lone/outcrop" w.lua --out o) >"$OUT" 2>"$ERR" </dev/null
+rc=$?
+status_is 1
+err_has "image support unavailable: "
+err_has "liboutcrop_oiio.so"
+[ ! -e "$W/o/r.png" ] || because "r.png was written"
+end
+
 set +m
 
 echo "runtime tests: $npass passed, $nfail failed"

@@ -1,6 +1,7 @@
 /*
 ** oiio_hf.cpp — exact heightfield reads through OpenImageIO: the first
-** channel of an image as stored (see lib/io/oiio_hf.h).
+** channel of an image as stored (see lib/io/oiio_hf.h); part of
+** liboutcrop_oiio.so (io/oiio_glue.h).
 **
 ** Every entry point catches every exception: C callers get a status and
 ** a message, never an unwinding stack.
@@ -127,7 +128,7 @@ int read_raw(const char *path, const oc_oiio_raw *r, oc_error *err) {
 
 } // namespace
 
-extern "C" int oc_oiio_read_raw(const char *path, const oc_oiio_raw *r,
+extern "C" int oc_glue_read_raw(const char *path, const oc_oiio_raw *r,
                                 oc_error *err) {
   try {
     return read_raw(path, r, err);

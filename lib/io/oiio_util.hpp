@@ -16,6 +16,14 @@
 extern "C" {
 #include "core/error.h"
 #include "io/infile.h"
+#include "io/oiio.h"
+#include "io/oiio_hf.h"
+
+/* The bridge's entry points, gathered by oiio_host.cpp into its table. */
+int oc_glue_encode(const oc_oiio_out *im, oc_oiio_sink sink, void *ud,
+                   char *why, size_t whysize);
+oc_image *oc_glue_read(const char *path, oc_error *err);
+int oc_glue_read_raw(const char *path, const oc_oiio_raw *r, oc_error *err);
 }
 
 /* OpenImageIO messages may span lines; ours are one line. */

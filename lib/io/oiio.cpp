@@ -1,9 +1,11 @@
 /*
 ** oiio.cpp — the bridge from lib/io to OpenImageIO: plain C functions
-** (declared in lib/io/oiio.h) that read and write image files.
+** (as lib/io/oiio.h describes them) that read and write image files,
+** part of liboutcrop_oiio.so (io/oiio_glue.h), loaded on first use.
 **
-** The only C++ in the project. Every entry point catches every exception:
-** C callers get a status code and a message, never an unwinding stack.
+** With oiio_hf.cpp the only C++ in the project. Every entry point catches
+** every exception: C callers get a status code and a message, never an
+** unwinding stack.
 */
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
@@ -222,7 +224,7 @@ oc_image *read_file(const char *path, oc_error *err) {
 
 } // namespace
 
-extern "C" int oc_oiio_encode(const oc_oiio_out *im, oc_oiio_sink sink,
+extern "C" int oc_glue_encode(const oc_oiio_out *im, oc_oiio_sink sink,
                               void *ud, char *why, size_t whysize) {
   try {
     return encode(im, sink, ud, why, whysize);
@@ -235,7 +237,7 @@ extern "C" int oc_oiio_encode(const oc_oiio_out *im, oc_oiio_sink sink,
   }
 }
 
-extern "C" oc_image *oc_oiio_read(const char *path, oc_error *err) {
+extern "C" oc_image *oc_glue_read(const char *path, oc_error *err) {
   try {
     return read_file(path, err);
   } catch (const std::bad_alloc &) {
