@@ -10,8 +10,8 @@
 ** the bindings raise as a Lua error. Lua's allocator (ocrt_lua_alloc)
 ** shares the count and the limit, so Lua tries an emergency collection
 ** and then raises "not enough memory". Memory of other libraries
-** (OpenImageIO, the C library's buffers, OpenMP) is not counted, nor the
-** little that lib/ gets from libc functions not wrapped (strndup).
+** (OpenImageIO, the C library's buffers, OpenMP) is not counted; lib/
+** allocates through the malloc family, strdup and realpath only.
 **
 ** OpenMP threads allocate concurrently: the counter is atomic. Memory
 ** freed here but allocated elsewhere (a library returning malloc'ed

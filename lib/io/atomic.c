@@ -76,8 +76,12 @@ static int make_temp(int dir, const char *path, char **name) {
 ** one or could not link it later (no /proc). */
 static int anonymous_temp(int dir, const char *path) {
   const char *slash = strrchr(path, '/');
-  char *folder = slash ? strndup(path, (size_t)(slash - path + 1)) : NULL;
+  /* malloc, not strndup: --max-memory and the allocation-failure tests
+  ** see only the malloc family */
+  size_t n = slash ? (size_t)(slash - path + 1) : 0;
+  char *folder = slash ? malloc(n + 1) : NULL;
   if (slash && !folder) return -1;
+  if (folder) memcpy(folder, path, n), folder[n] = '\0';
   int fd = openat(dir, folder ? folder : ".", O_WRONLY | O_TMPFILE | O_CLOEXEC,
                   0666);
   free(folder);
