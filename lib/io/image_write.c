@@ -88,7 +88,10 @@ static double unit(float x) {
 ** light (the renderer's output). Integer files are display-referred, so
 ** its colour channels go through the sRGB transfer function there and the
 ** file is tagged sRGB; float files (EXR, float TIFF) keep linear values
-** and are tagged linear. Alpha and any other channel stay as they are. */
+** and are tagged linear. Alpha and any other channel stay as they are.
+** The marker itself is written as what the file holds (sRGB in integer
+** files): an encoded PNG read back must not pass for linear light, or a
+** second write would encode it again. */
 
 #define LINEAR_KEY "outcrop:colorspace"
 
@@ -222,12 +225,15 @@ int oc_image_write_at(const oc_image *img, int dirfd, const char *path,
     free(meta);
     return oc_seterr(err, OC_ENOMEM, "cannot write '%s': out of memory", path);
   }
+  int integer = t == OC_OIIO_U8 || t == OC_OIIO_U16;
   for (size_t i = 0; i < nmeta; i++) {
     meta[2 * i] = oc_image_meta_key(img, i);
     meta[2 * i + 1] = oc_image_meta_value(img, i);
+    if (integer && strcasecmp(meta[2 * i], LINEAR_KEY) == 0 &&
+        strcasecmp(meta[2 * i + 1], "linear") == 0)
+      meta[2 * i + 1] = "sRGB";
   }
   if (is_linear(img)) {
-    int integer = t == OC_OIIO_U8 || t == OC_OIIO_U16;
     meta[2 * nmeta] = "oiio:ColorSpace";
     meta[2 * nmeta + 1] = integer ? "sRGB" : "Linear";
     nmeta++;
