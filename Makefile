@@ -4,6 +4,8 @@
 #   make         library (static + shared), Lua module, `outcrop` binary
 #   make test    deps, build, every test, plus the ASan/UBSan pass
 #   make demo    deps, build, run examples/demo.lua, say where outputs are
+#   make pictures  build, run the examples that make the README's pictures,
+#                copy those into docs/ (PICTURES below says which is which)
 #   make bench   deps, build, run scripts/bench/ (prints `name: value unit`)
 #   make fuzz    the scene fuzzer, long run (FUZZ_TIME seconds; fuzz-smoke:
 #                about 2 minutes, part of make test)
@@ -84,7 +86,7 @@ BIN := $(B)/outcrop
 GLUE := $(B)/liboutcrop_oiio.so
 
 .PHONY: bench-peer-deps all deps test check-c check-lua check-lua-gc check-runtime check-asan demo bench \
-        clean format tests-bin
+        clean format tests-bin pictures
 .DEFAULT_GOAL := all
 
 all: $(LIBA) $(LIBSO) $(MODULE) $(BIN) $(GLUE)
@@ -177,6 +179,8 @@ check-runtime: $(BIN)
 	@echo "== interpreter tests ($(B))"
 	@OUTCROP=$(abspath $(BIN)) bash tests/runtime/run.sh
 	@OUTCROP=$(abspath $(BIN)) bash tests/runtime/outpaths.sh
+	@OUTCROP=$(abspath $(BIN)) bash tests/runtime/examples.sh
+	@OUTCROP=$(abspath $(BIN)) bash tests/runtime/readme_snippets.sh
 
 # The sanitizer pass: C tests, Lua specs (stock lua5.4 with libasan
 # preloaded; leak checking off there because lua5.4 itself is not
@@ -204,6 +208,29 @@ demo: deps
 	@mkdir -p out/demo
 	$(BIN) run examples/demo.lua --out out/demo
 	@echo "demo outputs are in $(abspath out/demo)/"
+
+# The README's pictures, each `docs/PICTURE:EXAMPLE:OUTPUT`: `make
+# pictures` runs every example named once (into out/pictures/EXAMPLE) and
+# copies its outputs over the pictures, so that they cannot go stale.
+PICTURES := demo_arch_render.png:demo:arch_render.png \
+  demo_arch_xz.png:demo:arch_xz.png \
+  example_canyon.png:canyon:canyon.png \
+  example_floating_islands.png:floating_islands:floating_islands.png \
+  example_hoodoos.png:hoodoos:hoodoos.png \
+  example_karst.png:karst:karst_network.png \
+  example_karst_cut.png:karst:karst.png \
+  example_sea_cliffs.png:sea_cliffs:sea_cliffs.png
+PICTURE_SCENES := $(sort $(foreach p,$(PICTURES),$(word 2,$(subst :, ,$(p)))))
+
+pictures: all
+	@set -e; for e in $(PICTURE_SCENES); do \
+	  echo "== examples/$$e.lua"; rm -rf out/pictures/$$e; \
+	  $(BIN) run examples/$$e.lua --out out/pictures/$$e; \
+	done; \
+	for p in $(PICTURES); do \
+	  IFS=: read -r pic scene file <<<"$$p"; \
+	  cp out/pictures/$$scene/$$file docs/$$pic; echo "docs/$$pic <- examples/$$scene.lua ($$file)"; \
+	done
 
 BENCH_SRC := $(wildcard scripts/bench/bench_*.c)
 BENCH_BIN := $(BENCH_SRC:scripts/bench/%.c=$(B)/bench/%)

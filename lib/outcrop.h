@@ -414,7 +414,8 @@ typedef enum oc_render_tone {
 /* Rule palette. Slopes are in degrees from the horizontal. When `levels`
 ** is 0, sea_level and snow_line are derived from the altitudes of the
 ** visible surface (z0 = lowest hit, z1 = highest): sea_level = z0 +
-** 0.04 (z1 - z0), snow_line = z0 + 0.75 (z1 - z0). */
+** 0.04 (z1 - z0), snow_line = z0 + 0.75 (z1 - z0); when it is 1, each
+** level is used as given, except a NaN one, which is derived so. */
 typedef struct oc_render_rules {
   int levels;        /* 1: use sea_level and snow_line as given */
   double sea_level;  /* sand below sea_level + beach */

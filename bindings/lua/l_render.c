@@ -239,14 +239,14 @@ static void read_rules(const oclua_fields *f, oc_render_params *rp) {
   int sea = oclua_field_push(&r, "sea_level") != LUA_TNIL;
   int snow = oclua_field_push(&r, "snow_line") != LUA_TNIL;
   lua_pop(L, 2);
-  if (sea != snow)
-    oclua_error(L, f->fname,
-                "give both 'rules.sea_level' and 'rules.snow_line' (or "
-                "neither: they then follow the visible altitudes)");
-  if (sea) {
+  /* a level not given follows the visible altitudes (NaN for the engine) */
+  if (sea || snow) {
     ru->levels = 1;
-    ru->sea_level = oclua_field_number(&r, "sea_level", OCLUA_FINITE);
-    ru->snow_line = oclua_field_number(&r, "snow_line", OCLUA_FINITE);
+    ru->sea_level = ru->snow_line = NAN;
+  }
+  if (sea) ru->sea_level = oclua_field_number(&r, "sea_level", OCLUA_FINITE);
+  if (snow) ru->snow_line = oclua_field_number(&r, "snow_line", OCLUA_FINITE);
+  if (sea && snow) {
     if (!(ru->sea_level < ru->snow_line))
       oclua_error(L, f->fname,
                   "'rules.sea_level' must be below 'rules.snow_line' "

@@ -93,7 +93,10 @@ static double unit(float x) {
 ** and are tagged linear. Alpha and any other channel stay as they are.
 ** A render made with a tone curve other than the clamp (render/tone.h)
 ** has its colour channels go through that curve before the sRGB
-** encoding, in integer files only: float files stay scene-referred. */
+** encoding, in integer files only: float files stay scene-referred.
+** The marker itself is written as what the file holds (sRGB in integer
+** files): an encoded PNG read back must not pass for linear light, or a
+** second write would encode it again. */
 
 #define LINEAR_KEY "outcrop:colorspace"
 
@@ -226,12 +229,15 @@ int oc_image_write_at(const oc_image *img, int dirfd, const char *path,
     free(meta);
     return oc_seterr(err, OC_ENOMEM, "cannot write '%s': out of memory", path);
   }
+  int integer = t == OC_OIIO_U8 || t == OC_OIIO_U16;
   for (size_t i = 0; i < nmeta; i++) {
     meta[2 * i] = oc_image_meta_key(img, i);
     meta[2 * i + 1] = oc_image_meta_value(img, i);
+    if (integer && strcasecmp(meta[2 * i], LINEAR_KEY) == 0 &&
+        strcasecmp(meta[2 * i + 1], "linear") == 0)
+      meta[2 * i + 1] = "sRGB";
   }
   if (is_linear(img)) {
-    int integer = t == OC_OIIO_U8 || t == OC_OIIO_U16;
     meta[2 * nmeta] = "oiio:ColorSpace";
     meta[2 * nmeta + 1] = integer ? "sRGB" : "Linear";
     nmeta++;

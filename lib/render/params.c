@@ -100,9 +100,11 @@ int oc_render_check_geometry(const oc_program *prog, const oc_render_params *rp,
 }
 
 static int check_rules(const oc_render_rules *r, oc_error *err) {
-  if (r->levels && (!isfinite(r->sea_level) || !isfinite(r->snow_line)))
+  /* NaN: that level is derived from the visible altitudes */
+  if (r->levels && (isinf(r->sea_level) || isinf(r->snow_line)))
     return oc_seterr(err, OC_EINVAL,
-                     "'sea_level' and 'snow_line' must be finite (got %g, %g)",
+                     "'sea_level' and 'snow_line' must be finite or NaN (got "
+                     "%g, %g)",
                      r->sea_level, r->snow_line);
   if (!(r->beach >= 0) || isinf(r->beach))
     return oc_seterr(err, OC_EINVAL, "'beach' must be finite and >= 0 (got %g)",

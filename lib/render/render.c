@@ -248,15 +248,11 @@ static void resolve_levels(oc_shader *sh, const oc_render_params *rp,
   }
   if (!(z0 <= z1)) z0 = z1 = 0;
   double relief = z1 - z0;
-  if (ru->levels) {
-    sh->sea = ru->sea_level;
-    sh->snow = ru->snow_line;
-    sh->beach = ru->beach;
-  } else {
-    sh->sea = z0 + 0.04 * relief;
-    sh->snow = z0 + 0.75 * relief;
-    sh->beach = ru->beach > 0 ? ru->beach : 0.015 * relief;
-  }
+  int sea = ru->levels && !isnan(ru->sea_level);
+  int snow = ru->levels && !isnan(ru->snow_line);
+  sh->sea = sea ? ru->sea_level : z0 + 0.04 * relief;
+  sh->snow = snow ? ru->snow_line : z0 + 0.75 * relief;
+  sh->beach = sea || ru->beach > 0 ? ru->beach : 0.015 * relief;
 }
 
 static oc_image *shade(const oc_program *prog, const oc_render_params *rp,

@@ -603,6 +603,14 @@ START_TEST(srgb_on_write) {
   ck_assert(fabs(pb[1] - 12.92 * 0.0031308 * 0.5) < 1e-4);
   ck_assert(fabs(pb[3] - 0.5) < 1e-4); /* alpha */
   ck_assert(px_[0] == 0.5f && px_[4] == 0.2f);
+  /* the encoded file says so: read back and written again, it is not
+  ** encoded twice; the EXR stays linear */
+  ck_assert_str_eq(oc_image_meta_get(b, "outcrop:colorspace"), "sRGB");
+  ck_assert_str_eq(oc_image_meta_get(x, "outcrop:colorspace"), "linear");
+  ck_assert_int_eq(oc_image_write(b, oct_in_dir(dir, "c.png"), 16, NULL), 0);
+  oc_image *c = oc_oiio_read(oct_in_dir(dir, "c.png"), NULL);
+  ck_assert(fabs(oc_image_cdata(c)[0] - s) < 1e-4);
+  oc_image_free(c);
   oc_image_free(a);
   oc_image_free(b);
   oc_image_free(x);

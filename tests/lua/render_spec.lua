@@ -90,7 +90,6 @@ describe("outcrop.render", function()
       R.check_error(function() oc.render(sphere, {color = sphere, palette = {}}) end, F, "outcrop.render", "'palette' must be an array")
       R.check_error(function() oc.render(sphere, {color = {field = sphere, palette = {{0, {1}}}}}) end, F, "outcrop.render", "'color.palette[1]' colour must be {r, g, b}")
       R.check_error(function() oc.render(sphere, {color = sphere, rules = {}}) end, F, "outcrop.render", "'rules'", "cannot go with 'color'")
-      R.check_error(function() oc.render(sphere, {rules = {sea_level = 0}}) end, F, "outcrop.render", "both 'rules.sea_level' and 'rules.snow_line'")
       R.check_error(function() oc.render(sphere, {rules = {sea_level = 5, snow_line = 1}}) end, F, "outcrop.render", "'rules.sea_level' must be below")
       R.check_error(function() oc.render(sphere, {rules = {rock_slope = 100}}) end, F, "outcrop.render", "'rules.rock_slope'")
       R.check_error(function() oc.render(sphere, {camera = cam}, 3) end, F, "outcrop.render")
@@ -366,6 +365,31 @@ describe("outcrop.render", function()
       -- the default palette for a resistance in [0, 1]
       local strata = oc.render(scene, {size = {24, 18}, camera = cam, color = scene, aov = false})
       assert.are.equal(4, strata:channels())
+    end)
+
+    it("takes either rule level alone, deriving the other", function()
+      -- every hit below a sea level of 100 m is sand; above a snow line of
+      -- -100 m the flat top of the ground is snow: one level given, the
+      -- other still derived (both used to be required)
+      local function mean(img)
+        local s, n = {0, 0, 0}, 0
+        for j = 1, 18 do
+          for i = 1, 24 do
+            local r, g, b, a = img:get(i, j)
+            if a == 1 then s[1], s[2], s[3], n = s[1] + r, s[2] + g, s[3] + b, n + 1 end
+          end
+        end
+        return s[1] / n, s[2] / n, s[3] / n
+      end
+      local opt = function(rules)
+        return {size = {24, 18}, camera = cam, background = {0, 0, 0, 0}, rules = rules}
+      end
+      local r0, g0, b0 = mean(oc.render(scene, opt(nil)))
+      local rs, gs, bs = mean(oc.render(scene, opt({sea_level = 100})))
+      local rw, gw, bw = mean(oc.render(scene, opt({snow_line = -100})))
+      assert.is_true(rs > gs and gs > bs and rs > r0)     -- sand: warm
+      assert.is_true(bw > b0 + 0.05 and gw > g0)          -- snow: white
+      assert.are_not.same({r0, g0, b0}, {rs, gs, bs})
     end)
 
     it("accepts the rule parameters", function()
