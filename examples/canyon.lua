@@ -43,7 +43,9 @@ print(string.format("canyon: %d columns, %d samples, %d primitives",
 local palette = {{0.0, {0.45, 0.20, 0.10}}, {0.5, {0.66, 0.38, 0.22}},
                  {1.0, {0.85, 0.70, 0.52}}}
 local mesh = oc.polygonize(scene, {box = {0, 0, -5, 300, 300, 60}, cell = cell,
-                                   colors = {field = rock, palette = palette}})
+                                   colors = {field = rock, palette = palette},
+                                   -- loose specks of a few vertices dropped
+                                   min_component = 50})
 assert(mesh:write("canyon.ply"))
 local ms = mesh:stats()
 print(string.format("canyon: wrote canyon.ply (%d triangles, %.2f s)",

@@ -42,7 +42,7 @@ print(string.format("hoodoos: %d hoodoos, %d primitives (%d blocks, %d " ..
 
 local x0, y0, z0, x1, y1, z1 = ground:bounds()
 local mesh = oc.polygonize(scene, {box = {x0, y0, z0 - 5, x1, y1, z1 + 40},
-                                   cell = cell})
+                                   cell = cell, min_component = 50})
 assert(mesh:write("hoodoos.ply"))
 local ms = mesh:stats()
 print(string.format("hoodoos: wrote hoodoos.ply (%d triangles, %.2f s)",

@@ -67,7 +67,8 @@ local shade = G.clamp(rock)
 local palette = {{0.6, {0.30, 0.20, 0.13}}, {0.85, {0.55, 0.42, 0.30}},
                  {1.0, {0.78, 0.70, 0.58}}}
 local mesh = oc.polygonize(scene, {box = {0, 0, -14, 300, 200, 60}, cell = cell,
-                                   colors = {field = shade, palette = palette}})
+                                   colors = {field = shade, palette = palette},
+                                   min_component = 50})
 assert(mesh:write("sea_cliffs.ply"))
 local ms = mesh:stats()
 print(string.format("sea_cliffs: wrote sea_cliffs.ply (%d triangles, %.2f s)",

@@ -85,3 +85,13 @@ assert(#kept == 1, string.format("%d components, not one", #kept))
 local k = kept[1]
 local genus = (2 - (V[k] - E[k] + F[k])) / 2
 assert(genus >= min_genus, string.format("genus %g < %d: no through-hole", genus, min_genus))
+
+-- the engine's own count agrees with the one above
+local comps = mesh:components()
+local big = 0
+for _, n in ipairs(comps) do
+  if n >= SPECK then big = big + 1 end
+end
+assert(big == 1 and #comps == #kept + specks,
+       string.format("mesh:components() gives %d components (%d big), the count above %d",
+                     #comps, big, #kept + specks))
