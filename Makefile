@@ -121,12 +121,17 @@ $(GLUE): $(GLUE_OBJ) lib/io/oiio_glue.map
 	$(CXX) -shared -o $@ $(GLUE_OBJ) -Wl,--version-script=lib/io/oiio_glue.map \
 	  $(OIIO_LIBS) $(LDLIBS) $(OPT)
 
+# -z nodelete: lua_close dlcloses the module, which would unmap libgomp
+# under its idle worker threads (a segfault at exit, one run in three
+# under stock lua5.4); the objects stay loaded until the process ends.
+NODELETE := -Wl,-z,nodelete
+
 $(LIBSO): $(LIB_OBJ) | $(GLUE)
-	$(CC) -shared -o $@ $^ $(LDLIBS) $(OPT)
+	$(CC) -shared -o $@ $^ $(LDLIBS) $(OPT) $(NODELETE)
 
 # The module is loaded into stock lua5.4, which provides the Lua symbols.
 $(MODULE): $(LUA_OBJ) $(LIB_OBJ) | $(GLUE)
-	$(CC) -shared -o $@ $^ $(LDLIBS) $(OPT)
+	$(CC) -shared -o $@ $^ $(LDLIBS) $(OPT) $(NODELETE)
 
 # The interpreter counts the allocations of the engine and the bindings
 # for --max-memory (runtime/memory.c): --wrap sends their calls, and only

@@ -381,8 +381,8 @@ end
 
 # Bash starts background jobs with SIGINT ignored, and outcrop (rightly)
 # keeps an ignored SIGINT ignored: restore the default for the child.
-if env --default-signal=INT true 2>/dev/null; then
-  DEFSIG=(env --default-signal=INT)
+if env --default-signal=INT,HUP,TERM true 2>/dev/null; then
+  DEFSIG=(env --default-signal=INT,HUP,TERM)
 else
   DEFSIG=()
   set -m # with job control, background jobs keep default signals
