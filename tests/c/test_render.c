@@ -278,6 +278,52 @@ START_TEST(open_edge_both_tracers) {
 }
 END_TEST
 
+/* A terrain thinner than the rays' tolerance (falloff 0.01, a 4.5 mm
+** solid, seen from 25 m by 32 x 24 pixels) shows as a pixel or two, or
+** nothing, and the render says why; one of falloff 4 (1.8 m) shows and
+** says nothing, and neither does a view that misses the scene. */
+START_TEST(thin_terrain_render_warns) {
+  float z[16 * 16] = {0};
+  oc_error e;
+  oc_heightfield *hf = oc_heightfield_new(16, 16, 1, 0, 0, z, &e);
+  ck_assert(hf);
+  for (int pass = 0; pass < 3; pass++) {
+    oc_elevation src;
+    ck_assert_int_eq(oc_heightfield_elevation(hf, &src, &e), OC_OK);
+    oc_terrain_params tp = {.falloff = pass == 1 ? 4 : 0.01};
+    oc_node *n = OCT_OK(oc_terrain(&src, &tp, &e));
+    src.release(src.ud);
+    oc_program *pr = oct_compile(n, 0, 0);
+    oc_render_params rp =
+        view(oct_v(-10, -12, 9), oct_v(pass == 2 ? -40 : 8, 8, 0), 45, 32, 24);
+    char warn[300] = "x";
+    rp.warning = warn;
+    rp.warning_size = sizeof warn;
+    for (int m = 0; m < 2; m++) {
+      rp.tracer = m ? OC_TRACE_SPHERE : OC_TRACE_SEGMENT;
+      oc_image *g = oc_render_geometry(pr, &rp, &e);
+      ck_assert_msg(g, "%s", e.msg);
+      int hits = 0;
+      for (int j = 0; j < 24; j++)
+        for (int i = 0; i < 32; i++)
+          hits += px(g, i, j)[OC_RG_HIT] > 0;
+      oc_image_free(g);
+      if (pass == 0) {
+        ck_assert_int_le(hits, 8);
+        ck_assert_msg(strstr(warn, "hit tolerance") &&
+                          strstr(warn, "falloff") && strstr(warn, "thickness"),
+                      "warning: '%s'", warn);
+      } else {
+        ck_assert_int_eq(hits > 100, pass == 1);
+        ck_assert_str_eq(warn, "");
+      }
+    }
+    oc_program_free(pr);
+  }
+  oc_heightfield_release(hf);
+}
+END_TEST
+
 /* A ray whose far end is 1e300 away (a scene's box grown by a huge warp)
 ** with a pixel-sized tolerance would take millions of steps: both tracers
 ** give up after OC_TRACE_MAX_STEPS, a miss. */
@@ -795,6 +841,7 @@ static Suite *suite(void) {
   tcase_add_test(t, threads_byte_identical);
   tcase_add_test(t, progress_and_cancel);
   tcase_add_test(t, bad_params);
+  tcase_add_test(t, thin_terrain_render_warns);
   suite_add_tcase(s, t);
   return s;
 }
