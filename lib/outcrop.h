@@ -462,6 +462,14 @@ typedef struct oc_render_params {
                            ** multiplied by 2^exposure (default 0) */
   oc_render_tone tone;     /* OC_TONE_CLAMP by default */
   oc_progress progress;
+  /* NULL (default), or where a warning goes (a sentence, "" when none)
+  ** when the image shows a terrain badly for a reason the engine can
+  ** tell: rays reached the scene's box and a terrain's solid is thinner
+  ** than their hit tolerance (at the box's nearest point; at its far end
+  ** when nothing was hit), so that it shows as scattered pixels or not at
+  ** all */
+  char *warning;
+  size_t warning_size;
 } oc_render_params;
 
 /* Fills `rp` with the defaults: a 640 x 360 view of nothing in particular
@@ -486,8 +494,8 @@ enum {
 /* Traces one primary ray per pixel (through the pixel's centre) and
 ** returns an image of OC_RG_COUNT channels named "hit", "Z", "N.x",
 ** "N.y", "N.z", "P.x", "P.y", "P.z", "evals"; on a miss N and P are 0.
-** Only the camera, size, threshold, max_distance, tracer and progress of
-** `rp` are used. NULL with err: OC_EINVAL (naming the parameter),
+** Only the camera, size, threshold, max_distance, tracer, progress and
+** warning of `rp` are used. NULL with err: OC_EINVAL (naming the parameter),
 ** OC_ENOMEM (sizes checked before allocating), OC_ECANCEL. */
 oc_image *oc_render_geometry(const oc_program *prog, const oc_render_params *rp,
                              oc_error *err);

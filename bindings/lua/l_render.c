@@ -530,6 +530,9 @@ static int l_render(lua_State *L) {
   default_camera(L, prog, &rp, &ci);
   memset(&rp.progress, 0, sizeof rp.progress);
   rp.progress = oclua_progress_start(L, &pl, FNAME);
+  char warning[300] = "";
+  rp.warning = warning;
+  rp.warning_size = sizeof warning;
 
   if (src.kind != SRC_FUNCTION) {
     /* The colour node is compiled at the render's threshold: were it the
@@ -541,6 +544,7 @@ static int l_render(lua_State *L) {
     u->img = oc_render(prog, &rp, &err);
     if (u->img == NULL) render_error(L, &pl, &err);
     oclua_progress_end(&pl);
+    if (warning[0]) oclua_warn(L, FNAME, "%s", warning);
     return 1;
   }
 
@@ -562,6 +566,7 @@ static int l_render(lua_State *L) {
   oclua_progress_end(&pl);
   oc_image_free(g->img); /* big: not left to the collector */
   g->img = NULL;
+  if (warning[0]) oclua_warn(L, FNAME, "%s", warning);
   return 1;
 }
 

@@ -281,6 +281,7 @@ static uint32_t compile_terrain(comp *c, const oc_node *n) {
   P->ops[op].par = at;
   P->ops[op].kid = (uint32_t)P->nterr;
   P->terr[P->nterr++] = t;
+  if (t->open) P->njump++;
   c->inf[op].lo = 0;
   c->inf[op].hi = 2 * c->T;
   c->inf[op].lip = oc_terrain_lipschitz(t, P->par + at);

@@ -64,6 +64,10 @@ struct oc_program {
   double T;
   oc_aabb bounds;
   double lip;
+  /* ops whose field jumps across a surface (an open terrain's sides):
+  ** their lip, and so P->lip, hold only off the jump, where
+  ** oc_op_lipschitz_in and oc_ray_dbound answer INFINITY instead */
+  uint32_t njump;
   oc_program_stats stats;
   oc_node *node; /* retained source */
 };

@@ -428,7 +428,8 @@ static double op_lip(const oc_program *P, uint32_t i, const oc_aabb *b,
         stack[sp++] = nd->first;
       }
     }
-    return fmin(acc, o->lip);
+    /* (the group's own bound holds off jumps only) */
+    return isinf(acc) ? acc : fmin(acc, o->lip);
   }
   case OC_K_INTER:
   case OC_K_DIFF: {
@@ -438,6 +439,7 @@ static double op_lip(const oc_program *P, uint32_t i, const oc_aabb *b,
     return m;
   }
   case OC_K_SCALE:
+    if (par[0] == 0) return 0; /* f == 0, whatever jumps below */
     return fabs(par[0]) * op_lip(P, P->kids[o->kid], b, depth + 1);
   case OC_K_XFORM: {
     /* the child's bound on the preimage of the box */

@@ -163,9 +163,10 @@ static void group_db(const oc_program *P, const oc_op *o, const oc_ray *r,
     }
   }
 #undef ACC
-  /* never looser than the group's own bound */
-  *lo += fmax(L, -o->lip);
-  *hi += fmin(H, o->lip);
+  /* never looser than the group's own bound, which holds off jumps
+  ** only: an infinite child's stays infinite */
+  *lo += isinf(L) ? L : fmax(L, -o->lip);
+  *hi += isinf(H) ? H : fmin(H, o->lip);
 }
 
 static void op_db(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
@@ -206,6 +207,7 @@ static void op_db(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
   case OC_K_SCALE: {
     double l = 0, h = 0, c = par[OC_P_FACTOR];
     op_db(P, P->kids[o->kid], r, t0, t1, &l, &h, depth + 1);
+    if (c == 0) return; /* f == 0, whatever jumps below (0 * inf) */
     *lo += c >= 0 ? c * l : c * h;
     *hi += c >= 0 ? c * h : c * l;
     return;
@@ -229,8 +231,8 @@ static void op_db(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
     oc_ray c = oc_ray_make(q, oc_mul(v, 1 / n));
     double l = 0, h = 0;
     op_db(P, P->kids[o->kid], &c, t0 * n, t1 * n, &l, &h, depth + 1);
-    *lo += fmax(l * n * (1 + REL), -o->lip);
-    *hi += fmin(h * n * (1 + REL), o->lip);
+    *lo += isinf(l) ? l : fmax(l * n * (1 + REL), -o->lip);
+    *hi += isinf(h) ? h : fmin(h * n * (1 + REL), o->lip);
     return;
   }
   case OC_K_POINT: {

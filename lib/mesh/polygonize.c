@@ -379,7 +379,8 @@ oc_mesh *oc_polygonize(const oc_program *prog, const oc_polygonize_params *pp,
   if (pp->warning && pp->warning_size) {
     pp->warning[0] = '\0';
     if (m && oc_mesh_triangle_count(m) == 0)
-      oc_terrain_thin_reason(prog, g.h[2], pp->warning, pp->warning_size);
+      oc_terrain_thin_reason(prog, g.h[2], "the cell", pp->warning,
+                             pp->warning_size);
   }
   return m;
 }

@@ -18,6 +18,7 @@
 #include "render/shade.h"
 #include "render/tone.h"
 #include "render/trace.h"
+#include "terrain/terrain.h"
 
 #define TILE 16
 #define NAOV 8
@@ -158,6 +159,39 @@ static void geom_tile(const void *ctx, int x0, int y0, int x1, int y1) {
       geom_pixel(g, i, j, g->px + ((size_t)j * g->cam.width + i) * OC_RG_COUNT);
 }
 
+/* A terrain thinner than the rays' tolerance shows as scattered pixels
+** or not at all: its solid lies between two samples of most rays. The
+** rays that reached the scene's box (they evaluated the field) sample it
+** no finer than the tolerance at the box's nearest point; when none hit
+** anything, the tolerance at its far end tells why. The renderer's part
+** of oc_terrain_thin_reason, the mesher's being its cell. */
+static void thin_reason(const gctx *g, const oc_render_params *rp) {
+  size_t npx = (size_t)rp->width * rp->height;
+  int entered = 0, hit = 0;
+  for (size_t k = 0; k < npx; k++) {
+    const float *p = g->px + k * OC_RG_COUNT;
+    hit |= p[OC_RG_HIT] > 0;
+    entered |= p[OC_RG_EVALS] > 0;
+  }
+  if (!entered) return;
+  oc_aabb b = oc_program_bounds(g->prog);
+  oc_vec3 e = g->cam.eye, d;
+  if (hit) {
+    d = oc_v3(fmax(fmax(b.lo.x - e.x, e.x - b.hi.x), 0),
+              fmax(fmax(b.lo.y - e.y, e.y - b.hi.y), 0),
+              fmax(fmax(b.lo.z - e.z, e.z - b.hi.z), 0));
+  } else {
+    d = oc_v3(fmax(fabs(b.lo.x - e.x), fabs(b.hi.x - e.x)),
+              fmax(fabs(b.lo.y - e.y), fabs(b.hi.y - e.y)),
+              fmax(fabs(b.lo.z - e.z), fabs(b.hi.z - e.z)));
+  }
+  double t = fmin(oc_len(d), g->far);
+  if (!isfinite(t)) return;
+  oc_terrain_thin_reason(g->prog, g->tr.eps_k * t + g->tr.eps_min,
+                         "the render's hit tolerance", rp->warning,
+                         rp->warning_size);
+}
+
 static oc_image *geometry(const oc_program *prog, const oc_render_params *rp,
                           double base, double span, oc_error *err) {
   if (oc_render_check_geometry(prog, rp, err)) return NULL;
@@ -165,6 +199,7 @@ static oc_image *geometry(const oc_program *prog, const oc_render_params *rp,
   if (!img) return NULL;
   for (int c = 0; c < OC_RG_COUNT; c++)
     oc_image_set_channel_name(img, c, geom_names[c], NULL);
+  if (rp->warning && rp->warning_size) rp->warning[0] = '\0';
   gctx g;
   camera_init(&g.cam, rp);
   g.prog = prog;
@@ -177,6 +212,7 @@ static oc_image *geometry(const oc_program *prog, const oc_render_params *rp,
     oc_seterr(err, OC_ECANCEL, "rendering cancelled");
     return NULL;
   }
+  if (rp->warning && rp->warning_size) thin_reason(&g, rp);
   return img;
 }
 

@@ -6,7 +6,14 @@
 ** where H bounds the derivative of f along the ray, so f stays below T
 ** while s < (T - f) / H.
 **  - Sphere tracing (seed 001 section 7.1): H is the program's global
-**    bound; the ray is clipped to the scene's box.
+**    bound; the ray is clipped to the scene's box. A program whose field
+**    jumps somewhere (an open terrain's sides) has a global bound that
+**    holds only off the jumps: there each step is first checked against
+**    the local bounds below, which are infinite across a jump, and
+**    halved until it crosses none or is down to the tolerance. So no
+**    step leaps over a jump (and the thin solid behind it) that the
+**    segment tracer would not, and away from the jumps the steps are
+**    plain sphere tracing's.
 **  - Segment tracing (seed 001 section 7.2; Galin et al. 2020): H bounds
 **    only the growth of f along the candidate segment [t, t + delta],
 **    from the nodes whose support the segment crosses (raybound.c); a
@@ -34,6 +41,7 @@ void oc_tracer_init(oc_tracer *tr, const oc_program *prog, double T,
   tr->prog = prog;
   tr->T = T;
   tr->L = oc_program_lipschitz(prog);
+  tr->jumps = prog->njump > 0;
   tr->mode = mode;
   oc_box_to_float(oc_program_bounds(prog), tr->lo, tr->hi);
   tr->eps_k = eps_k;
@@ -90,15 +98,30 @@ static int found(const oc_tracer *tr, oc_vec3 o, oc_vec3 u, double prev,
   return 1;
 }
 
-static int sphere_trace(const oc_tracer *tr, oc_vec3 o, oc_vec3 u, double t,
+/* The step s from t, shortened while [t, t + s] crosses a jump of the
+** field (an infinite local bound), down to the tolerance e. */
+static double off_jumps(const oc_tracer *tr, const oc_ray *r, double t,
+                        double s, double e) {
+  while (s > e) {
+    double lo, hi;
+    oc_ray_dbound(tr->prog, r, t, t + s, &lo, &hi);
+    if (!isinf(hi)) return s;
+    s = fmax(0.5 * s, e);
+  }
+  return s;
+}
+
+static int sphere_trace(const oc_tracer *tr, const oc_ray *r, double t,
                         double t1, double d0, double *thit, double *evals) {
+  oc_vec3 o = r->o, u = r->u;
   double prev = t, fp = 0;
   for (long k = 0; t <= t1 && k < OC_TRACE_MAX_STEPS; k++) {
     double f = oc_program_eval(tr->prog, at(o, u, t));
     *evals += 1;
     if (!(f < tr->T)) return found(tr, o, u, prev, fp, t, f, d0, thit, evals);
     if (!(tr->L > 0)) break; /* constant field below T */
-    double s = fmax((tr->T - f) / tr->L, tol(tr, d0, t));
+    double e = tol(tr, d0, t), s = fmax((tr->T - f) / tr->L, e);
+    if (tr->jumps) s = off_jumps(tr, r, t, s, e);
     if (t + s == t) break;
     prev = t, fp = f;
     t += s;
@@ -141,7 +164,7 @@ int oc_trace(const oc_tracer *tr, oc_vec3 o, oc_vec3 u, double t0, double t1,
     return 1;
   }
   if (tr->mode == OC_TRACE_SPHERE || tr->T <= 0) {
-    if (sphere_trace(tr, o, u, t0, t1, d0, t, evals)) return 1;
+    if (sphere_trace(tr, &r, t0, t1, d0, t, evals)) return 1;
     *t = INFINITY;
     return 0;
   }

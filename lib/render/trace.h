@@ -13,8 +13,9 @@
 
 typedef struct oc_tracer {
   const oc_program *prog;
-  double T; /* iso-value */
-  double L; /* global Lipschitz bound */
+  double T;  /* iso-value */
+  double L;  /* global Lipschitz bound (off the field's jumps) */
+  int jumps; /* the field jumps somewhere: sphere steps avoid the jumps */
   oc_render_tracer mode;
   float lo[3], hi[3]; /* the scene's box, rounded outwards */
   /* Steps are at least eps = eps_k * (distance from the eye) + eps_min,
@@ -29,7 +30,8 @@ void oc_tracer_init(oc_tracer *tr, const oc_program *prog, double T,
 
 /* Traces o + t u (u unit) over [t0, t1]; d0 is the distance of o from the
 ** eye (for the tolerance). Returns 1 and the distance in *t on a hit, 0 on
-** a miss (or after OC_TRACE_MAX_STEPS steps); adds the field evaluations made to *evals. Allocation-free. */
+** a miss (or after OC_TRACE_MAX_STEPS steps); adds the field evaluations made
+*to *evals. Allocation-free. */
 int oc_trace(const oc_tracer *tr, oc_vec3 o, oc_vec3 u, double t0, double t1,
              double d0, double *t, double *evals);
 

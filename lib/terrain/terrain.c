@@ -259,8 +259,8 @@ int oc_terrain_spans(const oc_tdata *t, const double *par, double x0, double y0,
 
 /* ---- empty meshes ------------------------------------------------------ */
 
-int oc_terrain_thin_reason(const struct oc_program *P, double cell, char *buf,
-                           size_t n) {
+int oc_terrain_thin_reason(const struct oc_program *P, double size,
+                           const char *what, char *buf, size_t n) {
   for (uint32_t i = 0; i < P->nops; i++) {
     if (P->ops[i].kind != OC_K_TERRAIN) continue;
     const oc_tdata *t = P->terr[P->ops[i].kid];
@@ -270,12 +270,12 @@ int oc_terrain_thin_reason(const struct oc_program *P, double cell, char *buf,
     t->src.range(t->src.ud, t->sx0, t->sy0, t->sx1, t->sy1, &lo, &hi);
     double solid =
         t->invert ? oc_terrain_cap_z(t) - hi : lo - oc_terrain_cap_z(t);
-    if (solid < cell) {
+    if (solid < size) {
       snprintf(buf, n,
                "the terrain's solid is %g thick where thinnest (%g x "
-               "'falloff' %g + 'thickness' %g), less than the cell %g: "
+               "'falloff' %g + 'thickness' %g), less than %s %g: "
                "give a larger 'falloff' or a 'thickness'",
-               solid, X_HALF, t->R, solid - X_HALF * t->R, cell);
+               solid, X_HALF, t->R, solid - X_HALF * t->R, what, size);
       return 1;
     }
   }

@@ -63,11 +63,13 @@ double oc_terrain_column_value(const oc_tdata *t, const double *par, double h,
                                double z);
 double oc_terrain_cap_z(const oc_tdata *t);
 
-/* When the terrains of P leave nothing to mesh at cells of size `cell`
-** (a solid thinner than a cell: a small falloff and no thickness), a
-** sentence saying so in buf and 1; else 0. */
-int oc_terrain_thin_reason(const struct oc_program *P, double cell, char *buf,
-                           size_t n);
+/* When a terrain of P has a solid thinner than `size` (a small falloff
+** and no thickness), so that samples `size` apart may all miss it (the
+** mesher's cells, the renderer's ray steps), a sentence saying so in buf
+** and 1; else 0. `what` names the size ("the cell"). The mesher and the
+** renderer call it once their result came out empty. */
+int oc_terrain_thin_reason(const struct oc_program *P, double size,
+                           const char *what, char *buf, size_t n);
 
 /* terrain_mask.c: the distance grid of a mask, and its queries. */
 int oc_terrain_mask(oc_tdata *t, const oc_heightfield *mask, oc_error *err);

@@ -207,6 +207,123 @@ START_TEST(thin_wall_against_march) {
 }
 END_TEST
 
+/* An open terrain (a flat grid at z = 10 over [0, 40]^2, falloff 2, so a
+** 0.91 m solid) seen from outside its side x = 0, from below the top, so
+** that rays climb through the corner where the side wall meets the top:
+** the rays that cross the wall just under z = 10 are in the solid for
+** less than one sphere-tracing step (T / L = 0.5 m). Both tracers must
+** hit the same pixels, as the march does; without the step check at the
+** jump the sphere tracer leaps over the corner. With a ball beside it
+** the terrain is under a blend, whose own bound must not hide the jump. */
+static oc_program *open_terrain_block(int ball) {
+  float z[41 * 41];
+  for (int k = 0; k < 41 * 41; k++)
+    z[k] = 10;
+  oc_error e;
+  oc_heightfield *hf = oc_heightfield_new(41, 41, 1, 0, 0, z, &e);
+  ck_assert_msg(hf != NULL, "%s", e.msg);
+  oc_elevation src;
+  ck_assert_int_eq(oc_heightfield_elevation(hf, &src, &e), OC_OK);
+  oc_terrain_params tp = {.falloff = 2, .transition = 1};
+  oc_node *n = oc_terrain(&src, &tp, &e);
+  src.release(src.ud);
+  oc_heightfield_release(hf);
+  ck_assert_msg(n != NULL, "%s", e.msg);
+  if (ball) {
+    oc_node *k[2] = {n, OCT_OK(oc_point(oct_v(20, 20, 30), 3, 1, &e))};
+    n = OCT_OK(oc_blend(k, 2, &e));
+    oc_node_release(k[0]);
+    oc_node_release(k[1]);
+  }
+  return oct_compile(n, 0, 0);
+}
+
+START_TEST(open_edge_both_tracers) {
+  oc_program *pr = open_terrain_block(_i);
+  double T = oc_program_threshold(pr);
+  oc_render_params rp = view(oct_v(-20, 20, 6), oct_v(0, 20, 10), 10, 64, 48);
+  oc_image *g[2];
+  for (int m = 0; m < 2; m++) {
+    rp.tracer = m ? OC_TRACE_SPHERE : OC_TRACE_SEGMENT;
+    oc_error e;
+    g[m] = oc_render_geometry(pr, &rp, &e);
+    ck_assert_msg(g[m], "%s", e.msg);
+  }
+  int differ = 0, corner = 0, hits = 0;
+  for (int j = 0; j < 48; j++)
+    for (int i = 0; i < 64; i++) {
+      const float *a = px(g[0], i, j), *b = px(g[1], i, j);
+      int ha = a[OC_RG_HIT] > 0, hb = b[OC_RG_HIT] > 0;
+      oc_vec3 d = pixel_ray(&rp, i, j);
+      double tref = march(pr, rp.camera.eye, d, T, 60, 0.002);
+      for (int m = 0; m < 2; m++) {
+        int h = m ? hb : ha;
+        if (h != isfinite(tref)) differ++;
+      }
+      if (ha != hb) differ++;
+      if (ha && hb) {
+        hits++;
+        ck_assert_msg(fabs(a[OC_RG_Z] - b[OC_RG_Z]) < 0.05,
+                      "pixel %d %d: Z %g vs %g", i, j, a[OC_RG_Z], b[OC_RG_Z]);
+        /* hit on the wall, within the top 0.25 m of it */
+        if (a[OC_RG_PX] < 0.01 && a[OC_RG_PX + 2] > 9.75) corner++;
+      }
+    }
+  oc_image_free(g[0]);
+  oc_image_free(g[1]);
+  oc_program_free(pr);
+  ck_assert_int_gt(hits, 500);
+  ck_assert_int_ge(corner, 64); /* the sliver rows are in view */
+  ck_assert_msg(differ <= 4, "%d disagreements", differ);
+}
+END_TEST
+
+/* A terrain thinner than the rays' tolerance (falloff 0.01, a 4.5 mm
+** solid, seen from 25 m by 32 x 24 pixels) shows as a pixel or two, or
+** nothing, and the render says why; one of falloff 4 (1.8 m) shows and
+** says nothing, and neither does a view that misses the scene. */
+START_TEST(thin_terrain_render_warns) {
+  float z[16 * 16] = {0};
+  oc_error e;
+  oc_heightfield *hf = oc_heightfield_new(16, 16, 1, 0, 0, z, &e);
+  ck_assert(hf);
+  for (int pass = 0; pass < 3; pass++) {
+    oc_elevation src;
+    ck_assert_int_eq(oc_heightfield_elevation(hf, &src, &e), OC_OK);
+    oc_terrain_params tp = {.falloff = pass == 1 ? 4 : 0.01};
+    oc_node *n = OCT_OK(oc_terrain(&src, &tp, &e));
+    src.release(src.ud);
+    oc_program *pr = oct_compile(n, 0, 0);
+    oc_render_params rp =
+        view(oct_v(-10, -12, 9), oct_v(pass == 2 ? -40 : 8, 8, 0), 45, 32, 24);
+    char warn[300] = "x";
+    rp.warning = warn;
+    rp.warning_size = sizeof warn;
+    for (int m = 0; m < 2; m++) {
+      rp.tracer = m ? OC_TRACE_SPHERE : OC_TRACE_SEGMENT;
+      oc_image *g = oc_render_geometry(pr, &rp, &e);
+      ck_assert_msg(g, "%s", e.msg);
+      int hits = 0;
+      for (int j = 0; j < 24; j++)
+        for (int i = 0; i < 32; i++)
+          hits += px(g, i, j)[OC_RG_HIT] > 0;
+      oc_image_free(g);
+      if (pass == 0) {
+        ck_assert_int_le(hits, 8);
+        ck_assert_msg(strstr(warn, "hit tolerance") &&
+                          strstr(warn, "falloff") && strstr(warn, "thickness"),
+                      "warning: '%s'", warn);
+      } else {
+        ck_assert_int_eq(hits > 100, pass == 1);
+        ck_assert_str_eq(warn, "");
+      }
+    }
+    oc_program_free(pr);
+  }
+  oc_heightfield_release(hf);
+}
+END_TEST
+
 /* A ray whose far end is 1e300 away (a scene's box grown by a huge warp)
 ** with a pixel-sized tolerance would take millions of steps: both tracers
 ** give up after OC_TRACE_MAX_STEPS, a miss. */
@@ -224,8 +341,8 @@ START_TEST(ray_step_budget) {
     oc_vec3 eye = oct_v(0, 0, 3), d = oct_v(1, 0, 0);
     int hit = oc_trace(&tr, eye, d, 0, 1e300, 0, &t, &ev);
     ck_assert_int_eq(hit, 0);
-    ck_assert_msg(ev <= OC_TRACE_MAX_STEPS + 1, "mode %d: %g evaluations",
-                  mode, ev);
+    ck_assert_msg(ev <= OC_TRACE_MAX_STEPS + 1, "mode %d: %g evaluations", mode,
+                  ev);
     if (mode) ck_assert(ev >= 1000); /* it did march */
   }
   oc_program_free(pr);
@@ -714,6 +831,7 @@ static Suite *suite(void) {
   tcase_add_test(t, sphere_silhouette_and_depth);
   tcase_add_test(t, thin_wall_against_march);
   tcase_add_test(t, ray_step_budget);
+  tcase_add_loop_test(t, open_edge_both_tracers, 0, 2);
   tcase_add_test(t, image_against_march);
   tcase_add_test(t, ray_bounds_hold);
   suite_add_tcase(s, t);
@@ -731,6 +849,7 @@ static Suite *suite(void) {
   tcase_add_test(t, threads_byte_identical);
   tcase_add_test(t, progress_and_cancel);
   tcase_add_test(t, bad_params);
+  tcase_add_test(t, thin_terrain_render_warns);
   suite_add_tcase(s, t);
   return s;
 }

@@ -447,6 +447,31 @@ describe("outcrop.render", function()
     assert.is_true(differ <= 2, differ .. " pixels hit by one tracer only")
   end)
 
+  it("traces an open terrain's side wall the same with both tracers", function()
+    -- rays climb through the corner where the wall x = 0 meets the top
+    -- z = 10: under it they cross less solid than one sphere step
+    local flat = oc.heightfield.from(function() return 10 end, {size = {41, 41}})
+    local t = oc.terrain(flat, {falloff = 2})
+    local cam = {eye = {-20, 20, 6}, target = {0, 20, 10}, fov = 10}
+    local a = oc.render(t, {size = {64, 48}, camera = cam, aov = true, tracer = "segment"})
+    local b = oc.render(t, {size = {64, 48}, camera = cam, aov = true, tracer = "sphere"})
+    local differ, corner = 0, 0
+    for j = 1, 48 do
+      for i = 1, 64 do
+        local va, vb = {a:get(i, j)}, {b:get(i, j)}
+        local ha, hb = va[5] < math.huge, vb[5] < math.huge
+        if ha ~= hb then differ = differ + 1 end
+        if ha and hb then
+          R.close(va[5], vb[5], 0.05, "Z")
+          -- P.x, P.z: on the wall, in its top 0.25 m
+          if va[9] < 0.01 and va[11] > 9.75 then corner = corner + 1 end
+        end
+      end
+    end
+    assert.is_true(corner >= 64, corner .. " hits at the corner")
+    assert.is_true(differ <= 2, differ .. " pixels hit by one tracer only")
+  end)
+
   it("is the same image when made twice", function()
     local cam = {eye = {5, -30, 5}, target = {0, 0, 0}}
     local dir = R.tmpdir()

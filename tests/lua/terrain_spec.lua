@@ -193,6 +193,36 @@ describe("outcrop.terrain", function()
     assert.are.equal(saved, io.stderr)
   end)
 
+  it("warns when a thin terrain renders to (almost) nothing", function()
+    -- the warning goes to the process's stderr: run in a child (one
+    -- thread: stock lua5.4 may crash at exit unloading libgomp's workers)
+    local function child(falloff)
+      local name = os.tmpname()
+      local f = assert(io.popen("OMP_NUM_THREADS=1 lua5.4 -e 'package.cpath=[[" ..
+        package.cpath .. "]] local oc = require \"outcrop\" " ..
+        "local hf = oc.heightfield.from(function() return 0 end, {size = {16, 16}}) " ..
+        "local img = oc.render(oc.terrain(hf, {falloff = " .. falloff .. "}), " ..
+        "{size = {32, 24}, camera = {eye = {-10, -12, 9}, target = {8, 8, 0}}}) " ..
+        "local n = 0 for j = 1, 24 do for i = 1, 32 do " ..
+        "if select(5, img:get(i, j)) < math.huge then n = n + 1 end end end " ..
+        "io.write(n)' 2>" .. name))
+      local out = f:read("a")
+      f:close()
+      local err = assert(io.open(name)):read("a")
+      os.remove(name)
+      return tonumber(out), err
+    end
+    local hits, err = child(0.01)
+    assert.is_true(hits <= 8, hits .. " pixels")
+    assert.is_truthy(err:find("outcrop: warning: (command line):1: outcrop.render: " ..
+      "the terrain's solid is", 1, true), err)
+    assert.is_truthy(err:find("hit tolerance", 1, true))
+    assert.is_truthy(err:find("'thickness'", 1, true))
+    hits, err = child(4)
+    assert.is_true(hits > 100, hits .. " pixels")
+    assert.are.equal("", err)
+  end)
+
   it("keeps its grid alive", function()
     local t = oc.terrain(oc.heightfield.fbm{size = {33, 33}, cell = 1,
                                             amplitude = 2, wavelength = 9})
