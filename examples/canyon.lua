@@ -1,4 +1,4 @@
--- canyon.lua — a river canyon with undercut walls (seed 000 figure 15):
+-- canyon.lua — a river canyon with undercut walls (Paris et al. 2019, figure 15):
 -- a plateau of horizontally bedded rock cut by a meandering canyon whose
 -- floor slopes downstream. River erosion reads the stream power of the
 -- heightfield: the riverbed (high stream power) and its banks are carved

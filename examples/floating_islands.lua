@@ -1,4 +1,4 @@
--- floating_islands.lua — islands in the sky (seed 000 figures 1 and 21):
+-- floating_islands.lua — islands in the sky (Paris et al. 2019, figures 1 and 21):
 -- each island is the intersection of a terrain (its top: solid below a
 -- heightfield) and an inverted terrain (its underside: solid above a
 -- second heightfield), cut to an island shape by a mask, then eroded

@@ -1,4 +1,4 @@
--- hoodoos.lua — a field of hoodoos (seed 000 figures 18, 19): an
+-- hoodoos.lua — a field of hoodoos (Paris et al. 2019, figures 18, 19): an
 -- amphitheatre rim, a plateau breaking into a talus slope that runs down
 -- to a basin, 350 m across. Hoodoos grow where the slope is medium and
 -- little water drains (the talus, between the gullies), from the grammar

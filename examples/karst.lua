@@ -1,4 +1,4 @@
--- karst.lua — a karst network under a plateau, cut open (seed 000 §6.2,
+-- karst.lua — a karst network under a plateau, cut open (Paris et al. 2019, §6.2,
 -- figures 14 and 17): invasion percolation from the sinks of the
 -- plateau's rough top carves tunnels that follow the soft strata. The
 -- front of the plateau is cut away by a vertical plane so the tunnels

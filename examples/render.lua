@@ -1,6 +1,6 @@
 -- render.lua — a mesa with a cliff, rendered three ways: rule colours by
 -- altitude and slope, strata from a layered "resistance" field mapped
--- through a palette (bands that show on the cliff, as in seed 000's
+-- through a palette (bands that show on the cliff, as in Paris et al. 2019's
 -- figures), and a Lua colour function; plus an EXR with the AOVs.
 --
 --   outcrop run examples/render.lua [--set size=640] [--out DIR]

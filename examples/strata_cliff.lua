@@ -1,5 +1,5 @@
 -- strata_cliff.lua — stratified cliffs and overhangs without primitives
--- (seed 000 figure 10): a block of rock whose +x face is eroded by an
+-- (Paris et al. 2019, figure 10): a block of rock whose +x face is eroded by an
 -- erosion node reading a geology tree of folded strata, a soft layer and
 -- a hard pocket. Soft beds are carved back into the cliff, hard ones stand
 -- out as ledges and overhangs.

@@ -113,7 +113,8 @@ oc_node *oc_union(oc_node *const *children, size_t n, oc_error *err);
 oc_node *oc_intersection(oc_node *const *children, size_t n, oc_error *err);
 /* min(fa, 2T - fb) */
 oc_node *oc_difference(oc_node *a, oc_node *b, oc_error *err);
-/* Cubic smooth max/min of seed 002 section 4.2 with a radius that fades
+/* Cubic smooth max/min of Paris et al. 2020, section 4.2 with a radius that
+** fades
 ** out where both fields vanish, so compact support is kept. */
 oc_node *oc_smooth_union(oc_node *a, oc_node *b, double radius, oc_error *err);
 oc_node *oc_smooth_intersection(oc_node *a, oc_node *b, double radius,
@@ -130,7 +131,8 @@ oc_node *oc_warp(oc_node *child, const oc_noise *noise, oc_node *control,
 ** invertible. */
 oc_node *oc_transform(oc_node *child, const double m[12], oc_error *err);
 /* Star-shaped anisotropic perturbation of a skeletal or volumetric
-** primitive (seed 000 section 5.2): d / (R + amplitude * t(v(p)/wl)). */
+** primitive (Paris et al. 2019, section 5.2): d / (R + amplitude *
+** t(v(p)/wl)). */
 oc_node *oc_perturb(oc_node *primitive, const oc_noise *noise, oc_error *err);
 
 void oc_node_retain(oc_node *node);
@@ -812,7 +814,8 @@ typedef struct oc_hf_flow_params {
 ** >= cell^2. fp may be NULL. */
 oc_heightfield *oc_hf_drainage(const oc_heightfield *hf,
                                const oc_hf_flow_params *fp, oc_error *err);
-/* Stream power A^(1/2) s (seed 000 section 6.1): A the drainage above, s
+/* Stream power A^(1/2) s (Paris et al. 2019, section 6.1): A the drainage
+** above, s
 ** the slope of the filled grid (so filled lakes are ~0). */
 oc_heightfield *oc_hf_stream_power(const oc_heightfield *hf,
                                    const oc_hf_flow_params *fp, oc_error *err);
@@ -906,7 +909,7 @@ typedef struct oc_terrain_params {
 } oc_terrain_params;
 enum { OC_TERRAIN_EDGES_DEFAULT, OC_TERRAIN_OPEN, OC_TERRAIN_SLAB };
 
-/* The implicitization of seed 000 section 5.1: f = min(f_T, f_P) with
+/* The implicitization of Paris et al. 2019, section 5.1: f = min(f_T, f_P) with
 ** f_T = sigma(h(x, y) - z) (inverted: sigma(z - h)), sigma the odd cubic
 ** of range [0, 2T], and f_P = 2T g(d(p, P) / R), P = (Omega shrunk by R)
 ** x [min h, max h] (slab edges; open edges: d the vertical distance to
@@ -922,7 +925,8 @@ oc_node *oc_terrain(const oc_elevation *src, const oc_terrain_params *tp,
 /* geology/geology.c and geology/erosion.c; docs/fields.md, "Geology", has the
 ** formulas. A resistance tree is an ordinary node whose value is rock
 ** resistance (0 softest, 1 hardest). Trees are not clamped as they are
-** built, so that blends add up as in seed 000 section 4.2: the erosion
+** built, so that blends add up as in Paris et al. 2019, section 4.2: the
+** erosion
 ** node clamps what it reads to [0, 1], palettes clamp at their ends, and
 ** oc_clamp() clamps a tree explicitly. Constructors return a new
 ** reference, or NULL with err. */
@@ -935,7 +939,8 @@ oc_node *oc_strata(const oc_noise *noise, oc_error *err);
 /* clamp(f, lo, hi); lo < hi, both finite. Retains child. */
 oc_node *oc_clamp(oc_node *child, double lo, double hi, oc_error *err);
 
-/* A plane layer (seed 000 section 4.2): resistance * g(|d| / radius), d
+/* A plane layer (Paris et al. 2019, section 4.2): resistance * g(|d| /
+** radius), d
 ** the signed distance to the plane through origin with that normal, plus
 ** the turbulence `noise` when not NULL (offset + amplitude t(p/wl)). Built
 ** from two half-space primitives (an intersection for resistance >= 0, a
@@ -958,7 +963,7 @@ typedef struct oc_taper_params {
 } oc_taper_params;
 oc_node *oc_taper(oc_node *child, const oc_taper_params *tp, oc_error *err);
 
-/* Fault (seed 000 section 4.4): rho(p - offset) strictly inside the
+/* Fault (Paris et al. 2019, section 4.4): rho(p - offset) strictly inside the
 ** domain, rho(p) elsewhere; discontinuous on the domain's boundary, so its
 ** global Lipschitz bound is infinite (local bounds of boxes that miss the
 ** boundary stay finite). */
@@ -976,7 +981,8 @@ typedef struct oc_fault_domain {
 oc_node *oc_fault(oc_node *child, const oc_fault_domain *dom, oc_vec3 offset,
                   oc_error *err);
 
-/* Erosion node (seed 000 section 6): f~ = max(f - f_D (1 - rho^), min(f,
+/* Erosion node (Paris et al. 2019, section 6): f~ = max(f - f_D (1 - rho^),
+** min(f,
 ** 0)), rho^ = clamp(geology, 0, 1), f_D = depth * clamp(control, 0, 1)
 ** (depth everywhere when control is NULL). It only removes material: f~
 ** <= f, and f~ = 0 wherever f = 0. depth > 0 is in field units. Retains
@@ -986,7 +992,8 @@ oc_node *oc_erosion(oc_node *terrain, oc_node *geology, oc_node *control,
 
 /* ---- generators: karst (gen/karst.c) ---------------------------------- */
 
-/* Karst networks by invasion percolation (seed 000 section 6.2). From the
+/* Karst networks by invasion percolation (Paris et al. 2019, section 6.2).
+** From the
 ** sinks, a priority queue of candidate points ordered by resistance rho
 ** (the geology, clamped to [0, 1]) plus epsilon times a uniform draw: the
 ** least resistant candidate is popped; where rho < rho0 a negative point
@@ -1059,7 +1066,7 @@ oc_node *oc_generate_karst(const oc_gen_karst_params *p, oc_gen_karst_stats *st,
 
 /* ---- generators: hoodoos (gen/hoodoos.c, gen/grammar.c) ---------------- */
 
-/* Hoodoos and goblins (seed 000 section 6.3). Placement: the maximal
+/* Hoodoos and goblins (Paris et al. 2019, section 6.3). Placement: the maximal
 ** Poisson disk set of spacing `radius` over the heightfield (shrunk by
 ** `margin`) is thinned with the probability
 **   P = probability * exp(-((s - slope) / slope_spread)^2) / (1 + A /
@@ -1168,7 +1175,7 @@ oc_node *oc_generate_hoodoos(const oc_gen_hoodoos_params *p,
 
 /* ---- generators: sea and river (gen/sea.c, gen/river.c, gen/stress.c) -- */
 
-/* Shallow erosion (seed 000 section 6.1). Both make negative point
+/* Shallow erosion (Paris et al. 2019, section 6.1). Both make negative point
 ** primitives of radius `radius` and energy -strength e(rho, sigma), with
 ** e(rho, sigma) = sigma (1 - rho)(1 - beta) + sigma beta, rho the geology
 ** at the sample clamped to [0, 1], and drop those with e < cutoff. Samples

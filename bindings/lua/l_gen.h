@@ -14,7 +14,8 @@
 ** metatable. */
 void oclua_open_gen(lua_State *L);
 
-/* The landform generators (seed 000 section 6), each from its own file,
+/* The landform generators (Paris et al. 2019, section 6), each from its own
+** file,
 ** NULL-terminated: outcrop.generate.sea and .river (l_gen_sea.c),
 ** .karst (l_gen_karst.c), .hoodoos (l_gen_hoodoos.c). */
 extern const luaL_Reg oclua_gen_sea[];

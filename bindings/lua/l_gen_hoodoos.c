@@ -1,6 +1,6 @@
 /*
 ** l_gen_hoodoos.c — hoodoos and goblins from a parameterized grammar:
-** outcrop.generate.hoodoos{heightfield=, ...} (seed 000 section 6.3).
+** outcrop.generate.hoodoos{heightfield=, ...} (Paris et al. 2019, section 6.3).
 **
 **   field        | default
 **   -------------+----------------------------------------------------------

@@ -1,6 +1,6 @@
 /*
 ** l_gen_karst.c — karst networks by invasion percolation:
-** outcrop.generate.karst{heightfield=, ...} (seed 000 section 6.2).
+** outcrop.generate.karst{heightfield=, ...} (Paris et al. 2019, section 6.2).
 **
 **   field          | default
 **   ---------------+--------------------------------------------------------

@@ -1,5 +1,5 @@
 /*
-** l_gen_sea.c — sea and river erosion (seed 000 section 6.1):
+** l_gen_sea.c — sea and river erosion (Paris et al. 2019, section 6.1):
 ** outcrop.generate.sea{...} and outcrop.generate.river{...}.
 **
 **   field (both)   | default

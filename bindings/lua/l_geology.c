@@ -1,5 +1,6 @@
 /*
-** l_geology.c — resistance trees (seed 000 section 4) and the erosion node
+** l_geology.c — resistance trees (Paris et al. 2019, section 4) and the
+** erosion node
 ** (section 6): the outcrop.geology table (strata, layer, sphere, curve,
 ** fold, taper, fault, clamp, slice) and outcrop.erosion.
 **
@@ -14,7 +15,7 @@
 **   taper    origin {0, 0, 0}, axis {0, 0, 1}, along {1, 0, 0}, from 0
 **   clamp    lo 0, hi 1
 **   slice    plane "xz", at 0, size {256, 256}, palette pale (hard) to
-**            dark (soft), as seed 000 figure 4; box required when the
+**            dark (soft), as Paris et al. 2019, figure 4; box required when the
 **            tree's bounds are infinite (strata always are)
 **   erosion  control = none (erode wherever there is rock)
 */
@@ -251,7 +252,7 @@ static int l_erosion(lua_State *L) {
 
 /* ---- slices coloured by resistance --------------------------------------- */
 
-/* Pale for hard rock, dark for soft (seed 000 figure 4). */
+/* Pale for hard rock, dark for soft (Paris et al. 2019, figure 4). */
 static const double default_stops[] = {0.00, 0.22, 0.13, 0.08, 0.35, 0.45,
                                        0.30, 0.18, 0.65, 0.72, 0.58, 0.40,
                                        1.00, 0.95, 0.91, 0.82};

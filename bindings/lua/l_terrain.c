@@ -1,6 +1,6 @@
 /*
 ** l_terrain.c — outcrop.terrain(hf, {falloff=, transition=, mask=,
-** invert=}): a heightfield implicitized into a terrain node (seed 000
+** invert=}): a heightfield implicitized into a terrain node (Paris et al. 2019
 ** section 5.1; docs/fields.md has the field).
 **
 **   field      | default

@@ -8,7 +8,8 @@
 #define OC_FALLOFF_H
 
 /* max |g'(x)| on [0, 1], reached at x = 1/sqrt(5): 96 sqrt(5) / 125.
-** For a radius R the bound is this divided by R (seed 001, appendix). */
+** For a radius R the bound is this divided by R (Génevaux et al. 2015,
+** appendix). */
 #define OC_FALLOFF_LIPSCHITZ 1.7173002067198386 /* 96*sqrt(5)/125 */
 
 /* g as a function of q = x^2. */

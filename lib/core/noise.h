@@ -1,6 +1,6 @@
 /*
 ** noise.h — 3D simplex noise and turbulence with analytic gradients and
-** Lipschitz bounds (seed 000 section 3.3).
+** Lipschitz bounds (Paris et al. 2019, section 3.3).
 **
 ** n : R^3 -> [0, 1], seeded by hashing lattice corners with the seed (no
 ** permutation tables, so a seed costs no memory).

@@ -2,7 +2,7 @@
 ** column.h — what the mesher learns about a column besides its z-spans
 ** (internal): whether a single heightfield-like op, a terrain or a plane,
 ** governs the column's footprint alone, and that op's surface as an
-** elevation, for direct elevation extraction (seed 000 section 7).
+** elevation, for direct elevation extraction (Paris et al. 2019, section 7).
 */
 #ifndef OC_COLUMN_H
 #define OC_COLUMN_H

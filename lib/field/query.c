@@ -1,6 +1,7 @@
 /*
 ** query.c — local queries on a compiled program: the z-spans where a
-** column may vary (surface bounds for the mesher, seed 000 section 7) and
+** column may vary (surface bounds for the mesher, Paris et al. 2019, section
+** 7) and
 ** Lipschitz bounds restricted to a box (for culling and sphere tracing).
 ** Both walk the program like evaluation does, pruning by support boxes and
 ** through the BVHs, and are read-only and allocation-free.

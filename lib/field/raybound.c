@@ -1,7 +1,8 @@
 /*
 ** raybound.c — queries along a ray for the tracer: bounds on the field's
 ** derivative over a segment (the local, directional Lipschitz bounds of
-** segment tracing, Galin et al. 2020, after seed 001 section 7.2) and the
+** segment tracing, Galin et al. 2020, after Génevaux et al. 2015, section 7.2)
+** and the
 ** intervals where the ray crosses a support (empty-space skipping, seed
 ** 000 section 7). Both prune by support boxes and through the BVHs like
 ** evaluation does; read-only and allocation-free.

@@ -1,6 +1,7 @@
 /*
 ** erode.h — shallow procedural erosion shared by the sea and river
-** generators (seed 000 section 6.1): the effect function e(rho, sigma),
+** generators (Paris et al. 2019, section 6.1): the effect function e(rho,
+** sigma),
 ** and the step that turns candidate rays into negative point primitives
 ** on the current surface (stress.c).
 **

@@ -1,6 +1,6 @@
 /*
 ** grammar.c — derivation of one hoodoo by the open parameterized grammar
-** of seed 000 figure 20:
+** of Paris et al. 2019, figure 20:
 **   A(p, s) -> B(p, s)
 **   B(p, s) -> b(p, s) B(p + s z, l s)  | b(p, s) C(p + s z, l s)
 **   C(p, s) -> c(p, s) B(p + s z, l s)  | c(p, s) | d(p, s)

@@ -1,5 +1,5 @@
 /*
-** hoodoos.c — the hoodoo generator (seed 000 section 6.3): placement
+** hoodoos.c — the hoodoo generator (Paris et al. 2019, section 6.3): placement
 ** probability from slope, drainage and a mask, Poisson disk axioms, one
 ** grammar derivation per axiom (gen/grammar.c) on both cores, and the
 ** symbols' solids blended with the terrain.

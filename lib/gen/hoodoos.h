@@ -1,6 +1,7 @@
 /*
 ** hoodoos.h — the open parameterized grammar of the hoodoo generator
-** (seed 000 figure 20), shared by gen/grammar.c, gen/hoodoos.c and the
+** (Paris et al. 2019, figure 20), shared by gen/grammar.c, gen/hoodoos.c and
+** the
 ** tests.
 */
 #ifndef OC_GEN_HOODOOS_H

@@ -1,5 +1,5 @@
 /*
-** karst.c — karst networks by invasion percolation (seed 000 section
+** karst.c — karst networks by invasion percolation (Paris et al. 2019, section
 ** 6.2): oc_karst_cavities runs the percolation, oc_generate_karst turns
 ** its cavities into a blend of negative point primitives.
 **

@@ -1,5 +1,5 @@
 /*
-** river.c — river erosion (seed 000 section 6.1, figure 15): canyons
+** river.c — river erosion (Paris et al. 2019, section 6.1, figure 15): canyons
 ** whose walls are undercut where the strata are soft.
 **
 ** The stress is the stream power A^(1/2) s of the heightfield: samples

@@ -1,5 +1,5 @@
 /*
-** sea.c — sea erosion (seed 000 section 6.1, figure 11): sea cliffs,
+** sea.c — sea erosion (Paris et al. 2019, section 6.1, figure 11): sea cliffs,
 ** overhangs, sea caves and arches carved by negative point primitives
 ** around sea level, deepest where the rock is soft.
 **

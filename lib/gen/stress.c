@@ -1,5 +1,6 @@
 /*
-** stress.c — the shared step of shallow erosion (seed 000 section 6.1):
+** stress.c — the shared step of shallow erosion (Paris et al. 2019, section
+** 6.1):
 ** candidate columns by Poisson sampling, rays marched to the current
 ** surface, stress and resistance at the samples, and negative point
 ** primitives with energy -strength e(rho, sigma). See erode.h.

@@ -1,5 +1,6 @@
 /*
-** erosion.c — the erosion node of seed 000 section 6: a terrain's field
+** erosion.c — the erosion node of Paris et al. 2019, section 6: a terrain's
+** field
 ** lowered where the rock is soft, f~ = f - f_D (1 - rho), over the region
 ** a control field selects; stratified cliffs and overhangs without any
 ** primitive.

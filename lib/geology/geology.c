@@ -1,5 +1,6 @@
 /*
-** geology.c — the node kinds of resistance trees (seed 000 section 4):
+** geology.c — the node kinds of resistance trees (Paris et al. 2019, section
+** 4):
 ** strata, clamp, taper and fault, with their constructors, compiled
 ** parameters, value and gradient, column spans and local Lipschitz
 ** bounds; and the plane layer, built from existing primitives. The

@@ -2,7 +2,8 @@
 ** mcband.c — the surface band of a slab: which cubes to visit.
 **
 ** 1. Every cube column asks the program for the z-spans where the field
-**    may vary over its footprint grown by one cube (the 1-ring of seed 000
+**    may vary over its footprint grown by one cube (the 1-ring of Paris et al.
+** 2019
 **    section 7); the cubes meeting a span, grown by one cube in z, are
 **    visited; closed meshes add the cap cubes against the bottom and top
 **    padding and whole columns along the box's sides (caps). The spans
@@ -30,7 +31,8 @@ static int32_t clampi(double v, int32_t lo, int32_t hi) {
 /* ---- 1. the band ------------------------------------------------------- */
 
 /* Cube and sample k-ranges of the z-span [zl, zh]: the cubes meeting it,
-** grown by `grow` cubes (1: seed 000's dilation), and the samples in it,
+** grown by `grow` cubes (1: Paris et al. 2019's dilation), and the samples in
+** it,
 ** with a margin far above the rounding of this arithmetic (a sample
 ** outside is in a gap, where the field is exactly constant along the
 ** column). The
@@ -174,7 +176,8 @@ int oc_mc_band(const oc_mcgrid *g, int ja, int jb, int jr, oc_mcwork *w) {
       if (g->direct && i >= 0 && j >= 0 && hs && oc_mc_direct_kind(hs))
         w->dsurf[(size_t)(j - ja) * (nx + 2) + (size_t)(i + 1)] = hs;
       /* cubes: where the field may vary, or, in a column one surface
-      ** governs alone, only where that surface may be (seed 000's exact
+      ** governs alone, only where that surface may be (Paris et al. 2019's
+      ** exact
       ** elevation bounds): elsewhere no sample is on the other side */
       const oc_zspan *csp = sp;
       int ncs = ns;

@@ -1,5 +1,6 @@
 /*
-** mcdirect.c — direct elevation extraction (seed 000 section 7): in the
+** mcdirect.c — direct elevation extraction (Paris et al. 2019, section 7): in
+** the
 ** sample columns that one heightfield-like op (a terrain, a plane)
 ** governs alone, the samples come from one elevation e(x, y) per column
 ** and the vertices straight from the elevation, with no field call.

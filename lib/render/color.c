@@ -2,7 +2,8 @@
 ** color.c — surface albedo for the renderer: the rule palette (sand,
 ** grass, rock, snow by altitude and slope), a field (e.g. a geology
 ** tree's resistance) through a palette of stops, and the triplanar
-** texture variation of seed 003 section 6 that every source receives.
+** texture variation of Peytavie et al. 2009, section 6 that every source
+** receives.
 */
 #include <math.h>
 

@@ -28,7 +28,7 @@ typedef struct oc_shader {
 void oc_albedo(const oc_shader *sh, oc_vec3 p, oc_vec3 n, double rgb[3],
                double *evals);
 
-/* Multiplies rgb by the triplanar texture variation at p (seed 003
+/* Multiplies rgb by the triplanar texture variation at p (Peytavie et al. 2009
 ** section 6): three planar projections of a procedural texture blended
 ** by |n_i|^8, stronger on steep faces. */
 void oc_texture(const oc_shader *sh, oc_vec3 p, oc_vec3 n, double rgb[3]);

@@ -5,7 +5,8 @@
 ** Lipschitz property proves free of the surface: f(t + s) <= f(t) + H s
 ** where H bounds the derivative of f along the ray, so f stays below T
 ** while s < (T - f) / H.
-**  - Sphere tracing (seed 001 section 7.1): H is the program's global
+**  - Sphere tracing (Génevaux et al. 2015, section 7.1): H is the program's
+** global
 **    bound; the ray is clipped to the scene's box. A program whose field
 **    jumps somewhere (an open terrain's sides) has a global bound that
 **    holds only off the jumps: there each step is first checked against
@@ -14,11 +15,13 @@
 **    step leaps over a jump (and the thin solid behind it) that the
 **    segment tracer would not, and away from the jumps the steps are
 **    plain sphere tracing's.
-**  - Segment tracing (seed 001 section 7.2; Galin et al. 2020): H bounds
+**  - Segment tracing (Génevaux et al. 2015, section 7.2; Galin et al. 2020): H
+** bounds
 **    only the growth of f along the candidate segment [t, t + delta],
 **    from the nodes whose support the segment crosses (raybound.c); a
 **    full step doubles the candidate. The ray is first cut into the
-**    intervals where it crosses a support (seed 000 section 7): outside
+**    intervals where it crosses a support (Paris et al. 2019, section 7):
+** outside
 **    them f == 0 < T, and no step is spent there.
 ** Either gives up after OC_TRACE_MAX_STEPS steps (a miss): the minimum
 ** step grows with the distance, so a ray needs about ln(far / near) / eps_k

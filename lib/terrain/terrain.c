@@ -1,5 +1,6 @@
 /*
-** terrain.c — the terrain primitive (seed 000 section 5.1): an elevation
+** terrain.c — the terrain primitive (Paris et al. 2019, section 5.1): an
+** elevation
 ** source h over a domain Omega made a 3D field f = min(f_T, f_P), with
 ** f_T = sigma(v), v = h(x, y) - z (z - h when inverted), and
 ** f_P = 2T g(d / R), d the distance to the prism (Omega shrunk by R) x

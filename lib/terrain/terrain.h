@@ -1,6 +1,6 @@
 /*
 ** terrain.h — the terrain primitive: an elevation source implicitized as
-** min(f_T, f_P) (seed 000 section 5.1), its value, gradient, support,
+** min(f_T, f_P) (Paris et al. 2019, section 5.1), its value, gradient, support,
 ** Lipschitz bounds and column spans (internal; docs/fields.md has the
 ** formulas).
 **

@@ -1,6 +1,6 @@
 /*
 ** bench_gen_hoodoos.c — the hoodoo generator on a field of about 500
-** hoodoos (seed 000 figure 19: 0.35 x 0.35 km): placement (slope,
+** hoodoos (Paris et al. 2019, figure 19: 0.35 x 0.35 km): placement (slope,
 ** drainage, Poisson disks), derivation and the node tree, then compiling
 ** it. Prints gen.hoodoos_seconds (generation, best of 3), the counts, and
 ** the compiled tree's size.

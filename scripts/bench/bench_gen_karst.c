@@ -1,5 +1,6 @@
 /*
-** bench_gen_karst.c — karst invasion percolation against seed 000 Table 1
+** bench_gen_karst.c — karst invasion percolation against Paris et al. 2019,
+** Table 1
 ** (figure 17: 165 773 primitives on a 5.2 x 5.2 km plateau in 6.2 s).
 **
 ** A 521 x 521 grid at 10 m: a plateau 300 m above a plain, its top
@@ -85,7 +86,8 @@ int main(int argc, char **argv) {
   double lo, hi;
   oc_heightfield_minmax(hf, &lo, &hi);
   oc_aabb box = {{0, 0, lo - 20}, {(N - 1) * CELL, (N - 1) * CELL, hi + 20}};
-  /* seed 000's t0 and t: the full grid with root finding on every edge,
+  /* Paris et al. 2019's t0 and t: the full grid with root finding on every
+  ** edge,
   ** surface bounds with direct elevation extraction; and surface bounds
   ** alone, which must give the full grid's mesh to the bit */
   double sb, sf, sr, dev;

@@ -1,5 +1,6 @@
 /*
-** bench_gen_sea.c — sea erosion speed against seed 000 Table 1 (issue 6).
+** bench_gen_sea.c — sea erosion speed against Paris et al. 2019, Table 1
+** (issue 6).
 **
 ** gen.sea_50k_seconds: oc_generate_sea on a 6 x 6 km island (1024 x 1024
 ** samples, fBm under a radial dome, sea level 0, cliffs where the dome

@@ -5,7 +5,7 @@
 **    with about 2 % of its area covered by 3D features (carved spheres,
 **    boulders, a perturbed arch), meshed over the same box and cell on
 **    the full grid (root finding on every edge) and with surface bounds
-**    and direct elevation extraction (seed 000's t0 and t); the meshes
+**    and direct elevation extraction (Paris et al. 2019's t0 and t); the meshes
 **    must have the same triangles on the same grid edges. Surface bounds
 **    with root finding everywhere, for context, must give the full grid's
 **    mesh to the bit.
@@ -126,7 +126,7 @@ static oc_mesh *mesh_best(const oc_program *p, oc_aabb box, double cell,
 
 /* One cell size of the speedup scene: the full grid (standard marching
 ** cubes, root finding on every edge) against surface bounds with direct
-** elevation extraction (seed 000's optimized polygonization: Table 1's
+** elevation extraction (Paris et al. 2019's optimized polygonization: Table 1's
 ** t0 / t), and against surface bounds alone (root finding everywhere,
 ** the same mesh to the bit). Returns 0 when a mesh differs. */
 static int speedup_at(const oc_program *p, oc_aabb box, double cell,
@@ -166,7 +166,8 @@ static int speedup_at(const oc_program *p, oc_aabb box, double cell,
 
 /* The issue's scene: a 400 m wide implicitized fBm ground with features on
 ** 2 % of it, in a box 128 m high. The figure is at cell 0.5 m (800 x 800
-** x 256 cells, the proportions of seed 000 Table 1's karst scene, whose
+** x 256 cells, the proportions of Paris et al. 2019, Table 1's karst scene,
+** whose
 ** 3D coverage is also 2 %: 1520 x 1520 x 447); 1 m for context. */
 static void terrain_speedup(void) {
   oc_error err;

@@ -1,5 +1,6 @@
 /*
-** test_gen_hoodoos.c — the hoodoo generator (seed 000 section 6.3): the
+** test_gen_hoodoos.c — the hoodoo generator (Paris et al. 2019, section 6.3):
+** the
 ** grammar's derivations are words of b+ (c b+)* (c | d) no longer than
 ** max_depth, stacked and scaled as the productions say; forced words for
 ** extreme probabilities; every base symbol is sunk into the ground and

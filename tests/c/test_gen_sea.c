@@ -1,5 +1,5 @@
 /*
-** test_gen_sea.c — sea and river erosion (seed 000 section 6.1): the
+** test_gen_sea.c — sea and river erosion (Paris et al. 2019, section 6.1): the
 ** effect function against its formula, determinism by seed and thread
 ** count, carving confined to the sea band and to the riverbed's reach,
 ** soft rock and later steps biting deeper, counts against the compiled

@@ -1,5 +1,6 @@
 /*
-** test_terrain.c — the terrain node (heightfield implicitization, seed 000
+** test_terrain.c — the terrain node (heightfield implicitization, Paris et al.
+** 2019
 ** section 5.1) and direct elevation extraction in the mesher (section 7).
 **
 ** Checked against formulas written here, not borrowed from lib/: sigma's
