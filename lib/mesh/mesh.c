@@ -63,11 +63,7 @@ void oc_mesh_free(oc_mesh *mesh) {
   free(mesh->nrm);
   free(mesh->col);
   free(mesh->tri);
-  for (size_t i = 0; i < mesh->nmeta; i++) {
-    free(mesh->meta[i].key);
-    free(mesh->meta[i].value);
-  }
-  free(mesh->meta);
+  oc_kvlist_free(&mesh->meta);
   free(mesh);
 }
 
@@ -189,13 +185,6 @@ static int check_key(const char *key, oc_error *err) {
   return OC_OK;
 }
 
-static char *dupstr(const char *s) {
-  size_t n = strlen(s) + 1;
-  char *d = malloc(n);
-  if (d) memcpy(d, s, n);
-  return d;
-}
-
 int oc_mesh_set_meta(oc_mesh *mesh, const char *key, const char *value,
                      oc_error *err) {
   if (!mesh) return oc_seterr(err, OC_EINVAL, "'mesh' is NULL");
@@ -208,48 +197,16 @@ int oc_mesh_set_meta(oc_mesh *mesh, const char *key, const char *value,
     return oc_seterr(err, OC_EINVAL,
                      "'value' of '%s' is too long (%zu > %d bytes)", key, vlen,
                      MAX_META_VALUE);
-  char *v = dupstr(value);
-  if (!v)
-    return oc_seterr(err, OC_ENOMEM, "out of memory for metadata '%s'", key);
   /* Exact comparison: JSON member names are case-sensitive. */
-  for (size_t i = 0; i < mesh->nmeta; i++)
-    if (strcmp(mesh->meta[i].key, key) == 0) {
-      free(mesh->meta[i].value);
-      mesh->meta[i].value = v;
-      return OC_OK;
-    }
-  if (mesh->nmeta == MAX_META) {
-    free(v);
-    return oc_seterr(err, OC_EINVAL, "too many metadata entries (limit %d)",
-                     MAX_META);
-  }
-  if (mesh->nmeta == mesh->capmeta) {
-    size_t cap = mesh->capmeta ? 2 * mesh->capmeta : 8;
-    oc_mesh_meta *m = realloc(mesh->meta, cap * sizeof *m);
-    if (!m) {
-      free(v);
-      return oc_seterr(err, OC_ENOMEM, "out of memory for metadata '%s'", key);
-    }
-    mesh->meta = m;
-    mesh->capmeta = cap;
-  }
-  char *k = dupstr(key);
-  if (!k) {
-    free(v);
-    return oc_seterr(err, OC_ENOMEM, "out of memory for metadata '%s'", key);
-  }
-  mesh->meta[mesh->nmeta].key = k;
-  mesh->meta[mesh->nmeta].value = v;
-  mesh->nmeta++;
-  return OC_OK;
+  return oc_kvlist_set(&mesh->meta, key, value, 0, MAX_META, err);
 }
 
 size_t oc_mesh_meta_count(const oc_mesh *mesh) {
-  return mesh->nmeta;
+  return mesh->meta.n;
 }
 const char *oc_mesh_meta_key(const oc_mesh *mesh, size_t i) {
-  return i < mesh->nmeta ? mesh->meta[i].key : NULL;
+  return i < mesh->meta.n ? mesh->meta.v[i].key : NULL;
 }
 const char *oc_mesh_meta_value(const oc_mesh *mesh, size_t i) {
-  return i < mesh->nmeta ? mesh->meta[i].value : NULL;
+  return i < mesh->meta.n ? mesh->meta.v[i].value : NULL;
 }

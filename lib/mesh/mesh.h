@@ -9,11 +9,8 @@
 #ifndef OC_MESH_H
 #define OC_MESH_H
 
+#include "core/kvlist.h"
 #include "outcrop.h"
-
-typedef struct oc_mesh_meta {
-  char *key, *value;
-} oc_mesh_meta;
 
 struct oc_mesh {
   float *pos;
@@ -23,8 +20,7 @@ struct oc_mesh {
   uint32_t *tri;
   size_t nt;
   oc_mesh_stats stats;
-  oc_mesh_meta *meta;
-  size_t nmeta, capmeta;
+  oc_kvlist meta;
 };
 
 /* An empty mesh with room for exactly nv vertices and nt triangles (both

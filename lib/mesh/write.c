@@ -60,8 +60,8 @@ static int check_mesh(const oc_mesh *m, const char *path, oc_error *err) {
 
 int oc_mesh_write_meta_lines(const oc_mesh *m, oc_atomic *a, const char *prefix,
                              oc_error *err) {
-  for (size_t i = 0; i < m->nmeta; i++) {
-    const oc_mesh_meta *e = &m->meta[i];
+  for (size_t i = 0; i < m->meta.n; i++) {
+    const oc_kv *e = &m->meta.v[i];
     char *q = malloc(oc_meta_quoted_size(e->value));
     if (!q)
       return oc_seterr(err, OC_ENOMEM, "cannot write '%s': out of memory",

@@ -43,8 +43,8 @@ static uint64_t bin_size(const oc_mesh *m) {
 ** quotes and separators. */
 static uint64_t meta_size(const oc_mesh *m) {
   uint64_t n = 16;
-  for (size_t i = 0; i < m->nmeta; i++)
-    n += 6 * ((uint64_t)strlen(m->meta[i].key) + strlen(m->meta[i].value)) + 8;
+  for (size_t i = 0; i < m->meta.n; i++)
+    n += 6 * ((uint64_t)strlen(m->meta.v[i].key) + strlen(m->meta.v[i].value)) + 8;
   return n;
 }
 
@@ -158,13 +158,13 @@ static void json(const oc_mesh *m, text *t) {
   t->n = 0;
   add(t, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"outcrop " OC_VERSION
          "\"");
-  if (m->nmeta) {
+  if (m->meta.n) {
     add(t, ",\"extras\":{");
-    for (size_t i = 0; i < m->nmeta; i++) {
+    for (size_t i = 0; i < m->meta.n; i++) {
       if (i) addc(t, ',');
-      add_string(t, m->meta[i].key);
+      add_string(t, m->meta.v[i].key);
       addc(t, ':');
-      add_string(t, m->meta[i].value);
+      add_string(t, m->meta.v[i].value);
     }
     addc(t, '}');
   }

@@ -12,6 +12,7 @@
 #include <strings.h>
 
 #include "core/error.h"
+#include "core/kvlist.h"
 #include "io/oiio.h"
 #include "outcrop.h"
 
@@ -23,16 +24,11 @@
 #define MAX_VALUE 65535
 #define MAX_META 1024
 
-typedef struct meta {
-  char *key, *value;
-} meta;
-
 struct oc_image {
   int width, height, channels;
   float *data;
   char (*names)[NAME_SIZE];
-  meta *meta;
-  size_t nmeta, capmeta;
+  oc_kvlist meta;
 };
 
 oc_image *oc_image_new(int width, int height, int channels, oc_error *err) {
@@ -89,11 +85,7 @@ oc_image *oc_image_new(int width, int height, int channels, oc_error *err) {
 
 void oc_image_free(oc_image *img) {
   if (!img) return;
-  for (size_t i = 0; i < img->nmeta; i++) {
-    free(img->meta[i].key);
-    free(img->meta[i].value);
-  }
-  free(img->meta);
+  oc_kvlist_free(&img->meta);
   free(img->names);
   free(img->data);
   free(img);
@@ -194,13 +186,6 @@ static int check_key(const char *key, oc_error *err) {
   return OC_OK;
 }
 
-static char *dupstr(const char *s) {
-  size_t n = strlen(s) + 1;
-  char *d = malloc(n);
-  if (d) memcpy(d, s, n);
-  return d;
-}
-
 /* Keys compare without case because OpenImageIO's attribute lists do:
 ** "Scene" and "scene" would land on the same attribute in the file. */
 int oc_image_set_meta(oc_image *img, const char *key, const char *value,
@@ -215,56 +200,21 @@ int oc_image_set_meta(oc_image *img, const char *key, const char *value,
     return oc_seterr(err, OC_EINVAL,
                      "'value' of '%s' is too long (%zu > %d bytes)", key, vlen,
                      MAX_VALUE);
-  char *v = dupstr(value);
-  if (!v)
-    return oc_seterr(err, OC_ENOMEM, "out of memory for metadata '%s'", key);
-  for (size_t i = 0; i < img->nmeta; i++) {
-    if (strcasecmp(img->meta[i].key, key) == 0) {
-      free(img->meta[i].value);
-      img->meta[i].value = v;
-      return OC_OK;
-    }
-  }
-  if (img->nmeta == MAX_META) {
-    free(v);
-    return oc_seterr(err, OC_EINVAL, "too many metadata entries (limit %d)",
-                     MAX_META);
-  }
-  if (img->nmeta == img->capmeta) {
-    size_t cap = img->capmeta ? 2 * img->capmeta : 8;
-    meta *m = realloc(img->meta, cap * sizeof *m);
-    if (!m) {
-      free(v);
-      return oc_seterr(err, OC_ENOMEM, "out of memory for metadata '%s'", key);
-    }
-    img->meta = m;
-    img->capmeta = cap;
-  }
-  char *k = dupstr(key);
-  if (!k) {
-    free(v);
-    return oc_seterr(err, OC_ENOMEM, "out of memory for metadata '%s'", key);
-  }
-  img->meta[img->nmeta].key = k;
-  img->meta[img->nmeta].value = v;
-  img->nmeta++;
-  return OC_OK;
+  return oc_kvlist_set(&img->meta, key, value, 1, MAX_META, err);
 }
 
 size_t oc_image_meta_count(const oc_image *img) {
-  return img->nmeta;
+  return img->meta.n;
 }
 
 const char *oc_image_meta_key(const oc_image *img, size_t i) {
-  return i < img->nmeta ? img->meta[i].key : NULL;
+  return i < img->meta.n ? img->meta.v[i].key : NULL;
 }
 
 const char *oc_image_meta_value(const oc_image *img, size_t i) {
-  return i < img->nmeta ? img->meta[i].value : NULL;
+  return i < img->meta.n ? img->meta.v[i].value : NULL;
 }
 
 const char *oc_image_meta_get(const oc_image *img, const char *key) {
-  for (size_t i = 0; i < img->nmeta; i++)
-    if (strcasecmp(img->meta[i].key, key) == 0) return img->meta[i].value;
-  return NULL;
+  return oc_kvlist_get(&img->meta, key, 1);
 }
