@@ -269,6 +269,17 @@ void oclua_configure(lua_State *L, int idx, const char *fname) {
   lua_settop(L, top);
 }
 
+/* Pushes a shallow raw copy of the table at idx. */
+static void copy_table(lua_State *L, int idx) {
+  lua_newtable(L);
+  lua_pushnil(L);
+  while (lua_next(L, idx)) {
+    lua_pushvalue(L, -2);
+    lua_insert(L, -2);
+    lua_rawset(L, -4);
+  }
+}
+
 static int l_configure(lua_State *L) {
   const char *fname = "outcrop.configure";
   if (lua_type(L, 1) != LUA_TTABLE)
@@ -277,21 +288,8 @@ static int l_configure(lua_State *L) {
   oclua_checkargs(L, 1, fname, "{seed =, params =, out =}");
   /* a copy of params: the caller's table is not changed */
   if (lua_getfield(L, 1, "params") == LUA_TTABLE) {
-    int src = lua_gettop(L);
-    lua_newtable(L);
-    lua_pushnil(L);
-    while (lua_next(L, src)) {
-      lua_pushvalue(L, -2);
-      lua_insert(L, -2);
-      lua_rawset(L, -4);
-    }
-    lua_newtable(L);
-    lua_pushnil(L);
-    while (lua_next(L, 1)) { /* the other fields as they are */
-      lua_pushvalue(L, -2);
-      lua_insert(L, -2);
-      lua_rawset(L, -4);
-    }
+    copy_table(L, lua_gettop(L));
+    copy_table(L, 1); /* the other fields as they are */
     lua_insert(L, -2);
     lua_setfield(L, -2, "params");
     oclua_configure(L, -1, fname);

@@ -232,6 +232,24 @@ static int l_fbm(lua_State *L) {
 
 /* Calls fn(x, y) for every sample, rows from j = 1 up, serially. The grid
 ** is already in its userdata (the only reference: writing is allowed). */
+/* Calls the function below its nargs arguments (then x, y are pushed)
+** and returns the finite elevation it gives for sample (i, j). */
+static float call_elevation(lua_State *L, int nargs, double x, double y,
+                            int i, int j, const char *fname) {
+  lua_pushnumber(L, x);
+  lua_pushnumber(L, y);
+  lua_call(L, nargs + 2, 1);
+  double v = lua_tonumber(L, -1);
+  if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(v) || fabs(v) > 3.4e38)
+    oclua_error(L, fname,
+                "the function must return a finite elevation (got %s at "
+                "sample (%d, %d), x = %f, y = %f)",
+                oclua_got(L, -1), i + 1, j + 1, (LUAI_UACNUMBER)x,
+                (LUAI_UACNUMBER)y);
+  lua_pop(L, 1);
+  return (float)v;
+}
+
 static void from_function(lua_State *L, int fn, oc_heightfield *hf,
                           const char *fname) {
   int nx = oc_heightfield_nx(hf), ny = oc_heightfield_ny(hf);
@@ -241,19 +259,8 @@ static void from_function(lua_State *L, int fn, oc_heightfield *hf,
   for (int j = 0; j < ny; j++)
     for (int i = 0; i < nx; i++) {
       lua_pushvalue(L, fn);
-      lua_pushnumber(L, x0 + i * cell);
-      lua_pushnumber(L, y0 + j * cell);
-      lua_call(L, 2, 1);
-      double v = lua_tonumber(L, -1);
-      if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(v) || fabs(v) > 3.4e38)
-        oclua_error(L, fname,
-                    "the function must return a finite elevation (got %s at "
-                    "sample (%d, %d), x = %f, y = %f)",
-                    oclua_got(L, -1), i + 1, j + 1,
-                    (LUAI_UACNUMBER)(x0 + i * cell),
-                    (LUAI_UACNUMBER)(y0 + j * cell));
-      z[(size_t)j * (size_t)nx + (size_t)i] = (float)v;
-      lua_pop(L, 1);
+      z[(size_t)j * (size_t)nx + (size_t)i] =
+          call_elevation(L, 0, x0 + i * cell, y0 + j * cell, i, j, fname);
     }
 }
 
@@ -761,19 +768,7 @@ static int hf_map(lua_State *L) {
       size_t k = (size_t)j * (size_t)nx + (size_t)i;
       lua_pushvalue(L, 2);
       lua_pushnumber(L, zin[k]);
-      lua_pushnumber(L, x0 + i * cell);
-      lua_pushnumber(L, y0 + j * cell);
-      lua_call(L, 3, 1);
-      double v = lua_tonumber(L, -1);
-      if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(v) || fabs(v) > 3.4e38)
-        oclua_error(L, fname,
-                    "the function must return a finite elevation (got %s at "
-                    "sample (%d, %d), x = %f, y = %f)",
-                    oclua_got(L, -1), i + 1, j + 1,
-                    (LUAI_UACNUMBER)(x0 + i * cell),
-                    (LUAI_UACNUMBER)(y0 + j * cell));
-      z[k] = (float)v;
-      lua_pop(L, 1);
+      z[k] = call_elevation(L, 1, x0 + i * cell, y0 + j * cell, i, j, fname);
     }
   lua_settop(L, ud);
   return 1;

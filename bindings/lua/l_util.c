@@ -27,16 +27,22 @@ static void where(lua_State *L) {
   lua_pushliteral(L, "");
 }
 
-int oclua_error(lua_State *L, const char *fname, const char *fmt, ...) {
-  va_list ap;
+/* Pushes "file:line: fname: message" (where() gives the position). */
+static void push_message(lua_State *L, const char *fname, const char *fmt,
+                         va_list ap) {
   luaL_checkstack(L, 4, NULL);
   where(L);
   lua_pushstring(L, fname);
   lua_pushliteral(L, ": ");
-  va_start(ap, fmt);
   lua_pushvfstring(L, fmt, ap);
-  va_end(ap);
   lua_concat(L, 4);
+}
+
+int oclua_error(lua_State *L, const char *fname, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  push_message(L, fname, fmt, ap);
+  va_end(ap);
   return lua_error(L);
 }
 
@@ -45,14 +51,9 @@ int oclua_error(lua_State *L, const char *fname, const char *fmt, ...) {
 ** should hear why. */
 void oclua_warn(lua_State *L, const char *fname, const char *fmt, ...) {
   va_list ap;
-  luaL_checkstack(L, 4, NULL);
-  where(L);
-  lua_pushstring(L, fname);
-  lua_pushliteral(L, ": ");
   va_start(ap, fmt);
-  lua_pushvfstring(L, fmt, ap);
+  push_message(L, fname, fmt, ap);
   va_end(ap);
-  lua_concat(L, 4);
   fprintf(stderr, "outcrop: warning: %s\n", lua_tostring(L, -1));
   fflush(stderr);
   lua_pop(L, 1);

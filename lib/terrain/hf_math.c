@@ -52,6 +52,22 @@ static double apply(oc_hf_op op, double a, double b) {
 static const char *const op_names[] = {"the sum", "the difference",
                                        "the difference", "the product"};
 
+/* A new grid like a holding op of a's samples and zb's (or of k when zb
+** is NULL), sample by sample; NULL when a result is not a finite float. */
+static oc_heightfield *combine(const oc_heightfield *a, const float *zb,
+                               double k, oc_hf_op op, oc_error *err) {
+  oc_heightfield *out = like(a, err);
+  if (!out) return NULL;
+  const float *za = oc_heightfield_samples(a);
+  size_t n = (size_t)oc_heightfield_nx(a) * (size_t)oc_heightfield_ny(a);
+  for (size_t s = 0; s < n; s++)
+    if (put(out, s, apply(op, za[s], zb ? zb[s] : k), op_names[op], err)) {
+      oc_heightfield_release(out);
+      return NULL;
+    }
+  return out;
+}
+
 static int check_op(oc_hf_op op, oc_error *err) {
   if (op < OC_HF_ADD || op > OC_HF_MUL)
     return oc_seterr(err, OC_EINVAL, "unknown grid operation %d", (int)op);
@@ -81,16 +97,7 @@ oc_heightfield *oc_heightfield_combine(const oc_heightfield *a,
               oc_heightfield_ny(b), oc_heightfield_cell(b), bx, by);
     return NULL;
   }
-  oc_heightfield *out = like(a, err);
-  if (!out) return NULL;
-  const float *za = oc_heightfield_samples(a), *zb = oc_heightfield_samples(b);
-  size_t n = (size_t)nx * (size_t)ny;
-  for (size_t k = 0; k < n; k++)
-    if (put(out, k, apply(op, za[k], zb[k]), op_names[op], err)) {
-      oc_heightfield_release(out);
-      return NULL;
-    }
-  return out;
+  return combine(a, oc_heightfield_samples(b), 0, op, err);
 }
 
 oc_heightfield *oc_heightfield_scalar(const oc_heightfield *a, double k,
@@ -104,16 +111,7 @@ oc_heightfield *oc_heightfield_scalar(const oc_heightfield *a, double k,
     oc_seterr(err, OC_EINVAL, "the number must be finite (got %g)", k);
     return NULL;
   }
-  oc_heightfield *out = like(a, err);
-  if (!out) return NULL;
-  const float *z = oc_heightfield_samples(a);
-  size_t n = (size_t)oc_heightfield_nx(a) * (size_t)oc_heightfield_ny(a);
-  for (size_t s = 0; s < n; s++)
-    if (put(out, s, apply(op, z[s], k), op_names[op], err)) {
-      oc_heightfield_release(out);
-      return NULL;
-    }
-  return out;
+  return combine(a, NULL, k, op, err);
 }
 
 oc_heightfield *oc_heightfield_clamp(const oc_heightfield *a, double lo,
