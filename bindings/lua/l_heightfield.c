@@ -230,12 +230,10 @@ static int l_fbm(lua_State *L) {
 
 /* ---- outcrop.heightfield.from ----------------------------------------- */
 
-/* Calls fn(x, y) for every sample, rows from j = 1 up, serially. The grid
-** is already in its userdata (the only reference: writing is allowed). */
 /* Calls the function below its nargs arguments (then x, y are pushed)
 ** and returns the finite elevation it gives for sample (i, j). */
-static float call_elevation(lua_State *L, int nargs, double x, double y,
-                            int i, int j, const char *fname) {
+static float call_elevation(lua_State *L, int nargs, double x, double y, int i,
+                            int j, const char *fname) {
   lua_pushnumber(L, x);
   lua_pushnumber(L, y);
   lua_call(L, nargs + 2, 1);
@@ -250,6 +248,8 @@ static float call_elevation(lua_State *L, int nargs, double x, double y,
   return (float)v;
 }
 
+/* Calls fn(x, y) for every sample, rows from j = 1 up, serially. The grid
+** is already in its userdata (the only reference: writing is allowed). */
 static void from_function(lua_State *L, int fn, oc_heightfield *hf,
                           const char *fname) {
   int nx = oc_heightfield_nx(hf), ny = oc_heightfield_ny(hf);
