@@ -17,11 +17,9 @@
 #include "core/falloff.h"
 #include "core/noise.h"
 #include "core/vec.h"
-#include "geology/geology.h"
 #include "field/node.h"
 #include "field/prim.h"
 #include "field/program.h"
-#include "terrain/terrain.h"
 
 /* Groups with at least this many plain point children store them inline
 ** in single precision; smaller groups keep every child as a double op. */
@@ -114,7 +112,7 @@ typedef struct info {
 
 typedef struct comp {
   oc_program *P;
-  size_t capops, cappar, capkids, capent, capbvh, capterr;
+  size_t capops, cappar, capkids, capent, capbvh, capext;
   info *inf; /* parallel to ops */
   size_t capinf;
   pmap memo;
@@ -262,31 +260,6 @@ static uint32_t pack_noise(comp *c, const oc_noise *nz) {
                  (double)(nz->seed >> 32),
                  (double)(nz->seed & 0xffffffffu)};
   return add_par(c, v, 6);
-}
-
-/* The terrain's data stays with its node (the program retains the root);
-** the op holds sigma's constants for this T and the data's index. */
-static uint32_t compile_terrain(comp *c, const oc_node *n) {
-  const oc_tdata *t = n->terrain;
-  oc_program *P = c->P;
-  double par[OC_TPAR_N];
-  oc_terrain_sigma(c->T, t->W, par);
-  uint32_t at = add_par(c, par, OC_TPAR_N);
-  uint32_t op = new_op(c, OC_K_TERRAIN);
-  if (at == OC_NONE || op == OC_NONE ||
-      !GROW(P->terr, P->nterr, c->capterr, 1)) {
-    nomem(c);
-    return OC_NONE;
-  }
-  P->ops[op].par = at;
-  P->ops[op].kid = (uint32_t)P->nterr;
-  P->terr[P->nterr++] = t;
-  if (t->open) P->njump++;
-  c->inf[op].lo = 0;
-  c->inf[op].hi = 2 * c->T;
-  c->inf[op].lip = oc_terrain_lipschitz(t, P->par + at);
-  set_box(c, op, oc_terrain_box(t));
-  return op;
 }
 
 static uint32_t compile_turb(comp *c, const oc_node *n) {
@@ -858,25 +831,55 @@ static uint32_t compile_perturb(comp *c, const oc_node *n) {
   return op;
 }
 
-/* ---- geology kinds (the formulas are in geology/geology.c) --- */
+/* ---- extension kinds (kind.h) --------------------------------------- */
 
-static uint32_t compile_geo(comp *c, const oc_node *n) {
-  uint32_t k[3];
-  oc_geo_info ki[3], out;
-  double par[OC_GP_COUNT];
-  if (n->nkids > 3) return (uint32_t)nomem(c), OC_NONE;
-  for (size_t i = 0; i < n->nkids; i++) {
-    if ((k[i] = compile_node(c, n->kids[i])) == OC_NONE) return OC_NONE;
-    info *ci = &c->inf[k[i]];
-    ki[i] = (oc_geo_info){ci->box, ci->lo, ci->hi, ci->lip};
+static uint32_t compile_ext(comp *c, const oc_node *n) {
+  const oc_kind_def *def = n->def;
+  oc_kcompile kc;
+  uint32_t inl[4], *k = n->nkids <= 4 ? inl : malloc(n->nkids * sizeof *k);
+  oc_kinfo kinl[4], *ki = n->nkids <= 4 ? kinl : malloc(n->nkids * sizeof *ki);
+  uint32_t op = OC_NONE;
+  if (!k || !ki) {
+    nomem(c);
+    goto done;
   }
-  size_t np = oc_geo_compile(n, c->T, ki, par, &out);
-  uint32_t op = emit(c, n->kind, k, n->nkids, par, np);
-  if (op == OC_NONE) return op;
-  c->inf[op].lo = out.lo;
-  c->inf[op].hi = out.hi;
-  c->inf[op].lip = out.lip;
-  set_box(c, op, out.box);
+  for (size_t i = 0; i < n->nkids; i++) {
+    if ((k[i] = compile_node(c, n->kids[i])) == OC_NONE) goto done;
+    info *ci = &c->inf[k[i]];
+    ki[i] = (oc_kinfo){ci->box, ci->lo, ci->hi, ci->lip};
+  }
+  kc.data = n->data;
+  kc.npar = 0;
+  kc.node_par = n->par;
+  kc.node_npar = n->nnpar;
+  kc.T = c->T;
+  kc.nkids = n->nkids;
+  kc.kid = ki;
+  kc.info = (oc_kinfo){oc_aabb_all(), -INFINITY, INFINITY, INFINITY};
+  kc.jump = 0;
+  if (def->compile && def->compile(&kc, c->err) != OC_OK) goto done;
+  if (kc.npar > OC_KIND_MAXPAR) {
+    oc_seterr(c->err, OC_EINVAL, "%s: compiled to %zu parameters", def->name,
+              kc.npar);
+    goto done;
+  }
+  oc_program *P = c->P;
+  if (!GROW(P->ext, P->next, c->capext, 1)) {
+    nomem(c);
+    goto done;
+  }
+  op = emit(c, OC_K_EXT, k, n->nkids, kc.par, kc.npar);
+  if (op == OC_NONE) goto done;
+  P->ops[op].ext = (uint32_t)P->next;
+  P->ext[P->next++] = (oc_pext){def, n->data};
+  if (kc.jump) P->njump++;
+  c->inf[op].lo = kc.info.lo;
+  c->inf[op].hi = kc.info.hi;
+  c->inf[op].lip = kc.info.lip;
+  set_box(c, op, kc.info.box);
+done:
+  if (k != inl) free(k);
+  if (ki != kinl) free(ki);
   return op;
 }
 
@@ -894,10 +897,6 @@ static uint32_t compile_node(comp *c, const oc_node *n) {
   switch (n->kind) {
   case OC_K_TURB:
     op = compile_turb(c, n);
-    break;
-  case OC_K_TERRAIN:
-    op = compile_terrain(c, n);
-    if (op != OC_NONE) c->inf[op].depth = 1;
     break;
   case OC_K_BLEND:
   case OC_K_UNION:
@@ -927,12 +926,8 @@ static uint32_t compile_node(comp *c, const oc_node *n) {
   case OC_K_PERTURB:
     op = compile_perturb(c, n);
     break;
-  case OC_K_STRATA:
-  case OC_K_CLAMP:
-  case OC_K_TAPER:
-  case OC_K_FAULT:
-  case OC_K_EROSION:
-    op = compile_geo(c, n);
+  case OC_K_EXT:
+    op = compile_ext(c, n);
     break;
   default:
     op = compile_prim(c, n);
@@ -967,7 +962,7 @@ static int count_nodes(const oc_node *root, size_t *nodes, size_t *prims) {
   while (n) {
     const oc_node *x = stack[--n];
     (*nodes)++;
-    if (OC_KIND_IS_PRIM(x->kind)) (*prims)++;
+    if (oc_node_is_prim(x)) (*prims)++;
     for (size_t i = 0; i < x->nkids; i++) {
       const oc_node *k = x->kids[i];
       if (pmap_slot(&seen, k, 0)) continue;
@@ -1036,7 +1031,7 @@ oc_program *oc_compile(oc_node *root, const oc_compile_options *opts,
   P->stats.bytes = sizeof *P + P->nops * sizeof *P->ops +
                    P->npar * sizeof *P->par + P->nkids * sizeof *P->kids +
                    P->nent * sizeof *P->ent + P->nbvh * sizeof *P->bvh +
-                   P->nterr * sizeof *P->terr;
+                   P->next * sizeof *P->ext;
   free(c.inf);
   pmap_free(&c.memo);
   return P;
@@ -1049,7 +1044,7 @@ void oc_program_free(oc_program *P) {
   free(P->kids);
   free(P->ent);
   free(P->bvh);
-  free(P->terr);
+  free(P->ext);
   oc_node_release(P->node);
   free(P);
 }

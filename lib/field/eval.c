@@ -9,10 +9,8 @@
 #include "core/noise.h"
 #include "core/rng.h"
 #include "core/vec.h"
-#include "geology/geology.h"
 #include "field/prim.h"
 #include "field/program.h"
-#include "terrain/terrain.h"
 
 #define BVH_STACK 64
 
@@ -31,9 +29,19 @@ static noisep unpack_noise(const double *v) {
 static double ev(const oc_program *P, uint32_t i, oc_vec3 p);
 static double evg(const oc_program *P, uint32_t i, oc_vec3 p, oc_vec3 *g);
 
-/* Children of the geology kinds (geology/geology.c) */
-static double ev_kid(const oc_program *P, uint32_t i, oc_vec3 p, oc_vec3 *g) {
-  return g ? evg(P, i, p, g) : ev(P, i, p);
+/* ---- extension kinds (kind.h) ----------------------------------------- */
+
+static inline double ext(const oc_program *P, uint32_t i, const oc_op *o,
+                         oc_vec3 p, oc_vec3 *g) {
+  const oc_pext *x = &P->ext[o->ext];
+  oc_kctx k = {P->par + o->par, x->data, P->T, o->lip, P, i, 0};
+  return x->def->eval(&k, p, g);
+}
+
+double oc_child_eval(const oc_kctx *k, size_t i, oc_vec3 p, oc_vec3 *g) {
+  const oc_program *P = k->P_;
+  uint32_t c = P->kids[P->ops[k->op_].kid + i];
+  return g ? evg(P, c, p, g) : ev(P, c, p);
 }
 
 static inline int in_op_box(const oc_op *o, oc_vec3 p) {
@@ -133,6 +141,9 @@ static double perturb(const oc_op *o, const double *par, oc_vec3 p) {
   double v;
   perturb_at(o, par, p, &v, NULL);
   return v;
+}
+static double perturb_fd(const void *o, const void *P, oc_vec3 p) {
+  return perturb(o, ((const oc_program *)P)->par + ((const oc_op *)o)->par, p);
 }
 
 /* ---- groups ------------------------------------------------------------ */
@@ -393,14 +404,8 @@ static double ev(const oc_program *P, uint32_t i, oc_vec3 p) {
     return ev(P, P->kids[o->kid], affine(par + OC_P_INV, p));
   case OC_K_PERTURB:
     return perturb(o, par, p);
-  case OC_K_TERRAIN:
-    return oc_terrain_eval(P->terr[o->kid], par, p, NULL);
-  case OC_K_STRATA:
-  case OC_K_CLAMP:
-  case OC_K_TAPER:
-  case OC_K_FAULT:
-  case OC_K_EROSION:
-    return oc_geo_eval(P, o, p, NULL, ev_kid);
+  case OC_K_EXT:
+    return ext(P, i, o, p, NULL);
   default:
     return prim((oc_kind)o->kind, par, p, NULL);
   }
@@ -477,25 +482,11 @@ static double evg(const oc_program *P, uint32_t i, oc_vec3 p, oc_vec3 *g) {
     ** takes central differences. */
     double v;
     if (perturb_at(o, par, p, &v, g)) return v;
-    double h = 1e-6 * fmax(par[OC_P_R], 1e-3);
-    v = perturb(o, par, p);
-    double gx = perturb(o, par, oc_v3(p.x + h, p.y, p.z)) -
-                perturb(o, par, oc_v3(p.x - h, p.y, p.z));
-    double gy = perturb(o, par, oc_v3(p.x, p.y + h, p.z)) -
-                perturb(o, par, oc_v3(p.x, p.y - h, p.z));
-    double gz = perturb(o, par, oc_v3(p.x, p.y, p.z + h)) -
-                perturb(o, par, oc_v3(p.x, p.y, p.z - h));
-    *g = oc_mul(oc_v3(gx, gy, gz), 0.5 / h);
-    return v;
+    return oc_fd_gradient(perturb_fd, o, P, p, 1e-6 * fmax(par[OC_P_R], 1e-3),
+                          g);
   }
-  case OC_K_TERRAIN:
-    return oc_terrain_eval(P->terr[o->kid], par, p, g);
-  case OC_K_STRATA:
-  case OC_K_CLAMP:
-  case OC_K_TAPER:
-  case OC_K_FAULT:
-  case OC_K_EROSION:
-    return oc_geo_eval(P, o, p, g, ev_kid);
+  case OC_K_EXT:
+    return ext(P, i, o, p, g);
   default:
     return prim((oc_kind)o->kind, par, p, g);
   }

@@ -8,22 +8,27 @@
 #include "core/error.h"
 #include "core/vec.h"
 #include "field/node.h"
-#include "terrain/terrain.h"
 
-static const char *const kind_names[OC_K_COUNT] = {
-    "point",      "sphere",       "box",
-    "segment",    "curve",        "cone",
-    "plane",      "turbulence",   "terrain",
-    "blend",      "union",        "intersection",
-    "difference", "smooth_union", "smooth_intersection",
-    "scale",      "warp",         "transform",
-    "perturb",
+#define OC_KIND_NAME(id, name, flags) name,
+#define OC_KIND_FLAGS(id, name, flags) flags,
+static const char *const kind_names[OC_K_COUNT] = {OC_CORE_KINDS(OC_KIND_NAME)};
+static const unsigned char kind_flags[OC_K_COUNT] = {
+    OC_CORE_KINDS(OC_KIND_FLAGS)};
+#undef OC_KIND_NAME
+#undef OC_KIND_FLAGS
 
-    "strata",     "clamp",        "taper",
-    "fault",      "erosion"};
+_Static_assert(OC_NPAR >= OC_KIND_NODE_MAXPAR,
+               "a node's par holds an extension node's parameters");
 
 const char *oc_kind_name(oc_kind kind) {
   return (unsigned)kind < OC_K_COUNT ? kind_names[kind] : "?";
+}
+unsigned oc_kind_flags(oc_kind kind) {
+  return (unsigned)kind < OC_K_COUNT ? kind_flags[kind] : 0;
+}
+int oc_node_is_prim(const oc_node *n) {
+  unsigned f = n->kind == OC_K_EXT ? n->def->flags : kind_flags[n->kind];
+  return (f & OC_KF_PRIM) != 0;
 }
 
 oc_node *oc_node_alloc(oc_kind kind, oc_node *const *kids, size_t nkids,
@@ -60,7 +65,7 @@ void oc_node_retain(oc_node *node) {
 static void free_one(oc_node *n) {
   if (n->kids != n->inl) free(n->kids);
   free(n->pts);
-  oc_tdata_free(n->terrain);
+  if (n->def && n->def->release) n->def->release(n->data);
   free(n);
 }
 
@@ -97,7 +102,34 @@ void oc_node_release(oc_node *node) {
 }
 
 const char *oc_node_kind(const oc_node *node) {
-  return node ? oc_kind_name(node->kind) : "?";
+  if (!node) return "?";
+  return node->kind == OC_K_EXT ? node->def->name : oc_kind_name(node->kind);
+}
+
+oc_node *oc_kind_node(const oc_kind_def *def, oc_node *const *kids,
+                      size_t nkids, const double *npar, size_t nnpar,
+                      void *data, oc_error *err) {
+  oc_node *n = NULL;
+  if (nnpar > OC_KIND_NODE_MAXPAR)
+    oc_seterr(err, OC_EINVAL, "%s: %zu parameters, more than %d", def->name,
+              nnpar, OC_KIND_NODE_MAXPAR);
+  else
+    n = oc_node_alloc(OC_K_EXT, kids, nkids, err);
+  if (!n) {
+    if (def->release) def->release(data);
+    return NULL;
+  }
+  n->def = def;
+  n->data = data;
+  n->nnpar = nnpar;
+  if (nnpar) memcpy(n->par, npar, nnpar * sizeof *npar);
+  return n;
+}
+const oc_kind_def *oc_node_def(const oc_node *n) {
+  return n->kind == OC_K_EXT ? n->def : NULL;
+}
+const void *oc_node_data(const oc_node *n) {
+  return n->kind == OC_K_EXT ? n->data : NULL;
 }
 size_t oc_node_child_count(const oc_node *node) {
   return node ? node->nkids : 0;
@@ -260,7 +292,7 @@ oc_node *oc_perturb(oc_node *prim, const oc_noise *noise, oc_error *err) {
         err, OC_EINVAL,
         "the node to perturb must be a point, sphere, box, segment, curve "
         "or cone primitive (got %s)",
-        oc_kind_name(prim->kind));
+        oc_node_kind(prim));
     return NULL;
   }
   double R = prim->par[OC_P_R];

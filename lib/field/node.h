@@ -7,42 +7,45 @@
 #ifndef OC_NODE_H
 #define OC_NODE_H
 
-#include "outcrop.h"
+#include "field/kind.h"
+
+/* The core kinds, in one list: enum constant, name (what oc_node_kind
+** answers) and flags. Every other kind is an extension (kind.h). */
+#define OC_KF_DIST 8u /* E g(d / R), d the distance to a skeleton or solid */
+#define OC_CORE_KINDS(X)                                                       \
+  /* primitives */                                                             \
+  X(POINT, "point", OC_KF_PRIM | OC_KF_DIST)                                   \
+  X(SPHERE, "sphere", OC_KF_PRIM | OC_KF_DIST)                                 \
+  X(BOX, "box", OC_KF_PRIM | OC_KF_DIST)                                       \
+  X(SEGMENT, "segment", OC_KF_PRIM | OC_KF_DIST)                               \
+  X(CURVE, "curve", OC_KF_PRIM | OC_KF_DIST)                                   \
+  X(CONE, "cone", OC_KF_PRIM | OC_KF_DIST)                                     \
+  X(PLANE, "plane", OC_KF_PRIM | OC_KF_DIST | OC_KF_HFLIKE)                    \
+  X(TURB, "turbulence", OC_KF_PRIM) /* offset + A t(p / wavelength) */         \
+  /* operators */                                                              \
+  X(BLEND, "blend", 0)                                                         \
+  X(UNION, "union", 0)                                                         \
+  X(INTER, "intersection", 0)                                                  \
+  X(DIFF, "difference", 0)                                                     \
+  X(SUNION, "smooth_union", 0)                                                 \
+  X(SINTER, "smooth_intersection", 0)                                          \
+  X(SCALE, "scale", 0)                                                         \
+  X(WARP, "warp", 0)                                                           \
+  X(XFORM, "transform", 0)                                                     \
+  X(PERTURB, "perturb", 0)                                                     \
+  /* every kind of kind.h: the node's table answers */                         \
+  X(EXT, "extension", 0)
 
 typedef enum oc_kind {
-  /* primitives: f = E g(d / R), d the distance to a skeleton or solid */
-  OC_K_POINT,
-  OC_K_SPHERE,
-  OC_K_BOX,
-  OC_K_SEGMENT,
-  OC_K_CURVE,
-  OC_K_CONE,
-  OC_K_PLANE,
-  OC_K_TURB,    /* offset + A t(p / wavelength) */
-  OC_K_TERRAIN, /* implicitized elevation (terrain.c) */
-  /* operators */
-  OC_K_BLEND,
-  OC_K_UNION,
-  OC_K_INTER,
-  OC_K_DIFF,
-  OC_K_SUNION,
-  OC_K_SINTER,
-  OC_K_SCALE,
-  OC_K_WARP,
-  OC_K_XFORM,
-  OC_K_PERTURB,
-  /* geology and erosion (geology/geology.c, geology/erosion.c) */
-  OC_K_STRATA,  /* primitive: offset + A t(p_z / wavelength) / tmax */
-  OC_K_CLAMP,   /* clamp(f, lo, hi) */
-  OC_K_TAPER,   /* strata compressed along an axis */
-  OC_K_FAULT,   /* child translated strictly inside a domain */
-  OC_K_EROSION, /* max(f - f_D (1 - rho), min(f, 0)) */
-  OC_K_COUNT
+#define OC_KIND_ENUM(id, name, flags) OC_K_##id,
+  OC_CORE_KINDS(OC_KIND_ENUM)
+#undef OC_KIND_ENUM
+      OC_K_COUNT
 } oc_kind;
 
-/* Skeletal/volumetric primitives whose field is E g(d / R). */
-#define OC_KIND_IS_DIST(k) ((k) <= OC_K_PLANE)
-#define OC_KIND_IS_PRIM(k) ((k) <= OC_K_TERRAIN || (k) == OC_K_STRATA)
+/* OC_KF_* flags of a core kind (kind.h, and OC_KF_DIST above). */
+unsigned oc_kind_flags(oc_kind kind);
+#define OC_KIND_IS_DIST(k) ((oc_kind_flags(k) & OC_KF_DIST) != 0)
 
 /* Parameter slots in oc_node.par, by kind. Every distance primitive has
 ** E at 0 and R (falloff radius) at 1. */
@@ -81,7 +84,9 @@ struct oc_node {
   oc_vec3 *pts;   /* curve: the polyline (Beziers already flattened) */
   size_t npts;
   oc_node *inl[2]; /* small inline child storage to avoid an allocation */
-  struct oc_tdata *terrain; /* terrain: source, prism, mask distances */
+  const oc_kind_def *def; /* OC_K_EXT: the kind's table, and its data */
+  void *data;             /* (owned: def->release frees it) */
+  size_t nnpar;           /* OC_K_EXT: parameters given in par */
 };
 
 /* Allocates a node with refs = 1 and room for nkids children (retained
@@ -89,12 +94,7 @@ struct oc_node {
 oc_node *oc_node_alloc(oc_kind kind, oc_node *const *kids, size_t nkids,
                        oc_error *err);
 const char *oc_kind_name(oc_kind kind);
-
-/* Parameter checks shared by constructors; they fill err and return 0 on
-** failure. `what` is the parameter name as Lua spells it. */
-int oc_check_positive(double v, const char *what, oc_error *err);
-int oc_check_finite(double v, const char *what, oc_error *err);
-int oc_check_vec(oc_vec3 v, const char *what, oc_error *err);
-int oc_check_noise(const oc_noise *n, oc_error *err);
+/* 1 when n counts as a primitive in program stats. */
+int oc_node_is_prim(const oc_node *n);
 
 #endif

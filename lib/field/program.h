@@ -39,13 +39,22 @@ typedef struct oc_op {
   uint32_t par;  /* first parameter in prog->par */
   uint32_t kid;  /* first child in prog->kids */
   uint32_t nkid; /* groups: unbounded children, always evaluated */
-  uint32_t ent;  /* groups: first entry */
+  union {
+    uint32_t ent; /* groups: first entry */
+    uint32_t ext; /* OC_K_EXT: its index in prog->ext */
+  };
   uint32_t nent;
   uint32_t bvh;       /* groups: BVH root, or OC_NONE */
   uint32_t ntotal;    /* groups: number of children in all */
   float lo[3], hi[3]; /* support box, rounded outwards */
   double lip;         /* global Lipschitz bound of this op */
 } oc_op;
+
+/* An extension op's kind (kind.h) and its node's data. */
+typedef struct oc_pext {
+  const oc_kind_def *def;
+  const void *data;
+} oc_pext;
 
 struct oc_program {
   oc_op *ops;
@@ -58,13 +67,14 @@ struct oc_program {
   size_t nent;
   oc_bvhnode *bvh;
   size_t nbvh;
-  const struct oc_tdata **terr; /* terrain ops' data (op.kid indexes it;
-                                ** owned by the retained nodes) */
-  size_t nterr;
+  oc_pext *ext; /* the extension ops' tables and data (op.ext indexes
+                ** it; the data is owned by the retained nodes) */
+  size_t next;
   double T;
   oc_aabb bounds;
   double lip;
-  /* ops whose field jumps across a surface (an open terrain's sides):
+  /* ops whose field jumps across a surface (an open terrain's sides, the
+  ** `jump` of kind.h):
   ** their lip, and so P->lip, hold only off the jump, where
   ** oc_op_lipschitz_in and oc_ray_dbound answer INFINITY instead */
   uint32_t njump;
@@ -86,6 +96,12 @@ int oc_op_zero_in(const oc_program *P, uint32_t op, const oc_aabb *b);
 /* The largest distance from its skeleton at which a perturb op is non-zero
 ** (eval.c). */
 double oc_perturb_reach(const oc_op *o, const double *par);
+
+/* f(p) and, in *g, its gradient by central differences of step h, for
+** f(a, b, .) (kinds without an analytic gradient). */
+double oc_fd_gradient(double (*f)(const void *a, const void *b, oc_vec3 p),
+                      const void *a, const void *b, oc_vec3 p, double h,
+                      oc_vec3 *g);
 
 /* Float box rounded outwards so that it contains the double box. */
 void oc_box_to_float(oc_aabb b, float lo[3], float hi[3]);

@@ -12,17 +12,16 @@
 #include "core/spanset.h"
 #include "core/noise.h"
 #include "core/vec.h"
-#include "geology/geology.h"
 #include "field/prim.h"
 #include "field/program.h"
-#include "terrain/terrain.h"
+#include "field/query.h"
 
 #define SPAN_CAP 64
 #define BVH_STACK 64
 
 /* ---- span sets ---------------------------------------------------------- */
 
-typedef struct spans {
+typedef struct oc_colq {
   oc_zspan s[SPAN_CAP];
   int n;
   /* when wz, terrains keep theirs apart: where they may vary (t), and
@@ -57,9 +56,29 @@ static void span_add_z(void *v, double lo, double hi) {
   if (!S->all && lo <= hi) oc_spanset_add(S->z, &S->nz, SPAN_CAP, lo, hi);
 }
 
-typedef struct foot {
-  double x0, y0, x1, y1;
-} foot;
+/* kind.h's names for them */
+void oc_col_add(void *q, double lo, double hi) {
+  span_add(q, lo, hi);
+}
+void oc_col_add_xy(void *q, double lo, double hi) {
+  spans *S = q;
+  if (S->wz)
+    span_add_t(S, lo, hi);
+  else
+    span_add(S, lo, hi);
+}
+void oc_col_add_z(void *q, double lo, double hi) {
+  spans *S = q;
+  if (S->wz) span_add_z(S, lo, hi);
+}
+int oc_col_wants_z(const oc_colq *q) {
+  return q->wz;
+}
+void oc_col_whole(oc_colq *q) {
+  q->all = 1;
+}
+
+typedef oc_foot foot;
 
 /* Squared distance from (x, y) to the footprint rectangle. */
 static double foot_d2(const foot *f, double x, double y) {
@@ -167,6 +186,14 @@ static int column_preserving(const double *m) {
   return m[2] == 0 && m[6] == 0 && m[8] == 0 && m[9] == 0 && m[10] != 0;
 }
 
+/* The z-range of the op's support box: where any op may vary. */
+static void box_spans(const oc_op *o, spans *S) {
+  if (isinf(o->lo[2]) || isinf(o->hi[2]))
+    S->all = 1;
+  else
+    span_add(S, o->lo[2], o->hi[2]);
+}
+
 static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
                      int depth, int direct) {
   const oc_op *o = &P->ops[i];
@@ -183,32 +210,17 @@ static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
     plane_spans(par, f, S);
     if (direct) S->hf = i;
     return;
-  case OC_K_TERRAIN: {
-    const oc_tdata *t = P->terr[o->kid];
-    if (oc_terrain_spans(t, par, f->x0, f->y0, f->x1, f->y1, 0,
-                         S->wz ? span_add_t : span_add_v, S) &&
-        direct)
-      S->hf = i;
-    if (S->wz)
-      oc_terrain_spans(t, par, f->x0, f->y0, f->x1, f->y1, 1, span_add_z, S);
-    return;
-  }
   case OC_K_TURB:
     S->all = 1;
     return;
-  case OC_K_STRATA:
-  case OC_K_CLAMP:
-  case OC_K_TAPER:
-  case OC_K_FAULT:
-  case OC_K_EROSION: { /* geology/geology.c */
-    double zlo, zhi;
-    int r = oc_geo_column(P, o, f->x0, f->y0, f->x1, f->y1, &zlo, &zhi);
-    if (r < 0) {
-      S->all = 1;
+  case OC_K_EXT: {
+    const oc_pext *x = &P->ext[o->ext];
+    if (!x->def->column) {
+      box_spans(o, S);
       return;
     }
-    if (r > 0) span_add(S, zlo, zhi);
-    op_spans(P, P->kids[o->kid], f, S, depth + 1, 0);
+    oc_kctx k = {par, x->data, P->T, o->lip, P, i, depth};
+    if (x->def->column(&k, f, S) && direct) S->hf = i;
     return;
   }
   case OC_K_BLEND:
@@ -294,12 +306,14 @@ static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
     return;
   }
   default: /* bounded primitives and perturb: their support box */
-    if (isinf(o->lo[2]) || isinf(o->hi[2]))
-      S->all = 1;
-    else
-      span_add(S, o->lo[2], o->hi[2]);
+    box_spans(o, S);
     return;
   }
+}
+
+void oc_child_spans(const oc_kctx *k, size_t i, const oc_foot *f, oc_colq *q) {
+  const oc_program *P = k->P_;
+  op_spans(P, P->kids[P->ops[k->op_].kid + i], f, q, k->depth_ + 1, 0);
 }
 
 /* Closes the smallest gaps of set s (n spans) until at most max remain,
@@ -382,10 +396,17 @@ static double box_far2(const oc_aabb *b, double x, double y, double z) {
 static double op_lip(const oc_program *P, uint32_t i, const oc_aabb *b,
                      int depth);
 
-/* A child's bound, for the geology kinds; ud is the depth. */
-static double geo_lip(const oc_program *P, uint32_t i, const oc_aabb *b,
-                      void *ud) {
-  return op_lip(P, i, b, *(const int *)ud + 1);
+static int op_zero(const oc_program *P, uint32_t i, const oc_aabb *b,
+                   int depth);
+
+double oc_child_lipschitz_in(const oc_kctx *k, size_t i, const oc_aabb *b) {
+  const oc_program *P = k->P_;
+  return op_lip(P, P->kids[P->ops[k->op_].kid + i], b, k->depth_ + 1);
+}
+int oc_child_zero_in(const oc_kctx *k, size_t i, const oc_aabb *b) {
+  const oc_program *P = k->P_;
+  return oc_aabb_is_empty(*b) ||
+         op_zero(P, P->kids[P->ops[k->op_].kid + i], b, k->depth_ + 1);
 }
 
 static double op_lip(const oc_program *P, uint32_t i, const oc_aabb *b,
@@ -470,16 +491,12 @@ static double op_lip(const oc_program *P, uint32_t i, const oc_aabb *b,
     if (r > 0 && box_far2(b, cx, cy, cz) < r * r * (1 - 1e-9)) return 0;
     return o->lip;
   }
-  case OC_K_TERRAIN: {
-    /* infinite across the sides of open edges, where f jumps: the global
-    ** bound holds only off them */
-    double l = oc_terrain_lipschitz_in(P->terr[o->kid], par, b);
-    return isinf(l) ? l : fmin(l, o->lip);
+  case OC_K_EXT: {
+    const oc_pext *x = &P->ext[o->ext];
+    if (!x->def->lipschitz_in) return o->lip;
+    oc_kctx k = {par, x->data, P->T, o->lip, P, i, depth};
+    return x->def->lipschitz_in(&k, b);
   }
-  case OC_K_CLAMP:
-  case OC_K_FAULT:
-  case OC_K_EROSION:
-    return oc_geo_lipschitz_in(P, o, b, geo_lip, &depth);
   default: /* primitives, perturb, warp, smooth operators: their bound */
     return o->lip;
   }
@@ -492,9 +509,14 @@ static int op_zero(const oc_program *P, uint32_t i, const oc_aabb *b,
                    int depth) {
   const oc_op *o = &P->ops[i];
   if (!box_meets(o->lo, o->hi, b)) return 1;
-  if (depth > OC_MAX_DEPTH + 8 ||
-      (o->kind != OC_K_BLEND && o->kind != OC_K_UNION))
-    return 0;
+  if (depth > OC_MAX_DEPTH + 8) return 0;
+  if (o->kind == OC_K_EXT) {
+    const oc_pext *x = &P->ext[o->ext];
+    if (!x->def->zero_in) return 0;
+    oc_kctx k = {P->par + o->par, x->data, P->T, o->lip, P, i, depth};
+    return x->def->zero_in(&k, b);
+  }
+  if (o->kind != OC_K_BLEND && o->kind != OC_K_UNION) return 0;
   for (uint32_t k = 0; k < o->nkid; k++)
     if (!op_zero(P, P->kids[o->kid + k], b, depth + 1)) return 0;
   if (!o->nent) return 1;

@@ -15,11 +15,24 @@
 
 /* ---- constructors ------------------------------------------------------ */
 
+static const oc_kind_def strata_kind, clamp_kind, taper_kind, fault_kind;
+
+/* Turbulence parameters: wavelength, amplitude, offset, octaves, seed (as
+** two 32-bit halves so it survives a double). */
+static void pack_noise(const oc_noise *nz, double *v) {
+  v[0] = nz->wavelength;
+  v[1] = nz->amplitude;
+  v[2] = nz->offset;
+  v[3] = (double)nz->octaves;
+  v[4] = (double)(nz->seed >> 32);
+  v[5] = (double)(nz->seed & 0xffffffffu);
+}
+
 oc_node *oc_strata(const oc_noise *noise, oc_error *err) {
+  double par[OC_GP_NNOISE];
   if (!oc_check_noise(noise, err)) return NULL;
-  oc_node *n = oc_node_alloc(OC_K_STRATA, NULL, 0, err);
-  if (n) n->noise = *noise;
-  return n;
+  pack_noise(noise, par);
+  return oc_kind_node(&strata_kind, NULL, 0, par, OC_GP_NNOISE, NULL, err);
 }
 
 oc_node *oc_clamp(oc_node *child, double lo, double hi, oc_error *err) {
@@ -34,12 +47,8 @@ oc_node *oc_clamp(oc_node *child, double lo, double hi, oc_error *err) {
               hi);
     return NULL;
   }
-  oc_node *n = oc_node_alloc(OC_K_CLAMP, &child, 1, err);
-  if (n) {
-    n->par[OC_GP_LO] = lo;
-    n->par[OC_GP_HI] = hi;
-  }
-  return n;
+  double par[2] = {lo, hi};
+  return oc_kind_node(&clamp_kind, &child, 1, par, 2, NULL, err);
 }
 
 static int unit(oc_vec3 v, const char *what, oc_vec3 *out, oc_error *err) {
@@ -77,16 +86,15 @@ oc_node *oc_taper(oc_node *child, const oc_taper_params *tp, oc_error *err) {
     oc_seterr(err, OC_EINVAL, "'to' must differ from 'from' (both %g)", tp->to);
     return NULL;
   }
-  oc_node *n = oc_node_alloc(OC_K_TAPER, &child, 1, err);
-  if (!n) return NULL;
-  put3(n->par + OC_GP_TO, tp->origin);
-  put3(n->par + OC_GP_TA, a);
-  put3(n->par + OC_GP_TB, b);
-  n->par[OC_GP_U0] = tp->from;
-  n->par[OC_GP_U1] = tp->to;
-  n->par[OC_GP_K] = tp->factor;
-  n->par[OC_GP_H] = tp->height;
-  return n;
+  double par[OC_GP_H + 1];
+  put3(par + OC_GP_TO, tp->origin);
+  put3(par + OC_GP_TA, a);
+  put3(par + OC_GP_TB, b);
+  par[OC_GP_U0] = tp->from;
+  par[OC_GP_U1] = tp->to;
+  par[OC_GP_K] = tp->factor;
+  par[OC_GP_H] = tp->height;
+  return oc_kind_node(&taper_kind, &child, 1, par, OC_GP_H + 1, NULL, err);
 }
 
 oc_node *oc_fault(oc_node *child, const oc_fault_domain *dom, oc_vec3 offset,
@@ -134,11 +142,8 @@ oc_node *oc_fault(oc_node *child, const oc_fault_domain *dom, oc_vec3 offset,
     oc_seterr(err, OC_EINVAL, "unknown fault domain kind %d", (int)dom->kind);
     return NULL;
   }
-  oc_node *n = oc_node_alloc(OC_K_FAULT, kids, kids[1] ? 2 : 1, err);
-  if (n)
-    for (int i = 0; i < OC_GP_COUNT; i++)
-      n->par[i] = par[i];
-  return n;
+  return oc_kind_node(&fault_kind, kids, kids[1] ? 2 : 1, par, OC_GP_COUNT,
+                      NULL, err);
 }
 
 oc_node *oc_geology_layer(oc_vec3 origin, oc_vec3 normal, double radius,
@@ -177,13 +182,11 @@ oc_node *oc_geology_layer(oc_vec3 origin, oc_vec3 normal, double radius,
 
 /* ---- compilation ------------------------------------------------------- */
 
-static void pack_noise(const oc_noise *nz, double *v) {
-  v[0] = nz->wavelength;
-  v[1] = nz->amplitude;
-  v[2] = nz->offset;
-  v[3] = (double)nz->octaves;
-  v[4] = (double)(nz->seed >> 32);
-  v[5] = (double)(nz->seed & 0xffffffffu);
+/* The node's parameters, unchanged by T, are the op's. */
+static void copy_par(oc_kcompile *c) {
+  for (size_t i = 0; i < c->node_npar; i++)
+    c->par[i] = c->node_par[i];
+  c->npar = c->node_npar;
 }
 
 static oc_aabb shifted(oc_aabb b, oc_vec3 d) {
@@ -192,8 +195,48 @@ static oc_aabb shifted(oc_aabb b, oc_vec3 d) {
   return r;
 }
 
+static int strata_compile(oc_kcompile *c, oc_error *err) {
+  const double *v = c->node_par;
+  double wl = v[0], A = v[1], off = v[2];
+  int oct = (int)v[3];
+  (void)err;
+  copy_par(c);
+  c->info.box = oc_aabb_all();
+  c->info.lo = off + fmin(0, A);
+  c->info.hi = off + fmax(0, A);
+  c->info.lip = fabs(A) / oc_turb3_max(oct) * oc_turb3_lipschitz(oct) / wl;
+  return OC_OK;
+}
+
+static int clamp_compile(oc_kcompile *c, oc_error *err) {
+  const oc_kinfo *C = c->kid;
+  double lo = c->node_par[OC_GP_LO], hi = c->node_par[OC_GP_HI];
+  (void)err;
+  copy_par(c);
+  c->info.box = lo <= 0 && hi >= 0 ? C->box : oc_aabb_all();
+  c->info.lo = fmin(fmax(C->lo, lo), hi);
+  c->info.hi = fmin(fmax(C->hi, lo), hi);
+  c->info.lip = C->lip;
+  return OC_OK;
+}
+
+static int taper_compile(oc_kcompile *c, oc_error *err) {
+  const oc_kinfo *C = c->kid;
+  const double *n = c->node_par;
+  double K = n[OC_GP_K], H = n[OC_GP_H];
+  double du = fabs(n[OC_GP_U1] - n[OC_GP_U0]);
+  (void)err;
+  copy_par(c);
+  /* the displacement is at most |K - 1| H along the axis */
+  c->info.box = oc_aabb_grow(C->box, fabs(K - 1) * H);
+  c->info.lo = C->lo;
+  c->info.hi = C->hi;
+  c->info.lip = C->lip * (fmax(1, K) + 1.5 * H * fabs(K - 1) / du);
+  return OC_OK;
+}
+
 /* Where a fault's domain may hold points (the node's: its support). */
-static oc_aabb fault_domain_box(const double *par, const oc_geo_info *kids) {
+static oc_aabb fault_domain_box(const double *par, const oc_kinfo *kids) {
   switch ((int)par[OC_GP_DOM]) {
   case OC_FAULT_BOX: {
     oc_aabb b = {get3(par + OC_GP_DA), get3(par + OC_GP_DB)};
@@ -206,78 +249,42 @@ static oc_aabb fault_domain_box(const double *par, const oc_geo_info *kids) {
   }
 }
 
-size_t oc_geo_compile(const oc_node *n, double T, const oc_geo_info *kids,
-                      double *par, oc_geo_info *out) {
-  const oc_geo_info *C = kids;
-  (void)T;
-  switch (n->kind) {
-  case OC_K_STRATA: {
-    const oc_noise *nz = &n->noise;
-    double tmax = oc_turb3_max(nz->octaves), A = nz->amplitude;
-    pack_noise(nz, par);
-    out->box = oc_aabb_all();
-    out->lo = nz->offset + fmin(0, A);
-    out->hi = nz->offset + fmax(0, A);
-    out->lip =
-        fabs(A) / tmax * oc_turb3_lipschitz(nz->octaves) / nz->wavelength;
-    return 6;
-  }
-  case OC_K_CLAMP: {
-    double lo = n->par[OC_GP_LO], hi = n->par[OC_GP_HI];
-    par[OC_GP_LO] = lo;
-    par[OC_GP_HI] = hi;
-    out->box = lo <= 0 && hi >= 0 ? C->box : oc_aabb_all();
-    out->lo = fmin(fmax(C->lo, lo), hi);
-    out->hi = fmin(fmax(C->hi, lo), hi);
-    out->lip = C->lip;
-    return 2;
-  }
-  case OC_K_TAPER: {
-    for (int i = 0; i <= OC_GP_H; i++)
-      par[i] = n->par[i];
-    double K = n->par[OC_GP_K], H = n->par[OC_GP_H];
-    double du = fabs(n->par[OC_GP_U1] - n->par[OC_GP_U0]);
-    /* the displacement is at most |K - 1| H along the axis */
-    out->box = oc_aabb_grow(C->box, fabs(K - 1) * H);
-    out->lo = C->lo;
-    out->hi = C->hi;
-    out->lip = C->lip * (fmax(1, K) + 1.5 * H * fabs(K - 1) / du);
-    return OC_GP_H + 1;
-  }
-  case OC_K_FAULT: {
-    for (int i = 0; i < OC_GP_COUNT; i++)
-      par[i] = n->par[i];
-    oc_aabb moved = shifted(C->box, get3(par + OC_GP_OFF));
-    out->box = oc_aabb_union(C->box,
-                             oc_aabb_inter(moved, fault_domain_box(par, kids)));
-    out->lo = C->lo;
-    out->hi = C->hi;
-    out->lip = C->lip > 0 ? INFINITY : 0;
-    return OC_GP_COUNT;
-  }
-  case OC_K_EROSION:
-    return oc_erosion_compile(n, kids, par, out);
-  default:
-    out->box = oc_aabb_all();
-    out->lo = -INFINITY;
-    out->hi = INFINITY;
-    out->lip = INFINITY;
-    return 0;
-  }
+static int fault_compile(oc_kcompile *c, oc_error *err) {
+  const oc_kinfo *C = c->kid;
+  (void)err;
+  copy_par(c);
+  oc_aabb moved = shifted(C->box, get3(c->par + OC_GP_OFF));
+  c->info.box = oc_aabb_union(
+      C->box, oc_aabb_inter(moved, fault_domain_box(c->par, c->kid)));
+  c->info.lo = C->lo;
+  c->info.hi = C->hi;
+  c->info.lip = C->lip > 0 ? INFINITY : 0;
+  return OC_OK;
 }
 
 /* ---- evaluation -------------------------------------------------------- */
 
-static double strata(const double *par, oc_vec3 p, oc_vec3 *g) {
+static double strata_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
+  const double *par = k->par;
   double wl = par[0], A = par[1], off = par[2];
   int oct = (int)par[3];
   uint64_t seed = ((uint64_t)par[4] << 32) | (uint64_t)par[5];
-  double k = A / oc_turb3_max(oct);
+  double kk = A / oc_turb3_max(oct);
   oc_vec3 gt;
   double t = oc_turb3(seed, oct, oc_v3(OC_STRATA_X, OC_STRATA_Y, p.z / wl),
                       g ? &gt : 0);
-  if (g) *g = oc_v3(0, 0, k * gt.z / wl);
-  return off + k * t;
+  if (g) *g = oc_v3(0, 0, kk * gt.z / wl);
+  return off + kk * t;
+}
+
+static double clamp_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
+  const double *par = k->par;
+  double v = oc_child_eval(k, 0, p, g);
+  if (v <= par[OC_GP_LO] || v >= par[OC_GP_HI]) {
+    if (g) *g = oc_v3(0, 0, 0);
+    return v <= par[OC_GP_LO] ? par[OC_GP_LO] : par[OC_GP_HI];
+  }
+  return v; /* NaN falls through unchanged */
 }
 
 /* k(u) = 1 + (K - 1) s(r), r = (u - u0) / (u1 - u0) clamped to [0, 1], s
@@ -293,26 +300,25 @@ static double taper_k(const double *par, double u, double *dk) {
   return 1 + (K - 1) * r * r * (3 - 2 * r);
 }
 
-static double taper(const oc_program *P, const oc_op *o, const double *par,
-                    oc_vec3 p, oc_vec3 *g, oc_geo_kid_fn kid) {
+static double taper_eval(const oc_kctx *kc, oc_vec3 p, oc_vec3 *g) {
+  const double *par = kc->par;
   oc_vec3 d = oc_sub(p, get3(par + OC_GP_TO));
   oc_vec3 a = get3(par + OC_GP_TA), b = get3(par + OC_GP_TB);
   double H = par[OC_GP_H], s = oc_dot(d, a), dk;
   double k = taper_k(par, oc_dot(d, b), &dk);
   double c = s < -H ? -H : s > H ? H : s;
   oc_vec3 q = oc_add(p, oc_mul(a, (k - 1) * c));
-  uint32_t ch = P->kids[o->kid];
-  if (!g) return kid(P, ch, q, NULL);
+  if (!g) return oc_child_eval(kc, 0, q, NULL);
   oc_vec3 gc;
-  double v = kid(P, ch, q, &gc);
+  double v = oc_child_eval(kc, 0, q, &gc);
   /* grad = J^T gc, J = I + (k - 1) c'(s) a a^T + c k'(u) a b^T */
   double ag = oc_dot(a, gc), dc = s > -H && s < H ? 1 : 0;
   *g = oc_add(gc, oc_add(oc_mul(a, (k - 1) * dc * ag), oc_mul(b, c * dk * ag)));
   return v;
 }
 
-static int in_fault(const oc_program *P, const oc_op *o, const double *par,
-                    oc_vec3 p, oc_geo_kid_fn kid) {
+static int in_fault(const oc_kctx *k, oc_vec3 p) {
+  const double *par = k->par;
   switch ((int)par[OC_GP_DOM]) {
   case OC_FAULT_BOX: {
     const double *lo = par + OC_GP_DA, *hi = par + OC_GP_DB;
@@ -322,127 +328,97 @@ static int in_fault(const oc_program *P, const oc_op *o, const double *par,
   case OC_FAULT_HALF:
     return oc_dot(oc_sub(p, get3(par + OC_GP_DA)), get3(par + OC_GP_DB)) < 0;
   default:
-    return kid(P, P->kids[o->kid + 1], p, NULL) > P->T;
+    return oc_child_eval(k, 1, p, NULL) > k->T;
   }
 }
 
-double oc_geo_eval(const oc_program *P, const oc_op *o, oc_vec3 p, oc_vec3 *g,
-                   oc_geo_kid_fn kid) {
-  const double *par = P->par + o->par;
-  switch ((oc_kind)o->kind) {
-  case OC_K_STRATA:
-    return strata(par, p, g);
-  case OC_K_CLAMP: {
-    double v = kid(P, P->kids[o->kid], p, g);
-    if (v <= par[OC_GP_LO] || v >= par[OC_GP_HI]) {
-      if (g) *g = oc_v3(0, 0, 0);
-      return v <= par[OC_GP_LO] ? par[OC_GP_LO] : par[OC_GP_HI];
-    }
-    return v; /* NaN falls through unchanged */
-  }
-  case OC_K_TAPER:
-    return taper(P, o, par, p, g, kid);
-  case OC_K_FAULT: {
-    /* a translation: the gradient is the child's at the moved point */
-    oc_vec3 q =
-        in_fault(P, o, par, p, kid) ? oc_sub(p, get3(par + OC_GP_OFF)) : p;
-    return kid(P, P->kids[o->kid], q, g);
-  }
-  case OC_K_EROSION:
-    return oc_erosion_eval(P, o, p, g, kid);
-  default:
-    if (g) *g = oc_v3(NAN, NAN, NAN);
-    return NAN;
-  }
+/* A translation: the gradient is the child's at the moved point. */
+static double fault_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
+  oc_vec3 q = in_fault(k, p) ? oc_sub(p, get3(k->par + OC_GP_OFF)) : p;
+  return oc_child_eval(k, 0, q, g);
 }
 
 /* ---- local queries ----------------------------------------------------- */
 
-static int foot_meets(const float *lo, const float *hi, double x0, double y0,
-                      double x1, double y1) {
-  return lo[0] <= x1 && hi[0] >= x0 && lo[1] <= y1 && hi[1] >= y0;
+static int foot_meets(oc_aabb b, const oc_foot *f) {
+  return b.lo.x <= f->x1 && b.hi.x >= f->x0 && b.lo.y <= f->y1 &&
+         b.hi.y >= f->y0;
 }
 
-/* z-range of a float box, or -1 when it is unbounded. */
-static int zrange(const float *lo, const float *hi, double *zlo, double *zhi) {
-  if (isinf(lo[2]) || isinf(hi[2])) return -1;
-  *zlo = lo[2];
-  *zhi = hi[2];
-  return 1;
+/* The z-range of box b, or the whole column when it is unbounded. */
+static void zrange(oc_aabb b, oc_colq *q) {
+  if (isinf(b.lo.z) || isinf(b.hi.z))
+    oc_col_whole(q);
+  else
+    oc_col_add(q, b.lo.z, b.hi.z);
 }
 
-int oc_geo_column(const oc_program *P, const oc_op *o, double x0, double y0,
-                  double x1, double y1, double *zlo, double *zhi) {
-  const double *par = P->par + o->par;
-  switch ((oc_kind)o->kind) {
-  case OC_K_CLAMP:
-    return 0; /* constant where the child is */
-  case OC_K_FAULT: {
-    /* inside the domain's z-range anything may happen; outside the
-    ** domain the field is the child's own */
-    float lo[3], hi[3];
-    switch ((int)par[OC_GP_DOM]) {
-    case OC_FAULT_BOX:
-      for (int i = 0; i < 3; i++) {
-        lo[i] = (float)par[OC_GP_DA + i];
-        hi[i] = (float)par[OC_GP_DB + i];
-        /* rounded outwards */
-        if ((double)lo[i] > par[OC_GP_DA + i])
-          lo[i] = nextafterf(lo[i], -INFINITY);
-        if ((double)hi[i] < par[OC_GP_DB + i])
-          hi[i] = nextafterf(hi[i], INFINITY);
-      }
-      break;
-    case OC_FAULT_NODE: {
-      const oc_op *d = &P->ops[P->kids[o->kid + 1]];
-      for (int i = 0; i < 3; i++)
-        lo[i] = d->lo[i], hi[i] = d->hi[i];
-      break;
-    }
-    default: {
-      /* a half-space: nothing to add when the footprint is all outside
-      ** at every z, which needs a horizontal normal */
-      const double *q = par + OC_GP_DA, *n = par + OC_GP_DB;
-      if (n[2] != 0) return -1;
-      double m = fmin(n[0] * (x0 - q[0]), n[0] * (x1 - q[0])) +
-                 fmin(n[1] * (y0 - q[1]), n[1] * (y1 - q[1]));
-      return m >= 0 ? 0 : -1;
-    }
-    }
-    if (!foot_meets(lo, hi, x0, y0, x1, y1)) return 0;
-    return zrange(lo, hi, zlo, zhi);
-  }
-  case OC_K_EROSION: {
-    /* f~ = f wherever f_D = 0 (outside the control's support) or f = 0
-    ** (outside the terrain's) */
-    const oc_op *f = &P->ops[P->kids[o->kid]];
-    float lo[3], hi[3];
-    for (int i = 0; i < 3; i++)
-      lo[i] = f->lo[i], hi[i] = f->hi[i];
-    if (par[OC_GP_HASCTL] != 0) {
-      const oc_op *c = &P->ops[P->kids[o->kid + 2]];
-      for (int i = 0; i < 3; i++) {
-        lo[i] = fmaxf(lo[i], c->lo[i]);
-        hi[i] = fminf(hi[i], c->hi[i]);
-      }
-    }
-    if (!(lo[2] <= hi[2]) || !foot_meets(lo, hi, x0, y0, x1, y1)) return 0;
-    return zrange(lo, hi, zlo, zhi);
-  }
-  default: /* strata and taper vary along every column */
-    return -1;
-  }
+/* Strata and taper vary along every column. */
+static int column_whole(const oc_kctx *k, const oc_foot *f, oc_colq *q) {
+  (void)k, (void)f;
+  oc_col_whole(q);
+  return 0;
 }
 
-static int box_meets(const float *lo, const float *hi, const oc_aabb *b) {
-  return lo[0] <= b->hi.x && hi[0] >= b->lo.x && lo[1] <= b->hi.y &&
-         hi[1] >= b->lo.y && lo[2] <= b->hi.z && hi[2] >= b->lo.z;
+/* Constant where the child is. */
+static int clamp_column(const oc_kctx *k, const oc_foot *f, oc_colq *q) {
+  oc_child_spans(k, 0, f, q);
+  return 0;
+}
+
+/* The domain's box rounded outwards to floats, as every support box. */
+static oc_aabb fault_box(const double *par) {
+  float lo[3], hi[3];
+  for (int i = 0; i < 3; i++) {
+    lo[i] = (float)par[OC_GP_DA + i];
+    hi[i] = (float)par[OC_GP_DB + i];
+    if ((double)lo[i] > par[OC_GP_DA + i]) lo[i] = nextafterf(lo[i], -INFINITY);
+    if ((double)hi[i] < par[OC_GP_DB + i]) hi[i] = nextafterf(hi[i], INFINITY);
+  }
+  oc_aabb b = {oc_v3(lo[0], lo[1], lo[2]), oc_v3(hi[0], hi[1], hi[2])};
+  return b;
+}
+
+/* Inside the domain's z-range anything may happen; outside the domain
+** the field is the child's own. */
+static int fault_column(const oc_kctx *k, const oc_foot *f, oc_colq *q) {
+  const double *par = k->par;
+  oc_aabb d;
+  switch ((int)par[OC_GP_DOM]) {
+  case OC_FAULT_BOX:
+    d = fault_box(par);
+    break;
+  case OC_FAULT_NODE:
+    d = oc_child_box(k, 1);
+    break;
+  default: {
+    /* a half-space: nothing to add when the footprint is all outside at
+    ** every z, which needs a horizontal normal */
+    const double *o = par + OC_GP_DA, *n = par + OC_GP_DB;
+    double m = fmin(n[0] * (f->x0 - o[0]), n[0] * (f->x1 - o[0])) +
+               fmin(n[1] * (f->y0 - o[1]), n[1] * (f->y1 - o[1]));
+    if (n[2] != 0 || m < 0) {
+      oc_col_whole(q);
+      return 0;
+    }
+    oc_child_spans(k, 0, f, q);
+    return 0;
+  }
+  }
+  if (foot_meets(d, f)) zrange(d, q);
+  oc_child_spans(k, 0, f, q);
+  return 0;
+}
+
+static int box_meets(oc_aabb a, const oc_aabb *b) {
+  return a.lo.x <= b->hi.x && a.hi.x >= b->lo.x && a.lo.y <= b->hi.y &&
+         a.hi.y >= b->lo.y && a.lo.z <= b->hi.z && a.hi.z >= b->lo.z;
 }
 
 /* Which side of a fault's boundary box b lies on: 1 inside, 0 outside,
 ** -1 when it may meet the boundary. */
-static int fault_side(const oc_program *P, const oc_op *o, const double *par,
-                      const oc_aabb *b) {
+static int fault_side(const oc_kctx *k, const oc_aabb *b) {
+  const double *par = k->par;
   switch ((int)par[OC_GP_DOM]) {
   case OC_FAULT_BOX: {
     const double *lo = par + OC_GP_DA, *hi = par + OC_GP_DB;
@@ -455,52 +431,62 @@ static int fault_side(const oc_program *P, const oc_op *o, const double *par,
     return -1;
   }
   case OC_FAULT_HALF: {
-    const double *q = par + OC_GP_DA, *n = par + OC_GP_DB;
+    const double *o = par + OC_GP_DA, *n = par + OC_GP_DB;
     double m = 0, M = 0;
     const double *bl = &b->lo.x, *bh = &b->hi.x;
     for (int i = 0; i < 3; i++) {
-      double u = n[i] * (bl[i] - q[i]), v = n[i] * (bh[i] - q[i]);
+      double u = n[i] * (bl[i] - o[i]), v = n[i] * (bh[i] - o[i]);
       m += fmin(u, v);
       M += fmax(u, v);
     }
     return M < 0 ? 1 : m >= 0 ? 0 : -1;
   }
-  default: {
-    const oc_op *d = &P->ops[P->kids[o->kid + 1]];
-    return box_meets(d->lo, d->hi, b) ? -1 : 0;
-  }
+  default:
+    return box_meets(oc_child_box(k, 1), b) ? -1 : 0;
   }
 }
 
-double oc_geo_lipschitz_in(const oc_program *P, const oc_op *o,
-                           const oc_aabb *b, oc_geo_lip_fn lip, void *ud) {
-  const double *par = P->par + o->par;
-  uint32_t ch = P->kids[o->kid];
-  switch ((oc_kind)o->kind) {
-  case OC_K_CLAMP:
-    return lip(P, ch, b, ud);
-  case OC_K_FAULT: {
-    int side = fault_side(P, o, par, b);
-    if (side < 0) return o->lip;
-    if (side == 0) return lip(P, ch, b, ud);
-    oc_aabb m = shifted(*b, oc_mul(get3(par + OC_GP_OFF), -1));
-    return lip(P, ch, &m, ud);
-  }
-  case OC_K_EROSION: {
-    /* where f <= 0 the erosion is f itself: 0 where f's support misses
-    ** the box (as between islands under one erosion) */
-    if (oc_op_zero_in(P, ch, b)) return 0;
-    /* L_f, plus depth (L_control + L_rho) where f_D may be non-zero */
-    double L = lip(P, ch, b, ud);
-    int hasctl = par[OC_GP_HASCTL] != 0;
-    if (hasctl && !box_meets(P->ops[P->kids[o->kid + 2]].lo,
-                             P->ops[P->kids[o->kid + 2]].hi, b))
-      return L;
-    double e = lip(P, P->kids[o->kid + 1], b, ud);
-    if (hasctl) e += lip(P, P->kids[o->kid + 2], b, ud);
-    return fmin(L + par[OC_GP_DEPTH] * e, o->lip);
-  }
-  default:
-    return o->lip;
-  }
+static double clamp_lip_in(const oc_kctx *k, const oc_aabb *b) {
+  return oc_child_lipschitz_in(k, 0, b);
 }
+
+static double fault_lip_in(const oc_kctx *k, const oc_aabb *b) {
+  int side = fault_side(k, b);
+  if (side < 0) return k->lip;
+  if (side == 0) return oc_child_lipschitz_in(k, 0, b);
+  oc_aabb m = shifted(*b, oc_mul(get3(k->par + OC_GP_OFF), -1));
+  return oc_child_lipschitz_in(k, 0, &m);
+}
+
+/* ---- the kinds (field/kind.h) ------------------------------------------ */
+
+static const oc_kind_def strata_kind = {
+    .name = "strata",
+    .flags = OC_KF_PRIM,
+    .compile = strata_compile,
+    .eval = strata_eval,
+    .column = column_whole,
+};
+
+static const oc_kind_def clamp_kind = {
+    .name = "clamp",
+    .compile = clamp_compile,
+    .eval = clamp_eval,
+    .lipschitz_in = clamp_lip_in,
+    .column = clamp_column,
+};
+
+static const oc_kind_def taper_kind = {
+    .name = "taper",
+    .compile = taper_compile,
+    .eval = taper_eval,
+    .column = column_whole,
+};
+
+static const oc_kind_def fault_kind = {
+    .name = "fault",
+    .compile = fault_compile,
+    .eval = fault_eval,
+    .lipschitz_in = fault_lip_in,
+    .column = fault_column,
+};

@@ -16,7 +16,8 @@
 #include <math.h>
 #include <string.h>
 
-#include "field/column.h"
+#include "field/hfsurf.h"
+#include "field/query.h"
 #include "mesh/mcwork.h"
 
 #define MAXSPANS 16

@@ -28,7 +28,8 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "field/column.h"
+#include "field/hfsurf.h"
+#include "field/query.h"
 #include "mesh/mcwork.h"
 
 /* Elevation lookups per horizontal vertex, at most, and the step (in
@@ -36,14 +37,12 @@
 #define NEWTON_STEPS 6
 #define NEWTON_TOL 1e-5
 
-/* Terrains only: a plane costs a dot product to evaluate, and its root
-** is found in one Newton step, so planes keep the root-found vertices
-** (and meshes made before terrains existed stay the same). */
-#define DIRECT(kind) ((kind) == OC_K_TERRAIN)
-#define HFLIKE(kind) ((kind) == OC_K_TERRAIN || (kind) == OC_K_PLANE)
-
+/* Kinds flagged OC_KF_DIRECT only (terrains): a plane costs a dot
+** product to evaluate, and its root is found in one Newton step, so planes
+** keep the root-found vertices (and meshes made before terrains existed
+** stay the same). */
 int oc_mc_direct_kind(const oc_hfsurf *s) {
-  return DIRECT(s->kind);
+  return s->direct;
 }
 
 int oc_mc_surfaces(oc_mcgrid *g, int direct) {
@@ -53,14 +52,14 @@ int oc_mc_surfaces(oc_mcgrid *g, int direct) {
   g->nsurf = 0;
   g->direct = 0;
   for (uint32_t i = 0; i < P->nops; i++)
-    n += HFLIKE(P->ops[i].kind);
+    n += oc_hfsurf_candidate(P, i);
   if (!n) return 0;
   oc_hfsurf *s = malloc(n * sizeof *s);
   if (!s) return -1;
   size_t k = 0;
   for (uint32_t i = 0; i < P->nops; i++)
-    if (HFLIKE(P->ops[i].kind) && oc_hfsurf_init(&s[k], P, i, g->T)) {
-      g->direct += direct && DIRECT(s[k].kind);
+    if (oc_hfsurf_candidate(P, i) && oc_hfsurf_init(&s[k], P, i, g->T)) {
+      g->direct += direct && s[k].direct;
       k++;
     }
   if (!k) {

@@ -20,8 +20,7 @@
 
 #include "core/error.h"
 #include "core/falloff.h"
-#include "field/node.h"
-#include "field/program.h"
+#include "field/kind.h"
 #include "terrain/terrain.h"
 
 /* g(x) = 1/2: where f_P = 2T g crosses T. sqrt(1 - 2^(-1/3)). */
@@ -260,11 +259,12 @@ int oc_terrain_spans(const oc_tdata *t, const double *par, double x0, double y0,
 
 /* ---- empty meshes ------------------------------------------------------ */
 
+static const oc_kind_def terrain_kind;
+
 int oc_terrain_thin_reason(const struct oc_program *P, double size,
                            const char *what, char *buf, size_t n) {
-  for (uint32_t i = 0; i < P->nops; i++) {
-    if (P->ops[i].kind != OC_K_TERRAIN) continue;
-    const oc_tdata *t = P->terr[P->ops[i].kid];
+  size_t it = 0;
+  for (const oc_tdata *t; (t = oc_program_kind_data(P, &terrain_kind, &it));) {
     /* the solid ends at the cap, X_HALF R past [zlo, zhi] on its side:
     ** thinnest under the lowest elevation (over the highest inverted) */
     double lo, hi;
@@ -282,6 +282,74 @@ int oc_terrain_thin_reason(const struct oc_program *P, double size,
   }
   return 0;
 }
+
+/* ---- the kind (field/kind.h) ------------------------------------------ */
+
+/* The data stays with the node; the op holds sigma's constants for its T. */
+static int terrain_compile(oc_kcompile *c, oc_error *err) {
+  const oc_tdata *t = c->data;
+  (void)err;
+  oc_terrain_sigma(c->T, t->W, c->par);
+  c->npar = OC_TPAR_N;
+  c->jump = t->open;
+  c->info.lo = 0;
+  c->info.hi = 2 * c->T;
+  c->info.lip = oc_terrain_lipschitz(t, c->par);
+  c->info.box = oc_terrain_box(t);
+  return OC_OK;
+}
+
+static double terrain_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
+  return oc_terrain_eval(k->data, k->par, p, g);
+}
+
+/* Infinite across the sides of open edges, where f jumps: the global
+** bound holds only off them. */
+static double terrain_lip_in(const oc_kctx *k, const oc_aabb *b) {
+  double l = oc_terrain_lipschitz_in(k->data, k->par, b);
+  return isinf(l) ? l : fmin(l, k->lip);
+}
+
+static int terrain_column(const oc_kctx *k, const oc_foot *f, oc_colq *q) {
+  int wz = oc_col_wants_z(q);
+  int in = oc_terrain_spans(k->data, k->par, f->x0, f->y0, f->x1, f->y1, 0,
+                            wz ? oc_col_add_xy : oc_col_add, q);
+  if (wz)
+    oc_terrain_spans(k->data, k->par, f->x0, f->y0, f->x1, f->y1, 1,
+                     oc_col_add_z, q);
+  return in;
+}
+
+static double terrain_surface_value(const oc_kctx *k, double e, double z) {
+  return oc_terrain_column_value(k->data, k->par, e, z);
+}
+
+/* Its sigma is compiled for one T: no surface for another. */
+static int terrain_surface(const oc_kctx *k, double T, oc_ksurf *s) {
+  const oc_tdata *t = k->data;
+  s->height = t->src.height;
+  s->range = t->src.range;
+  s->ud = t->src.ud;
+  s->value = terrain_surface_value;
+  s->up = t->invert ? -1 : 1;
+  s->cap = oc_terrain_cap_z(t);
+  return T == k->T;
+}
+
+static void terrain_release(void *data) {
+  oc_tdata_free(data);
+}
+
+static const oc_kind_def terrain_kind = {
+    .name = "terrain",
+    .flags = OC_KF_PRIM | OC_KF_HFLIKE | OC_KF_DIRECT,
+    .compile = terrain_compile,
+    .eval = terrain_eval,
+    .lipschitz_in = terrain_lip_in,
+    .column = terrain_column,
+    .surface = terrain_surface,
+    .release = terrain_release,
+};
 
 /* ---- construction ----------------------------------------------------- */
 
@@ -381,15 +449,8 @@ oc_node *oc_terrain(const oc_elevation *src, const oc_terrain_params *tp,
     oc_tdata_free(t);
     return NULL;
   }
-  oc_node *n = oc_node_alloc(OC_K_TERRAIN, NULL, 0, err);
-  if (!n) {
-    oc_tdata_free(t);
-    return NULL;
-  }
   if (src->retain) src->retain(src->ud);
   t->src.retain = src->retain;
   t->src.release = src->release;
-  n->terrain = t;
-  n->par[OC_P_R] = R;
-  return n;
+  return oc_kind_node(&terrain_kind, NULL, 0, NULL, 0, t, err);
 }

@@ -9,7 +9,8 @@
 */
 #include <stdlib.h>
 
-#include "field/column.h"
+#include "field/hfsurf.h"
+#include "field/query.h"
 #include "ocheck.h"
 
 /* A terrain-like scene: a ground plane (optionally tilted), carved and

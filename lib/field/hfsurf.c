@@ -1,9 +1,11 @@
 /*
-** column.c — the surface of a heightfield-like op as an elevation: what
+** hfsurf.c — the surface of a heightfield-like op as an elevation: what
 ** direct elevation extraction reads instead of evaluating the program.
 **
-** Terrain: f = min(sigma(+-(h - z)), f_P(z)) where the mesher uses it, so
-** the surface is z = h (sigma(0) = T) plus the prism's flat cap. Plane:
+** Extension kinds (a terrain) describe theirs through their surface hook
+** (kind.h): for a terrain, f = min(sigma(+-(h - z)), f_P(z)) where the
+** mesher uses it, so the surface is z = h (sigma(0) = T) plus the prism's
+** flat cap. Plane:
 ** f = E g(max(0, d) / R), d = (p - o).n, so f = T at d = R x*,
 ** g(x*) = T / E, which is the elevation e(x, y) = oz + (R x* - nx (x - ox)
 ** - ny (y - oy)) / nz, and d = R x* + nz (z - e) along the column.
@@ -11,20 +13,32 @@
 #include <math.h>
 
 #include "core/falloff.h"
-#include "field/column.h"
-#include "terrain/terrain.h"
+#include "field/hfsurf.h"
+
+int oc_hfsurf_candidate(const oc_program *P, uint32_t op) {
+  const oc_op *o = &P->ops[op];
+  if (o->kind == OC_K_EXT)
+    return (P->ext[o->ext].def->flags & OC_KF_HFLIKE) != 0;
+  return (oc_kind_flags((oc_kind)o->kind) & OC_KF_HFLIKE) != 0;
+}
 
 int oc_hfsurf_init(oc_hfsurf *s, const oc_program *P, uint32_t op, double T) {
   const oc_op *o = &P->ops[op];
   s->op = op;
-  s->kind = o->kind;
   s->par = P->par + o->par;
-  s->t = NULL;
-  if (o->kind == OC_K_TERRAIN) {
-    s->t = P->terr[o->kid];
-    s->up = s->t->invert ? -1 : 1;
-    s->cap = oc_terrain_cap_z(s->t);
-    return T == P->T;
+  s->ext = 0;
+  s->direct = 0;
+  s->cap = NAN;
+  if (o->kind == OC_K_EXT) {
+    const oc_pext *x = &P->ext[o->ext];
+    if (!(x->def->flags & OC_KF_HFLIKE) || !x->def->surface) return 0;
+    s->ext = 1;
+    s->direct = (x->def->flags & OC_KF_DIRECT) != 0;
+    s->k = (oc_kctx){s->par, x->data, P->T, o->lip, P, op, 0};
+    if (!x->def->surface(&s->k, T, &s->ks)) return 0;
+    s->up = s->ks.up;
+    s->cap = s->ks.cap;
+    return 1;
   }
   if (o->kind != OC_K_PLANE) return 0;
   double E = s->par[OC_P_E], R = s->par[OC_P_R], nz = s->par[OC_P_N + 2];
@@ -36,7 +50,7 @@ int oc_hfsurf_init(oc_hfsurf *s, const oc_program *P, uint32_t op, double T) {
 
 double oc_hfsurf_height(const oc_hfsurf *s, double x, double y,
                         double grad[2]) {
-  if (s->t) return s->t->src.height(s->t->src.ud, x, y, grad);
+  if (s->ext) return s->ks.height(s->ks.ud, x, y, grad);
   const double *p = s->par;
   double nx = p[OC_P_N], ny = p[OC_P_N + 1], nz = p[OC_P_N + 2];
   if (grad) {
@@ -48,7 +62,7 @@ double oc_hfsurf_height(const oc_hfsurf *s, double x, double y,
 }
 
 double oc_hfsurf_value(const oc_hfsurf *s, double e, double z) {
-  if (s->t) return oc_terrain_column_value(s->t, s->par, e, z);
+  if (s->ext) return s->ks.value(&s->k, e, z);
   const double *p = s->par;
   double d = s->ds + p[OC_P_N + 2] * (z - e);
   return p[OC_P_E] * oc_falloff(fmax(0, d) / p[OC_P_R]);
@@ -58,7 +72,7 @@ double oc_hfsurf_vertical(const oc_hfsurf *s, double e, double za, double zb,
                           int *cap) {
   *cap = 0;
   if (e >= za && e <= zb) return e;
-  if (s->t && s->cap >= za && s->cap <= zb) {
+  if (s->cap >= za && s->cap <= zb) { /* (false for NAN) */
     *cap = 1;
     return s->cap;
   }
@@ -68,8 +82,8 @@ double oc_hfsurf_vertical(const oc_hfsurf *s, double e, double za, double zb,
 int oc_hfsurf_level_spans(const oc_hfsurf *s, double x0, double y0, double x1,
                           double y1, oc_zspan out[2]) {
   double lo, hi;
-  if (s->t) {
-    s->t->src.range(s->t->src.ud, x0, y0, x1, y1, &lo, &hi);
+  if (s->ext) {
+    s->ks.range(s->ks.ud, x0, y0, x1, y1, &lo, &hi);
   } else { /* a plane: its elevation is affine, extreme at the corners */
     double e[4] = {
         oc_hfsurf_height(s, x0, y0, NULL), oc_hfsurf_height(s, x1, y0, NULL),
@@ -88,7 +102,7 @@ int oc_hfsurf_elev_spans(const oc_hfsurf *s, double lo, double hi,
   /* rounding of the elevation and of the range: far below a cell */
   double m = 1e-9 * (fabs(lo) + fabs(hi) + 1);
   oc_zspan a = {lo - m, hi + m};
-  if (!s->t) {
+  if (isnan(s->cap)) {
     out[0] = a;
     return 1;
   }

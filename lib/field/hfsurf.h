@@ -1,44 +1,33 @@
 /*
-** column.h — what the mesher learns about a column besides its z-spans
-** (internal): whether a single heightfield-like op, a terrain or a plane,
-** governs the column's footprint alone, and that op's surface as an
-** elevation, for direct elevation extraction (Paris et al. 2019, section 7).
+** hfsurf.h — the surface of a heightfield-like op (a plane, or an
+** extension kind flagged OC_KF_HFLIKE such as a terrain) as an elevation,
+** for direct elevation extraction (Paris et al. 2019, section 7)
+** (internal). Which op governs a column alone is what the column query
+** of query.h tells.
 */
-#ifndef OC_COLUMN_H
-#define OC_COLUMN_H
+#ifndef OC_HFSURF_H
+#define OC_HFSURF_H
 
 #include <stdint.h>
 
 #include "field/program.h"
 
-/* oc_program_column_spans, and in *hf the op that alone makes the field
-** over the footprint (every other op is 0 there, and it is reached
-** through blends and unions only, so f is its value), when that op is
-** heightfield-like in all the footprint; OC_NONE otherwise. */
-int oc_program_column_query(const oc_program *P, double x0, double y0,
-                            double x1, double y1, oc_zspan *out, int max,
-                            uint32_t *hf);
-/* The same, and in zout (*nz of them, at most max; -1 with the whole
-** column) the z-spans outside which the field is constant along every
-** column of the footprint: those are the samples a column must evaluate
-** one by one. A subset of the spans' union: near a terrain's walls the
-** field varies across the footprint at every z, but along a column only
-** near the floor and the surface. */
-int oc_program_column_query_z(const oc_program *P, double x0, double y0,
-                              double x1, double y1, oc_zspan *out, int max,
-                              uint32_t *hf, oc_zspan *zout, int *nz);
-
 /* The surface f = T of such an op, for one threshold T. */
 typedef struct oc_hfsurf {
   uint32_t op;
-  int kind;
+  int ext;    /* 1: an extension kind's surface (ks, k); 0: a plane's */
+  int direct; /* the mesher extracts it directly (OC_KF_DIRECT) */
   const double *par;
-  const struct oc_tdata *t;
+  oc_ksurf ks;
+  oc_kctx k;  /* what ks.value takes */
   double up;  /* 1: inside below the surface; -1: above */
-  double cap; /* terrain: z of the prism's flat cap (bottom, or top) */
+  double cap; /* z of a flat cap (a terrain's prism bottom or top), or NAN */
   double ds;  /* plane: distance along the normal of the surface */
 } oc_hfsurf;
 
+/* 1 when op may have such a surface: a plane, or a kind flagged
+** OC_KF_HFLIKE. */
+int oc_hfsurf_candidate(const oc_program *P, uint32_t op);
 /* Fills s for op at threshold T; 0 when that op has no such surface at T
 ** (a terrain compiled for another T, a plane whose energy is <= T). */
 int oc_hfsurf_init(oc_hfsurf *s, const oc_program *P, uint32_t op, double T);
