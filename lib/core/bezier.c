@@ -1,0 +1,368 @@
+/*
+** bezier.c — one Bézier piece: evaluation, arc length, closest point,
+** curvature bound, flattening (see bezier.h).
+*/
+#include <math.h>
+
+#include "core/bezier.h"
+#include "core/vec.h"
+
+/* Binomial coefficients up to 5 (the degree of (B - p) . B' for a cubic). */
+static const double binom[6][6] = {
+    {1, 0, 0, 0, 0, 0}, {1, 1, 0, 0, 0, 0}, {1, 2, 1, 0, 0, 0},
+    {1, 3, 3, 1, 0, 0}, {1, 4, 6, 4, 1, 0}, {1, 5, 10, 10, 5, 1},
+};
+
+static void casteljau(const oc_vec3 *p, int n, double t, oc_vec3 *left,
+                      oc_vec3 *right) {
+  oc_vec3 w[OC_BEZ_MAXDEG + 1];
+  for (int i = 0; i <= n; i++)
+    w[i] = p[i];
+  for (int k = 0;; k++) {
+    if (left) left[k] = w[0];
+    if (right) right[n - k] = w[n - k];
+    if (k == n) break;
+    for (int i = 0; i < n - k; i++)
+      w[i] = oc_add(oc_mul(w[i], 1 - t), oc_mul(w[i + 1], t));
+  }
+}
+
+oc_vec3 oc_bez_eval(const oc_vec3 *p, int n, double t) {
+  oc_vec3 w[OC_BEZ_MAXDEG + 1];
+  for (int i = 0; i <= n; i++)
+    w[i] = p[i];
+  for (int k = n; k > 0; k--)
+    for (int i = 0; i < k; i++)
+      w[i] = oc_add(oc_mul(w[i], 1 - t), oc_mul(w[i + 1], t));
+  return w[0];
+}
+
+oc_vec3 oc_bez_d1(const oc_vec3 *p, int n, double t) {
+  oc_vec3 h[OC_BEZ_MAXDEG];
+  for (int i = 0; i < n; i++)
+    h[i] = oc_mul(oc_sub(p[i + 1], p[i]), n);
+  return oc_bez_eval(h, n - 1, t);
+}
+
+oc_vec3 oc_bez_d2(const oc_vec3 *p, int n, double t) {
+  if (n < 2) return oc_v3(0, 0, 0);
+  oc_vec3 h[OC_BEZ_MAXDEG - 1];
+  for (int i = 0; i + 1 < n; i++)
+    h[i] = oc_mul(oc_add(oc_sub(p[i + 2], oc_mul(p[i + 1], 2)), p[i]),
+                  n * (n - 1));
+  return oc_bez_eval(h, n - 2, t);
+}
+
+void oc_bez_sub(const oc_vec3 *p, int n, double a, double b, oc_vec3 *out) {
+  oc_vec3 left[OC_BEZ_MAXDEG + 1];
+  if (b < 1) {
+    casteljau(p, n, b, left, NULL);
+  } else {
+    for (int i = 0; i <= n; i++)
+      left[i] = p[i];
+  }
+  if (a > 0)
+    casteljau(left, n, a / b, NULL, out);
+  else
+    for (int i = 0; i <= n; i++)
+      out[i] = left[i];
+}
+
+/* ---- arc length ------------------------------------------------------- */
+
+static const double gl_x[4] = {0.1834346424956498049, 0.5255324099163289858,
+                               0.7966664774136267396, 0.9602898564975362317};
+static const double gl_w[4] = {0.3626837833783619830, 0.3137066458778872873,
+                               0.2223810344533744705, 0.1012285362903762592};
+
+static double speed(const oc_vec3 *p, int n, double t) {
+  oc_vec3 d = oc_bez_d1(p, n, t);
+  return hypot(d.x, d.y);
+}
+
+double oc_bez_arclen(const oc_vec3 *p, int n, double a, double b) {
+  double c = 0.5 * (a + b), h = 0.5 * (b - a), s = 0;
+  for (int i = 0; i < 4; i++)
+    s +=
+        gl_w[i] * (speed(p, n, c - h * gl_x[i]) + speed(p, n, c + h * gl_x[i]));
+  return s * h;
+}
+
+/* ---- closest point ------------------------------------------------------ */
+
+/* A polynomial in Bernstein form of degree m <= 5 on some interval. */
+static double bern_eval(const double *c, int m, double t) {
+  double w[6];
+  for (int i = 0; i <= m; i++)
+    w[i] = c[i];
+  for (int k = m; k > 0; k--)
+    for (int i = 0; i < k; i++)
+      w[i] = w[i] * (1 - t) + w[i + 1] * t;
+  return w[0];
+}
+
+static void bern_halves(const double *c, int m, double *l, double *r) {
+  double w[6];
+  for (int i = 0; i <= m; i++)
+    w[i] = c[i];
+  for (int k = 0;; k++) {
+    l[k] = w[0];
+    r[m - k] = w[m - k];
+    if (k == m) break;
+    for (int i = 0; i < m - k; i++)
+      w[i] = 0.5 * (w[i] + w[i + 1]);
+  }
+}
+
+static int sign_changes(const double *c, int m) {
+  int v = 0, last = 0;
+  for (int i = 0; i <= m; i++) {
+    int s = (c[i] > 0) - (c[i] < 0);
+    if (s && last && s != last) v++;
+    if (s) last = s;
+  }
+  return v;
+}
+
+typedef struct span {
+  double a, b;
+  double f[6];         /* (B - p) . B' on [a, b] */
+  double qx[4], qy[4]; /* control points of B - p on [a, b] */
+  int depth;
+} span;
+
+/* The root of f in (a, b), where f(a) and f(b) have opposite signs. */
+static double solve_bracketed(const double *f, const double *df, int m,
+                              double a, double b) {
+  double fa = bern_eval(f, m, a), t = 0.5 * (a + b);
+  for (int it = 0; it < 100; it++) {
+    double ft = bern_eval(f, m, t);
+    if (ft == 0) return t;
+    if ((ft > 0) == (fa > 0))
+      a = t;
+    else
+      b = t;
+    double d = bern_eval(df, m - 1, t);
+    double tn = t - ft / d;
+    if (!(tn > a && tn < b)) tn = 0.5 * (a + b);
+    if (tn == t || b - a <= 4e-16 * fmax(1, fabs(t))) return tn;
+    t = tn;
+  }
+  return t;
+}
+
+static double dist2_at(const oc_vec3 *p, int n, double x, double y, double t) {
+  oc_vec3 q = oc_bez_eval(p, n, t);
+  return (q.x - x) * (q.x - x) + (q.y - y) * (q.y - y);
+}
+
+double oc_bez_closest(const oc_vec3 *p, int n, double x, double y, double best2,
+                      double *t) {
+  double best = best2;
+  if (n == 1) {
+    double dx = p[1].x - p[0].x, dy = p[1].y - p[0].y;
+    double ux = x - p[0].x, uy = y - p[0].y, l2 = dx * dx + dy * dy;
+    double u = l2 > 0 ? (ux * dx + uy * dy) / l2 : 0;
+    u = u < 0 ? 0 : u > 1 ? 1 : u;
+    double ex = ux - u * dx, ey = uy - u * dy, d2 = ex * ex + ey * ey;
+    if (d2 < best) *t = u;
+    return d2;
+  }
+  double d0 = dist2_at(p, n, x, y, 0), d1 = dist2_at(p, n, x, y, 1);
+  if (d0 < best) best = d0, *t = 0;
+  if (d1 < best) best = d1, *t = 1;
+
+  int m = 2 * n - 1;
+  double qx[4], qy[4], dx[3], dy[3], f[6] = {0}, df[5];
+  for (int i = 0; i <= n; i++)
+    qx[i] = p[i].x - x, qy[i] = p[i].y - y;
+  for (int j = 0; j < n; j++)
+    dx[j] = n * (qx[j + 1] - qx[j]), dy[j] = n * (qy[j + 1] - qy[j]);
+  for (int i = 0; i <= n; i++)
+    for (int j = 0; j < n; j++)
+      f[i + j] += binom[n][i] * binom[n - 1][j] / binom[m][i + j] *
+                  (qx[i] * dx[j] + qy[i] * dy[j]);
+  for (int l = 0; l < m; l++)
+    df[l] = m * (f[l + 1] - f[l]);
+
+  /* Depth-first with the right half pushed first: the stack holds at most
+  ** one pending sibling per level. */
+  span st[64];
+  int top = 0;
+  st[top].a = 0, st[top].b = 1, st[top].depth = 0;
+  for (int i = 0; i <= m; i++)
+    st[top].f[i] = f[i];
+  for (int i = 0; i <= n; i++)
+    st[top].qx[i] = qx[i], st[top].qy[i] = qy[i];
+  top++;
+  while (top > 0) {
+    span s = st[--top];
+    double lx = INFINITY, hx = -INFINITY, ly = INFINITY, hy = -INFINITY;
+    for (int i = 0; i <= n; i++) {
+      lx = fmin(lx, s.qx[i]), hx = fmax(hx, s.qx[i]);
+      ly = fmin(ly, s.qy[i]), hy = fmax(hy, s.qy[i]);
+    }
+    double bx = fmax(0, fmax(lx, -hx)), by = fmax(0, fmax(ly, -hy));
+    if (bx * bx + by * by >= best) continue;
+    /* A root on a split point may leave no sign change on either side. */
+    if (s.f[0] == 0 && s.a > 0) {
+      double d2 = dist2_at(p, n, x, y, s.a);
+      if (d2 < best) best = d2, *t = s.a;
+    }
+    if (sign_changes(s.f, m) == 0) continue; /* no stationary point inside */
+    double cand = -1;
+    if (s.f[0] * s.f[m] < 0 && sign_changes(s.f, m) == 1) {
+      cand = solve_bracketed(f, df, m, s.a, s.b);
+    } else if (s.depth >= 52) {
+      cand = 0.5 * (s.a + s.b); /* a double root, pinned to rounding */
+    } else {
+      span l, r;
+      double mid = 0.5 * (s.a + s.b);
+      l.a = s.a, l.b = mid, r.a = mid, r.b = s.b;
+      l.depth = r.depth = s.depth + 1;
+      bern_halves(s.f, m, l.f, r.f);
+      oc_vec3 c[4], cl[4], cr[4];
+      for (int i = 0; i <= n; i++)
+        c[i] = oc_v3(s.qx[i], s.qy[i], 0);
+      casteljau(c, n, 0.5, cl, cr);
+      for (int i = 0; i <= n; i++) {
+        l.qx[i] = cl[i].x, l.qy[i] = cl[i].y;
+        r.qx[i] = cr[i].x, r.qy[i] = cr[i].y;
+      }
+      st[top++] = r;
+      st[top++] = l;
+      continue;
+    }
+    double d2 = dist2_at(p, n, x, y, cand);
+    if (d2 < best) best = d2, *t = cand;
+  }
+  return best < best2 ? best : best2;
+}
+
+/* ---- curvature ------------------------------------------------------- */
+
+double oc_bez_curvature(const oc_vec3 *p, int n, double t) {
+  if (n < 2) return 0;
+  oc_vec3 a = oc_bez_d1(p, n, t), b = oc_bez_d2(p, n, t);
+  double cr = a.x * b.y - a.y * b.x, v = hypot(a.x, a.y);
+  if (v == 0) return cr == 0 && hypot(b.x, b.y) == 0 ? 0 : INFINITY;
+  return cr / (v * v * v);
+}
+
+/* Distance from the origin to the segment [a, b] of the plane. */
+static double seg_dist0(double ax, double ay, double bx, double by) {
+  double dx = bx - ax, dy = by - ay, l2 = dx * dx + dy * dy;
+  double u = l2 > 0 ? -(ax * dx + ay * dy) / l2 : 0;
+  u = u < 0 ? 0 : u > 1 ? 1 : u;
+  return hypot(ax + u * dx, ay + u * dy);
+}
+
+/* Distance from the origin to the convex hull of k <= 3 points. */
+static double hull_dist0(const double *x, const double *y, int k) {
+  if (k == 1) return hypot(x[0], y[0]);
+  if (k == 2) return seg_dist0(x[0], y[0], x[1], y[1]);
+  double c1 = (x[1] - x[0]) * (-y[0]) - (y[1] - y[0]) * (-x[0]);
+  double c2 = (x[2] - x[1]) * (-y[1]) - (y[2] - y[1]) * (-x[1]);
+  double c3 = (x[0] - x[2]) * (-y[2]) - (y[0] - y[2]) * (-x[2]);
+  if ((c1 >= 0 && c2 >= 0 && c3 >= 0) || (c1 <= 0 && c2 <= 0 && c3 <= 0))
+    return 0;
+  return fmin(seg_dist0(x[0], y[0], x[1], y[1]),
+              fmin(seg_dist0(x[1], y[1], x[2], y[2]),
+                   seg_dist0(x[2], y[2], x[0], y[0])));
+}
+
+/* An upper bound of |curvature| of the piece on [a, b]. */
+static double kappa_on(const oc_vec3 *p, int n, double a, double b) {
+  oc_vec3 s[4];
+  oc_bez_sub(p, n, a, b, s);
+  double dx[3], dy[3], ex[2], ey[2];
+  for (int i = 0; i < n; i++)
+    dx[i] = n * (s[i + 1].x - s[i].x), dy[i] = n * (s[i + 1].y - s[i].y);
+  for (int j = 0; j + 1 < n; j++)
+    ex[j] = (n - 1) * (dx[j + 1] - dx[j]),
+    ey[j] = (n - 1) * (dy[j + 1] - dy[j]);
+  int m = 2 * n - 3;
+  double c[4] = {0};
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j + 1 < n; j++)
+      c[i + j] += binom[n - 1][i] * binom[n - 2][j] / binom[m][i + j] *
+                  (dx[i] * ey[j] - dy[i] * ex[j]);
+  double num = 0;
+  for (int l = 0; l <= m; l++)
+    num = fmax(num, fabs(c[l]));
+  double lo = hull_dist0(dx, dy, n);
+  if (!(lo > 0)) return num == 0 ? 0 : INFINITY;
+  return num / (lo * lo * lo);
+}
+
+double oc_bez_kappa_bound(const oc_vec3 *p, int n, double rel_tol,
+                          double abs_tol) {
+  if (n < 2) return 0;
+  double lo = fmax(
+      fabs(oc_bez_curvature(p, n, 0)),
+      fmax(fabs(oc_bez_curvature(p, n, 0.5)), fabs(oc_bez_curvature(p, n, 1))));
+  double hi = 0;
+  struct {
+    double a, b;
+    int depth;
+  } st[48];
+  int top = 0, evals = 0;
+  st[top].a = 0, st[top].b = 1, st[top].depth = 0, top++;
+  while (top > 0) {
+    double a = st[top - 1].a, b = st[top - 1].b;
+    int depth = st[top - 1].depth;
+    top--;
+    double u = kappa_on(p, n, a, b), mid = 0.5 * (a + b);
+    lo = fmax(lo, fabs(oc_bez_curvature(p, n, mid)));
+    evals++;
+    /* Past the depth or the budget the interval's bound is kept as is:
+    ** looser, still an upper bound. */
+    if (u <= lo * (1 + rel_tol) + abs_tol || depth >= 40 || evals > 4096) {
+      hi = fmax(hi, u);
+      continue;
+    }
+    st[top].a = mid, st[top].b = b, st[top].depth = depth + 1, top++;
+    st[top].a = a, st[top].b = mid, st[top].depth = depth + 1, top++;
+  }
+  return fmax(hi, lo) * (1 + 1e-9);
+}
+
+/* ---- flattening -------------------------------------------------------- */
+
+/* Squared distance from (x, y) to the segment [a, b] (xy). */
+static double seg_d2(oc_vec3 a, oc_vec3 b, double x, double y) {
+  double d = seg_dist0(a.x - x, a.y - y, b.x - x, b.y - y);
+  return d * d;
+}
+
+size_t oc_bez_flatten(const oc_vec3 *p, int n, double tol,
+                      void (*emit)(void *ud, double t), void *ud) {
+  struct {
+    double a, b;
+    int depth;
+  } st[40];
+  int top = 0;
+  size_t k = 0;
+  st[top].a = 0, st[top].b = 1, st[top].depth = 0, top++;
+  while (top > 0) {
+    double a = st[top - 1].a, b = st[top - 1].b;
+    int depth = st[top - 1].depth;
+    top--;
+    int flat = 1;
+    if (n > 1 && depth < 30) {
+      oc_vec3 s[4];
+      oc_bez_sub(p, n, a, b, s);
+      for (int i = 1; i < n && flat; i++)
+        flat = seg_d2(s[0], s[n], s[i].x, s[i].y) <= tol * tol;
+    }
+    if (flat) {
+      if (emit) emit(ud, b);
+      k++;
+      continue;
+    }
+    double mid = 0.5 * (a + b);
+    st[top].a = mid, st[top].b = b, st[top].depth = depth + 1, top++;
+    st[top].a = a, st[top].b = mid, st[top].depth = depth + 1, top++;
+  }
+  return k;
+}

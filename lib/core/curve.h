@@ -1,0 +1,115 @@
+/*
+** curve.h — a piecewise planar curve carrying an elevation: line segments,
+** quadratic and cubic Bézier pieces with control points (x, y, z). The
+** skeleton of the curve primitives of elevation trees (Génevaux et al.
+** 2015, f = q_z + c(d)) and of the feature curves of diffusion (Hnaidi et
+** al. 2010): one implementation of arc length, closest point, frames,
+** curvature bound and flattening.
+**
+** Geometry is planar: arc length s, distances, tangents and curvature are
+** in xy; z is carried along each piece's parameter (q_z of the closest
+** point). A built curve is immutable; every query below is read-only,
+** allocates nothing and may run from any number of threads at once.
+*/
+#ifndef OC_CURVE_H
+#define OC_CURVE_H
+
+#include <stddef.h>
+
+#include "outcrop.h"
+
+/* (oc_curve is taken by the 3D curve primitive of outcrop.h, hence the
+** type's name; the functions are oc_curve_*.) */
+typedef struct oc_pcurve oc_pcurve;
+
+/* One piece: degree 1 (segment p[0] p[1]), 2 or 3 (Bézier p[0..degree]). */
+typedef struct oc_curve_piece {
+  int degree;
+  oc_vec3 p[4];
+} oc_curve_piece;
+
+/* A point of the curve, as answered by oc_curve_at and oc_curve_closest. */
+typedef struct oc_curve_point {
+  double s;      /* arc length from the start, in [0, length] */
+  oc_vec3 q;     /* the point on the curve (x, y) and the skeleton z there */
+  double tx, ty; /* unit tangent (direction of travel) */
+  double nx, ny; /* unit left normal (-ty, tx) */
+  double d;      /* closest only: signed xy distance, > 0 on the left */
+  size_t piece;  /* index among the kept pieces, and parameter in it */
+  double t;
+  int end; /* closest only: -1 / +1 when q is the start / end of an
+           ** open curve (then the sign of d is the side of the end
+           ** tangent's line), else 0 */
+} oc_curve_point;
+
+/* Builds a curve from n pieces (copied). Checked: degree 1..3, finite
+** coordinates, each piece starting where the previous one ends (within
+** 1e-9 of the coordinates' scale; the start is then snapped to that end),
+** at least one piece with non-zero xy length. Pieces of zero xy length
+** are dropped (refused if their z changes: a vertical step has no closest
+** point). The curve is closed when its last end meets its first start.
+** Errors name the piece index (from 0). The caller frees the result with
+** oc_curve_free; NULL (err set) on failure. */
+oc_pcurve *oc_curve_new(const oc_curve_piece *pieces, size_t n, oc_error *err);
+
+/* A spline through shared points: with degree k, n = k m + 1 points make
+** m pieces (point k i is where piece i starts). Same checks; the count is
+** named 'points'. */
+oc_pcurve *oc_curve_from_points(const oc_vec3 *pts, size_t n, int degree,
+                                oc_error *err);
+
+void oc_curve_free(oc_pcurve *c);
+
+size_t oc_curve_npieces(const oc_pcurve *c); /* pieces kept */
+int oc_curve_closed(const oc_pcurve *c);
+/* Total xy arc length. Each Bézier piece's arc length is tabulated at
+** build (adaptive Gauss–Legendre); the length and every s below are
+** accurate to about 1e-13 relative (documented bound: 1e-9). */
+double oc_curve_length(const oc_pcurve *c);
+
+/* The point, unit tangent and left normal at arc length s (clamped to
+** [0, length]); at a join the tangent is the bisector of the two pieces'
+** tangents. Returns 0 (out untouched) when s is NaN. */
+int oc_curve_at(const oc_pcurve *c, double s, oc_curve_point *out);
+
+/* The closest point of the curve to (x, y) in xy, if it lies within r
+** (r may be INFINITY): returns 1 and fills out (s, q, tangent, normal,
+** signed d), else 0. The global minimum: pieces are pruned through a box
+** tree over their control-polygon boxes (a far query costs one box test),
+** segments are exact to rounding, Bézier pieces isolate every stationary
+** point of the distance (bezier.h). */
+int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
+                     oc_curve_point *out);
+
+/* An upper bound of the planar curvature |kappa| inside the pieces,
+** rigorous up to rounding and within about 1 % of the true maximum
+** (bezier.h); 0 for a polyline, INFINITY when a Bézier piece has a cusp.
+** Joins are not included: see oc_curve_max_turn. Computed at build. */
+double oc_curve_kappa_max(const oc_pcurve *c);
+
+/* The largest angle (radians, in [0, pi]) between the tangents meeting at
+** a join (and at the closing point of a closed curve): 0 for a G1 curve.
+** A corner has infinite curvature, so a profile of half-width w is safe
+** (w kappa_max < 1) only on a curve without corners. */
+double oc_curve_max_turn(const oc_pcurve *c);
+
+/* The tight box of the curve (x, y and z) with x and y grown by r >= 0. */
+oc_aabb oc_curve_bounds(const oc_pcurve *c, double r);
+
+/* A vertex of a flattened curve: the point and its arc length. */
+typedef struct oc_curve_vertex {
+  double x, y, z, s;
+} oc_curve_vertex;
+
+/* Flattens the curve to a polyline whose vertices lie on the curve and
+** such that every point of the curve is within tol (xy) of the polyline;
+** z and s are the curve's at the vertices (segments keep their two ends).
+** Writes at most cap vertices into out (which may be NULL to count) and
+** sets *count to the number the whole polyline needs (first and last
+** vertices included; a closed curve repeats its start at the end). tol
+** must be finite and >= 1e-9 of the curve's length (so counts stay
+** bounded). Returns 0 or an error code. */
+int oc_curve_flatten(const oc_pcurve *c, double tol, oc_curve_vertex *out,
+                     size_t cap, size_t *count, oc_error *err);
+
+#endif

@@ -1,0 +1,528 @@
+/*
+** test_curve.c — piecewise planar curves (lib/core/curve.h): closest
+** points against a dense brute-force search, arc length against a fine
+** numeric integral, signed distance, frames, the curvature bound against
+** sampled curvature, flattening tolerance, bounds, closed curves, bad
+** input. The references below (Bernstein sums, Simpson's rule, golden
+** section search) are written here, independently of lib/core/bezier.c.
+*/
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "core/curve.h"
+#include "ocheck.h"
+
+/* 4/3 (sqrt 2 - 1): the cubic closest to a quarter circle. */
+#define OCT_PI 3.14159265358979323846
+#define KAPPA_Q 0.55228474983079339840
+
+/* ---- references --------------------------------------------------------- */
+
+static oc_vec3 ref_eval(const oc_curve_piece *pc, double t) {
+  double u = 1 - t, w[4];
+  switch (pc->degree) {
+  case 1:
+    w[0] = u, w[1] = t;
+    break;
+  case 2:
+    w[0] = u * u, w[1] = 2 * u * t, w[2] = t * t;
+    break;
+  default:
+    w[0] = u * u * u, w[1] = 3 * u * u * t, w[2] = 3 * u * t * t,
+    w[3] = t * t * t;
+  }
+  oc_vec3 q = {0, 0, 0};
+  for (int i = 0; i <= pc->degree; i++)
+    q = oct_add(q, oct_mul(pc->p[i], w[i]));
+  return q;
+}
+
+/* Derivatives by the power form of each degree. */
+static void ref_deriv(const oc_curve_piece *pc, double t, oc_vec3 *d1,
+                      oc_vec3 *d2) {
+  const oc_vec3 *p = pc->p;
+  double u = 1 - t;
+  if (pc->degree == 1) {
+    *d1 = oct_sub(p[1], p[0]);
+    *d2 = oct_v(0, 0, 0);
+  } else if (pc->degree == 2) {
+    *d1 = oct_add(oct_mul(oct_sub(p[1], p[0]), 2 * u),
+                  oct_mul(oct_sub(p[2], p[1]), 2 * t));
+    *d2 = oct_mul(oct_add(oct_sub(p[2], oct_mul(p[1], 2)), p[0]), 2);
+  } else {
+    *d1 = oct_add(oct_add(oct_mul(oct_sub(p[1], p[0]), 3 * u * u),
+                          oct_mul(oct_sub(p[2], p[1]), 6 * u * t)),
+                  oct_mul(oct_sub(p[3], p[2]), 3 * t * t));
+    *d2 =
+        oct_add(oct_mul(oct_add(oct_sub(p[2], oct_mul(p[1], 2)), p[0]), 6 * u),
+                oct_mul(oct_add(oct_sub(p[3], oct_mul(p[2], 2)), p[1]), 6 * t));
+  }
+}
+
+static double ref_speed(const oc_curve_piece *pc, double t) {
+  oc_vec3 a, b;
+  ref_deriv(pc, t, &a, &b);
+  return hypot(a.x, a.y);
+}
+
+static double ref_kappa(const oc_curve_piece *pc, double t) {
+  oc_vec3 a, b;
+  ref_deriv(pc, t, &a, &b);
+  double v = hypot(a.x, a.y);
+  return fabs(a.x * b.y - a.y * b.x) / (v * v * v);
+}
+
+/* Composite Simpson on [a, b] with 2m intervals. */
+static double ref_arclen(const oc_curve_piece *pc, double a, double b, int m) {
+  double h = (b - a) / (2 * m), s = ref_speed(pc, a) + ref_speed(pc, b);
+  for (int i = 1; i < 2 * m; i++)
+    s += (i % 2 ? 4 : 2) * ref_speed(pc, a + i * h);
+  return s * h / 3;
+}
+
+static double d2xy(oc_vec3 q, double x, double y) {
+  return (q.x - x) * (q.x - x) + (q.y - y) * (q.y - y);
+}
+
+/* Closest point by dense sampling then golden-section refinement around
+** the best samples (the distance is unimodal near a local minimum). */
+static double ref_closest(const oc_curve_piece *pcs, int n, double x, double y,
+                          int *bp, double *bt) {
+  const int N = 4000;
+  double best = INFINITY;
+  for (int i = 0; i < n; i++)
+    for (int k = 0; k <= N; k++) {
+      double t = (double)k / N, d = d2xy(ref_eval(&pcs[i], t), x, y);
+      if (d < best) best = d, *bp = i, *bt = t;
+    }
+  /* refine every sample within a margin of the best (several basins) */
+  double out = INFINITY;
+  int op = *bp;
+  double ot = *bt;
+  for (int i = 0; i < n; i++)
+    for (int k = 0; k <= N; k++) {
+      double t = (double)k / N;
+      double d = d2xy(ref_eval(&pcs[i], t), x, y);
+      if (d > best * 1.01 + 1e-12) continue;
+      double a = fmax(0, t - 1.0 / N), b = fmin(1, t + 1.0 / N);
+      const double g = 0.6180339887498949;
+      for (int it = 0; it < 80; it++) {
+        double c1 = b - g * (b - a), c2 = a + g * (b - a);
+        if (d2xy(ref_eval(&pcs[i], c1), x, y) <
+            d2xy(ref_eval(&pcs[i], c2), x, y))
+          b = c2;
+        else
+          a = c1;
+      }
+      double tm = 0.5 * (a + b), dm = d2xy(ref_eval(&pcs[i], tm), x, y);
+      if (dm < out) out = dm, op = i, ot = tm;
+    }
+  *bp = op, *bt = ot;
+  return sqrt(out);
+}
+
+/* A wiggly G1 spline of m cubic pieces (shared tangents at joins). */
+static int make_wiggle(oc_curve_piece *pcs, int m, oct_rng *r) {
+  oc_vec3 p = oct_v(0, 0, 5), v = oct_v(10, 0, 0);
+  for (int i = 0; i < m; i++) {
+    oc_vec3 q = oct_add(p, oct_v(20 + oct_unif(r, -5, 5), oct_unif(r, -15, 15),
+                                 oct_unif(r, -2, 2)));
+    oc_vec3 w = oct_v(oct_unif(r, 5, 12), oct_unif(r, -8, 8), 0);
+    pcs[i].degree = 3;
+    pcs[i].p[0] = p;
+    pcs[i].p[1] = oct_add(p, v);
+    pcs[i].p[2] = oct_sub(q, w);
+    pcs[i].p[3] = q;
+    p = q, v = w;
+  }
+  return m;
+}
+
+static oc_pcurve *new_ok(const oc_curve_piece *pcs, int n) {
+  oc_error err = {0};
+  oc_pcurve *c = oc_curve_new(pcs, n, &err);
+  ck_assert_msg(c, "oc_curve_new: %s", err.msg);
+  return c;
+}
+
+/* ---- tests ----------------------------------------------------------- */
+
+START_TEST(closest_matches_brute_force) {
+  oct_rng r = oct_rng_new(17);
+  oc_curve_piece pcs[8];
+  int n = make_wiggle(pcs, 5, &r);
+  /* one quadratic and one segment at the end, joined */
+  oc_vec3 e = pcs[n - 1].p[3];
+  pcs[n].degree = 2;
+  pcs[n].p[0] = e;
+  pcs[n].p[1] = oct_add(e, oct_v(10, 10, 1));
+  pcs[n].p[2] = oct_add(e, oct_v(0, 20, 0));
+  n++;
+  pcs[n].degree = 1;
+  pcs[n].p[0] = pcs[n - 1].p[2];
+  pcs[n].p[1] = oct_add(pcs[n].p[0], oct_v(-30, 5, -3));
+  n++;
+  oc_pcurve *c = new_ok(pcs, n);
+  oc_aabb b = oc_curve_bounds(c, 15);
+  double worst = 0;
+  int signs_bad = 0;
+  for (int k = 0; k < 400; k++) {
+    double x = oct_unif(&r, b.lo.x, b.hi.x), y = oct_unif(&r, b.lo.y, b.hi.y);
+    int bp;
+    double bt, ref = ref_closest(pcs, n, x, y, &bp, &bt);
+    oc_curve_point cp;
+    ck_assert(oc_curve_closest(c, x, y, INFINITY, &cp));
+    double got = fabs(cp.d);
+    worst = fmax(worst, fabs(got - ref));
+    ck_assert_msg(fabs(got - ref) <= 1e-9 * (1 + ref),
+                  "closest (%g, %g): %.15g vs reference %.15g", x, y, got, ref);
+    /* q is on the curve at (piece, t) and at distance |d| */
+    oc_vec3 q = ref_eval(&pcs[cp.piece], cp.t);
+    ck_assert(hypot(q.x - cp.q.x, q.y - cp.q.y) < 1e-9);
+    ck_assert(fabs(q.z - cp.q.z) < 1e-9);
+    ck_assert(fabs(sqrt(d2xy(cp.q, x, y)) - got) < 1e-9);
+    /* the sign from the reference tangent, where it is unambiguous */
+    oc_vec3 d1, d2;
+    ref_deriv(&pcs[cp.piece], cp.t, &d1, &d2);
+    double cr = d1.x * (y - q.y) - d1.y * (x - q.x);
+    if (cp.end == 0 && got > 1e-6 && (cr > 0) != (cp.d > 0)) signs_bad++;
+    /* s against the reference arc length */
+    double s = 0;
+    for (size_t i = 0; i < cp.piece; i++)
+      s += ref_arclen(&pcs[i], 0, 1, 2000);
+    s += ref_arclen(&pcs[cp.piece], 0, cp.t, 2000);
+    ck_assert_msg(fabs(s - cp.s) < 1e-8 * oc_curve_length(c),
+                  "s %.12g vs %.12g", cp.s, s);
+  }
+  printf("curve: closest vs brute force, worst |difference| %.3g\n", worst);
+  ck_assert_int_eq(signs_bad, 0);
+  oc_curve_free(c);
+}
+END_TEST
+
+START_TEST(closest_within_radius) {
+  oc_curve_piece seg = {1, {{0, 0, 0}, {10, 0, 2}}};
+  oc_pcurve *c = new_ok(&seg, 1);
+  oc_curve_point cp;
+  ck_assert(!oc_curve_closest(c, 5, 3, 2.9, &cp));
+  ck_assert(oc_curve_closest(c, 5, 3, 3.0, &cp)); /* exactly r: within */
+  ck_assert_double_eq_tol(cp.d, 3, 1e-15);
+  ck_assert_double_eq_tol(cp.s, 5, 1e-15);
+  ck_assert_double_eq_tol(cp.q.z, 1, 1e-15);
+  ck_assert(!oc_curve_closest(c, NAN, 0, 1, &cp));
+  ck_assert(!oc_curve_closest(c, 0, 0, -1, &cp));
+  oc_curve_free(c);
+}
+END_TEST
+
+START_TEST(signed_distance_sign) {
+  oc_curve_piece seg = {1, {{0, 0, 0}, {10, 0, 0}}};
+  oc_pcurve *c = new_ok(&seg, 1);
+  oc_curve_point cp;
+  ck_assert(oc_curve_closest(c, 5, 2, INFINITY, &cp));
+  ck_assert_double_eq_tol(cp.d, 2, 1e-15);
+  ck_assert(oc_curve_closest(c, 5, -3, INFINITY, &cp));
+  ck_assert_double_eq_tol(cp.d, -3, 1e-15);
+  ck_assert(oc_curve_closest(c, -4, 3, INFINITY, &cp)); /* beyond the start */
+  ck_assert_int_eq(cp.end, -1);
+  ck_assert_double_eq_tol(cp.d, 5, 1e-15);
+  oc_curve_free(c);
+  /* a counter-clockwise circle of four cubics: the inside is on the left */
+  oc_curve_piece q[4];
+  double R = 50;
+  for (int i = 0; i < 4; i++) {
+    double a0 = i * OCT_PI / 2, a1 = (i + 1) * OCT_PI / 2;
+    oc_vec3 p0 = oct_v(R * cos(a0), R * sin(a0), 0);
+    oc_vec3 p3 = oct_v(R * cos(a1), R * sin(a1), 0);
+    q[i].degree = 3;
+    q[i].p[0] = p0;
+    q[i].p[1] =
+        oct_add(p0, oct_v(-R * KAPPA_Q * sin(a0), R * KAPPA_Q * cos(a0), 0));
+    q[i].p[2] =
+        oct_add(p3, oct_v(R * KAPPA_Q * sin(a1), -R * KAPPA_Q * cos(a1), 0));
+    q[i].p[3] = p3;
+  }
+  c = new_ok(q, 4);
+  ck_assert(oc_curve_closed(c));
+  ck_assert(oc_curve_max_turn(c) < 1e-12);
+  ck_assert(oc_curve_closest(c, 5, 7, INFINITY, &cp));
+  ck_assert(cp.d > 0 && cp.end == 0);
+  ck_assert_double_eq_tol(cp.d, R - hypot(5, 7), 1e-3 * R);
+  ck_assert(oc_curve_closest(c, 80, -10, INFINITY, &cp));
+  ck_assert(cp.d < 0);
+  oc_curve_free(c);
+}
+END_TEST
+
+START_TEST(arclength_quarter_circle) {
+  double R = 100;
+  oc_curve_piece q = {
+      3, {{R, 0, 0}, {R, R * KAPPA_Q, 1}, {R * KAPPA_Q, R, 2}, {0, R, 3}}};
+  oc_pcurve *c = new_ok(&q, 1);
+  double ref = ref_arclen(&q, 0, 1, 200000);
+  double L = oc_curve_length(c);
+  printf("curve: quarter-circle cubic length %.15g, Simpson %.15g, "
+         "rel. difference %.3g (circle %.15g)\n",
+         L, ref, fabs(L - ref) / ref, OCT_PI * R / 2);
+  ck_assert(fabs(L - ref) <= 1e-9 * ref);
+  ck_assert(fabs(L - OCT_PI * R / 2) < 1e-3 * L); /* it is circle-like */
+  /* arc length parametrization: s -> t -> reference s */
+  double worst = 0;
+  for (int k = 0; k <= 64; k++) {
+    double s = L * k / 64;
+    oc_curve_point p;
+    ck_assert(oc_curve_at(c, s, &p));
+    double back = ref_arclen(&q, 0, p.t, 20000);
+    worst = fmax(worst, fabs(back - s) / L);
+    oc_vec3 e = ref_eval(&q, p.t);
+    ck_assert(hypot(e.x - p.q.x, e.y - p.q.y) < 1e-9 * R);
+    ck_assert(fabs(e.z - p.q.z) < 1e-12 * R);
+    ck_assert_double_eq_tol(p.s, s, 1e-12 * L);
+  }
+  printf("curve: s(t(s)) worst relative error %.3g\n", worst);
+  ck_assert(worst < 1e-9);
+  oc_curve_point p;
+  ck_assert(!oc_curve_at(c, NAN, &p));
+  ck_assert(oc_curve_at(c, -5, &p) && p.s == 0 && p.q.x == R);
+  ck_assert(oc_curve_at(c, 1e300, &p) && p.s == L && p.q.y == R);
+  oc_curve_free(c);
+}
+END_TEST
+
+START_TEST(frames_are_unit_and_left) {
+  oct_rng r = oct_rng_new(5);
+  oc_curve_piece pcs[4];
+  int n = make_wiggle(pcs, 4, &r);
+  oc_pcurve *c = new_ok(pcs, n);
+  double L = oc_curve_length(c);
+  for (int k = 1; k < 200; k++) {
+    oc_curve_point p;
+    ck_assert(oc_curve_at(c, L * k / 200, &p));
+    oc_vec3 d1, d2;
+    ref_deriv(&pcs[p.piece], p.t, &d1, &d2);
+    double v = hypot(d1.x, d1.y);
+    ck_assert(fabs(p.tx - d1.x / v) < 1e-9 && fabs(p.ty - d1.y / v) < 1e-9);
+    ck_assert(fabs(hypot(p.tx, p.ty) - 1) < 1e-14);
+    ck_assert(p.nx == -p.ty && p.ny == p.tx);
+  }
+  oc_curve_free(c);
+}
+END_TEST
+
+START_TEST(kappa_bound_holds_and_is_tight) {
+  double R = 100;
+  oc_curve_piece q = {
+      3, {{R, 0, 0}, {R, R * KAPPA_Q, 0}, {R * KAPPA_Q, R, 0}, {0, R, 0}}};
+  oct_rng r = oct_rng_new(9);
+  oc_curve_piece w[6];
+  make_wiggle(w, 6, &r);
+  oc_curve_piece quad = {2, {{0, 0, 0}, {10, 20, 0}, {30, 0, 0}}};
+  struct {
+    const oc_curve_piece *p;
+    int n;
+    const char *name;
+  } cases[] = {{&q, 1, "quarter circle"}, {w, 6, "wiggle"}, {&quad, 1, "quad"}};
+  for (int k = 0; k < 3; k++) {
+    oc_pcurve *c = new_ok(cases[k].p, cases[k].n);
+    double bound = oc_curve_kappa_max(c), sampled = 0;
+    for (int i = 0; i < cases[k].n; i++)
+      for (int j = 0; j <= 100000; j++)
+        sampled = fmax(sampled, ref_kappa(&cases[k].p[i], j / 100000.0));
+    printf("curve: kappa_max %s %.9g, sampled %.9g (ratio %.5f)\n",
+           cases[k].name, bound, sampled, bound / sampled);
+    ck_assert(bound >= sampled);
+    ck_assert(bound <= 1.05 * sampled);
+    if (k == 0) ck_assert(bound <= 2.0 / R);
+    oc_curve_free(c);
+  }
+  /* a polyline has kappa 0 and corners */
+  oc_vec3 sq[5] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 0}};
+  oc_error err = {0};
+  oc_pcurve *c = oc_curve_from_points(sq, 5, 1, &err);
+  ck_assert(c && oc_curve_closed(c));
+  ck_assert(oc_curve_kappa_max(c) == 0);
+  ck_assert_double_eq_tol(oc_curve_max_turn(c), OCT_PI / 2, 1e-12);
+  ck_assert_double_eq_tol(oc_curve_length(c), 4, 1e-15);
+  oc_curve_free(c);
+  /* a cusp: the derivative vanishes where the curve turns */
+  oc_curve_piece cusp = {3, {{0, 0, 0}, {10, 10, 0}, {0, 10, 0}, {10, 0, 0}}};
+  c = new_ok(&cusp, 1);
+  ck_assert(isinf(oc_curve_kappa_max(c)));
+  oc_curve_free(c);
+}
+END_TEST
+
+START_TEST(flatten_within_tolerance) {
+  oct_rng r = oct_rng_new(23);
+  oc_curve_piece pcs[5];
+  int n = make_wiggle(pcs, 5, &r);
+  oc_pcurve *c = new_ok(pcs, n);
+  double tol = 1e-2;
+  size_t count = 0;
+  oc_error err = {0};
+  ck_assert_int_eq(oc_curve_flatten(c, tol, NULL, 0, &count, &err), OC_OK);
+  ck_assert(count > 10);
+  oc_curve_vertex *v = malloc(count * sizeof *v);
+  size_t again = 0;
+  ck_assert_int_eq(oc_curve_flatten(c, tol, v, count, &again, &err), OC_OK);
+  ck_assert_uint_eq(again, count);
+  ck_assert(v[0].s == 0 && v[count - 1].s == oc_curve_length(c));
+  for (size_t i = 1; i < count; i++)
+    ck_assert(v[i].s > v[i - 1].s);
+  /* every dense sample of the curve is within tol of the polyline */
+  double worst = 0;
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j <= 2000; j++) {
+      oc_vec3 q = ref_eval(&pcs[i], j / 2000.0);
+      double best = INFINITY;
+      for (size_t k = 1; k < count; k++) {
+        oc_vec3 a = oct_v(v[k - 1].x, v[k - 1].y, 0),
+                b = oct_v(v[k].x, v[k].y, 0);
+        best = fmin(best, oct_dist_segment(oct_v(q.x, q.y, 0), a, b, NULL));
+      }
+      worst = fmax(worst, best);
+    }
+  printf("curve: flatten tol %g: %zu vertices, worst distance %.3g\n", tol,
+         count, worst);
+  ck_assert(worst <= tol);
+  /* vertices lie on the curve, at their arc length */
+  for (size_t k = 0; k < count; k += 7) {
+    oc_curve_point p;
+    oc_curve_at(c, v[k].s, &p);
+    ck_assert(hypot(p.q.x - v[k].x, p.q.y - v[k].y) < 1e-7);
+  }
+  free(v);
+  ck_assert_int_eq(oc_curve_flatten(c, 0, NULL, 0, &count, &err), OC_EINVAL);
+  ck_assert(strstr(err.msg, "'tolerance'"));
+  ck_assert_int_eq(oc_curve_flatten(c, NAN, NULL, 0, &count, &err), OC_EINVAL);
+  oc_curve_free(c);
+}
+END_TEST
+
+START_TEST(bounds_contain_the_curve) {
+  oct_rng r = oct_rng_new(31);
+  oc_curve_piece pcs[4];
+  int n = make_wiggle(pcs, 4, &r);
+  oc_pcurve *c = new_ok(pcs, n);
+  oc_aabb b = oc_curve_bounds(c, 0), g = oc_curve_bounds(c, 3);
+  oc_vec3 lo = oct_v(INFINITY, INFINITY, INFINITY), hi = oct_mul(lo, -1);
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j <= 5000; j++) {
+      oc_vec3 q = ref_eval(&pcs[i], j / 5000.0);
+      ck_assert(q.x >= b.lo.x - 1e-12 && q.x <= b.hi.x + 1e-12);
+      ck_assert(q.y >= b.lo.y - 1e-12 && q.y <= b.hi.y + 1e-12);
+      ck_assert(q.z >= b.lo.z - 1e-12 && q.z <= b.hi.z + 1e-12);
+      lo = oct_v(fmin(lo.x, q.x), fmin(lo.y, q.y), fmin(lo.z, q.z));
+      hi = oct_v(fmax(hi.x, q.x), fmax(hi.y, q.y), fmax(hi.z, q.z));
+    }
+  /* tight: the sampled extremes reach the box */
+  ck_assert(b.lo.x > lo.x - 1e-5 && b.lo.y > lo.y - 1e-5 &&
+            b.lo.z > lo.z - 1e-5);
+  ck_assert(b.hi.x < hi.x + 1e-5 && b.hi.y < hi.y + 1e-5 &&
+            b.hi.z < hi.z + 1e-5);
+  ck_assert(g.lo.x == b.lo.x - 3 && g.hi.y == b.hi.y + 3 && g.lo.z == b.lo.z);
+  oc_curve_free(c);
+}
+END_TEST
+
+START_TEST(bad_input_is_refused) {
+  oc_error err = {0};
+  oc_vec3 one = {1, 2, 3};
+  ck_assert(!oc_curve_from_points(&one, 1, 3, &err));
+  ck_assert_int_eq(err.code, OC_EINVAL);
+  ck_assert(strstr(err.msg, "'points'"));
+  oc_vec3 five[5] = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}, {4, 0, 0}};
+  ck_assert(!oc_curve_from_points(five, 5, 3, &err)); /* not 3m + 1 */
+  ck_assert(strstr(err.msg, "'points'"));
+  ck_assert(!oc_curve_new(NULL, 0, &err));
+  oc_curve_piece p[3] = {{1, {{0, 0, 0}, {1, 0, 0}}},
+                         {1, {{1, 0, 0}, {2, NAN, 0}}},
+                         {1, {{2, 0, 0}, {3, 0, 0}}}};
+  ck_assert(!oc_curve_new(p, 3, &err));
+  ck_assert_msg(strstr(err.msg, "piece 1") && strstr(err.msg, "finite"), "%s",
+                err.msg);
+  p[1].p[1].y = 0;
+  p[2].p[0].x = 2.5;
+  ck_assert(!oc_curve_new(p, 3, &err));
+  ck_assert_msg(strstr(err.msg, "piece 2 does not start"), "%s", err.msg);
+  p[2].p[0].x = 2;
+  p[1].degree = 4;
+  ck_assert(!oc_curve_new(p, 3, &err));
+  ck_assert_msg(strstr(err.msg, "piece 1: degree"), "%s", err.msg);
+  /* zero length everywhere, and a vertical step */
+  oc_curve_piece dot = {3, {{1, 1, 0}, {1, 1, 0}, {1, 1, 0}, {1, 1, 0}}};
+  ck_assert(!oc_curve_new(&dot, 1, &err));
+  ck_assert_msg(strstr(err.msg, "no length"), "%s", err.msg);
+  oc_curve_piece step[2] = {{1, {{0, 0, 0}, {1, 0, 0}}},
+                            {1, {{1, 0, 0}, {1, 0, 5}}}};
+  ck_assert(!oc_curve_new(step, 2, &err));
+  ck_assert_msg(strstr(err.msg, "piece 1") && strstr(err.msg, "z changes"),
+                "%s", err.msg);
+  /* a zero-length piece with constant z is dropped */
+  step[1].p[1].z = 0;
+  oc_pcurve *c = oc_curve_new(step, 2, &err);
+  ck_assert(c && oc_curve_npieces(c) == 1);
+  oc_curve_free(c);
+}
+END_TEST
+
+START_TEST(many_pieces_answer_fast) {
+  /* a meandering G1 spline of 1000 pieces; queries near and far */
+  oct_rng r = oct_rng_new(77);
+  int n = 1000;
+  oc_curve_piece *pcs = malloc(n * sizeof *pcs);
+  make_wiggle(pcs, n, &r);
+  oc_pcurve *c = new_ok(pcs, n);
+  oc_aabb b = oc_curve_bounds(c, 20);
+  int nq = 20000, hits = 0;
+  clock_t t0 = clock();
+  double sum = 0;
+  for (int k = 0; k < nq; k++) {
+    double x = oct_unif(&r, b.lo.x, b.hi.x), y = oct_unif(&r, b.lo.y, b.hi.y);
+    oc_curve_point cp;
+    if (oc_curve_closest(c, x, y, 10, &cp)) hits++, sum += cp.d;
+  }
+  double sec = (double)(clock() - t0) / CLOCKS_PER_SEC;
+  printf("curve: 1000 pieces, %d queries within r = 10 in %.3f s (%.2f us "
+         "each, %d hits)\n",
+         nq, sec, 1e6 * sec / nq, hits);
+  ck_assert(hits > 0);
+  /* a few answers against the reference over all pieces */
+  for (int k = 0; k < 5; k++) {
+    int i = (int)oct_unif(&r, 0, n - 1);
+    oc_vec3 q = ref_eval(&pcs[i], 0.37);
+    double x = q.x + 3, y = q.y - 2;
+    oc_curve_point cp;
+    ck_assert(oc_curve_closest(c, x, y, INFINITY, &cp));
+    int bp;
+    double bt, ref = ref_closest(pcs, n, x, y, &bp, &bt);
+    ck_assert(fabs(fabs(cp.d) - ref) < 1e-9 * (1 + ref));
+  }
+  ck_assert(sec < 5.0); /* generous: 20000 queries, any machine */
+  oc_curve_free(c);
+  free(pcs);
+}
+END_TEST
+
+int main(void) {
+  setvbuf(stdout, NULL, _IOLBF, 0);
+  Suite *s = suite_create("curve");
+  TCase *tc = tcase_create("curve");
+  tcase_set_timeout(tc, 300);
+  tcase_add_test(tc, closest_matches_brute_force);
+  tcase_add_test(tc, closest_within_radius);
+  tcase_add_test(tc, signed_distance_sign);
+  tcase_add_test(tc, arclength_quarter_circle);
+  tcase_add_test(tc, frames_are_unit_and_left);
+  tcase_add_test(tc, kappa_bound_holds_and_is_tight);
+  tcase_add_test(tc, flatten_within_tolerance);
+  tcase_add_test(tc, bounds_contain_the_curve);
+  tcase_add_test(tc, bad_input_is_refused);
+  tcase_add_test(tc, many_pieces_answer_fast);
+  suite_add_tcase(s, tc);
+  return oct_run(s);
+}
