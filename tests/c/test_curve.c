@@ -476,7 +476,10 @@ START_TEST(many_pieces_answer_fast) {
   int n = 1000;
   oc_curve_piece *pcs = malloc(n * sizeof *pcs);
   make_wiggle(pcs, n, &r);
+  clock_t tb = clock();
   oc_pcurve *c = new_ok(pcs, n);
+  printf("curve: 1000 cubic pieces built in %.3f s (CPU)\n",
+         (double)(clock() - tb) / CLOCKS_PER_SEC);
   oc_aabb b = oc_curve_bounds(c, 20);
   int nq = 20000, hits = 0;
   clock_t t0 = clock();
@@ -508,6 +511,72 @@ START_TEST(many_pieces_answer_fast) {
 }
 END_TEST
 
+START_TEST(hard_closest_cases) {
+  /* the centre of a circle-like arc (every point nearly equidistant), the
+  ** cusp curve near its cusp, a looping cubic near its crossing, points
+  ** right on the curve */
+  double R = 100;
+  oc_curve_piece cases[3] = {
+      {3, {{R, 0, 0}, {R, R * KAPPA_Q, 0}, {R * KAPPA_Q, R, 0}, {0, R, 0}}},
+      {3, {{0, 0, 0}, {10, 10, 0}, {0, 10, 0}, {10, 0, 0}}},
+      {3, {{0, 0, 0}, {30, 20, 1}, {-10, 20, 2}, {20, 0, 3}}}};
+  oct_rng r = oct_rng_new(99);
+  for (int k = 0; k < 3; k++) {
+    oc_pcurve *c = new_ok(&cases[k], 1);
+    oc_aabb b = oc_curve_bounds(c, 2);
+    for (int i = 0; i < 300; i++) {
+      double x, y;
+      if (i == 0 && k == 0) {
+        x = 0, y = 0;
+      } else if (i % 3 == 0) {
+        oc_vec3 q = ref_eval(&cases[k], oct_unif(&r, 0, 1));
+        x = q.x + oct_unif(&r, -1e-7, 1e-7),
+        y = q.y + oct_unif(&r, -1e-7, 1e-7);
+      } else if (k == 1 && i % 3 == 1) {
+        x = 5 + oct_unif(&r, -1, 1), y = 7.5 + oct_unif(&r, -1, 1);
+      } else {
+        x = oct_unif(&r, b.lo.x, b.hi.x), y = oct_unif(&r, b.lo.y, b.hi.y);
+      }
+      int bp;
+      double bt, ref = ref_closest(&cases[k], 1, x, y, &bp, &bt);
+      oc_curve_point cp;
+      ck_assert(oc_curve_closest(c, x, y, INFINITY, &cp));
+      ck_assert_msg(fabs(fabs(cp.d) - ref) <= 1e-9 * (1 + ref),
+                    "case %d (%g, %g): %.15g vs %.15g", k, x, y, fabs(cp.d),
+                    ref);
+    }
+    oc_curve_free(c);
+  }
+}
+END_TEST
+
+START_TEST(queries_are_thread_safe) {
+  /* the same queries from two threads and from one give the same bits */
+  oct_rng r = oct_rng_new(8);
+  oc_curve_piece pcs[30];
+  make_wiggle(pcs, 30, &r);
+  oc_pcurve *c = new_ok(pcs, 30);
+  enum { NQ = 20000 };
+  static double xs[NQ], ys[NQ], d1[NQ], d2[NQ], s1[NQ], s2[NQ];
+  oc_aabb b = oc_curve_bounds(c, 10);
+  for (int i = 0; i < NQ; i++)
+    xs[i] = oct_unif(&r, b.lo.x, b.hi.x), ys[i] = oct_unif(&r, b.lo.y, b.hi.y);
+  for (int i = 0; i < NQ; i++) {
+    oc_curve_point cp;
+    oc_curve_closest(c, xs[i], ys[i], INFINITY, &cp);
+    d1[i] = cp.d, s1[i] = cp.s;
+  }
+#pragma omp parallel for num_threads(2) schedule(dynamic, 64)
+  for (int i = 0; i < NQ; i++) {
+    oc_curve_point cp;
+    oc_curve_closest(c, xs[i], ys[i], INFINITY, &cp);
+    d2[i] = cp.d, s2[i] = cp.s;
+  }
+  ck_assert(memcmp(d1, d2, sizeof d1) == 0 && memcmp(s1, s2, sizeof s1) == 0);
+  oc_curve_free(c);
+}
+END_TEST
+
 int main(void) {
   setvbuf(stdout, NULL, _IOLBF, 0);
   Suite *s = suite_create("curve");
@@ -523,6 +592,8 @@ int main(void) {
   tcase_add_test(tc, bounds_contain_the_curve);
   tcase_add_test(tc, bad_input_is_refused);
   tcase_add_test(tc, many_pieces_answer_fast);
+  tcase_add_test(tc, hard_closest_cases);
+  tcase_add_test(tc, queries_are_thread_safe);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }
