@@ -83,7 +83,9 @@ int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
 
 /* An upper bound of the planar curvature |kappa| inside the pieces,
 ** rigorous up to rounding and within about 1 % of the true maximum
-** (bezier.h); 0 for a polyline, INFINITY when a Bézier piece has a cusp.
+** (bezier.h); 0 for a polyline, INFINITY where a Bézier piece's
+** derivative vanishes: a cusp, or an end control point doubled (p[1] =
+** p[0]), whose curvature is generally unbounded near that end.
 ** Joins are not included: see oc_curve_max_turn. Computed at build. */
 double oc_curve_kappa_max(const oc_pcurve *c);
 

@@ -254,6 +254,12 @@ START_TEST(signed_distance_sign) {
   ck_assert_double_eq_tol(cp.d, R - hypot(5, 7), 1e-3 * R);
   ck_assert(oc_curve_closest(c, 80, -10, INFINITY, &cp));
   ck_assert(cp.d < 0);
+  /* at the closing point: no end, the tangent is the bisector (0, 1) */
+  ck_assert(oc_curve_closest(c, R + 5, 0, INFINITY, &cp));
+  ck_assert(cp.end == 0 && cp.d < 0);
+  ck_assert_double_eq_tol(cp.d, -5, 1e-12);
+  ck_assert(fabs(cp.tx) < 1e-12 && fabs(cp.ty - 1) < 1e-12);
+  ck_assert(cp.s == 0 || cp.s == oc_curve_length(c));
   oc_curve_free(c);
 }
 END_TEST
