@@ -291,7 +291,18 @@ static double kappa_on(const oc_vec3 *p, int n, double a, double b) {
   for (int l = 0; l <= m; l++)
     num = fmax(num, fabs(c[l]));
   double lo = hull_dist0(dx, dy, n);
-  if (!(lo > 0)) return num == 0 ? 0 : INFINITY;
+  if (!(lo > 0)) {
+    /* The speed may vanish here. Straight (num = 0) and never reversing
+    ** (every hodograph point on one side of their sum) is kappa 0; a
+    ** straight piece doubling back on itself is a cusp. */
+    double sx = 0, sy = 0;
+    for (int i = 0; i < n; i++)
+      sx += dx[i], sy += dy[i];
+    int forward = sx != 0 || sy != 0;
+    for (int i = 0; i < n && forward; i++)
+      forward = dx[i] * sx + dy[i] * sy >= 0;
+    return num == 0 && forward ? 0 : INFINITY;
+  }
   return num / (lo * lo * lo);
 }
 

@@ -359,6 +359,16 @@ START_TEST(kappa_bound_holds_and_is_tight) {
   c = new_ok(&cusp, 1);
   ck_assert(isinf(oc_curve_kappa_max(c)));
   oc_curve_free(c);
+  /* a straight cubic has kappa 0; one that doubles back along its line
+  ** is a cusp */
+  oc_curve_piece line = {3, {{0, 0, 0}, {1, 2, 0}, {5, 10, 0}, {6, 12, 0}}};
+  c = new_ok(&line, 1);
+  ck_assert(oc_curve_kappa_max(c) == 0);
+  oc_curve_free(c);
+  oc_curve_piece back = {3, {{0, 0, 0}, {6, 0, 0}, {-2, 0, 0}, {3, 0, 0}}};
+  c = new_ok(&back, 1);
+  ck_assert(isinf(oc_curve_kappa_max(c)));
+  oc_curve_free(c);
 }
 END_TEST
 
