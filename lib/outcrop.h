@@ -920,6 +920,183 @@ enum { OC_TERRAIN_EDGES_DEFAULT, OC_TERRAIN_OPEN, OC_TERRAIN_SLAB };
 oc_node *oc_terrain(const oc_elevation *src, const oc_terrain_params *tp,
                     oc_error *err);
 
+/* ---- elevation trees (Génevaux et al. 2015) ----------------------- */
+
+/* lib/elevation; docs/fields.md, "Elevation trees", has the formulas. A
+** node maps a point (x, y) to an elevation f and a weight alpha, with
+** compact support Omega_0 = {alpha > 0}; the terrain is where alpha >=
+** 1/2. f is defined on the whole plane (a blend divides by max(sum
+** alpha, 1/2), which is the paper's f where the terrain is), and every
+** node knows the range of f and alpha and Lipschitz bounds of both, over
+** the plane and inside any box. Nodes are immutable and reference
+** counted; a tree is a DAG (instancing). Constructors retain their
+** children and return a new reference or NULL with err. */
+typedef struct oc_enode oc_enode;
+
+typedef struct oc_enode_sample {
+  double f, a;   /* elevation and weight */
+  double fx, fy; /* grad f */
+  double ax, ay; /* grad alpha */
+} oc_enode_sample;
+
+typedef enum oc_enoise_kind {
+  OC_ENOISE_NONE,       /* flat: f = height */
+  OC_ENOISE_PLAIN,      /* sum a_i eta(s_i (p - c)) */
+  OC_ENOISE_TURBULENCE, /* sum a_i |eta| */
+  OC_ENOISE_RIDGED      /* Musgrave's ridged multifractal, terms in [0, a_i] */
+} oc_enoise_kind;
+
+/* a_i = amplitude gain^i, s_i = lacunarity^i / wavelength, i < octaves;
+** eta is the engine's simplex noise on z = 0 remapped to [-1, 1]. */
+typedef struct oc_enode_noise {
+  oc_enoise_kind kind;
+  double amplitude;  /* >= 0 */
+  double wavelength; /* > 0 */
+  int octaves;       /* 1 .. 16 */
+  double gain;       /* in (0, 1]; 0: 1/2 */
+  double lacunarity; /* >= 1; 0: 2 */
+  uint64_t seed;
+} oc_enode_noise;
+
+typedef struct oc_enode_disc_params {
+  double cx, cy; /* centre */
+  double radius; /* > 0: alpha = (1 - (d / radius)^2)^3 */
+  double height; /* base elevation */
+  oc_enode_noise noise;
+} oc_enode_disc_params;
+
+oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err);
+
+/* A cross-section: knots (d[i], v[i]) of the signed distance d (> 0 on
+** the left of the direction of travel), d increasing, interpolated by a
+** C1 shape-preserving quadratic spline, constant beyond the end knots;
+** placed at arc length fraction `at` in [0, 1] of the skeleton. */
+typedef struct oc_enode_profile {
+  double at;
+  const double *d, *v;
+  size_t n;
+} oc_enode_profile;
+
+typedef enum oc_ecurve_spline {
+  OC_ECURVE_CATMULL, /* a C1 cubic through the points (uniform Catmull-Rom) */
+  OC_ECURVE_BEZIER,  /* the points are cubic Bézier control points (3k + 1) */
+  OC_ECURVE_LINEAR   /* segments (refused where they make a corner) */
+} oc_ecurve_spline;
+
+/* f = q_z + c(s, d), alpha = g(max(0, |p - q| - core) / (radius - core)),
+** q the closest point of the skeleton (points x, y and its elevation z),
+** c the profiles interpolated by arc length. Refused when radius is not
+** below the skeleton's smallest radius of curvature, or at a corner. */
+typedef struct oc_enode_curve_params {
+  const oc_vec3 *points;
+  size_t npoints;
+  oc_ecurve_spline spline;
+  double radius; /* > 0: where alpha reaches 0 */
+  double core;   /* in [0, radius): where alpha is 1 */
+  const oc_enode_profile *profiles;
+  size_t nprofiles;
+} oc_enode_curve_params;
+oc_enode *oc_enode_curve(const oc_enode_curve_params *p, oc_error *err);
+
+/* Presets (docs/fields.md, "Elevation trees", has their cross-sections):
+** a river's channel (width, depth, banks; 0 picks the kind's) and a road
+** levelling its neighbourhood (carriageway width 7, shoulders 1.5,
+** embankment 12 by default: 0, or shoulder < 0, picks them). */
+typedef enum oc_river_kind {
+  OC_RIVER_STREAM,  /* 3 m wide, 0.8 deep, banks 4 */
+  OC_RIVER_RIVER,   /* 20, 3, 25 */
+  OC_RIVER_MEANDER, /* 40, 4, 60 */
+  OC_RIVER_MAIN     /* main stem: 150, 10, 200 */
+} oc_river_kind;
+typedef struct oc_enode_river_params {
+  const oc_vec3 *points;
+  size_t npoints;
+  oc_ecurve_spline spline;
+  oc_river_kind kind;
+  double width, depth, bank;
+} oc_enode_river_params;
+oc_enode *oc_enode_river(const oc_enode_river_params *p, oc_error *err);
+typedef struct oc_enode_road_params {
+  const oc_vec3 *points;
+  size_t npoints;
+  oc_ecurve_spline spline;
+  double width, shoulder, embankment;
+} oc_enode_road_params;
+oc_enode *oc_enode_road(const oc_enode_road_params *p, oc_error *err);
+/* f = sum alpha_i f_i / max(sum alpha_i, 1/2), alpha = sum alpha_i. */
+oc_enode *oc_enode_blend(oc_enode *const *kids, size_t n, oc_error *err);
+/* w = clamp(alpha_B, 0, 1): f = (1 - w) f_A + w f_B; alpha = alpha_A, or
+** with lerp (1 - w) alpha_A + w^2. */
+oc_enode *oc_enode_replace(oc_enode *a, oc_enode *b, int lerp, oc_error *err);
+
+typedef struct oc_enode_add_params {
+  int sum_weight; /* 1: alpha = alpha_A + w_B^2 (else alpha_A) */
+  int below;      /* 1: B only below an altitude of A: */
+  double below_z; /* the weight is 1 where f_A <= below_z - fade, 0 where */
+  double fade;    /* f_A >= below_z, smooth between; fade > 0 */
+} oc_enode_add_params;
+/* w = clamp(alpha_B, 0, 1) (times the altitude weight): f = f_A + w f_B. */
+oc_enode *oc_enode_add(oc_enode *a, oc_enode *b, const oc_enode_add_params *p,
+                       oc_error *err);
+
+/* p = scale R(angle) p' + (tx, ty): f(p) = vscale f(p') + voffset,
+** alpha(p) = alpha(p'). Consecutive transforms are concatenated. */
+typedef struct oc_enode_xform {
+  double tx, ty;
+  double angle;  /* degrees, counter-clockwise */
+  double scale;  /* > 0 (0: 1) */
+  double vscale; /* != 0 (0: 1) */
+  double voffset;
+} oc_enode_xform;
+oc_enode *oc_enode_transform(oc_enode *e, const oc_enode_xform *x,
+                             oc_error *err);
+
+/* f(p) = f_A(p + delta(p)), delta = amplitude (eta_1, eta_2) summed over
+** octaves (gain 1/2, lacunarity 2) at p / wavelength; refused unless
+** delta's Lipschitz bound is < 1, so p -> p + delta(p) is a bijection. */
+typedef struct oc_enode_warp_params {
+  double amplitude, wavelength;
+  int octaves;
+  uint64_t seed;
+} oc_enode_warp_params;
+oc_enode *oc_enode_warp(oc_enode *e, const oc_enode_warp_params *p,
+                        oc_error *err);
+
+void oc_enode_retain(oc_enode *e);
+void oc_enode_release(oc_enode *e);
+const char *oc_enode_kind(const oc_enode *e);
+
+/* f, alpha and their gradients at (x, y); NaN in gives NaN out. */
+void oc_enode_eval(const oc_enode *e, double x, double y, oc_enode_sample *s);
+/* The box holding Omega_0 (x0, y0, x1, y1) and the range of f over the
+** plane; the Lipschitz bound of f over the plane. */
+void oc_enode_get_bounds(const oc_enode *e, double box[4], double *flo,
+                         double *fhi);
+double oc_enode_lipschitz(const oc_enode *e);
+
+/* Inside the box [x0, x1] x [y0, y1]: ranges of f and alpha, and
+** Lipschitz bounds of f and alpha (conservative). */
+typedef struct oc_enode_bound {
+  double flo, fhi, alo, ahi, lf, la;
+} oc_enode_bound;
+void oc_enode_bound_in(const oc_enode *e, double x0, double y0, double x1,
+                       double y1, oc_enode_bound *b);
+
+typedef struct oc_enode_stats {
+  size_t nodes;      /* distinct nodes of the DAG */
+  size_t primitives; /* distinct primitives */
+  size_t bytes;      /* their memory */
+} oc_enode_stats;
+/* OC_OK, or OC_ENOMEM with err. */
+int oc_enode_get_stats(const oc_enode *e, oc_enode_stats *st, oc_error *err);
+
+/* An elevation source (for oc_terrain, oc_heightfield_from_elevation…)
+** over domain (x0, y0, x1, y1; NULL: the box of Omega_0): height f,
+** ranges and slopes from the tree's own bounds. Holds one reference to
+** e. OC_OK, or OC_EINVAL with err for an empty or infinite domain. */
+int oc_enode_elevation(oc_enode *e, const double *domain, oc_elevation *src,
+                       oc_error *err);
+
 /* ---- geology: resistance trees and the erosion node ----- */
 
 /* geology/geology.c and geology/erosion.c; docs/fields.md, "Geology", has the

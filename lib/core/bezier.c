@@ -306,6 +306,31 @@ static double kappa_on(const oc_vec3 *p, int n, double a, double b) {
   return num / (lo * lo * lo);
 }
 
+/* An upper bound of |z'| / |xy'| of the piece on [a, b] (depth: splits
+** left where the hodograph's hull holds the origin). */
+static double grade_on(const oc_vec3 *p, int n, double a, double b, int depth) {
+  oc_vec3 s[4];
+  oc_bez_sub(p, n, a, b, s);
+  double dx[3], dy[3], dz = 0;
+  for (int i = 0; i < n; i++) {
+    dx[i] = n * (s[i + 1].x - s[i].x), dy[i] = n * (s[i + 1].y - s[i].y);
+    dz = fmax(dz, fabs(n * (s[i + 1].z - s[i].z)));
+  }
+  if (dz == 0) return 0;
+  double lo = hull_dist0(dx, dy, n);
+  if (lo > 0) return dz / lo * (1 + 1e-9);
+  if (depth >= 12) return INFINITY;
+  double m = (a + b) / 2;
+  return fmax(grade_on(p, n, a, m, depth + 1), grade_on(p, n, m, b, depth + 1));
+}
+
+double oc_bez_grade_bound(const oc_vec3 *p, int n) {
+  double g = 0;
+  for (int k = 0; k < 16; k++)
+    g = fmax(g, grade_on(p, n, k / 16.0, (k + 1) / 16.0, 0));
+  return g;
+}
+
 double oc_bez_kappa_bound(const oc_vec3 *p, int n, double rel_tol,
                           double abs_tol) {
   if (n < 2) return 0;

@@ -53,6 +53,13 @@ double oc_bez_curvature(const oc_vec3 *p, int n, double t);
 double oc_bez_kappa_bound(const oc_vec3 *p, int n, double rel_tol,
                           double abs_tol);
 
+/* An upper bound of the grade |dz/ds| (z against planar arc length) over
+** the piece, rigorous up to rounding: on 16 sub-intervals (split further
+** where needed) the largest |z'| of the hodograph's control points over
+** the distance of the origin to the hull of their xy. INFINITY where the
+** planar speed may vanish while z changes. */
+double oc_bez_grade_bound(const oc_vec3 *p, int n);
+
 /* Flattening: calls emit(ud, t) (when emit is not NULL) for the
 ** increasing parameters 0 < t_1 < ... < t_k = 1 at which to cut the piece
 ** so that every point of the piece lies within tol (in xy) of the chord of

@@ -365,6 +365,25 @@ double oc_curve_max_turn(const oc_pcurve *c) {
   return c->turn;
 }
 
+double oc_curve_grade_max(const oc_pcurve *c) {
+  double g = 0;
+  for (size_t i = 0; i < c->n; i++)
+    g = fmax(g, oc_bez_grade_bound(c->pc[i].p, c->pc[i].deg));
+  return g;
+}
+
+double oc_curve_curvature_at(const oc_pcurve *c, const oc_curve_point *pt) {
+  const piece *pc = &c->pc[pt->piece];
+  return pc->deg < 2 ? 0 : oc_bez_curvature(pc->p, pc->deg, pt->t);
+}
+
+double oc_curve_grade_at(const oc_pcurve *c, const oc_curve_point *pt) {
+  const piece *pc = &c->pc[pt->piece];
+  oc_vec3 d = oc_bez_d1(pc->p, pc->deg, pt->t);
+  double v = hypot(d.x, d.y);
+  return v > 0 ? d.z / v : 0;
+}
+
 oc_aabb oc_curve_bounds(const oc_pcurve *c, double r) {
   oc_aabb b = c->box;
   b.lo.x -= r, b.lo.y -= r, b.hi.x += r, b.hi.y += r;

@@ -95,6 +95,15 @@ double oc_curve_kappa_max(const oc_pcurve *c);
 ** (w kappa_max < 1) only on a curve without corners. */
 double oc_curve_max_turn(const oc_pcurve *c);
 
+/* An upper bound of the grade |dz/ds| along the whole curve (rigorous up
+** to rounding; oc_bez_grade_bound per piece). */
+double oc_curve_grade_max(const oc_pcurve *c);
+/* At a point answered by oc_curve_at or oc_curve_closest: the signed
+** planar curvature (> 0 turning left; 0 at the ends of pieces' joins
+** treated as the piece's own) and the grade dz/ds. */
+double oc_curve_curvature_at(const oc_pcurve *c, const oc_curve_point *pt);
+double oc_curve_grade_at(const oc_pcurve *c, const oc_curve_point *pt);
+
 /* The tight box of the curve (x, y and z) with x and y grown by r >= 0. */
 oc_aabb oc_curve_bounds(const oc_pcurve *c, double r);
 

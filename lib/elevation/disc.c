@@ -1,0 +1,256 @@
+/*
+** disc.c — the disc primitive of elevation trees (Génevaux et al. 2015,
+** section 4.1): alpha = g(|p - c| / r) with Wyvill's g(x) = (1 - x^2)^3,
+** and f = height + a sum of noise octaves centred on c, plain, turbulent
+** or ridged (Musgrave's ridged multifractal). The noise eta is the
+** engine's simplex noise on z = 0 remapped to [-1, 1], whose Lipschitz
+** bound is proven (core/noise.c), so the disc's is too: lambda_eta sum
+** a_i s_i for plain and turbulent sums (the extracted text of the paper
+** prints a_i lambda_eta / s_i).
+*/
+#include <math.h>
+
+#include "core/error.h"
+#include "core/falloff.h"
+#include "core/noise.h"
+#include "core/rng.h"
+#include "core/vec.h"
+#include "elevation/enode.h"
+
+/* Ridged octaves: w_i = clamp(RIDGE_GAIN s_(i-1), 0, 1). */
+#define RIDGE_GAIN 2.0
+
+double oc_eta(uint64_t seed, double x, double y, double g[2]) {
+  oc_vec3 gr;
+  double n = oc_noise3(seed, oc_v3(x, y, 0), g ? &gr : NULL);
+  if (g) {
+    g[0] = 2 * gr.x;
+    g[1] = 2 * gr.y;
+  }
+  return 2 * n - 1;
+}
+
+static uint64_t octave_seed(uint64_t seed, int i) {
+  return oc_mix64(seed + 0x9e3779b97f4a7c15ull * (uint64_t)(i + 1));
+}
+
+/* The noise sum at (u, v) = p - c, and its gradient in g when not NULL. */
+static double noise_sum(const oc_enoise *nz, double u, double v, double g[2]) {
+  double sum = 0, a = nz->amplitude, s = 1 / nz->wavelength;
+  double prev = 1, gprev[2] = {0, 0}; /* ridged: s_(i-1) and its gradient */
+  if (g) g[0] = g[1] = 0;
+  for (int i = 0; i < nz->octaves; i++) {
+    double ge[2];
+    double e = oc_eta(octave_seed(nz->seed, i), s * u, s * v, g ? ge : NULL);
+    switch (nz->kind) {
+    case OC_ENOISE_PLAIN:
+      sum += a * e;
+      if (g) g[0] += a * s * ge[0], g[1] += a * s * ge[1];
+      break;
+    case OC_ENOISE_TURBULENCE: {
+      double sg = e < 0 ? -1 : 1;
+      sum += a * fabs(e);
+      if (g) g[0] += a * s * sg * ge[0], g[1] += a * s * sg * ge[1];
+      break;
+    }
+    default: { /* ridged */
+      double sg = e < 0 ? -1 : 1, r = 1 - fabs(e);
+      double w = 1, gw[2] = {0, 0};
+      if (i > 0) {
+        w = RIDGE_GAIN * prev;
+        if (w >= 1) {
+          w = 1;
+        } else if (w <= 0) {
+          w = 0;
+        } else if (g) {
+          gw[0] = RIDGE_GAIN * gprev[0];
+          gw[1] = RIDGE_GAIN * gprev[1];
+        }
+      }
+      double t = w * r * r;
+      sum += a * t;
+      if (g) {
+        /* grad t = r^2 grad w - 2 w r sign(e) s grad eta */
+        double k = -2 * w * r * sg * s;
+        gprev[0] = r * r * gw[0] + k * ge[0];
+        gprev[1] = r * r * gw[1] + k * ge[1];
+        g[0] += a * gprev[0];
+        g[1] += a * gprev[1];
+      }
+      prev = t;
+    }
+    }
+    a *= nz->gain;
+    s *= nz->lacunarity;
+  }
+  return sum;
+}
+
+/* Range and Lipschitz bound of the noise sum. */
+static void noise_bounds(const oc_enoise *nz, double *lo, double *hi,
+                         double *lip) {
+  double a = nz->amplitude, s = 1 / nz->wavelength, asum = 0, l = 0, lr = 0;
+  double le = 2 * oc_noise3_lipschitz;
+  for (int i = 0; i < nz->octaves; i++) {
+    asum += a;
+    if (nz->kind == OC_ENOISE_RIDGED) {
+      /* |grad s_i| <= G |grad s_(i-1)| + 2 lambda_eta s_i */
+      lr = (i ? RIDGE_GAIN * lr : 0) + 2 * le * s;
+      l += a * lr;
+    } else {
+      l += a * le * s;
+    }
+    a *= nz->gain;
+    s *= nz->lacunarity;
+  }
+  *lo = nz->kind == OC_ENOISE_PLAIN ? -asum : 0;
+  *hi = asum;
+  *lip = l;
+}
+
+void oc_edisc_ev(const oc_enode *n, double x, double y, int want,
+                 oc_enode_sample *s) {
+  const double *p = n->par; /* cx, cy, r, height */
+  double u = x - p[0], v = y - p[1], r = p[2];
+  double q = (u * u + v * v) / (r * r);
+  int grad = want & OC_EV_GRAD;
+  s->ax = s->ay = 0;
+  if (q < 1) {
+    double k = 1 - q;
+    s->a = k * k * k;
+    if (grad) {
+      double c = -6 * k * k / (r * r);
+      s->ax = c * u;
+      s->ay = c * v;
+    }
+  } else {
+    s->a = q == q ? 0 : q; /* NaN stays NaN */
+    if (want & OC_EV_LAZY && s->a == 0) {
+      s->f = s->fx = s->fy = 0;
+      return;
+    }
+  }
+  double g[2] = {0, 0};
+  s->f = p[3] + (n->noise.kind == OC_ENOISE_NONE
+                     ? 0
+                     : noise_sum(&n->noise, u, v, grad ? g : NULL));
+  s->fx = g[0];
+  s->fy = g[1];
+}
+
+/* Distances from (cx, cy) to the nearest and farthest points of b. */
+static void rect_dist(const oc_erect *b, double cx, double cy, double *dmin,
+                      double *dmax) {
+  double dx = fmax(fmax(b->x0 - cx, cx - b->x1), 0);
+  double dy = fmax(fmax(b->y0 - cy, cy - b->y1), 0);
+  double fx = fmax(fabs(b->x0 - cx), fabs(b->x1 - cx));
+  double fy = fmax(fabs(b->y0 - cy), fabs(b->y1 - cy));
+  *dmin = sqrt(dx * dx + dy * dy);
+  *dmax = sqrt(fx * fx + fy * fy);
+}
+
+static double wyvill(double x) {
+  if (!(x < 1)) return 0;
+  double k = 1 - x * x;
+  return k * k * k;
+}
+
+void oc_edisc_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+  *o = n->glob;
+  if (!oc_erect_meets(&n->box, b)) {
+    o->alo = o->ahi = o->la = 0;
+    return;
+  }
+  double dmin, dmax, r = n->par[2];
+  rect_dist(b, n->par[0], n->par[1], &dmin, &dmax);
+  /* rounding: alpha's bounds a hair wider than the formula */
+  o->alo = fmax(0, wyvill(dmax / r) * (1 - 1e-12) - 1e-300);
+  o->ahi = fmin(1, wyvill(dmin / r) * (1 + 1e-12));
+}
+
+static int check_noise(const oc_enode_noise *nz, oc_enoise *out,
+                       oc_error *err) {
+  if ((unsigned)nz->kind > OC_ENOISE_RIDGED)
+    return oc_seterr(err, OC_EINVAL, "'noise.kind' is not a noise kind (%d)",
+                     (int)nz->kind);
+  out->kind = nz->kind;
+  out->amplitude = nz->amplitude;
+  out->wavelength = nz->wavelength;
+  out->octaves = nz->octaves;
+  out->gain = nz->gain == 0 ? 0.5 : nz->gain;
+  out->lacunarity = nz->lacunarity == 0 ? 2 : nz->lacunarity;
+  out->seed = nz->seed;
+  if (nz->kind == OC_ENOISE_NONE) return OC_OK;
+  if (!(isfinite(nz->amplitude) && nz->amplitude >= 0))
+    return oc_seterr(err, OC_EINVAL,
+                     "'noise.amplitude' must be a finite number >= 0 (got %g)",
+                     nz->amplitude);
+  if (!(isfinite(nz->wavelength) && nz->wavelength > 0))
+    return oc_seterr(err, OC_EINVAL,
+                     "'noise.wavelength' must be a positive number (got %g)",
+                     nz->wavelength);
+  if (nz->octaves < 1 || nz->octaves > 16)
+    return oc_seterr(err, OC_EINVAL,
+                     "'noise.octaves' must be an integer in 1..16 (got %d)",
+                     nz->octaves);
+  if (!(out->gain > 0 && out->gain <= 1))
+    return oc_seterr(err, OC_EINVAL, "'noise.gain' must be in (0, 1] (got %g)",
+                     nz->gain);
+  if (!(isfinite(out->lacunarity) && out->lacunarity >= 1))
+    return oc_seterr(err, OC_EINVAL,
+                     "'noise.lacunarity' must be a finite number >= 1 (got %g)",
+                     nz->lacunarity);
+  return OC_OK;
+}
+
+oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err) {
+  oc_enoise nz;
+  if (!p) {
+    oc_seterr(err, OC_EINVAL, "disc: no parameters");
+    return NULL;
+  }
+  if (!isfinite(p->cx) || !isfinite(p->cy)) {
+    oc_seterr(err, OC_EINVAL, "'center' must have finite coordinates");
+    return NULL;
+  }
+  if (!(isfinite(p->radius) && p->radius > 0)) {
+    oc_seterr(err, OC_EINVAL, "'radius' must be a positive number (got %g)",
+              p->radius);
+    return NULL;
+  }
+  if (!isfinite(p->height)) {
+    oc_seterr(err, OC_EINVAL, "'height' must be a finite number (got %g)",
+              p->height);
+    return NULL;
+  }
+  if (check_noise(&p->noise, &nz, err)) return NULL;
+  double lo = 0, hi = 0, lip = 0;
+  if (nz.kind != OC_ENOISE_NONE) noise_bounds(&nz, &lo, &hi, &lip);
+  oc_erect box = {p->cx - p->radius, p->cy - p->radius, p->cx + p->radius,
+                  p->cy + p->radius};
+  if (!isfinite(p->height + lo) || !isfinite(p->height + hi) ||
+      !isfinite(lip) || !isfinite(box.x0) || !isfinite(box.x1) ||
+      !isfinite(box.y0) || !isfinite(box.y1) ||
+      !isfinite(OC_FALLOFF_LIPSCHITZ / p->radius)) {
+    oc_seterr(err, OC_EINVAL,
+              "disc: the elevations or slopes of these parameters overflow "
+              "(height %g, radius %g, noise amplitude %g, wavelength %g)",
+              p->height, p->radius, nz.amplitude, nz.wavelength);
+    return NULL;
+  }
+  oc_enode *n = oc_enode_alloc(OC_E_DISC, NULL, 0, err);
+  if (!n) return NULL;
+  n->par[0] = p->cx;
+  n->par[1] = p->cy;
+  n->par[2] = p->radius;
+  n->par[3] = p->height;
+  n->noise = nz;
+  n->box = box;
+  n->glob = (oc_ebound){p->height + lo,
+                        p->height + hi,
+                        0,
+                        1,
+                        lip,
+                        OC_FALLOFF_LIPSCHITZ / p->radius};
+  return n;
+}

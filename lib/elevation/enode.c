@@ -1,0 +1,221 @@
+/*
+** enode.c — elevation-tree nodes: allocation, reference counting,
+** evaluation and bounds dispatch, statistics, and the elevation source
+** through which a tree is a terrain like a grid (oc_terrain, heightfield
+** sampling, rendering).
+*/
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "core/grow.h"
+#include "core/pmap.h"
+#include "elevation/enode.h"
+
+static const char *const kind_names[OC_E_COUNT] = {
+    "disc", "curve", "blend", "replace", "add", "transform", "warp"};
+
+oc_enode *oc_enode_alloc(oc_ekind kind, oc_enode *const *kids, size_t nkids,
+                         oc_error *err) {
+  oc_enode *n = calloc(1, sizeof *n);
+  if (!n) {
+    oc_seterr(err, OC_ENOMEM, "out of memory");
+    return NULL;
+  }
+  n->refs = 1;
+  n->kind = kind;
+  if (nkids <= 2) {
+    n->kids = n->inl;
+  } else if (nkids > SIZE_MAX / sizeof *n->kids ||
+             !(n->kids = malloc(nkids * sizeof *n->kids))) {
+    free(n);
+    oc_seterr(err, OC_ENOMEM, "out of memory (%zu children)", nkids);
+    return NULL;
+  }
+  n->nkids = nkids;
+  for (size_t i = 0; i < nkids; i++) {
+    n->kids[i] = kids[i];
+    oc_enode_retain(kids[i]);
+  }
+  return n;
+}
+
+void oc_enode_retain(oc_enode *e) {
+  if (e) e->refs++;
+}
+
+/* Iterative, so that deep chains do not overflow the C stack. */
+void oc_enode_release(oc_enode *e) {
+  if (!e || --e->refs > 0) return;
+  oc_enode **stack = NULL;
+  size_t top = 0, cap = 0;
+  for (oc_enode *cur = e;;) {
+    for (size_t i = 0; i < cur->nkids; i++) {
+      oc_enode *k = cur->kids[i];
+      if (--k->refs > 0) continue;
+      if (!OC_GROW(stack, top, cap, 1)) { /* no memory: recurse for it */
+        k->refs = 1;
+        oc_enode_release(k);
+        continue;
+      }
+      stack[top++] = k;
+    }
+    if (cur->kids != cur->inl) free(cur->kids);
+    if (cur->kind == OC_E_CURVE) oc_ecurve_free(cur->data);
+    free(cur);
+    if (!top) break;
+    cur = stack[--top];
+  }
+  free(stack);
+}
+
+const char *oc_enode_kind(const oc_enode *e) {
+  return e && (unsigned)e->kind < OC_E_COUNT ? kind_names[e->kind] : "?";
+}
+
+void oc_enode_ev(const oc_enode *n, double x, double y, int want,
+                 oc_enode_sample *s) {
+  if (n->kind == OC_E_DISC)
+    oc_edisc_ev(n, x, y, want, s);
+  else if (n->kind == OC_E_CURVE)
+    oc_ecurve_ev(n, x, y, want, s);
+  else
+    oc_eop_ev(n, x, y, want, s);
+}
+
+void oc_enode_bnd(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+  if (n->kind == OC_E_DISC)
+    oc_edisc_bound_in(n, b, o);
+  else if (n->kind == OC_E_CURVE)
+    oc_ecurve_bound_in(n, b, o);
+  else
+    oc_eop_bound_in(n, b, o);
+}
+
+/* ---- public queries --------------------------------------------------- */
+
+void oc_enode_eval(const oc_enode *e, double x, double y, oc_enode_sample *s) {
+  if (!isfinite(x) || !isfinite(y)) {
+    s->f = s->a = s->fx = s->fy = s->ax = s->ay = NAN;
+    return;
+  }
+  oc_enode_ev(e, x, y, OC_EV_GRAD, s);
+}
+
+void oc_enode_get_bounds(const oc_enode *e, double box[4], double *flo,
+                         double *fhi) {
+  if (box) {
+    box[0] = e->box.x0;
+    box[1] = e->box.y0;
+    box[2] = e->box.x1;
+    box[3] = e->box.y1;
+  }
+  if (flo) *flo = e->glob.flo;
+  if (fhi) *fhi = e->glob.fhi;
+}
+
+double oc_enode_lipschitz(const oc_enode *e) {
+  return e->glob.lf;
+}
+
+void oc_enode_bound_in(const oc_enode *e, double x0, double y0, double x1,
+                       double y1, oc_enode_bound *b) {
+  oc_erect r = {x0, y0, x1, y1};
+  if (!(x0 <= x1 && y0 <= y1)) { /* empty (or NaN): nothing there */
+    *b = (oc_enode_bound){0, 0, 0, 0, 0, 0};
+    b->flo = INFINITY, b->fhi = -INFINITY;
+    return;
+  }
+  oc_enode_bnd(e, &r, b);
+}
+
+int oc_enode_get_stats(const oc_enode *e, oc_enode_stats *st, oc_error *err) {
+  oc_pmap seen = {0};
+  const oc_enode **stack = NULL;
+  size_t n = 0, cap = 0;
+  int rc = OC_OK;
+  memset(st, 0, sizeof *st);
+  if (!oc_pmap_slot(&seen, e, 1) || !OC_GROW(stack, n, cap, 1)) goto nomem;
+  stack[n++] = e;
+  while (n) {
+    const oc_enode *x = stack[--n];
+    st->nodes++;
+    st->primitives += x->kind == OC_E_DISC || x->kind == OC_E_CURVE;
+    st->bytes +=
+        sizeof *x + (x->kids != x->inl ? x->nkids * sizeof *x->kids : 0);
+    for (size_t i = 0; i < x->nkids; i++) {
+      const oc_enode *k = x->kids[i];
+      if (oc_pmap_slot(&seen, k, 0)) continue;
+      if (!oc_pmap_slot(&seen, k, 1) || !OC_GROW(stack, n, cap, 1)) goto nomem;
+      stack[n++] = k;
+    }
+  }
+  goto done;
+nomem:
+  rc = oc_seterr(err, OC_ENOMEM, "out of memory while counting the tree");
+done:
+  oc_pmap_free(&seen);
+  free(stack);
+  return rc;
+}
+
+/* ---- the elevation source --------------------------------------------- */
+
+static double src_height(void *ud, double x, double y, double grad[2]) {
+  oc_enode_sample s;
+  oc_enode_ev(ud, x, y, grad ? OC_EV_GRAD : 0, &s);
+  if (grad) {
+    grad[0] = s.fx;
+    grad[1] = s.fy;
+  }
+  return s.f;
+}
+
+static void src_range(void *ud, double x0, double y0, double x1, double y1,
+                      double *lo, double *hi) {
+  oc_ebound b;
+  oc_erect r = {x0, y0, x1, y1};
+  oc_enode_bnd(ud, &r, &b);
+  *lo = b.flo;
+  *hi = b.fhi;
+}
+
+static double src_slope(void *ud, double x0, double y0, double x1, double y1) {
+  oc_ebound b;
+  oc_erect r = {x0, y0, x1, y1};
+  oc_enode_bnd(ud, &r, &b);
+  return b.lf;
+}
+
+static void src_retain(void *ud) {
+  oc_enode_retain(ud);
+}
+static void src_release(void *ud) {
+  oc_enode_release(ud);
+}
+
+int oc_enode_elevation(oc_enode *e, const double *domain, oc_elevation *src,
+                       oc_error *err) {
+  double d[4] = {e->box.x0, e->box.y0, e->box.x1, e->box.y1};
+  if (domain) memcpy(d, domain, sizeof d);
+  if (!(isfinite(d[0]) && isfinite(d[1]) && isfinite(d[2]) && isfinite(d[3]) &&
+        d[0] < d[2] && d[1] < d[3]))
+    return oc_seterr(err, OC_EINVAL,
+                     "the elevation domain [%g, %g] x [%g, %g] must be "
+                     "finite and not empty",
+                     d[0], d[2], d[1], d[3]);
+  memset(src, 0, sizeof *src);
+  src->height = src_height;
+  src->range = src_range;
+  src->slope = src_slope;
+  src->retain = src_retain;
+  src->release = src_release;
+  src->ud = e;
+  src->x0 = d[0];
+  src->y0 = d[1];
+  src->x1 = d[2];
+  src->y1 = d[3];
+  oc_enode_retain(e);
+  return OC_OK;
+}

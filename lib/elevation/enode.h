@@ -1,0 +1,101 @@
+/*
+** enode.h — the nodes of 2D elevation trees (Génevaux et al. 2015)
+** (internal): every node maps a point p of the plane to an elevation f and
+** a weight alpha, with their gradients, in one traversal.
+**
+** Conventions (docs/fields.md, "Elevation trees"):
+**  - alpha has compact support Omega_0 = {alpha > 0}, inside the node's
+**    box; the terrain is where alpha >= T (T = OC_ENODE_T, 1/2).
+**  - f is defined and Lipschitz on the whole plane. The paper leaves a
+**    blend undefined where the weights vanish; here a blend divides by
+**    max(sum alpha, T), which is the paper's f on Omega_T and fades to 0
+**    outside it, so one Lipschitz bound holds everywhere (what tracing,
+**    implicitization and sampling need).
+**  - Bounds come in one struct, for the whole plane (at construction) or
+**    inside a box (oc_enode_bound_in): the range of f and of alpha and
+**    Lipschitz bounds of both.
+*/
+#ifndef OC_ENODE_H
+#define OC_ENODE_H
+
+#include <stddef.h>
+
+#include "outcrop.h"
+
+#define OC_ENODE_T 0.5
+
+typedef enum oc_ekind {
+  OC_E_DISC,
+  OC_E_CURVE,
+  OC_E_BLEND,
+  OC_E_REPLACE,
+  OC_E_ADD,
+  OC_E_XFORM,
+  OC_E_WARP,
+  OC_E_COUNT
+} oc_ekind;
+
+/* Ranges and Lipschitz bounds of f and alpha over a region (outcrop.h). */
+typedef oc_enode_bound oc_ebound;
+
+/* A rectangle [x0, x1] x [y0, y1]. */
+typedef struct oc_erect {
+  double x0, y0, x1, y1;
+} oc_erect;
+
+/* Noise sums of discs and warps. */
+typedef struct oc_enoise {
+  int kind; /* oc_enoise_kind */
+  int octaves;
+  double amplitude, wavelength, gain, lacunarity;
+  uint64_t seed;
+} oc_enoise;
+
+struct oc_enode {
+  int refs; /* built from one thread (Lua), like 3D nodes */
+  oc_ekind kind;
+  size_t nkids;
+  oc_enode **kids; /* retained */
+  oc_enode *inl[2];
+  oc_erect box;   /* Omega_0 lies inside */
+  oc_ebound glob; /* over the whole plane */
+  double par[12];
+  oc_enoise noise;
+  void *data; /* curve: skeleton and profiles (ecurve.c), owned */
+};
+
+/* What a caller asks of eval. */
+#define OC_EV_GRAD 1 /* gradients too */
+#define OC_EV_LAZY 2 /* f may be left 0 where alpha = 0 (blend children) */
+
+void oc_enode_ev(const oc_enode *n, double x, double y, int want,
+                 oc_enode_sample *s);
+
+/* Allocation (refs = 1) with nkids children retained from kids. */
+oc_enode *oc_enode_alloc(oc_ekind kind, oc_enode *const *kids, size_t nkids,
+                         oc_error *err);
+
+/* Kinds' parts (disc.c, eops.c): evaluation and bounds in a box. */
+void oc_edisc_ev(const oc_enode *n, double x, double y, int want,
+                 oc_enode_sample *s);
+void oc_edisc_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o);
+void oc_ecurve_ev(const oc_enode *n, double x, double y, int want,
+                  oc_enode_sample *s);
+void oc_ecurve_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o);
+void oc_ecurve_free(void *data);
+void oc_eop_ev(const oc_enode *n, double x, double y, int want,
+               oc_enode_sample *s);
+void oc_eop_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o);
+
+/* The bound of n in box b (dispatch). */
+void oc_enode_bnd(const oc_enode *n, const oc_erect *b, oc_ebound *o);
+
+static inline int oc_erect_meets(const oc_erect *a, const oc_erect *b) {
+  return a->x0 <= b->x1 && a->x1 >= b->x0 && a->y0 <= b->y1 && a->y1 >= b->y0;
+}
+
+/* Noise: eta on z = 0 remapped to [-1, 1], and its Lipschitz bound. */
+double oc_eta(uint64_t seed, double x, double y, double g[2]);
+extern const double oc_eta_lipschitz;
+
+#endif

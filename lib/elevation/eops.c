@@ -1,0 +1,686 @@
+/*
+** eops.c — the operators of elevation trees (Génevaux et al. 2015, section
+** 5 and the appendix): blend, replace, add, affine transforms and warps,
+** with their values, gradients and bounds (whole plane and in a box).
+**
+** The appendix's bounds, corrected, with w = clamp(alpha_B, 0, 1):
+**  blend    lambda <= max lambda_i + Lambda D / max(inf sum alpha, T),
+**           D the width of the children's range of f, Lambda =
+**           max(lambda_alpha) for two children, the smaller of the sum and
+**           (n - 1) times the largest for n; where sum alpha may be < T,
+**           also at most max lambda_i + sum lambda_alpha_i sup|f_i| / T;
+**  replace  lambda <= max(lambda_A, lambda_B) + lambda_alphaB sup|f_A - f_B|;
+**  add      lambda <= lambda_A + lambda_w sup|f_B| + sup w lambda_B;
+**  warp     lambda_A (1 + lambda_delta);
+**  transform |vscale| lambda_A / scale.
+*/
+#include <math.h>
+#include <stdlib.h>
+
+#include "core/error.h"
+#include "core/noise.h"
+#include "core/rng.h"
+#include "elevation/enode.h"
+
+#define T OC_ENODE_T
+#define DEG (3.14159265358979323846 / 180)
+
+/* par slots */
+enum {
+  /* replace: 1 with the lerped weight */
+  P_LERP = 0,
+  /* add: sum weight, below, below_z, fade */
+  P_SUMW = 0,
+  P_BELOW = 1,
+  P_BZ = 2,
+  P_FADE = 3,
+  /* transform: inverse 2x2 (row-major) and translation, then 1 / scale,
+  ** vscale, voffset; p' = Minv (p - t) */
+  P_MI = 0,
+  P_TX = 4,
+  P_TY = 5,
+  P_ISCALE = 6,
+  P_VS = 7,
+  P_VO = 8,
+  P_SCALE = 9,
+  P_ANGLE = 10,
+  /* warp: largest displacement per axis, and delta's Lipschitz bound */
+  P_WMAX = 0,
+  P_WLIP = 1
+};
+
+static double clamp01(double v, int *inside) {
+  *inside = v > 0 && v < 1;
+  return v <= 0 ? 0 : v >= 1 ? 1 : v; /* (NaN stays NaN) */
+}
+
+/* ---- blend ------------------------------------------------------------ */
+
+static void blend_ev(const oc_enode *n, double x, double y, int want,
+                     oc_enode_sample *s) {
+  int grad = want & OC_EV_GRAD;
+  double N = 0, S = 0, nx = 0, ny = 0, sx = 0, sy = 0;
+  for (size_t i = 0; i < n->nkids; i++) {
+    const oc_enode *k = n->kids[i];
+    if (!(x >= k->box.x0 && x <= k->box.x1 && y >= k->box.y0 && y <= k->box.y1))
+      continue; /* alpha = 0 there: no contribution */
+    oc_enode_sample c;
+    oc_enode_ev(k, x, y, grad | OC_EV_LAZY, &c);
+    if (c.a == 0) continue;
+    N += c.a * c.f;
+    S += c.a;
+    if (grad) {
+      nx += c.ax * c.f + c.a * c.fx;
+      ny += c.ay * c.f + c.a * c.fy;
+      sx += c.ax;
+      sy += c.ay;
+    }
+  }
+  s->a = S;
+  s->ax = sx;
+  s->ay = sy;
+  if (x != x || y != y) { /* NaN fails every box test */
+    s->f = s->a = NAN;
+    s->fx = s->fy = s->ax = s->ay = NAN;
+    return;
+  }
+  if (S >= T) {
+    s->f = N / S;
+    s->fx = (nx - s->f * sx) / S;
+    s->fy = (ny - s->f * sy) / S;
+  } else {
+    s->f = N / T;
+    s->fx = nx / T;
+    s->fy = ny / T;
+  }
+  if (!grad) s->fx = s->fy = s->ax = s->ay = 0;
+}
+
+/* Combines the children's bounds (those whose box meets the region; the
+** others have alpha = 0 there). Where sum alpha >= T, f is a convex
+** combination: its slope is at most max lambda_i + Lambda D / inf S, D
+** the width of the children's range; where sum alpha < T, f = sum
+** alpha_i f_i / T: at most max lambda_i + sum lambda_alpha_i sup|f_i| / T. */
+static void blend_combine(const oc_ebound *kb, size_t n, oc_ebound *o) {
+  if (n == 0) {
+    *o = (oc_ebound){0, 0, 0, 0, 0, 0};
+    return;
+  }
+  double flo = INFINITY, fhi = -INFINITY, slo = 0, shi = 0, lmax = 0;
+  double lasum = 0, lamax = 0, M = 0;
+  for (size_t i = 0; i < n; i++) {
+    flo = fmin(flo, kb[i].flo);
+    fhi = fmax(fhi, kb[i].fhi);
+    slo += kb[i].alo;
+    shi += kb[i].ahi;
+    lmax = fmax(lmax, kb[i].lf);
+    lasum += kb[i].la;
+    lamax = fmax(lamax, kb[i].la);
+    M += kb[i].la * fmax(fabs(kb[i].flo), fabs(kb[i].fhi));
+  }
+  double lam = fmin(lasum, (double)(n - 1) * lamax);
+  o->lf = lmax + lam * (fhi - flo) / fmax(slo, T);
+  if (slo < T) { /* f fades towards 0 where sum alpha < T */
+    o->lf = fmax(o->lf, lmax + M / T);
+    flo = fmin(flo, 0);
+    fhi = fmax(fhi, 0);
+  }
+  o->flo = flo;
+  o->fhi = fhi;
+  o->alo = slo;
+  o->ahi = shi;
+  o->la = lasum;
+}
+
+#define KB_STACK 16
+
+static void blend_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+  oc_ebound stack[KB_STACK], *kb = stack;
+  if (n->nkids > KB_STACK && !(kb = malloc(n->nkids * sizeof *kb))) {
+    *o = n->glob; /* (conservative: the whole plane's) */
+    return;
+  }
+  size_t m = 0;
+  for (size_t i = 0; i < n->nkids; i++)
+    if (oc_erect_meets(&n->kids[i]->box, b))
+      oc_enode_bnd(n->kids[i], b, &kb[m++]);
+  blend_combine(kb, m, o);
+  if (kb != stack) free(kb);
+}
+
+oc_enode *oc_enode_blend(oc_enode *const *kids, size_t n, oc_error *err) {
+  if (!kids || n == 0) {
+    oc_seterr(err, OC_EINVAL, "blend needs at least one elevation node");
+    return NULL;
+  }
+  for (size_t i = 0; i < n; i++)
+    if (!kids[i]) {
+      oc_seterr(err, OC_EINVAL, "blend: child %zu is NULL", i + 1);
+      return NULL;
+    }
+  oc_ebound *kb = malloc(n * sizeof *kb);
+  if (!kb) {
+    oc_seterr(err, OC_ENOMEM, "out of memory (%zu children)", n);
+    return NULL;
+  }
+  oc_enode *e = oc_enode_alloc(OC_E_BLEND, kids, n, err);
+  if (!e) {
+    free(kb);
+    return NULL;
+  }
+  e->box = kids[0]->box;
+  for (size_t i = 0; i < n; i++) {
+    kb[i] = kids[i]->glob;
+    oc_erect c = kids[i]->box;
+    e->box.x0 = fmin(e->box.x0, c.x0);
+    e->box.y0 = fmin(e->box.y0, c.y0);
+    e->box.x1 = fmax(e->box.x1, c.x1);
+    e->box.y1 = fmax(e->box.y1, c.y1);
+  }
+  /* over the whole plane, some points are outside every support */
+  for (size_t i = 0; i < n; i++)
+    kb[i].alo = 0;
+  blend_combine(kb, n, &e->glob);
+  free(kb);
+  return e;
+}
+
+/* ---- replace ---------------------------------------------------------- */
+
+static void replace_ev(const oc_enode *n, double x, double y, int want,
+                       oc_enode_sample *s) {
+  int grad = want & OC_EV_GRAD, in;
+  const oc_enode *A = n->kids[0], *B = n->kids[1];
+  oc_enode_sample a, b;
+  b.a = b.f = b.fx = b.fy = b.ax = b.ay = 0;
+  if (x >= B->box.x0 && x <= B->box.x1 && y >= B->box.y0 && y <= B->box.y1)
+    oc_enode_ev(B, x, y, grad | OC_EV_LAZY, &b);
+  double w = clamp01(b.a, &in);
+  /* A's f is not needed where B replaces it wholly, nor, for a lazy
+  ** caller, where A's weight (the node's, unless lerped) is 0 */
+  int lerp = n->par[P_LERP] != 0;
+  int alazy = w >= 1 || (!lerp && (want & OC_EV_LAZY));
+  oc_enode_ev(A, x, y, grad | (alazy ? OC_EV_LAZY : 0), &a);
+  if (w >= 1) {
+    /* f = f_B; a.f may be unset only where alpha_A = 0, where the lazy
+    ** caller does not read it either */
+    a.f = a.fx = a.fy = 0;
+  }
+  if (want & OC_EV_LAZY && a.a == 0 && !lerp) {
+    *s = a;
+    s->f = s->fx = s->fy = 0;
+    return;
+  }
+  double wx = grad && in ? b.ax : 0, wy = grad && in ? b.ay : 0;
+  s->f = (1 - w) * a.f + w * b.f;
+  s->fx = (1 - w) * a.fx + w * b.fx + wx * (b.f - a.f);
+  s->fy = (1 - w) * a.fy + w * b.fy + wy * (b.f - a.f);
+  if (lerp) {
+    s->a = (1 - w) * a.a + w * w;
+    s->ax = (1 - w) * a.ax - wx * a.a + 2 * w * wx;
+    s->ay = (1 - w) * a.ay - wy * a.a + 2 * w * wy;
+  } else {
+    s->a = a.a;
+    s->ax = a.ax;
+    s->ay = a.ay;
+  }
+  if (!grad) s->fx = s->fy = s->ax = s->ay = 0;
+}
+
+/* Bounds from A's and B's over one region. */
+static void replace_combine(const oc_enode *n, const oc_ebound *A,
+                            const oc_ebound *B, int bmeets, oc_ebound *o) {
+  int lerp = n->par[P_LERP] != 0;
+  double wlo = bmeets ? fmin(fmax(B->alo, 0), 1) : 0;
+  double whi = bmeets ? fmin(fmax(B->ahi, 0), 1) : 0;
+  double law = bmeets ? B->la : 0;
+  *o = *A;
+  if (whi > 0) {
+    o->flo = fmin(A->flo, B->flo);
+    o->fhi = fmax(A->fhi, B->fhi);
+    o->lf = fmax(A->lf, B->lf) + law * fmax(A->fhi - B->flo, B->fhi - A->flo);
+  }
+  if (lerp) {
+    /* (1 - w) a + w^2 on [wlo, whi] x [alo, ahi]: convex in w */
+    double v = fmin(fmax(A->alo / 2, wlo), whi);
+    o->alo = fmax(0, (1 - v) * A->alo + v * v);
+    o->ahi =
+        fmax((1 - wlo) * A->ahi + wlo * wlo, (1 - whi) * A->ahi + whi * whi);
+    o->la = A->la + law * (A->ahi + 2 * whi);
+  }
+}
+
+static void replace_bound_in(const oc_enode *n, const oc_erect *b,
+                             oc_ebound *o) {
+  oc_ebound A, B;
+  oc_enode_bnd(n->kids[0], b, &A);
+  int meets = oc_erect_meets(&n->kids[1]->box, b);
+  if (meets) oc_enode_bnd(n->kids[1], b, &B);
+  replace_combine(n, &A, &B, meets, o);
+}
+
+static oc_enode *binary(oc_ekind kind, oc_enode *a, oc_enode *b,
+                        oc_error *err) {
+  if (!a || !b) {
+    oc_seterr(err, OC_EINVAL, "%s needs two elevation nodes",
+              kind == OC_E_REPLACE ? "replace" : "add");
+    return NULL;
+  }
+  oc_enode *k[2] = {a, b};
+  return oc_enode_alloc(kind, k, 2, err);
+}
+
+oc_enode *oc_enode_replace(oc_enode *a, oc_enode *b, int lerp, oc_error *err) {
+  oc_enode *n = binary(OC_E_REPLACE, a, b, err);
+  if (!n) return NULL;
+  n->par[P_LERP] = lerp != 0;
+  n->box = a->box;
+  if (lerp) { /* alpha = w^2 where B alone is */
+    n->box.x0 = fmin(a->box.x0, b->box.x0);
+    n->box.y0 = fmin(a->box.y0, b->box.y0);
+    n->box.x1 = fmax(a->box.x1, b->box.x1);
+    n->box.y1 = fmax(a->box.y1, b->box.y1);
+  }
+  oc_ebound B = b->glob;
+  B.alo = 0;
+  replace_combine(n, &a->glob, &B, 1, &n->glob);
+  return n;
+}
+
+/* ---- add -------------------------------------------------------------- */
+
+/* The altitude weight: 1 below below_z - fade, 0 above below_z, the C1
+** smoothstep between; its derivative in *d. */
+static double below_w(const double *par, double z, double *d) {
+  double t = (par[P_BZ] - z) / par[P_FADE];
+  if (t <= 0 || t >= 1) {
+    *d = 0;
+    return t >= 1 ? 1 : 0;
+  }
+  *d = -6 * t * (1 - t) / par[P_FADE];
+  return t * t * (3 - 2 * t);
+}
+
+static void add_ev(const oc_enode *n, double x, double y, int want,
+                   oc_enode_sample *s) {
+  int grad = want & OC_EV_GRAD, in;
+  const oc_enode *A = n->kids[0], *B = n->kids[1];
+  oc_enode_sample a, b;
+  int sumw = n->par[P_SUMW] != 0;
+  /* alpha_A + w^2 may be > 0 where alpha_A = 0: then f_A is needed */
+  oc_enode_ev(A, x, y, sumw ? grad : want, &a);
+  if (want & OC_EV_LAZY && a.a == 0 && !sumw) {
+    *s = a;
+    return;
+  }
+  b.a = b.f = b.fx = b.fy = b.ax = b.ay = 0;
+  if (x >= B->box.x0 && x <= B->box.x1 && y >= B->box.y0 && y <= B->box.y1)
+    oc_enode_ev(B, x, y, grad | OC_EV_LAZY, &b);
+  double c = clamp01(b.a, &in), cx = grad && in ? b.ax : 0,
+         cy = grad && in ? b.ay : 0;
+  double w = c, wx = cx, wy = cy;
+  if (n->par[P_BELOW] != 0) {
+    double dW, W = below_w(n->par, a.f, &dW);
+    w = c * W;
+    wx = cx * W + c * dW * a.fx;
+    wy = cy * W + c * dW * a.fy;
+  }
+  s->f = a.f + w * b.f;
+  s->fx = a.fx + wx * b.f + w * b.fx;
+  s->fy = a.fy + wy * b.f + w * b.fy;
+  s->a = sumw ? a.a + c * c : a.a;
+  s->ax = sumw ? a.ax + 2 * c * cx : a.ax;
+  s->ay = sumw ? a.ay + 2 * c * cy : a.ay;
+  if (!grad) s->fx = s->fy = s->ax = s->ay = 0;
+}
+
+static void add_combine(const oc_enode *n, const oc_ebound *A,
+                        const oc_ebound *B, int bmeets, oc_ebound *o) {
+  double clo = bmeets ? fmin(fmax(B->alo, 0), 1) : 0;
+  double chi = bmeets ? fmin(fmax(B->ahi, 0), 1) : 0;
+  double lc = bmeets ? B->la : 0;
+  *o = *A;
+  if (chi > 0) {
+    double wlo = clo, whi = chi, lw = lc;
+    if (n->par[P_BELOW] != 0) {
+      wlo = 0; /* the altitude weight may be 0 */
+      lw = lc + 1.5 / n->par[P_FADE] * A->lf;
+    }
+    /* w f_B with w in [wlo, whi] */
+    double p[4] = {wlo * B->flo, wlo * B->fhi, whi * B->flo, whi * B->fhi};
+    double plo = fmin(fmin(p[0], p[1]), fmin(p[2], p[3]));
+    double phi = fmax(fmax(p[0], p[1]), fmax(p[2], p[3]));
+    o->flo = A->flo + plo;
+    o->fhi = A->fhi + phi;
+    o->lf = A->lf + lw * fmax(fabs(B->flo), fabs(B->fhi)) + whi * B->lf;
+  }
+  if (n->par[P_SUMW] != 0) {
+    o->alo = A->alo + clo * clo;
+    o->ahi = A->ahi + chi * chi;
+    o->la = A->la + 2 * chi * lc;
+  }
+}
+
+static void add_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+  oc_ebound A, B;
+  oc_enode_bnd(n->kids[0], b, &A);
+  int meets = oc_erect_meets(&n->kids[1]->box, b);
+  if (meets) oc_enode_bnd(n->kids[1], b, &B);
+  add_combine(n, &A, &B, meets, o);
+}
+
+oc_enode *oc_enode_add(oc_enode *a, oc_enode *b, const oc_enode_add_params *p,
+                       oc_error *err) {
+  oc_enode_add_params d = {0, 0, 0, 0};
+  if (!p) p = &d;
+  if (p->below) {
+    if (!isfinite(p->below_z)) {
+      oc_seterr(err, OC_EINVAL, "'below' must be a finite number (got %g)",
+                p->below_z);
+      return NULL;
+    }
+    if (!(isfinite(p->fade) && p->fade > 0)) {
+      oc_seterr(err, OC_EINVAL, "'fade' must be a positive number (got %g)",
+                p->fade);
+      return NULL;
+    }
+  }
+  oc_enode *n = binary(OC_E_ADD, a, b, err);
+  if (!n) return NULL;
+  n->par[P_SUMW] = p->sum_weight != 0;
+  n->par[P_BELOW] = p->below != 0;
+  n->par[P_BZ] = p->below_z;
+  n->par[P_FADE] = p->fade;
+  n->box = a->box;
+  if (p->sum_weight) {
+    n->box.x0 = fmin(a->box.x0, b->box.x0);
+    n->box.y0 = fmin(a->box.y0, b->box.y0);
+    n->box.x1 = fmax(a->box.x1, b->box.x1);
+    n->box.y1 = fmax(a->box.y1, b->box.y1);
+  }
+  oc_ebound B = b->glob;
+  B.alo = 0;
+  add_combine(n, &a->glob, &B, 1, &n->glob);
+  return n;
+}
+
+/* ---- affine transforms ------------------------------------------------ */
+
+static void xform_ev(const oc_enode *n, double x, double y, int want,
+                     oc_enode_sample *s) {
+  const double *m = n->par + P_MI;
+  double u = x - n->par[P_TX], v = y - n->par[P_TY];
+  oc_enode_sample c;
+  oc_enode_ev(n->kids[0], m[0] * u + m[1] * v, m[2] * u + m[3] * v, want, &c);
+  double vs = n->par[P_VS];
+  s->a = c.a;
+  if (want & OC_EV_LAZY && c.a == 0)
+    s->f = 0;
+  else
+    s->f = vs * c.f + n->par[P_VO];
+  /* grad = Minv^T grad_child */
+  s->fx = vs * (m[0] * c.fx + m[2] * c.fy);
+  s->fy = vs * (m[1] * c.fx + m[3] * c.fy);
+  s->ax = m[0] * c.ax + m[2] * c.ay;
+  s->ay = m[1] * c.ax + m[3] * c.ay;
+}
+
+/* The box of the image of rectangle r under p -> M p + t (fwd) or
+** Minv (p - t) (inverse). */
+static oc_erect map_rect(const oc_enode *n, const oc_erect *r, int inverse) {
+  double xs[2] = {r->x0, r->x1}, ys[2] = {r->y0, r->y1};
+  oc_erect o = {INFINITY, INFINITY, -INFINITY, -INFINITY};
+  const double *mi = n->par + P_MI;
+  double s = n->par[P_SCALE];
+  /* M = s^2 Minv^T for a similarity: Minv = R^T / s, M = s R */
+  double m[4] = {mi[0] * s * s, mi[2] * s * s, mi[1] * s * s, mi[3] * s * s};
+  for (int a = 0; a < 2; a++)
+    for (int b = 0; b < 2; b++) {
+      double u, v;
+      if (inverse) {
+        double px = xs[a] - n->par[P_TX], py = ys[b] - n->par[P_TY];
+        u = mi[0] * px + mi[1] * py;
+        v = mi[2] * px + mi[3] * py;
+      } else {
+        u = m[0] * xs[a] + m[1] * ys[b] + n->par[P_TX];
+        v = m[2] * xs[a] + m[3] * ys[b] + n->par[P_TY];
+      }
+      o.x0 = fmin(o.x0, u);
+      o.x1 = fmax(o.x1, u);
+      o.y0 = fmin(o.y0, v);
+      o.y1 = fmax(o.y1, v);
+    }
+  /* rounding of the map: a relative hair */
+  double pad = 1e-12 * (fabs(o.x0) + fabs(o.x1) + fabs(o.y0) + fabs(o.y1));
+  o.x0 -= pad, o.y0 -= pad, o.x1 += pad, o.y1 += pad;
+  return o;
+}
+
+static void xform_map_bound(const oc_enode *n, const oc_ebound *c,
+                            oc_ebound *o) {
+  double vs = n->par[P_VS], vo = n->par[P_VO], is = n->par[P_ISCALE];
+  double a = vs * c->flo + vo, b = vs * c->fhi + vo;
+  *o = *c;
+  o->flo = fmin(a, b);
+  o->fhi = fmax(a, b);
+  o->lf = fabs(vs) * c->lf * is;
+  o->la = c->la * is;
+}
+
+static void xform_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+  oc_erect r = map_rect(n, b, 1);
+  oc_ebound c;
+  oc_enode_bnd(n->kids[0], &r, &c);
+  xform_map_bound(n, &c, o);
+}
+
+oc_enode *oc_enode_transform(oc_enode *e, const oc_enode_xform *x,
+                             oc_error *err) {
+  if (!e || !x) {
+    oc_seterr(err, OC_EINVAL, "transform needs an elevation node");
+    return NULL;
+  }
+  double s = x->scale == 0 ? 1 : x->scale, vs = x->vscale == 0 ? 1 : x->vscale;
+  if (!isfinite(x->tx) || !isfinite(x->ty)) {
+    oc_seterr(err, OC_EINVAL, "'translate' must have finite coordinates");
+    return NULL;
+  }
+  if (!isfinite(x->angle)) {
+    oc_seterr(err, OC_EINVAL, "'rotate' must be a finite number (got %g)",
+              x->angle);
+    return NULL;
+  }
+  if (!(isfinite(s) && s > 0 && isfinite(1 / s))) {
+    oc_seterr(err, OC_EINVAL, "'scale' must be a positive number (got %g)",
+              x->scale);
+    return NULL;
+  }
+  if (!(isfinite(vs) && isfinite(x->voffset))) {
+    oc_seterr(err, OC_EINVAL,
+              "'vscale' and 'voffset' must be finite numbers (got %g, %g)",
+              x->vscale, x->voffset);
+    return NULL;
+  }
+  /* concatenate with a transform below: p = s R p' + t, p' = s' R' p'' +
+  ** t', so p = s s' R R' p'' + (s R t' + t) */
+  double ang = x->angle, tx = x->tx, ty = x->ty, vo = x->voffset;
+  oc_enode *child = e;
+  if (e->kind == OC_E_XFORM) {
+    double s2 = e->par[P_SCALE];
+    double c1 = cos(ang * DEG), s1 = sin(ang * DEG);
+    double t2x = e->par[P_TX], t2y = e->par[P_TY];
+    tx += s * (c1 * t2x - s1 * t2y);
+    ty += s * (s1 * t2x + c1 * t2y);
+    vo += vs * e->par[P_VO];
+    vs *= e->par[P_VS];
+    s *= s2;
+    ang += e->par[P_ANGLE];
+    child = e->kids[0];
+  }
+  if (!(isfinite(s) && s > 0 && isfinite(1 / s) && isfinite(tx) &&
+        isfinite(ty) && isfinite(vs) && vs != 0 && isfinite(vo))) {
+    oc_seterr(err, OC_EINVAL, "transform: the composed transform overflows");
+    return NULL;
+  }
+  oc_enode *n = oc_enode_alloc(OC_E_XFORM, &child, 1, err);
+  if (!n) return NULL;
+  double th = ang * DEG, c = cos(th), sn = sin(th);
+  /* Minv = R^T / s */
+  n->par[P_MI + 0] = c / s;
+  n->par[P_MI + 1] = sn / s;
+  n->par[P_MI + 2] = -sn / s;
+  n->par[P_MI + 3] = c / s;
+  n->par[P_TX] = tx;
+  n->par[P_TY] = ty;
+  n->par[P_ISCALE] = 1 / s;
+  n->par[P_VS] = vs;
+  n->par[P_VO] = vo;
+  n->par[P_SCALE] = s;
+  n->par[P_ANGLE] = ang;
+  n->box = map_rect(n, &child->box, 0);
+  xform_map_bound(n, &child->glob, &n->glob);
+  return n;
+}
+
+/* ---- warp ------------------------------------------------------------- */
+
+/* delta(p) = A sum_k 2^-k (eta_1, eta_2)(2^k p / wl); with jac, its
+** Jacobian rows. */
+static void warp_delta(const oc_enode *n, double x, double y, double d[2],
+                       double jac[4]) {
+  const oc_enoise *nz = &n->noise;
+  double a = nz->amplitude, s = 1 / nz->wavelength;
+  d[0] = d[1] = 0;
+  if (jac) jac[0] = jac[1] = jac[2] = jac[3] = 0;
+  for (int k = 0; k < nz->octaves; k++) {
+    for (int c = 0; c < 2; c++) {
+      double g[2];
+      uint64_t seed = oc_mix64(nz->seed + 0x9e3779b97f4a7c15ull *
+                                              (uint64_t)(2 * k + c + 1));
+      d[c] += a * oc_eta(seed, x * s, y * s, jac ? g : NULL);
+      if (jac) {
+        jac[2 * c] += a * s * g[0];
+        jac[2 * c + 1] += a * s * g[1];
+      }
+    }
+    a *= 0.5;
+    s *= 2;
+  }
+}
+
+static void warp_ev(const oc_enode *n, double x, double y, int want,
+                    oc_enode_sample *s) {
+  int grad = want & OC_EV_GRAD;
+  double d[2], J[4];
+  warp_delta(n, x, y, d, grad ? J : NULL);
+  oc_enode_sample c;
+  oc_enode_ev(n->kids[0], x + d[0], y + d[1], want, &c);
+  *s = c;
+  if (!grad) return;
+  /* grad = (I + J)^T grad_child */
+  s->fx = c.fx + J[0] * c.fx + J[2] * c.fy;
+  s->fy = c.fy + J[1] * c.fx + J[3] * c.fy;
+  s->ax = c.ax + J[0] * c.ax + J[2] * c.ay;
+  s->ay = c.ay + J[1] * c.ax + J[3] * c.ay;
+}
+
+static void warp_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+  double m = n->par[P_WMAX], l = n->par[P_WLIP];
+  oc_erect r = {b->x0 - m, b->y0 - m, b->x1 + m, b->y1 + m};
+  oc_enode_bnd(n->kids[0], &r, o);
+  o->lf *= 1 + l;
+  o->la *= 1 + l;
+}
+
+oc_enode *oc_enode_warp(oc_enode *e, const oc_enode_warp_params *p,
+                        oc_error *err) {
+  if (!e || !p) {
+    oc_seterr(err, OC_EINVAL, "warp needs an elevation node");
+    return NULL;
+  }
+  if (!(isfinite(p->amplitude) && p->amplitude >= 0)) {
+    oc_seterr(err, OC_EINVAL,
+              "'amplitude' must be a finite number >= 0 (got %g)",
+              p->amplitude);
+    return NULL;
+  }
+  if (!(isfinite(p->wavelength) && p->wavelength > 0)) {
+    oc_seterr(err, OC_EINVAL, "'wavelength' must be a positive number (got %g)",
+              p->wavelength);
+    return NULL;
+  }
+  if (p->octaves < 1 || p->octaves > 16) {
+    oc_seterr(err, OC_EINVAL, "'octaves' must be an integer in 1..16 (got %d)",
+              p->octaves);
+    return NULL;
+  }
+  /* each component's gradient is at most A lambda_eta / wl per octave
+  ** (2^-k A times 2^k / wl); the Jacobian's norm at most sqrt(2) times */
+  double lip = sqrt(2.0) * p->amplitude * 2 * oc_noise3_lipschitz * p->octaves /
+               p->wavelength;
+  double maxd = p->amplitude * (2 - ldexp(1.0, 1 - p->octaves));
+  if (!(lip < 1)) {
+    oc_seterr(err, OC_EINVAL,
+              "warp: its Lipschitz bound %g is not below 1, so it may fold "
+              "the plane (not a bijection): lower 'amplitude' below %g or "
+              "raise 'wavelength'",
+              lip, p->amplitude / lip);
+    return NULL;
+  }
+  oc_enode *n = oc_enode_alloc(OC_E_WARP, &e, 1, err);
+  if (!n) return NULL;
+  n->noise = (oc_enoise){OC_ENOISE_PLAIN, p->octaves, p->amplitude,
+                         p->wavelength,   0.5,        2,
+                         p->seed};
+  n->par[P_WMAX] = maxd;
+  n->par[P_WLIP] = lip;
+  n->box = (oc_erect){e->box.x0 - maxd, e->box.y0 - maxd, e->box.x1 + maxd,
+                      e->box.y1 + maxd};
+  n->glob = e->glob;
+  n->glob.lf *= 1 + lip;
+  n->glob.la *= 1 + lip;
+  return n;
+}
+
+/* ---- dispatch --------------------------------------------------------- */
+
+void oc_eop_ev(const oc_enode *n, double x, double y, int want,
+               oc_enode_sample *s) {
+  switch (n->kind) {
+  case OC_E_BLEND:
+    blend_ev(n, x, y, want, s);
+    return;
+  case OC_E_REPLACE:
+    replace_ev(n, x, y, want, s);
+    return;
+  case OC_E_ADD:
+    add_ev(n, x, y, want, s);
+    return;
+  case OC_E_XFORM:
+    xform_ev(n, x, y, want, s);
+    return;
+  default:
+    warp_ev(n, x, y, want, s);
+    return;
+  }
+}
+
+void oc_eop_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+  switch (n->kind) {
+  case OC_E_BLEND:
+    blend_bound_in(n, b, o);
+    return;
+  case OC_E_REPLACE:
+    replace_bound_in(n, b, o);
+    return;
+  case OC_E_ADD:
+    add_bound_in(n, b, o);
+    return;
+  case OC_E_XFORM:
+    xform_bound_in(n, b, o);
+    return;
+  default:
+    warp_bound_in(n, b, o);
+    return;
+  }
+}

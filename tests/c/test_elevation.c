@@ -1,0 +1,459 @@
+/*
+** test_elevation.c — elevation trees (Génevaux et al. 2015): every
+** primitive and operator against its formula, gradients against central
+** differences, the Lipschitz bounds and ranges never exceeded (over the
+** plane and inside random boxes), transforms concatenated exactly, the
+** elevation source, statistics of a DAG, and bad input refused with the
+** field named.
+*/
+#include <math.h>
+#include <string.h>
+
+#include "ocheck.h"
+
+#define PI 3.14159265358979323846
+
+static oc_enode *eok_(oc_enode *e, const oc_error *err, const char *what,
+                      int line) {
+  ck_assert_msg(e != NULL, "line %d: %s failed: %s", line, what, err->msg);
+  return e;
+}
+#define EOK(expr) eok_((expr), &err, #expr, __LINE__)
+
+static oc_enode *disc(double cx, double cy, double r, double h,
+                      oc_enoise_kind kind, double amp, double wl, int oct) {
+  oc_error err;
+  oc_enode_disc_params p = {cx, cy, r, h, {kind, amp, wl, oct, 0, 0, 42}};
+  return EOK(oc_enode_disc(&p, &err));
+}
+
+static double wyv(double x) {
+  if (x >= 1) return 0;
+  double k = 1 - x * x;
+  return k * k * k;
+}
+
+/* f and alpha at (x, y) with central-difference gradients checked
+** against the analytic ones (where the function is smooth enough). */
+static void check_gradient(const oc_enode *e, double x, double y, double tol) {
+  oc_enode_sample s, a, b;
+  double h = 1e-5;
+  oc_enode_eval(e, x, y, &s);
+  oc_enode_eval(e, x + h, y, &a);
+  oc_enode_eval(e, x - h, y, &b);
+  double fx = (a.f - b.f) / (2 * h), ax = (a.a - b.a) / (2 * h);
+  oc_enode_eval(e, x, y + h, &a);
+  oc_enode_eval(e, x, y - h, &b);
+  double fy = (a.f - b.f) / (2 * h), ay = (a.a - b.a) / (2 * h);
+  double sc = 1 + fabs(fx) + fabs(fy);
+  ck_assert_msg(fabs(fx - s.fx) <= tol * sc && fabs(fy - s.fy) <= tol * sc,
+                "%s grad f at (%g, %g): (%g, %g) vs fd (%g, %g)",
+                oc_enode_kind(e), x, y, s.fx, s.fy, fx, fy);
+  double sa = 1 + fabs(ax) + fabs(ay);
+  ck_assert_msg(fabs(ax - s.ax) <= tol * sa && fabs(ay - s.ay) <= tol * sa,
+                "%s grad alpha at (%g, %g): (%g, %g) vs fd (%g, %g)",
+                oc_enode_kind(e), x, y, s.ax, s.ay, ax, ay);
+}
+
+/* Ranges and Lipschitz bounds of a box hold on random points and pairs
+** in it. */
+static void check_bound_in(const oc_enode *e, oct_rng *r, double x0, double y0,
+                           double x1, double y1) {
+  oc_enode_bound b;
+  oc_enode_bound_in(e, x0, y0, x1, y1, &b);
+  for (int i = 0; i < 256; i++) {
+    double px = oct_unif(r, x0, x1), py = oct_unif(r, y0, y1);
+    double qx = oct_unif(r, x0, x1), qy = oct_unif(r, y0, y1);
+    oc_enode_sample p, q;
+    oc_enode_eval(e, px, py, &p);
+    oc_enode_eval(e, qx, qy, &q);
+    double m = 1e-9 * (1 + fabs(b.flo) + fabs(b.fhi));
+    ck_assert_msg(p.f >= b.flo - m && p.f <= b.fhi + m,
+                  "%s: f %g outside [%g, %g]", oc_enode_kind(e), p.f, b.flo,
+                  b.fhi);
+    ck_assert_msg(p.a >= b.alo - 1e-9 && p.a <= b.ahi + 1e-9,
+                  "%s: alpha %g outside [%g, %g]", oc_enode_kind(e), p.a, b.alo,
+                  b.ahi);
+    /* the gradient's norm is the sharpest test of a Lipschitz bound */
+    ck_assert_msg(hypot(p.fx, p.fy) <= b.lf * (1 + 1e-9) + m,
+                  "%s: |grad f| %g > %g", oc_enode_kind(e), hypot(p.fx, p.fy),
+                  b.lf);
+    ck_assert_msg(hypot(p.ax, p.ay) <= b.la * (1 + 1e-9) + 1e-12,
+                  "%s: |grad alpha| %g > %g", oc_enode_kind(e),
+                  hypot(p.ax, p.ay), b.la);
+    double d = hypot(px - qx, py - qy);
+    ck_assert_msg(fabs(p.f - q.f) <= b.lf * d * (1 + 1e-9) + m,
+                  "%s: |df| %g > %g x %g", oc_enode_kind(e), fabs(p.f - q.f),
+                  b.lf, d);
+    ck_assert_msg(fabs(p.a - q.a) <= b.la * d * (1 + 1e-9) + 1e-12,
+                  "%s: |dalpha| %g > %g x %g", oc_enode_kind(e),
+                  fabs(p.a - q.a), b.la, d);
+  }
+}
+
+/* The bounds of e hold in random boxes of every size around (cx, cy). */
+static void check_bounds(const oc_enode *e, double cx, double cy, double R) {
+  oct_rng r = oct_rng_new(99);
+  for (int i = 0; i < 60; i++) {
+    double w = R * pow(10, oct_unif(&r, -3, 0.3));
+    double x0 = cx + oct_unif(&r, -R, R), y0 = cy + oct_unif(&r, -R, R);
+    check_bound_in(e, &r, x0, y0, x0 + w, y0 + w * oct_unif(&r, 0.2, 1));
+  }
+  /* the whole-plane bounds, through a box wider than the supports */
+  double box[4], lo, hi;
+  oc_enode_get_bounds(e, box, &lo, &hi);
+  oc_enode_bound b;
+  oc_enode_bound_in(e, cx - 4 * R, cy - 4 * R, cx + 4 * R, cy + 4 * R, &b);
+  ck_assert(b.lf <= oc_enode_lipschitz(e) * (1 + 1e-12));
+  ck_assert(b.flo >= lo - 1e-9 && b.fhi <= hi + 1e-9);
+}
+
+START_TEST(disc_formula) {
+  oc_enode *d = disc(10, -5, 4, 7, OC_ENOISE_NONE, 0, 1, 1);
+  oct_rng r = oct_rng_new(1);
+  for (int i = 0; i < 200; i++) {
+    double x = oct_unif(&r, 4, 16), y = oct_unif(&r, -11, 1);
+    oc_enode_sample s;
+    oc_enode_eval(d, x, y, &s);
+    double dist = hypot(x - 10, y + 5);
+    ck_assert_double_eq_tol(s.a, wyv(dist / 4), 1e-14);
+    ck_assert(s.f == 7 && s.fx == 0 && s.fy == 0);
+  }
+  double box[4];
+  oc_enode_get_bounds(d, box, NULL, NULL);
+  ck_assert(box[0] == 6 && box[1] == -9 && box[2] == 14 && box[3] == -1);
+  /* a lone disc shows terrain (alpha >= 1/2) only for d <= 0.4542 r */
+  oc_enode_sample s;
+  oc_enode_eval(d, 10 + 0.454 * 4, -5, &s);
+  ck_assert(s.a > 0.5);
+  oc_enode_eval(d, 10 + 0.455 * 4, -5, &s);
+  ck_assert(s.a < 0.5);
+  ck_assert_str_eq(oc_enode_kind(d), "disc");
+  oc_enode_release(d);
+}
+END_TEST
+
+START_TEST(disc_noises) {
+  oc_enoise_kind kinds[3] = {OC_ENOISE_PLAIN, OC_ENOISE_TURBULENCE,
+                             OC_ENOISE_RIDGED};
+  for (int k = 0; k < 3; k++) {
+    oc_enode *d = disc(0, 0, 100, 20, kinds[k], 15, 40, 6);
+    double lo, hi;
+    oc_enode_get_bounds(d, NULL, &lo, &hi);
+    /* ranges: plain [h - sum a, h + sum a], the others [h, h + sum a] */
+    double asum = 15 * (2 - ldexp(1, 1 - 6));
+    ck_assert_double_eq_tol(hi, 20 + asum, 1e-9);
+    ck_assert_double_eq_tol(lo, kinds[k] == OC_ENOISE_PLAIN ? 20 - asum : 20,
+                            1e-9);
+    oct_rng r = oct_rng_new(3 + k);
+    for (int i = 0; i < 100; i++)
+      check_gradient(d, oct_unif(&r, -90, 90), oct_unif(&r, -90, 90), 2e-4);
+    check_bounds(d, 0, 0, 100);
+    oc_enode_release(d);
+  }
+}
+END_TEST
+
+START_TEST(blend_formula) {
+  oc_error err;
+  oc_enode *a = disc(0, 0, 10, 5, OC_ENOISE_PLAIN, 2, 6, 3);
+  oc_enode *b = disc(8, 0, 10, 15, OC_ENOISE_RIDGED, 3, 5, 3);
+  oc_enode *k[2] = {a, b};
+  oc_enode *e = EOK(oc_enode_blend(k, 2, &err));
+  oct_rng r = oct_rng_new(5);
+  for (int i = 0; i < 300; i++) {
+    double x = oct_unif(&r, -12, 20), y = oct_unif(&r, -12, 12);
+    oc_enode_sample s, sa, sb;
+    oc_enode_eval(e, x, y, &s);
+    oc_enode_eval(a, x, y, &sa);
+    oc_enode_eval(b, x, y, &sb);
+    double S = sa.a + sb.a, N = sa.a * sa.f + sb.a * sb.f;
+    ck_assert_double_eq_tol(s.a, S, 1e-12);
+    ck_assert_double_eq_tol(s.f, S >= 0.5 ? N / S : N / 0.5, 1e-9);
+    if (fabs(S - 0.5) > 1e-3) check_gradient(e, x, y, 1e-4);
+  }
+  check_bounds(e, 4, 0, 14);
+  /* flat discs: the transition alone, where the appendix's bound is
+  ** nearly reached (a bound 0.6 times as large fails here) */
+  oc_enode *fa = disc(0, 0, 10, 0, OC_ENOISE_NONE, 0, 1, 1);
+  oc_enode *fb = disc(12, 0, 10, 10, OC_ENOISE_NONE, 0, 1, 1);
+  oc_enode *fk[2] = {fa, fb};
+  oc_enode *fe = EOK(oc_enode_blend(fk, 2, &err));
+  check_bounds(fe, 6, 0, 10);
+  oct_rng r2 = oct_rng_new(55);
+  double steepest = 0, lf = oc_enode_lipschitz(fe);
+  for (int i = 0; i < 20000; i++) {
+    oc_enode_sample q;
+    oc_enode_eval(fe, oct_unif(&r2, 0, 12), oct_unif(&r2, -6, 6), &q);
+    steepest = fmax(steepest, hypot(q.fx, q.fy));
+  }
+  ck_assert_msg(steepest > 0.6 * lf && steepest <= lf, "steepest %g, bound %g",
+                steepest, lf);
+  oc_enode_release(fa);
+  oc_enode_release(fb);
+  oc_enode_release(fe);
+  oc_enode_release(a);
+  oc_enode_release(b);
+  oc_enode_release(e);
+}
+END_TEST
+
+START_TEST(replace_and_add_formulas) {
+  oc_error err;
+  oc_enode *a = disc(0, 0, 50, 10, OC_ENOISE_PLAIN, 4, 12, 4);
+  oc_enode *b = disc(5, 5, 12, -3, OC_ENOISE_NONE, 0, 1, 1);
+  oc_enode *rep = EOK(oc_enode_replace(a, b, 0, &err));
+  oc_enode *lerp = EOK(oc_enode_replace(a, b, 1, &err));
+  oc_enode_add_params ap = {0, 0, 0, 0}, bp = {1, 1, 9, 4};
+  oc_enode *add = EOK(oc_enode_add(a, b, &ap, &err));
+  oc_enode *addb = EOK(oc_enode_add(a, b, &bp, &err));
+  oct_rng r = oct_rng_new(6);
+  for (int i = 0; i < 300; i++) {
+    double x = oct_unif(&r, -20, 25), y = oct_unif(&r, -20, 25);
+    oc_enode_sample s, sa, sb;
+    oc_enode_eval(a, x, y, &sa);
+    oc_enode_eval(b, x, y, &sb);
+    double w = fmin(fmax(sb.a, 0), 1);
+    oc_enode_eval(rep, x, y, &s);
+    ck_assert_double_eq_tol(s.f, (1 - w) * sa.f + w * sb.f, 1e-9);
+    ck_assert_double_eq_tol(s.a, sa.a, 1e-15);
+    oc_enode_eval(lerp, x, y, &s);
+    ck_assert_double_eq_tol(s.a, (1 - w) * sa.a + w * w, 1e-12);
+    oc_enode_eval(add, x, y, &s);
+    ck_assert_double_eq_tol(s.f, sa.f + w * sb.f, 1e-9);
+    oc_enode_eval(addb, x, y, &s);
+    double t = (9 - sa.f) / 4, W = t <= 0   ? 0
+                                   : t >= 1 ? 1
+                                            : t * t * (3 - 2 * t);
+    ck_assert_double_eq_tol(s.f, sa.f + w * W * sb.f, 1e-9);
+    ck_assert_double_eq_tol(s.a, sa.a + w * w, 1e-12);
+    check_gradient(rep, x, y, 1e-4);
+    check_gradient(lerp, x, y, 1e-4);
+    check_gradient(add, x, y, 1e-4);
+    check_gradient(addb, x, y, 1e-4);
+  }
+  check_bounds(rep, 5, 5, 30);
+  check_bounds(lerp, 5, 5, 30);
+  check_bounds(add, 5, 5, 30);
+  check_bounds(addb, 5, 5, 30);
+  oc_enode *all[6] = {a, b, rep, lerp, add, addb};
+  for (int i = 0; i < 6; i++)
+    oc_enode_release(all[i]);
+}
+END_TEST
+
+START_TEST(transform_concatenates) {
+  oc_error err;
+  oc_enode *a = disc(1, 2, 6, 3, OC_ENOISE_PLAIN, 2, 3, 3);
+  oc_enode_xform x1 = {10, -4, 30, 2, 1.5, 7}, x2 = {-3, 5, -75, 0.5, -2, 1};
+  oc_enode *t1 = EOK(oc_enode_transform(a, &x1, &err));
+  oc_enode *t2 = EOK(oc_enode_transform(t1, &x2, &err));
+  oc_enode_stats st;
+  ck_assert_int_eq(oc_enode_get_stats(t2, &st, &err), OC_OK);
+  ck_assert_uint_eq(st.nodes, 2); /* concatenated: one transform */
+  oct_rng r = oct_rng_new(8);
+  for (int i = 0; i < 200; i++) {
+    double x = oct_unif(&r, -30, 30), y = oct_unif(&r, -30, 30);
+    /* p = s2 R2 p' + t2, p' = s1 R1 p'' + t1, by hand */
+    double c2 = cos(-75 * PI / 180), s2 = sin(-75 * PI / 180);
+    double u = (x + 3) / 0.5, v = (y - 5) / 0.5;
+    double px = c2 * u + s2 * v, py = -s2 * u + c2 * v;
+    double c1 = cos(30 * PI / 180), s1 = sin(30 * PI / 180);
+    u = (px - 10) / 2, v = (py + 4) / 2;
+    double qx = c1 * u + s1 * v, qy = -s1 * u + c1 * v;
+    oc_enode_sample s, sa;
+    oc_enode_eval(t2, x, y, &s);
+    oc_enode_eval(a, qx, qy, &sa);
+    ck_assert_double_eq_tol(s.a, sa.a, 1e-12);
+    ck_assert_double_eq_tol(s.f, -2 * (1.5 * sa.f + 7) + 1, 1e-9);
+    check_gradient(t2, x, y, 1e-4);
+  }
+  double box[4];
+  oc_enode_get_bounds(t2, box, NULL, NULL);
+  check_bounds(t2, (box[0] + box[2]) / 2, (box[1] + box[3]) / 2,
+               box[2] - box[0]);
+  oc_enode_release(a);
+  oc_enode_release(t1);
+  oc_enode_release(t2);
+}
+END_TEST
+
+START_TEST(warp_bijective_only) {
+  oc_error err;
+  oc_enode *a = disc(0, 0, 30, 5, OC_ENOISE_RIDGED, 6, 10, 4);
+  oc_enode_warp_params ok = {2, 40, 2, 5}, bad = {20, 10, 3, 5};
+  oc_enode *w = EOK(oc_enode_warp(a, &ok, &err));
+  oct_rng r = oct_rng_new(9);
+  for (int i = 0; i < 200; i++)
+    check_gradient(w, oct_unif(&r, -25, 25), oct_unif(&r, -25, 25), 2e-4);
+  check_bounds(w, 0, 0, 35);
+  ck_assert_ptr_null(oc_enode_warp(a, &bad, &err));
+  ck_assert_int_eq(err.code, OC_EINVAL);
+  ck_assert_ptr_nonnull(strstr(err.msg, "bijection"));
+  oc_enode_release(a);
+  oc_enode_release(w);
+}
+END_TEST
+
+START_TEST(dag_stats_and_source) {
+  oc_error err;
+  oc_enode *base = disc(0, 0, 1000, 50, OC_ENOISE_PLAIN, 30, 300, 5);
+  oc_enode *hill = disc(100, 0, 200, 150, OC_ENOISE_RIDGED, 40, 80, 5);
+  oc_enode_xform m = {300, 0, 45, 1, 1, 0};
+  oc_enode *moved = EOK(oc_enode_transform(hill, &m, &err));
+  oc_enode *k[3] = {base, hill, moved};
+  oc_enode *e = EOK(oc_enode_blend(k, 3, &err));
+  oc_enode_stats st;
+  ck_assert_int_eq(oc_enode_get_stats(e, &st, &err), OC_OK);
+  ck_assert_uint_eq(st.nodes, 4); /* hill shared */
+  ck_assert_uint_eq(st.primitives, 2);
+  ck_assert(st.bytes > 0 && st.bytes <= 4 * 400);
+  /* the source answers the tree's own values and bounds */
+  oc_elevation src;
+  ck_assert_int_eq(oc_enode_elevation(e, NULL, &src, &err), OC_OK);
+  ck_assert(src.x0 == -1000 && src.x1 == 1000);
+  double g[2];
+  oc_enode_sample s;
+  oc_enode_eval(e, 120, 30, &s);
+  ck_assert(src.height(src.ud, 120, 30, g) == s.f && g[0] == s.fx);
+  double lo, hi;
+  src.range(src.ud, 50, -50, 150, 50, &lo, &hi);
+  oc_enode_bound b;
+  oc_enode_bound_in(e, 50, -50, 150, 50, &b);
+  ck_assert(lo == b.flo && hi == b.fhi);
+  ck_assert(src.slope(src.ud, 50, -50, 150, 50) == b.lf);
+  /* a terrain over it: its surface is f where the base covers */
+  oc_terrain_params tp = {0};
+  tp.falloff = 20;
+  oc_node *t = OCT_OK(oc_terrain(&src, &tp, &err));
+  src.release(src.ud);
+  oc_program *P = oct_compile(t, 0.5, 0);
+  ck_assert_double_eq_tol(oc_program_eval(P, oct_v(120, 30, s.f)), 0.5, 1e-9);
+  ck_assert(oc_program_eval(P, oct_v(120, 30, s.f - 5)) > 0.5);
+  ck_assert(oc_program_eval(P, oct_v(120, 30, s.f + 5)) < 0.5);
+  oc_program_free(P);
+  double bad[4] = {0, 0, NAN, 1};
+  ck_assert_int_eq(oc_enode_elevation(e, bad, &src, &err), OC_EINVAL);
+  oc_enode *all[4] = {base, hill, moved, e};
+  for (int i = 0; i < 4; i++)
+    oc_enode_release(all[i]);
+}
+END_TEST
+
+/* A straight river: f = q_z + its cross-section, alpha flat over the
+** channel; a winding one: gradients and bounds where alpha > 0. */
+START_TEST(curve_river_road) {
+  oc_error err;
+  oc_vec3 straight[2] = {{0, 0, 10}, {100, 0, 20}};
+  oc_enode_river_params rp = {straight, 2, OC_ECURVE_LINEAR, OC_RIVER_RIVER, 0,
+                              0,        0};
+  oc_enode *r = EOK(oc_enode_river(&rp, &err));
+  ck_assert_str_eq(oc_enode_kind(r), "curve");
+  oc_enode_sample s;
+  oc_enode_eval(r, 50, 0, &s); /* channel centre: bed at q_z - depth */
+  ck_assert_double_eq_tol(s.f, 15 - 3, 1e-9);
+  ck_assert_double_eq_tol(s.a, 1, 1e-15);
+  ck_assert_double_eq_tol(s.fx, 0.1, 1e-9); /* the skeleton's grade */
+  oc_enode_eval(r, 50, 10, &s);             /* bank top of the channel, w / 2 */
+  ck_assert_double_eq_tol(s.f, 15 - 1.5, 1e-9);
+  ck_assert_double_eq_tol(s.a, 1, 1e-15);
+  oc_enode_eval(r, 50, -(10 + 12.5), &s); /* half-way up the bank */
+  ck_assert_double_eq_tol(s.a, wyv(0.5), 1e-12);
+  oc_enode_eval(r, 50, 36, &s); /* beyond the banks */
+  ck_assert(s.a == 0 && fabs(s.f - 15) < 1e-9);
+  oc_enode_eval(r, 120, 5, &s); /* past the end: straight on, round cap */
+  ck_assert_double_eq_tol(s.a, wyv((hypot(20, 5) - 10) / 25), 1e-12);
+  /* a winding road and river: gradients and bounds on the support */
+  oc_vec3 wind[5] = {
+      {0, 0, 0}, {100, 60, 5}, {200, -40, 12}, {300, 50, 8}, {400, 0, 3}};
+  oc_enode_road_params dp = {wind, 5, OC_ECURVE_CATMULL, 0, -1, 0};
+  oc_enode *road = EOK(oc_enode_road(&dp, &err));
+  oc_enode_river_params wp = {wind, 5, OC_ECURVE_CATMULL, OC_RIVER_STREAM, 0,
+                              0,    0};
+  oc_enode *riv = EOK(oc_enode_river(&wp, &err));
+  oc_enode *cs[2] = {road, riv};
+  oct_rng g = oct_rng_new(17);
+  for (int c = 0; c < 2; c++) {
+    double lf = oc_enode_lipschitz(cs[c]),
+           la = 1.7173002067198386 / (c ? 4 : 12);
+    int n = 0;
+    for (int i = 0; i < 20000 && n < 400; i++) {
+      double x = oct_unif(&g, 0, 400), y = oct_unif(&g, -80, 80);
+      oc_enode_eval(cs[c], x, y, &s);
+      if (!(s.a > 1e-6 && s.a < 1 - 1e-6)) continue;
+      n++;
+      check_gradient(cs[c], x, y, 1e-3);
+      ck_assert(hypot(s.fx, s.fy) <= lf);
+      ck_assert(hypot(s.ax, s.ay) <= la * (1 + 1e-9));
+    }
+    ck_assert_int_ge(n, 100);
+  }
+  /* a corner, and a radius wider than the bends allow */
+  oc_vec3 corner[3] = {{0, 0, 0}, {10, 0, 0}, {10, 10, 0}};
+  oc_enode_river_params bp = {corner, 3, OC_ECURVE_LINEAR, OC_RIVER_STREAM, 0,
+                              0,      0};
+  ck_assert_ptr_null(oc_enode_river(&bp, &err));
+  ck_assert_ptr_nonnull(strstr(err.msg, "corner"));
+  oc_vec3 tight[4] = {{0, 0, 0}, {10, 10, 0}, {20, 0, 0}, {30, 10, 0}};
+  oc_enode_river_params tp = {tight, 4, OC_ECURVE_CATMULL, OC_RIVER_MAIN, 0,
+                              0,     0};
+  ck_assert_ptr_null(oc_enode_river(&tp, &err));
+  ck_assert_ptr_nonnull(strstr(err.msg, "'radius'"));
+  oc_vec3 one[1] = {{0, 0, 0}};
+  oc_enode_river_params op = {one, 1, OC_ECURVE_CATMULL, OC_RIVER_STREAM, 0,
+                              0,   0};
+  ck_assert_ptr_null(oc_enode_river(&op, &err));
+  ck_assert_ptr_nonnull(strstr(err.msg, "'points'"));
+  oc_enode_release(r);
+  oc_enode_release(road);
+  oc_enode_release(riv);
+}
+END_TEST
+
+START_TEST(bad_input) {
+  oc_error err;
+  oc_enode_disc_params p = {0, 0, NAN, 0, {OC_ENOISE_NONE, 0, 1, 1, 0, 0, 0}};
+  ck_assert_ptr_null(oc_enode_disc(&p, &err));
+  ck_assert_ptr_nonnull(strstr(err.msg, "'radius'"));
+  p.radius = 1;
+  p.noise = (oc_enode_noise){OC_ENOISE_PLAIN, 1, 0, 3, 0, 0, 0};
+  ck_assert_ptr_null(oc_enode_disc(&p, &err));
+  ck_assert_ptr_nonnull(strstr(err.msg, "'noise.wavelength'"));
+  p.noise = (oc_enode_noise){OC_ENOISE_PLAIN, 1e308, 1, 3, 0, 0, 0};
+  ck_assert_ptr_null(oc_enode_disc(&p, &err));
+  ck_assert_ptr_nonnull(strstr(err.msg, "overflow"));
+  p.noise = (oc_enode_noise){OC_ENOISE_PLAIN, 1, 1, 17, 0, 0, 0};
+  ck_assert_ptr_null(oc_enode_disc(&p, &err));
+  ck_assert_ptr_nonnull(strstr(err.msg, "'noise.octaves'"));
+  p.noise.octaves = 3;
+  oc_enode *d = EOK(oc_enode_disc(&p, &err));
+  oc_enode_xform x = {0, 0, 0, -1, 1, 0};
+  ck_assert_ptr_null(oc_enode_transform(d, &x, &err));
+  ck_assert_ptr_nonnull(strstr(err.msg, "'scale'"));
+  oc_enode_add_params ap = {0, 1, 0, 0};
+  ck_assert_ptr_null(oc_enode_add(d, d, &ap, &err));
+  ck_assert_ptr_nonnull(strstr(err.msg, "'fade'"));
+  ck_assert_ptr_null(oc_enode_blend(NULL, 0, &err));
+  oc_enode_sample s;
+  oc_enode_eval(d, NAN, 0, &s);
+  ck_assert(isnan(s.f) && isnan(s.a));
+  oc_enode_release(d);
+}
+END_TEST
+
+int main(void) {
+  Suite *s = suite_create("elevation");
+  TCase *tc = tcase_create("elevation");
+  tcase_set_timeout(tc, 60);
+  tcase_add_test(tc, disc_formula);
+  tcase_add_test(tc, disc_noises);
+  tcase_add_test(tc, blend_formula);
+  tcase_add_test(tc, replace_and_add_formulas);
+  tcase_add_test(tc, transform_concatenates);
+  tcase_add_test(tc, warp_bijective_only);
+  tcase_add_test(tc, dag_stats_and_source);
+  tcase_add_test(tc, curve_river_road);
+  tcase_add_test(tc, bad_input);
+  suite_add_tcase(s, tc);
+  return oct_run(s);
+}
