@@ -215,9 +215,11 @@ typedef struct oc_progress {
 typedef struct oc_mesh oc_mesh;
 
 typedef struct oc_polygonize_params {
-  oc_aabb box;      /* region to mesh: finite, non-empty */
+  oc_aabb box;      /* region to mesh: finite, non-empty (see
+                    ** oc_polygonize_default_box) */
   double cell;      /* cell size; or 0 to use nx, ny, nz */
-  int nx, ny, nz;   /* cells per axis when cell == 0 */
+  int nx, ny, nz;   /* cells per axis when cell == 0; all 0 (with cell 0):
+                    ** oc_polygonize_default_cell(box) */
   double threshold; /* iso-value; 0 means the program's T */
   int open;         /* 1: no caps; the surface runs up to the box faces */
   int steps;        /* root-finding steps per edge (0: default 6) */
@@ -249,6 +251,15 @@ typedef struct oc_polygonize_params {
 ** thread count. */
 oc_mesh *oc_polygonize(const oc_program *prog, const oc_polygonize_params *pp,
                        oc_error *err);
+
+/* The defaults every front end takes (mesh/polygonize.c). The box: prog's
+** bounds, OC_EINVAL when they are empty (the field is 0 everywhere) or
+** infinite (*box then unchanged). The cell: cubic, 1 /
+** OC_POLYGONIZE_DEFAULT_RESOLUTION of the box's longest side. */
+#define OC_POLYGONIZE_DEFAULT_RESOLUTION 64
+int oc_polygonize_default_box(const oc_program *prog, oc_aabb *box,
+                              oc_error *err);
+double oc_polygonize_default_cell(oc_aabb box);
 void oc_mesh_free(oc_mesh *mesh);
 
 size_t oc_mesh_vertex_count(const oc_mesh *mesh);
@@ -339,6 +350,13 @@ const char *oc_image_channel_name(const oc_image *img, int channel);
 /* Adds a string attribute written as image metadata (provenance). */
 int oc_image_set_meta(oc_image *img, const char *key, const char *value,
                       oc_error *err);
+/* Read access to an image's metadata (in the order set; keys compare
+** without case): the count, the i-th key and value (NULL past the end),
+** and the value of `key` (NULL when absent). The strings are the image's. */
+size_t oc_image_meta_count(const oc_image *img);
+const char *oc_image_meta_key(const oc_image *img, size_t i);
+const char *oc_image_meta_value(const oc_image *img, size_t i);
+const char *oc_image_meta_get(const oc_image *img, const char *key);
 /* Writes through OpenImageIO; the format follows the extension (.png,
 ** .jpg, .tif, .exr). `bits` is 8 or 16 for PNG/TIFF (0: 8 for PNG/JPEG,
 ** 16 for TIFF, half for EXR). Atomic: written to a temporary name in the
@@ -353,6 +371,28 @@ int oc_image_write(const oc_image *img, const char *path, int bits,
 ** oc_mesh_write_at). */
 int oc_image_write_at(const oc_image *img, int dirfd, const char *path,
                       int bits, oc_error *err);
+
+/* ---- palettes ------------------------------------------------------- */
+
+/* Colour maps (core/palette.c): n stops of 4 doubles (value, r, g, b)
+** sorted by value, linear between neighbours, the end colours beyond them.
+** Meshes, renders, slices and heightfield images colour values through
+** them. */
+
+/* OC_OK when n >= 1 stops have finite, ascending values and colour
+** components in [0, 1]; else OC_EINVAL naming 'stops'. */
+int oc_palette_check(const double *stops, int n, oc_error *err);
+/* The colour of v. Where stops share a value the colour steps (the later
+** stop wins from that value on). NaN takes the first stop's colour. */
+void oc_palette_eval(const double *stops, int n, double v, double rgb[3]);
+/* Built-in palettes, static (never freed), their stop count in *n:
+** - strata: soft sandstone to hard limestone for a resistance in [0, 1],
+**   linear albedos about as bright as the render rules' rock (the
+**   default of a render coloured by a node);
+** - resistance: dark for soft rock to pale for hard (Paris et al. 2019,
+**   figure 4; the default of a geology slice). */
+const double *oc_palette_strata(int *n);
+const double *oc_palette_resistance(int *n);
 
 /* ---- slices ---------------------------------------------------------- */
 
@@ -376,6 +416,19 @@ typedef struct oc_slice_params {
 ** height (v grows upwards). */
 oc_image *oc_slice(const oc_program *prog, const oc_slice_params *sp,
                    oc_error *err);
+
+/* The window a slice takes when none is given (render/slice.c): the
+** program's bounds on sp->plane's two axes (x, y for "xy", x, z for "xz",
+** y, z for "yz") into u0, v0, u1, v1. OC_EINVAL when they are infinite
+** (they may be empty: oc_slice refuses those); sp is then unchanged. */
+int oc_slice_default_window(const oc_program *prog, oc_slice_params *sp,
+                            oc_error *err);
+
+/* Recolours a slice image (made by oc_slice) through a palette: R, G, B
+** from the value in its "field" channel (oc_palette_eval), A = 1; the
+** iso-line is not drawn. The "field" channel is kept. */
+int oc_slice_apply_palette(oc_image *img, const double *stops, int n,
+                           oc_error *err);
 
 /* ---- rendering --------------------------------------------------------- */
 
@@ -479,8 +532,20 @@ typedef struct oc_render_params {
 ** intensity 2.2, sky (0.45, 0.6, 0.85), shadows and AO on, no fog (fog
 ** colour = sky), no background (sky), texture 0.3, rule colours with
 ** derived levels, segment tracer, AOV channels on, exposure 0, tone
-** OC_TONE_CLAMP. */
+** OC_TONE_CLAMP; camera up (0, 0, 1), fov 40 degrees (vertical). */
 void oc_render_defaults(oc_render_params *rp);
+
+/* The default framing (render/framing.c), the one the Lua front end uses:
+** where has_target is 0 the target becomes the centre of prog's bounds;
+** where has_eye is 0 the eye looks at the target from the south-west
+** (azimuth -135 degrees), 30 degrees above the horizon, along
+** rp->camera.up, just far enough (4 % margin, never inside the bounds'
+** sphere) for the eight corners of the bounds to fall inside the view of
+** rp->camera.fov at rp->width x rp->height. Both given: nothing changes.
+** OC_EINVAL when the bounds are empty or infinite, or camera.up is
+** parallel to the view; rp is then unchanged. */
+int oc_render_default_camera(const oc_program *prog, oc_render_params *rp,
+                             int has_eye, int has_target, oc_error *err);
 
 /* Channels of a geometry image (OC_RG_COUNT floats per pixel). */
 enum {
@@ -770,6 +835,29 @@ oc_heightfield *oc_heightfield_resample(const oc_heightfield *hf,
 ** grid, its origin at sample (i0, j0). */
 oc_heightfield *oc_heightfield_crop(const oc_heightfield *hf, int i0, int j0,
                                     int i1, int j1, oc_error *err);
+
+/* -- resampling and cropping in the caller's terms (terrain/hf_resample.c) */
+
+/* The grid oc_heightfield_resample makes from hf given either `cell` > 0
+** (nx = ny = 0: floor(extent / cell) + 1 samples per side, the extent
+** kept up to a cell) or nx, ny in 2..65535 (cell = 0: the extent kept,
+** cells square, so nx, ny must keep hf's proportions), with hf's origin.
+** OC_EINVAL naming 'cell' or 'size' when neither or both are given, or
+** the grid would have fewer than 2 or too many samples. */
+int oc_heightfield_resample_grid(const oc_heightfield *hf, double cell, int nx,
+                                 int ny, oc_hf_grid *g, oc_error *err);
+/* The 0-based inclusive sample range {i0, j0, i1, j1} of the samples of
+** hf lying in the box [x0, x1] x [y0, y1] (with a slack of 1e-9 cell);
+** OC_EINVAL when x0 >= x1 or y0 >= y1 or the box holds fewer than 2 x 2
+** samples. oc_heightfield_crop_box crops to it (a new grid). */
+int oc_heightfield_crop_range(const oc_heightfield *hf, double x0, double y0,
+                              double x1, double y1, int ij[4], oc_error *err);
+oc_heightfield *oc_heightfield_crop_box(const oc_heightfield *hf, double x0,
+                                        double y0, double x1, double y1,
+                                        oc_error *err);
+/* The sum of the samples, in index order in double (the same for any
+** thread count); 0 for NULL. */
+double oc_heightfield_sum(const oc_heightfield *hf);
 
 /* -- analysis (terrain/slope.c, fill.c, flow.c, sinks.c, access.c,
 **    edt.c) -- */
@@ -1274,6 +1362,38 @@ typedef struct oc_gen_river_params {
 void oc_gen_river_defaults(oc_gen_river_params *p);
 oc_node *oc_generate_river(const oc_gen_river_params *p, oc_gen_sea_stats *st,
                            oc_error *err);
+
+/* ---- hashes (provenance) --------------------------------------------- */
+
+/* SHA-256 (FIPS 180-4): the hash of a scene file and of every input file a
+** run read, recorded in the metadata of what it wrote. Incremental: init,
+** update any number of times with any lengths, final. The state is a
+** plain struct the caller owns; nothing is allocated. */
+#define OC_SHA256_BYTES 32
+#define OC_SHA256_HEX 65 /* 64 lowercase hex digits and the NUL */
+
+typedef struct oc_sha256 {
+  uint32_t h[8];
+  uint64_t bytes; /* message length so far */
+  unsigned char block[64];
+  size_t n; /* bytes waiting in block */
+} oc_sha256;
+
+void oc_sha256_init(oc_sha256 *s);
+void oc_sha256_update(oc_sha256 *s, const void *data, size_t n);
+/* Writes the digest; s must be initialized again before reuse. */
+void oc_sha256_final(oc_sha256 *s, unsigned char out[OC_SHA256_BYTES]);
+/* The digest as lowercase hex, NUL terminated. */
+void oc_sha256_hex(const unsigned char d[OC_SHA256_BYTES],
+                   char hex[OC_SHA256_HEX]);
+/* One call: the hex digest of n bytes. */
+void oc_sha256_text(const void *data, size_t n, char hex[OC_SHA256_HEX]);
+
+/* The SHA-256 of the regular file `path` as lowercase hex in `hex`
+** (OC_SHA256_HEX bytes), for provenance. Refuses FIFOs, devices and
+** folders without blocking, but takes any content. OC_OK, or OC_EIO with
+** a message naming the path. (lib/io/infile.c) */
+int oc_infile_sha256(const char *path, char *hex, oc_error *err);
 
 #ifdef __cplusplus
 }

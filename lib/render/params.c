@@ -11,7 +11,7 @@
 
 void oc_render_defaults(oc_render_params *rp) {
   static const oc_render_params d = {
-      .camera = {{0, -100, 50}, {0, 0, 0}, {0, 0, 1}, 45},
+      .camera = {{0, -100, 50}, {0, 0, 0}, {0, 0, 1}, 40},
       .width = 640,
       .height = 360,
       .sun_direction = {-0.5, -0.4, 0.77},
