@@ -130,6 +130,21 @@ oc_node *oc_warp(oc_node *child, const oc_noise *noise, oc_node *control,
 ** space to world space: world = M[:, 0:3] * local + M[:, 3]. Must be
 ** invertible. */
 oc_node *oc_transform(oc_node *child, const double m[12], oc_error *err);
+
+/* Building such maps (core/xform.c), as the Lua front end does: */
+void oc_xform_identity(double m[12]);
+/* out = a * b (b applied first); out may be a or b. */
+void oc_xform_mul(const double a[12], const double b[12], double out[12]);
+/* Rotation by `degrees` about `axis` (normalised here; right-handed).
+** OC_EINVAL naming 'rotate.axis' for a zero or non-finite axis. */
+int oc_xform_axis_angle(oc_vec3 axis, double degrees, double m[12],
+                        oc_error *err);
+/* Euler angles in degrees applied about X, then Y, then Z: Rz Ry Rx. */
+int oc_xform_euler(oc_vec3 degrees, double m[12], oc_error *err);
+/* M = T * R * S: scale (non-zero factors, else OC_EINVAL naming 'scale'),
+** then the rotation `rotate` (NULL: none), then the translation. */
+int oc_xform_compose(oc_vec3 translate, const double rotate[12], oc_vec3 scale,
+                     double m[12], oc_error *err);
 /* Star-shaped anisotropic perturbation of a skeletal or volumetric
 ** primitive (Paris et al. 2019, section 5.2): d / (R + amplitude *
 ** t(v(p)/wl)). */
@@ -1008,6 +1023,30 @@ enum { OC_TERRAIN_EDGES_DEFAULT, OC_TERRAIN_OPEN, OC_TERRAIN_SLAB };
 oc_node *oc_terrain(const oc_elevation *src, const oc_terrain_params *tp,
                     oc_error *err);
 
+/* -- the defaults front ends take from a grid (terrain/hf_defaults.c) -- */
+
+/* The default terrain parameters for hf: falloff 4 cells of hf,
+** transition 1 (metre), no mask, open edges, not inverted, thickness 0. */
+void oc_terrain_defaults(const oc_heightfield *hf, oc_terrain_params *tp);
+/* The terrain node of hf's elevation with tp, or with
+** oc_terrain_defaults(hf) when tp is NULL: the node outcrop.terrain(hf)
+** makes, and the one the generators march when given no terrain. New
+** reference or NULL with err. */
+oc_node *oc_heightfield_terrain(oc_heightfield *hf, const oc_terrain_params *tp,
+                                oc_error *err);
+/* The sea generator's default sea level: 0 when hf's samples span it
+** (lowest < 0 < highest), else the lowest plus a quarter of the relief. */
+double oc_heightfield_sea_level(const oc_heightfield *hf);
+/* A mask for oc_terrain_params.mask from the grey image at `path`:
+** stretched over hf's width (its cell = hf's extent along x / (its nx -
+** 1), origin hf's), its samples divided by the brightest, so Omega is
+** where the image is >= half its brightest pixel. New grid, or NULL with
+** err: the read's error after "'mask': ", or OC_EINVAL when the image is
+** black. */
+oc_heightfield *oc_heightfield_load_mask(const char *path,
+                                         const oc_heightfield *hf,
+                                         oc_error *err);
+
 /* ---- geology: resistance trees and the erosion node ----- */
 
 /* geology/geology.c and geology/erosion.c; docs/fields.md, "Geology", has the
@@ -1290,30 +1329,42 @@ typedef struct oc_gen_sea_stats {
   size_t primitives; /* primitives made */
 } oc_gen_sea_stats;
 
-typedef struct oc_gen_sea_params {
+/* The parameters the sea and river generators share (oc_gen_sea_params
+** and oc_gen_river_params hold them as `erode`); oc_gen_erode_defaults
+** fills beta and cutoff, the generators' own defaults the rest. */
+typedef struct oc_gen_erode_params {
   oc_heightfield *heightfield; /* required */
-  oc_node *terrain;            /* or NULL (see above) */
-  int no_terrain;              /* 1: return the primitives alone */
-  oc_node *geology;            /* resistance; NULL: 0.5 everywhere */
+  oc_node *terrain; /* or NULL: oc_heightfield_terrain(heightfield) */
+  int no_terrain;   /* 1: return the primitives alone */
+  oc_node *geology; /* resistance; NULL: 0.5 everywhere */
   uint64_t seed;
-  double sea_level; /* finite (0) */
+  double radius;    /* of the point primitives, > 0 (0: the generator's) */
+  double spacing;   /* Poisson radius > 0 (0: radius / 2) */
+  double beta;      /* in [0, 1] (0.2): e(1, 1), the bite on the hardest rock */
+  double strength;  /* > 0: energy = -strength e (sea 4, river 2) */
+  double cutoff;    /* >= 0 (0.05): samples with a smaller e make nothing */
+  int steps;        /* 1 .. 64: rounds on the updated tree (sea 3, river 2) */
+  double threshold; /* T; 0: OC_DEFAULT_THRESHOLD */
+  oc_progress progress;
+} oc_gen_erode_params;
+
+/* Zero, then beta 0.2 and cutoff 0.05 (strength and steps stay 0: the
+** sea's and river's defaults set them). */
+void oc_gen_erode_defaults(oc_gen_erode_params *e);
+
+typedef struct oc_gen_sea_params {
+  oc_gen_erode_params erode; /* radius 0: range; strength 4; steps 3 */
+  double sea_level; /* finite; NaN: oc_heightfield_sea_level(heightfield),
+                    ** the default */
   double range;     /* > 0: sigma falls off as g(|z - sea_level| / range);
                     ** columns lower than sea_level - range are not
                     ** sampled (8, the paper's figure 11) */
-  double radius;    /* > 0 (0: range) */
-  double spacing;   /* Poisson radius > 0 (0: radius / 2) */
   double reach;     /* > 0: columns above sea_level + range are candidates
                     ** within this horizontal distance of the band, their
                     ** ray cast at a height drawn in the band (steep cliff
                     ** faces) (0: 2 radius) */
-  double beta;      /* in [0, 1] (0.2) */
-  double strength;  /* > 0 (4) */
-  double cutoff;    /* >= 0 (0.05) */
-  int steps;        /* 1 .. 64 (3) */
   int rays;         /* accessibility rays per column, 0 .. 4096; 0: alpha
                     ** = 1 (16) */
-  double threshold; /* T; 0: OC_DEFAULT_THRESHOLD */
-  oc_progress progress;
 } oc_gen_sea_params;
 
 /* Sea erosion: candidate columns within `range` of sea level (the
@@ -1333,24 +1384,12 @@ oc_node *oc_generate_sea(const oc_gen_sea_params *p, oc_gen_sea_stats *st,
                          oc_error *err);
 
 typedef struct oc_gen_river_params {
-  oc_heightfield *heightfield; /* required */
-  oc_node *terrain;            /* or NULL (see above) */
-  int no_terrain;              /* 1: return the primitives alone */
-  oc_node *geology;            /* resistance; NULL: 0.5 everywhere */
-  uint64_t seed;
-  double power;     /* stream power A^(1/2) s above which a sample is
-                    ** riverbed, > 0; 0: the 95th percentile of the grid */
-  int banks;        /* widening of the bed in cells, 0 .. 64 (3) */
-  double depth;     /* > 0: bank rays are cast at z drawn in [h - depth, h]
-                    ** (0: 3 radius) */
-  double radius;    /* > 0 (0: 1.5 cells) */
-  double spacing;   /* Poisson radius > 0 (0: radius / 2) */
-  double beta;      /* in [0, 1] (0.2) */
-  double strength;  /* > 0 (2) */
-  double cutoff;    /* >= 0 (0.05) */
-  int steps;        /* 1 .. 64 (2) */
-  double threshold; /* T; 0: OC_DEFAULT_THRESHOLD */
-  oc_progress progress;
+  oc_gen_erode_params erode; /* radius 0: 1.5 cells; strength 2; steps 2 */
+  double power;              /* stream power A^(1/2) s above which a sample is
+                             ** riverbed, > 0; 0: the 95th percentile of the grid */
+  int banks;                 /* widening of the bed in cells, 0 .. 64 (3) */
+  double depth; /* > 0: bank rays are cast at z drawn in [h - depth, h]
+                ** (0: 3 radius) */
 } oc_gen_river_params;
 
 /* River erosion: sigma per sample is 1 on the riverbed (stream power >=
