@@ -561,6 +561,11 @@ void oc_render_defaults(oc_render_params *rp);
 ** parallel to the view; rp is then unchanged. */
 int oc_render_default_camera(const oc_program *prog, oc_render_params *rp,
                              int has_eye, int has_target, oc_error *err);
+/* Every check oc_render makes of prog and rp before it traces anything
+** (the messages name the Lua table fields): for a caller that does work
+** of its own between oc_render_geometry and oc_render_shade. */
+int oc_render_check(const oc_program *prog, const oc_render_params *rp,
+                    oc_error *err);
 
 /* Channels of a geometry image (OC_RG_COUNT floats per pixel). */
 enum {

@@ -70,14 +70,11 @@ static void read_common(oclua_fields *f, oc_gen_erode_params *c) {
   c->seed = oclua_field_seed(f, "seed");
   c->radius = oclua_field_optnumber(f, "radius", OCLUA_POSITIVE, 0);
   c->spacing = oclua_field_optnumber(f, "spacing", OCLUA_POSITIVE, 0);
+  /* beta's range and cutoff's sign are the lib's to check */
   c->beta = oclua_field_optnumber(f, "beta", OCLUA_FINITE, c->beta);
-  if (!(c->beta >= 0 && c->beta <= 1))
-    oclua_error(f->L, f->fname, "'beta' must be in [0, 1] (got %f)", c->beta);
   c->strength =
       oclua_field_optnumber(f, "strength", OCLUA_POSITIVE, c->strength);
   c->cutoff = oclua_field_optnumber(f, "cutoff", OCLUA_FINITE, c->cutoff);
-  if (c->cutoff < 0)
-    oclua_error(f->L, f->fname, "'cutoff' must be >= 0 (got %f)", c->cutoff);
   c->steps = (int)oclua_field_optint(f, "steps", 1, 64, c->steps);
   c->threshold = oclua_threshold(f->L, f->fname);
 }

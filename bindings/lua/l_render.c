@@ -36,8 +36,6 @@
 
 #define FNAME "outcrop.render"
 #define MAX_SIDE 16384
-#define DEFAULT_FOV 40.0
-#define MAX_FOV 179.0
 #define MAX_EV 20.0 /* exposure, stops either way (lib/render/render.h) */
 /* Fog given as a distance: the transmittance there is exp(-3), 5 %. */
 #define FOG_DISTANCE_FACTOR 3.0
@@ -150,19 +148,14 @@ static void read_camera(const oclua_fields *f, oc_render_params *rp,
                         camera_in *ci) {
   static const char *const known[] = {"eye", "target", "up", "fov", NULL};
   oclua_fields c;
-  rp->camera.up = (oc_vec3){0, 0, 1};
-  rp->camera.fov = DEFAULT_FOV;
   ci->has_eye = ci->has_target = 0;
   if (!open_sub(f, "camera", &c, known)) return;
   ci->has_eye = oclua_field_optvec(&c, "eye", &rp->camera.eye);
   ci->has_target = oclua_field_optvec(&c, "target", &rp->camera.target);
   oclua_field_optvec(&c, "up", &rp->camera.up);
+  /* (the range is the lib's to check: oc_render_default_camera) */
   rp->camera.fov =
-      oclua_field_optnumber(&c, "fov", OCLUA_POSITIVE, DEFAULT_FOV);
-  if (rp->camera.fov > MAX_FOV)
-    oclua_error(f->L, f->fname,
-                "'camera.fov' must be in (0, %d] degrees (got %f)",
-                (int)MAX_FOV, rp->camera.fov);
+      oclua_field_optnumber(&c, "fov", OCLUA_POSITIVE, rp->camera.fov);
   close_sub(f->L);
 }
 
@@ -171,17 +164,12 @@ static void read_sun(const oclua_fields *f, oc_render_params *rp) {
   oclua_fields s;
   oc_vec3 d;
   if (!open_sub(f, "sun", &s, known)) return;
-  if (oclua_field_optvec(&s, "direction", &d)) {
-    if (d.x == 0 && d.y == 0 && d.z == 0)
-      oclua_error(f->L, f->fname, "'sun.direction' must not be {0, 0, 0}");
-    rp->sun_direction = d;
-  }
+  /* a zero direction and a negative intensity are the lib's to refuse
+  ** (oc_render_check) */
+  if (oclua_field_optvec(&s, "direction", &d)) rp->sun_direction = d;
   read_rgb(&s, "color", rp->sun_color, 0);
-  double i =
+  rp->sun_intensity =
       oclua_field_optnumber(&s, "intensity", OCLUA_FINITE, rp->sun_intensity);
-  if (i < 0)
-    oclua_error(f->L, f->fname, "'sun.intensity' must be >= 0 (got %f)", i);
-  rp->sun_intensity = i;
   close_sub(f->L);
 }
 
@@ -453,6 +441,13 @@ static int l_render(lua_State *L) {
   const oc_program *prog = oclua_program_at(L, 1, FNAME, t);
   if (oc_render_default_camera(prog, &rp, ci.has_eye, ci.has_target, &err))
     oclua_liberror(L, FNAME, &err);
+  /* The colour node is compiled at the render's threshold: were it the
+  ** main node itself, another threshold would replace (and free) the
+  ** program in use. Everything is checked before any work (a colour
+  ** function runs between the lib's passes). */
+  if (src.kind == SRC_FIELD)
+    rp.color_field = oclua_program_at(L, src.idx, FNAME, t);
+  if (oc_render_check(prog, &rp, &err)) oclua_liberror(L, FNAME, &err);
   memset(&rp.progress, 0, sizeof rp.progress);
   rp.progress = oclua_progress_start(L, &pl, FNAME);
   char warning[300] = "";
@@ -460,11 +455,6 @@ static int l_render(lua_State *L) {
   rp.warning_size = sizeof warning;
 
   if (src.kind != SRC_FUNCTION) {
-    /* The colour node is compiled at the render's threshold: were it the
-    ** main node itself, another threshold would replace (and free) the
-    ** program in use. */
-    if (src.kind == SRC_FIELD)
-      rp.color_field = oclua_program_at(L, src.idx, FNAME, t);
     oclua_image *u = oclua_newimage(L);
     u->img = oc_render(prog, &rp, &err);
     if (u->img == NULL) render_error(L, &pl, &err);

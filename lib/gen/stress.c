@@ -467,22 +467,27 @@ int oc_erode_check(const oc_gen_erode_params *c, oc_error *err) {
   double radius = c->radius, spacing = c->spacing, beta = c->beta;
   double strength = c->strength, cutoff = c->cutoff, threshold = c->threshold;
   int steps = c->steps;
+  char b[OC_NUMSTR];
   if (!(radius > 0 && isfinite(radius)))
-    return oc_seterr(err, OC_EINVAL, "'radius' must be > 0 (got %g)", radius);
+    return oc_seterr(err, OC_EINVAL, "'radius' must be > 0 (got %s)",
+                     oc_numstr(radius, b));
   if (!(spacing > 0 && isfinite(spacing)))
-    return oc_seterr(err, OC_EINVAL, "'spacing' must be > 0 (got %g)", spacing);
+    return oc_seterr(err, OC_EINVAL, "'spacing' must be > 0 (got %s)",
+                     oc_numstr(spacing, b));
   if (!(beta >= 0 && beta <= 1))
-    return oc_seterr(err, OC_EINVAL, "'beta' must be in [0, 1] (got %g)", beta);
+    return oc_seterr(err, OC_EINVAL, "'beta' must be in [0, 1] (got %s)",
+                     oc_numstr(beta, b));
   if (!(strength > 0 && isfinite(strength)))
-    return oc_seterr(err, OC_EINVAL, "'strength' must be > 0 (got %g)",
-                     strength);
+    return oc_seterr(err, OC_EINVAL, "'strength' must be > 0 (got %s)",
+                     oc_numstr(strength, b));
   if (!(cutoff >= 0 && isfinite(cutoff)))
-    return oc_seterr(err, OC_EINVAL, "'cutoff' must be >= 0 (got %g)", cutoff);
+    return oc_seterr(err, OC_EINVAL, "'cutoff' must be >= 0 (got %s)",
+                     oc_numstr(cutoff, b));
   if (steps < 1 || steps > 64)
     return oc_seterr(err, OC_EINVAL, "'steps' must be in 1..64 (got %d)",
                      steps);
   if (!(threshold >= 0 && isfinite(threshold)))
-    return oc_seterr(err, OC_EINVAL, "'threshold' must be > 0 (got %g)",
-                     threshold);
+    return oc_seterr(err, OC_EINVAL, "'threshold' must be > 0 (got %s)",
+                     oc_numstr(threshold, b));
   return OC_OK;
 }

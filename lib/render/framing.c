@@ -32,12 +32,15 @@ int oc_render_default_camera(const oc_program *prog, oc_render_params *rp,
                        "the node's bounds are infinite: give 'camera' = "
                        "{eye =, target =}");
   }
-  if (rp->width < 1 || rp->height < 1 || !(rp->camera.fov > 0) ||
-      !(rp->camera.fov <= 179))
+  char f[OC_NUMSTR];
+  if (!(rp->camera.fov > 0 && rp->camera.fov <= 179))
     return oc_seterr(err, OC_EINVAL,
-                     "framing needs 'size' >= 1 and 'camera.fov' in (0, 179] "
-                     "(got %d x %d, %g)",
-                     rp->width, rp->height, rp->camera.fov);
+                     "'camera.fov' must be in (0, 179] degrees (got %s)",
+                     oc_numstr(rp->camera.fov, f));
+  if (rp->width < 1 || rp->height < 1)
+    return oc_seterr(err, OC_EINVAL,
+                     "'size' must be at least 1 x 1 (got %d x %d)", rp->width,
+                     rp->height);
   double c[3] = {(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2};
   if (!has_target) rp->camera.target = (oc_vec3){c[0], c[1], c[2]};
   if (has_eye) return OC_OK;

@@ -111,6 +111,26 @@ START_TEST(render_framing) {
   ck_assert_str_eq(e.msg, "the node's bounds are infinite: give 'camera' = "
                           "{eye =, target =}");
   ck_assert_int_eq(oc_render_default_camera(pl, &rp, 1, 1, &e), OC_OK);
+  /* The checks oc_render makes, before any work; fov as framing says it. */
+  oc_render_defaults(&rp);
+  rp.camera.eye = oct_v(0, -20, 0);
+  ck_assert_int_eq(oc_render_check(pr, &rp, &e), OC_OK);
+  rp.camera.fov = 180;
+  ck_assert_int_eq(oc_render_check(pr, &rp, &e), OC_EINVAL);
+  ck_assert_str_eq(e.msg, "'camera.fov' must be in (0, 179] degrees (got "
+                          "180.0)");
+  ck_assert_int_eq(oc_render_default_camera(pr, &rp, 0, 0, &e), OC_EINVAL);
+  ck_assert_str_eq(e.msg, "'camera.fov' must be in (0, 179] degrees (got "
+                          "180.0)");
+  rp.camera.fov = 40;
+  rp.sun_intensity = -2;
+  ck_assert_int_eq(oc_render_check(pr, &rp, &e), OC_EINVAL);
+  ck_assert_str_eq(e.msg, "'sun.intensity' must be finite and >= 0 (got "
+                          "-2.0)");
+  rp.sun_intensity = 1;
+  rp.sun_direction = oct_v(0, 0, 0);
+  ck_assert_int_eq(oc_render_check(pr, &rp, &e), OC_EINVAL);
+  assert_msg(&e, "'sun.direction'");
   oc_program_free(pl);
   oc_program_free(pr);
 }
@@ -383,6 +403,19 @@ START_TEST(erosion_shared_defaults) {
   ck_assert_double_eq(r.erode.strength, 2);
   ck_assert_int_eq(r.erode.steps, 2);
   ck_assert_int_eq(r.banks, 3);
+  oc_gen_sea_params bad;
+  oc_gen_sea_defaults(&bad);
+  oc_error e0 = {0};
+  oc_heightfield *h0 = ramp(8, 8, 1, 0, 0, -1, 0.1);
+  bad.erode.heightfield = h0;
+  bad.erode.beta = 2;
+  ck_assert(oc_generate_sea(&bad, NULL, &e0) == NULL);
+  ck_assert_str_eq(e0.msg, "'beta' must be in [0, 1] (got 2.0)");
+  bad.erode.beta = 0.2;
+  bad.erode.cutoff = -0.5;
+  ck_assert(oc_generate_sea(&bad, NULL, &e0) == NULL);
+  ck_assert_str_eq(e0.msg, "'cutoff' must be >= 0 (got -0.5)");
+  oc_heightfield_release(h0);
 
   /* The default sea level is oc_heightfield_sea_level's: the same node. */
   oc_heightfield *hf = ramp(24, 24, 1, 0, 0, 10, 0.05); /* 10 .. 38.75 */
