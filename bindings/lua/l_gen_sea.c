@@ -19,7 +19,8 @@
 **
 **   sea only       |
 **   sea_level      | 0 when the heightfield spans it, else its lowest
-**                  | sample plus a quarter of its relief
+**                  | sample plus a quarter of its relief (the lib's
+**                  | oc_heightfield_sea_level)
 **   range          | 8 (metres): sigma falls off over range from sea level
 **   reach          | 2 radius: cliff columns sampled this far from the band
 **   rays           | 16: accessibility rays per sample (0: alpha = 1)
@@ -30,7 +31,8 @@
 **   depth          | 3 radius: bank rays are cast down to this below h
 **
 ** Each returns the node (blend of the terrain and the primitives) and a
-** table {columns=, samples=, primitives=}.
+** table {columns=, samples=, primitives=}. The shared fields go into the
+** lib's oc_gen_erode_params (p.erode), whose checks report what is wrong.
 */
 #include "l_field.h"
 #include "l_gen.h"
