@@ -1149,7 +1149,9 @@ typedef struct oc_karst_cavity {
 
 typedef struct oc_gen_karst_params {
   oc_heightfield *heightfield; /* required: the surface and the sinks */
-  oc_node *terrain;     /* blended with the cavities; NULL: cavities alone */
+  oc_node *terrain;     /* blended with the cavities; NULL: the default terrain
+                        ** of the heightfield (oc_heightfield_terrain) */
+  int no_terrain;       /* 1 (with terrain NULL): the cavities alone */
   oc_node *geology;     /* resistance; NULL: strata of wavelength 8 radius
                         ** (oc_strata, 3 octaves, the seed below) */
   const oc_vec3 *sinks; /* nsinks starting points; NULL: oc_hf_sinks of the
@@ -1246,7 +1248,9 @@ typedef struct oc_hoodoo_symbol {
 
 typedef struct oc_gen_hoodoos_params {
   oc_heightfield *heightfield; /* required: placement and ground level */
-  oc_node *terrain; /* blended with the hoodoos; NULL: hoodoos alone */
+  oc_node *terrain; /* blended with the hoodoos; NULL: the default terrain
+                    ** of the heightfield (oc_heightfield_terrain) */
+  int no_terrain;   /* 1 (with terrain NULL): the hoodoos alone */
   oc_node *geology; /* resistance; NULL: rho = 0.5 everywhere */
   const oc_heightfield *mask; /* NULL, or a factor of P (clamped [0, 1]) */
   /* NULL, or a factor of P in [0, 1], called from the calling thread once

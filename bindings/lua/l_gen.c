@@ -270,11 +270,3 @@ void oclua_open_gen(lua_State *L) {
   luaL_setfuncs(L, oclua_gen_hoodoos, 0);
   lua_setfield(L, -2, "generate");
 }
-
-oc_node *oclua_gen_default_terrain(lua_State *L, oc_heightfield *hf,
-                                   const char *fname) {
-  oc_error err = {OC_OK, ""};
-  oc_node *t = oc_heightfield_terrain(hf, NULL, &err);
-  if (!t) oclua_liberror(L, fname, &err);
-  return t;
-}
