@@ -5,7 +5,8 @@
 **   field        | default
 **   -------------+----------------------------------------------------------
 **   heightfield  | required: placement (slope, drainage) and ground level
-**   terrain      | outcrop.terrain(heightfield); false: the hoodoos alone
+**   terrain      | outcrop.terrain(heightfield) (the lib makes it:
+**                | no_terrain = 0); false: the hoodoos alone
 **   geology      | none (rho = 0.5): a resistance tree driving the grammar
 **   mask         | none: a heightfield or a function (x, y) -> [0, 1]
 **                | multiplying the placement probability

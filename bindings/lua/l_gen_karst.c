@@ -5,7 +5,8 @@
 **   field          | default
 **   ---------------+--------------------------------------------------------
 **   heightfield    | required: the surface cavities stay under, and sinks
-**   terrain        | outcrop.terrain(heightfield); false: the cavities alone
+**   terrain        | outcrop.terrain(heightfield) (the lib makes it:
+**                  | no_terrain = 0); false: the cavities alone
 **   geology        | strata of wavelength 8 radius, 3 octaves, the seed
 **   sinks          | hf:sinks(): an array of {x, y, z} starting points
 **   seed           | the scene seed
