@@ -52,9 +52,12 @@ CHECK_LIBS = $(shell $(PKGCONF) --libs check 2>/dev/null)
 
 # -ffp-contract=off: no fused multiply-add, so results do not depend on
 # what the compiler chose to contract (determinism).
-COMMON := $(OPT) -fPIC -fopenmp -ffp-contract=off -Wall -Wextra -Ilib
-CFLAGS := -std=c17 -D_POSIX_C_SOURCE=200809L $(COMMON)
-CXXFLAGS := -std=c++17 $(COMMON)
+COMMON := $(OPT) -fPIC -fopenmp -ffp-contract=off -Wall -Wextra
+# The engine, its tests and tools see every lib header (INC); the front
+# ends see outcrop.h alone (below).
+INC = -Ilib
+CFLAGS = -std=c17 -D_POSIX_C_SOURCE=200809L $(COMMON) $(INC)
+CXXFLAGS = -std=c++17 $(COMMON) $(INC)
 LDLIBS := -lm -fopenmp -ldl -lpthread
 
 LIB_SRC := $(shell find lib -name '*.c' | sort)
@@ -91,6 +94,17 @@ GLUE := $(B)/liboutcrop_oiio.so
 
 all: $(LIBA) $(LIBSO) $(MODULE) $(BIN) $(GLUE)
 	@ln -sf release/outcrop build/outcrop-bin 2>/dev/null || true
+
+# The bindings and the interpreter are compiled against a folder holding
+# a copy of the public header alone, so that including an internal lib
+# header (core/..., io/...) fails the build: the front ends use the C API
+# that C users have.
+PUBINC := $(B)/include
+$(LUA_OBJ) $(RT_OBJ): INC = -I$(PUBINC)
+$(LUA_OBJ) $(RT_OBJ): | $(PUBINC)/outcrop.h
+$(PUBINC)/outcrop.h: lib/outcrop.h
+	@mkdir -p $(dir $@)
+	cp $< $@
 
 deps:
 	@missing=""; for p in $(PKGS); do \

@@ -130,6 +130,21 @@ oc_node *oc_warp(oc_node *child, const oc_noise *noise, oc_node *control,
 ** space to world space: world = M[:, 0:3] * local + M[:, 3]. Must be
 ** invertible. */
 oc_node *oc_transform(oc_node *child, const double m[12], oc_error *err);
+
+/* Building such maps (core/xform.c), as the Lua front end does: */
+void oc_xform_identity(double m[12]);
+/* out = a * b (b applied first); out may be a or b. */
+void oc_xform_mul(const double a[12], const double b[12], double out[12]);
+/* Rotation by `degrees` about `axis` (normalised here; right-handed).
+** OC_EINVAL naming 'rotate.axis' for a zero or non-finite axis. */
+int oc_xform_axis_angle(oc_vec3 axis, double degrees, double m[12],
+                        oc_error *err);
+/* Euler angles in degrees applied about X, then Y, then Z: Rz Ry Rx. */
+int oc_xform_euler(oc_vec3 degrees, double m[12], oc_error *err);
+/* M = T * R * S: scale (non-zero factors, else OC_EINVAL naming 'scale'),
+** then the rotation `rotate` (NULL: none), then the translation. */
+int oc_xform_compose(oc_vec3 translate, const double rotate[12], oc_vec3 scale,
+                     double m[12], oc_error *err);
 /* Star-shaped anisotropic perturbation of a skeletal or volumetric
 ** primitive (Paris et al. 2019, section 5.2): d / (R + amplitude *
 ** t(v(p)/wl)). */
@@ -215,9 +230,11 @@ typedef struct oc_progress {
 typedef struct oc_mesh oc_mesh;
 
 typedef struct oc_polygonize_params {
-  oc_aabb box;      /* region to mesh: finite, non-empty */
+  oc_aabb box;      /* region to mesh: finite, non-empty (see
+                    ** oc_polygonize_default_box) */
   double cell;      /* cell size; or 0 to use nx, ny, nz */
-  int nx, ny, nz;   /* cells per axis when cell == 0 */
+  int nx, ny, nz;   /* cells per axis when cell == 0; all 0 (with cell 0):
+                    ** oc_polygonize_default_cell(box) */
   double threshold; /* iso-value; 0 means the program's T */
   int open;         /* 1: no caps; the surface runs up to the box faces */
   int steps;        /* root-finding steps per edge (0: default 6) */
@@ -249,6 +266,15 @@ typedef struct oc_polygonize_params {
 ** thread count. */
 oc_mesh *oc_polygonize(const oc_program *prog, const oc_polygonize_params *pp,
                        oc_error *err);
+
+/* The defaults every front end takes (mesh/polygonize.c). The box: prog's
+** bounds, OC_EINVAL when they are empty (the field is 0 everywhere) or
+** infinite (*box then unchanged). The cell: cubic, 1 /
+** OC_POLYGONIZE_DEFAULT_RESOLUTION of the box's longest side. */
+#define OC_POLYGONIZE_DEFAULT_RESOLUTION 64
+int oc_polygonize_default_box(const oc_program *prog, oc_aabb *box,
+                              oc_error *err);
+double oc_polygonize_default_cell(oc_aabb box);
 void oc_mesh_free(oc_mesh *mesh);
 
 size_t oc_mesh_vertex_count(const oc_mesh *mesh);
@@ -339,6 +365,13 @@ const char *oc_image_channel_name(const oc_image *img, int channel);
 /* Adds a string attribute written as image metadata (provenance). */
 int oc_image_set_meta(oc_image *img, const char *key, const char *value,
                       oc_error *err);
+/* Read access to an image's metadata (in the order set; keys compare
+** without case): the count, the i-th key and value (NULL past the end),
+** and the value of `key` (NULL when absent). The strings are the image's. */
+size_t oc_image_meta_count(const oc_image *img);
+const char *oc_image_meta_key(const oc_image *img, size_t i);
+const char *oc_image_meta_value(const oc_image *img, size_t i);
+const char *oc_image_meta_get(const oc_image *img, const char *key);
 /* Writes through OpenImageIO; the format follows the extension (.png,
 ** .jpg, .tif, .exr). `bits` is 8 or 16 for PNG/TIFF (0: 8 for PNG/JPEG,
 ** 16 for TIFF, half for EXR). Atomic: written to a temporary name in the
@@ -353,6 +386,28 @@ int oc_image_write(const oc_image *img, const char *path, int bits,
 ** oc_mesh_write_at). */
 int oc_image_write_at(const oc_image *img, int dirfd, const char *path,
                       int bits, oc_error *err);
+
+/* ---- palettes ------------------------------------------------------- */
+
+/* Colour maps (core/palette.c): n stops of 4 doubles (value, r, g, b)
+** sorted by value, linear between neighbours, the end colours beyond them.
+** Meshes, renders, slices and heightfield images colour values through
+** them. */
+
+/* OC_OK when n >= 1 stops have finite, ascending values and colour
+** components in [0, 1]; else OC_EINVAL naming 'stops'. */
+int oc_palette_check(const double *stops, int n, oc_error *err);
+/* The colour of v. Where stops share a value the colour steps (the later
+** stop wins from that value on). NaN takes the first stop's colour. */
+void oc_palette_eval(const double *stops, int n, double v, double rgb[3]);
+/* Built-in palettes, static (never freed), their stop count in *n:
+** - strata: soft sandstone to hard limestone for a resistance in [0, 1],
+**   linear albedos about as bright as the render rules' rock (the
+**   default of a render coloured by a node);
+** - resistance: dark for soft rock to pale for hard (Paris et al. 2019,
+**   figure 4; the default of a geology slice). */
+const double *oc_palette_strata(int *n);
+const double *oc_palette_resistance(int *n);
 
 /* ---- slices ---------------------------------------------------------- */
 
@@ -376,6 +431,19 @@ typedef struct oc_slice_params {
 ** height (v grows upwards). */
 oc_image *oc_slice(const oc_program *prog, const oc_slice_params *sp,
                    oc_error *err);
+
+/* The window a slice takes when none is given (render/slice.c): the
+** program's bounds on sp->plane's two axes (x, y for "xy", x, z for "xz",
+** y, z for "yz") into u0, v0, u1, v1. OC_EINVAL when they are infinite
+** (they may be empty: oc_slice refuses those); sp is then unchanged. */
+int oc_slice_default_window(const oc_program *prog, oc_slice_params *sp,
+                            oc_error *err);
+
+/* Recolours a slice image (made by oc_slice) through a palette: R, G, B
+** from the value in its "field" channel (oc_palette_eval), A = 1; the
+** iso-line is not drawn. The "field" channel is kept. */
+int oc_slice_apply_palette(oc_image *img, const double *stops, int n,
+                           oc_error *err);
 
 /* ---- rendering --------------------------------------------------------- */
 
@@ -479,8 +547,25 @@ typedef struct oc_render_params {
 ** intensity 2.2, sky (0.45, 0.6, 0.85), shadows and AO on, no fog (fog
 ** colour = sky), no background (sky), texture 0.3, rule colours with
 ** derived levels, segment tracer, AOV channels on, exposure 0, tone
-** OC_TONE_CLAMP. */
+** OC_TONE_CLAMP; camera up (0, 0, 1), fov 40 degrees (vertical). */
 void oc_render_defaults(oc_render_params *rp);
+
+/* The default framing (render/framing.c), the one the Lua front end uses:
+** where has_target is 0 the target becomes the centre of prog's bounds;
+** where has_eye is 0 the eye looks at the target from the south-west
+** (azimuth -135 degrees), 30 degrees above the horizon, along
+** rp->camera.up, just far enough (4 % margin, never inside the bounds'
+** sphere) for the eight corners of the bounds to fall inside the view of
+** rp->camera.fov at rp->width x rp->height. Both given: nothing changes.
+** OC_EINVAL when the bounds are empty or infinite, or camera.up is
+** parallel to the view; rp is then unchanged. */
+int oc_render_default_camera(const oc_program *prog, oc_render_params *rp,
+                             int has_eye, int has_target, oc_error *err);
+/* Every check oc_render makes of prog and rp before it traces anything
+** (the messages name the Lua table fields): for a caller that does work
+** of its own between oc_render_geometry and oc_render_shade. */
+int oc_render_check(const oc_program *prog, const oc_render_params *rp,
+                    oc_error *err);
 
 /* Channels of a geometry image (OC_RG_COUNT floats per pixel). */
 enum {
@@ -771,6 +856,29 @@ oc_heightfield *oc_heightfield_resample(const oc_heightfield *hf,
 oc_heightfield *oc_heightfield_crop(const oc_heightfield *hf, int i0, int j0,
                                     int i1, int j1, oc_error *err);
 
+/* -- resampling and cropping in the caller's terms (terrain/hf_resample.c) */
+
+/* The grid oc_heightfield_resample makes from hf given either `cell` > 0
+** (nx = ny = 0: floor(extent / cell) + 1 samples per side, the extent
+** kept up to a cell) or nx, ny in 2..65535 (cell = 0: the extent kept,
+** cells square, so nx, ny must keep hf's proportions), with hf's origin.
+** OC_EINVAL naming 'cell' or 'size' when neither or both are given, or
+** the grid would have fewer than 2 or too many samples. */
+int oc_heightfield_resample_grid(const oc_heightfield *hf, double cell, int nx,
+                                 int ny, oc_hf_grid *g, oc_error *err);
+/* The 0-based inclusive sample range {i0, j0, i1, j1} of the samples of
+** hf lying in the box [x0, x1] x [y0, y1] (with a slack of 1e-9 cell);
+** OC_EINVAL when x0 >= x1 or y0 >= y1 or the box holds fewer than 2 x 2
+** samples. oc_heightfield_crop_box crops to it (a new grid). */
+int oc_heightfield_crop_range(const oc_heightfield *hf, double x0, double y0,
+                              double x1, double y1, int ij[4], oc_error *err);
+oc_heightfield *oc_heightfield_crop_box(const oc_heightfield *hf, double x0,
+                                        double y0, double x1, double y1,
+                                        oc_error *err);
+/* The sum of the samples, in index order in double (the same for any
+** thread count); 0 for NULL. */
+double oc_heightfield_sum(const oc_heightfield *hf);
+
 /* -- analysis (terrain/slope.c, fill.c, flow.c, sinks.c, access.c,
 **    edt.c) -- */
 
@@ -919,6 +1027,30 @@ enum { OC_TERRAIN_EDGES_DEFAULT, OC_TERRAIN_OPEN, OC_TERRAIN_SLAB };
 ** Retains the source (src is copied). New reference or NULL with err. */
 oc_node *oc_terrain(const oc_elevation *src, const oc_terrain_params *tp,
                     oc_error *err);
+
+/* -- the defaults front ends take from a grid (terrain/hf_defaults.c) -- */
+
+/* The default terrain parameters for hf: falloff 4 cells of hf,
+** transition 1 (metre), no mask, open edges, not inverted, thickness 0. */
+void oc_terrain_defaults(const oc_heightfield *hf, oc_terrain_params *tp);
+/* The terrain node of hf's elevation with tp, or with
+** oc_terrain_defaults(hf) when tp is NULL: the node outcrop.terrain(hf)
+** makes, and the one the generators march when given no terrain. New
+** reference or NULL with err. */
+oc_node *oc_heightfield_terrain(oc_heightfield *hf, const oc_terrain_params *tp,
+                                oc_error *err);
+/* The sea generator's default sea level: 0 when hf's samples span it
+** (lowest < 0 < highest), else the lowest plus a quarter of the relief. */
+double oc_heightfield_sea_level(const oc_heightfield *hf);
+/* A mask for oc_terrain_params.mask from the grey image at `path`:
+** stretched over hf's width (its cell = hf's extent along x / (its nx -
+** 1), origin hf's), its samples divided by the brightest, so Omega is
+** where the image is >= half its brightest pixel. New grid, or NULL with
+** err: the read's error after "'mask': ", or OC_EINVAL when the image is
+** black. */
+oc_heightfield *oc_heightfield_load_mask(const char *path,
+                                         const oc_heightfield *hf,
+                                         oc_error *err);
 
 /* ---- elevation trees (Génevaux et al. 2015) ----------------------- */
 
@@ -1194,7 +1326,9 @@ typedef struct oc_karst_cavity {
 
 typedef struct oc_gen_karst_params {
   oc_heightfield *heightfield; /* required: the surface and the sinks */
-  oc_node *terrain;     /* blended with the cavities; NULL: cavities alone */
+  oc_node *terrain;     /* blended with the cavities; NULL: the default terrain
+                        ** of the heightfield (oc_heightfield_terrain) */
+  int no_terrain;       /* 1 (with terrain NULL): the cavities alone */
   oc_node *geology;     /* resistance; NULL: strata of wavelength 8 radius
                         ** (oc_strata, 3 octaves, the seed below) */
   const oc_vec3 *sinks; /* nsinks starting points; NULL: oc_hf_sinks of the
@@ -1291,7 +1425,9 @@ typedef struct oc_hoodoo_symbol {
 
 typedef struct oc_gen_hoodoos_params {
   oc_heightfield *heightfield; /* required: placement and ground level */
-  oc_node *terrain; /* blended with the hoodoos; NULL: hoodoos alone */
+  oc_node *terrain; /* blended with the hoodoos; NULL: the default terrain
+                    ** of the heightfield (oc_heightfield_terrain) */
+  int no_terrain;   /* 1 (with terrain NULL): the hoodoos alone */
   oc_node *geology; /* resistance; NULL: rho = 0.5 everywhere */
   const oc_heightfield *mask; /* NULL, or a factor of P (clamped [0, 1]) */
   /* NULL, or a factor of P in [0, 1], called from the calling thread once
@@ -1379,30 +1515,42 @@ typedef struct oc_gen_sea_stats {
   size_t primitives; /* primitives made */
 } oc_gen_sea_stats;
 
-typedef struct oc_gen_sea_params {
+/* The parameters the sea and river generators share (oc_gen_sea_params
+** and oc_gen_river_params hold them as `erode`); oc_gen_erode_defaults
+** fills beta and cutoff, the generators' own defaults the rest. */
+typedef struct oc_gen_erode_params {
   oc_heightfield *heightfield; /* required */
-  oc_node *terrain;            /* or NULL (see above) */
-  int no_terrain;              /* 1: return the primitives alone */
-  oc_node *geology;            /* resistance; NULL: 0.5 everywhere */
+  oc_node *terrain; /* or NULL: oc_heightfield_terrain(heightfield) */
+  int no_terrain;   /* 1: return the primitives alone */
+  oc_node *geology; /* resistance; NULL: 0.5 everywhere */
   uint64_t seed;
-  double sea_level; /* finite (0) */
+  double radius;    /* of the point primitives, > 0 (0: the generator's) */
+  double spacing;   /* Poisson radius > 0 (0: radius / 2) */
+  double beta;      /* in [0, 1] (0.2): e(1, 1), the bite on the hardest rock */
+  double strength;  /* > 0: energy = -strength e (sea 4, river 2) */
+  double cutoff;    /* >= 0 (0.05): samples with a smaller e make nothing */
+  int steps;        /* 1 .. 64: rounds on the updated tree (sea 3, river 2) */
+  double threshold; /* T; 0: OC_DEFAULT_THRESHOLD */
+  oc_progress progress;
+} oc_gen_erode_params;
+
+/* Zero, then beta 0.2 and cutoff 0.05 (strength and steps stay 0: the
+** sea's and river's defaults set them). */
+void oc_gen_erode_defaults(oc_gen_erode_params *e);
+
+typedef struct oc_gen_sea_params {
+  oc_gen_erode_params erode; /* radius 0: range; strength 4; steps 3 */
+  double sea_level; /* finite; NaN: oc_heightfield_sea_level(heightfield),
+                    ** the default */
   double range;     /* > 0: sigma falls off as g(|z - sea_level| / range);
                     ** columns lower than sea_level - range are not
                     ** sampled (8, the paper's figure 11) */
-  double radius;    /* > 0 (0: range) */
-  double spacing;   /* Poisson radius > 0 (0: radius / 2) */
   double reach;     /* > 0: columns above sea_level + range are candidates
                     ** within this horizontal distance of the band, their
                     ** ray cast at a height drawn in the band (steep cliff
                     ** faces) (0: 2 radius) */
-  double beta;      /* in [0, 1] (0.2) */
-  double strength;  /* > 0 (4) */
-  double cutoff;    /* >= 0 (0.05) */
-  int steps;        /* 1 .. 64 (3) */
   int rays;         /* accessibility rays per column, 0 .. 4096; 0: alpha
                     ** = 1 (16) */
-  double threshold; /* T; 0: OC_DEFAULT_THRESHOLD */
-  oc_progress progress;
 } oc_gen_sea_params;
 
 /* Sea erosion: candidate columns within `range` of sea level (the
@@ -1422,24 +1570,12 @@ oc_node *oc_generate_sea(const oc_gen_sea_params *p, oc_gen_sea_stats *st,
                          oc_error *err);
 
 typedef struct oc_gen_river_params {
-  oc_heightfield *heightfield; /* required */
-  oc_node *terrain;            /* or NULL (see above) */
-  int no_terrain;              /* 1: return the primitives alone */
-  oc_node *geology;            /* resistance; NULL: 0.5 everywhere */
-  uint64_t seed;
-  double power;     /* stream power A^(1/2) s above which a sample is
-                    ** riverbed, > 0; 0: the 95th percentile of the grid */
-  int banks;        /* widening of the bed in cells, 0 .. 64 (3) */
-  double depth;     /* > 0: bank rays are cast at z drawn in [h - depth, h]
-                    ** (0: 3 radius) */
-  double radius;    /* > 0 (0: 1.5 cells) */
-  double spacing;   /* Poisson radius > 0 (0: radius / 2) */
-  double beta;      /* in [0, 1] (0.2) */
-  double strength;  /* > 0 (2) */
-  double cutoff;    /* >= 0 (0.05) */
-  int steps;        /* 1 .. 64 (2) */
-  double threshold; /* T; 0: OC_DEFAULT_THRESHOLD */
-  oc_progress progress;
+  oc_gen_erode_params erode; /* radius 0: 1.5 cells; strength 2; steps 2 */
+  double power;              /* stream power A^(1/2) s above which a sample is
+                             ** riverbed, > 0; 0: the 95th percentile of the grid */
+  int banks;                 /* widening of the bed in cells, 0 .. 64 (3) */
+  double depth; /* > 0: bank rays are cast at z drawn in [h - depth, h]
+                ** (0: 3 radius) */
 } oc_gen_river_params;
 
 /* River erosion: sigma per sample is 1 on the riverbed (stream power >=
@@ -1451,6 +1587,38 @@ typedef struct oc_gen_river_params {
 void oc_gen_river_defaults(oc_gen_river_params *p);
 oc_node *oc_generate_river(const oc_gen_river_params *p, oc_gen_sea_stats *st,
                            oc_error *err);
+
+/* ---- hashes (provenance) --------------------------------------------- */
+
+/* SHA-256 (FIPS 180-4): the hash of a scene file and of every input file a
+** run read, recorded in the metadata of what it wrote. Incremental: init,
+** update any number of times with any lengths, final. The state is a
+** plain struct the caller owns; nothing is allocated. */
+#define OC_SHA256_BYTES 32
+#define OC_SHA256_HEX 65 /* 64 lowercase hex digits and the NUL */
+
+typedef struct oc_sha256 {
+  uint32_t h[8];
+  uint64_t bytes; /* message length so far */
+  unsigned char block[64];
+  size_t n; /* bytes waiting in block */
+} oc_sha256;
+
+void oc_sha256_init(oc_sha256 *s);
+void oc_sha256_update(oc_sha256 *s, const void *data, size_t n);
+/* Writes the digest; s must be initialized again before reuse. */
+void oc_sha256_final(oc_sha256 *s, unsigned char out[OC_SHA256_BYTES]);
+/* The digest as lowercase hex, NUL terminated. */
+void oc_sha256_hex(const unsigned char d[OC_SHA256_BYTES],
+                   char hex[OC_SHA256_HEX]);
+/* One call: the hex digest of n bytes. */
+void oc_sha256_text(const void *data, size_t n, char hex[OC_SHA256_HEX]);
+
+/* The SHA-256 of the regular file `path` as lowercase hex in `hex`
+** (OC_SHA256_HEX bytes), for provenance. Refuses FIFOs, devices and
+** folders without blocking, but takes any content. OC_OK, or OC_EIO with
+** a message naming the path. (lib/io/infile.c) */
+int oc_infile_sha256(const char *path, char *hex, oc_error *err);
 
 #ifdef __cplusplus
 }

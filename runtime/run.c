@@ -22,7 +22,7 @@
 #include <lualib.h>
 
 #include "../bindings/lua/oclua.h"
-#include "core/sha256.h"
+#include "outcrop.h"
 #include "ocrt.h"
 
 typedef struct run {

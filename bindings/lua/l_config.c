@@ -30,8 +30,6 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "core/sha256.h"
-#include "io/infile.h"
 #include "l_config.h"
 
 /* Names longer than this get no "did you mean" (the distance is

@@ -270,19 +270,3 @@ void oclua_open_gen(lua_State *L) {
   luaL_setfuncs(L, oclua_gen_hoodoos, 0);
   lua_setfield(L, -2, "generate");
 }
-
-oc_node *oclua_gen_default_terrain(lua_State *L, oc_heightfield *hf,
-                                   const char *fname) {
-  oc_error err = {OC_OK, ""};
-  oc_terrain_params tp = {0};
-  tp.falloff = 4 * oc_heightfield_cell(hf);
-  tp.transition = 1;
-  oc_elevation src;
-  oc_node *t = NULL;
-  if (oc_heightfield_elevation(hf, &src, &err) == OC_OK) {
-    t = oc_terrain(&src, &tp, &err);
-    src.release(src.ud);
-  }
-  if (!t) oclua_liberror(L, fname, &err);
-  return t;
-}

@@ -19,11 +19,6 @@ void oclua_open_gen(lua_State *L);
 ** NULL-terminated: outcrop.generate.sea and .river (l_gen_sea.c),
 ** .karst (l_gen_karst.c), .hoodoos (l_gen_hoodoos.c). */
 extern const luaL_Reg oclua_gen_sea[];
-/* The terrain a generator grows on when none is given: the heightfield
-** implicitized with a falloff of 4 cells and a transition of 1 (a new
-** reference; raises with fname on error). */
-oc_node *oclua_gen_default_terrain(lua_State *L, oc_heightfield *hf,
-                                   const char *fname);
 extern const luaL_Reg oclua_gen_karst[];
 extern const luaL_Reg oclua_gen_hoodoos[];
 

@@ -5,7 +5,8 @@
 **   field        | default
 **   -------------+----------------------------------------------------------
 **   heightfield  | required: placement (slope, drainage) and ground level
-**   terrain      | outcrop.terrain(heightfield); false: the hoodoos alone
+**   terrain      | outcrop.terrain(heightfield) (the lib makes it:
+**                | no_terrain = 0); false: the hoodoos alone
 **   geology      | none (rho = 0.5): a resistance tree driving the grammar
 **   mask         | none: a heightfield or a function (x, y) -> [0, 1]
 **                | multiplying the placement probability
@@ -104,8 +105,8 @@ static int l_hoodoos(lua_State *L) {
   /* pinned, with the value, until the generator has run */
   oc_heightfield *hf = oclua_pinheightfield(L, -1, FNAME);
   oc_gen_hoodoos_defaults(&p, hf);
-  int no_terrain = 0;
-  p.terrain = optnode(&f, "terrain", &no_terrain);
+  /* nil: the lib's default terrain; false: none */
+  p.terrain = optnode(&f, "terrain", &p.no_terrain);
   p.geology = optnode(&f, "geology", NULL);
   int t = oclua_field_push(&f, "mask");
   if (t == LUA_TFUNCTION) {
@@ -157,14 +158,9 @@ static int l_hoodoos(lua_State *L) {
   oclua_node *u = oclua_newnode(L);
   oclua_progress pl;
   oc_gen_hoodoos_stats st = {0};
-  oc_node *terrain = !p.terrain && !no_terrain
-                         ? oclua_gen_default_terrain(L, p.heightfield, FNAME)
-                         : NULL;
-  if (terrain) p.terrain = terrain;
   p.progress = oclua_progress_start(L, &pl, FNAME);
   oc_node *n = oc_generate_hoodoos(&p, &st, &err);
   oclua_progress_end(&pl);
-  if (terrain) oc_node_release(terrain);
   if (!n && M.raised) {
     lua_pushvalue(L, M.err); /* the mask's own error, as raised */
     return lua_error(L);

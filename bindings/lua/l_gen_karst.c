@@ -5,7 +5,8 @@
 **   field          | default
 **   ---------------+--------------------------------------------------------
 **   heightfield    | required: the surface cavities stay under, and sinks
-**   terrain        | outcrop.terrain(heightfield); false: the cavities alone
+**   terrain        | outcrop.terrain(heightfield) (the lib makes it:
+**                  | no_terrain = 0); false: the cavities alone
 **   geology        | strata of wavelength 8 radius, 3 octaves, the seed
 **   sinks          | hf:sinks(): an array of {x, y, z} starting points
 **   seed           | the scene seed
@@ -80,15 +81,14 @@ static int l_karst(lua_State *L) {
   ** generator has run: an __index may have made them, or a finalizer
   ** drop them from the table or close the grid. */
   p.heightfield = oclua_pinheightfield(L, -1, FNAME);
-  int own_terrain = 1;
+  /* nil: the lib's default terrain; false: none */
   int t = oclua_field_push(&f, "terrain");
   if (t == LUA_TBOOLEAN && !lua_toboolean(L, -1))
-    own_terrain = 0;
+    p.no_terrain = 1;
   else if (t != LUA_TNIL) {
     oclua_node *u = oclua_testnode(L, -1);
     if (!u) oclua_field_error(&f, "terrain", -1, "must be a node or false");
     p.terrain = u->node;
-    own_terrain = 0;
   }
   if (oclua_field_push(&f, "geology") != LUA_TNIL) {
     oclua_node *u = oclua_testnode(L, -1);
@@ -112,13 +112,9 @@ static int l_karst(lua_State *L) {
   oclua_node *u = oclua_newnode(L);
   oclua_progress pl;
   oc_gen_karst_stats st = {0};
-  oc_node *terrain =
-      own_terrain ? oclua_gen_default_terrain(L, p.heightfield, FNAME) : NULL;
-  if (terrain) p.terrain = terrain;
   p.progress = oclua_progress_start(L, &pl, FNAME);
   oc_node *n = oc_generate_karst(&p, &st, &err);
   oclua_progress_end(&pl);
-  if (terrain) oc_node_release(terrain);
   if (!n && err.code == OC_ECANCEL) return luaL_error(L, "interrupted");
   oclua_setnode(L, u, n, &err, FNAME);
   lua_createtable(L, 0, 4);

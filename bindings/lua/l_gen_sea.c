@@ -19,7 +19,8 @@
 **
 **   sea only       |
 **   sea_level      | 0 when the heightfield spans it, else its lowest
-**                  | sample plus a quarter of its relief
+**                  | sample plus a quarter of its relief (the lib's
+**                  | oc_heightfield_sea_level)
 **   range          | 8 (metres): sigma falls off over range from sea level
 **   reach          | 2 radius: cliff columns sampled this far from the band
 **   rays           | 16: accessibility rays per sample (0: alpha = 1)
@@ -30,20 +31,13 @@
 **   depth          | 3 radius: bank rays are cast down to this below h
 **
 ** Each returns the node (blend of the terrain and the primitives) and a
-** table {columns=, samples=, primitives=}.
+** table {columns=, samples=, primitives=}. The shared fields go into the
+** lib's oc_gen_erode_params (p.erode), whose checks report what is wrong.
 */
 #include "l_field.h"
 #include "l_gen.h"
 #include "l_heightfield.h"
 #include "l_progress.h"
-
-typedef struct common {
-  oc_heightfield *hf;
-  oc_node *terrain, *geology;
-  uint64_t seed;
-  double radius, spacing, beta, strength, cutoff, threshold;
-  int steps, no_terrain;
-} common;
 
 /* A node or nil; false sets *nofalse when nofalse is not NULL. The value
 ** stays on the stack (an __index may have made it, or a finalizer drop
@@ -63,27 +57,27 @@ static oc_node *optnode(oclua_fields *f, const char *name, int *nofalse) {
   return n;
 }
 
-static void read_common(oclua_fields *f, common *c, int steps,
-                        double strength) {
+/* The fields the sea and river share, into the lib's shared struct c
+** (its defaults already in it). */
+static void read_common(oclua_fields *f, oc_gen_erode_params *c) {
   if (oclua_field_push(f, "heightfield") == LUA_TNIL)
     oclua_field_missing(f, "heightfield", "a heightfield");
   if (!oclua_isheightfield(f->L, -1))
     oclua_field_error(f, "heightfield", -1, "must be a heightfield");
-  c->hf = oclua_pinheightfield(f->L, -1, f->fname); /* value and pin stay */
+  c->heightfield =
+      oclua_pinheightfield(f->L, -1, f->fname); /* value and pin stay */
   c->no_terrain = 0;
   c->terrain = optnode(f, "terrain", &c->no_terrain);
   c->geology = optnode(f, "geology", NULL);
   c->seed = oclua_field_seed(f, "seed");
   c->radius = oclua_field_optnumber(f, "radius", OCLUA_POSITIVE, 0);
   c->spacing = oclua_field_optnumber(f, "spacing", OCLUA_POSITIVE, 0);
-  c->beta = oclua_field_optnumber(f, "beta", OCLUA_FINITE, 0.2);
-  if (!(c->beta >= 0 && c->beta <= 1))
-    oclua_error(f->L, f->fname, "'beta' must be in [0, 1] (got %f)", c->beta);
-  c->strength = oclua_field_optnumber(f, "strength", OCLUA_POSITIVE, strength);
-  c->cutoff = oclua_field_optnumber(f, "cutoff", OCLUA_FINITE, 0.05);
-  if (c->cutoff < 0)
-    oclua_error(f->L, f->fname, "'cutoff' must be >= 0 (got %f)", c->cutoff);
-  c->steps = (int)oclua_field_optint(f, "steps", 1, 64, steps);
+  /* beta's range and cutoff's sign are the lib's to check */
+  c->beta = oclua_field_optnumber(f, "beta", OCLUA_FINITE, c->beta);
+  c->strength =
+      oclua_field_optnumber(f, "strength", OCLUA_POSITIVE, c->strength);
+  c->cutoff = oclua_field_optnumber(f, "cutoff", OCLUA_FINITE, c->cutoff);
+  c->steps = (int)oclua_field_optint(f, "steps", 1, 64, c->steps);
   c->threshold = oclua_threshold(f->L, f->fname);
 }
 
@@ -100,15 +94,6 @@ static int finish(lua_State *L, const char *fname, oclua_node *u, oc_node *n,
   lua_setfield(L, -2, "primitives");
   return 2;
 }
-
-/* Copies the common fields into the generator's params p: the sea's and
-** the river's share their names. */
-#define SET_COMMON(p, c)                                                       \
-  ((p).heightfield = (c).hf, (p).terrain = (c).terrain,                        \
-   (p).no_terrain = (c).no_terrain, (p).geology = (c).geology,                 \
-   (p).seed = (c).seed, (p).radius = (c).radius, (p).spacing = (c).spacing,    \
-   (p).beta = (c).beta, (p).strength = (c).strength, (p).cutoff = (c).cutoff,  \
-   (p).steps = (c).steps, (p).threshold = (c).threshold)
 
 /* Runs the sea (sea = 1) or river generator on params (whose progress
 ** field is prog) with progress, and returns finish's results. */
@@ -132,22 +117,18 @@ static int l_sea(lua_State *L) {
       "sea_level",   "range",   "reach",    "rays",   NULL};
   const char *fname = "outcrop.generate.sea";
   oclua_fields f;
-  common c;
   oc_gen_sea_params p;
   oclua_checkargs(L, 1, fname, "{heightfield =, sea_level =, range =, ...}");
   oclua_fields_open(&f, L, 1, fname, NULL, known, 0);
   oc_gen_sea_defaults(&p);
-  read_common(&f, &c, p.steps, p.strength);
-  double lo, hi;
-  oc_heightfield_minmax(c.hf, &lo, &hi);
+  read_common(&f, &p.erode);
   p.sea_level =
       oclua_field_optnumber(&f, "sea_level", OCLUA_FINITE,
-                            lo < 0 && hi > 0 ? 0 : lo + 0.25 * (hi - lo));
+                            oc_heightfield_sea_level(p.erode.heightfield));
   p.range = oclua_field_optnumber(&f, "range", OCLUA_POSITIVE, p.range);
   p.reach = oclua_field_optnumber(&f, "reach", OCLUA_POSITIVE, 0);
   p.rays = (int)oclua_field_optint(&f, "rays", 0, 4096, p.rays);
-  SET_COMMON(p, c);
-  return run(L, fname, 1, &p, &p.progress);
+  return run(L, fname, 1, &p, &p.erode.progress);
 }
 
 static int l_river(lua_State *L) {
@@ -156,17 +137,15 @@ static int l_river(lua_State *L) {
       "strength",    "cutoff",  "steps",   "power", "banks",  "depth",   NULL};
   const char *fname = "outcrop.generate.river";
   oclua_fields f;
-  common c;
   oc_gen_river_params p;
   oclua_checkargs(L, 1, fname, "{heightfield =, power =, banks =, ...}");
   oclua_fields_open(&f, L, 1, fname, NULL, known, 0);
   oc_gen_river_defaults(&p);
-  read_common(&f, &c, p.steps, p.strength);
+  read_common(&f, &p.erode);
   p.power = oclua_field_optnumber(&f, "power", OCLUA_POSITIVE, 0);
   p.banks = (int)oclua_field_optint(&f, "banks", 0, 64, p.banks);
   p.depth = oclua_field_optnumber(&f, "depth", OCLUA_POSITIVE, 0);
-  SET_COMMON(p, c);
-  return run(L, fname, 0, &p, &p.progress);
+  return run(L, fname, 0, &p, &p.erode.progress);
 }
 
 const luaL_Reg oclua_gen_sea[] = {

@@ -252,15 +252,11 @@ static int l_erosion(lua_State *L) {
 
 /* ---- slices coloured by resistance --------------------------------------- */
 
-/* Pale for hard rock, dark for soft (Paris et al. 2019, figure 4). */
-static const double default_stops[] = {0.00, 0.22, 0.13, 0.08, 0.35, 0.45,
-                                       0.30, 0.18, 0.65, 0.72, 0.58, 0.40,
-                                       1.00, 0.95, 0.91, 0.82};
-
 /* outcrop.slice with a resistance palette by default. */
 static int l_slice(lua_State *L) {
-  return oclua_slice(L, "outcrop.geology.slice", default_stops,
-                     (int)(sizeof default_stops / sizeof default_stops[0] / 4));
+  int n;
+  const double *stops = oc_palette_resistance(&n);
+  return oclua_slice(L, "outcrop.geology.slice", stops, n);
 }
 
 static const luaL_Reg geology_funcs[] = {

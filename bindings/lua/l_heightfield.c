@@ -20,7 +20,6 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "io/oiio.h"
 #include "l_field.h"
 #include "l_heightfield.h"
 #include "l_progress.h"
@@ -409,26 +408,15 @@ static int hf_max(lua_State *L) {
   return 1;
 }
 
-/* In index order, in double: the same sum for any thread count. */
+/* The lib's sum: in index order, in double. */
 static int hf_sum(lua_State *L) {
   oc_heightfield *hf = oclua_checkheightfield(L, 1, "heightfield:sum");
-  size_t n = (size_t)oc_heightfield_nx(hf) * (size_t)oc_heightfield_ny(hf);
-  const float *z = oc_heightfield_samples(hf);
-  double s = 0;
   oclua_checkargs(L, 1, "heightfield:sum", "()");
-  for (size_t k = 0; k < n; k++)
-    s += z[k];
-  lua_pushnumber(L, s);
+  lua_pushnumber(L, oc_heightfield_sum(hf));
   return 1;
 }
 
 /* ---- resample and crop ------------------------------------------------- */
-
-/* Samples along an axis of extent w at spacing c: floor(w / c) + 1, with
-** a relative slack so that 100 / 0.1 counts 1001 samples. */
-static double count_samples(double w, double c) {
-  return floor(w / c * (1 + 1e-12)) + 1;
-}
 
 static int hf_resample(lua_State *L) {
   static const char *const known[] = {"cell", "size", NULL};
@@ -441,46 +429,16 @@ static int hf_resample(lua_State *L) {
   oclua_checkargs(L, 2, fname, "{cell = or size =}");
   hf = oclua_pinheightfield(L, 1, fname);
   oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
-  double c = oc_heightfield_cell(hf);
-  double wx = (oc_heightfield_nx(hf) - 1) * c,
-         wy = (oc_heightfield_ny(hf) - 1) * c;
   int hassize = oclua_field_push(&f, "size") != LUA_TNIL;
   lua_pop(L, 1);
   double cell = oclua_field_optnumber(&f, "cell", OCLUA_POSITIVE, 0);
-  if (hassize == (cell > 0))
-    oclua_error(L, fname, "give either 'cell' or 'size' = {nx, ny}");
-  oc_heightfield_origin(hf, &g.x0, &g.y0);
-  if (hassize) {
-    field_size(&f, &g.nx, &g.ny);
-    double cx = wx / (g.nx - 1), cy = wy / (g.ny - 1);
-    if (fabs(cx - cy) > 1e-6 * fmax(cx, cy))
-      oclua_error(L, fname,
-                  "'size' {%d, %d} needs cells of %f along x but %f along y "
-                  "(cells are square): keep the grid's proportions or give "
-                  "'cell'",
-                  g.nx, g.ny, (LUAI_UACNUMBER)cx, (LUAI_UACNUMBER)cy);
-    g.cell = cx;
-  } else {
-    double nx = count_samples(wx, cell), ny = count_samples(wy, cell);
-    if (nx < 2 || ny < 2)
-      oclua_error(L, fname,
-                  "'cell' %f is larger than the grid (%f x %f): it would "
-                  "leave fewer than 2 samples per side",
-                  (LUAI_UACNUMBER)cell, (LUAI_UACNUMBER)wx, (LUAI_UACNUMBER)wy);
-    if (nx > MAX_SIDE || ny > MAX_SIDE)
-      oclua_error(L, fname,
-                  "'cell' %f gives %I x %I samples (at most %d per side)",
-                  (LUAI_UACNUMBER)cell, (LUAI_UACINT)fmin(nx, 1e18),
-                  (LUAI_UACINT)fmin(ny, 1e18), MAX_SIDE);
-    if (nx * ny > (double)OC_HF_MAX_SAMPLES)
-      oclua_error(L, fname,
-                  "'cell' %f gives %I x %I samples, over the limit of %I",
-                  (LUAI_UACNUMBER)cell, (LUAI_UACINT)nx, (LUAI_UACINT)ny,
-                  (LUAI_UACINT)OC_HF_MAX_SAMPLES);
-    g.nx = (int)nx;
-    g.ny = (int)ny;
-    g.cell = cell;
-  }
+  int nx = 0, ny = 0;
+  if (hassize && cell > 0)
+    nx = ny = -1; /* both: the lib's to refuse */
+  else if (hassize)
+    field_size(&f, &nx, &ny);
+  if (oc_heightfield_resample_grid(hf, cell, nx, ny, &g, &err))
+    oclua_liberror(L, fname, &err);
   oc_progress pr = oclua_progress_start(L, &pl, fname);
   oclua_heightfield *u = oclua_newheightfield(L);
   oc_heightfield *out = oc_heightfield_resample(hf, &g, pr, &err);
@@ -508,21 +466,8 @@ static int hf_crop(lua_State *L) {
                 "give the sample range {i0, j0, i1, j1} (1-based, inclusive) "
                 "or box = {x0, y0, x1, y1}");
   if (hasbox) {
-    double x0, y0, c = oc_heightfield_cell(hf);
-    oc_heightfield_origin(hf, &x0, &y0);
-    if (!(box[0] < box[2] && box[1] < box[3]))
-      oclua_error(L, fname,
-                  "'box' = {x0, y0, x1, y1} needs x0 < x1 and y0 < y1");
-    /* The samples inside, with a relative slack for rounding. */
-    double e = 1e-9;
-    double a[4] = {ceil((box[0] - x0) / c - e), ceil((box[1] - y0) / c - e),
-                   floor((box[2] - x0) / c + e), floor((box[3] - y0) / c + e)};
-    a[0] = fmax(a[0], 0), a[1] = fmax(a[1], 0);
-    a[2] = fmin(a[2], nx - 1), a[3] = fmin(a[3], ny - 1);
-    if (!(a[2] - a[0] >= 1 && a[3] - a[1] >= 1))
-      oclua_error(L, fname, "'box' holds fewer than 2 x 2 samples of the grid");
-    for (int k = 0; k < 4; k++)
-      ij[k] = (int)a[k];
+    if (oc_heightfield_crop_range(hf, box[0], box[1], box[2], box[3], ij, &err))
+      oclua_liberror(L, fname, &err);
   } else {
     for (int k = 0; k < 4; k++) {
       int isint, lim = k % 2 == 0 ? nx : ny;

@@ -14,7 +14,6 @@
 #include <string.h>
 
 #include "l_field.h"
-#include "core/palette.h"
 #include "l_image.h"
 #include "l_provenance.h"
 
@@ -238,16 +237,9 @@ int oclua_slice(lua_State *L, const char *fname, const double *stops,
     stops = oclua_read_palette(L, -1, fname, "palette", &nstops);
   const oc_program *prog = oclua_program(L, 1, fname);
   if (!given) {
-    oc_aabb b = oc_program_bounds(prog);
-    double lo[3] = {b.lo.x, b.lo.y, b.lo.z}, hi[3] = {b.hi.x, b.hi.y, b.hi.z};
-    int u = sp.plane == OC_PLANE_YZ ? 1 : 0;
-    int v = sp.plane == OC_PLANE_XY ? 1 : 2;
-    box[0] = lo[u], box[1] = lo[v], box[2] = hi[u], box[3] = hi[v];
-    if (!(isfinite(box[0]) && isfinite(box[1]) && isfinite(box[2]) &&
-          isfinite(box[3])))
-      oclua_error(L, fname,
-                  "the node's bounds are infinite: give 'box' = "
-                  "{u0, v0, u1, v1}");
+    if (oc_slice_default_window(prog, &sp, &err))
+      oclua_liberror(L, fname, &err);
+    box[0] = sp.u0, box[1] = sp.v0, box[2] = sp.u1, box[3] = sp.v1;
   }
   if (!(box[0] < box[2] && box[1] < box[3]))
     oclua_error(L, fname,
@@ -259,20 +251,10 @@ int oclua_slice(lua_State *L, const char *fname, const double *stops,
   oclua_image *u = oclua_newimage(L);
   u->img = oc_slice(prog, &sp, &err);
   if (u->img == NULL) oclua_liberror(L, fname, &err);
-  if (stops) {
-    /* the colours follow the palette; the "field" channel keeps the raw
-    ** value */
-    float *px = oc_image_data(u->img);
-    int nc = oc_image_channels(u->img);
-    size_t npx = (size_t)sp.width * (size_t)sp.height;
-    for (size_t i = 0; i < npx; i++) {
-      float *q = px + i * (size_t)nc;
-      double rgb[3];
-      oc_palette_eval(stops, nstops, q[4], rgb);
-      q[0] = (float)rgb[0], q[1] = (float)rgb[1], q[2] = (float)rgb[2];
-      q[3] = 1;
-    }
-  }
+  /* the colours follow the palette; the "field" channel keeps the raw
+  ** value */
+  if (stops && oc_slice_apply_palette(u->img, stops, nstops, &err))
+    oclua_liberror(L, fname, &err);
   return 1;
 }
 

@@ -2,7 +2,8 @@
 ** l_mesh.c — outcrop.polygonize and the mesh userdata (write, stats,
 ** counts, vertex, triangle, components).
 **
-** polygonize defaults: box = the node's bounds (an error when they are
+** polygonize defaults (the lib's, oc_polygonize_default_box and _cell):
+** box = the node's bounds (an error when they are
 ** infinite or empty); when neither 'cell' nor 'resolution' is given,
 ** cubic cells of 1/64 of the box's longest side; threshold =
 ** outcrop.threshold; open = false; steps = 6; full_grid = false;
@@ -37,8 +38,7 @@
 #include "l_progress.h"
 #include "l_provenance.h"
 
-#define DEFAULT_RESOLUTION 64 /* cells along the longest side */
-#define MAX_CELLS (1 << 20)   /* per axis, as the lib allows */
+#define MAX_CELLS (1 << 20) /* per axis, as the lib allows */
 #define DEFAULT_STEPS 6
 #define MAX_STEPS 64
 
@@ -406,19 +406,11 @@ static int l_polygonize(lua_State *L) {
 
   const oc_program *prog = oclua_program_at(L, 1, fname, t);
   if (!hasbox) {
-    oc_aabb b = oc_program_bounds(prog);
+    oc_aabb b;
+    if (oc_polygonize_default_box(prog, &b, &err))
+      oclua_liberror(L, fname, &err);
     box[0] = b.lo.x, box[1] = b.lo.y, box[2] = b.lo.z;
     box[3] = b.hi.x, box[4] = b.hi.y, box[5] = b.hi.z;
-    for (int k = 0; k < 3; k++)
-      if (box[k] > box[k + 3])
-        oclua_error(L, fname,
-                    "the node's bounds are empty (its field is 0 "
-                    "everywhere): give 'box' = {x0, y0, z0, x1, y1, z1}");
-    for (int k = 0; k < 6; k++)
-      if (!isfinite(box[k]))
-        oclua_error(L, fname,
-                    "the node's bounds are infinite: give 'box' = "
-                    "{x0, y0, z0, x1, y1, z1}");
   }
   for (int k = 0; k < 3; k++)
     if (!(box[k] < box[k + 3]))
@@ -429,12 +421,9 @@ static int l_polygonize(lua_State *L) {
                   hasbox ? "" : " (from the node's bounds)");
   /* A cell too small for the box is the lib's to refuse: it knows its
   ** grid limits. */
-  if (!hasres && cell == 0) {
-    double longest = 0;
-    for (int k = 0; k < 3; k++)
-      longest = fmax(longest, box[k + 3] - box[k]);
-    cell = longest / DEFAULT_RESOLUTION;
-  }
+  if (!hasres && cell == 0)
+    cell = oc_polygonize_default_cell(
+        (oc_aabb){{box[0], box[1], box[2]}, {box[3], box[4], box[5]}});
 
   memset(&pp, 0, sizeof pp);
   pp.box = (oc_aabb){{box[0], box[1], box[2]}, {box[3], box[4], box[5]}};

@@ -14,8 +14,6 @@
 
 #include "l_field.h"
 
-#define OCLUA_PI 3.14159265358979323846
-
 /* ---- n-ary operators ------------------------------------------------- */
 
 typedef oc_node *(*nary_fn)(oc_node *const *, size_t, oc_error *);
@@ -152,50 +150,15 @@ static int l_perturb(lua_State *L) {
 
 /* ---- transform ------------------------------------------------------- */
 
-/* 3x4 row-major affine maps; the implicit last row is (0 0 0 1). */
-static void mat_identity(double m[12]) {
-  memset(m, 0, 12 * sizeof *m);
-  m[0] = m[5] = m[10] = 1;
-}
-
-/* out = a * b (b applied first) */
-static void mat_mul(const double a[12], const double b[12], double out[12]) {
-  double r[12];
-  for (int i = 0; i < 3; i++) {
-    for (int j = 0; j < 4; j++) {
-      double s = j == 3 ? a[i * 4 + 3] : 0;
-      for (int k = 0; k < 3; k++)
-        s += a[i * 4 + k] * b[k * 4 + j];
-      r[i * 4 + j] = s;
-    }
-  }
-  memcpy(out, r, sizeof r);
-}
-
-/* Rotation by `deg` degrees about the unit axis k (Rodrigues). */
-static void mat_rotation(oc_vec3 k, double deg, double m[12]) {
-  double a = deg * (OCLUA_PI / 180.0), c = cos(a), s = sin(a), t = 1 - c;
-  mat_identity(m);
-  m[0] = c + t * k.x * k.x;
-  m[1] = t * k.x * k.y - s * k.z;
-  m[2] = t * k.x * k.z + s * k.y;
-  m[4] = t * k.y * k.x + s * k.z;
-  m[5] = c + t * k.y * k.y;
-  m[6] = t * k.y * k.z - s * k.x;
-  m[8] = t * k.z * k.x - s * k.y;
-  m[9] = t * k.z * k.y + s * k.x;
-  m[10] = c + t * k.z * k.z;
-}
-
+/* The maps themselves are the lib's (oc_xform_*): here only the fields. */
 static void check_rotate(lua_State *L, const char *fname, int idx,
                          double rot[12]) {
   static const char *const known[] = {"axis", "angle", NULL};
   oclua_fields f;
   oclua_fields_open(&f, L, idx, fname, "rotate.", known, 1);
-  mat_identity(rot);
+  oc_error err = {OC_OK, ""};
+  oc_xform_identity(rot);
   if (f.narray > 0) {
-    /* Euler angles: X first, so R = Rz * Ry * Rx. */
-    static const oc_vec3 axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     oc_vec3 e;
     int named = lua_getfield(L, idx, "axis") != LUA_TNIL;
     named |= lua_getfield(L, idx, "angle") != LUA_TNIL;
@@ -205,20 +168,13 @@ static void check_rotate(lua_State *L, const char *fname, int idx,
                   "'rotate' must be {axis = {x, y, z}, angle = "
                   "degrees} or Euler angles {rx, ry, rz} in degrees");
     e = oclua_tovec(L, idx, fname, "rotate", 0);
-    for (int i = 0; i < 3; i++) {
-      double r[12];
-      mat_rotation(axes[i], i == 0 ? e.x : i == 1 ? e.y : e.z, r);
-      mat_mul(r, rot, rot);
-    }
+    if (oc_xform_euler(e, rot, &err)) oclua_liberror(L, fname, &err);
     return;
   }
   oc_vec3 axis = oclua_field_vec(&f, "axis");
   double angle = oclua_field_number(&f, "angle", OCLUA_FINITE);
-  double len = sqrt(axis.x * axis.x + axis.y * axis.y + axis.z * axis.z);
-  if (!(len > 0) || !isfinite(len))
-    oclua_error(L, fname, "'rotate.axis' must be a non-zero vector");
-  axis.x /= len, axis.y /= len, axis.z /= len;
-  mat_rotation(axis, angle, rot);
+  if (oc_xform_axis_angle(axis, angle, rot, &err))
+    oclua_liberror(L, fname, &err);
 }
 
 static int l_transform(lua_State *L) {
@@ -226,13 +182,13 @@ static int l_transform(lua_State *L) {
   const char *fname = "outcrop.transform";
   oclua_fields f;
   oc_error err = {OC_OK, ""};
-  double m[12], rot[12], sc[12];
+  double m[12], rot[12];
   oc_vec3 t = {0, 0, 0}, s = {1, 1, 1};
   oclua_checkargs(L, 2, fname, "(node, {translate =, rotate =, scale =})");
   oc_node *child = oclua_checknode(L, 1, fname, "argument #1");
   oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
   oclua_field_optvec(&f, "translate", &t);
-  mat_identity(rot);
+  oc_xform_identity(rot);
   if (oclua_field_push(&f, "rotate") != LUA_TNIL)
     check_rotate(L, fname, lua_gettop(L), rot);
   lua_pop(L, 1);
@@ -249,16 +205,9 @@ static int l_transform(lua_State *L) {
       oclua_field_error(&f, "scale", -1, "must be a number or {sx, sy, sz}");
     lua_pop(L, 1);
     oclua_field_optvec(&f, "scale", &s);
-    if (s.x == 0 || s.y == 0 || s.z == 0)
-      oclua_error(L, fname,
-                  "'scale' factors must be non-zero (got {%f, %f, %f})", s.x,
-                  s.y, s.z);
   }
-  /* M = T * R * S */
-  mat_identity(sc);
-  sc[0] = s.x, sc[5] = s.y, sc[10] = s.z;
-  mat_mul(rot, sc, m);
-  m[3] = t.x, m[7] = t.y, m[11] = t.z;
+  /* M = T * R * S, the lib's; it refuses zero scale factors */
+  if (oc_xform_compose(t, rot, s, m, &err)) oclua_liberror(L, fname, &err);
   oclua_node *u = oclua_newnode(L);
   return oclua_setnode(L, u, oc_transform(child, m, &err), &err, fname);
 }

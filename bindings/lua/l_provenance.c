@@ -8,8 +8,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/sha256.h"
-#include "io/infile.h"
 #include "l_config.h"
 #include "l_provenance.h"
 

@@ -3,10 +3,11 @@
 ** traced by lib/render, with every option checked before any work.
 **
 ** Defaults (the lib's, oc_render_defaults, except where said): 640 x 360;
-** camera looking at the centre of the node's bounds from the south-west,
-** 30 degrees up, just far enough for the corners of the bounds to fit the
-** view (an error when the bounds are infinite and camera.eye or
-** camera.target is missing), up = {0, 0, 1}, fov = 40 degrees (vertical);
+** camera framed by oc_render_default_camera, looking at the centre of the
+** node's bounds from the south-west, 30 degrees up, just far enough for
+** the corners of the bounds to fit the view (an error when the bounds are
+** infinite and camera.eye or camera.target is missing), up = {0, 0, 1},
+** fov = 40 degrees (vertical);
 ** sun, sky, shadows, AO and texture as the lib; no fog; the sky behind
 ** the surface; threshold = outcrop.threshold; rule colours by altitude
 ** and slope; the AOV channels (Z, N, P, evals) after R, G, B, A unless
@@ -14,8 +15,9 @@
 ** before the option existed), or "filmic".
 **
 ** `color` selects the albedo: nil (rules, tuned by `rules = {...}`), a
-** node mapped through `palette` (a default palette of strata colours for
-** resistances in [0, 1]), {field = node, palette = ...} as polygonize
+** node mapped through `palette` (the lib's oc_palette_strata by default,
+** strata colours for resistances in [0, 1]), {field = node, palette = ...} as
+*polygonize
 ** takes it, or a function (x, y, z, nx, ny, nz) -> r, g, b called once
 ** per pixel that hits the surface, row by row from the top left, between
 ** the lib's two passes (geometry, then shading). Colours are linear RGB.
@@ -34,26 +36,9 @@
 
 #define FNAME "outcrop.render"
 #define MAX_SIDE 16384
-#define DEFAULT_FOV 40.0
-#define MAX_FOV 179.0
 #define MAX_EV 20.0 /* exposure, stops either way (lib/render/render.h) */
-/* Default view: from the south-west, 30 degrees above the horizon. */
-#define VIEW_AZIMUTH (-135.0)
-#define VIEW_ELEVATION 30.0
 /* Fog given as a distance: the transmittance there is exp(-3), 5 %. */
 #define FOG_DISTANCE_FACTOR 3.0
-#define PI 3.14159265358979323846
-
-/* Strata colours for a resistance in [0, 1]: soft sandstone to hard
-** limestone, linear albedos about as bright as the rules' rock, so that
-** layers of different hardness read as bands on cliffs. */
-static const double default_palette[][4] = {{0.00, 0.36, 0.22, 0.11},
-                                            {0.30, 0.28, 0.13, 0.07},
-                                            {0.50, 0.40, 0.32, 0.20},
-                                            {0.70, 0.16, 0.11, 0.08},
-                                            {1.00, 0.30, 0.29, 0.27}};
-#define DEFAULT_PALETTE_STOPS                                                  \
-  (int)(sizeof default_palette / sizeof default_palette[0])
 
 static const char *const rgb_names[3] = {"r", "g", "b"};
 
@@ -163,19 +148,14 @@ static void read_camera(const oclua_fields *f, oc_render_params *rp,
                         camera_in *ci) {
   static const char *const known[] = {"eye", "target", "up", "fov", NULL};
   oclua_fields c;
-  rp->camera.up = (oc_vec3){0, 0, 1};
-  rp->camera.fov = DEFAULT_FOV;
   ci->has_eye = ci->has_target = 0;
   if (!open_sub(f, "camera", &c, known)) return;
   ci->has_eye = oclua_field_optvec(&c, "eye", &rp->camera.eye);
   ci->has_target = oclua_field_optvec(&c, "target", &rp->camera.target);
   oclua_field_optvec(&c, "up", &rp->camera.up);
+  /* (the range is the lib's to check: oc_render_default_camera) */
   rp->camera.fov =
-      oclua_field_optnumber(&c, "fov", OCLUA_POSITIVE, DEFAULT_FOV);
-  if (rp->camera.fov > MAX_FOV)
-    oclua_error(f->L, f->fname,
-                "'camera.fov' must be in (0, %d] degrees (got %f)",
-                (int)MAX_FOV, rp->camera.fov);
+      oclua_field_optnumber(&c, "fov", OCLUA_POSITIVE, rp->camera.fov);
   close_sub(f->L);
 }
 
@@ -184,17 +164,12 @@ static void read_sun(const oclua_fields *f, oc_render_params *rp) {
   oclua_fields s;
   oc_vec3 d;
   if (!open_sub(f, "sun", &s, known)) return;
-  if (oclua_field_optvec(&s, "direction", &d)) {
-    if (d.x == 0 && d.y == 0 && d.z == 0)
-      oclua_error(f->L, f->fname, "'sun.direction' must not be {0, 0, 0}");
-    rp->sun_direction = d;
-  }
+  /* a zero direction and a negative intensity are the lib's to refuse
+  ** (oc_render_check) */
+  if (oclua_field_optvec(&s, "direction", &d)) rp->sun_direction = d;
   read_rgb(&s, "color", rp->sun_color, 0);
-  double i =
+  rp->sun_intensity =
       oclua_field_optnumber(&s, "intensity", OCLUA_FINITE, rp->sun_intensity);
-  if (i < 0)
-    oclua_error(f->L, f->fname, "'sun.intensity' must be >= 0 (got %f)", i);
-  rp->sun_intensity = i;
   close_sub(f->L);
 }
 
@@ -323,67 +298,6 @@ static void read_color(const oclua_fields *f, oc_render_params *rp,
   oclua_field_error(f, "color", -1,
                     "must be an outcrop node, a function (x, y, z, nx, ny, "
                     "nz) -> r, g, b, or {field = node, palette = ...}");
-}
-
-/* ---- the default camera ---------------------------------------------- */
-
-/* Points the camera at the node's bounds where the script did not: the
-** target at their centre, the eye back along the default view direction
-** (or the given eye's) just far enough for the eight corners of the
-** bounds to fall inside the view. */
-static void default_camera(lua_State *L, const oc_program *prog,
-                           oc_render_params *rp, const camera_in *ci) {
-  oc_aabb b = oc_program_bounds(prog);
-  double lo[3] = {b.lo.x, b.lo.y, b.lo.z}, hi[3] = {b.hi.x, b.hi.y, b.hi.z};
-  if (ci->has_eye && ci->has_target) return;
-  for (int k = 0; k < 3; k++) {
-    if (lo[k] > hi[k])
-      oclua_error(L, FNAME,
-                  "the node's bounds are empty (its field is 0 everywhere): "
-                  "give 'camera' = {eye =, target =}");
-    if (!isfinite(lo[k]) || !isfinite(hi[k]))
-      oclua_error(L, FNAME,
-                  "the node's bounds are infinite: give 'camera' = "
-                  "{eye =, target =}");
-  }
-  double c[3] = {(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2};
-  if (!ci->has_target) rp->camera.target = (oc_vec3){c[0], c[1], c[2]};
-  if (ci->has_eye) return;
-  /* Viewing direction (from the eye to the target) and the camera's
-  ** right and up vectors; a vertical view falls back to the default. */
-  double az = VIEW_AZIMUTH * PI / 180, el = VIEW_ELEVATION * PI / 180;
-  double fw[3] = {-cos(el) * cos(az), -cos(el) * sin(az), -sin(el)};
-  oc_vec3 u = rp->camera.up;
-  double rt[3] = {fw[1] * u.z - fw[2] * u.y, fw[2] * u.x - fw[0] * u.z,
-                  fw[0] * u.y - fw[1] * u.x};
-  double n = sqrt(rt[0] * rt[0] + rt[1] * rt[1] + rt[2] * rt[2]);
-  if (!(n > 1e-9 * sqrt(u.x * u.x + u.y * u.y + u.z * u.z)))
-    oclua_error(L, FNAME,
-                "'camera.up' is parallel to the default view direction: "
-                "give 'camera.eye'");
-  for (int k = 0; k < 3; k++)
-    rt[k] /= n;
-  double up[3] = {rt[1] * fw[2] - rt[2] * fw[1], rt[2] * fw[0] - rt[0] * fw[2],
-                  rt[0] * fw[1] - rt[1] * fw[0]};
-  double tv = tan(rp->camera.fov * PI / 360);
-  double th = tv * (double)rp->width / (double)rp->height;
-  double t[3] = {rp->camera.target.x, rp->camera.target.y, rp->camera.target.z};
-  double dist = 0, radius = 0;
-  for (int corner = 0; corner < 8; corner++) {
-    double q[3], x = 0, y = 0, z = 0;
-    for (int k = 0; k < 3; k++) {
-      q[k] = ((corner >> k) & 1 ? hi[k] : lo[k]) - t[k];
-      x += q[k] * rt[k], y += q[k] * up[k], z += q[k] * fw[k];
-    }
-    /* The corner is in view when |x| <= th (dist + z), |y| <= tv (dist + z). */
-    dist = fmax(dist, fmax(fabs(x) / th, fabs(y) / tv) - z);
-    radius = fmax(radius, sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]));
-  }
-  /* A small margin, and never inside the bounds' sphere. */
-  dist = fmax(1.04 * dist, 1.01 * radius);
-  if (!(dist > 0)) dist = 1;
-  rp->camera.eye =
-      (oc_vec3){t[0] - dist * fw[0], t[1] - dist * fw[1], t[2] - dist * fw[2]};
 }
 
 /* ---- the colour function ----------------------------------------------- */
@@ -521,13 +435,19 @@ static int l_render(lua_State *L) {
                   ? OC_TRACE_SPHERE
                   : OC_TRACE_SEGMENT;
   read_color(&f, &rp, &src);
-  if (src.kind == SRC_FIELD && rp.stops == NULL) {
-    rp.stops = default_palette[0];
-    rp.nstops = DEFAULT_PALETTE_STOPS;
-  }
+  if (src.kind == SRC_FIELD && rp.stops == NULL)
+    rp.stops = oc_palette_strata(&rp.nstops);
 
   const oc_program *prog = oclua_program_at(L, 1, FNAME, t);
-  default_camera(L, prog, &rp, &ci);
+  if (oc_render_default_camera(prog, &rp, ci.has_eye, ci.has_target, &err))
+    oclua_liberror(L, FNAME, &err);
+  /* The colour node is compiled at the render's threshold: were it the
+  ** main node itself, another threshold would replace (and free) the
+  ** program in use. Everything is checked before any work (a colour
+  ** function runs between the lib's passes). */
+  if (src.kind == SRC_FIELD)
+    rp.color_field = oclua_program_at(L, src.idx, FNAME, t);
+  if (oc_render_check(prog, &rp, &err)) oclua_liberror(L, FNAME, &err);
   memset(&rp.progress, 0, sizeof rp.progress);
   rp.progress = oclua_progress_start(L, &pl, FNAME);
   char warning[300] = "";
@@ -535,11 +455,6 @@ static int l_render(lua_State *L) {
   rp.warning_size = sizeof warning;
 
   if (src.kind != SRC_FUNCTION) {
-    /* The colour node is compiled at the render's threshold: were it the
-    ** main node itself, another threshold would replace (and free) the
-    ** program in use. */
-    if (src.kind == SRC_FIELD)
-      rp.color_field = oclua_program_at(L, src.idx, FNAME, t);
     oclua_image *u = oclua_newimage(L);
     u->img = oc_render(prog, &rp, &err);
     if (u->img == NULL) render_error(L, &pl, &err);

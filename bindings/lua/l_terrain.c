@@ -27,37 +27,6 @@
 #include "l_heightfield.h"
 #include "l_terrain.h"
 
-/* A mask image read from `path`, stretched over hf's width, its samples
-** divided by the largest one so that Omega is where they are >= 0.5.
-** Raises on error (nothing to release then). */
-static oc_heightfield *mask_from_path(lua_State *L, const char *fname,
-                                      const char *path,
-                                      const oc_heightfield *hf) {
-  oc_error err = {OC_OK, ""};
-  oc_heightfield *m = oc_heightfield_load(path, NULL, &err);
-  if (!m) oclua_error(L, fname, "'mask': %s", err.msg);
-  int nx = oc_heightfield_nx(m), ny = oc_heightfield_ny(m);
-  double lo, hi, x0, y0;
-  oc_heightfield_minmax(m, &lo, &hi);
-  oc_heightfield_origin(hf, &x0, &y0);
-  double cell =
-      oc_heightfield_cell(hf) * (oc_heightfield_nx(hf) - 1) / (double)(nx - 1);
-  oc_heightfield *s = NULL;
-  if (hi > 0) s = oc_heightfield_new(nx, ny, cell, x0, y0, NULL, &err);
-  if (s) {
-    const float *a = oc_heightfield_samples(m);
-    float *b = oc_heightfield_samples_mut(s);
-    for (size_t k = 0; k < (size_t)nx * (size_t)ny; k++)
-      b[k] = (float)(a[k] / hi);
-  }
-  oc_heightfield_release(m);
-  if (!s && hi > 0) oclua_error(L, fname, "'mask': %s", err.msg);
-  if (!s)
-    oclua_error(L, fname, "'mask' image '%s' is black: nothing is inside",
-                path);
-  return s;
-}
-
 static int l_terrain(lua_State *L) {
   static const char *const known[] = {
       "falloff", "transition", "thickness", "mask", "invert", "edges", NULL};
@@ -70,8 +39,8 @@ static int l_terrain(lua_State *L) {
   lua_settop(L, 2);
   /* pinned: the options' metamethods and finalizers may close it */
   oc_heightfield *hf = oclua_pinheightfield(L, 1, fname);
-  oc_terrain_params tp = {0};
-  tp.falloff = 4 * oc_heightfield_cell(hf);
+  oc_terrain_params tp;
+  oc_terrain_defaults(hf, &tp); /* the lib's: falloff 4 cells, W 1 */
   const char *mask_path = NULL;
   oc_heightfield *mask = NULL;
   if (!lua_isnoneornil(L, 2)) {
@@ -79,7 +48,8 @@ static int l_terrain(lua_State *L) {
     oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
     tp.falloff =
         oclua_field_optnumber(&f, "falloff", OCLUA_POSITIVE, tp.falloff);
-    tp.transition = oclua_field_optnumber(&f, "transition", OCLUA_POSITIVE, 1);
+    tp.transition =
+        oclua_field_optnumber(&f, "transition", OCLUA_POSITIVE, tp.transition);
     tp.thickness = oclua_field_optnumber(&f, "thickness", OCLUA_FINITE, 0);
     if (tp.thickness < 0)
       oclua_error(L, fname, "'thickness' must be >= 0 (got %f)", tp.thickness);
@@ -99,16 +69,16 @@ static int l_terrain(lua_State *L) {
       mask = oclua_pinheightfield(L, -1, fname);
   }
   oclua_node *u = oclua_newnode(L);
-  oc_heightfield *own =
-      mask_path ? mask_from_path(L, fname, mask_path, hf) : NULL;
-  tp.mask = own ? own : mask;
   oc_error err = {OC_OK, ""};
-  oc_elevation src;
-  oc_node *n = NULL;
-  if (oc_heightfield_elevation(hf, &src, &err) == OC_OK) {
-    n = oc_terrain(&src, &tp, &err);
-    src.release(src.ud); /* the node holds its own reference */
+  oc_heightfield *own = NULL;
+  if (mask_path) {
+    /* the image stretched over hf and normalised (the lib's), raising
+    ** with nothing to release */
+    own = oc_heightfield_load_mask(mask_path, hf, &err);
+    if (!own) oclua_liberror(L, fname, &err);
   }
+  tp.mask = own ? own : mask;
+  oc_node *n = oc_heightfield_terrain(hf, &tp, &err);
   oc_heightfield_release(own);
   return oclua_setnode(L, u, n, &err, fname);
 }

@@ -3,6 +3,7 @@
 */
 #include <stdarg.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "core/error.h"
 
@@ -22,4 +23,12 @@ void oc_clearerr(oc_error *err) {
     err->code = OC_OK;
     err->msg[0] = '\0';
   }
+}
+
+const char *oc_numstr(double x, char buf[OC_NUMSTR]) {
+  int n = snprintf(buf, OC_NUMSTR, "%.14g", x);
+  if (n > 0 && n < OC_NUMSTR - 2 && buf[strspn(buf, "-0123456789")] == '\0') {
+    buf[n] = '.', buf[n + 1] = '0', buf[n + 2] = '\0';
+  }
+  return buf;
 }

@@ -18,4 +18,10 @@ int oc_seterr(oc_error *err, oc_status code, const char *fmt, ...)
     OC_PRINTF(3, 4);
 void oc_clearerr(oc_error *err);
 
+/* x as the front ends print numbers in messages ("%.14g", and ".0" after
+** a whole number: 2.0, 0.25, 1e+20, inf), so that a message made here
+** reads as one made by the Lua bindings. Returns buf. */
+#define OC_NUMSTR 48
+const char *oc_numstr(double x, char buf[OC_NUMSTR]);
+
 #endif

@@ -1,5 +1,6 @@
 /*
-** palette.c — colour maps (see palette.h).
+** palette.c — colour maps (outcrop.h, "palettes"): checks, evaluation
+** and the built-in palettes.
 */
 #include <math.h>
 
@@ -52,4 +53,26 @@ void oc_palette_eval(const double *stops, int n, double v, double rgb[3]) {
   }
   for (int c = 1; c <= 3; c++)
     rgb[c - 1] = s[c];
+}
+
+/* Strata colours for a resistance in [0, 1]: soft sandstone to hard
+** limestone, so that layers of different hardness read as bands on
+** cliffs. */
+static const double strata[] = {0.00, 0.36, 0.22, 0.11, 0.30, 0.28, 0.13,
+                                0.07, 0.50, 0.40, 0.32, 0.20, 0.70, 0.16,
+                                0.11, 0.08, 1.00, 0.30, 0.29, 0.27};
+
+/* Pale for hard rock, dark for soft (Paris et al. 2019, figure 4). */
+static const double resistance[] = {0.00, 0.22, 0.13, 0.08, 0.35, 0.45,
+                                    0.30, 0.18, 0.65, 0.72, 0.58, 0.40,
+                                    1.00, 0.95, 0.91, 0.82};
+
+const double *oc_palette_strata(int *n) {
+  if (n) *n = (int)(sizeof strata / sizeof strata[0] / 4);
+  return strata;
+}
+
+const double *oc_palette_resistance(int *n) {
+  if (n) *n = (int)(sizeof resistance / sizeof resistance[0] / 4);
+  return resistance;
 }

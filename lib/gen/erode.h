@@ -80,22 +80,14 @@ typedef struct oc_erode_params {
 oc_node *oc_erode_run(const oc_erode_params *ep, const oc_erode_cand *cand,
                       size_t n, oc_gen_sea_stats *st, oc_error *err);
 
-/* The parameters of the sea and river generators that oc_erode_params
-** takes as they are. */
-typedef struct oc_erode_common {
-  double radius, strength, beta, cutoff;
-  int steps;
-  uint64_t seed;
-} oc_erode_common;
-
-/* Fills *ep from those, the rest zero: resistance 0.5 without geology,
-** the default threshold for 0, a marching step of half the smaller of
-** hf's cell and the radius (but at least 1/32 cell: a tinier radius only
-** makes the march longer) and rays cut to hf's extent. */
-void oc_erode_shared(oc_erode_params *ep, oc_node *base, int omit_base,
-                     oc_node *geology, double threshold,
-                     const oc_heightfield *hf, const oc_erode_common *c,
-                     oc_progress progress);
+/* Fills *ep from the generators' shared parameters c (outcrop.h), the
+** rest zero: the primitives alone when c->no_terrain, resistance 0.5
+** without geology, the default threshold for 0, a marching step of half
+** the smaller of hf's cell and the radius (but at least 1/32 cell: a
+** tinier radius only makes the march longer) and rays cut to hf's
+** extent. */
+void oc_erode_shared(oc_erode_params *ep, oc_node *base,
+                     const oc_heightfield *hf, const oc_gen_erode_params *c);
 
 /* Candidate columns: maximal Poisson disk sets of radius `spacing` on
 ** square tiles of the heightfield's extent, only on the tiles that hold a
@@ -112,12 +104,12 @@ double *oc_erode_columns(const oc_heightfield *hf, const unsigned char *mask,
                          int (*keep)(void *, double, double), void *ud,
                          oc_progress pr, double at, size_t *n, oc_error *err);
 
-/* A new reference to `terrain`, or when it is NULL to a terrain node of
-** the heightfield (falloff 4 cells); NULL with err. */
+/* A new reference to `terrain`, or when it is NULL to the default terrain
+** node of the heightfield (oc_heightfield_terrain); NULL with err. */
 oc_node *oc_erode_base(oc_heightfield *hf, oc_node *terrain, oc_error *err);
 
-/* Checks the parameters both generators share, naming the field. */
-int oc_erode_check(double radius, double spacing, double beta, double strength,
-                   double cutoff, int steps, double threshold, oc_error *err);
+/* Checks the parameters both generators share (radius and spacing once
+** their defaults are applied), naming the field. */
+int oc_erode_check(const oc_gen_erode_params *c, oc_error *err);
 
 #endif

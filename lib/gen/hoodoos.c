@@ -391,11 +391,19 @@ oc_node *oc_generate_hoodoos(const oc_gen_hoodoos_params *p,
   if (!st) st = &local;
   if (oc_hoodoo_symbols(p, &sym, &n, st, err)) return NULL;
   double t0 = omp_get_wtime();
-  size_t nk = n + (p->terrain != NULL), k = 0;
+  /* the default terrain, the one outcrop.generate.hoodoos blends with */
+  oc_node *terrain = p->terrain, *own = NULL;
+  if (!terrain && !p->no_terrain &&
+      !(terrain = own = oc_heightfield_terrain(p->heightfield, NULL, err))) {
+    free(sym);
+    return NULL;
+  }
+  size_t nk = n + (terrain != NULL), k = 0;
   if (nk == 0) {
     oc_seterr(err, OC_EINVAL,
               "no hoodoo was placed and no 'terrain' was given (raise "
               "'probability', or check 'mask')");
+    free(sym);
     return NULL;
   }
   oc_node **kids = malloc(nk * sizeof *kids);
@@ -403,11 +411,12 @@ oc_node *oc_generate_hoodoos(const oc_gen_hoodoos_params *p,
   if (!kids) {
     oc_seterr(err, OC_ENOMEM, "out of memory for %zu hoodoo symbols", n);
     free(sym);
+    oc_node_release(own);
     return NULL;
   }
-  if (p->terrain) {
-    oc_node_retain(p->terrain);
-    kids[k++] = p->terrain;
+  if (terrain) {
+    oc_node_retain(terrain);
+    kids[k++] = terrain;
   }
   for (size_t i = 0; i < n; i++) {
     oc_node *x =
@@ -421,6 +430,7 @@ done:
     oc_node_release(kids[i]);
   free(kids);
   free(sym);
+  oc_node_release(own);
   st->seconds += omp_get_wtime() - t0;
   return r;
 }

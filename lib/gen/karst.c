@@ -501,7 +501,14 @@ oc_node *oc_generate_karst(const oc_gen_karst_params *p, oc_gen_karst_stats *st,
   oc_karst_cavity *cav;
   size_t n;
   if (oc_karst_cavities(p, &cav, &n, st, err)) return NULL;
-  size_t nt = p->terrain ? 1 : 0;
+  /* the default terrain, the one outcrop.generate.karst blends with */
+  oc_node *terrain = p->terrain, *own = NULL;
+  if (!terrain && !p->no_terrain &&
+      !(terrain = own = oc_heightfield_terrain(p->heightfield, NULL, err))) {
+    free(cav);
+    return NULL;
+  }
+  size_t nt = terrain ? 1 : 0;
   if (n + nt == 0) {
     oc_seterr(err, OC_EINVAL,
               "nothing was carved and there is no 'terrain' to return");
@@ -514,7 +521,7 @@ oc_node *oc_generate_karst(const oc_gen_karst_params *p, oc_gen_karst_stats *st,
     oc_seterr(err, OC_ENOMEM, "out of memory for %zu cavities", n);
     goto done;
   }
-  if (p->terrain) kids[made++] = p->terrain;
+  if (terrain) kids[made++] = terrain;
   for (size_t i = 0; i < n; i++) {
     oc_node *pt = oc_point(cav[i].center, cav[i].radius, cav[i].energy, err);
     if (!pt) goto done;
@@ -526,6 +533,7 @@ done:
     oc_node_release(kids[i]);
   free(kids);
   free(cav);
+  oc_node_release(own); /* the blend holds its own reference */
   if (st) st->seconds = now() - t0;
   return res;
 }

@@ -24,11 +24,10 @@
 
 void oc_gen_river_defaults(oc_gen_river_params *p) {
   memset(p, 0, sizeof *p);
+  oc_gen_erode_defaults(&p->erode);
+  p->erode.strength = 2;
+  p->erode.steps = 2;
   p->banks = 3;
-  p->beta = 0.2;
-  p->strength = 2;
-  p->cutoff = 0.05;
-  p->steps = 2;
 }
 
 static int cmpf(const void *a, const void *b) {
@@ -99,20 +98,18 @@ static int keep_column(void *ud, double x, double y) {
 static int check(const oc_gen_river_params *p, oc_gen_river_params *q,
                  oc_error *err) {
   *q = *p;
-  if (!p->heightfield)
+  if (!p->erode.heightfield)
     return oc_seterr(err, OC_EINVAL, "'heightfield' is required");
-  double cell = oc_heightfield_cell(p->heightfield);
+  double cell = oc_heightfield_cell(p->erode.heightfield);
   if (!(p->power >= 0 && isfinite(p->power)))
     return oc_seterr(err, OC_EINVAL, "'power' must be > 0 (got %g)", p->power);
   if (p->banks < 0 || p->banks > 64)
     return oc_seterr(err, OC_EINVAL, "'banks' must be in 0..64 (got %d)",
                      p->banks);
-  if (q->radius == 0) q->radius = 1.5 * cell;
-  if (q->spacing == 0) q->spacing = q->radius / 2;
-  if (q->depth == 0) q->depth = fmin(3 * q->radius, DBL_MAX);
-  if (oc_erode_check(q->radius, q->spacing, q->beta, q->strength, q->cutoff,
-                     q->steps, q->threshold, err))
-    return err ? err->code : OC_EINVAL;
+  if (q->erode.radius == 0) q->erode.radius = 1.5 * cell;
+  if (q->erode.spacing == 0) q->erode.spacing = q->erode.radius / 2;
+  if (q->depth == 0) q->depth = fmin(3 * q->erode.radius, DBL_MAX);
+  if (oc_erode_check(&q->erode, err)) return err ? err->code : OC_EINVAL;
   if (!(q->depth > 0 && isfinite(q->depth)))
     return oc_seterr(err, OC_EINVAL, "'depth' must be > 0 (got %g)", q->depth);
   return OC_OK;
@@ -122,7 +119,7 @@ oc_node *oc_generate_river(const oc_gen_river_params *pin, oc_gen_sea_stats *st,
                            oc_error *err) {
   oc_gen_river_params p;
   if (check(pin, &p, err)) return NULL;
-  oc_heightfield *hf = p.heightfield, *pw = NULL, *sig = NULL;
+  oc_heightfield *hf = p.erode.heightfield, *pw = NULL, *sig = NULL;
   int nx = oc_heightfield_nx(hf), ny = oc_heightfield_ny(hf);
   double x0, y0, cell = oc_heightfield_cell(hf), *xy = NULL;
   oc_heightfield_origin(hf, &x0, &y0);
@@ -132,8 +129,8 @@ oc_node *oc_generate_river(const oc_gen_river_params *pin, oc_gen_sea_stats *st,
   size_t ncol = 0, nc = 0;
   double thr = p.power;
 
-  if (!(base = oc_erode_base(hf, p.terrain, err))) return NULL;
-  oc_hf_flow_params fp = {0, 0, p.progress};
+  if (!(base = oc_erode_base(hf, p.erode.terrain, err))) return NULL;
+  oc_hf_flow_params fp = {0, 0, p.erode.progress};
   if (!(pw = oc_hf_stream_power(hf, &fp, err))) goto done;
   if (thr == 0 &&
       quantile(oc_heightfield_samples(pw), (size_t)nx * ny, 0.95, &thr, err))
@@ -141,7 +138,8 @@ oc_node *oc_generate_river(const oc_gen_river_params *pin, oc_gen_sea_stats *st,
   if (!(thr > 0)) thr = 1e-30; /* a flat grid: anything that flows */
   if (!(sig = oc_heightfield_new(nx, ny, cell, x0, y0, NULL, err))) goto done;
   widening W = {oc_heightfield_samples(pw), thr, p.banks};
-  if (oc_hf_each_row(sig, widen_row, &W, p.progress, "river erosion", err))
+  if (oc_hf_each_row(sig, widen_row, &W, p.erode.progress, "river erosion",
+                     err))
     goto done;
   bed B = {sig, x0, y0, cell, nx, ny};
   size_t ns = (size_t)nx * ny;
@@ -151,8 +149,8 @@ oc_node *oc_generate_river(const oc_gen_river_params *pin, oc_gen_sea_stats *st,
   }
   for (size_t k = 0; k < ns; k++)
     mask[k] = oc_heightfield_samples(sig)[k] > 0;
-  xy = oc_erode_columns(hf, mask, p.spacing, p.seed, keep_column, &B,
-                        p.progress, 0.3, &ncol, err);
+  xy = oc_erode_columns(hf, mask, p.erode.spacing, p.erode.seed, keep_column,
+                        &B, p.erode.progress, 0.3, &ncol, err);
   if (!xy) goto done;
   cand = malloc((ncol ? ncol : 1) * sizeof *cand);
   if (!cand) {
@@ -166,7 +164,7 @@ oc_node *oc_generate_river(const oc_gen_river_params *pin, oc_gen_sea_stats *st,
     c->x = x;
     c->y = y;
     c->stress = sigma_at(&B, x, y);
-    c->fwd = p.steps * p.radius + cell;
+    c->fwd = p.erode.steps * p.erode.radius + cell;
     if (s < FLAT) { /* the bed floor */
       c->zlo = c->zhi = h;
       c->ux = c->uy = 0;
@@ -179,14 +177,11 @@ oc_node *oc_generate_river(const oc_gen_river_params *pin, oc_gen_sea_stats *st,
     c->zhi = h;
     double back = p.depth / s;
     if (back > 4 * p.depth) back = 4 * p.depth;
-    c->back = back + p.radius + cell;
+    c->back = back + p.erode.radius + cell;
   }
 
   oc_erode_params ep;
-  oc_erode_common com = {p.radius, p.strength, p.beta,
-                         p.cutoff, p.steps,    p.seed};
-  oc_erode_shared(&ep, base, p.no_terrain, p.geology, p.threshold, hf, &com,
-                  p.progress);
+  oc_erode_shared(&ep, base, hf, &p.erode);
   ep.pbase = 0.3;
   ep.pspan = 0.7;
   out = oc_erode_run(&ep, cand, nc, st, err);

@@ -21,11 +21,11 @@
 
 void oc_gen_sea_defaults(oc_gen_sea_params *p) {
   memset(p, 0, sizeof *p);
+  oc_gen_erode_defaults(&p->erode);
+  p->erode.strength = 4;
+  p->erode.steps = 3;
+  p->sea_level = NAN; /* follows the grid (oc_heightfield_sea_level) */
   p->range = 8;
-  p->beta = 0.2;
-  p->strength = 4;
-  p->cutoff = 0.05;
-  p->steps = 3;
   p->rays = 16;
 }
 
@@ -62,7 +62,7 @@ static unsigned char *coast_mask(const coast *C, oc_error *err) {
 static int make_cand(const coast *C, const oc_gen_sea_params *p, double cell,
                      double x, double y, oc_erode_cand *c) {
   double g[2], h = oc_heightfield_height(C->hf, x, y, g);
-  double fwd = p->steps * p->radius + cell;
+  double fwd = p->erode.steps * p->erode.radius + cell;
   c->x = x;
   c->y = y;
   c->stress = 1;
@@ -74,7 +74,7 @@ static int make_cand(const coast *C, const oc_gen_sea_params *p, double cell,
       c->ux = g[0] / len;
       c->uy = g[1] / len;
     }
-    c->back = p->radius + cell;
+    c->back = p->erode.radius + cell;
     c->fwd = fwd;
     return 1;
   }
@@ -85,7 +85,7 @@ static int make_cand(const coast *C, const oc_gen_sea_params *p, double cell,
   c->uy = g[1] / len;
   c->zlo = C->lo;
   c->zhi = C->hi;
-  c->back = (d > 0 ? d : 0) + 2 * (p->radius + cell);
+  c->back = (d > 0 ? d : 0) + 2 * (p->erode.radius + cell);
   c->fwd = fwd;
   return 1;
 }
@@ -93,19 +93,19 @@ static int make_cand(const coast *C, const oc_gen_sea_params *p, double cell,
 static int check(const oc_gen_sea_params *p, oc_gen_sea_params *q,
                  oc_error *err) {
   *q = *p;
-  if (!p->heightfield)
+  if (!p->erode.heightfield)
     return oc_seterr(err, OC_EINVAL, "'heightfield' is required");
-  if (!isfinite(p->sea_level))
+  if (isnan(q->sea_level))
+    q->sea_level = oc_heightfield_sea_level(p->erode.heightfield);
+  if (!isfinite(q->sea_level))
     return oc_seterr(err, OC_EINVAL, "'sea_level' must be finite (got %g)",
-                     p->sea_level);
+                     q->sea_level);
   if (!(p->range > 0 && isfinite(p->range)))
     return oc_seterr(err, OC_EINVAL, "'range' must be > 0 (got %g)", p->range);
-  if (q->radius == 0) q->radius = q->range;
-  if (q->spacing == 0) q->spacing = q->radius / 2;
-  if (q->reach == 0) q->reach = fmin(2 * q->radius, DBL_MAX);
-  if (oc_erode_check(q->radius, q->spacing, q->beta, q->strength, q->cutoff,
-                     q->steps, q->threshold, err))
-    return err ? err->code : OC_EINVAL;
+  if (q->erode.radius == 0) q->erode.radius = q->range;
+  if (q->erode.spacing == 0) q->erode.spacing = q->erode.radius / 2;
+  if (q->reach == 0) q->reach = fmin(2 * q->erode.radius, DBL_MAX);
+  if (oc_erode_check(&q->erode, err)) return err ? err->code : OC_EINVAL;
   if (!(q->reach > 0 && isfinite(q->reach)))
     return oc_seterr(err, OC_EINVAL, "'reach' must be > 0 (got %g)", q->reach);
   if (p->rays < 0 || p->rays > 4096)
@@ -118,17 +118,16 @@ oc_node *oc_generate_sea(const oc_gen_sea_params *pin, oc_gen_sea_stats *st,
                          oc_error *err) {
   oc_gen_sea_params p;
   if (check(pin, &p, err)) return NULL;
-  oc_heightfield *hf = p.heightfield, *dist = NULL;
+  oc_heightfield *hf = p.erode.heightfield, *dist = NULL;
   unsigned char *mask = NULL;
   double cell = oc_heightfield_cell(hf), *xy = NULL;
   oc_erode_cand *cand = NULL;
   oc_node *base = NULL, *out = NULL;
   size_t ncol = 0, nc = 0;
-  double T = p.threshold > 0 ? p.threshold : OC_DEFAULT_THRESHOLD;
   coast C = {hf, NULL, p.sea_level - p.range, p.sea_level + p.range, p.reach};
   oc_error e2 = {OC_OK, ""};
 
-  if (!(base = oc_erode_base(hf, p.terrain, err))) return NULL;
+  if (!(base = oc_erode_base(hf, p.erode.terrain, err))) return NULL;
   /* No sample at or below the band: no cliff to reach, only the band. */
   dist = oc_hf_distance_to_level(hf, C.hi, &e2);
   if (!dist && e2.code != OC_EINVAL) {
@@ -137,10 +136,10 @@ oc_node *oc_generate_sea(const oc_gen_sea_params *pin, oc_gen_sea_stats *st,
   }
   C.dist = dist;
   if (!(mask = coast_mask(&C, err))) goto done;
-  xy = oc_erode_columns(hf, mask, p.spacing, p.seed, keep_column, &C,
-                        p.progress, 0.05, &ncol, err);
+  xy = oc_erode_columns(hf, mask, p.erode.spacing, p.erode.seed, keep_column,
+                        &C, p.erode.progress, 0.05, &ncol, err);
   if (!xy) goto done;
-  if (p.progress.fn && p.progress.fn(p.progress.ud, 0.1)) {
+  if (p.erode.progress.fn && p.erode.progress.fn(p.erode.progress.ud, 0.1)) {
     oc_seterr(err, OC_ECANCEL, "sea erosion cancelled");
     goto done;
   }
@@ -153,14 +152,12 @@ oc_node *oc_generate_sea(const oc_gen_sea_params *pin, oc_gen_sea_stats *st,
     nc += make_cand(&C, &p, cell, xy[2 * i], xy[2 * i + 1], &cand[nc]);
 
   oc_erode_params ep;
-  oc_erode_common com = {p.radius, p.strength, p.beta,
-                         p.cutoff, p.steps,    p.seed};
-  oc_erode_shared(&ep, base, p.no_terrain, p.geology, T, hf, &com, p.progress);
+  oc_erode_shared(&ep, base, hf, &p.erode);
   ep.sea_level = p.sea_level;
   ep.range = p.range;
   ep.alpha = p.rays > 0 ? hf : NULL;
   ep.rays = p.rays;
-  ep.reach = 8 * p.radius;
+  ep.reach = 8 * p.erode.radius;
   ep.pbase = 0.1;
   ep.pspan = 0.9;
   out = oc_erode_run(&ep, cand, nc, st, err);

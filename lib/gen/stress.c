@@ -434,26 +434,23 @@ oc_node *oc_erode_base(oc_heightfield *hf, oc_node *terrain, oc_error *err) {
     oc_node_retain(terrain);
     return terrain;
   }
-  oc_elevation src;
-  if (oc_heightfield_elevation(hf, &src, err) != OC_OK) return NULL;
-  oc_terrain_params tp;
-  memset(&tp, 0, sizeof tp);
-  tp.falloff = 4 * oc_heightfield_cell(hf);
-  oc_node *t = oc_terrain(&src, &tp, err);
-  src.release(src.ud);
-  return t;
+  return oc_heightfield_terrain(hf, NULL, err);
 }
 
-void oc_erode_shared(oc_erode_params *ep, oc_node *base, int omit_base,
-                     oc_node *geology, double threshold,
-                     const oc_heightfield *hf, const oc_erode_common *c,
-                     oc_progress progress) {
+void oc_gen_erode_defaults(oc_gen_erode_params *e) {
+  memset(e, 0, sizeof *e);
+  e->beta = 0.2;
+  e->cutoff = 0.05;
+}
+
+void oc_erode_shared(oc_erode_params *ep, oc_node *base,
+                     const oc_heightfield *hf, const oc_gen_erode_params *c) {
   memset(ep, 0, sizeof *ep);
   ep->base = base;
-  ep->omit_base = omit_base;
-  ep->geology = geology;
+  ep->omit_base = c->no_terrain;
+  ep->geology = c->geology;
   ep->rho = 0.5;
-  ep->threshold = threshold > 0 ? threshold : OC_DEFAULT_THRESHOLD;
+  ep->threshold = c->threshold > 0 ? c->threshold : OC_DEFAULT_THRESHOLD;
   ep->radius = c->radius;
   ep->strength = c->strength;
   ep->beta = c->beta;
@@ -463,27 +460,34 @@ void oc_erode_shared(oc_erode_params *ep, oc_node *base, int omit_base,
   ep->span = cell * (hypot(oc_heightfield_nx(hf), oc_heightfield_ny(hf)) + 1);
   ep->steps = c->steps;
   ep->seed = c->seed;
-  ep->progress = progress;
+  ep->progress = c->progress;
 }
 
-int oc_erode_check(double radius, double spacing, double beta, double strength,
-                   double cutoff, int steps, double threshold, oc_error *err) {
+int oc_erode_check(const oc_gen_erode_params *c, oc_error *err) {
+  double radius = c->radius, spacing = c->spacing, beta = c->beta;
+  double strength = c->strength, cutoff = c->cutoff, threshold = c->threshold;
+  int steps = c->steps;
+  char b[OC_NUMSTR];
   if (!(radius > 0 && isfinite(radius)))
-    return oc_seterr(err, OC_EINVAL, "'radius' must be > 0 (got %g)", radius);
+    return oc_seterr(err, OC_EINVAL, "'radius' must be > 0 (got %s)",
+                     oc_numstr(radius, b));
   if (!(spacing > 0 && isfinite(spacing)))
-    return oc_seterr(err, OC_EINVAL, "'spacing' must be > 0 (got %g)", spacing);
+    return oc_seterr(err, OC_EINVAL, "'spacing' must be > 0 (got %s)",
+                     oc_numstr(spacing, b));
   if (!(beta >= 0 && beta <= 1))
-    return oc_seterr(err, OC_EINVAL, "'beta' must be in [0, 1] (got %g)", beta);
+    return oc_seterr(err, OC_EINVAL, "'beta' must be in [0, 1] (got %s)",
+                     oc_numstr(beta, b));
   if (!(strength > 0 && isfinite(strength)))
-    return oc_seterr(err, OC_EINVAL, "'strength' must be > 0 (got %g)",
-                     strength);
+    return oc_seterr(err, OC_EINVAL, "'strength' must be > 0 (got %s)",
+                     oc_numstr(strength, b));
   if (!(cutoff >= 0 && isfinite(cutoff)))
-    return oc_seterr(err, OC_EINVAL, "'cutoff' must be >= 0 (got %g)", cutoff);
+    return oc_seterr(err, OC_EINVAL, "'cutoff' must be >= 0 (got %s)",
+                     oc_numstr(cutoff, b));
   if (steps < 1 || steps > 64)
     return oc_seterr(err, OC_EINVAL, "'steps' must be in 1..64 (got %d)",
                      steps);
   if (!(threshold >= 0 && isfinite(threshold)))
-    return oc_seterr(err, OC_EINVAL, "'threshold' must be > 0 (got %g)",
-                     threshold);
+    return oc_seterr(err, OC_EINVAL, "'threshold' must be > 0 (got %s)",
+                     oc_numstr(threshold, b));
   return OC_OK;
 }

@@ -25,11 +25,7 @@ extern "C" {
 int oc_infile_open(const char *path, FILE **fp, const char **format,
                    oc_error *err);
 
-/* The SHA-256 of the regular file `path` as lowercase hex (core/sha256.h)
-** in `hex` (OC_SHA256_HEX bytes), for provenance. Refuses what
-** oc_infile_open refuses (FIFOs, devices, folders) without blocking, but
-** takes any content. OC_OK, or OC_EIO with a message naming the path. */
-int oc_infile_sha256(const char *path, char *hex, oc_error *err);
+/* oc_infile_sha256, the hash of such a file, is declared in outcrop.h. */
 
 #ifdef __cplusplus
 }

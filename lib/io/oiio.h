@@ -71,13 +71,7 @@ int oc_oiio_write_at(int dirfd, const char *name, const oc_oiio_out *im,
 ** error of oc_image_new for images too large. */
 oc_image *oc_oiio_read(const char *path, oc_error *err);
 
-/* Read access to an image's metadata, for the writer and the reader's
-** tests (defined in render/image.c; not in outcrop.h yet). Keys compare
-** without case. */
-size_t oc_image_meta_count(const oc_image *img);
-const char *oc_image_meta_key(const oc_image *img, size_t i);
-const char *oc_image_meta_value(const oc_image *img, size_t i);
-const char *oc_image_meta_get(const oc_image *img, const char *key);
+/* (oc_image_meta_count, _key, _value and _get are in outcrop.h.) */
 
 #ifdef __cplusplus
 }

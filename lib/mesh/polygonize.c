@@ -61,16 +61,19 @@ static int setup(const oc_program *prog, const oc_polygonize_params *pp,
                        lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
   memset(g, 0, sizeof *g);
   g->prog = prog;
-  if (pp->cell != 0) {
-    if (!(pp->cell > 0) || !isfinite(pp->cell))
-      return oc_seterr(err, OC_EINVAL, "'cell' must be > 0 (got %g)", pp->cell);
+  double cell = pp->cell;
+  if (cell == 0 && pp->nx == 0 && pp->ny == 0 && pp->nz == 0)
+    cell = oc_polygonize_default_cell(pp->box);
+  if (cell != 0) {
+    if (!(cell > 0) || !isfinite(cell))
+      return oc_seterr(err, OC_EINVAL, "'cell' must be > 0 (got %g)", cell);
     for (int a = 0; a < 3; a++) {
-      double n = (hi[a] - lo[a]) / pp->cell;
+      double n = (hi[a] - lo[a]) / cell;
       n = ceil(n * (1 - 1e-12)); /* 127.5 / 0.25 is 510 cells, not 511 */
       if (!(n <= MAX_AXIS))
         return oc_seterr(err, OC_EINVAL,
                          "'cell' %g gives %.0f cells along %c (at most %d)",
-                         pp->cell, n, "xyz"[a], MAX_AXIS);
+                         cell, n, "xyz"[a], MAX_AXIS);
       g->n[a] = n < 1 ? 1 : (int)n;
     }
   } else {
@@ -383,4 +386,31 @@ oc_mesh *oc_polygonize(const oc_program *prog, const oc_polygonize_params *pp,
                              pp->warning_size);
   }
   return m;
+}
+
+int oc_polygonize_default_box(const oc_program *prog, oc_aabb *box,
+                              oc_error *err) {
+  if (!prog || !box)
+    return oc_seterr(err, OC_EINVAL, "polygonize needs a program and a box");
+  oc_aabb b = oc_program_bounds(prog);
+  const double lo[3] = {b.lo.x, b.lo.y, b.lo.z};
+  const double hi[3] = {b.hi.x, b.hi.y, b.hi.z};
+  for (int k = 0; k < 3; k++)
+    if (lo[k] > hi[k])
+      return oc_seterr(err, OC_EINVAL,
+                       "the node's bounds are empty (its field is 0 "
+                       "everywhere): give 'box' = {x0, y0, z0, x1, y1, z1}");
+  for (int k = 0; k < 3; k++)
+    if (!isfinite(lo[k]) || !isfinite(hi[k]))
+      return oc_seterr(err, OC_EINVAL,
+                       "the node's bounds are infinite: give 'box' = "
+                       "{x0, y0, z0, x1, y1, z1}");
+  *box = b;
+  return OC_OK;
+}
+
+double oc_polygonize_default_cell(oc_aabb box) {
+  double longest =
+      fmax(fmax(box.hi.x - box.lo.x, box.hi.y - box.lo.y), box.hi.z - box.lo.z);
+  return fmax(longest, 0) / OC_POLYGONIZE_DEFAULT_RESOLUTION;
 }

@@ -11,7 +11,7 @@
 
 void oc_render_defaults(oc_render_params *rp) {
   static const oc_render_params d = {
-      .camera = {{0, -100, 50}, {0, 0, 0}, {0, 0, 1}, 45},
+      .camera = {{0, -100, 50}, {0, 0, 0}, {0, 0, 1}, 40},
       .width = 640,
       .height = 360,
       .sun_direction = {-0.5, -0.4, 0.77},
@@ -57,10 +57,11 @@ static int check_camera(const oc_camera *c, oc_error *err) {
     return oc_seterr(err, OC_EINVAL,
                      "'camera.up' must be non-zero and not parallel to the "
                      "view direction");
+  char b[OC_NUMSTR];
   if (!(c->fov > 0 && c->fov <= 179))
     return oc_seterr(err, OC_EINVAL,
-                     "'camera.fov' must be in (0, 179] degrees (got %g)",
-                     c->fov);
+                     "'camera.fov' must be in (0, 179] degrees (got %s)",
+                     oc_numstr(c->fov, b));
   return OC_OK;
 }
 
@@ -152,10 +153,11 @@ int oc_render_check_shade(const oc_render_params *rp, oc_error *err) {
   if (!color_ok(rp->sun_color, 3, 1e6))
     return oc_seterr(err, OC_EINVAL,
                      "'sun.color' components must be finite and >= 0");
+  char b[OC_NUMSTR];
   if (!(rp->sun_intensity >= 0) || isinf(rp->sun_intensity))
     return oc_seterr(err, OC_EINVAL,
-                     "'sun.intensity' must be finite and >= 0 (got %g)",
-                     rp->sun_intensity);
+                     "'sun.intensity' must be finite and >= 0 (got %s)",
+                     oc_numstr(rp->sun_intensity, b));
   if (!color_ok(rp->sky, 3, 1e6))
     return oc_seterr(err, OC_EINVAL,
                      "'sky' components must be finite and >= 0");
@@ -196,4 +198,10 @@ int oc_render_check_shade(const oc_render_params *rp, oc_error *err) {
   }
   return oc_seterr(err, OC_EINVAL, "'color' source is unknown (%d)",
                    (int)rp->color);
+}
+
+int oc_render_check(const oc_program *prog, const oc_render_params *rp,
+                    oc_error *err) {
+  int rc = oc_render_check_geometry(prog, rp, err);
+  return rc ? rc : oc_render_check_shade(rp, err);
 }

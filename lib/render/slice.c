@@ -1,6 +1,8 @@
 /*
 ** slice.c — oc_slice: the field sampled on an axis-aligned plane, as a
-** colour map with the surface f = T drawn in black, plus the raw values.
+** colour map with the surface f = T drawn in black, plus the raw values;
+** the default window (the program's bounds) and recolouring through a
+** palette.
 **
 ** Two passes over rows: the field first (stored in the image's "field"
 ** channel), then colours, which need each pixel's four neighbours. Each
@@ -153,4 +155,42 @@ oc_image *oc_slice(const oc_program *prog, const oc_slice_params *sp,
     }
   }
   return img;
+}
+
+int oc_slice_default_window(const oc_program *prog, oc_slice_params *sp,
+                            oc_error *err) {
+  if (!prog) return oc_seterr(err, OC_EINVAL, "'program' is NULL");
+  if (!sp) return oc_seterr(err, OC_EINVAL, "slice parameters are NULL");
+  oc_aabb b = oc_program_bounds(prog);
+  double lo[3] = {b.lo.x, b.lo.y, b.lo.z}, hi[3] = {b.hi.x, b.hi.y, b.hi.z};
+  int u = sp->plane == OC_PLANE_YZ ? 1 : 0;
+  int v = sp->plane == OC_PLANE_XY ? 1 : 2;
+  if (!(isfinite(lo[u]) && isfinite(lo[v]) && isfinite(hi[u]) &&
+        isfinite(hi[v])))
+    return oc_seterr(err, OC_EINVAL,
+                     "the node's bounds are infinite: give 'box' = "
+                     "{u0, v0, u1, v1}");
+  sp->u0 = lo[u], sp->v0 = lo[v], sp->u1 = hi[u], sp->v1 = hi[v];
+  return OC_OK;
+}
+
+int oc_slice_apply_palette(oc_image *img, const double *stops, int n,
+                           oc_error *err) {
+  if (!img) return oc_seterr(err, OC_EINVAL, "'image' is NULL");
+  if (oc_image_channels(img) != NCH)
+    return oc_seterr(err, OC_EINVAL,
+                     "'image' must be a slice (%d channels, got %d)", NCH,
+                     oc_image_channels(img));
+  int rc = oc_palette_check(stops, n, err);
+  if (rc) return rc;
+  float *px = oc_image_data(img);
+  size_t npx = (size_t)oc_image_width(img) * (size_t)oc_image_height(img);
+  for (size_t i = 0; i < npx; i++) {
+    float *q = px + i * NCH;
+    double rgb[3];
+    oc_palette_eval(stops, n, q[FIELD], rgb);
+    q[0] = (float)rgb[0], q[1] = (float)rgb[1], q[2] = (float)rgb[2];
+    q[3] = 1;
+  }
+  return OC_OK;
 }

@@ -26,6 +26,7 @@ int main(void) {
   oc_gen_hoodoos_params p;
   oc_gen_hoodoos_defaults(&p, hf);
   p.geology = geo;
+  p.no_terrain = 1; /* the hoodoos alone, as measured before */
   p.radius = 6.5;
   p.seed = 1;
   double best = 1e30;

@@ -56,12 +56,13 @@ static double run(oc_heightfield *hf, oc_node *geo, int threads,
   oc_error err;
   oc_gen_sea_params p;
   oc_gen_sea_defaults(&p);
-  p.heightfield = hf;
-  p.geology = geo;
-  p.seed = 2026;
+  p.erode.heightfield = hf;
+  p.erode.geology = geo;
+  p.erode.seed = 2026;
+  p.sea_level = 0; /* as before the default followed the grid */
   p.range = 8;
-  p.radius = 8;
-  p.spacing = 3.7;
+  p.erode.radius = 8;
+  p.erode.spacing = 3.7;
   omp_set_num_threads(threads);
   double t0 = omp_get_wtime();
   oc_node *n = must(oc_generate_sea(&p, st, &err), &err);

@@ -340,9 +340,27 @@ START_TEST(test_counts_match_tree) {
   oc_node_release(n);
   /* without the terrain: the hoodoos alone */
   p.terrain = NULL;
+  p.no_terrain = 1;
   n = oc_generate_hoodoos(&p, &st, &err);
   ck_assert_ptr_nonnull(n);
   ck_assert_uint_eq(oc_node_child_count(n), st.primitives);
+  oc_node_release(n);
+  /* terrain NULL: the default terrain of the grid comes first, the node
+  ** oc_heightfield_terrain makes (the Lua API's default) */
+  p.no_terrain = 0;
+  n = oc_generate_hoodoos(&p, &st, &err);
+  ck_assert_ptr_nonnull(n);
+  ck_assert_uint_eq(oc_node_child_count(n), st.primitives + 1);
+  oc_node *dt = oc_heightfield_terrain(hf, NULL, &err);
+  oc_program *p1 = oc_compile(oc_node_child(n, 0), NULL, NULL);
+  oc_program *p2 = oc_compile(dt, NULL, NULL);
+  for (int k = 0; k < 20; k++) {
+    oc_vec3 q = {3.0 * k, 2.5 * k, -1 + 0.5 * k};
+    ck_assert_double_eq(oc_program_eval(p1, q), oc_program_eval(p2, q));
+  }
+  oc_program_free(p1);
+  oc_program_free(p2);
+  oc_node_release(dt);
   oc_node_release(n);
   oc_node_release(ter);
   oc_heightfield_release(hf);
@@ -415,6 +433,7 @@ START_TEST(test_errors) {
   EXPECT_ERR(OC_ECANCEL, "");
   p = d;
   p.probability = 0;
+  p.no_terrain = 1; /* else the default terrain alone comes back */
   oc_error e;
   ck_assert_ptr_null(oc_generate_hoodoos(&p, NULL, &e));
   ck_assert_int_eq(e.code, OC_EINVAL);

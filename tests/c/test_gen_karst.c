@@ -273,10 +273,18 @@ START_TEST(node_carves) {
   ck_assert_double_eq(oc_program_eval(pr, q), oc_program_eval(pt, q));
   /* the cavities alone: a blend of points */
   p.terrain = NULL;
+  p.no_terrain = 1;
   oc_node *k2 = OCT_OK(oc_generate_karst(&p, NULL, NULL));
   ck_assert_uint_eq(oc_node_child_count(k2), n);
   ck_assert_str_eq(oc_node_kind(oc_node_child(k2, 0)), "point");
   oc_node_release(k2);
+  /* terrain NULL without no_terrain: the grid's default terrain first */
+  p.no_terrain = 0;
+  oc_node *k3 = OCT_OK(oc_generate_karst(&p, NULL, NULL));
+  ck_assert_uint_eq(oc_node_child_count(k3), n + 1);
+  ck_assert_str_eq(oc_node_kind(oc_node_child(k3, 0)), oc_node_kind(terr));
+  ck_assert_str_eq(oc_node_kind(oc_node_child(k3, 1)), "point");
+  oc_node_release(k3);
   free(c);
   oc_program_free(pr);
   oc_program_free(pt);
@@ -324,7 +332,7 @@ START_TEST(errors) {
   s[1] = (oc_vec3){128, NAN, 0};
   q = p, q.sinks = s, q.nsinks = 2, einval(q, "'sinks'[2]");
   /* nothing carved and no terrain: an error, not an empty blend */
-  q = p, q.rho0 = 1e-9, q.epsilon = 0;
+  q = p, q.rho0 = 1e-9, q.epsilon = 0, q.no_terrain = 1;
   oc_error err = {OC_OK, ""};
   ck_assert_ptr_null(oc_generate_karst(&q, NULL, &err));
   ck_assert_int_eq(err.code, OC_EINVAL);

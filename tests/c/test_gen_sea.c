@@ -35,13 +35,13 @@ static oc_heightfield *cliff(void) {
 static oc_gen_sea_params sea_params(oc_heightfield *hf, uint64_t seed) {
   oc_gen_sea_params p;
   oc_gen_sea_defaults(&p);
-  p.heightfield = hf;
-  p.seed = seed;
+  p.erode.heightfield = hf;
+  p.erode.seed = seed;
   p.range = 4;
-  p.radius = 3;
-  p.spacing = 1.5;
-  p.steps = 2;
-  p.strength = 4;
+  p.erode.radius = 3;
+  p.erode.spacing = 1.5;
+  p.erode.steps = 2;
+  p.erode.strength = 4;
   return p;
 }
 
@@ -94,7 +94,7 @@ START_TEST(sea_deterministic) {
   oc_program *a = sea_prog(&p, &s1);
   omp_set_num_threads(2);
   oc_program *b = sea_prog(&p, &s2);
-  p.seed = 8;
+  p.erode.seed = 8;
   oc_program *c = sea_prog(&p, &s3);
   ck_assert_uint_eq(s1.primitives, s2.primitives);
   ck_assert_uint_eq(s1.samples, s2.samples);
@@ -122,7 +122,7 @@ START_TEST(sea_carves_near_sea_level_only) {
     p.sea_level = k ? 6 : 0;
     oc_gen_sea_stats st;
     oc_program *e = sea_prog(&p, &st), *t = terrain_prog(hf);
-    double band = p.range + p.radius;
+    double band = p.range + p.erode.radius;
     oct_rng r = oct_rng_new(5);
     int near = 0, removed = 0;
     for (int i = 0; i < 40000; i++) {
@@ -156,11 +156,11 @@ START_TEST(sea_soft_rock_and_steps) {
   oc_node *geo =
       OCT_OK(oc_box(oct_v(60, -1e3, -1e3), oct_v(1e3, 1e3, 1e3), 0.5, 1, &err));
   oc_gen_sea_params p = sea_params(hf, 3);
-  p.geology = geo;
-  p.steps = 1;
+  p.erode.geology = geo;
+  p.erode.steps = 1;
   oc_gen_sea_stats st;
   oc_program *t = terrain_prog(hf), *e1 = sea_prog(&p, &st);
-  p.steps = 3;
+  p.erode.steps = 3;
   oc_program *e3 = sea_prog(&p, &st);
   int soft1 = carved(t, e1, 4, 56, -4, 4),
       hard1 = carved(t, e1, 64, 116, -4, 4);
@@ -220,9 +220,9 @@ START_TEST(river_follows_stream_power) {
   ck_assert(channel > 20); /* the V channel holds high stream power */
   oc_gen_river_params p;
   oc_gen_river_defaults(&p);
-  p.heightfield = hf;
-  p.seed = 4;
-  p.radius = 2;
+  p.erode.heightfield = hf;
+  p.erode.seed = 4;
+  p.erode.radius = 2;
   oc_gen_sea_stats st, st2;
   omp_set_num_threads(1);
   oc_node *n = oc_generate_river(&p, &st, &err);
@@ -233,7 +233,8 @@ START_TEST(river_follows_stream_power) {
   ck_assert_uint_eq(st.primitives, st2.primitives);
   /* columns reach banks cells past the bed (rounded to the nearest
   ** sample), rays go up to steps R + cell further, spheres R around */
-  double reach = p.banks + 0.75 + p.steps * p.radius + 1 + p.radius;
+  double reach =
+      p.banks + 0.75 + p.erode.steps * p.erode.radius + 1 + p.erode.radius;
   oct_rng r = oct_rng_new(9);
   int bed = 0, far = 0;
   for (int i = 0; i < 40000; i++) {
@@ -272,40 +273,40 @@ START_TEST(parameter_errors) {
   oc_gen_sea_params p = sea_params(hf, 1), q;
   oc_gen_sea_stats st;
   q = p;
-  q.heightfield = NULL;
+  q.erode.heightfield = NULL;
   OCT_EINVAL(oc_generate_sea(&q, &st, &err), err, "heightfield");
   q = p;
   q.range = 0;
   OCT_EINVAL(oc_generate_sea(&q, &st, &err), err, "range");
   q = p;
-  q.sea_level = NAN;
+  q.sea_level = INFINITY; /* NaN is the default, not an error */
   OCT_EINVAL(oc_generate_sea(&q, &st, &err), err, "sea_level");
   q = p;
-  q.beta = 1.5;
+  q.erode.beta = 1.5;
   OCT_EINVAL(oc_generate_sea(&q, &st, &err), err, "beta");
   q = p;
-  q.steps = 0;
+  q.erode.steps = 0;
   OCT_EINVAL(oc_generate_sea(&q, &st, &err), err, "steps");
   q = p;
-  q.radius = -1;
+  q.erode.radius = -1;
   OCT_EINVAL(oc_generate_sea(&q, &st, &err), err, "radius");
   q = p;
   q.rays = -2;
   OCT_EINVAL(oc_generate_sea(&q, &st, &err), err, "rays");
   q = p;
-  q.cutoff = NAN;
+  q.erode.cutoff = NAN;
   OCT_EINVAL(oc_generate_sea(&q, &st, &err), err, "cutoff");
   q = p;
-  q.spacing = 1e-6; /* would need billions of columns */
+  q.erode.spacing = 1e-6; /* would need billions of columns */
   ck_assert_ptr_null(oc_generate_sea(&q, &st, &err));
   ck_assert_int_eq(err.code, OC_ENOMEM);
   ck_assert_ptr_nonnull(strstr(err.msg, "'spacing'"));
 
   oc_gen_river_params r, s;
   oc_gen_river_defaults(&r);
-  r.heightfield = hf;
+  r.erode.heightfield = hf;
   s = r;
-  s.heightfield = NULL;
+  s.erode.heightfield = NULL;
   OCT_EINVAL(oc_generate_river(&s, &st, &err), err, "heightfield");
   s = r;
   s.banks = -1;
@@ -317,8 +318,8 @@ START_TEST(parameter_errors) {
   s.depth = -3;
   OCT_EINVAL(oc_generate_river(&s, &st, &err), err, "depth");
   s = r;
-  s.strength = 0;
-  s.radius = 1;
+  s.erode.strength = 0;
+  s.erode.radius = 1;
   OCT_EINVAL(oc_generate_river(&s, &st, &err), err, "strength");
   oc_heightfield_release(hf);
 }
@@ -332,7 +333,7 @@ START_TEST(primitives_alone) {
   oc_gen_sea_params p = sea_params(hf, 21);
   oc_gen_sea_stats s1, s2;
   oc_program *full = sea_prog(&p, &s1), *t = terrain_prog(hf);
-  p.no_terrain = 1;
+  p.erode.no_terrain = 1;
   oc_node *n = oc_generate_sea(&p, &s2, &err);
   ck_assert_ptr_nonnull(n);
   ck_assert_uint_eq(oc_node_child_count(n), s2.primitives);
@@ -347,7 +348,7 @@ START_TEST(primitives_alone) {
                             oc_program_eval(full, q), 1e-12);
   }
   /* nothing reaches an impossible cutoff: an error, not an empty blend */
-  p.cutoff = 2;
+  p.erode.cutoff = 2;
   OCT_EINVAL(oc_generate_sea(&p, &s2, &err), err, "cutoff");
   oc_program_free(full);
   oc_program_free(alone);
@@ -366,7 +367,7 @@ START_TEST(cancel) {
   oc_error err;
   oc_heightfield *hf = cliff();
   oc_gen_sea_params p = sea_params(hf, 1);
-  p.progress = (oc_progress){cancel_at, NULL};
+  p.erode.progress = (oc_progress){cancel_at, NULL};
   ck_assert_ptr_null(oc_generate_sea(&p, NULL, &err));
   ck_assert_int_eq(err.code, OC_ECANCEL);
   oc_heightfield_release(hf);

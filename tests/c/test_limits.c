@@ -41,9 +41,9 @@ static void river(oc_heightfield *hf, double spacing, double radius,
   oc_gen_sea_stats st;
   oc_gen_river_params r;
   oc_gen_river_defaults(&r);
-  r.heightfield = hf;
-  r.spacing = spacing;
-  r.radius = radius;
+  r.erode.heightfield = hf;
+  r.erode.spacing = spacing;
+  r.erode.radius = radius;
   r.depth = depth;
   node_or_error(oc_generate_river(&r, &st, &err), &err, field);
 }
@@ -59,8 +59,8 @@ START_TEST(erosion_huge_spacing) {
     river(hf, odd[k], 0, 0, "'spacing'");
     oc_gen_sea_params s;
     oc_gen_sea_defaults(&s);
-    s.heightfield = hf;
-    s.spacing = odd[k];
+    s.erode.heightfield = hf;
+    s.erode.spacing = odd[k];
     node_or_error(oc_generate_sea(&s, &st, &err), &err, "'spacing'");
   }
   oc_heightfield_release(hf);
@@ -166,10 +166,10 @@ START_TEST(erosion_primitive_budget) {
   oc_gen_sea_stats st;
   oc_gen_river_params r;
   oc_gen_river_defaults(&r);
-  r.heightfield = hf;
+  r.erode.heightfield = hf;
   r.banks = 64; /* the whole valley is bank */
-  r.spacing = 0.04;
-  r.steps = 64;
+  r.erode.spacing = 0.04;
+  r.erode.steps = 64;
   double t0 = omp_get_wtime();
   ck_assert_ptr_null(oc_generate_river(&r, &st, &err));
   ck_assert_int_eq(err.code, OC_ENOMEM);
@@ -224,14 +224,14 @@ START_TEST(erosion_cancels_at_every_poll) {
       oc_progress pr = {cancel_at, &left};
       oc_gen_river_params r;
       oc_gen_river_defaults(&r);
-      r.heightfield = hf;
+      r.erode.heightfield = hf;
       r.banks = 64;
-      r.progress = pr;
+      r.erode.progress = pr;
       oc_gen_sea_params q;
       oc_gen_sea_defaults(&q);
-      q.heightfield = hf;
+      q.erode.heightfield = hf;
       q.sea_level = 4;
-      q.progress = pr;
+      q.erode.progress = pr;
       oc_node *nd = sea ? oc_generate_sea(&q, &st, &err)
                         : oc_generate_river(&r, &st, &err);
       if (nd) {

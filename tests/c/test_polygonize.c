@@ -862,6 +862,7 @@ START_TEST(bad_params) {
   pp.cell = 1e-9; /* 2e9 cells per axis */
   expect_fail(pr, &pp, OC_EINVAL, "'cell'");
   pp = params(box, 0);
+  pp.nx = 4; /* some but not all given */
   expect_fail(pr, &pp, OC_EINVAL, "'resolution'");
   pp.nx = pp.ny = 10, pp.nz = (1 << 20) + 1;
   expect_fail(pr, &pp, OC_EINVAL, "'resolution'");
