@@ -17,8 +17,10 @@
 ** the pixel-footprint tolerance of trace.c, and count a hit at the first
 ** sample on or below the surface (where the weight allows one), located
 ** by regula falsi between it and the sample before. A hole's edge (where
-** the weight falls below T) is not bounded by the slopes: a ray passing
-** under a hole and into the ground meets its wall within one step.
+** the weight falls below T) is not bounded by the slopes: over a hole the
+** steps are the slopes' as elsewhere (a ray may cross an edge within one
+** step), and under its surface the tolerance, so that a ray passing under
+** a hole meets its wall within that.
 */
 #include <math.h>
 
@@ -110,14 +112,15 @@ static double refine(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double a,
 
 /* The step from a sample at height h that the slope bound lam proves free
 ** of the surface on a candidate segment of length e. Under the surface
-** (h <= 0, in a hole) the bound keeps the ray from rising through it. */
+** (h <= 0, in a hole) nothing bounds the distance to the hole's wall: the
+** ray goes on by the tolerance. */
 static double safe_step(double h, double uz, double uxy, double lam, double e) {
   if (h > 0) {
     double k = uz - uxy * lam;
     return k >= 0 ? e : fmin(e, h / -k);
   }
-  double k = uz + uxy * lam;
-  return k <= 0 ? e : fmin(e, -h / k);
+  (void)uz, (void)uxy, (void)lam, (void)e;
+  return 0; /* the tolerance: a hole's wall may be near */
 }
 
 static int march(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
@@ -131,9 +134,11 @@ static int march(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
     double h = height_above(tr, p, &solid, n);
     if (h != h) return 0; /* NaN: no surface can be located */
     if (solid && h <= 0) {
-      *thit = tr->refine && have_prev && hp > 0
-                  ? refine(tr, o, u, prev, hp, t, h, d0, n)
-                  : t;
+      if (!(have_prev && hp > 0)) {
+        *thit = t; /* through a side of the domain or of a hole */
+        return 2;
+      }
+      *thit = tr->refine ? refine(tr, o, u, prev, hp, t, h, d0, n) : t;
       return 1;
     }
     double s;
@@ -164,9 +169,30 @@ int oc_etrace(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0, double t1,
               double d0, double *t, double *evals) {
   *t = INFINITY;
   if (!clip(tr, o, u, &t0, &t1)) return 0;
-  if (march(tr, o, u, t0, t1, d0, t, evals)) return 1;
-  *t = INFINITY;
-  return 0;
+  int hit = march(tr, o, u, t0, t1, d0, t, evals);
+  if (!hit) *t = INFINITY;
+  return hit;
+}
+
+oc_vec3 oc_etracer_wall(const oc_etracer *tr, oc_vec3 p, oc_vec3 u) {
+  const double q[3] = {p.x, p.y, p.z};
+  double best = INFINITY;
+  oc_vec3 n = {0, 0, 0};
+  for (int k = 0; k < 3; k++)
+    for (int side = 0; side < 2; side++) {
+      double d = fabs(q[k] - (side ? tr->hi[k] : tr->lo[k]));
+      if (d < best) {
+        double c[3] = {0, 0, 0};
+        c[k] = side ? 1 : -1;
+        best = d;
+        n = (oc_vec3){c[0], c[1], c[2]};
+      }
+    }
+  /* farther from every face: a hole's wall inside the domain, which faces
+  ** the ray */
+  double span = (tr->hi[0] - tr->lo[0]) + (tr->hi[1] - tr->lo[1]);
+  if (!(best <= 1e-9 * span)) n = (oc_vec3){-u.x, -u.y, -u.z};
+  return n;
 }
 
 oc_vec3 oc_esurface_normal(const oc_esurface *s, double x, double y,

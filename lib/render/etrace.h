@@ -37,11 +37,17 @@ void oc_etracer_init(oc_etracer *tr, const oc_esurface *s,
                      oc_render_tracer mode, double eps_k, double eps_min);
 
 /* Traces o + t u (u unit) over [t0, t1]; d0 is the distance of o from the
-** eye. Returns 1 and the distance in *t on a hit, 0 on a miss (or after
+** eye. Returns 1 and the distance in *t on a hit of the surface, 2 on a
+** hit of a wall (the ray entered the solid under the surface through a
+** side of the domain's box or of a hole), 0 on a miss (or after
 ** OC_TRACE_MAX_STEPS steps); adds the height calls made to *evals.
 ** Allocation-free. */
 int oc_etrace(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0, double t1,
               double d0, double *t, double *evals);
+
+/* The outward normal of the wall hit at p by a ray along u: the nearest
+** face of the box, or -u for a hole's wall. */
+oc_vec3 oc_etracer_wall(const oc_etracer *tr, oc_vec3 p, oc_vec3 u);
 
 /* The unit upward normal at (x, y) from the height gradient: one height
 ** call, counted in *evals. */

@@ -154,7 +154,8 @@ static void geom_pixel(const gctx *g, int i, int j, float *out) {
   }
   oc_vec3 p = oc_add(g->cam.eye, oc_mul(u, t)), n;
   if (g->es) {
-    n = oc_esurface_normal(g->es, p.x, p.y, &ev);
+    n = hit == 2 ? oc_etracer_wall(&g->etr, p, u)
+                 : oc_esurface_normal(g->es, p.x, p.y, &ev);
   } else {
     oc_vec3 gr;
     oc_program_gradient(g->prog, p, &gr);
