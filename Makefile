@@ -222,6 +222,7 @@ PICTURES := demo_arch_render.png:demo:arch_render.png \
   demo_arch_xz.png:demo:arch_xz.png \
   example_canyon.png:canyon:canyon.png \
   example_floating_islands.png:floating_islands:floating_islands.png \
+  example_hf_render.png:hf_render:hf_render.png \
   example_hoodoos.png:hoodoos:hoodoos.png \
   example_karst.png:karst:karst_network.png \
   example_karst_cut.png:karst:karst.png \
