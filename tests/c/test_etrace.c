@@ -336,6 +336,25 @@ START_TEST(render_heightfield) {
 }
 END_TEST
 
+static int stop_now(void *ud, double done) {
+  (void)done;
+  ++*(int *)ud;
+  return 1;
+}
+
+START_TEST(cancelled) {
+  oc_elevation src = wave_source();
+  oc_render_params rp = view(oct_v(-600, -700, 300), oct_v(0, 0, 0), 64, 64);
+  int calls = 0;
+  rp.progress.fn = stop_now;
+  rp.progress.ud = &calls;
+  oc_error e;
+  ck_assert_ptr_null(oc_render_elevation(&src, &rp, NULL, &e));
+  ck_assert_int_eq(e.code, OC_ECANCEL);
+  ck_assert(calls >= 1);
+}
+END_TEST
+
 START_TEST(bad_sources) {
   oc_render_params rp = view(oct_v(-600, -700, 300), oct_v(0, 0, 0), 8, 8);
   oc_error e;
@@ -367,6 +386,7 @@ static Suite *suite(void) {
   t = tcase_create("rendering");
   tcase_set_timeout(t, 300);
   tcase_add_test(t, render_heightfield);
+  tcase_add_test(t, cancelled);
   tcase_add_test(t, bad_sources);
   suite_add_tcase(s, t);
   return s;

@@ -103,6 +103,16 @@ describe("outcrop.render of a heightfield", function()
     assert.are.equal(1, select(4, img:get(8, 5)))
   end)
 
+  it("keeps the grid alive while a colour function closes it", function()
+    local doomed = hills()
+    local img = oc.render(doomed, {size = {16, 9}, color = function()
+      do local _ <close> = doomed end -- deferred: the render pins it
+      return 0.5, 0.5, 0.5
+    end})
+    assert.are.equal(1, select(4, img:get(8, 5)))
+    R.check_error(function() oc.render(doomed, {size = {4, 4}}) end, F, "outcrop.render", "closed")
+  end)
+
   it("is the same across calls", function()
     local a = oc.render(hf, {size = {24, 16}})
     local b = oc.render(hf, {size = {24, 16}})
