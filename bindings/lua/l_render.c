@@ -4,7 +4,9 @@
 ** outcrop.render(heightfield, {...}), the surface z = h(x, y) traced
 ** directly (lib/render/etrace.c), with the same options, returning the
 ** image and the height calls made ({pixels =, hits =, calls =,
-** calls_per_pixel =, calls_total =, calls_total_per_pixel =}).
+** calls_per_pixel =, calls_total =, calls_total_per_pixel =}). For an
+** elevation surface `threshold` is the T of its weight (no surface where
+** the weight is below it); a heightfield has none, so it is unused there.
 **
 ** Defaults (the lib's, oc_render_defaults, except where said): 640 x 360;
 ** camera looking at the centre of the node's bounds (a heightfield's
