@@ -9,8 +9,10 @@
 **  - The accelerated tracer (Génevaux et al. 2015, section 7.2) takes
 **    lambda from the source's bound on that segment's box alone, skips
 **    the segment at once when the ray stays above the box's elevation
-**    range, and doubles the candidate delta after each step, so that it
-**    strides over flat ground and far from the surface.
+**    range (and, descending, up to where it comes down to the range's
+**    top, when that is farther than the slope's step), and doubles the
+**    candidate delta after each step, so that it strides over flat ground
+**    and far from the surface.
 **  - Sphere tracing (`OC_TRACE_SPHERE`, section 7.1) uses the slope bound of
 **    the whole domain for every step: the baseline the paper compares to.
 ** Both clip the ray to the domain x [min f, max f] first, never step below
@@ -135,7 +137,7 @@ static inline double greater(double a, double b) {
 static int march(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
                  double t1, double d0, double *thit, double *n) {
   const oc_elevation *src = tr->s->src;
-  double uxy = hypot(u.x, u.y), delta = t1 - t, prev = t, hp = 0;
+  double uxy = hypot(u.x, u.y), delta = (t1 - t) / 16, prev = t, hp = 0;
   int accel = tr->mode == OC_TRACE_SEGMENT, have_prev = 0;
   for (long k = 0; k < OC_TRACE_MAX_STEPS; k++) {
     oc_vec3 p = at(o, u, t);
@@ -150,7 +152,7 @@ static int march(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
       *thit = tr->refine ? refine(tr, o, u, prev, hp, t, h, d0, n) : t;
       return 1;
     }
-    double s;
+    double s, grow = -1;
     if (accel) {
       double e = lesser(delta, t1 - t);
       oc_vec3 q = at(o, u, t + e);
@@ -158,10 +160,16 @@ static int march(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
       double y0 = lesser(p.y, q.y), y1 = greater(p.y, q.y);
       double lo, hi;
       src->range(src->ud, x0, y0, x1, y1, &lo, &hi);
-      if (lesser(p.z, q.z) > hi)
+      if (lesser(p.z, q.z) > hi) {
         s = e; /* above everything the segment's box holds */
-      else
+      } else {
         s = safe_step(h, u.z, uxy, src->slope(src->ud, x0, y0, x1, y1), e);
+        /* a descending ray is free, too, until it comes down to hi (the
+        ** candidate grows from the slope's step: the range's may end
+        ** right above a slope) */
+        grow = s;
+        if (p.z > hi) s = greater(s, (p.z - hi) / -u.z);
+      }
     } else {
       s = safe_step(h, u.z, uxy, tr->L, t1 - t);
     }
@@ -169,7 +177,7 @@ static int march(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
     if (t + s > t1 || t + s == t) return 0; /* left the box */
     prev = t, hp = h, have_prev = 1;
     t += s;
-    delta = GROW * s;
+    delta = GROW * (grow >= 0 ? greater(grow, tol(tr, d0, t)) : s);
   }
   return 0;
 }
