@@ -187,7 +187,8 @@ check-lua: $(MODULE)
 # luv's CI does: a use after free shows at once. About 6 minutes under
 # the sanitizer; heightfield_spec passes too but adds 4 more (its
 # callbacks are in hostile_spec): GC_SPECS="..." to choose.
-GC_SPECS := hostile_spec.lua gc_spec.lua mesh_spec.lua render_spec.lua
+GC_SPECS := hostile_spec.lua gc_spec.lua mesh_spec.lua render_spec.lua \
+  render_elevation_spec.lua
 
 check-lua-gc: $(MODULE)
 	@echo "== busted specs, eager collector ($(B))"
@@ -235,6 +236,7 @@ PICTURES := demo_arch_render.png:demo:arch_render.png \
   demo_arch_xz.png:demo:arch_xz.png \
   example_canyon.png:canyon:canyon.png \
   example_floating_islands.png:floating_islands:floating_islands.png \
+  example_hf_render.png:hf_render:hf_render.png \
   example_hoodoos.png:hoodoos:hoodoos.png \
   example_karst.png:karst:karst_network.png \
   example_karst_cut.png:karst:karst.png \

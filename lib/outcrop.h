@@ -561,6 +561,10 @@ void oc_render_defaults(oc_render_params *rp);
 ** parallel to the view; rp is then unchanged. */
 int oc_render_default_camera(const oc_program *prog, oc_render_params *rp,
                              int has_eye, int has_target, oc_error *err);
+/* The same framing for any bounds b (an elevation surface's: its domain x
+** its elevation range). */
+int oc_render_frame_box(oc_aabb b, oc_render_params *rp, int has_eye,
+                        int has_target, oc_error *err);
 /* Every check oc_render makes of prog and rp before it traces anything
 ** (the messages name the Lua table fields): for a caller that does work
 ** of its own between oc_render_geometry and oc_render_shade. */
@@ -993,6 +997,75 @@ typedef struct oc_elevation {
 ** retains hf. Returns OC_OK, or OC_ENOMEM with err. */
 int oc_heightfield_elevation(oc_heightfield *hf, oc_elevation *src,
                              oc_error *err);
+
+/* ---- rendering elevation surfaces (render/render.c, render/etrace.c) ---- */
+
+/* Images of the surface z = h(x, y) of an elevation source, traced
+** directly (no implicitization): the height above the surface along the
+** ray, p_z - h(p_xy), is marched with the accelerated local-Lipschitz
+** step of Génevaux et al. 2015, section 7.2 (rp->tracer =
+** OC_TRACE_SEGMENT, the default: per segment [t, t + delta] of the ray
+** the slope and elevation range of its xy box, the candidate delta
+** doubling after each step) or with plain sphere tracing on the slope
+** bound of the whole domain (OC_TRACE_SPHERE), the ray first clipped to
+** the domain x [min h, max h]. Normals are analytic (the height
+** gradient). Camera, size, shading, colours, AOVs, exposure, tone,
+** progress and the returned image are those of oc_render (threshold and
+** warning are unused: there is no iso-value and no thin solid). */
+
+typedef struct oc_render_stats {
+  long long pixels, hits;
+  double calls;           /* height calls of the primary rays, the normal
+                          ** of each hit included */
+  double calls_per_pixel; /* calls / pixels */
+  double calls_total;     /* the same with shadow rays and AO */
+  double calls_total_per_pixel;
+} oc_render_stats;
+
+/* What the renderer traces: an elevation source, and where it has holes.
+** A surface exists at (x, y) only where weight(wud, x, y) >= T (the
+** elevation trees' Omega_T); weight NULL (heightfields): everywhere on
+** the source's domain. */
+typedef struct oc_esurface {
+  const oc_elevation *src;
+  double (*weight)(void *wud, double x, double y);
+  void *wud;
+  double T;
+} oc_esurface;
+
+/* oc_render_elevation and its two phases for a surface with holes; the
+** oc_render_elevation* functions below pass none. */
+oc_image *oc_render_surface(const oc_esurface *es, const oc_render_params *rp,
+                            oc_render_stats *st, oc_error *err);
+oc_image *oc_render_surface_geometry(const oc_esurface *es,
+                                     const oc_render_params *rp, oc_error *err);
+oc_image *oc_render_surface_shade(const oc_esurface *es,
+                                  const oc_render_params *rp,
+                                  const oc_image *geometry, const float *albedo,
+                                  oc_error *err);
+/* oc_render_check for a surface: a usable source, then the tracing
+** parameters; and the shading parameters alone. */
+int oc_render_check_surface(const oc_esurface *es, const oc_render_params *rp,
+                            oc_error *err);
+int oc_render_check_shade(const oc_render_params *rp, oc_error *err);
+
+/* Traces and shades in one call; *st (when not NULL) receives the height
+** calls, summed in pixel order (the same for any thread count). NULL with
+** err as oc_render (OC_EINVAL also for a source without its functions or
+** with an empty or infinite domain). */
+oc_image *oc_render_elevation(const oc_elevation *src,
+                              const oc_render_params *rp, oc_render_stats *st,
+                              oc_error *err);
+
+/* The two phases, as oc_render_geometry and oc_render_shade (the "evals"
+** channel counts height calls). */
+oc_image *oc_render_elevation_geometry(const oc_elevation *src,
+                                       const oc_render_params *rp,
+                                       oc_error *err);
+oc_image *oc_render_elevation_shade(const oc_elevation *src,
+                                    const oc_render_params *rp,
+                                    const oc_image *geometry,
+                                    const float *albedo, oc_error *err);
 
 typedef struct oc_terrain_params {
   double falloff;    /* R > 0: the prism P = (Omega shrunk by R) x dz and

@@ -1,13 +1,20 @@
 /*
 ** l_render.c — outcrop.render(node, {...}): an image of the surface f = T
-** traced by lib/render, with every option checked before any work.
+** traced by lib/render, with every option checked before any work; and
+** outcrop.render(heightfield, {...}), the surface z = h(x, y) traced
+** directly (lib/render/etrace.c), with the same options, returning the
+** image and the height calls made ({pixels =, hits =, calls =,
+** calls_per_pixel =, calls_total =, calls_total_per_pixel =}). For an
+** elevation surface `threshold` is the T of its weight (no surface where
+** the weight is below it); a heightfield has none, so it is unused there.
 **
 ** Defaults (the lib's, oc_render_defaults, except where said): 640 x 360;
-** camera framed by oc_render_default_camera, looking at the centre of the
-** node's bounds from the south-west, 30 degrees up, just far enough for
-** the corners of the bounds to fit the view (an error when the bounds are
-** infinite and camera.eye or camera.target is missing), up = {0, 0, 1},
-** fov = 40 degrees (vertical);
+** camera framed by oc_render_default_camera (oc_render_frame_box for an
+** elevation surface: a heightfield's extent x its elevation range),
+** looking at the centre of the bounds from the south-west, 30 degrees up,
+** just far enough for the corners of the bounds to fit the view (an error
+** when the bounds are infinite and camera.eye or camera.target is
+** missing), up = {0, 0, 1}, fov = 40 degrees (vertical);
 ** sun, sky, shadows, AO and texture as the lib; no fog; the sky behind
 ** the surface; threshold = outcrop.threshold; rule colours by altitude
 ** and slope; the AOV channels (Z, N, P, evals) after R, G, B, A unless
@@ -30,6 +37,7 @@
 #include <unistd.h>
 
 #include "l_field.h"
+#include "l_heightfield.h"
 #include "l_image.h"
 #include "l_progress.h"
 #include "l_render.h"
@@ -375,6 +383,107 @@ static const float *run_colour_function(lua_State *L, int fn, const oc_image *g,
   return ac.rgb;
 }
 
+/* ---- elevation surfaces ---------------------------------------------- */
+
+#define SURFACE_MT "outcrop.render.surface"
+
+/* An elevation surface made for one render, released by the collector
+** (so that an error anywhere after it leaks nothing). */
+typedef struct lsurface {
+  oc_elevation src;
+  int has_src;
+  oc_esurface es;
+} lsurface;
+
+static int surface_gc(lua_State *L) {
+  lsurface *s = lua_touserdata(L, 1);
+  if (s->has_src && s->src.release) s->src.release(s->src.ud);
+  s->has_src = 0;
+  return 0;
+}
+
+/* Whether the value at idx is traced as an elevation surface: pins it
+** (a guard slot the caller keeps) before any option is read, so no
+** metamethod of the options can close it. */
+static int pin_surface(lua_State *L, int idx) {
+  if (!oclua_isheightfield(L, idx)) return 0;
+  oclua_pinheightfield(L, idx, FNAME);
+  return 1;
+}
+
+/* The elevation surface of the (pinned) value at idx: its source and,
+** for sources that have holes, their weight with threshold T. Pushes the
+** userdata that owns it. This is where every kind of elevation value
+** turns into an oc_esurface: heightfields now (no holes); the elevation
+** trees of issue 14 will set es.weight and es.wud to their alpha (no
+** terrain where alpha < T, the trees' Omega_T). */
+static const oc_esurface *surface_at(lua_State *L, int idx, double T) {
+  oc_heightfield *hf = oclua_checkheightfield(L, idx, FNAME);
+  lsurface *s = lua_newuserdatauv(L, sizeof *s, 0);
+  memset(s, 0, sizeof *s);
+  if (luaL_newmetatable(L, SURFACE_MT)) {
+    lua_pushcfunction(L, surface_gc);
+    lua_setfield(L, -2, "__gc");
+  }
+  lua_setmetatable(L, -2);
+  oc_error err = {OC_OK, ""};
+  if (oc_heightfield_elevation(hf, &s->src, &err) != OC_OK)
+    oclua_liberror(L, FNAME, &err);
+  s->has_src = 1;
+  s->es.src = &s->src;
+  s->es.weight = NULL;
+  s->es.wud = NULL;
+  s->es.T = T;
+  return &s->es;
+}
+
+/* The box the default camera frames: the domain x the elevation range. */
+static oc_aabb surface_bounds(const oc_esurface *es) {
+  const oc_elevation *e = es->src;
+  double lo, hi;
+  e->range(e->ud, e->x0, e->y0, e->x1, e->y1, &lo, &hi);
+  oc_aabb b = {{e->x0, e->y0, lo}, {e->x1, e->y1, hi}};
+  return b;
+}
+
+static void set_number(lua_State *L, const char *k, double v) {
+  lua_pushnumber(L, v);
+  lua_setfield(L, -2, k);
+}
+
+/* Pushes the statistics table; calls_total only when counted. */
+static void push_stats(lua_State *L, const oc_render_stats *st, int total) {
+  lua_createtable(L, 0, 6);
+  lua_pushinteger(L, (lua_Integer)st->pixels);
+  lua_setfield(L, -2, "pixels");
+  lua_pushinteger(L, (lua_Integer)st->hits);
+  lua_setfield(L, -2, "hits");
+  set_number(L, "calls", st->calls);
+  set_number(L, "calls_per_pixel", st->calls_per_pixel);
+  if (!total) return;
+  set_number(L, "calls_total", st->calls_total);
+  set_number(L, "calls_total_per_pixel", st->calls_total_per_pixel);
+}
+
+/* The statistics of a render in two phases: from the geometry image, and
+** the shading's from the final image's "evals" channel when it has one. */
+static int stats_of(const oc_image *geo, const oc_image *img,
+                    oc_render_stats *st) {
+  size_t npx = (size_t)oc_image_width(geo) * oc_image_height(geo);
+  const float *g = oc_image_cdata(geo), *q = oc_image_cdata(img);
+  int nch = oc_image_channels(img), total = nch > 4;
+  memset(st, 0, sizeof *st);
+  st->pixels = (long long)npx;
+  for (size_t k = 0; k < npx; k++) {
+    st->hits += g[k * OC_RG_COUNT + OC_RG_HIT] > 0;
+    st->calls += g[k * OC_RG_COUNT + OC_RG_EVALS];
+    if (total) st->calls_total += q[k * nch + nch - 1];
+  }
+  st->calls_per_pixel = st->calls / (double)npx;
+  st->calls_total_per_pixel = st->calls_total / (double)npx;
+  return total;
+}
+
 /* ---- outcrop.render -------------------------------------------------- */
 
 static int l_render(lua_State *L) {
@@ -394,14 +503,20 @@ static int l_render(lua_State *L) {
   source src;
   double bg[4] = {0, 0, 0, 1};
   oclua_checkargs(L, 2, FNAME,
-                  "(node, {camera =, size =, sun =, sky =, shadows =, ao =, "
-                  "fog =, color =, background =, aov =, ...})");
-  oclua_checknode(L, 1, FNAME, "argument #1");
+                  "(node or heightfield, {camera =, size =, sun =, sky =, "
+                  "shadows =, ao =, fog =, color =, background =, aov =, "
+                  "...})");
+  if (!oclua_isheightfield(L, 1) && !oclua_testnode(L, 1))
+    oclua_error(L, FNAME,
+                "argument #1 must be an outcrop node or a heightfield (got %s)",
+                oclua_got(L, 1));
+  if (!oclua_isheightfield(L, 1)) oclua_checknode(L, 1, FNAME, "argument #1");
   lua_settop(L, 2);
   if (lua_isnil(L, 2)) {
     lua_newtable(L);
     lua_replace(L, 2);
   }
+  int elev = pin_surface(L, 1);
   oclua_fields_open(&f, L, 2, FNAME, NULL, known, 0);
   oc_render_defaults(&rp);
   read_size(&f, &rp);
@@ -438,16 +553,28 @@ static int l_render(lua_State *L) {
   if (src.kind == SRC_FIELD && rp.stops == NULL)
     rp.stops = oc_palette_strata(&rp.nstops);
 
-  const oc_program *prog = oclua_program_at(L, 1, FNAME, t);
-  if (oc_render_default_camera(prog, &rp, ci.has_eye, ci.has_target, &err))
-    oclua_liberror(L, FNAME, &err);
+  const oc_program *prog = NULL;
+  const oc_esurface *es = NULL;
+  if (elev) {
+    es = surface_at(L, 1, t);
+    if (oc_render_frame_box(surface_bounds(es), &rp, ci.has_eye,
+                            ci.has_target, &err))
+      oclua_liberror(L, FNAME, &err);
+  } else {
+    prog = oclua_program_at(L, 1, FNAME, t);
+    if (oc_render_default_camera(prog, &rp, ci.has_eye, ci.has_target, &err))
+      oclua_liberror(L, FNAME, &err);
+  }
   /* The colour node is compiled at the render's threshold: were it the
   ** main node itself, another threshold would replace (and free) the
   ** program in use. Everything is checked before any work (a colour
   ** function runs between the lib's passes). */
   if (src.kind == SRC_FIELD)
     rp.color_field = oclua_program_at(L, src.idx, FNAME, t);
-  if (oc_render_check(prog, &rp, &err)) oclua_liberror(L, FNAME, &err);
+  if (prog ? oc_render_check(prog, &rp, &err)
+           : oc_render_check_surface(es, &rp, &err) ||
+                 oc_render_check_shade(&rp, &err))
+    oclua_liberror(L, FNAME, &err);
   memset(&rp.progress, 0, sizeof rp.progress);
   rp.progress = oclua_progress_start(L, &pl, FNAME);
   char warning[300] = "";
@@ -456,33 +583,43 @@ static int l_render(lua_State *L) {
 
   if (src.kind != SRC_FUNCTION) {
     oclua_image *u = oclua_newimage(L);
-    u->img = oc_render(prog, &rp, &err);
+    oc_render_stats st;
+    u->img =
+        es ? oc_render_surface(es, &rp, &st, &err) : oc_render(prog, &rp, &err);
     if (u->img == NULL) render_error(L, &pl, &err);
     oclua_progress_end(&pl);
     if (warning[0]) oclua_warn(L, FNAME, "%s", warning);
-    return 1;
+    if (!es) return 1;
+    push_stats(L, &st, 1);
+    return 2;
   }
 
   /* A Lua function colours the pixels, serially, between the two passes;
   ** every buffer is a userdata, so an error in it leaks nothing. */
   oclua_image *g = oclua_newimage(L);
   pl.span = 0.2;
-  g->img = oc_render_geometry(prog, &rp, &err);
+  g->img = es ? oc_render_surface_geometry(es, &rp, &err)
+              : oc_render_geometry(prog, &rp, &err);
   if (g->img == NULL) render_error(L, &pl, &err);
   pl.base = 0.2, pl.span = 0.6;
   const float *albedo = run_colour_function(L, src.idx, g->img, &pl);
   pl.base = 0.8, pl.span = 0.2;
   /* The function may have queried the node at another threshold, which
   ** recompiles it: fetch the program again. */
-  prog = oclua_program_at(L, 1, FNAME, t);
+  if (!es) prog = oclua_program_at(L, 1, FNAME, t);
   oclua_image *u = oclua_newimage(L);
-  u->img = oc_render_shade(prog, &rp, g->img, albedo, &err);
+  u->img = es ? oc_render_surface_shade(es, &rp, g->img, albedo, &err)
+              : oc_render_shade(prog, &rp, g->img, albedo, &err);
   if (u->img == NULL) render_error(L, &pl, &err);
   oclua_progress_end(&pl);
+  oc_render_stats st;
+  int total = es ? stats_of(g->img, u->img, &st) : 0;
   oc_image_free(g->img); /* big: not left to the collector */
   g->img = NULL;
   if (warning[0]) oclua_warn(L, FNAME, "%s", warning);
-  return 1;
+  if (!es) return 1;
+  push_stats(L, &st, total);
+  return 2;
 }
 
 static const luaL_Reg render_funcs[] = {{"render", l_render}, {NULL, NULL}};

@@ -18,9 +18,14 @@
 int oc_render_default_camera(const oc_program *prog, oc_render_params *rp,
                              int has_eye, int has_target, oc_error *err) {
   if (!prog) return oc_seterr(err, OC_EINVAL, "'program' is NULL");
+  return oc_render_frame_box(oc_program_bounds(prog), rp, has_eye, has_target,
+                             err);
+}
+
+int oc_render_frame_box(oc_aabb b, oc_render_params *rp, int has_eye,
+                        int has_target, oc_error *err) {
   if (!rp) return oc_seterr(err, OC_EINVAL, "render parameters are NULL");
   if (has_eye && has_target) return OC_OK;
-  oc_aabb b = oc_program_bounds(prog);
   double lo[3] = {b.lo.x, b.lo.y, b.lo.z}, hi[3] = {b.hi.x, b.hi.y, b.hi.z};
   for (int k = 0; k < 3; k++) {
     if (lo[k] > hi[k])

@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/vec.h"
+#include "render/etrace.h"
 #include "render/render.h"
 
 void oc_render_defaults(oc_render_params *rp) {
@@ -65,10 +66,8 @@ static int check_camera(const oc_camera *c, oc_error *err) {
   return OC_OK;
 }
 
-/* Checks what tracing needs. */
-int oc_render_check_geometry(const oc_program *prog, const oc_render_params *rp,
-                             oc_error *err) {
-  if (!prog) return oc_seterr(err, OC_EINVAL, "'program' is NULL");
+/* Checks what tracing needs, whatever is traced. */
+static int check_trace(const oc_render_params *rp, oc_error *err) {
   if (!rp) return oc_seterr(err, OC_EINVAL, "render parameters are NULL");
   if (rp->width < 1 || rp->width > OC_RENDER_MAX_SIDE)
     return oc_seterr(err, OC_EINVAL, "'size' width must be in 1..%d (got %d)",
@@ -98,6 +97,33 @@ int oc_render_check_geometry(const oc_program *prog, const oc_render_params *rp,
                      "'tracer' must be \"segment\" or "
                      "\"sphere\"");
   return OC_OK;
+}
+
+int oc_render_check_geometry(const oc_program *prog, const oc_render_params *rp,
+                             oc_error *err) {
+  if (!prog) return oc_seterr(err, OC_EINVAL, "'program' is NULL");
+  return check_trace(rp, err);
+}
+
+int oc_render_check_surface(const oc_esurface *es, const oc_render_params *rp,
+                            oc_error *err) {
+  const oc_elevation *src = es ? es->src : NULL;
+  if (!src) return oc_seterr(err, OC_EINVAL, "'source' is NULL");
+  if (!src->height || !src->range || !src->slope)
+    return oc_seterr(err, OC_EINVAL,
+                     "the elevation source lacks its height, range or slope "
+                     "function");
+  if (!(isfinite(src->x0) && isfinite(src->x1) && isfinite(src->y0) &&
+        isfinite(src->y1) && src->x0 < src->x1 && src->y0 < src->y1))
+    return oc_seterr(err, OC_EINVAL,
+                     "the elevation source's domain must be finite and not "
+                     "empty (got [%g, %g] x [%g, %g])",
+                     src->x0, src->x1, src->y0, src->y1);
+  if (es->weight && !isfinite(es->T))
+    return oc_seterr(err, OC_EINVAL,
+                     "'threshold' of the weight must be finite (got %g)",
+                     es->T);
+  return check_trace(rp, err);
 }
 
 static int check_rules(const oc_render_rules *r, oc_error *err) {

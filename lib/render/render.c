@@ -1,7 +1,9 @@
 /*
 ** render.c — oc_render and its two phases: primary rays into a geometry
 ** image (hit, distance, normal, position, evaluation count per pixel),
-** then colour and light into the final image.
+** then colour and light into the final image. The same two phases render
+** a 3D field (trace.c) or an elevation surface (etrace.c, oc_render_elevation):
+** only the tracer, the normals, the shadow rays and the occlusion differ.
 **
 ** Pixels are independent, and each depends only on its own ray, so the
 ** image is byte-identical for any thread count: tiles are handed out
@@ -10,10 +12,12 @@
 */
 #include <math.h>
 #include <omp.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
 #include "core/vec.h"
+#include "render/etrace.h"
 #include "render/render.h"
 #include "render/shade.h"
 #include "render/tone.h"
@@ -72,12 +76,20 @@ static void tracer_for(oc_tracer *tr, const oc_program *prog,
                  1e-7 * c->scale);
 }
 
+/* An elevation surface's tracer, its tolerance as a field's. */
+static void etracer_for(oc_etracer *tr, const oc_esurface *es,
+                        const oc_render_params *rp, const camera *c) {
+  double pixel = 2 * c->th / c->height;
+  oc_etracer_init(tr, es, rp->tracer, EPS_PIXEL * pixel, 1e-7 * c->scale);
+}
+
 /* Rays end where the scene's box ends, or at max_distance; an unbounded
 ** scene needs a finite end, or a ray grazing a half-space would march
-** for ever. */
+** for ever. (An elevation surface's box, its domain, is always finite.) */
 static double far_for(const oc_program *prog, const oc_render_params *rp,
                       const camera *c) {
   if (rp->max_distance > 0) return rp->max_distance;
+  if (!prog) return INFINITY;
   oc_aabb b = oc_program_bounds(prog);
   if (oc_vfinite(b.lo) && oc_vfinite(b.hi)) return INFINITY;
   return 1000 * c->scale;
@@ -120,9 +132,11 @@ static int run_tiles(int w, int h, tile_fn fn, const void *ctx,
  */
 
 typedef struct gctx {
-  const oc_program *prog;
+  const oc_program *prog; /* a field, or NULL and */
+  const oc_esurface *es;  /* an elevation surface */
   camera cam;
   oc_tracer tr;
+  oc_etracer etr;
   double far;
   float *px;
 } gctx;
@@ -131,16 +145,24 @@ static void geom_pixel(const gctx *g, int i, int j, float *out) {
   oc_vec3 u = ray_dir(&g->cam, i, j);
   double t, ev = 0;
   memset(out, 0, OC_RG_COUNT * sizeof *out);
-  if (!oc_trace(&g->tr, g->cam.eye, u, 0, g->far, 0, &t, &ev)) {
+  int hit = g->es ? oc_etrace(&g->etr, g->cam.eye, u, 0, g->far, 0, &t, &ev)
+                  : oc_trace(&g->tr, g->cam.eye, u, 0, g->far, 0, &t, &ev);
+  if (!hit) {
     out[OC_RG_Z] = INFINITY;
     out[OC_RG_EVALS] = (float)ev;
     return;
   }
-  oc_vec3 p = oc_add(g->cam.eye, oc_mul(u, t)), gr;
-  oc_program_gradient(g->prog, p, &gr);
-  ev += 1;
-  double gl = oc_len(gr);
-  oc_vec3 n = gl > 0 && isfinite(gl) ? oc_mul(gr, -1 / gl) : oc_mul(u, -1);
+  oc_vec3 p = oc_add(g->cam.eye, oc_mul(u, t)), n;
+  if (g->es) {
+    n = hit == 2 ? oc_etracer_wall(&g->etr, p, u)
+                 : oc_esurface_normal(g->es, p.x, p.y, &ev);
+  } else {
+    oc_vec3 gr;
+    oc_program_gradient(g->prog, p, &gr);
+    ev += 1;
+    double gl = oc_len(gr);
+    n = gl > 0 && isfinite(gl) ? oc_mul(gr, -1 / gl) : oc_mul(u, -1);
+  }
   out[OC_RG_HIT] = 1;
   out[OC_RG_Z] = (float)t;
   out[OC_RG_NX] = (float)n.x;
@@ -192,9 +214,18 @@ static void thin_reason(const gctx *g, const oc_render_params *rp) {
                          rp->warning_size);
 }
 
-static oc_image *geometry(const oc_program *prog, const oc_render_params *rp,
-                          double base, double span, oc_error *err) {
-  if (oc_render_check_geometry(prog, rp, err)) return NULL;
+/* Checks the scene (a program, or an elevation surface when es) and what
+** tracing needs. */
+static int check_scene(const oc_program *prog, const oc_esurface *es,
+                       const oc_render_params *rp, oc_error *err) {
+  return es ? oc_render_check_surface(es, rp, err)
+            : oc_render_check_geometry(prog, rp, err);
+}
+
+static oc_image *geometry(const oc_program *prog, const oc_esurface *es,
+                          const oc_render_params *rp, double base, double span,
+                          oc_error *err) {
+  if (check_scene(prog, es, rp, err)) return NULL;
   oc_image *img = oc_image_new(rp->width, rp->height, OC_RG_COUNT, err);
   if (!img) return NULL;
   for (int c = 0; c < OC_RG_COUNT; c++)
@@ -203,7 +234,11 @@ static oc_image *geometry(const oc_program *prog, const oc_render_params *rp,
   gctx g;
   camera_init(&g.cam, rp);
   g.prog = prog;
-  tracer_for(&g.tr, prog, rp, &g.cam);
+  g.es = es;
+  if (es)
+    etracer_for(&g.etr, es, rp, &g.cam);
+  else
+    tracer_for(&g.tr, prog, rp, &g.cam);
   g.far = far_for(prog, rp, &g.cam);
   g.px = oc_image_data(img);
   if (run_tiles(rp->width, rp->height, geom_tile, &g, &rp->progress, base,
@@ -212,13 +247,13 @@ static oc_image *geometry(const oc_program *prog, const oc_render_params *rp,
     oc_seterr(err, OC_ECANCEL, "rendering cancelled");
     return NULL;
   }
-  if (rp->warning && rp->warning_size) thin_reason(&g, rp);
+  if (prog && rp->warning && rp->warning_size) thin_reason(&g, rp);
   return img;
 }
 
 oc_image *oc_render_geometry(const oc_program *prog, const oc_render_params *rp,
                              oc_error *err) {
-  return geometry(prog, rp, 0, 1, err);
+  return geometry(prog, NULL, rp, 0, 1, err);
 }
 
 /* ---- shading -------------------------------------------------------------
@@ -230,6 +265,7 @@ typedef struct sctx {
   const float *geo;
   const float *albedo;
   float *px;
+  float *evals; /* NULL, or each pixel's evaluations (for the stats) */
   int nch;
   double gain; /* 2^exposure */
 } sctx;
@@ -262,6 +298,7 @@ static void shade_pixel(const sctx *s, int i, int j) {
     memcpy(out + 4, g + OC_RG_Z, 7 * sizeof *out);
     out[11] = (float)ev;
   }
+  if (s->evals) s->evals[k] = (float)ev;
 }
 
 static void shade_tile(const void *ctx, int x0, int y0, int x1, int y1) {
@@ -291,10 +328,11 @@ static void resolve_levels(oc_shader *sh, const oc_render_params *rp,
   sh->beach = sea || ru->beach > 0 ? ru->beach : 0.015 * relief;
 }
 
-static oc_image *shade(const oc_program *prog, const oc_render_params *rp,
-                       const oc_image *geo, const float *albedo, double base,
+static oc_image *shade(const oc_program *prog, const oc_esurface *es,
+                       const oc_render_params *rp, const oc_image *geo,
+                       const float *albedo, float *evals, double base,
                        double span, oc_error *err) {
-  if (oc_render_check_geometry(prog, rp, err)) return NULL;
+  if (check_scene(prog, es, rp, err)) return NULL;
   if (oc_render_check_shade(rp, err)) return NULL;
   if (!geo) {
     oc_seterr(err, OC_EINVAL, "'geometry' is NULL");
@@ -325,14 +363,22 @@ static oc_image *shade(const oc_program *prog, const oc_render_params *rp,
   s.geo = oc_image_cdata(geo);
   s.albedo = albedo;
   s.px = oc_image_data(img);
+  s.evals = evals;
   s.nch = nch;
   s.gain = exp2(rp->exposure);
   oc_shader *sh = &s.sh;
   sh->rp = rp;
   sh->prog = prog;
-  tracer_for(&sh->tracer, prog, rp, &s.cam);
-  sh->tracer.refine = 0; /* shadow rays need no exact distance */
-  sh->T = sh->tracer.T;
+  sh->es = es;
+  if (es) {
+    etracer_for(&sh->etracer, es, rp, &s.cam);
+    sh->etracer.refine = 0;
+    sh->T = es->T;
+  } else {
+    tracer_for(&sh->tracer, prog, rp, &s.cam);
+    sh->tracer.refine = 0; /* shadow rays need no exact distance */
+    sh->T = sh->tracer.T;
+  }
   sh->sun = oc_mul(rp->sun_direction, 1 / oc_len(rp->sun_direction));
   sh->far = far_for(prog, rp, &s.cam);
   sh->ao_step = rp->ao_distance > 0 ? rp->ao_distance : s.cam.scale / 150;
@@ -350,7 +396,7 @@ static oc_image *shade(const oc_program *prog, const oc_render_params *rp,
 oc_image *oc_render_shade(const oc_program *prog, const oc_render_params *rp,
                           const oc_image *geometry, const float *albedo,
                           oc_error *err) {
-  return shade(prog, rp, geometry, albedo, 0, 1, err);
+  return shade(prog, NULL, rp, geometry, albedo, NULL, 0, 1, err);
 }
 
 oc_image *oc_render(const oc_program *prog, const oc_render_params *rp,
@@ -358,9 +404,89 @@ oc_image *oc_render(const oc_program *prog, const oc_render_params *rp,
   /* checked before any tracing: a bad colour should not cost a render */
   if (oc_render_check_geometry(prog, rp, err) || oc_render_check_shade(rp, err))
     return NULL;
-  oc_image *geo = geometry(prog, rp, 0, GEOM_SHARE, err);
+  oc_image *geo = geometry(prog, NULL, rp, 0, GEOM_SHARE, err);
   if (!geo) return NULL;
-  oc_image *img = shade(prog, rp, geo, NULL, GEOM_SHARE, 1 - GEOM_SHARE, err);
+  oc_image *img =
+      shade(prog, NULL, rp, geo, NULL, NULL, GEOM_SHARE, 1 - GEOM_SHARE, err);
   oc_image_free(geo);
   return img;
+}
+
+/* ---- elevation surfaces ---------------------------------------------------
+ */
+
+oc_image *oc_render_surface_geometry(const oc_esurface *es,
+                                     const oc_render_params *rp,
+                                     oc_error *err) {
+  return geometry(NULL, es, rp, 0, 1, err);
+}
+
+oc_image *oc_render_surface_shade(const oc_esurface *es,
+                                  const oc_render_params *rp,
+                                  const oc_image *geometry, const float *albedo,
+                                  oc_error *err) {
+  return shade(NULL, es, rp, geometry, albedo, NULL, 0, 1, err);
+}
+
+/* Sums the evaluations of the geometry image and the per-pixel totals,
+** serially, so that the figures are the same for any thread count. */
+static void count(oc_render_stats *st, const oc_image *geo,
+                  const float *total) {
+  size_t npx = (size_t)oc_image_width(geo) * oc_image_height(geo);
+  const float *g = oc_image_cdata(geo);
+  memset(st, 0, sizeof *st);
+  st->pixels = (long long)npx;
+  for (size_t k = 0; k < npx; k++) {
+    const float *p = g + k * OC_RG_COUNT;
+    st->hits += p[OC_RG_HIT] > 0;
+    st->calls += p[OC_RG_EVALS];
+    st->calls_total += total[k];
+  }
+  st->calls_per_pixel = st->calls / (double)npx;
+  st->calls_total_per_pixel = st->calls_total / (double)npx;
+}
+
+oc_image *oc_render_surface(const oc_esurface *es, const oc_render_params *rp,
+                            oc_render_stats *st, oc_error *err) {
+  if (oc_render_check_surface(es, rp, err) || oc_render_check_shade(rp, err))
+    return NULL;
+  oc_image *geo = geometry(NULL, es, rp, 0, GEOM_SHARE, err);
+  if (!geo) return NULL;
+  float *total = NULL;
+  if (st) {
+    total = malloc((size_t)rp->width * rp->height * sizeof *total);
+    if (!total) {
+      oc_image_free(geo);
+      oc_seterr(err, OC_ENOMEM, "out of memory for the render's statistics");
+      return NULL;
+    }
+  }
+  oc_image *img =
+      shade(NULL, es, rp, geo, NULL, total, GEOM_SHARE, 1 - GEOM_SHARE, err);
+  if (img && st) count(st, geo, total);
+  free(total);
+  oc_image_free(geo);
+  return img;
+}
+
+oc_image *oc_render_elevation(const oc_elevation *src,
+                              const oc_render_params *rp, oc_render_stats *st,
+                              oc_error *err) {
+  oc_esurface es = {src, NULL, NULL, 0.5};
+  return oc_render_surface(&es, rp, st, err);
+}
+
+oc_image *oc_render_elevation_geometry(const oc_elevation *src,
+                                       const oc_render_params *rp,
+                                       oc_error *err) {
+  oc_esurface es = {src, NULL, NULL, 0.5};
+  return oc_render_surface_geometry(&es, rp, err);
+}
+
+oc_image *oc_render_elevation_shade(const oc_elevation *src,
+                                    const oc_render_params *rp,
+                                    const oc_image *geometry,
+                                    const float *albedo, oc_error *err) {
+  oc_esurface es = {src, NULL, NULL, 0.5};
+  return oc_render_surface_shade(&es, rp, geometry, albedo, err);
 }

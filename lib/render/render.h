@@ -1,6 +1,6 @@
 /*
-** render.h — limits and parameter checks shared by the renderer's files
-** (internal).
+** render.h — limits and parameter checks shared by the renderer's files,
+** and the elevation renders with holes (internal).
 */
 #ifndef OC_RENDER_H
 #define OC_RENDER_H
@@ -14,6 +14,7 @@
 
 int oc_render_check_geometry(const oc_program *prog, const oc_render_params *rp,
                              oc_error *err);
-int oc_render_check_shade(const oc_render_params *rp, oc_error *err);
+/* (oc_render_check_surface, oc_render_check_shade and the surface
+** renders are public: outcrop.h.) */
 
 #endif

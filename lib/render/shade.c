@@ -10,6 +10,28 @@
 
 #define AO_SAMPLES 5
 
+/* Ambient occlusion of an elevation surface from heights along the
+** normal: leaving the surface along n, the height above it grows at
+** least as fast as the distance on open ground (sqrt(1 + |grad f|^2)
+** times on a plane); where it falls short, higher ground is near. The
+** shortfall, relative to the distance, is the occlusion. */
+static double eocclusion(const oc_shader *sh, oc_vec3 p, oc_vec3 n,
+                         double *evals) {
+  const oc_elevation *src = sh->es->src;
+  double occ = 0, w = 0.5;
+  for (int k = 1; k <= AO_SAMPLES; k++, w *= 0.5) {
+    double d = k * sh->ao_step;
+    oc_vec3 q = {p.x + d * n.x, p.y + d * n.y, p.z + d * n.z};
+    double h = q.z - src->height(src->ud, q.x, q.y, NULL);
+    *evals += 1;
+    if (!isfinite(h)) return 1;
+    double lack = 1 - h / d;
+    occ += w * (lack < 0 ? 0 : lack > 1 ? 1 : lack);
+  }
+  double a = 1 - 1.5 * occ;
+  return a < 0 ? 0 : a;
+}
+
 /* Ambient occlusion from field samples along the normal. Leaving a free
 ** surface, the field only falls (and, with compact support, soon stays
 ** at 0); wherever it rises again on the way out, another surface is
@@ -19,6 +41,7 @@
 ** Closer samples weigh more. */
 static double occlusion(const oc_shader *sh, oc_vec3 p, oc_vec3 n,
                         double *evals) {
+  if (sh->es) return eocclusion(sh, p, n, evals);
   double low = oc_program_eval(sh->prog, p);
   *evals += 1;
   if (!isfinite(low)) return 1;
@@ -38,6 +61,12 @@ static double occlusion(const oc_shader *sh, oc_vec3 p, oc_vec3 n,
 
 static double shadow(const oc_shader *sh, oc_vec3 p, oc_vec3 n, double z,
                      double *evals) {
+  if (sh->es) {
+    const oc_etracer *et = &sh->etracer;
+    double off = 4 * (et->eps_k * z + et->eps_min), t;
+    oc_vec3 o = {p.x + off * n.x, p.y + off * n.y, p.z + off * n.z};
+    return oc_etrace(et, o, sh->sun, off, sh->far, z, &t, evals) ? 0 : 1;
+  }
   const oc_tracer *tr = &sh->tracer;
   /* leave the surface by a few tolerances, or the first step would stop
   ** on it */

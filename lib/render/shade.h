@@ -7,13 +7,16 @@
 #define OC_SHADE_H
 
 #include "outcrop.h"
+#include "render/etrace.h"
 #include "render/trace.h"
 
 /* Everything shading needs, resolved once per image. */
 typedef struct oc_shader {
   const oc_render_params *rp;
-  const oc_program *prog;
-  oc_tracer tracer;
+  const oc_program *prog; /* a field, or NULL and */
+  const oc_esurface *es;  /* an elevation surface */
+  oc_tracer tracer;       /* shadow rays of a field */
+  oc_etracer etracer;     /* of an elevation surface */
   double T;
   oc_vec3 sun;      /* unit, towards the sun */
   double sea, snow; /* resolved rule levels */

@@ -1,0 +1,48 @@
+/*
+** etrace.h — finding where a ray first meets an elevation surface
+** z = f(x, y) (internal): the accelerated tracer of Génevaux et al. 2015,
+** section 7.2 (local slope bounds on the ray's segment, a doubling
+** candidate step, elevation ranges to skip empty space) and the
+** global-bound sphere tracing it is measured against.
+*/
+#ifndef OC_ETRACE_H
+#define OC_ETRACE_H
+
+#include "outcrop.h"
+
+/* oc_esurface, what the renderer traces, is in outcrop.h. */
+
+typedef struct oc_etracer {
+  const oc_esurface *s;
+  oc_render_tracer mode;
+  double lo[3], hi[3]; /* the domain x [min f, max f], padded */
+  double L;            /* slope bound over the whole domain */
+  /* Steps are at least eps = eps_k * (distance from the eye) + eps_min, as
+  ** the 3D tracers' (trace.h); a hit is the first sample below the
+  ** surface, then located by regula falsi. */
+  double eps_k, eps_min;
+  int refine; /* 1: locate hits (0 for shadow rays) */
+} oc_etracer;
+
+void oc_etracer_init(oc_etracer *tr, const oc_esurface *s,
+                     oc_render_tracer mode, double eps_k, double eps_min);
+
+/* Traces o + t u (u unit) over [t0, t1]; d0 is the distance of o from the
+** eye. Returns 1 and the distance in *t on a hit of the surface, 2 on a
+** hit of a wall (the ray entered the solid under the surface through a
+** side of the domain's box or of a hole), 0 on a miss (or after
+** OC_TRACE_MAX_STEPS steps); adds the height calls made to *evals.
+** Allocation-free. */
+int oc_etrace(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0, double t1,
+              double d0, double *t, double *evals);
+
+/* The outward normal of the wall hit at p by a ray along u: the nearest
+** face of the box, or -u for a hole's wall. */
+oc_vec3 oc_etracer_wall(const oc_etracer *tr, oc_vec3 p, oc_vec3 u);
+
+/* The unit upward normal at (x, y) from the height gradient: one height
+** call, counted in *evals. */
+oc_vec3 oc_esurface_normal(const oc_esurface *s, double x, double y,
+                           double *evals);
+
+#endif

@@ -1,0 +1,397 @@
+/*
+** test_etrace.c — rendering elevation surfaces z = f(x, y): traced
+** depths against a dense fixed-step march (an fBm heightfield and an
+** analytic source defined here), the accelerated and sphere tracers
+** against each other and their height-call counts, holes from a weight,
+** whole renders (AOVs, statistics, thread-count determinism) and bad
+** sources.
+*/
+#include <check.h>
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ocheck.h"
+#include "outcrop.h"
+#include "render/etrace.h"
+#include "render/render.h"
+
+#define PI 3.14159265358979323846
+
+/* ---- an analytic source: f = B + A sin(x / w) cos(y / w) ---------------- */
+
+typedef struct wave {
+  double A, B, w;
+} wave;
+
+static double wave_h(void *ud, double x, double y, double g[2]) {
+  const wave *s = ud;
+  double sx = sin(x / s->w), cx = cos(x / s->w);
+  double sy = sin(y / s->w), cy = cos(y / s->w);
+  if (g) {
+    g[0] = s->A / s->w * cx * cy;
+    g[1] = -s->A / s->w * sx * sy;
+  }
+  return s->B + s->A * sx * cy;
+}
+
+/* |grad f| <= A / w everywhere: a local range from the centre's value. */
+static void wave_range(void *ud, double x0, double y0, double x1, double y1,
+                       double *lo, double *hi) {
+  const wave *s = ud;
+  double c = wave_h(ud, 0.5 * (x0 + x1), 0.5 * (y0 + y1), NULL);
+  double r = s->A / s->w * 0.5 * hypot(x1 - x0, y1 - y0);
+  *lo = fmax(c - r, s->B - s->A);
+  *hi = fmin(c + r, s->B + s->A);
+}
+
+static double wave_slope(void *ud, double x0, double y0, double x1, double y1) {
+  (void)x0, (void)y0, (void)x1, (void)y1;
+  const wave *s = ud;
+  return s->A / s->w;
+}
+
+static wave WAVE = {40, 10, 60};
+
+static oc_elevation wave_source(void) {
+  oc_elevation e = {wave_h, wave_range, wave_slope, NULL, NULL,
+                    &WAVE,  -500,       -500,       500,  500};
+  return e;
+}
+
+/* ---- an fBm heightfield ------------------------------------------------ */
+
+static oc_heightfield *fbm_grid(void) {
+  oc_hf_grid g = {257, 257, 4, 0, 0};
+  oc_noise nz = {300, 120, 0, 6, 7};
+  oc_progress none = {0};
+  oc_error e;
+  oc_heightfield *hf = oc_heightfield_fbm(&g, &nz, none, &e);
+  ck_assert_msg(hf, "%s", e.msg);
+  return hf;
+}
+
+/* ---- rays -------------------------------------------------------------- */
+
+static oc_render_params view(oc_vec3 eye, oc_vec3 target, int w, int h) {
+  oc_render_params rp;
+  oc_render_defaults(&rp);
+  rp.camera.eye = eye;
+  rp.camera.target = target;
+  rp.camera.up = oct_v(0, 0, 1);
+  rp.camera.fov = 50;
+  rp.width = w;
+  rp.height = h;
+  return rp;
+}
+
+/* The pinhole ray through pixel (i, j), written independently of lib/. */
+static oc_vec3 pixel_ray(const oc_render_params *rp, int i, int j) {
+  oc_vec3 w = oct_sub(rp->camera.target, rp->camera.eye);
+  w = oct_mul(w, 1 / oct_len(w));
+  oc_vec3 r = oct_cross(w, rp->camera.up);
+  r = oct_mul(r, 1 / oct_len(r));
+  oc_vec3 u = oct_cross(r, w);
+  double th = tan(rp->camera.fov * PI / 360);
+  double x = ((i + 0.5) / rp->width * 2 - 1) * th * rp->width / rp->height;
+  double y = (1 - (j + 0.5) / rp->height * 2) * th;
+  oc_vec3 d = oct_add(w, oct_add(oct_mul(r, x), oct_mul(u, y)));
+  return oct_mul(d, 1 / oct_len(d));
+}
+
+/* First t in [0, t1] where o + t d is on or below the surface inside the
+** domain x [its lowest elevation, oo) (and where the weight allows), by
+** fixed steps ds then bisection; INFINITY when none. */
+static double march(const oc_esurface *es, oc_vec3 o, oc_vec3 d, double t1,
+                    double ds) {
+  const oc_elevation *s = es->src;
+  double prev = 0, zlo, zhi;
+  s->range(s->ud, s->x0, s->y0, s->x1, s->y1, &zlo, &zhi);
+  int above = 0; /* the sample before was above the surface */
+  for (double t = 0; t <= t1; prev = t, t += ds) {
+    oc_vec3 p = oct_add(o, oct_mul(d, t));
+    if (p.x < s->x0 || p.x > s->x1 || p.y < s->y0 || p.y > s->y1 || p.z < zlo) {
+      above = 0;
+      continue;
+    }
+    double h = p.z - s->height(s->ud, p.x, p.y, NULL);
+    int hole = es->weight && es->weight(es->wud, p.x, p.y) < es->T;
+    if (hole || h > 0) {
+      above = h > 0;
+      continue;
+    }
+    if (!above) return t; /* through a side of the domain or a hole's */
+    double a = prev, b = t;
+    for (int k = 0; k < 40; k++) {
+      double m = 0.5 * (a + b);
+      oc_vec3 q = oct_add(o, oct_mul(d, m));
+      if (q.z - s->height(s->ud, q.x, q.y, NULL) > 0)
+        a = m;
+      else
+        b = m;
+    }
+    return b;
+  }
+  return INFINITY;
+}
+
+/* Traces nx x ny pixel rays with both tracers and the march: every hit
+** within the march's step and the tracers' tolerance, the same pixels hit
+** (a grazing ray or two may differ), the tracers within the tolerance of
+** each other; returns the height calls of each tracer. */
+static void compare(const oc_esurface *es, const oc_render_params *rp,
+                    double ds, double evals[2]) {
+  /* the tolerance of a 1080-line image: the rays are a sparse sample */
+  double pixel = 2 * tan(rp->camera.fov * PI / 360) / 1080;
+  double eps_k = 0.25 * pixel;
+  oc_vec3 tw = oct_sub(rp->camera.target, rp->camera.eye);
+  double scale = oct_len(tw), eps_min = 1e-7 * scale;
+  oc_etracer tr[2];
+  oc_etracer_init(&tr[0], es, OC_TRACE_SEGMENT, eps_k, eps_min);
+  oc_etracer_init(&tr[1], es, OC_TRACE_SPHERE, eps_k, eps_min);
+  int hits = 0, differ = 0, n = rp->width * rp->height;
+  evals[0] = evals[1] = 0;
+  for (int j = 0; j < rp->height; j++)
+    for (int i = 0; i < rp->width; i++) {
+      oc_vec3 d = pixel_ray(rp, i, j);
+      double t[2];
+      int h0 =
+          oc_etrace(&tr[0], rp->camera.eye, d, 0, 1e5, 0, &t[0], &evals[0]);
+      int h1 =
+          oc_etrace(&tr[1], rp->camera.eye, d, 0, 1e5, 0, &t[1], &evals[1]);
+      double tref = march(es, rp->camera.eye, d, 4 * scale, ds);
+      if ((h0 != 0) != isfinite(tref) || (h1 != 0) != isfinite(tref)) {
+        differ++;
+        continue;
+      }
+      if (!h0) continue;
+      hits++;
+      double e = eps_k * tref + eps_min;
+      /* a step can cross a ridge thinner than itself: the march's step
+      ** and the tolerance bound the difference, but it is in depth */
+      ck_assert_msg(fabs(t[0] - tref) <= ds + 4 * e,
+                    "pixel %d %d: accelerated %.6f, march %.6f", i, j, t[0],
+                    tref);
+      ck_assert_msg(fabs(t[1] - tref) <= ds + 4 * e,
+                    "pixel %d %d: sphere %.6f, march %.6f", i, j, t[1], tref);
+      ck_assert_msg(fabs(t[0] - t[1]) <= 4 * e,
+                    "pixel %d %d: accelerated %.6f, sphere %.6f", i, j, t[0],
+                    t[1]);
+    }
+  ck_assert_msg(hits > n / 3, "only %d of %d rays hit", hits, n);
+  ck_assert_msg(differ <= n / 100, "%d of %d rays disagree on a hit", differ,
+                n);
+}
+
+START_TEST(heightfield_against_march) {
+  oc_heightfield *hf = fbm_grid();
+  oc_elevation src;
+  oc_error e;
+  ck_assert_int_eq(oc_heightfield_elevation(hf, &src, &e), OC_OK);
+  oc_esurface es = {&src, NULL, NULL, 0.5};
+  oc_render_params rp =
+      view(oct_v(-150, -250, 450), oct_v(600, 500, 20), 24, 16);
+  double ev[2];
+  compare(&es, &rp, 0.05, ev);
+  /* the local bounds and the doubling step save most of the calls */
+  ck_assert_msg(ev[0] * 2 < ev[1], "accelerated %g calls, sphere %g", ev[0],
+                ev[1]);
+  src.release(src.ud);
+  oc_heightfield_release(hf);
+}
+END_TEST
+
+START_TEST(analytic_against_march) {
+  oc_elevation src = wave_source();
+  oc_esurface es = {&src, NULL, NULL, 0.5};
+  oc_render_params rp =
+      view(oct_v(-600, -700, 300), oct_v(100, 100, -60), 24, 16);
+  double ev[2];
+  compare(&es, &rp, 0.05, ev);
+  ck_assert_msg(ev[0] < ev[1], "accelerated %g calls, sphere %g", ev[0], ev[1]);
+  /* also from straight above, where the steps are the heights */
+  rp = view(oct_v(1, 2, 400), oct_v(0, 0, 0), 16, 16);
+  compare(&es, &rp, 0.02, ev);
+}
+END_TEST
+
+/* No surface where x < 0: those rays go on to the far side of the hole,
+** or out. */
+static double half(void *wud, double x, double y) {
+  (void)wud, (void)y;
+  return x < 0 ? 0 : 1;
+}
+
+START_TEST(weight_makes_holes) {
+  oc_elevation src = wave_source();
+  oc_esurface es = {&src, half, NULL, 0.5};
+  oc_etracer tr;
+  oc_etracer_init(&tr, &es, OC_TRACE_SEGMENT, 1e-4, 1e-6);
+  double ev = 0, t;
+  /* straight down into the hole: nothing */
+  ck_assert(!oc_etrace(&tr, oct_v(-100, 30, 200), oct_v(0, 0, -1), 0, 1e4, 0,
+                       &t, &ev));
+  /* straight down beside it: the surface */
+  ck_assert(
+      oc_etrace(&tr, oct_v(100, 30, 200), oct_v(0, 0, -1), 0, 1e4, 0, &t, &ev));
+  ck_assert(fabs(200 - t - wave_h(&WAVE, 100, 30, NULL)) < 1e-3);
+  /* oblique rays against the march, which honours the weight too */
+  oc_render_params rp = view(oct_v(-600, 0, 200), oct_v(100, 0, 0), 16, 12);
+  int hits = 0;
+  for (int j = 0; j < rp.height; j++)
+    for (int i = 0; i < rp.width; i++) {
+      oc_vec3 d = pixel_ray(&rp, i, j);
+      double tref = march(&es, rp.camera.eye, d, 3000, 0.05);
+      int h = oc_etrace(&tr, rp.camera.eye, d, 0, 1e5, 0, &t, &ev);
+      if (!h || !isfinite(tref)) continue;
+      hits++;
+      oc_vec3 p = oct_add(rp.camera.eye, oct_mul(d, t));
+      ck_assert_msg(p.x >= -0.5, "hit in the hole at x = %g", p.x);
+      ck_assert_msg(fabs(t - tref) < 0.05 + 4e-4 * t,
+                    "pixel %d %d: %g, march %g", i, j, t, tref);
+    }
+  ck_assert(hits > 20);
+}
+END_TEST
+
+/* ---- whole renders ----------------------------------------------------- */
+
+START_TEST(render_heightfield) {
+  oc_heightfield *hf = fbm_grid();
+  oc_elevation src;
+  oc_error e;
+  ck_assert_int_eq(oc_heightfield_elevation(hf, &src, &e), OC_OK);
+  oc_render_params rp =
+      view(oct_v(-150, -250, 450), oct_v(600, 500, 20), 64, 40);
+  oc_render_stats st[2];
+  oc_image *img[2];
+  for (int k = 0; k < 2; k++) {
+    omp_set_num_threads(k + 1);
+    img[k] = oc_render_elevation(&src, &rp, &st[k], &e);
+    ck_assert_msg(img[k], "%s", e.msg);
+  }
+  omp_set_num_threads(2);
+  ck_assert_int_eq(oc_image_channels(img[0]), 12);
+  size_t n = (size_t)64 * 40 * 12;
+  ck_assert(memcmp(oc_image_cdata(img[0]), oc_image_cdata(img[1]),
+                   n * sizeof(float)) == 0);
+  ck_assert(memcmp(&st[0], &st[1], sizeof st[0]) == 0);
+  ck_assert_int_eq(st[0].pixels, 64 * 40);
+  ck_assert(st[0].hits > 64 * 40 / 3);
+  ck_assert(st[0].calls_per_pixel > 1 && st[0].calls_per_pixel < 100);
+  ck_assert(st[0].calls_total > st[0].calls); /* shadows and AO */
+  /* hits: P on the surface, N the height's normal, Z the distance */
+  const float *px = oc_image_cdata(img[0]);
+  double tot = 0;
+  int hits = 0;
+  for (int k = 0; k < 64 * 40; k++) {
+    const float *q = px + (size_t)k * 12;
+    tot += q[11];
+    if (!isfinite(q[4])) continue;
+    hits++;
+    if (q[7] < 1e-3) continue; /* a side of the block */
+    double g[2], z = oc_heightfield_height(hf, q[8], q[9], g);
+    ck_assert_msg(fabs(q[10] - z) < 0.05, "P.z %g, height %g", q[10], z);
+    double l = sqrt(1 + g[0] * g[0] + g[1] * g[1]);
+    ck_assert(fabs(q[7] - 1 / l) < 1e-3);
+    oc_vec3 d = oct_sub(oct_v(q[8], q[9], q[10]), rp.camera.eye);
+    ck_assert(fabs(oct_len(d) - q[4]) < 1e-2);
+  }
+  ck_assert_int_eq(hits, st[0].hits);
+  ck_assert(fabs(tot - st[0].calls_total) < 1e-6 * tot);
+  /* the sphere tracer draws the same picture at a greater cost */
+  rp.tracer = OC_TRACE_SPHERE;
+  oc_render_stats ss;
+  oc_image *sph = oc_render_elevation(&src, &rp, &ss, &e);
+  ck_assert_msg(sph, "%s", e.msg);
+  /* (a ray grazing a ridge within the tolerance may differ) */
+  ck_assert(llabs(ss.hits - st[0].hits) <= 2);
+  ck_assert_msg(ss.calls > 1.5 * st[0].calls, "sphere %g, accelerated %g",
+                ss.calls, st[0].calls);
+  /* depths within 4 tolerances (a pixel is 2 tan(25 deg) / 40 rad), but
+  ** for the rays that graze a ridge thinner than the tolerance (metres
+  ** at this coarse size), which either tracer may step over */
+  const float *sp = oc_image_cdata(sph);
+  double tolk = 4 * 0.25 * 2 * tan(25 * PI / 180) / 40;
+  int off = 0;
+  for (int k = 0; k < 64 * 40; k++)
+    if (isfinite(px[k * 12 + 4]) && isfinite(sp[k * 12 + 4]))
+      off += fabs(sp[k * 12 + 4] - px[k * 12 + 4]) > tolk * px[k * 12 + 4];
+  ck_assert_msg(off <= st[0].hits / 100, "%d pixels differ in depth", off);
+  oc_image_free(sph);
+  /* the two phases give the same image */
+  rp.tracer = OC_TRACE_SEGMENT;
+  oc_image *geo = oc_render_elevation_geometry(&src, &rp, &e);
+  ck_assert_msg(geo, "%s", e.msg);
+  oc_image *two = oc_render_elevation_shade(&src, &rp, geo, NULL, &e);
+  ck_assert_msg(two, "%s", e.msg);
+  ck_assert(memcmp(oc_image_cdata(two), px, n * sizeof(float)) == 0);
+  oc_image_free(two);
+  oc_image_free(geo);
+  for (int k = 0; k < 2; k++)
+    oc_image_free(img[k]);
+  src.release(src.ud);
+  oc_heightfield_release(hf);
+}
+END_TEST
+
+static int stop_now(void *ud, double done) {
+  (void)done;
+  ++*(int *)ud;
+  return 1;
+}
+
+START_TEST(cancelled) {
+  oc_elevation src = wave_source();
+  oc_render_params rp = view(oct_v(-600, -700, 300), oct_v(0, 0, 0), 64, 64);
+  int calls = 0;
+  rp.progress.fn = stop_now;
+  rp.progress.ud = &calls;
+  oc_error e;
+  ck_assert_ptr_null(oc_render_elevation(&src, &rp, NULL, &e));
+  ck_assert_int_eq(e.code, OC_ECANCEL);
+  ck_assert(calls >= 1);
+}
+END_TEST
+
+START_TEST(bad_sources) {
+  oc_render_params rp = view(oct_v(-600, -700, 300), oct_v(0, 0, 0), 8, 8);
+  oc_error e;
+  ck_assert_ptr_null(oc_render_elevation(NULL, &rp, NULL, &e));
+  ck_assert_int_eq(e.code, OC_EINVAL);
+  oc_elevation src = wave_source();
+  src.x1 = src.x0;
+  ck_assert_ptr_null(oc_render_elevation(&src, &rp, NULL, &e));
+  ck_assert(strstr(e.msg, "domain"));
+  src = wave_source();
+  src.slope = NULL;
+  ck_assert_ptr_null(oc_render_elevation(&src, &rp, NULL, &e));
+  ck_assert(strstr(e.msg, "slope"));
+  src = wave_source();
+  rp.camera.fov = 0;
+  ck_assert_ptr_null(oc_render_elevation(&src, &rp, NULL, &e));
+  ck_assert(strstr(e.msg, "'camera.fov'"));
+}
+END_TEST
+
+static Suite *suite(void) {
+  Suite *s = suite_create("etrace");
+  TCase *t = tcase_create("tracing");
+  tcase_set_timeout(t, 300);
+  tcase_add_test(t, heightfield_against_march);
+  tcase_add_test(t, analytic_against_march);
+  tcase_add_test(t, weight_makes_holes);
+  suite_add_tcase(s, t);
+  t = tcase_create("rendering");
+  tcase_set_timeout(t, 300);
+  tcase_add_test(t, render_heightfield);
+  tcase_add_test(t, cancelled);
+  tcase_add_test(t, bad_sources);
+  suite_add_tcase(s, t);
+  return s;
+}
+
+int main(void) {
+  return oct_run(suite());
+}

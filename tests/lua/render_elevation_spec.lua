@@ -1,0 +1,145 @@
+-- render_elevation_spec.lua — outcrop.render of a heightfield: the
+-- surface z = h(x, y) traced directly (no implicitization) with the
+-- accelerated or the sphere tracer, the image's size and AOVs against the
+-- grid, a golden-ish colour check, the height-call statistics, and option
+-- errors naming the field.
+local oc = require "outcrop"
+require "helpers.gcstress" -- OUTCROP_GC_STRESS: eager collector
+local R = require "helpers.ref"
+
+local F = "render_elevation_spec.lua"
+local HF = oc.heightfield
+
+-- 1 km of fBm hills, 120 m of relief
+local function hills()
+  return HF.fbm{size = {129, 129}, cell = 8, wavelength = 300, amplitude = 120, octaves = 6, seed = 7}
+end
+
+-- Mean linear R, G, B over the pixels that see the surface, and their count.
+local function mean_rgb(img)
+  local w, h = img:size()
+  local s, n = {0, 0, 0}, 0
+  for j = 1, h do
+    for i = 1, w do
+      local r, g, b, _, Z = img:get(i, j)
+      if Z < math.huge then
+        n = n + 1
+        s[1], s[2], s[3] = s[1] + r, s[2] + g, s[3] + b
+      end
+    end
+  end
+  return s[1] / n, s[2] / n, s[3] / n, n
+end
+
+describe("outcrop.render of a heightfield", function()
+  local hf = hills()
+
+  it("frames the grid by default and returns the statistics", function()
+    local img, st = oc.render(hf, {size = {48, 27}})
+    local w, h = img:size()
+    assert.are.equal(48, w)
+    assert.are.equal(27, h)
+    assert.are.equal(12, img:channels())
+    assert.are.equal(48 * 27, st.pixels)
+    -- the block fills the middle of the view, the sky its corners
+    assert.is_true(st.hits > st.pixels / 8 and st.hits < st.pixels / 2)
+    assert.are.equal(1, select(4, img:get(24, 14)))
+    assert.is_true(select(5, img:get(1, 1)) == math.huge)
+    assert.is_true(st.calls_per_pixel > 1 and st.calls_per_pixel < 30)
+    assert.is_true(st.calls_total > st.calls) -- shadow rays and AO
+  end)
+
+  it("puts the centre pixel's Z and P on the grid's surface", function()
+    -- the centre ray of an odd-sized view goes through the target
+    local x, y = 430, 610
+    local z = hf:height(x, y)
+    local eye = {x - 60, y - 80, z + 400}
+    local img = oc.render(hf, {size = {31, 21}, camera = {eye = eye, target = {x, y, z}}})
+    local d = math.sqrt(60 ^ 2 + 80 ^ 2 + 400 ^ 2)
+    local _, _, _, a, Z, nx, ny, nz, px, py, pz = img:get(16, 11)
+    assert.are.equal(1, a)
+    assert.is_true(math.abs(Z - d) < 1e-3 * d, "Z " .. Z .. ", want " .. d)
+    assert.is_true(math.abs(px - x) < 0.5 and math.abs(py - y) < 0.5)
+    assert.is_true(math.abs(pz - hf:height(px, py)) < 1e-2)
+    -- the normal from the grid's gradient
+    local gx, gy = hf:gradient(px, py)
+    local l = math.sqrt(1 + gx * gx + gy * gy)
+    assert.is_true(math.abs(nx + gx / l) < 1e-3 and math.abs(ny + gy / l) < 1e-3 and math.abs(nz - 1 / l) < 1e-3)
+  end)
+
+  it("draws the same picture with either tracer, the accelerated one cheaper", function()
+    local opts = {size = {64, 36}}
+    local a, sa = oc.render(hf, opts)
+    opts.tracer = "sphere"
+    local b, sb = oc.render(hf, opts)
+    -- (at this coarse size most calls locate the hits and take the
+    -- normals, which both tracers share)
+    assert.is_true(sb.calls > 1.3 * sa.calls, sb.calls .. " vs " .. sa.calls)
+    local r1, g1, b1, n1 = mean_rgb(a)
+    local r2, g2, b2, n2 = mean_rgb(b)
+    assert.is_true(math.abs(n1 - n2) <= 3)
+    assert.is_true(math.abs(r1 - r2) < 0.01 and math.abs(g1 - g2) < 0.01 and math.abs(b1 - b2) < 0.01)
+    -- golden-ish: the mean colour of the surface in this view, measured
+    -- when written (rock, grass and snow on the block's top, its sides)
+    assert.is_true(math.abs(n1 - 508) <= 3)
+    local want = {0.4232, 0.4220, 0.3204}
+    local got = {r1, g1, b1}
+    for k = 1, 3 do
+      assert.is_true(math.abs(got[k] - want[k]) < 0.02, ("channel %d: %.4f, want %.4f"):format(k, got[k], want[k]))
+    end
+  end)
+
+  it("takes every colour source", function()
+    local calls = 0
+    local img = oc.render(hf, {size = {16, 9}, color = function(x, y, z, nx, ny, nz)
+      calls = calls + 1
+      return 1, 0, 0
+    end, ao = false, shadows = false, texture = 0})
+    assert.is_true(calls > 16)
+    local r, g, b = img:get(8, 5)
+    assert.is_true(r > 0 and g == 0 and b == 0)
+    local strata = oc.point{center = {512, 512, 60}, radius = 2000}
+    img = oc.render(hf, {size = {16, 9}, color = strata})
+    assert.are.equal(1, select(4, img:get(8, 5)))
+  end)
+
+  it("keeps the grid alive while a colour function closes it", function()
+    local doomed = hills()
+    local img = oc.render(doomed, {size = {16, 9}, color = function()
+      do local _ <close> = doomed end -- deferred: the render pins it
+      return 0.5, 0.5, 0.5
+    end})
+    assert.are.equal(1, select(4, img:get(8, 5)))
+    R.check_error(function() oc.render(doomed, {size = {4, 4}}) end, F, "outcrop.render", "closed")
+  end)
+
+  it("is the same across calls", function()
+    local a = oc.render(hf, {size = {24, 16}})
+    local b = oc.render(hf, {size = {24, 16}})
+    for j = 1, 16 do
+      for i = 1, 24 do
+        local p = {a:get(i, j)}
+        local q = {b:get(i, j)}
+        for c = 1, 12 do assert.are.equal(p[c], q[c]) end
+      end
+    end
+  end)
+
+  it("checks its options and names the field", function()
+    R.check_error(function() oc.render(5) end, F, "outcrop.render", "argument #1 must be an outcrop node or a heightfield")
+    R.check_error(function() oc.render(hf, {tracer = "fast"}) end, F, "outcrop.render", "'tracer' must be one of", "\"sphere\"")
+    R.check_error(function() oc.render(hf, {size = {0, 4}}) end, F, "outcrop.render", "'size'")
+    R.check_error(function() oc.render(hf, {sise = {4, 4}}) end, F, "outcrop.render", "unknown field 'sise'")
+    R.check_error(function() oc.render(hf, {camera = {fov = 200}}) end, F, "outcrop.render", "'camera.fov'")
+    R.check_error(function() oc.render(hf, {threshold = -1}) end, F, "outcrop.render", "'threshold'")
+    R.check_error(function() oc.render(hf, {exposure = 99}) end, F, "outcrop.render", "'exposure'")
+    R.check_error(function() oc.render(hf, {color = 3}) end, F, "outcrop.render", "'color' must be")
+    R.check_error(function() oc.render(hf, {size = {4, 4}, camera = {eye = {0, 0, 9}, target = {0, 0, 9}}}) end, F, "outcrop.render", "'camera.target'")
+    local gone
+    do
+      local g <close> = hills()
+      gone = g
+    end
+    R.check_error(function() oc.render(gone, {size = {4, 4}}) end, F, "outcrop.render", "closed")
+  end)
+end)
