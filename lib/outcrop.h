@@ -1273,6 +1273,10 @@ const char *oc_enode_kind(const oc_enode *e);
 
 /* f, alpha and their gradients at (x, y); NaN in gives NaN out. */
 void oc_enode_eval(const oc_enode *e, double x, double y, oc_enode_sample *s);
+/* alpha alone (cheaper: no gradients, f skipped where alpha = 0); the
+** terrain is where it is >= OC_ENODE_T. */
+#define OC_ENODE_T 0.5
+double oc_enode_weight(const oc_enode *e, double x, double y);
 /* The box holding Omega_0 (x0, y0, x1, y1) and the range of f over the
 ** plane; the Lipschitz bound of f over the plane. */
 void oc_enode_get_bounds(const oc_enode *e, double box[4], double *flo,
@@ -1295,8 +1299,13 @@ typedef struct oc_enode_stats {
 /* OC_OK, or OC_ENOMEM with err. */
 int oc_enode_get_stats(const oc_enode *e, oc_enode_stats *st, oc_error *err);
 
+/* A box (x0, y0, x1, y1) holding the terrain, Omega_T = {alpha >= 1/2},
+** from the tree's bounds (conservative, within 1/128 of Omega_0's box of
+** the true one); 0 when the tree has no terrain. */
+int oc_enode_terrain_box(const oc_enode *e, double box[4]);
+
 /* An elevation source (for oc_terrain, oc_heightfield_from_elevation…)
-** over domain (x0, y0, x1, y1; NULL: the box of Omega_0): height f,
+** over domain (x0, y0, x1, y1; NULL: oc_enode_terrain_box): height f,
 ** ranges and slopes from the tree's own bounds. Holds one reference to
 ** e. OC_OK, or OC_EINVAL with err for an empty or infinite domain. */
 int oc_enode_elevation(oc_enode *e, const double *domain, oc_elevation *src,

@@ -126,6 +126,172 @@ static int l_disc(lua_State *L) {
   return setenode(L, u, oc_enode_disc(&p, &err), &err, fname);
 }
 
+/* ---- curves ----------------------------------------------------------- */
+
+#define MAX_POINTS (1 << 20)
+
+/* points = {{x, y, z}, ...}: pushed as a Lua-owned array (no leak on
+** error); raw reads, so no metamethod runs. */
+static oc_vec3 *read_points(oclua_fields *f, size_t *n) {
+  lua_State *L = f->L;
+  if (oclua_field_push(f, "points") != LUA_TTABLE)
+    oclua_field_error(f, "points", -1, "must be an array of {x, y, z}");
+  int t = lua_gettop(L);
+  lua_Integer m = (lua_Integer)lua_rawlen(L, t);
+  if (m < 2)
+    oclua_error(L, f->fname, "'points' must hold at least 2 points (got %I)",
+                m);
+  if (m > MAX_POINTS)
+    oclua_error(L, f->fname, "'points': %I points, at most %d", m, MAX_POINTS);
+  oc_vec3 *p = lua_newuserdatauv(L, (size_t)m * sizeof *p, 0);
+  for (lua_Integer i = 1; i <= m; i++) {
+    lua_rawgeti(L, t, i);
+    p[i - 1] = oclua_tovec(L, -1, f->fname, "points", i);
+    lua_pop(L, 1);
+  }
+  *n = (size_t)m;
+  return p; /* the table and the array stay on the stack */
+}
+
+static oc_ecurve_spline read_spline(oclua_fields *f) {
+  static const char *const splines[] = {"catmull", "bezier", "linear", NULL};
+  return (oc_ecurve_spline)oclua_field_optoption(f, "spline", splines, 0);
+}
+
+/* knots = {{d, v}, ...} at stack index idx into Lua-owned arrays. */
+static size_t read_knots(lua_State *L, int idx, const char *fname,
+                         const char *label, const double **d,
+                         const double **v) {
+  if (!lua_istable(L, idx))
+    oclua_error(L, fname, "'%s' must be an array of {d, v} (got %s)", label,
+                oclua_got(L, idx));
+  lua_Integer m = (lua_Integer)lua_rawlen(L, idx);
+  if (m < 2)
+    oclua_error(L, fname, "'%s' must hold at least 2 knots {d, v} (got %I)",
+                label, m);
+  if (m > MAX_POINTS)
+    oclua_error(L, fname, "'%s': %I knots, at most %d", label, m, MAX_POINTS);
+  double *a = lua_newuserdatauv(L, 2 * (size_t)m * sizeof *a, 0);
+  for (lua_Integer i = 1; i <= m; i++) {
+    lua_rawgeti(L, idx, i);
+    int ok = lua_istable(L, -1) && lua_rawlen(L, -1) == 2;
+    for (int k = 1; ok && k <= 2; k++) {
+      lua_rawgeti(L, -1, k);
+      ok = lua_type(L, -1) == LUA_TNUMBER && isfinite(lua_tonumber(L, -1));
+      if (ok) a[(k - 1) * m + (i - 1)] = lua_tonumber(L, -1);
+      lua_pop(L, 1);
+    }
+    if (!ok)
+      oclua_error(L, fname, "'%s[%I]' must be {d, v} with finite numbers", label,
+                  i);
+    lua_pop(L, 1);
+  }
+  *d = a;
+  *v = a + m;
+  return (size_t)m;
+}
+
+static int l_curve(lua_State *L) {
+  static const char *const known[] = {"points", "radius",  "core", "spline",
+                                      "profile", "profiles", NULL};
+  const char *fname = "outcrop.elevation.curve";
+  oclua_fields f;
+  oclua_checkargs(L, 1, fname, "a table of named fields");
+  oclua_fields_open(&f, L, 1, fname, NULL, known, 0);
+  oc_enode_curve_params p = {0};
+  p.points = read_points(&f, &p.npoints);
+  p.spline = read_spline(&f);
+  p.radius = oclua_field_number(&f, "radius", OCLUA_POSITIVE);
+  p.core = oclua_field_optnumber(&f, "core", OCLUA_FINITE, 0);
+  int one = oclua_field_push(&f, "profile") != LUA_TNIL;
+  int many = oclua_field_push(&f, "profiles") != LUA_TNIL;
+  if (one == many)
+    oclua_error(L, fname, "give either 'profile' = {{d, v}, ...} or "
+                          "'profiles' = {{at =, knots = {{d, v}, ...}}, ...}");
+  oc_enode_profile *pr;
+  if (one) {
+    pr = lua_newuserdatauv(L, sizeof *pr, 0);
+    pr->at = 0;
+    pr->n = read_knots(L, lua_gettop(L) - 2, fname, "profile", &pr->d, &pr->v);
+    p.nprofiles = 1;
+  } else {
+    int t = lua_gettop(L);
+    if (!lua_istable(L, t))
+      oclua_field_error(&f, "profiles", t, "must be an array of {at =, knots =}");
+    lua_Integer m = (lua_Integer)lua_rawlen(L, t);
+    if (m < 1 || m > 4096)
+      oclua_error(L, fname, "'profiles' must hold 1 to 4096 profiles (got %I)",
+                  m);
+    luaL_checkstack(L, (int)m + 8, "too many profiles");
+    pr = lua_newuserdatauv(L, (size_t)m * sizeof *pr, 0);
+    for (lua_Integer i = 1; i <= m; i++) {
+      char label[48];
+      snprintf(label, sizeof label, "profiles[%lld]", (long long)i);
+      if (lua_rawgeti(L, t, i) != LUA_TTABLE)
+        oclua_error(L, fname, "'%s' must be {at =, knots = {{d, v}, ...}}",
+                    label);
+      lua_getfield(L, -1, "at");
+      if (lua_type(L, -1) != LUA_TNUMBER)
+        oclua_error(L, fname, "'%s.at' must be a number in [0, 1]", label);
+      pr[i - 1].at = lua_tonumber(L, -1);
+      lua_pop(L, 1);
+      lua_getfield(L, -1, "knots");
+      snprintf(label, sizeof label, "profiles[%lld].knots", (long long)i);
+      pr[i - 1].n = read_knots(L, lua_gettop(L), fname, label, &pr[i - 1].d,
+                               &pr[i - 1].v);
+      /* keep the knots' array on the stack, drop the tables above it */
+      lua_replace(L, -3);
+      lua_pop(L, 1);
+    }
+    p.nprofiles = (size_t)m;
+  }
+  p.profiles = pr;
+  oc_error err = {OC_OK, ""};
+  oclua_enode *u = newenode(L);
+  return setenode(L, u, oc_enode_curve(&p, &err), &err, fname);
+}
+
+static int l_river(lua_State *L) {
+  static const char *const known[] = {"points", "kind",  "width", "depth",
+                                      "bank",   "spline", NULL};
+  static const char *const kinds[] = {"stream", "river", "meander", "main",
+                                      NULL};
+  const char *fname = "outcrop.elevation.river";
+  oclua_fields f;
+  oclua_checkargs(L, 1, fname, "a table of named fields");
+  oclua_fields_open(&f, L, 1, fname, NULL, known, 0);
+  oc_enode_river_params p = {0};
+  p.points = read_points(&f, &p.npoints);
+  p.spline = read_spline(&f);
+  p.kind = (oc_river_kind)oclua_field_optoption(&f, "kind", kinds, 1);
+  p.width = oclua_field_optnumber(&f, "width", OCLUA_POSITIVE, 0);
+  p.depth = oclua_field_optnumber(&f, "depth", OCLUA_POSITIVE, 0);
+  p.bank = oclua_field_optnumber(&f, "bank", OCLUA_POSITIVE, 0);
+  oc_error err = {OC_OK, ""};
+  oclua_enode *u = newenode(L);
+  return setenode(L, u, oc_enode_river(&p, &err), &err, fname);
+}
+
+static int l_road(lua_State *L) {
+  static const char *const known[] = {"points",     "width",  "shoulder",
+                                      "embankment", "spline", NULL};
+  const char *fname = "outcrop.elevation.road";
+  oclua_fields f;
+  oclua_checkargs(L, 1, fname, "a table of named fields");
+  oclua_fields_open(&f, L, 1, fname, NULL, known, 0);
+  oc_enode_road_params p = {0};
+  p.points = read_points(&f, &p.npoints);
+  p.spline = read_spline(&f);
+  p.width = oclua_field_optnumber(&f, "width", OCLUA_POSITIVE, 7);
+  p.shoulder = oclua_field_optnumber(&f, "shoulder", OCLUA_FINITE, 1.5);
+  if (p.shoulder < 0)
+    oclua_error(L, fname, "'shoulder' must be >= 0 (got %f)", p.shoulder);
+  p.embankment = oclua_field_optnumber(&f, "embankment", OCLUA_POSITIVE, 12);
+  oc_error err = {OC_OK, ""};
+  oclua_enode *u = newenode(L);
+  return setenode(L, u, oc_enode_road(&p, &err), &err, fname);
+}
+
 /* ---- operators -------------------------------------------------------- */
 
 static int l_blend(lua_State *L) {
@@ -350,7 +516,8 @@ void oclua_open_elevation(lua_State *L) {
       {"stats", e_stats},   {"kind", e_kind},
       {NULL, NULL}};
   static const luaL_Reg funcs[] = {
-      {"disc", l_disc}, {"blend", l_blend}, {"replace", l_replace},
+      {"disc", l_disc},   {"curve", l_curve},   {"river", l_river},
+      {"road", l_road},   {"blend", l_blend}, {"replace", l_replace},
       {"add", l_add},   {"warp", l_warp},   {"transform", l_transform},
       {NULL, NULL}};
   oclua_newmeta(L, OCLUA_ELEVATION, meta, methods);

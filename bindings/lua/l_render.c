@@ -36,6 +36,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "l_elevation.h"
 #include "l_field.h"
 #include "l_heightfield.h"
 #include "l_image.h"
@@ -406,6 +407,7 @@ static int surface_gc(lua_State *L) {
 ** (a guard slot the caller keeps) before any option is read, so no
 ** metamethod of the options can close it. */
 static int pin_surface(lua_State *L, int idx) {
+  if (oclua_testenode(L, idx)) return 1; /* immutable: on the stack */
   if (!oclua_isheightfield(L, idx)) return 0;
   oclua_pinheightfield(L, idx, FNAME);
   return 1;
@@ -417,8 +419,13 @@ static int pin_surface(lua_State *L, int idx) {
 ** turns into an oc_esurface: heightfields now (no holes); the elevation
 ** trees of issue 14 will set es.weight and es.wud to their alpha (no
 ** terrain where alpha < T, the trees' Omega_T). */
+static double tree_weight(void *wud, double x, double y) {
+  return oc_enode_weight(wud, x, y);
+}
+
 static const oc_esurface *surface_at(lua_State *L, int idx, double T) {
-  oc_heightfield *hf = oclua_checkheightfield(L, idx, FNAME);
+  oc_enode *tree = oclua_testenode(L, idx);
+  oc_heightfield *hf = tree ? NULL : oclua_checkheightfield(L, idx, FNAME);
   lsurface *s = lua_newuserdatauv(L, sizeof *s, 0);
   memset(s, 0, sizeof *s);
   if (luaL_newmetatable(L, SURFACE_MT)) {
@@ -427,13 +434,15 @@ static const oc_esurface *surface_at(lua_State *L, int idx, double T) {
   }
   lua_setmetatable(L, -2);
   oc_error err = {OC_OK, ""};
-  if (oc_heightfield_elevation(hf, &s->src, &err) != OC_OK)
+  if ((tree ? oclua_toelevation(L, idx, NULL, &s->src, &err)
+            : oc_heightfield_elevation(hf, &s->src, &err)) != OC_OK)
     oclua_liberror(L, FNAME, &err);
   s->has_src = 1;
   s->es.src = &s->src;
-  s->es.weight = NULL;
-  s->es.wud = NULL;
-  s->es.T = T;
+  /* a tree's terrain is where its weight reaches 1/2 (Omega_T) */
+  s->es.weight = tree ? tree_weight : NULL;
+  s->es.wud = tree;
+  s->es.T = tree ? OC_ENODE_T : T;
   return &s->es;
 }
 
@@ -503,14 +512,18 @@ static int l_render(lua_State *L) {
   source src;
   double bg[4] = {0, 0, 0, 1};
   oclua_checkargs(L, 2, FNAME,
-                  "(node or heightfield, {camera =, size =, sun =, sky =, "
+                  "(node, heightfield or elevation tree, {camera =, size =, "
+                  "sun =, sky =, "
                   "shadows =, ao =, fog =, color =, background =, aov =, "
                   "...})");
-  if (!oclua_isheightfield(L, 1) && !oclua_testnode(L, 1))
+  int tree = oclua_testenode(L, 1) != NULL;
+  if (!tree && !oclua_isheightfield(L, 1) && !oclua_testnode(L, 1))
     oclua_error(L, FNAME,
-                "argument #1 must be an outcrop node or a heightfield (got %s)",
+                "argument #1 must be an outcrop node or a heightfield (or an "
+                "elevation tree) (got %s)",
                 oclua_got(L, 1));
-  if (!oclua_isheightfield(L, 1)) oclua_checknode(L, 1, FNAME, "argument #1");
+  if (!tree && !oclua_isheightfield(L, 1))
+    oclua_checknode(L, 1, FNAME, "argument #1");
   lua_settop(L, 2);
   if (lua_isnil(L, 2)) {
     lua_newtable(L);

@@ -103,6 +103,13 @@ void oc_enode_eval(const oc_enode *e, double x, double y, oc_enode_sample *s) {
   oc_enode_ev(e, x, y, OC_EV_GRAD, s);
 }
 
+double oc_enode_weight(const oc_enode *e, double x, double y) {
+  if (!isfinite(x) || !isfinite(y)) return NAN;
+  oc_enode_sample s;
+  oc_enode_ev(e, x, y, OC_EV_LAZY, &s);
+  return s.a;
+}
+
 void oc_enode_get_bounds(const oc_enode *e, double box[4], double *flo,
                          double *fhi) {
   if (box) {
@@ -160,6 +167,39 @@ done:
   return rc;
 }
 
+/* ---- where the terrain is --------------------------------------------- */
+
+/* Grows *acc by the parts of r where alpha may reach T, splitting r in four
+** down to depth 0. */
+static void terrain_cells(const oc_enode *e, oc_erect r, int depth,
+                          oc_erect *acc) {
+  oc_ebound b;
+  oc_enode_bnd(e, &r, &b);
+  if (!(b.ahi >= OC_ENODE_T)) return;
+  if (depth == 0 || b.alo >= OC_ENODE_T) {
+    acc->x0 = fmin(acc->x0, r.x0);
+    acc->y0 = fmin(acc->y0, r.y0);
+    acc->x1 = fmax(acc->x1, r.x1);
+    acc->y1 = fmax(acc->y1, r.y1);
+    return;
+  }
+  double mx = (r.x0 + r.x1) / 2, my = (r.y0 + r.y1) / 2;
+  oc_erect q[4] = {{r.x0, r.y0, mx, my},
+                   {mx, r.y0, r.x1, my},
+                   {r.x0, my, mx, r.y1},
+                   {mx, my, r.x1, r.y1}};
+  for (int k = 0; k < 4; k++)
+    terrain_cells(e, q[k], depth - 1, acc);
+}
+
+int oc_enode_terrain_box(const oc_enode *e, double box[4]) {
+  oc_erect acc = {INFINITY, INFINITY, -INFINITY, -INFINITY};
+  terrain_cells(e, e->box, 7, &acc);
+  if (!(acc.x0 < acc.x1 && acc.y0 < acc.y1)) return 0;
+  box[0] = acc.x0, box[1] = acc.y0, box[2] = acc.x1, box[3] = acc.y1;
+  return 1;
+}
+
 /* ---- the elevation source --------------------------------------------- */
 
 static double src_height(void *ud, double x, double y, double grad[2]) {
@@ -198,7 +238,12 @@ static void src_release(void *ud) {
 int oc_enode_elevation(oc_enode *e, const double *domain, oc_elevation *src,
                        oc_error *err) {
   double d[4] = {e->box.x0, e->box.y0, e->box.x1, e->box.y1};
-  if (domain) memcpy(d, domain, sizeof d);
+  if (domain)
+    memcpy(d, domain, sizeof d);
+  else if (!oc_enode_terrain_box(e, d))
+    return oc_seterr(err, OC_EINVAL,
+                     "the tree has no terrain (its weight never reaches "
+                     "1/2): add a base primitive that covers the scene");
   if (!(isfinite(d[0]) && isfinite(d[1]) && isfinite(d[2]) && isfinite(d[3]) &&
         d[0] < d[2] && d[1] < d[3]))
     return oc_seterr(err, OC_EINVAL,

@@ -22,7 +22,6 @@
 
 #include "outcrop.h"
 
-#define OC_ENODE_T 0.5
 
 typedef enum oc_ekind {
   OC_E_DISC,
