@@ -19,6 +19,7 @@
 #include "core/vec.h"
 #include "geology/geology.h"
 #include "field/node.h"
+#include "field/bvhwalk.h"
 #include "field/prim.h"
 #include "field/program.h"
 #include "terrain/terrain.h"
@@ -429,215 +430,267 @@ fail:
 
 static uint32_t scaled(comp *c, uint32_t kid, double f);
 
-/* Builds a blend or union op over leaves. */
-static uint32_t make_group(comp *c, oc_kind kind, const leaf *lv, size_t nl) {
-  int is_blend = kind == OC_K_BLEND;
-  size_t npoints = 0;
-  for (size_t i = 0; i < nl; i++)
-    if (lv[i].node->kind == OC_K_POINT) npoints++;
-  int inl = npoints >= INLINE_MIN;
-  /* compile non-inline children first (their ops precede ours) */
-  oc_aabb *box = malloc((nl ? nl : 1) * sizeof *box);
-  oc_ent *ent = malloc((nl ? nl : 1) * sizeof *ent);
-  double *lip = malloc((nl ? nl : 1) * sizeof *lip);
-  uint32_t *unb = malloc((nl ? nl : 1) * sizeof *unb);
-  uint32_t *perm = NULL;
-  oc_bvhnode *nodes = NULL;
-  uint32_t op = OC_NONE;
-  if (!box || !ent || !lip || !unb) {
-    nomem(c);
-    goto done;
-  }
-  size_t nent = 0, nunb = 0, ncount = 0;
-  double lo = is_blend ? 0 : -INFINITY, hi = is_blend ? 0 : -INFINITY;
-  double lipmax = 0, lipunb = 0;
-  int depth = 0;
-  oc_aabb all = oc_aabb_empty();
+/* A group under construction: its bounded children ("entries": inline
+** points or ops, each with its box and Lipschitz bound), its unbounded
+** ones, always evaluated, its BVH, and what it knows of its value. */
+typedef struct group {
+  int is_blend, inl;
+  oc_aabb *box; /* per entry */
+  oc_ent *ent;
+  double *lip;
+  size_t nent;
+  uint32_t *unb; /* unbounded children's ops */
+  size_t nunb;
+  size_t ncount;  /* children with a non-zero weight */
+  double lo, hi;  /* value range */
+  double lipmax;  /* largest child bound (unions) */
+  double lipunb;  /* sum of the unbounded children's bounds (blends) */
+  int depth;      /* deepest child */
+  oc_aabb all;    /* union of the supports */
+  uint32_t *perm; /* BVH order of the entries */
+  oc_bvhnode *nodes;
+  size_t nnodes;
+} group;
+
+static void group_free(group *g) {
+  free(g->box);
+  free(g->ent);
+  free(g->lip);
+  free(g->unb);
+  free(g->perm);
+  free(g->nodes);
+}
+
+/* An inline point entry, weighted by w; its box and bound are those of
+** what is stored, single precision, with a margin for the rounding. */
+static void inline_point(const oc_node *n, double w, oc_ent *e, oc_aabb *cb,
+                         double *clo, double *chi, double *clip) {
+  double R = n->par[OC_P_R];
+  e->c[0] = (float)n->par[OC_P_C];
+  e->c[1] = (float)n->par[OC_P_C + 1];
+  e->c[2] = (float)n->par[OC_P_C + 2];
+  e->ir2 = (float)(1.0 / (R * R));
+  e->e = (float)(n->par[OC_P_E] * w);
+  e->ref = OC_NONE;
+  double Rf = 1.0 / sqrt((double)e->ir2) * (1 + 1e-6);
+  oc_vec3 cf = oc_v3(e->c[0], e->c[1], e->c[2]);
+  cb->lo = oc_sub(cf, oc_v3(Rf, Rf, Rf));
+  cb->hi = oc_add(cf, oc_v3(Rf, Rf, Rf));
+  *clo = fmin(0, e->e);
+  *chi = fmax(0, e->e);
+  *clip = fabs((double)e->e) * OC_FALLOFF_LIPSCHITZ / R * (1 + 1e-6);
+}
+
+/* Step 1: compiles the children that are not inline points (their ops
+** precede the group's), sorts them into entries and unbounded children,
+** and sums up their value ranges and bounds. */
+static int group_children(comp *c, group *g, const leaf *lv, size_t nl) {
+  int is_blend = g->is_blend;
+  g->lo = g->hi = is_blend ? 0 : -INFINITY;
+  g->all = oc_aabb_empty();
   for (size_t i = 0; i < nl; i++) {
     const oc_node *n = lv[i].node;
     double w = is_blend ? lv[i].w : 1;
     if (w == 0) continue;
-    ncount++;
+    g->ncount++;
     double clo, chi, clip;
     oc_aabb cb;
-    if (inl && n->kind == OC_K_POINT) {
-      oc_ent *e = &ent[nent];
-      double R = n->par[OC_P_R];
-      e->c[0] = (float)n->par[OC_P_C];
-      e->c[1] = (float)n->par[OC_P_C + 1];
-      e->c[2] = (float)n->par[OC_P_C + 2];
-      e->ir2 = (float)(1.0 / (R * R));
-      e->e = (float)(n->par[OC_P_E] * w);
-      e->ref = OC_NONE;
-      /* the support of what is stored, with a margin for float rounding */
-      double Rf = 1.0 / sqrt((double)e->ir2) * (1 + 1e-6);
-      oc_vec3 cf = oc_v3(e->c[0], e->c[1], e->c[2]);
-      cb.lo = oc_sub(cf, oc_v3(Rf, Rf, Rf));
-      cb.hi = oc_add(cf, oc_v3(Rf, Rf, Rf));
-      clo = fmin(0, e->e);
-      chi = fmax(0, e->e);
-      clip = fabs((double)e->e) * OC_FALLOFF_LIPSCHITZ / R * (1 + 1e-6);
+    if (g->inl && n->kind == OC_K_POINT) {
+      inline_point(n, w, &g->ent[g->nent], &cb, &clo, &chi, &clip);
     } else {
       uint32_t k = compile_node(c, n);
-      if (k == OC_NONE) goto done;
-      if (w != 1 && (k = scaled(c, k, w)) == OC_NONE) goto done;
+      if (k == OC_NONE) return -1;
+      if (w != 1 && (k = scaled(c, k, w)) == OC_NONE) return -1;
       info *ci = &c->inf[k];
       cb = ci->box;
       clo = ci->lo;
       chi = ci->hi;
       clip = ci->lip;
-      if (ci->depth > depth) depth = ci->depth;
+      if (ci->depth > g->depth) g->depth = ci->depth;
       if (!oc_aabb_is_bounded(cb)) {
-        unb[nunb++] = k;
-        lipunb += clip;
+        g->unb[g->nunb++] = k;
+        g->lipunb += clip;
         goto acc;
       }
-      ent[nent].ref = k;
-      memset(ent[nent].c, 0, sizeof ent[nent].c);
-      ent[nent].ir2 = ent[nent].e = 0;
+      oc_ent *e = &g->ent[g->nent];
+      e->ref = k;
+      memset(e->c, 0, sizeof e->c);
+      e->ir2 = e->e = 0;
     }
     if (oc_aabb_is_empty(cb)) continue; /* identically zero */
-    box[nent] = cb;
-    lip[nent] = clip;
-    nent++;
+    g->box[g->nent] = cb;
+    g->lip[g->nent] = clip;
+    g->nent++;
   acc:
-    all = oc_aabb_union(all, cb);
+    g->all = oc_aabb_union(g->all, cb);
     if (is_blend) {
-      lo += clo;
-      hi += chi;
+      g->lo += clo;
+      g->hi += chi;
     } else {
-      lo = fmax(lo, clo);
-      hi = fmax(hi, chi);
-      lipmax = fmax(lipmax, clip);
+      g->lo = fmax(g->lo, clo);
+      g->hi = fmax(g->hi, chi);
+      g->lipmax = fmax(g->lipmax, clip);
     }
   }
-  if (!is_blend && ncount == 0) lo = hi = 0;
-  if (!is_blend && ncount > nent + nunb) { /* identically zero children */
-    lo = fmax(lo, 0);
-    hi = fmax(hi, 0);
+  if (!is_blend && g->ncount == 0) g->lo = g->hi = 0;
+  if (!is_blend && g->ncount > g->nent + g->nunb) {
+    /* identically zero children */
+    g->lo = fmax(g->lo, 0);
+    g->hi = fmax(g->hi, 0);
   }
-  /* A bounded child spanning most of the group (a terrain under scattered
-  ** features) would sit in every BVH path and every query would descend
-  ** to its leaf: evaluate it always, as the unbounded ones. */
-  if (nent > 2 * OC_BVH_LEAF) {
-    size_t keep = 0;
-    for (size_t i = 0; i < nent; i++) {
-      int wide = 0;
-      for (int a = 0; a < 2; a++) {
-        double ga = a ? all.hi.y - all.lo.y : all.hi.x - all.lo.x;
-        double ca = a ? box[i].hi.y - box[i].lo.y : box[i].hi.x - box[i].lo.x;
-        wide += ca > 0.5 * ga;
-      }
-      if (wide == 2 && ent[i].ref != OC_NONE) {
-        unb[nunb++] = ent[i].ref;
-        lipunb += lip[i];
-        continue;
-      }
-      box[keep] = box[i];
-      ent[keep] = ent[i];
-      lip[keep] = lip[i];
-      keep++;
+  return 0;
+}
+
+/* Step 2: a bounded child spanning most of the group (a terrain under
+** scattered features) would sit in every BVH path and every query would
+** descend to its leaf: it is evaluated always, as the unbounded ones. */
+static void group_hoist_wide(group *g) {
+  if (g->nent <= 2 * OC_BVH_LEAF) return;
+  size_t keep = 0;
+  for (size_t i = 0; i < g->nent; i++) {
+    int wide = 0;
+    for (int a = 0; a < 2; a++) {
+      double ga = a ? g->all.hi.y - g->all.lo.y : g->all.hi.x - g->all.lo.x;
+      double ca =
+          a ? g->box[i].hi.y - g->box[i].lo.y : g->box[i].hi.x - g->box[i].lo.x;
+      wide += ca > 0.5 * ga;
     }
-    nent = keep;
-  }
-  /* BVH over bounded entries (also used for the Lipschitz bound) */
-  size_t nnodes = 0;
-  if (nent) {
-    perm = malloc(nent * sizeof *perm);
-    nodes = malloc(2 * nent * sizeof *nodes);
-    if (!perm || !nodes) {
-      nomem(c);
-      goto done;
+    if (wide == 2 && g->ent[i].ref != OC_NONE) {
+      g->unb[g->nunb++] = g->ent[i].ref;
+      g->lipunb += g->lip[i];
+      continue;
     }
-    nnodes = oc_bvh_build(box, nent, nodes, perm);
-    if (!nnodes) {
-      nomem(c);
-      goto done;
-    }
+    g->box[keep] = g->box[i];
+    g->ent[keep] = g->ent[i];
+    g->lip[keep] = g->lip[i];
+    keep++;
   }
-  double lipv;
-  if (is_blend) {
-    /* the largest sum of bounds over children overlapping one child */
-    double best = 0;
-    uint32_t stack[64];
-    for (size_t i = 0; i < nent; i++) {
-      float qlo[3], qhi[3];
-      oc_box_to_float(box[i], qlo, qhi);
-      double s = 0;
-      int sp = 0;
-      stack[sp++] = 0;
-      while (sp) {
-        const oc_bvhnode *nd = &nodes[stack[--sp]];
-        if (nd->lo[0] > qhi[0] || nd->hi[0] < qlo[0] || nd->lo[1] > qhi[1] ||
-            nd->hi[1] < qlo[1] || nd->lo[2] > qhi[2] || nd->hi[2] < qlo[2])
-          continue;
-        if (nd->count) {
-          for (uint32_t j = nd->first; j < nd->first + nd->count; j++)
-            if (oc_aabb_overlaps(box[perm[j]], box[i])) s += lip[perm[j]];
-        } else {
-          stack[sp++] = nd->first;
-          stack[sp++] = nd->first + 1;
-        }
-      }
-      if (s > best) best = s;
-    }
-    lipv = best + lipunb;
-  } else {
-    lipv = lipmax;
+  g->nent = keep;
+}
+
+/* Step 3: the BVH over the entries (also used for the blend's bound),
+** refused when deeper than the walks' stack (bvhwalk.h: it cannot
+** happen, and evaluation has no bound to fall back to). */
+static int group_bvh(comp *c, group *g) {
+  if (!g->nent) return 0;
+  g->perm = malloc(g->nent * sizeof *g->perm);
+  g->nodes = malloc(2 * g->nent * sizeof *g->nodes);
+  if (!g->perm || !g->nodes) return nomem(c);
+  int levels;
+  g->nnodes = oc_bvh_build(g->box, g->nent, g->nodes, g->perm, &levels);
+  if (!g->nnodes) return nomem(c);
+  if (levels > OC_BVH_STACK)
+    return oc_seterr(c->err, OC_ETOODEEP,
+                     "bounding volume hierarchy of %d levels: deeper than "
+                     "its walks allow (%d)",
+                     levels, OC_BVH_STACK);
+  return 0;
+}
+
+/* The largest sum of bounds over the entries overlapping one entry. */
+typedef struct lipsum {
+  const group *g;
+  oc_aabb b;
+  float lo[3], hi[3];
+  double s;
+} lipsum;
+
+static int lipsum_meets(const oc_bvhnode *nd, void *q) {
+  const lipsum *w = q;
+  return !(nd->lo[0] > w->hi[0] || nd->hi[0] < w->lo[0] ||
+           nd->lo[1] > w->hi[1] || nd->hi[1] < w->lo[1] ||
+           nd->lo[2] > w->hi[2] || nd->hi[2] < w->lo[2]);
+}
+
+static int lipsum_leaf(const oc_bvhnode *nd, void *q) {
+  lipsum *w = q;
+  const group *g = w->g;
+  for (uint32_t j = nd->first; j < nd->first + nd->count; j++)
+    if (oc_aabb_overlaps(g->box[g->perm[j]], w->b)) w->s += g->lip[g->perm[j]];
+  return 0;
+}
+
+/* Step 4: the group's Lipschitz bound. A union's is its largest child's;
+** a blend's, the largest sum over children overlapping one child, plus
+** the unbounded children's. */
+static double group_lipschitz(const group *g) {
+  if (!g->is_blend) return g->lipmax;
+  double best = 0, total = 0;
+  for (size_t i = 0; i < g->nent; i++)
+    total += g->lip[i];
+  for (size_t i = 0; i < g->nent; i++) {
+    lipsum w = {g, g->box[i], {0}, {0}, 0};
+    oc_box_to_float(g->box[i], w.lo, w.hi);
+    /* a subtree left out: every entry's bound */
+    if (oc_bvh_walk(g->nodes, 0, lipsum_meets, lipsum_leaf, &w) == OC_WALK_FULL)
+      w.s = total;
+    if (w.s > best) best = w.s;
   }
-  /* emit */
-  op = new_op(c, kind);
-  if (op == OC_NONE) {
-    nomem(c);
-    goto done;
-  }
+  return best + g->lipunb;
+}
+
+/* Step 5: the op, its entries in BVH order and its nodes, re-indexed
+** into the program's arrays. */
+static uint32_t group_emit(comp *c, oc_kind kind, const group *g, double lipv) {
+  uint32_t op = new_op(c, kind);
+  if (op == OC_NONE) return (uint32_t)nomem(c), OC_NONE;
   oc_program *P = c->P;
   oc_op *o = &P->ops[op];
-  o->ntotal = (uint32_t)ncount;
+  o->ntotal = (uint32_t)g->ncount;
   o->nobvh = (uint8_t)c->nobvh;
-  o->kid = add_kids(c, unb, nunb);
-  if (o->kid == OC_NONE) {
-    op = OC_NONE;
-    nomem(c);
-    goto done;
-  }
-  o->nkid = (uint32_t)nunb;
-  if (!GROW(P->ent, P->nent, c->capent, nent) ||
-      !GROW(P->bvh, P->nbvh, c->capbvh, nnodes)) {
-    op = OC_NONE;
-    nomem(c);
-    goto done;
-  }
+  o->kid = add_kids(c, g->unb, g->nunb);
+  if (o->kid == OC_NONE) return (uint32_t)nomem(c), OC_NONE;
+  o->nkid = (uint32_t)g->nunb;
+  if (!GROW(P->ent, P->nent, c->capent, g->nent) ||
+      !GROW(P->bvh, P->nbvh, c->capbvh, g->nnodes))
+    return (uint32_t)nomem(c), OC_NONE;
   o = &P->ops[op];
   o->ent = (uint32_t)P->nent;
-  o->nent = (uint32_t)nent;
-  for (size_t j = 0; j < nent; j++)
-    P->ent[P->nent + j] = ent[perm[j]];
-  P->nent += nent;
-  if (nnodes) {
+  o->nent = (uint32_t)g->nent;
+  for (size_t j = 0; j < g->nent; j++)
+    P->ent[P->nent + j] = g->ent[g->perm[j]];
+  P->nent += g->nent;
+  if (g->nnodes) {
     o->bvh = (uint32_t)P->nbvh;
-    for (size_t j = 0; j < nnodes; j++) {
-      oc_bvhnode nd = nodes[j];
+    for (size_t j = 0; j < g->nnodes; j++) {
+      oc_bvhnode nd = g->nodes[j];
       if (nd.count)
         nd.first += o->ent;
       else
         nd.first += o->bvh;
       P->bvh[P->nbvh + j] = nd;
     }
-    P->nbvh += nnodes;
+    P->nbvh += g->nnodes;
   }
-  c->inf[op].lo = lo;
-  c->inf[op].hi = hi;
+  c->inf[op].lo = g->lo;
+  c->inf[op].hi = g->hi;
   c->inf[op].lip = lipv;
-  c->inf[op].depth = depth + 1;
-  set_box(c, op, all);
-done:
-  free(box);
-  free(ent);
-  free(lip);
-  free(unb);
-  free(perm);
-  free(nodes);
+  c->inf[op].depth = g->depth + 1;
+  set_box(c, op, g->all);
+  return op;
+}
+
+/* Builds a blend or union op over leaves. */
+static uint32_t make_group(comp *c, oc_kind kind, const leaf *lv, size_t nl) {
+  group g = {0};
+  g.is_blend = kind == OC_K_BLEND;
+  size_t npoints = 0;
+  for (size_t i = 0; i < nl; i++)
+    if (lv[i].node->kind == OC_K_POINT) npoints++;
+  g.inl = npoints >= INLINE_MIN;
+  size_t cap = nl ? nl : 1;
+  g.box = malloc(cap * sizeof *g.box);
+  g.ent = malloc(cap * sizeof *g.ent);
+  g.lip = malloc(cap * sizeof *g.lip);
+  g.unb = malloc(cap * sizeof *g.unb);
+  uint32_t op = OC_NONE;
+  if (!g.box || !g.ent || !g.lip || !g.unb)
+    nomem(c);
+  else if (!group_children(c, &g, lv, nl)) {
+    group_hoist_wide(&g);
+    if (!group_bvh(c, &g)) op = group_emit(c, kind, &g, group_lipschitz(&g));
+  }
+  group_free(&g);
   return op;
 }
 

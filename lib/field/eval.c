@@ -10,11 +10,10 @@
 #include "core/rng.h"
 #include "core/vec.h"
 #include "geology/geology.h"
+#include "field/bvhwalk.h"
 #include "field/prim.h"
 #include "field/program.h"
 #include "terrain/terrain.h"
-
-#define BVH_STACK 64
 
 typedef struct noisep {
   double wl, amp, off;
@@ -167,71 +166,74 @@ static inline double ent_eval(const oc_program *P, const oc_ent *e, oc_vec3 p,
   return g ? evg(P, e->ref, p, g) : ev(P, e->ref, p);
 }
 
+/* A group's running result: a union keeps its largest child, a blend
+** sums them. */
+typedef struct gacc {
+  const oc_program *P;
+  oc_vec3 p;
+  int uni, grad;
+  double acc;
+  oc_vec3 gacc;
+  uint32_t visited;
+} gacc;
+
+static inline __attribute__((always_inline)) void take(gacc *a, double v,
+                                                       oc_vec3 gk) {
+  if (a->uni) {
+    if (v > a->acc || a->visited == 0) {
+      a->acc = v;
+      if (a->grad) a->gacc = gk;
+    }
+  } else {
+    a->acc += v;
+    if (a->grad) a->gacc = oc_add(a->gacc, gk);
+  }
+  a->visited++;
+}
+
+static inline __attribute__((always_inline)) void take_ent(gacc *a,
+                                                           const oc_ent *e) {
+  int hit;
+  oc_vec3 gk = oc_v3(0, 0, 0);
+  double v = ent_eval(a->P, e, a->p, a->grad ? &gk : NULL, &hit);
+  if (hit) take(a, v, gk);
+}
+
+static int group_meets(const oc_bvhnode *nd, void *q) {
+  return in_node(nd, ((const gacc *)q)->p);
+}
+
+static int group_leaf(const oc_bvhnode *nd, void *q) {
+  gacc *a = q;
+  for (uint32_t j = nd->first; j < nd->first + nd->count; j++)
+    take_ent(a, &a->P->ent[j]);
+  return 0;
+}
+
 static double group(const oc_program *P, const oc_op *o, oc_vec3 p,
                     oc_vec3 *g) {
-  int uni = o->kind == OC_K_UNION;
-  double acc = uni ? -INFINITY : 0;
-  oc_vec3 gacc = oc_v3(0, 0, 0), gk;
-  uint32_t visited = 0;
-#define TAKE(val)                                                              \
-  do {                                                                         \
-    double v_ = (val);                                                         \
-    if (uni) {                                                                 \
-      if (v_ > acc || visited == 0) {                                          \
-        acc = v_;                                                              \
-        if (g) gacc = gk;                                                      \
-      }                                                                        \
-    } else {                                                                   \
-      acc += v_;                                                               \
-      if (g) gacc = oc_add(gacc, gk);                                          \
-    }                                                                          \
-    visited++;                                                                 \
-  } while (0)
-  gk = oc_v3(0, 0, 0);
+  gacc a = {P, p, o->kind == OC_K_UNION, g != NULL, 0, oc_v3(0, 0, 0), 0};
+  a.acc = a.uni ? -INFINITY : 0;
   for (uint32_t k = 0; k < o->nkid; k++) {
     uint32_t ki = P->kids[o->kid + k];
-    TAKE(g ? evg(P, ki, p, &gk) : ev(P, ki, p));
+    oc_vec3 gk = oc_v3(0, 0, 0);
+    take(&a, g ? evg(P, ki, p, &gk) : ev(P, ki, p), gk);
   }
-  const oc_ent *ent = P->ent;
   if (o->nent && (o->nobvh || o->bvh == OC_NONE)) {
-    for (uint32_t j = o->ent; j < o->ent + o->nent; j++) {
-      int hit;
-      gk = oc_v3(0, 0, 0);
-      double v = ent_eval(P, &ent[j], p, g ? &gk : NULL, &hit);
-      if (hit) TAKE(v);
-    }
+    for (uint32_t j = o->ent; j < o->ent + o->nent; j++)
+      take_ent(&a, &P->ent[j]);
   } else if (o->nent) {
-    /* children are tested before being pushed: misses cost no stack
-    ** traffic, and the stack only holds nodes that contain p */
-    uint32_t stack[BVH_STACK];
-    int sp = 0;
-    if (in_node(&P->bvh[o->bvh], p)) stack[sp++] = o->bvh;
-    while (sp) {
-      const oc_bvhnode *nd = &P->bvh[stack[--sp]];
-      if (nd->count) {
-        for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
-          int hit;
-          gk = oc_v3(0, 0, 0);
-          double v = ent_eval(P, &ent[j], p, g ? &gk : NULL, &hit);
-          if (hit) TAKE(v);
-        }
-        continue;
-      }
-      const oc_bvhnode *l = &P->bvh[nd->first];
-      int hr = in_node(l + 1, p), hl = in_node(l, p);
-      if (sp + 2 > BVH_STACK) continue; /* cannot happen: depth <= 32 */
-      if (hr) stack[sp++] = nd->first + 1;
-      if (hl) stack[sp++] = nd->first;
-    }
+    /* OC_WALK_FULL cannot happen: compile.c refuses trees deeper than
+    ** the stack (bvhwalk.h) */
+    oc_bvh_walk(P->bvh, o->bvh, group_meets, group_leaf, &a);
   }
-#undef TAKE
   /* children not visited are exactly 0 here */
-  if (uni && visited < o->ntotal && acc < 0) {
-    acc = 0;
-    gacc = oc_v3(0, 0, 0);
+  if (a.uni && a.visited < o->ntotal && a.acc < 0) {
+    a.acc = 0;
+    a.gacc = oc_v3(0, 0, 0);
   }
-  if (g) *g = gacc;
-  return acc;
+  if (g) *g = a.gacc;
+  return a.acc;
 }
 
 /* ---- smooth operators --------------------------------------------------- */

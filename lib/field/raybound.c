@@ -12,11 +12,11 @@
 #include "core/falloff.h"
 #include "core/spanset.h"
 #include "core/vec.h"
+#include "field/bvhwalk.h"
 #include "field/prim.h"
 #include "field/program.h"
 #include "field/raybound.h"
 
-#define BVH_STACK 64
 #define IV_CAP 64
 /* Rounding slack: bounds are inflated, intervals widened, by this much. */
 #define REL 1e-6
@@ -107,67 +107,79 @@ static void point_db(const oc_ray *r, double cx, double cy, double cz,
 static void op_db(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
                   double t1, double *lo, double *hi, int depth);
 
+/* A ray query's walk under a group's BVH: the segment [t0, t1]; the
+** bounds of a derivative (L, H) or the support intervals (S). */
+typedef struct raywalk {
+  const oc_program *P;
+  const oc_ray *r;
+  double t0, t1;
+  int depth, uni;
+  double L, H;
+  struct ivset *S;
+} raywalk;
+
+static int ray_meets(const oc_bvhnode *nd, void *q) {
+  const raywalk *w = q;
+  double a = w->t0, b = w->t1;
+  return oc_ray_clip(w->r, nd->lo, nd->hi, &a, &b);
+}
+
+/* a union's derivative is one of its children's, or 0 */
+static inline void db_acc(raywalk *w, double l, double h) {
+  if (w->uni) {
+    w->L = fmin(w->L, l);
+    w->H = fmax(w->H, h);
+  } else {
+    w->L += l;
+    w->H += h;
+  }
+}
+
+/* One entry's derivative bounds over [a, b]. */
+static inline void ent_db(raywalk *w, const oc_ent *e, double a, double b) {
+  double l = 0, h = 0;
+  if (e->ref != OC_NONE)
+    op_db(w->P, e->ref, w->r, a, b, &l, &h, w->depth + 1);
+  else
+    point_db(w->r, e->c[0], e->c[1], e->c[2], e->ir2, e->e, a, b, &l, &h);
+  db_acc(w, l, h);
+}
+
+static int db_leaf(const oc_bvhnode *nd, void *q) {
+  raywalk *w = q;
+  /* the leaf's part of the segment (the walk tested it, and will not
+  ** keep what it found) */
+  double a = w->t0, b = w->t1;
+  oc_ray_clip(w->r, nd->lo, nd->hi, &a, &b);
+  for (uint32_t j = nd->first; j < nd->first + nd->count; j++)
+    ent_db(w, &w->P->ent[j], a, b);
+  return 0;
+}
+
 static void group_db(const oc_program *P, const oc_op *o, const oc_ray *r,
                      double t0, double t1, double *lo, double *hi, int depth) {
-  int uni = o->kind == OC_K_UNION;
-  double L = 0, H = 0;
-  /* a union's derivative is one of its children's, or 0 */
-#define ACC(l, h)                                                              \
-  do {                                                                         \
-    if (uni) {                                                                 \
-      L = fmin(L, l);                                                          \
-      H = fmax(H, h);                                                          \
-    } else {                                                                   \
-      L += l;                                                                  \
-      H += h;                                                                  \
-    }                                                                          \
-  } while (0)
+  raywalk w = {P, r, t0, t1, depth, o->kind == OC_K_UNION, 0, 0, NULL};
   for (uint32_t k = 0; k < o->nkid; k++) {
     double l = 0, h = 0;
     op_db(P, P->kids[o->kid + k], r, t0, t1, &l, &h, depth + 1);
-    ACC(l, h);
+    db_acc(&w, l, h);
   }
-  if (o->nent) {
-    uint32_t stack[BVH_STACK];
-    int sp = 0;
-    if (o->nobvh || o->bvh == OC_NONE) {
-      for (uint32_t j = o->ent; j < o->ent + o->nent; j++) {
-        const oc_ent *e = &P->ent[j];
-        double l = 0, h = 0;
-        if (e->ref != OC_NONE)
-          op_db(P, e->ref, r, t0, t1, &l, &h, depth + 1);
-        else
-          point_db(r, e->c[0], e->c[1], e->c[2], e->ir2, e->e, t0, t1, &l, &h);
-        ACC(l, h);
-      }
-    } else {
-      stack[sp++] = o->bvh;
-    }
-    while (sp) {
-      const oc_bvhnode *nd = &P->bvh[stack[--sp]];
-      double a = t0, b = t1;
-      if (!oc_ray_clip(r, nd->lo, nd->hi, &a, &b)) continue;
-      if (nd->count) {
-        for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
-          const oc_ent *e = &P->ent[j];
-          double l = 0, h = 0;
-          if (e->ref != OC_NONE)
-            op_db(P, e->ref, r, a, b, &l, &h, depth + 1);
-          else
-            point_db(r, e->c[0], e->c[1], e->c[2], e->ir2, e->e, a, b, &l, &h);
-          ACC(l, h);
-        }
-      } else if (sp + 2 <= BVH_STACK) {
-        stack[sp++] = nd->first + 1;
-        stack[sp++] = nd->first;
-      }
-    }
+  if (o->nent && (o->nobvh || o->bvh == OC_NONE)) {
+    for (uint32_t j = o->ent; j < o->ent + o->nent; j++)
+      ent_db(&w, &P->ent[j], t0, t1);
+  } else if (o->nent && oc_bvh_walk(P->bvh, o->bvh, ray_meets, db_leaf, &w) ==
+                            OC_WALK_FULL) {
+    /* a subtree left out: the group's global bound (none across a
+    ** jump) */
+    double k = P->njump ? INFINITY : o->lip;
+    *lo -= k;
+    *hi += k;
+    return;
   }
-#undef ACC
   /* never looser than the group's own bound, which holds off jumps
   ** only: an infinite child's stays infinite */
-  *lo += isinf(L) ? L : fmax(L, -o->lip);
-  *hi += isinf(H) ? H : fmin(H, o->lip);
+  *lo += isinf(w.L) ? w.L : fmax(w.L, -o->lip);
+  *hi += isinf(w.H) ? w.H : fmin(w.H, o->lip);
 }
 
 static void op_db(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
@@ -314,6 +326,24 @@ static void iv_add(ivset *S, double lo, double hi) {
 }
 
 static void op_sup(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
+                   double t1, ivset *S, int depth);
+
+static int sup_leaf(const oc_bvhnode *nd, void *q) {
+  raywalk *w = q;
+  double ta = w->t0, tb = w->t1, tc, a, s0, s1;
+  oc_ray_clip(w->r, nd->lo, nd->hi, &ta, &tb);
+  for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
+    const oc_ent *e = &w->P->ent[j];
+    if (e->ref != OC_NONE)
+      op_sup(w->P, e->ref, w->r, ta, tb, w->S, w->depth + 1);
+    else if (ball_chord(w->r, e->c[0], e->c[1], e->c[2], e->ir2, ta, tb, &tc,
+                        &a, &s0, &s1))
+      iv_add(w->S, tc + s0, tc + s1);
+  }
+  return 0;
+}
+
+static void op_sup(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
                    double t1, ivset *S, int depth) {
   const oc_op *o = &P->ops[i];
   if (!oc_ray_clip(r, o->lo, o->hi, &t0, &t1)) return;
@@ -332,31 +362,10 @@ static void op_sup(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
       return;
     }
     {
-      uint32_t stack[BVH_STACK];
-      int sp = 0;
-      stack[sp++] = o->bvh;
-      while (sp) {
-        const oc_bvhnode *nd = &P->bvh[stack[--sp]];
-        double ta = t0, tb = t1;
-        if (!oc_ray_clip(r, nd->lo, nd->hi, &ta, &tb)) continue;
-        if (!nd->count) {
-          if (sp + 2 <= BVH_STACK) {
-            stack[sp++] = nd->first + 1;
-            stack[sp++] = nd->first;
-          } else {
-            iv_add(S, ta, tb);
-          }
-          continue;
-        }
-        for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
-          const oc_ent *e = &P->ent[j];
-          if (e->ref != OC_NONE)
-            op_sup(P, e->ref, r, ta, tb, S, depth + 1);
-          else if (ball_chord(r, e->c[0], e->c[1], e->c[2], e->ir2, ta, tb, &tc,
-                              &a, &s0, &s1))
-            iv_add(S, tc + s0, tc + s1);
-        }
-      }
+      raywalk w = {P, r, t0, t1, depth, 0, 0, 0, S};
+      /* a subtree left out: the group's whole segment */
+      if (oc_bvh_walk(P->bvh, o->bvh, ray_meets, sup_leaf, &w) == OC_WALK_FULL)
+        iv_add(S, t0, t1);
     }
     return;
   case OC_K_POINT:
