@@ -253,16 +253,12 @@ static uint32_t compile_prim(comp *c, const oc_node *n) {
   return op;
 }
 
-/* Turbulence and noise-driven ops keep wavelength, amplitude, offset,
-** octaves, seed (as two 32-bit halves so it survives a double). */
+/* Turbulence and noise-driven ops keep their noise packed
+** (oc_noise_pack). */
 static uint32_t pack_noise(comp *c, const oc_noise *nz) {
-  double v[6] = {nz->wavelength,
-                 nz->amplitude,
-                 nz->offset,
-                 (double)nz->octaves,
-                 (double)(nz->seed >> 32),
-                 (double)(nz->seed & 0xffffffffu)};
-  return add_par(c, v, 6);
+  double v[OC_NOISE_NPAR];
+  oc_noise_pack(nz, v);
+  return add_par(c, v, OC_NOISE_NPAR);
 }
 
 /* The terrain's data stays with its node (the program retains the root);

@@ -237,7 +237,8 @@ static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
   case OC_K_WARP: {
     /* the child's spans around the displaced column, grown by the
     ** largest displacement */
-    double A = fabs(par[1]) * oc_turb3_max((int)par[3]) / 2;
+    oc_noise nz = oc_noise_unpack(par);
+    double A = fabs(nz.amplitude) * oc_turb3_max(nz.octaves) / 2;
     foot g = {f->x0 - A, f->y0 - A, f->x1 + A, f->y1 + A};
     spans C;
     C.n = C.nt = C.nz = C.wz = C.all = C.nleaf = 0;
@@ -315,19 +316,7 @@ static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
 /* Closes the smallest gaps of set s (n spans) until at most max remain,
 ** and copies it to out. */
 static int reduce(oc_zspan *s, int n, oc_zspan *out, int max) {
-  while (n > max) {
-    int best = 0;
-    double gap = INFINITY;
-    for (int k = 0; k + 1 < n; k++)
-      if (s[k + 1].lo - s[k].hi < gap) {
-        gap = s[k + 1].lo - s[k].hi;
-        best = k;
-      }
-    s[best].hi = s[best + 1].hi;
-    for (int k = best + 1; k + 1 < n; k++)
-      s[k] = s[k + 1];
-    n--;
-  }
+  oc_spanset_reduce(s, &n, max);
   for (int k = 0; k < n; k++)
     out[k] = s[k];
   return n;

@@ -388,19 +388,7 @@ int oc_ray_supports(const oc_program *P, const oc_ray *r, double t0, double t1,
   ivset S;
   S.n = 0;
   op_sup(P, P->root, r, t0, t1, &S, 0);
-  while (S.n > max) {
-    int best = 0;
-    double gap = INFINITY;
-    for (int k = 0; k + 1 < S.n; k++)
-      if (S.s[k + 1].lo - S.s[k].hi < gap) {
-        gap = S.s[k + 1].lo - S.s[k].hi;
-        best = k;
-      }
-    S.s[best].hi = S.s[best + 1].hi;
-    for (int k = best + 1; k + 1 < S.n; k++)
-      S.s[k] = S.s[k + 1];
-    S.n--;
-  }
+  oc_spanset_reduce(S.s, &S.n, max);
   for (int k = 0; k < S.n; k++) {
     out[k].lo = fmax(S.s[k].lo, t0);
     out[k].hi = fmin(S.s[k].hi, t1);
