@@ -15,7 +15,9 @@
 
 #include "core/error.h"
 #include "core/falloff.h"
+#include "core/grow.h"
 #include "core/noise.h"
+#include "core/pmap.h"
 #include "core/vec.h"
 #include "geology/geology.h"
 #include "field/node.h"
@@ -27,82 +29,6 @@
 /* Groups with at least this many plain point children store them inline
 ** in single precision; smaller groups keep every child as a double op. */
 #define INLINE_MIN 32
-
-/* ---- growable arrays ------------------------------------------------ */
-
-#define GROW(arr, n, cap, need)                                                \
-  ((n) + (need) <= (cap) ||                                                    \
-           grow((void **)&(arr), &(cap), (n) + (need), sizeof *(arr))          \
-       ? 1                                                                     \
-       : 0)
-
-static int grow(void **arr, size_t *cap, size_t need, size_t elem) {
-  size_t nc = *cap ? *cap : 16;
-  while (nc < need)
-    nc *= 2;
-  void *p = realloc(*arr, nc * elem);
-  if (!p) return 0;
-  *arr = p;
-  *cap = nc;
-  return 1;
-}
-
-/* ---- pointer -> index map (open addressing) -------------------------- */
-
-typedef struct pmap {
-  const void **key;
-  uint32_t *val;
-  size_t cap, n;
-} pmap;
-
-static size_t phash(const void *p) {
-  uint64_t x = (uint64_t)(uintptr_t)p;
-  x ^= x >> 33;
-  x *= 0xff51afd7ed558ccdull;
-  x ^= x >> 33;
-  return (size_t)x;
-}
-
-static uint32_t *pmap_slot(pmap *m, const void *k, int create) {
-  if (create && (m->n + 1) * 2 > m->cap) {
-    size_t nc = m->cap ? m->cap * 2 : 64;
-    const void **nk = calloc(nc, sizeof *nk);
-    uint32_t *nv = malloc(nc * sizeof *nv);
-    if (!nk || !nv) {
-      free(nk);
-      free(nv);
-      return NULL;
-    }
-    for (size_t i = 0; i < m->cap; i++)
-      if (m->key[i]) {
-        size_t h = phash(m->key[i]) & (nc - 1);
-        while (nk[h])
-          h = (h + 1) & (nc - 1);
-        nk[h] = m->key[i];
-        nv[h] = m->val[i];
-      }
-    free(m->key);
-    free(m->val);
-    m->key = nk;
-    m->val = nv;
-    m->cap = nc;
-  }
-  if (!m->cap) return NULL;
-  size_t h = phash(k) & (m->cap - 1);
-  while (m->key[h]) {
-    if (m->key[h] == k) return &m->val[h];
-    h = (h + 1) & (m->cap - 1);
-  }
-  if (!create) return NULL;
-  m->key[h] = k;
-  m->n++;
-  return &m->val[h];
-}
-
-static void pmap_free(pmap *m) {
-  free(m->key);
-  free(m->val);
-}
 
 /* ---- compiler state -------------------------------------------------- */
 
@@ -118,7 +44,7 @@ typedef struct comp {
   size_t capops, cappar, capkids, capent, capbvh, capterr;
   info *inf; /* parallel to ops */
   size_t capinf;
-  pmap memo;
+  oc_pmap memo;
   double T;
   int nobvh;
   oc_error *err;
@@ -132,8 +58,8 @@ static int nomem(comp *c) {
 static uint32_t new_op(comp *c, oc_kind kind) {
   oc_program *P = c->P;
   if (P->nops >= OC_NONE - 1) return OC_NONE;
-  if (!GROW(P->ops, P->nops, c->capops, 1) ||
-      !GROW(c->inf, P->nops, c->capinf, 1))
+  if (!OC_GROW(P->ops, P->nops, c->capops, 1) ||
+      !OC_GROW(c->inf, P->nops, c->capinf, 1))
     return OC_NONE;
   oc_op *op = &P->ops[P->nops];
   memset(op, 0, sizeof *op);
@@ -145,7 +71,7 @@ static uint32_t new_op(comp *c, oc_kind kind) {
 
 static uint32_t add_par(comp *c, const double *v, size_t n) {
   oc_program *P = c->P;
-  if (!GROW(P->par, P->npar, c->cappar, n)) return OC_NONE;
+  if (!OC_GROW(P->par, P->npar, c->cappar, n)) return OC_NONE;
   uint32_t at = (uint32_t)P->npar;
   if (v) memcpy(P->par + at, v, n * sizeof *v);
   P->npar += n;
@@ -154,7 +80,7 @@ static uint32_t add_par(comp *c, const double *v, size_t n) {
 
 static uint32_t add_kids(comp *c, const uint32_t *k, size_t n) {
   oc_program *P = c->P;
-  if (!GROW(P->kids, P->nkids, c->capkids, n ? n : 1)) return OC_NONE;
+  if (!OC_GROW(P->kids, P->nkids, c->capkids, n ? n : 1)) return OC_NONE;
   uint32_t at = (uint32_t)P->nkids;
   if (n) memcpy(P->kids + at, k, n * sizeof *k);
   P->nkids += n;
@@ -271,7 +197,7 @@ static uint32_t compile_terrain(comp *c, const oc_node *n) {
   uint32_t at = add_par(c, par, OC_TPAR_N);
   uint32_t op = new_op(c, OC_K_TERRAIN);
   if (at == OC_NONE || op == OC_NONE ||
-      !GROW(P->terr, P->nterr, c->capterr, 1)) {
+      !OC_GROW(P->terr, P->nterr, c->capterr, 1)) {
     nomem(c);
     return OC_NONE;
   }
@@ -320,7 +246,7 @@ static int collect(comp *c, const oc_node *root, oc_kind kind, leaf **out,
                    size_t *nout) {
   int is_blend = kind == OC_K_BLEND;
 #define FLAT(x) ((x)->kind == kind || (is_blend && (x)->kind == OC_K_SCALE))
-  pmap seen = {0};
+  oc_pmap seen = {0};
   const oc_node **order = NULL, **stack = NULL;
   size_t norder = 0, caporder = 0, nstack = 0, capstack = 0;
   unsigned char *done = NULL;
@@ -331,9 +257,9 @@ static int collect(comp *c, const oc_node *root, oc_kind kind, leaf **out,
   size_t nl = 0, capl = 0;
   int ok = 0;
   /* iterative DFS post-order over internal (flattenable) nodes */
-  if (!pmap_slot(&seen, root, 1)) goto fail;
-  *pmap_slot(&seen, root, 0) = 0;
-  if (!GROW(stack, nstack, capstack, 1) || !GROW(done, 0, capdone, 1))
+  if (!oc_pmap_slot(&seen, root, 1)) goto fail;
+  *oc_pmap_slot(&seen, root, 0) = 0;
+  if (!OC_GROW(stack, nstack, capstack, 1) || !OC_GROW(done, 0, capdone, 1))
     goto fail;
   stack[nstack++] = root;
   done[0] = 0;
@@ -341,20 +267,20 @@ static int collect(comp *c, const oc_node *root, oc_kind kind, leaf **out,
     /* state per internal node index: 0 new, 1 expanded */
     const oc_node **idxnode = NULL;
     size_t nidx = 0, capidx = 0;
-    if (!GROW(idxnode, nidx, capidx, 1)) goto fail;
+    if (!OC_GROW(idxnode, nidx, capidx, 1)) goto fail;
     idxnode[nidx++] = root;
     while (nstack) {
       const oc_node *x = stack[nstack - 1];
-      uint32_t xi = *pmap_slot(&seen, x, 0);
+      uint32_t xi = *oc_pmap_slot(&seen, x, 0);
       if (!done[xi]) {
         done[xi] = 1;
         for (size_t i = x->nkids; i-- > 0;) {
           const oc_node *k = x->kids[i];
-          if (!FLAT(k) || pmap_slot(&seen, k, 0)) continue;
-          uint32_t *s = pmap_slot(&seen, k, 1);
-          if (!s || !GROW(idxnode, nidx, capidx, 1) ||
-              !GROW(done, nidx, capdone, 1) ||
-              !GROW(stack, nstack, capstack, 1)) {
+          if (!FLAT(k) || oc_pmap_slot(&seen, k, 0)) continue;
+          uint32_t *s = oc_pmap_slot(&seen, k, 1);
+          if (!s || !OC_GROW(idxnode, nidx, capidx, 1) ||
+              !OC_GROW(done, nidx, capdone, 1) ||
+              !OC_GROW(stack, nstack, capstack, 1)) {
             free(idxnode);
             goto fail;
           }
@@ -365,7 +291,7 @@ static int collect(comp *c, const oc_node *root, oc_kind kind, leaf **out,
         }
       } else {
         nstack--;
-        if (!GROW(order, norder, caporder, 1)) {
+        if (!OC_GROW(order, norder, caporder, 1)) {
           free(idxnode);
           goto fail;
         }
@@ -374,29 +300,29 @@ static int collect(comp *c, const oc_node *root, oc_kind kind, leaf **out,
     }
     free(idxnode);
     /* weights: reverse post-order is a topological order (parents first) */
-    if (!GROW(w, 0, capw, nidx)) goto fail;
+    if (!OC_GROW(w, 0, capw, nidx)) goto fail;
     for (size_t i = 0; i < nidx; i++)
       w[i] = 0;
     w[0] = 1;
-    pmap lmap = {0};
+    oc_pmap lmap = {0};
     for (size_t oi = norder; oi-- > 0;) {
       const oc_node *x = order[oi];
-      double wx = w[*pmap_slot(&seen, x, 0)];
+      double wx = w[*oc_pmap_slot(&seen, x, 0)];
       double f = x->kind == OC_K_SCALE ? x->par[OC_P_FACTOR] : 1;
       for (size_t i = 0; i < x->nkids; i++) {
         const oc_node *k = x->kids[i];
         if (FLAT(k)) {
-          w[*pmap_slot(&seen, k, 0)] += wx * f;
+          w[*oc_pmap_slot(&seen, k, 0)] += wx * f;
           continue;
         }
-        uint32_t *s = pmap_slot(&lmap, k, 0);
+        uint32_t *s = oc_pmap_slot(&lmap, k, 0);
         if (s) {
           lv[*s].w += wx * f;
           continue;
         }
-        s = pmap_slot(&lmap, k, 1);
-        if (!s || !GROW(lv, nl, capl, 1)) {
-          pmap_free(&lmap);
+        s = oc_pmap_slot(&lmap, k, 1);
+        if (!s || !OC_GROW(lv, nl, capl, 1)) {
+          oc_pmap_free(&lmap);
           goto fail;
         }
         *s = (uint32_t)nl;
@@ -405,12 +331,12 @@ static int collect(comp *c, const oc_node *root, oc_kind kind, leaf **out,
         nl++;
       }
     }
-    pmap_free(&lmap);
+    oc_pmap_free(&lmap);
   }
   ok = 1;
 fail:
 #undef FLAT
-  pmap_free(&seen);
+  oc_pmap_free(&seen);
   free(order);
   free(stack);
   free(done);
@@ -637,8 +563,8 @@ static uint32_t group_emit(comp *c, oc_kind kind, const group *g, double lipv) {
   o->kid = add_kids(c, g->unb, g->nunb);
   if (o->kid == OC_NONE) return (uint32_t)nomem(c), OC_NONE;
   o->nkid = (uint32_t)g->nunb;
-  if (!GROW(P->ent, P->nent, c->capent, g->nent) ||
-      !GROW(P->bvh, P->nbvh, c->capbvh, g->nnodes))
+  if (!OC_GROW(P->ent, P->nent, c->capent, g->nent) ||
+      !OC_GROW(P->bvh, P->nbvh, c->capbvh, g->nnodes))
     return (uint32_t)nomem(c), OC_NONE;
   o = &P->ops[op];
   o->ent = (uint32_t)P->nent;
@@ -930,7 +856,7 @@ static uint32_t compile_geo(comp *c, const oc_node *n) {
 }
 
 static uint32_t compile_node(comp *c, const oc_node *n) {
-  uint32_t *memo = pmap_slot(&c->memo, n, 0);
+  uint32_t *memo = oc_pmap_slot(&c->memo, n, 0);
   if (memo) return *memo;
   if (++c->depth > OC_MAX_DEPTH) {
     oc_seterr(c->err, OC_ETOODEEP,
@@ -997,7 +923,7 @@ static uint32_t compile_node(comp *c, const oc_node *n) {
               OC_MAX_DEPTH);
     return OC_NONE;
   }
-  uint32_t *slot = pmap_slot(&c->memo, n, 1);
+  uint32_t *slot = oc_pmap_slot(&c->memo, n, 1);
   if (!slot) return (uint32_t)nomem(c), OC_NONE;
   *slot = op;
   return op;
@@ -1006,12 +932,12 @@ static uint32_t compile_node(comp *c, const oc_node *n) {
 /* ---- statistics ------------------------------------------------------ */
 
 static int count_nodes(const oc_node *root, size_t *nodes, size_t *prims) {
-  pmap seen = {0};
+  oc_pmap seen = {0};
   const oc_node **stack = NULL;
   size_t n = 0, cap = 0;
   int ok = 0;
   *nodes = *prims = 0;
-  if (!pmap_slot(&seen, root, 1) || !GROW(stack, n, cap, 1)) goto done;
+  if (!oc_pmap_slot(&seen, root, 1) || !OC_GROW(stack, n, cap, 1)) goto done;
   stack[n++] = root;
   while (n) {
     const oc_node *x = stack[--n];
@@ -1019,14 +945,14 @@ static int count_nodes(const oc_node *root, size_t *nodes, size_t *prims) {
     if (OC_KIND_IS_PRIM(x->kind)) (*prims)++;
     for (size_t i = 0; i < x->nkids; i++) {
       const oc_node *k = x->kids[i];
-      if (pmap_slot(&seen, k, 0)) continue;
-      if (!pmap_slot(&seen, k, 1) || !GROW(stack, n, cap, 1)) goto done;
+      if (oc_pmap_slot(&seen, k, 0)) continue;
+      if (!oc_pmap_slot(&seen, k, 1) || !OC_GROW(stack, n, cap, 1)) goto done;
       stack[n++] = k;
     }
   }
   ok = 1;
 done:
-  pmap_free(&seen);
+  oc_pmap_free(&seen);
   free(stack);
   return ok;
 }
@@ -1062,13 +988,13 @@ oc_program *oc_compile(oc_node *root, const oc_compile_options *opts,
   P->T = T;
   /* an array even without parameters: every op reads P->par + offset
   ** (NULL + 0 is undefined) */
-  uint32_t r = GROW(P->par, P->npar, c.cappar, 1) ? compile_node(&c, root)
-                                                  : (nomem(&c), OC_NONE);
+  uint32_t r = OC_GROW(P->par, P->npar, c.cappar, 1) ? compile_node(&c, root)
+                                                     : (nomem(&c), OC_NONE);
   size_t nn, np;
   if (r == OC_NONE || !count_nodes(root, &nn, &np)) {
     if (r != OC_NONE) nomem(&c);
     free(c.inf);
-    pmap_free(&c.memo);
+    oc_pmap_free(&c.memo);
     P->node = NULL;
     oc_program_free(P);
     return NULL;
@@ -1087,7 +1013,7 @@ oc_program *oc_compile(oc_node *root, const oc_compile_options *opts,
                    P->nent * sizeof *P->ent + P->nbvh * sizeof *P->bvh +
                    P->nterr * sizeof *P->terr;
   free(c.inf);
-  pmap_free(&c.memo);
+  oc_pmap_free(&c.memo);
   return P;
 }
 
