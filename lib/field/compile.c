@@ -1016,28 +1016,3 @@ oc_program *oc_compile(oc_node *root, const oc_compile_options *opts,
   oc_pmap_free(&c.memo);
   return P;
 }
-
-void oc_program_free(oc_program *P) {
-  if (!P) return;
-  free(P->ops);
-  free(P->par);
-  free(P->kids);
-  free(P->ent);
-  free(P->bvh);
-  free(P->terr);
-  oc_node_release(P->node);
-  free(P);
-}
-
-oc_aabb oc_program_bounds(const oc_program *P) {
-  return P->bounds;
-}
-double oc_program_lipschitz(const oc_program *P) {
-  return P->lip;
-}
-double oc_program_threshold(const oc_program *P) {
-  return P->T;
-}
-void oc_program_get_stats(const oc_program *P, oc_program_stats *st) {
-  *st = P->stats;
-}
