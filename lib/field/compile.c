@@ -372,6 +372,7 @@ typedef struct group {
   uint32_t *perm; /* BVH order of the entries */
   oc_bvhnode *nodes;
   size_t nnodes;
+  uint32_t *leaves; /* scratch of the blend's bound: one per node */
 } group;
 
 static void group_free(group *g) {
@@ -381,6 +382,7 @@ static void group_free(group *g) {
   free(g->unb);
   free(g->perm);
   free(g->nodes);
+  free(g->leaves);
 }
 
 /* An inline point entry, weighted by w; its box and bound are those of
@@ -497,7 +499,8 @@ static int group_bvh(comp *c, group *g) {
   if (!g->nent) return 0;
   g->perm = malloc(g->nent * sizeof *g->perm);
   g->nodes = malloc(2 * g->nent * sizeof *g->nodes);
-  if (!g->perm || !g->nodes) return nomem(c);
+  g->leaves = malloc(2 * g->nent * sizeof *g->leaves);
+  if (!g->perm || !g->nodes || !g->leaves) return nomem(c);
   int levels;
   g->nnodes = oc_bvh_build(g->box, g->nent, g->nodes, g->perm, &levels);
   if (!g->nnodes) return nomem(c);
@@ -509,12 +512,12 @@ static int group_bvh(comp *c, group *g) {
   return 0;
 }
 
-/* The largest sum of bounds over the entries overlapping one entry. */
+/* The leaves whose boxes meet one entry's box. */
 typedef struct lipsum {
-  const group *g;
-  oc_aabb b;
+  const oc_bvhnode *nodes;
   float lo[3], hi[3];
-  double s;
+  uint32_t *leaf; /* their nodes' indices, in the walk's order */
+  size_t n;
 } lipsum;
 
 static int lipsum_meets(const oc_bvhnode *nd, void *q) {
@@ -526,9 +529,7 @@ static int lipsum_meets(const oc_bvhnode *nd, void *q) {
 
 static int lipsum_leaf(const oc_bvhnode *nd, void *q) {
   lipsum *w = q;
-  const group *g = w->g;
-  for (uint32_t j = nd->first; j < nd->first + nd->count; j++)
-    if (oc_aabb_overlaps(g->box[g->perm[j]], w->b)) w->s += g->lip[g->perm[j]];
+  w->leaf[w->n++] = (uint32_t)(nd - w->nodes);
   return 0;
 }
 
@@ -541,12 +542,24 @@ static double group_lipschitz(const group *g) {
   for (size_t i = 0; i < g->nent; i++)
     total += g->lip[i];
   for (size_t i = 0; i < g->nent; i++) {
-    lipsum w = {g, g->box[i], {0}, {0}, 0};
+    lipsum w = {g->nodes, {0}, {0}, g->leaves, 0};
     oc_box_to_float(g->box[i], w.lo, w.hi);
+    double s = 0;
     /* a subtree left out: every entry's bound */
-    if (oc_bvh_walk(g->nodes, 0, lipsum_meets, lipsum_leaf, &w) == OC_WALK_FULL)
-      w.s = total;
-    if (w.s > best) best = w.s;
+    if (oc_bvh_walk(g->nodes, 0, lipsum_meets, lipsum_leaf, &w) ==
+        OC_WALK_FULL) {
+      s = total;
+    } else {
+      /* summed over the leaves last first, as before the walk was
+      ** shared (it went right first): the same bits */
+      for (size_t k = w.n; k-- > 0;) {
+        const oc_bvhnode *nd = &g->nodes[w.leaf[k]];
+        for (uint32_t j = nd->first; j < nd->first + nd->count; j++)
+          if (oc_aabb_overlaps(g->box[g->perm[j]], g->box[i]))
+            s += g->lip[g->perm[j]];
+      }
+    }
+    if (s > best) best = s;
   }
   return best + g->lipunb;
 }
