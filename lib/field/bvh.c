@@ -3,7 +3,10 @@
 **
 ** Top-down median split on the longest axis of the centroids' extent.
 ** Deterministic: ties are broken by entry index, so the same input always
-** gives the same tree.
+** gives the same tree. Each split leaves half the leaves (rounded down to
+** a whole one) on the left, so n entries make ceil(log2(ceil(n / 8))) + 1
+** levels, at most 30 for 2^32: the bound the walks' stack relies on
+** (bvhwalk.h), reported by oc_bvh_build and checked by compile.c.
 */
 #define _GNU_SOURCE /* qsort_r */
 #include <math.h>

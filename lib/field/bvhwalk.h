@@ -24,7 +24,7 @@
 **
 ** bvh.c's median split puts half the leaves (rounded down to a whole
 ** leaf) on each side, so a tree over n entries has
-** ceil(log2(ceil(n / OC_BVH_LEAF))) + 1 levels: at most 31 for the 2^32
+** ceil(log2(ceil(n / OC_BVH_LEAF))) + 1 levels: at most 30 for the 2^32
 ** entries a uint32_t index allows. compile.c measures every tree it
 ** builds and refuses one deeper than OC_BVH_STACK (it cannot happen), so
 ** evaluation, which has no bound to fall back to, never meets a full

@@ -288,7 +288,7 @@ END_TEST
 ** point that matters (at the origin, radius 1, energy 1). A walk stacks
 ** one right sibling per level, so past OC_BVH_STACK levels the deepest
 ** leaf is out of reach; compile.c never builds such a tree (bvh.c's are
-** at most 31 levels deep). */
+** at most 30 levels deep). */
 #define DEEP_LIP 1.75 /* the op's global bound (>= OCT_LG) */
 
 static oc_program *deep_bvh(int d) {
