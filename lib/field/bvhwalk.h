@@ -3,11 +3,10 @@
 ** shared by evaluation (eval.c), the local queries (query.c, raybound.c)
 ** and the compiler's blend Lipschitz bound (compile.c).
 **
-** The walk is a static inline function taking two small static
-** functions: `meets` (may this node's subtree matter to the query?) and
-** `leaf` (visit one leaf's entries). Forced inline, the calls through
-** the two pointers become direct calls to known functions, which the
-** compiler inlines in turn: evaluation's hot loop is the hand-written one.
+** One walk, OC_BVH_FOREACH, written once: it takes the test "may this
+** node's subtree matter to the query?" and runs a leaf visit. Evaluation
+** uses the macro itself; the queries use oc_bvh_walk, the same walk with
+** the test and the visit as static functions.
 */
 #ifndef OC_BVHWALK_H
 #define OC_BVHWALK_H
@@ -39,32 +38,55 @@
   2 /* the stack filled: a subtree was left out, the                           \
     ** caller answers its conservative bound */
 
+/* Runs the statements after `full` for each leaf nd, depth first and
+** left child first, whose every node on the path from the root passes
+** MEETS(node) (a function or function-like macro). A `break` in them ends
+** the walk; `full` (an int lvalue) is set to 1 when the stack filled and
+** a subtree was left out. A macro so that evaluation's loop is exactly
+** the hand-written one: its accumulators stay in registers. */
+#define OC_BVH_FOREACH(nodes, root, nd, MEETS, full, ...)                      \
+  do {                                                                         \
+    uint32_t oc_st_[OC_BVH_STACK];                                             \
+    int oc_sp_ = 0;                                                            \
+    /* misses cost no stack traffic: the stack only holds nodes that meet */   \
+    if (MEETS(&(nodes)[root])) oc_st_[oc_sp_++] = (root);                      \
+    while (oc_sp_) {                                                           \
+      const oc_bvhnode *nd = &(nodes)[oc_st_[--oc_sp_]];                       \
+      if (nd->count) {                                                         \
+        __VA_ARGS__                                                            \
+        continue;                                                              \
+      }                                                                        \
+      const oc_bvhnode *oc_l_ = &(nodes)[nd->first];                           \
+      int oc_hr_ = MEETS(oc_l_ + 1), oc_hl_ = MEETS(oc_l_);                    \
+      if (oc_sp_ + 2 > OC_BVH_STACK) {                                         \
+        (full) = 1;                                                            \
+        break;                                                                 \
+      }                                                                        \
+      if (oc_hr_) oc_st_[oc_sp_++] = nd->first + 1;                            \
+      if (oc_hl_) oc_st_[oc_sp_++] = nd->first;                                \
+    }                                                                          \
+  } while (0)
+
 typedef int (*oc_bvh_meets_fn)(const oc_bvhnode *nd, void *q);
 typedef int (*oc_bvh_leaf_fn)(const oc_bvhnode *nd, void *q);
 
-/* Visits, depth first and left child first, the leaves of the tree at
-** nodes[root] whose every node on the path from the root passes
-** meets(node, q); leaf(node, q) returns nonzero to end the walk. */
+/* The same walk for the queries, through two small static functions:
+** meets(node, q), and leaf(node, q) which returns nonzero to end the walk.
+** Forced inline, the calls through the pointers become direct calls to
+** known functions, which the compiler inlines in turn. */
 static inline __attribute__((always_inline)) int
 oc_bvh_walk(const oc_bvhnode *nodes, uint32_t root, oc_bvh_meets_fn meets,
             oc_bvh_leaf_fn leaf, void *q) {
-  uint32_t stack[OC_BVH_STACK];
-  int sp = 0;
-  /* misses cost no stack traffic: the stack only holds nodes that meet */
-  if (meets(&nodes[root], q)) stack[sp++] = root;
-  while (sp) {
-    const oc_bvhnode *nd = &nodes[stack[--sp]];
-    if (nd->count) {
-      if (leaf(nd, q)) return OC_WALK_STOPPED;
-      continue;
+  int full = 0, stopped = 0;
+#define OC_MEETS_Q_(x) meets(x, q)
+  OC_BVH_FOREACH(nodes, root, nd, OC_MEETS_Q_, full, {
+    if (leaf(nd, q)) {
+      stopped = 1;
+      break;
     }
-    const oc_bvhnode *l = &nodes[nd->first];
-    int hr = meets(l + 1, q), hl = meets(l, q);
-    if (sp + 2 > OC_BVH_STACK) return OC_WALK_FULL;
-    if (hr) stack[sp++] = nd->first + 1;
-    if (hl) stack[sp++] = nd->first;
-  }
-  return OC_WALK_DONE;
+  });
+#undef OC_MEETS_Q_
+  return stopped ? OC_WALK_STOPPED : full ? OC_WALK_FULL : OC_WALK_DONE;
 }
 
 #endif

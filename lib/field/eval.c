@@ -155,74 +155,63 @@ static inline double ent_eval(const oc_program *P, const oc_ent *e, oc_vec3 p,
   return g ? evg(P, e->ref, p, g) : ev(P, e->ref, p);
 }
 
-/* A group's running result: a union keeps its largest child, a blend
-** sums them. */
-typedef struct gacc {
-  const oc_program *P;
-  oc_vec3 p;
-  int uni, grad;
-  double acc;
-  oc_vec3 gacc;
-  uint32_t visited;
-} gacc;
-
-static inline __attribute__((always_inline)) void take(gacc *a, double v,
-                                                       oc_vec3 gk) {
-  if (a->uni) {
-    if (v > a->acc || a->visited == 0) {
-      a->acc = v;
-      if (a->grad) a->gacc = gk;
-    }
-  } else {
-    a->acc += v;
-    if (a->grad) a->gacc = oc_add(a->gacc, gk);
-  }
-  a->visited++;
-}
-
-static inline __attribute__((always_inline)) void take_ent(gacc *a,
-                                                           const oc_ent *e) {
-  int hit;
-  oc_vec3 gk = oc_v3(0, 0, 0);
-  double v = ent_eval(a->P, e, a->p, a->grad ? &gk : NULL, &hit);
-  if (hit) take(a, v, gk);
-}
-
-static int group_meets(const oc_bvhnode *nd, void *q) {
-  return in_node(nd, ((const gacc *)q)->p);
-}
-
-static int group_leaf(const oc_bvhnode *nd, void *q) {
-  gacc *a = q;
-  for (uint32_t j = nd->first; j < nd->first + nd->count; j++)
-    take_ent(a, &a->P->ent[j]);
-  return 0;
-}
-
 static double group(const oc_program *P, const oc_op *o, oc_vec3 p,
                     oc_vec3 *g) {
-  gacc a = {P, p, o->kind == OC_K_UNION, g != NULL, 0, oc_v3(0, 0, 0), 0};
-  a.acc = a.uni ? -INFINITY : 0;
+  int uni = o->kind == OC_K_UNION;
+  double acc = uni ? -INFINITY : 0;
+  oc_vec3 gacc = oc_v3(0, 0, 0), gk;
+  uint32_t visited = 0;
+#define TAKE(val)                                                              \
+  do {                                                                         \
+    double v_ = (val);                                                         \
+    if (uni) {                                                                 \
+      if (v_ > acc || visited == 0) {                                          \
+        acc = v_;                                                              \
+        if (g) gacc = gk;                                                      \
+      }                                                                        \
+    } else {                                                                   \
+      acc += v_;                                                               \
+      if (g) gacc = oc_add(gacc, gk);                                          \
+    }                                                                          \
+    visited++;                                                                 \
+  } while (0)
+  gk = oc_v3(0, 0, 0);
   for (uint32_t k = 0; k < o->nkid; k++) {
     uint32_t ki = P->kids[o->kid + k];
-    oc_vec3 gk = oc_v3(0, 0, 0);
-    take(&a, g ? evg(P, ki, p, &gk) : ev(P, ki, p), gk);
+    TAKE(g ? evg(P, ki, p, &gk) : ev(P, ki, p));
   }
+  const oc_ent *ent = P->ent;
+#define TAKE_ENT(j)                                                            \
+  do {                                                                         \
+    int hit;                                                                   \
+    gk = oc_v3(0, 0, 0);                                                       \
+    double v = ent_eval(P, &ent[j], p, g ? &gk : NULL, &hit);                  \
+    if (hit) TAKE(v);                                                          \
+  } while (0)
   if (o->nent && (o->nobvh || o->bvh == OC_NONE)) {
     for (uint32_t j = o->ent; j < o->ent + o->nent; j++)
-      take_ent(&a, &P->ent[j]);
+      TAKE_ENT(j);
   } else if (o->nent) {
-    /* OC_WALK_FULL cannot happen: compile.c refuses trees deeper than
-    ** the stack (bvhwalk.h) */
-    oc_bvh_walk(P->bvh, o->bvh, group_meets, group_leaf, &a);
+    /* full cannot happen: compile.c refuses trees deeper than the stack
+    ** (bvhwalk.h) */
+    int full = 0;
+#define IN_P(x) in_node(x, p)
+    OC_BVH_FOREACH(P->bvh, o->bvh, nd, IN_P, full, {
+      for (uint32_t j = nd->first; j < nd->first + nd->count; j++)
+        TAKE_ENT(j);
+    });
+#undef IN_P
+    (void)full;
   }
+#undef TAKE_ENT
+#undef TAKE
   /* children not visited are exactly 0 here */
-  if (a.uni && a.visited < o->ntotal && a.acc < 0) {
-    a.acc = 0;
-    a.gacc = oc_v3(0, 0, 0);
+  if (uni && visited < o->ntotal && acc < 0) {
+    acc = 0;
+    gacc = oc_v3(0, 0, 0);
   }
-  if (g) *g = a.gacc;
-  return a.acc;
+  if (g) *g = gacc;
+  return acc;
 }
 
 /* ---- smooth operators --------------------------------------------------- */
