@@ -118,10 +118,12 @@ typedef struct raywalk {
   struct ivset *S;
 } raywalk;
 
+/* A leaf passes here and is clipped by its visit, which needs its part
+** of the segment: each node is clipped once. */
 static int ray_meets(const oc_bvhnode *nd, void *q) {
   const raywalk *w = q;
   double a = w->t0, b = w->t1;
-  return oc_ray_clip(w->r, nd->lo, nd->hi, &a, &b);
+  return nd->count || oc_ray_clip(w->r, nd->lo, nd->hi, &a, &b);
 }
 
 /* a union's derivative is one of its children's, or 0 */
@@ -147,10 +149,8 @@ static inline void ent_db(raywalk *w, const oc_ent *e, double a, double b) {
 
 static int db_leaf(const oc_bvhnode *nd, void *q) {
   raywalk *w = q;
-  /* the leaf's part of the segment (the walk tested it, and will not
-  ** keep what it found) */
   double a = w->t0, b = w->t1;
-  oc_ray_clip(w->r, nd->lo, nd->hi, &a, &b);
+  if (!oc_ray_clip(w->r, nd->lo, nd->hi, &a, &b)) return 0;
   for (uint32_t j = nd->first; j < nd->first + nd->count; j++)
     ent_db(w, &w->P->ent[j], a, b);
   return 0;
@@ -331,7 +331,7 @@ static void op_sup(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
 static int sup_leaf(const oc_bvhnode *nd, void *q) {
   raywalk *w = q;
   double ta = w->t0, tb = w->t1, tc, a, s0, s1;
-  oc_ray_clip(w->r, nd->lo, nd->hi, &ta, &tb);
+  if (!oc_ray_clip(w->r, nd->lo, nd->hi, &ta, &tb)) return 0; /* ray_meets */
   for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
     const oc_ent *e = &w->P->ent[j];
     if (e->ref != OC_NONE)
