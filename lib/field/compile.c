@@ -30,6 +30,9 @@
 ** in single precision; smaller groups keep every child as a double op. */
 #define INLINE_MIN 32
 
+/* 1 when arr (n used, capacity cap) has room for need more (core/grow.h) */
+#define GROW OC_GROW
+
 /* ---- compiler state -------------------------------------------------- */
 
 typedef struct info {
@@ -58,8 +61,8 @@ static int nomem(comp *c) {
 static uint32_t new_op(comp *c, oc_kind kind) {
   oc_program *P = c->P;
   if (P->nops >= OC_NONE - 1) return OC_NONE;
-  if (!OC_GROW(P->ops, P->nops, c->capops, 1) ||
-      !OC_GROW(c->inf, P->nops, c->capinf, 1))
+  if (!GROW(P->ops, P->nops, c->capops, 1) ||
+      !GROW(c->inf, P->nops, c->capinf, 1))
     return OC_NONE;
   oc_op *op = &P->ops[P->nops];
   memset(op, 0, sizeof *op);
@@ -71,7 +74,7 @@ static uint32_t new_op(comp *c, oc_kind kind) {
 
 static uint32_t add_par(comp *c, const double *v, size_t n) {
   oc_program *P = c->P;
-  if (!OC_GROW(P->par, P->npar, c->cappar, n)) return OC_NONE;
+  if (!GROW(P->par, P->npar, c->cappar, n)) return OC_NONE;
   uint32_t at = (uint32_t)P->npar;
   if (v) memcpy(P->par + at, v, n * sizeof *v);
   P->npar += n;
@@ -80,7 +83,7 @@ static uint32_t add_par(comp *c, const double *v, size_t n) {
 
 static uint32_t add_kids(comp *c, const uint32_t *k, size_t n) {
   oc_program *P = c->P;
-  if (!OC_GROW(P->kids, P->nkids, c->capkids, n ? n : 1)) return OC_NONE;
+  if (!GROW(P->kids, P->nkids, c->capkids, n ? n : 1)) return OC_NONE;
   uint32_t at = (uint32_t)P->nkids;
   if (n) memcpy(P->kids + at, k, n * sizeof *k);
   P->nkids += n;
@@ -197,7 +200,7 @@ static uint32_t compile_terrain(comp *c, const oc_node *n) {
   uint32_t at = add_par(c, par, OC_TPAR_N);
   uint32_t op = new_op(c, OC_K_TERRAIN);
   if (at == OC_NONE || op == OC_NONE ||
-      !OC_GROW(P->terr, P->nterr, c->capterr, 1)) {
+      !GROW(P->terr, P->nterr, c->capterr, 1)) {
     nomem(c);
     return OC_NONE;
   }
@@ -259,7 +262,7 @@ static int collect(comp *c, const oc_node *root, oc_kind kind, leaf **out,
   /* iterative DFS post-order over internal (flattenable) nodes */
   if (!oc_pmap_slot(&seen, root, 1)) goto fail;
   *oc_pmap_slot(&seen, root, 0) = 0;
-  if (!OC_GROW(stack, nstack, capstack, 1) || !OC_GROW(done, 0, capdone, 1))
+  if (!GROW(stack, nstack, capstack, 1) || !GROW(done, 0, capdone, 1))
     goto fail;
   stack[nstack++] = root;
   done[0] = 0;
@@ -267,7 +270,7 @@ static int collect(comp *c, const oc_node *root, oc_kind kind, leaf **out,
     /* state per internal node index: 0 new, 1 expanded */
     const oc_node **idxnode = NULL;
     size_t nidx = 0, capidx = 0;
-    if (!OC_GROW(idxnode, nidx, capidx, 1)) goto fail;
+    if (!GROW(idxnode, nidx, capidx, 1)) goto fail;
     idxnode[nidx++] = root;
     while (nstack) {
       const oc_node *x = stack[nstack - 1];
@@ -278,9 +281,9 @@ static int collect(comp *c, const oc_node *root, oc_kind kind, leaf **out,
           const oc_node *k = x->kids[i];
           if (!FLAT(k) || oc_pmap_slot(&seen, k, 0)) continue;
           uint32_t *s = oc_pmap_slot(&seen, k, 1);
-          if (!s || !OC_GROW(idxnode, nidx, capidx, 1) ||
-              !OC_GROW(done, nidx, capdone, 1) ||
-              !OC_GROW(stack, nstack, capstack, 1)) {
+          if (!s || !GROW(idxnode, nidx, capidx, 1) ||
+              !GROW(done, nidx, capdone, 1) ||
+              !GROW(stack, nstack, capstack, 1)) {
             free(idxnode);
             goto fail;
           }
@@ -291,7 +294,7 @@ static int collect(comp *c, const oc_node *root, oc_kind kind, leaf **out,
         }
       } else {
         nstack--;
-        if (!OC_GROW(order, norder, caporder, 1)) {
+        if (!GROW(order, norder, caporder, 1)) {
           free(idxnode);
           goto fail;
         }
@@ -300,7 +303,7 @@ static int collect(comp *c, const oc_node *root, oc_kind kind, leaf **out,
     }
     free(idxnode);
     /* weights: reverse post-order is a topological order (parents first) */
-    if (!OC_GROW(w, 0, capw, nidx)) goto fail;
+    if (!GROW(w, 0, capw, nidx)) goto fail;
     for (size_t i = 0; i < nidx; i++)
       w[i] = 0;
     w[0] = 1;
@@ -321,7 +324,7 @@ static int collect(comp *c, const oc_node *root, oc_kind kind, leaf **out,
           continue;
         }
         s = oc_pmap_slot(&lmap, k, 1);
-        if (!s || !OC_GROW(lv, nl, capl, 1)) {
+        if (!s || !GROW(lv, nl, capl, 1)) {
           oc_pmap_free(&lmap);
           goto fail;
         }
@@ -576,8 +579,8 @@ static uint32_t group_emit(comp *c, oc_kind kind, const group *g, double lipv) {
   o->kid = add_kids(c, g->unb, g->nunb);
   if (o->kid == OC_NONE) return (uint32_t)nomem(c), OC_NONE;
   o->nkid = (uint32_t)g->nunb;
-  if (!OC_GROW(P->ent, P->nent, c->capent, g->nent) ||
-      !OC_GROW(P->bvh, P->nbvh, c->capbvh, g->nnodes))
+  if (!GROW(P->ent, P->nent, c->capent, g->nent) ||
+      !GROW(P->bvh, P->nbvh, c->capbvh, g->nnodes))
     return (uint32_t)nomem(c), OC_NONE;
   o = &P->ops[op];
   o->ent = (uint32_t)P->nent;
@@ -950,7 +953,7 @@ static int count_nodes(const oc_node *root, size_t *nodes, size_t *prims) {
   size_t n = 0, cap = 0;
   int ok = 0;
   *nodes = *prims = 0;
-  if (!oc_pmap_slot(&seen, root, 1) || !OC_GROW(stack, n, cap, 1)) goto done;
+  if (!oc_pmap_slot(&seen, root, 1) || !GROW(stack, n, cap, 1)) goto done;
   stack[n++] = root;
   while (n) {
     const oc_node *x = stack[--n];
@@ -959,7 +962,7 @@ static int count_nodes(const oc_node *root, size_t *nodes, size_t *prims) {
     for (size_t i = 0; i < x->nkids; i++) {
       const oc_node *k = x->kids[i];
       if (oc_pmap_slot(&seen, k, 0)) continue;
-      if (!oc_pmap_slot(&seen, k, 1) || !OC_GROW(stack, n, cap, 1)) goto done;
+      if (!oc_pmap_slot(&seen, k, 1) || !GROW(stack, n, cap, 1)) goto done;
       stack[n++] = k;
     }
   }
@@ -1001,8 +1004,8 @@ oc_program *oc_compile(oc_node *root, const oc_compile_options *opts,
   P->T = T;
   /* an array even without parameters: every op reads P->par + offset
   ** (NULL + 0 is undefined) */
-  uint32_t r = OC_GROW(P->par, P->npar, c.cappar, 1) ? compile_node(&c, root)
-                                                     : (nomem(&c), OC_NONE);
+  uint32_t r = GROW(P->par, P->npar, c.cappar, 1) ? compile_node(&c, root)
+                                                  : (nomem(&c), OC_NONE);
   size_t nn, np;
   if (r == OC_NONE || !count_nodes(root, &nn, &np)) {
     if (r != OC_NONE) nomem(&c);
