@@ -107,79 +107,73 @@ static void point_db(const oc_ray *r, double cx, double cy, double cz,
 static void op_db(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
                   double t1, double *lo, double *hi, int depth);
 
-/* A ray query's walk under a group's BVH: the segment [t0, t1]; the
-** bounds of a derivative (L, H) or the support intervals (S). */
-typedef struct raywalk {
-  const oc_program *P;
-  const oc_ray *r;
-  double t0, t1;
-  int depth, uni;
-  double L, H;
-  struct ivset *S;
-} raywalk;
-
-/* A leaf passes here and is clipped by its visit, which needs its part
-** of the segment: each node is clipped once. */
-static int ray_meets(const oc_bvhnode *nd, void *q) {
-  const raywalk *w = q;
-  double a = w->t0, b = w->t1;
-  return nd->count || oc_ray_clip(w->r, nd->lo, nd->hi, &a, &b);
-}
-
-/* a union's derivative is one of its children's, or 0 */
-static inline void db_acc(raywalk *w, double l, double h) {
-  if (w->uni) {
-    w->L = fmin(w->L, l);
-    w->H = fmax(w->H, h);
-  } else {
-    w->L += l;
-    w->H += h;
-  }
-}
-
-/* One entry's derivative bounds over [a, b]. */
-static inline void ent_db(raywalk *w, const oc_ent *e, double a, double b) {
-  double l = 0, h = 0;
-  if (e->ref != OC_NONE)
-    op_db(w->P, e->ref, w->r, a, b, &l, &h, w->depth + 1);
-  else
-    point_db(w->r, e->c[0], e->c[1], e->c[2], e->ir2, e->e, a, b, &l, &h);
-  db_acc(w, l, h);
-}
-
-static int db_leaf(const oc_bvhnode *nd, void *q) {
-  raywalk *w = q;
-  double a = w->t0, b = w->t1;
-  if (!oc_ray_clip(w->r, nd->lo, nd->hi, &a, &b)) return 0;
-  for (uint32_t j = nd->first; j < nd->first + nd->count; j++)
-    ent_db(w, &w->P->ent[j], a, b);
-  return 0;
+/* Whether the ray's segment [t0, t1] meets node nd. A leaf passes here
+** and is clipped by its visit, which needs its part of the segment: each
+** node is clipped once. */
+static inline int ray_meets(const oc_ray *r, const oc_bvhnode *nd, double t0,
+                            double t1) {
+  return nd->count || oc_ray_clip(r, nd->lo, nd->hi, &t0, &t1);
 }
 
 static void group_db(const oc_program *P, const oc_op *o, const oc_ray *r,
                      double t0, double t1, double *lo, double *hi, int depth) {
-  raywalk w = {P, r, t0, t1, depth, o->kind == OC_K_UNION, 0, 0, NULL};
+  int uni = o->kind == OC_K_UNION;
+  double L = 0, H = 0;
+  /* a union's derivative is one of its children's, or 0 */
+#define ACC(l, h)                                                              \
+  do {                                                                         \
+    if (uni) {                                                                 \
+      L = fmin(L, l);                                                          \
+      H = fmax(H, h);                                                          \
+    } else {                                                                   \
+      L += l;                                                                  \
+      H += h;                                                                  \
+    }                                                                          \
+  } while (0)
+  /* entry j over [a, b] */
+#define ENT_DB(j, a, b)                                                        \
+  do {                                                                         \
+    const oc_ent *e = &P->ent[j];                                              \
+    double l = 0, h = 0;                                                       \
+    if (e->ref != OC_NONE)                                                     \
+      op_db(P, e->ref, r, a, b, &l, &h, depth + 1);                            \
+    else                                                                       \
+      point_db(r, e->c[0], e->c[1], e->c[2], e->ir2, e->e, a, b, &l, &h);      \
+    ACC(l, h);                                                                 \
+  } while (0)
   for (uint32_t k = 0; k < o->nkid; k++) {
     double l = 0, h = 0;
     op_db(P, P->kids[o->kid + k], r, t0, t1, &l, &h, depth + 1);
-    db_acc(&w, l, h);
+    ACC(l, h);
   }
   if (o->nent && (o->nobvh || o->bvh == OC_NONE)) {
     for (uint32_t j = o->ent; j < o->ent + o->nent; j++)
-      ent_db(&w, &P->ent[j], t0, t1);
-  } else if (o->nent && oc_bvh_walk(P->bvh, o->bvh, ray_meets, db_leaf, &w) ==
-                            OC_WALK_FULL) {
-    /* a subtree left out: the group's global bound (none across a
-    ** jump) */
-    double k = P->njump ? INFINITY : o->lip;
-    *lo -= k;
-    *hi += k;
-    return;
+      ENT_DB(j, t0, t1);
+  } else if (o->nent) {
+    int full = 0;
+#define MEETS(x) ray_meets(r, x, t0, t1)
+    OC_BVH_FOREACH(P->bvh, o->bvh, nd, MEETS, full, {
+      double a = t0, b = t1;
+      if (oc_ray_clip(r, nd->lo, nd->hi, &a, &b))
+        for (uint32_t j = nd->first; j < nd->first + nd->count; j++)
+          ENT_DB(j, a, b);
+    });
+#undef MEETS
+    if (full) {
+      /* a subtree left out: the group's global bound (none across a
+      ** jump) */
+      double k = P->njump ? INFINITY : o->lip;
+      *lo -= k;
+      *hi += k;
+      return;
+    }
   }
+#undef ENT_DB
+#undef ACC
   /* never looser than the group's own bound, which holds off jumps
   ** only: an infinite child's stays infinite */
-  *lo += isinf(w.L) ? w.L : fmax(w.L, -o->lip);
-  *hi += isinf(w.H) ? w.H : fmin(w.H, o->lip);
+  *lo += isinf(L) ? L : fmax(L, -o->lip);
+  *hi += isinf(H) ? H : fmin(H, o->lip);
 }
 
 static void op_db(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
@@ -328,21 +322,6 @@ static void iv_add(ivset *S, double lo, double hi) {
 static void op_sup(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
                    double t1, ivset *S, int depth);
 
-static int sup_leaf(const oc_bvhnode *nd, void *q) {
-  raywalk *w = q;
-  double ta = w->t0, tb = w->t1, tc, a, s0, s1;
-  if (!oc_ray_clip(w->r, nd->lo, nd->hi, &ta, &tb)) return 0; /* ray_meets */
-  for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
-    const oc_ent *e = &w->P->ent[j];
-    if (e->ref != OC_NONE)
-      op_sup(w->P, e->ref, w->r, ta, tb, w->S, w->depth + 1);
-    else if (ball_chord(w->r, e->c[0], e->c[1], e->c[2], e->ir2, ta, tb, &tc,
-                        &a, &s0, &s1))
-      iv_add(w->S, tc + s0, tc + s1);
-  }
-  return 0;
-}
-
 static void op_sup(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
                    double t1, ivset *S, int depth) {
   const oc_op *o = &P->ops[i];
@@ -362,10 +341,23 @@ static void op_sup(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
       return;
     }
     {
-      raywalk w = {P, r, t0, t1, depth, 0, 0, 0, S};
+      int full = 0;
+#define MEETS(x) ray_meets(r, x, t0, t1)
+      OC_BVH_FOREACH(P->bvh, o->bvh, nd, MEETS, full, {
+        double ta = t0, tb = t1;
+        if (oc_ray_clip(r, nd->lo, nd->hi, &ta, &tb))
+          for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
+            const oc_ent *e = &P->ent[j];
+            if (e->ref != OC_NONE)
+              op_sup(P, e->ref, r, ta, tb, S, depth + 1);
+            else if (ball_chord(r, e->c[0], e->c[1], e->c[2], e->ir2, ta, tb,
+                                &tc, &a, &s0, &s1))
+              iv_add(S, tc + s0, tc + s1);
+          }
+      });
+#undef MEETS
       /* a subtree left out: the group's whole segment */
-      if (oc_bvh_walk(P->bvh, o->bvh, ray_meets, sup_leaf, &w) == OC_WALK_FULL)
-        iv_add(S, t0, t1);
+      if (full) iv_add(S, t0, t1);
     }
     return;
   case OC_K_POINT:
