@@ -27,4 +27,26 @@ double oc_turb3_max(int octaves);
 /* Lipschitz bound of t: octaves * oc_noise3_lipschitz. */
 double oc_turb3_lipschitz(int octaves);
 
+/* Noise parameters as a compiled program stores them: wavelength,
+** amplitude, offset, octaves, and the seed as two 32-bit halves (so it
+** survives a double). Turbulence, warp and perturb ops (lib/field) and
+** strata (lib/geology) read them back with oc_noise_unpack. */
+#define OC_NOISE_NPAR 6
+
+static inline void oc_noise_pack(const oc_noise *nz,
+                                 double out[OC_NOISE_NPAR]) {
+  out[0] = nz->wavelength;
+  out[1] = nz->amplitude;
+  out[2] = nz->offset;
+  out[3] = (double)nz->octaves;
+  out[4] = (double)(nz->seed >> 32);
+  out[5] = (double)(nz->seed & 0xffffffffu);
+}
+
+static inline oc_noise oc_noise_unpack(const double *par) {
+  oc_noise nz = {par[0], par[1], par[2], (int)par[3],
+                 ((uint64_t)par[4] << 32) | (uint64_t)par[5]};
+  return nz;
+}
+
 #endif

@@ -14,4 +14,9 @@
 ** empty or NaN interval is ignored. */
 void oc_spanset_add(oc_zspan *s, int *n, int cap, double lo, double hi);
 
+/* Closes the smallest gaps of the n sorted, disjoint intervals of s
+** (merging each closest pair of neighbours, the leftmost on ties) until
+** at most max remain (at least one). */
+void oc_spanset_reduce(oc_zspan *s, int *n, int max);
+
 #endif

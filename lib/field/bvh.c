@@ -3,7 +3,10 @@
 **
 ** Top-down median split on the longest axis of the centroids' extent.
 ** Deterministic: ties are broken by entry index, so the same input always
-** gives the same tree.
+** gives the same tree. Each split leaves half the leaves (rounded down to
+** a whole one) on the left, so n entries make ceil(log2(ceil(n / 8))) + 1
+** levels, at most 30 for 2^32: the bound the walks' stack relies on
+** (bvhwalk.h), reported by oc_bvh_build and checked by compile.c.
 */
 #define _GNU_SOURCE /* qsort_r */
 #include <math.h>
@@ -29,6 +32,7 @@ typedef struct builder {
   uint32_t *idx;
   oc_bvhnode *nodes;
   size_t count;
+  int levels; /* deepest leaf's depth + 1 */
 } builder;
 
 static double cen(const builder *b, uint32_t i, int axis) {
@@ -56,7 +60,8 @@ static void select_mid(builder *b, size_t lo, size_t hi, int axis) {
   qsort_r(b->idx + lo, hi - lo, sizeof *b->idx, cmp, &c);
 }
 
-static void build(builder *b, size_t node, size_t lo, size_t hi) {
+static void build(builder *b, size_t node, size_t lo, size_t hi, int depth) {
+  if (depth + 1 > b->levels) b->levels = depth + 1;
   oc_aabb box = oc_aabb_empty(), cb = oc_aabb_empty();
   for (size_t i = lo; i < hi; i++) {
     uint32_t k = b->idx[i];
@@ -83,14 +88,15 @@ static void build(builder *b, size_t node, size_t lo, size_t hi) {
   b->count += 2;
   nd->first = (uint32_t)left;
   nd->count = 0;
-  build(b, left, lo, mid);
-  build(b, left + 1, mid, hi);
+  build(b, left, lo, mid, depth + 1);
+  build(b, left + 1, mid, hi, depth + 1);
 }
 
 size_t oc_bvh_build(const oc_aabb *boxes, size_t n, oc_bvhnode *nodes,
-                    uint32_t *perm) {
+                    uint32_t *perm, int *levels) {
+  *levels = 0;
   if (n == 0) return 0;
-  builder b = {boxes, malloc(3 * n * sizeof(double)), perm, nodes, 1};
+  builder b = {boxes, malloc(3 * n * sizeof(double)), perm, nodes, 1, 0};
   if (!b.cen) return 0;
   for (size_t i = 0; i < n; i++) {
     perm[i] = (uint32_t)i;
@@ -98,7 +104,8 @@ size_t oc_bvh_build(const oc_aabb *boxes, size_t n, oc_bvhnode *nodes,
     b.cen[3 * i + 1] = 0.5 * (boxes[i].lo.y + boxes[i].hi.y);
     b.cen[3 * i + 2] = 0.5 * (boxes[i].lo.z + boxes[i].hi.z);
   }
-  build(&b, 0, 0, n);
+  build(&b, 0, 0, n, 0);
   free(b.cen);
+  *levels = b.levels;
   return b.count;
 }

@@ -15,9 +15,12 @@
 
 #include "core/error.h"
 #include "core/falloff.h"
+#include "core/grow.h"
 #include "core/noise.h"
+#include "core/pmap.h"
 #include "core/vec.h"
 #include "field/node.h"
+#include "field/bvhwalk.h"
 #include "field/prim.h"
 #include "field/program.h"
 
@@ -25,81 +28,8 @@
 ** in single precision; smaller groups keep every child as a double op. */
 #define INLINE_MIN 32
 
-/* ---- growable arrays ------------------------------------------------ */
-
-#define GROW(arr, n, cap, need)                                                \
-  ((n) + (need) <= (cap) ||                                                    \
-           grow((void **)&(arr), &(cap), (n) + (need), sizeof *(arr))          \
-       ? 1                                                                     \
-       : 0)
-
-static int grow(void **arr, size_t *cap, size_t need, size_t elem) {
-  size_t nc = *cap ? *cap : 16;
-  while (nc < need)
-    nc *= 2;
-  void *p = realloc(*arr, nc * elem);
-  if (!p) return 0;
-  *arr = p;
-  *cap = nc;
-  return 1;
-}
-
-/* ---- pointer -> index map (open addressing) -------------------------- */
-
-typedef struct pmap {
-  const void **key;
-  uint32_t *val;
-  size_t cap, n;
-} pmap;
-
-static size_t phash(const void *p) {
-  uint64_t x = (uint64_t)(uintptr_t)p;
-  x ^= x >> 33;
-  x *= 0xff51afd7ed558ccdull;
-  x ^= x >> 33;
-  return (size_t)x;
-}
-
-static uint32_t *pmap_slot(pmap *m, const void *k, int create) {
-  if (create && (m->n + 1) * 2 > m->cap) {
-    size_t nc = m->cap ? m->cap * 2 : 64;
-    const void **nk = calloc(nc, sizeof *nk);
-    uint32_t *nv = malloc(nc * sizeof *nv);
-    if (!nk || !nv) {
-      free(nk);
-      free(nv);
-      return NULL;
-    }
-    for (size_t i = 0; i < m->cap; i++)
-      if (m->key[i]) {
-        size_t h = phash(m->key[i]) & (nc - 1);
-        while (nk[h])
-          h = (h + 1) & (nc - 1);
-        nk[h] = m->key[i];
-        nv[h] = m->val[i];
-      }
-    free(m->key);
-    free(m->val);
-    m->key = nk;
-    m->val = nv;
-    m->cap = nc;
-  }
-  if (!m->cap) return NULL;
-  size_t h = phash(k) & (m->cap - 1);
-  while (m->key[h]) {
-    if (m->key[h] == k) return &m->val[h];
-    h = (h + 1) & (m->cap - 1);
-  }
-  if (!create) return NULL;
-  m->key[h] = k;
-  m->n++;
-  return &m->val[h];
-}
-
-static void pmap_free(pmap *m) {
-  free(m->key);
-  free(m->val);
-}
+/* 1 when arr (n used, capacity cap) has room for need more (core/grow.h) */
+#define GROW OC_GROW
 
 /* ---- compiler state -------------------------------------------------- */
 
@@ -115,7 +45,7 @@ typedef struct comp {
   size_t capops, cappar, capkids, capent, capbvh, capext;
   info *inf; /* parallel to ops */
   size_t capinf;
-  pmap memo;
+  oc_pmap memo;
   double T;
   int nobvh;
   oc_error *err;
@@ -250,16 +180,12 @@ static uint32_t compile_prim(comp *c, const oc_node *n) {
   return op;
 }
 
-/* Turbulence and noise-driven ops keep wavelength, amplitude, offset,
-** octaves, seed (as two 32-bit halves so it survives a double). */
+/* Turbulence and noise-driven ops keep their noise packed
+** (oc_noise_pack). */
 static uint32_t pack_noise(comp *c, const oc_noise *nz) {
-  double v[6] = {nz->wavelength,
-                 nz->amplitude,
-                 nz->offset,
-                 (double)nz->octaves,
-                 (double)(nz->seed >> 32),
-                 (double)(nz->seed & 0xffffffffu)};
-  return add_par(c, v, 6);
+  double v[OC_NOISE_NPAR];
+  oc_noise_pack(nz, v);
+  return add_par(c, v, OC_NOISE_NPAR);
 }
 
 static uint32_t compile_turb(comp *c, const oc_node *n) {
@@ -296,7 +222,7 @@ static int collect(comp *c, const oc_node *root, oc_kind kind, leaf **out,
                    size_t *nout) {
   int is_blend = kind == OC_K_BLEND;
 #define FLAT(x) ((x)->kind == kind || (is_blend && (x)->kind == OC_K_SCALE))
-  pmap seen = {0};
+  oc_pmap seen = {0};
   const oc_node **order = NULL, **stack = NULL;
   size_t norder = 0, caporder = 0, nstack = 0, capstack = 0;
   unsigned char *done = NULL;
@@ -307,8 +233,8 @@ static int collect(comp *c, const oc_node *root, oc_kind kind, leaf **out,
   size_t nl = 0, capl = 0;
   int ok = 0;
   /* iterative DFS post-order over internal (flattenable) nodes */
-  if (!pmap_slot(&seen, root, 1)) goto fail;
-  *pmap_slot(&seen, root, 0) = 0;
+  if (!oc_pmap_slot(&seen, root, 1)) goto fail;
+  *oc_pmap_slot(&seen, root, 0) = 0;
   if (!GROW(stack, nstack, capstack, 1) || !GROW(done, 0, capdone, 1))
     goto fail;
   stack[nstack++] = root;
@@ -321,13 +247,13 @@ static int collect(comp *c, const oc_node *root, oc_kind kind, leaf **out,
     idxnode[nidx++] = root;
     while (nstack) {
       const oc_node *x = stack[nstack - 1];
-      uint32_t xi = *pmap_slot(&seen, x, 0);
+      uint32_t xi = *oc_pmap_slot(&seen, x, 0);
       if (!done[xi]) {
         done[xi] = 1;
         for (size_t i = x->nkids; i-- > 0;) {
           const oc_node *k = x->kids[i];
-          if (!FLAT(k) || pmap_slot(&seen, k, 0)) continue;
-          uint32_t *s = pmap_slot(&seen, k, 1);
+          if (!FLAT(k) || oc_pmap_slot(&seen, k, 0)) continue;
+          uint32_t *s = oc_pmap_slot(&seen, k, 1);
           if (!s || !GROW(idxnode, nidx, capidx, 1) ||
               !GROW(done, nidx, capdone, 1) ||
               !GROW(stack, nstack, capstack, 1)) {
@@ -354,25 +280,25 @@ static int collect(comp *c, const oc_node *root, oc_kind kind, leaf **out,
     for (size_t i = 0; i < nidx; i++)
       w[i] = 0;
     w[0] = 1;
-    pmap lmap = {0};
+    oc_pmap lmap = {0};
     for (size_t oi = norder; oi-- > 0;) {
       const oc_node *x = order[oi];
-      double wx = w[*pmap_slot(&seen, x, 0)];
+      double wx = w[*oc_pmap_slot(&seen, x, 0)];
       double f = x->kind == OC_K_SCALE ? x->par[OC_P_FACTOR] : 1;
       for (size_t i = 0; i < x->nkids; i++) {
         const oc_node *k = x->kids[i];
         if (FLAT(k)) {
-          w[*pmap_slot(&seen, k, 0)] += wx * f;
+          w[*oc_pmap_slot(&seen, k, 0)] += wx * f;
           continue;
         }
-        uint32_t *s = pmap_slot(&lmap, k, 0);
+        uint32_t *s = oc_pmap_slot(&lmap, k, 0);
         if (s) {
           lv[*s].w += wx * f;
           continue;
         }
-        s = pmap_slot(&lmap, k, 1);
+        s = oc_pmap_slot(&lmap, k, 1);
         if (!s || !GROW(lv, nl, capl, 1)) {
-          pmap_free(&lmap);
+          oc_pmap_free(&lmap);
           goto fail;
         }
         *s = (uint32_t)nl;
@@ -381,12 +307,12 @@ static int collect(comp *c, const oc_node *root, oc_kind kind, leaf **out,
         nl++;
       }
     }
-    pmap_free(&lmap);
+    oc_pmap_free(&lmap);
   }
   ok = 1;
 fail:
 #undef FLAT
-  pmap_free(&seen);
+  oc_pmap_free(&seen);
   free(order);
   free(stack);
   free(done);
@@ -402,215 +328,280 @@ fail:
 
 static uint32_t scaled(comp *c, uint32_t kid, double f);
 
-/* Builds a blend or union op over leaves. */
-static uint32_t make_group(comp *c, oc_kind kind, const leaf *lv, size_t nl) {
-  int is_blend = kind == OC_K_BLEND;
-  size_t npoints = 0;
-  for (size_t i = 0; i < nl; i++)
-    if (lv[i].node->kind == OC_K_POINT) npoints++;
-  int inl = npoints >= INLINE_MIN;
-  /* compile non-inline children first (their ops precede ours) */
-  oc_aabb *box = malloc((nl ? nl : 1) * sizeof *box);
-  oc_ent *ent = malloc((nl ? nl : 1) * sizeof *ent);
-  double *lip = malloc((nl ? nl : 1) * sizeof *lip);
-  uint32_t *unb = malloc((nl ? nl : 1) * sizeof *unb);
-  uint32_t *perm = NULL;
-  oc_bvhnode *nodes = NULL;
-  uint32_t op = OC_NONE;
-  if (!box || !ent || !lip || !unb) {
-    nomem(c);
-    goto done;
-  }
-  size_t nent = 0, nunb = 0, ncount = 0;
-  double lo = is_blend ? 0 : -INFINITY, hi = is_blend ? 0 : -INFINITY;
-  double lipmax = 0, lipunb = 0;
-  int depth = 0;
-  oc_aabb all = oc_aabb_empty();
+/* A group under construction: its bounded children ("entries": inline
+** points or ops, each with its box and Lipschitz bound), its unbounded
+** ones, always evaluated, its BVH, and what it knows of its value. */
+typedef struct group {
+  int is_blend, inl;
+  oc_aabb *box; /* per entry */
+  oc_ent *ent;
+  double *lip;
+  size_t nent;
+  uint32_t *unb; /* unbounded children's ops */
+  size_t nunb;
+  size_t ncount;  /* children with a non-zero weight */
+  double lo, hi;  /* value range */
+  double lipmax;  /* largest child bound (unions) */
+  double lipunb;  /* sum of the unbounded children's bounds (blends) */
+  int depth;      /* deepest child */
+  oc_aabb all;    /* union of the supports */
+  uint32_t *perm; /* BVH order of the entries */
+  oc_bvhnode *nodes;
+  size_t nnodes;
+  uint32_t *leaves; /* scratch of the blend's bound: one per node */
+} group;
+
+static void group_free(group *g) {
+  free(g->box);
+  free(g->ent);
+  free(g->lip);
+  free(g->unb);
+  free(g->perm);
+  free(g->nodes);
+  free(g->leaves);
+}
+
+/* An inline point entry, weighted by w; its box and bound are those of
+** what is stored, single precision, with a margin for the rounding. */
+static void inline_point(const oc_node *n, double w, oc_ent *e, oc_aabb *cb,
+                         double *clo, double *chi, double *clip) {
+  double R = n->par[OC_P_R];
+  e->c[0] = (float)n->par[OC_P_C];
+  e->c[1] = (float)n->par[OC_P_C + 1];
+  e->c[2] = (float)n->par[OC_P_C + 2];
+  e->ir2 = (float)(1.0 / (R * R));
+  e->e = (float)(n->par[OC_P_E] * w);
+  e->ref = OC_NONE;
+  double Rf = 1.0 / sqrt((double)e->ir2) * (1 + 1e-6);
+  oc_vec3 cf = oc_v3(e->c[0], e->c[1], e->c[2]);
+  cb->lo = oc_sub(cf, oc_v3(Rf, Rf, Rf));
+  cb->hi = oc_add(cf, oc_v3(Rf, Rf, Rf));
+  *clo = fmin(0, e->e);
+  *chi = fmax(0, e->e);
+  *clip = fabs((double)e->e) * OC_FALLOFF_LIPSCHITZ / R * (1 + 1e-6);
+}
+
+/* Step 1: compiles the children that are not inline points (their ops
+** precede the group's), sorts them into entries and unbounded children,
+** and sums up their value ranges and bounds. */
+static int group_children(comp *c, group *g, const leaf *lv, size_t nl) {
+  int is_blend = g->is_blend;
+  g->lo = g->hi = is_blend ? 0 : -INFINITY;
+  g->all = oc_aabb_empty();
   for (size_t i = 0; i < nl; i++) {
     const oc_node *n = lv[i].node;
     double w = is_blend ? lv[i].w : 1;
     if (w == 0) continue;
-    ncount++;
+    g->ncount++;
     double clo, chi, clip;
     oc_aabb cb;
-    if (inl && n->kind == OC_K_POINT) {
-      oc_ent *e = &ent[nent];
-      double R = n->par[OC_P_R];
-      e->c[0] = (float)n->par[OC_P_C];
-      e->c[1] = (float)n->par[OC_P_C + 1];
-      e->c[2] = (float)n->par[OC_P_C + 2];
-      e->ir2 = (float)(1.0 / (R * R));
-      e->e = (float)(n->par[OC_P_E] * w);
-      e->ref = OC_NONE;
-      /* the support of what is stored, with a margin for float rounding */
-      double Rf = 1.0 / sqrt((double)e->ir2) * (1 + 1e-6);
-      oc_vec3 cf = oc_v3(e->c[0], e->c[1], e->c[2]);
-      cb.lo = oc_sub(cf, oc_v3(Rf, Rf, Rf));
-      cb.hi = oc_add(cf, oc_v3(Rf, Rf, Rf));
-      clo = fmin(0, e->e);
-      chi = fmax(0, e->e);
-      clip = fabs((double)e->e) * OC_FALLOFF_LIPSCHITZ / R * (1 + 1e-6);
+    if (g->inl && n->kind == OC_K_POINT) {
+      inline_point(n, w, &g->ent[g->nent], &cb, &clo, &chi, &clip);
     } else {
       uint32_t k = compile_node(c, n);
-      if (k == OC_NONE) goto done;
-      if (w != 1 && (k = scaled(c, k, w)) == OC_NONE) goto done;
+      if (k == OC_NONE) return -1;
+      if (w != 1 && (k = scaled(c, k, w)) == OC_NONE) return -1;
       info *ci = &c->inf[k];
       cb = ci->box;
       clo = ci->lo;
       chi = ci->hi;
       clip = ci->lip;
-      if (ci->depth > depth) depth = ci->depth;
+      if (ci->depth > g->depth) g->depth = ci->depth;
       if (!oc_aabb_is_bounded(cb)) {
-        unb[nunb++] = k;
-        lipunb += clip;
+        g->unb[g->nunb++] = k;
+        g->lipunb += clip;
         goto acc;
       }
-      ent[nent].ref = k;
-      memset(ent[nent].c, 0, sizeof ent[nent].c);
-      ent[nent].ir2 = ent[nent].e = 0;
+      oc_ent *e = &g->ent[g->nent];
+      e->ref = k;
+      memset(e->c, 0, sizeof e->c);
+      e->ir2 = e->e = 0;
     }
     if (oc_aabb_is_empty(cb)) continue; /* identically zero */
-    box[nent] = cb;
-    lip[nent] = clip;
-    nent++;
+    g->box[g->nent] = cb;
+    g->lip[g->nent] = clip;
+    g->nent++;
   acc:
-    all = oc_aabb_union(all, cb);
+    g->all = oc_aabb_union(g->all, cb);
     if (is_blend) {
-      lo += clo;
-      hi += chi;
+      g->lo += clo;
+      g->hi += chi;
     } else {
-      lo = fmax(lo, clo);
-      hi = fmax(hi, chi);
-      lipmax = fmax(lipmax, clip);
+      g->lo = fmax(g->lo, clo);
+      g->hi = fmax(g->hi, chi);
+      g->lipmax = fmax(g->lipmax, clip);
     }
   }
-  if (!is_blend && ncount == 0) lo = hi = 0;
-  if (!is_blend && ncount > nent + nunb) { /* identically zero children */
-    lo = fmax(lo, 0);
-    hi = fmax(hi, 0);
+  if (!is_blend && g->ncount == 0) g->lo = g->hi = 0;
+  if (!is_blend && g->ncount > g->nent + g->nunb) {
+    /* identically zero children */
+    g->lo = fmax(g->lo, 0);
+    g->hi = fmax(g->hi, 0);
   }
-  /* A bounded child spanning most of the group (a terrain under scattered
-  ** features) would sit in every BVH path and every query would descend
-  ** to its leaf: evaluate it always, as the unbounded ones. */
-  if (nent > 2 * OC_BVH_LEAF) {
-    size_t keep = 0;
-    for (size_t i = 0; i < nent; i++) {
-      int wide = 0;
-      for (int a = 0; a < 2; a++) {
-        double ga = a ? all.hi.y - all.lo.y : all.hi.x - all.lo.x;
-        double ca = a ? box[i].hi.y - box[i].lo.y : box[i].hi.x - box[i].lo.x;
-        wide += ca > 0.5 * ga;
+  return 0;
+}
+
+/* Step 2: a bounded child spanning most of the group (a terrain under
+** scattered features) would sit in every BVH path and every query would
+** descend to its leaf: it is evaluated always, as the unbounded ones. */
+static void group_hoist_wide(group *g) {
+  if (g->nent <= 2 * OC_BVH_LEAF) return;
+  size_t keep = 0;
+  for (size_t i = 0; i < g->nent; i++) {
+    int wide = 0;
+    for (int a = 0; a < 2; a++) {
+      double ga = a ? g->all.hi.y - g->all.lo.y : g->all.hi.x - g->all.lo.x;
+      double ca =
+          a ? g->box[i].hi.y - g->box[i].lo.y : g->box[i].hi.x - g->box[i].lo.x;
+      wide += ca > 0.5 * ga;
+    }
+    if (wide == 2 && g->ent[i].ref != OC_NONE) {
+      g->unb[g->nunb++] = g->ent[i].ref;
+      g->lipunb += g->lip[i];
+      continue;
+    }
+    g->box[keep] = g->box[i];
+    g->ent[keep] = g->ent[i];
+    g->lip[keep] = g->lip[i];
+    keep++;
+  }
+  g->nent = keep;
+}
+
+/* Step 3: the BVH over the entries (also used for the blend's bound),
+** refused when deeper than the walks' stack (bvhwalk.h: it cannot
+** happen, and evaluation has no bound to fall back to). */
+static int group_bvh(comp *c, group *g) {
+  if (!g->nent) return 0;
+  g->perm = malloc(g->nent * sizeof *g->perm);
+  g->nodes = malloc(2 * g->nent * sizeof *g->nodes);
+  g->leaves = malloc(2 * g->nent * sizeof *g->leaves);
+  if (!g->perm || !g->nodes || !g->leaves) return nomem(c);
+  int levels;
+  g->nnodes = oc_bvh_build(g->box, g->nent, g->nodes, g->perm, &levels);
+  if (!g->nnodes) return nomem(c);
+  if (levels > OC_BVH_STACK)
+    return oc_seterr(c->err, OC_ETOODEEP,
+                     "bounding volume hierarchy of %d levels: deeper than "
+                     "its walks allow (%d)",
+                     levels, OC_BVH_STACK);
+  return 0;
+}
+
+/* The leaves whose boxes meet one entry's box. */
+typedef struct lipsum {
+  const oc_bvhnode *nodes;
+  float lo[3], hi[3];
+  uint32_t *leaf; /* their nodes' indices, in the walk's order */
+  size_t n;
+} lipsum;
+
+static int lipsum_meets(const oc_bvhnode *nd, void *q) {
+  const lipsum *w = q;
+  return !(nd->lo[0] > w->hi[0] || nd->hi[0] < w->lo[0] ||
+           nd->lo[1] > w->hi[1] || nd->hi[1] < w->lo[1] ||
+           nd->lo[2] > w->hi[2] || nd->hi[2] < w->lo[2]);
+}
+
+static int lipsum_leaf(const oc_bvhnode *nd, void *q) {
+  lipsum *w = q;
+  w->leaf[w->n++] = (uint32_t)(nd - w->nodes);
+  return 0;
+}
+
+/* Step 4: the group's Lipschitz bound. A union's is its largest child's;
+** a blend's, the largest sum over children overlapping one child, plus
+** the unbounded children's. */
+static double group_lipschitz(const group *g) {
+  if (!g->is_blend) return g->lipmax;
+  double best = 0, total = 0;
+  for (size_t i = 0; i < g->nent; i++)
+    total += g->lip[i];
+  for (size_t i = 0; i < g->nent; i++) {
+    lipsum w = {g->nodes, {0}, {0}, g->leaves, 0};
+    oc_box_to_float(g->box[i], w.lo, w.hi);
+    double s = 0;
+    /* a subtree left out: every entry's bound */
+    if (oc_bvh_walk(g->nodes, 0, lipsum_meets, lipsum_leaf, &w) ==
+        OC_WALK_FULL) {
+      s = total;
+    } else {
+      /* summed over the leaves last first, as before the walk was
+      ** shared (it went right first): the same bits */
+      for (size_t k = w.n; k-- > 0;) {
+        const oc_bvhnode *nd = &g->nodes[w.leaf[k]];
+        for (uint32_t j = nd->first; j < nd->first + nd->count; j++)
+          if (oc_aabb_overlaps(g->box[g->perm[j]], g->box[i]))
+            s += g->lip[g->perm[j]];
       }
-      if (wide == 2 && ent[i].ref != OC_NONE) {
-        unb[nunb++] = ent[i].ref;
-        lipunb += lip[i];
-        continue;
-      }
-      box[keep] = box[i];
-      ent[keep] = ent[i];
-      lip[keep] = lip[i];
-      keep++;
     }
-    nent = keep;
+    if (s > best) best = s;
   }
-  /* BVH over bounded entries (also used for the Lipschitz bound) */
-  size_t nnodes = 0;
-  if (nent) {
-    perm = malloc(nent * sizeof *perm);
-    nodes = malloc(2 * nent * sizeof *nodes);
-    if (!perm || !nodes) {
-      nomem(c);
-      goto done;
-    }
-    nnodes = oc_bvh_build(box, nent, nodes, perm);
-    if (!nnodes) {
-      nomem(c);
-      goto done;
-    }
-  }
-  double lipv;
-  if (is_blend) {
-    /* the largest sum of bounds over children overlapping one child */
-    double best = 0;
-    uint32_t stack[64];
-    for (size_t i = 0; i < nent; i++) {
-      float qlo[3], qhi[3];
-      oc_box_to_float(box[i], qlo, qhi);
-      double s = 0;
-      int sp = 0;
-      stack[sp++] = 0;
-      while (sp) {
-        const oc_bvhnode *nd = &nodes[stack[--sp]];
-        if (nd->lo[0] > qhi[0] || nd->hi[0] < qlo[0] || nd->lo[1] > qhi[1] ||
-            nd->hi[1] < qlo[1] || nd->lo[2] > qhi[2] || nd->hi[2] < qlo[2])
-          continue;
-        if (nd->count) {
-          for (uint32_t j = nd->first; j < nd->first + nd->count; j++)
-            if (oc_aabb_overlaps(box[perm[j]], box[i])) s += lip[perm[j]];
-        } else {
-          stack[sp++] = nd->first;
-          stack[sp++] = nd->first + 1;
-        }
-      }
-      if (s > best) best = s;
-    }
-    lipv = best + lipunb;
-  } else {
-    lipv = lipmax;
-  }
-  /* emit */
-  op = new_op(c, kind);
-  if (op == OC_NONE) {
-    nomem(c);
-    goto done;
-  }
+  return best + g->lipunb;
+}
+
+/* Step 5: the op, its entries in BVH order and its nodes, re-indexed
+** into the program's arrays. */
+static uint32_t group_emit(comp *c, oc_kind kind, const group *g, double lipv) {
+  uint32_t op = new_op(c, kind);
+  if (op == OC_NONE) return (uint32_t)nomem(c), OC_NONE;
   oc_program *P = c->P;
   oc_op *o = &P->ops[op];
-  o->ntotal = (uint32_t)ncount;
+  o->ntotal = (uint32_t)g->ncount;
   o->nobvh = (uint8_t)c->nobvh;
-  o->kid = add_kids(c, unb, nunb);
-  if (o->kid == OC_NONE) {
-    op = OC_NONE;
-    nomem(c);
-    goto done;
-  }
-  o->nkid = (uint32_t)nunb;
-  if (!GROW(P->ent, P->nent, c->capent, nent) ||
-      !GROW(P->bvh, P->nbvh, c->capbvh, nnodes)) {
-    op = OC_NONE;
-    nomem(c);
-    goto done;
-  }
+  o->kid = add_kids(c, g->unb, g->nunb);
+  if (o->kid == OC_NONE) return (uint32_t)nomem(c), OC_NONE;
+  o->nkid = (uint32_t)g->nunb;
+  if (!GROW(P->ent, P->nent, c->capent, g->nent) ||
+      !GROW(P->bvh, P->nbvh, c->capbvh, g->nnodes))
+    return (uint32_t)nomem(c), OC_NONE;
   o = &P->ops[op];
   o->ent = (uint32_t)P->nent;
-  o->nent = (uint32_t)nent;
-  for (size_t j = 0; j < nent; j++)
-    P->ent[P->nent + j] = ent[perm[j]];
-  P->nent += nent;
-  if (nnodes) {
+  o->nent = (uint32_t)g->nent;
+  for (size_t j = 0; j < g->nent; j++)
+    P->ent[P->nent + j] = g->ent[g->perm[j]];
+  P->nent += g->nent;
+  if (g->nnodes) {
     o->bvh = (uint32_t)P->nbvh;
-    for (size_t j = 0; j < nnodes; j++) {
-      oc_bvhnode nd = nodes[j];
+    for (size_t j = 0; j < g->nnodes; j++) {
+      oc_bvhnode nd = g->nodes[j];
       if (nd.count)
         nd.first += o->ent;
       else
         nd.first += o->bvh;
       P->bvh[P->nbvh + j] = nd;
     }
-    P->nbvh += nnodes;
+    P->nbvh += g->nnodes;
   }
-  c->inf[op].lo = lo;
-  c->inf[op].hi = hi;
+  c->inf[op].lo = g->lo;
+  c->inf[op].hi = g->hi;
   c->inf[op].lip = lipv;
-  c->inf[op].depth = depth + 1;
-  set_box(c, op, all);
-done:
-  free(box);
-  free(ent);
-  free(lip);
-  free(unb);
-  free(perm);
-  free(nodes);
+  c->inf[op].depth = g->depth + 1;
+  set_box(c, op, g->all);
+  return op;
+}
+
+/* Builds a blend or union op over leaves. */
+static uint32_t make_group(comp *c, oc_kind kind, const leaf *lv, size_t nl) {
+  group g = {0};
+  g.is_blend = kind == OC_K_BLEND;
+  size_t npoints = 0;
+  for (size_t i = 0; i < nl; i++)
+    if (lv[i].node->kind == OC_K_POINT) npoints++;
+  g.inl = npoints >= INLINE_MIN;
+  size_t cap = nl ? nl : 1;
+  g.box = malloc(cap * sizeof *g.box);
+  g.ent = malloc(cap * sizeof *g.ent);
+  g.lip = malloc(cap * sizeof *g.lip);
+  g.unb = malloc(cap * sizeof *g.unb);
+  uint32_t op = OC_NONE;
+  if (!g.box || !g.ent || !g.lip || !g.unb)
+    nomem(c);
+  else if (!group_children(c, &g, lv, nl)) {
+    group_hoist_wide(&g);
+    if (!group_bvh(c, &g)) op = group_emit(c, kind, &g, group_lipschitz(&g));
+  }
+  group_free(&g);
   return op;
 }
 
@@ -884,7 +875,7 @@ done:
 }
 
 static uint32_t compile_node(comp *c, const oc_node *n) {
-  uint32_t *memo = pmap_slot(&c->memo, n, 0);
+  uint32_t *memo = oc_pmap_slot(&c->memo, n, 0);
   if (memo) return *memo;
   if (++c->depth > OC_MAX_DEPTH) {
     oc_seterr(c->err, OC_ETOODEEP,
@@ -943,7 +934,7 @@ static uint32_t compile_node(comp *c, const oc_node *n) {
               OC_MAX_DEPTH);
     return OC_NONE;
   }
-  uint32_t *slot = pmap_slot(&c->memo, n, 1);
+  uint32_t *slot = oc_pmap_slot(&c->memo, n, 1);
   if (!slot) return (uint32_t)nomem(c), OC_NONE;
   *slot = op;
   return op;
@@ -952,12 +943,12 @@ static uint32_t compile_node(comp *c, const oc_node *n) {
 /* ---- statistics ------------------------------------------------------ */
 
 static int count_nodes(const oc_node *root, size_t *nodes, size_t *prims) {
-  pmap seen = {0};
+  oc_pmap seen = {0};
   const oc_node **stack = NULL;
   size_t n = 0, cap = 0;
   int ok = 0;
   *nodes = *prims = 0;
-  if (!pmap_slot(&seen, root, 1) || !GROW(stack, n, cap, 1)) goto done;
+  if (!oc_pmap_slot(&seen, root, 1) || !GROW(stack, n, cap, 1)) goto done;
   stack[n++] = root;
   while (n) {
     const oc_node *x = stack[--n];
@@ -965,14 +956,14 @@ static int count_nodes(const oc_node *root, size_t *nodes, size_t *prims) {
     if (oc_node_is_prim(x)) (*prims)++;
     for (size_t i = 0; i < x->nkids; i++) {
       const oc_node *k = x->kids[i];
-      if (pmap_slot(&seen, k, 0)) continue;
-      if (!pmap_slot(&seen, k, 1) || !GROW(stack, n, cap, 1)) goto done;
+      if (oc_pmap_slot(&seen, k, 0)) continue;
+      if (!oc_pmap_slot(&seen, k, 1) || !GROW(stack, n, cap, 1)) goto done;
       stack[n++] = k;
     }
   }
   ok = 1;
 done:
-  pmap_free(&seen);
+  oc_pmap_free(&seen);
   free(stack);
   return ok;
 }
@@ -1014,7 +1005,7 @@ oc_program *oc_compile(oc_node *root, const oc_compile_options *opts,
   if (r == OC_NONE || !count_nodes(root, &nn, &np)) {
     if (r != OC_NONE) nomem(&c);
     free(c.inf);
-    pmap_free(&c.memo);
+    oc_pmap_free(&c.memo);
     P->node = NULL;
     oc_program_free(P);
     return NULL;
@@ -1033,31 +1024,6 @@ oc_program *oc_compile(oc_node *root, const oc_compile_options *opts,
                    P->nent * sizeof *P->ent + P->nbvh * sizeof *P->bvh +
                    P->next * sizeof *P->ext;
   free(c.inf);
-  pmap_free(&c.memo);
+  oc_pmap_free(&c.memo);
   return P;
-}
-
-void oc_program_free(oc_program *P) {
-  if (!P) return;
-  free(P->ops);
-  free(P->par);
-  free(P->kids);
-  free(P->ent);
-  free(P->bvh);
-  free(P->ext);
-  oc_node_release(P->node);
-  free(P);
-}
-
-oc_aabb oc_program_bounds(const oc_program *P) {
-  return P->bounds;
-}
-double oc_program_lipschitz(const oc_program *P) {
-  return P->lip;
-}
-double oc_program_threshold(const oc_program *P) {
-  return P->T;
-}
-void oc_program_get_stats(const oc_program *P, oc_program_stats *st) {
-  *st = P->stats;
 }

@@ -9,22 +9,9 @@
 #include "core/noise.h"
 #include "core/rng.h"
 #include "core/vec.h"
+#include "field/bvhwalk.h"
 #include "field/prim.h"
 #include "field/program.h"
-
-#define BVH_STACK 64
-
-typedef struct noisep {
-  double wl, amp, off;
-  int oct;
-  uint64_t seed;
-} noisep;
-
-static noisep unpack_noise(const double *v) {
-  noisep n = {v[0], v[1], v[2], (int)v[3],
-              ((uint64_t)v[4] << 32) | (uint64_t)v[5]};
-  return n;
-}
 
 static double ev(const oc_program *P, uint32_t i, oc_vec3 p);
 static double evg(const oc_program *P, uint32_t i, oc_vec3 p, oc_vec3 *g);
@@ -79,8 +66,8 @@ static double prim(oc_kind kind, const double *par, oc_vec3 p, oc_vec3 *g) {
 
 /* The largest radius the perturbation can reach: R + max(0, A) tmax. */
 static inline double rho_max(const oc_op *o, const double *par) {
-  const double *nz = par + o->nkid;
-  return par[OC_P_R] + fmax(0, nz[1]) * oc_turb3_max((int)nz[3]);
+  oc_noise nz = oc_noise_unpack(par + o->nkid);
+  return par[OC_P_R] + fmax(0, nz.amplitude) * oc_turb3_max(nz.octaves);
 }
 
 double oc_perturb_reach(const oc_op *o, const double *par) {
@@ -97,7 +84,7 @@ double oc_perturb_reach(const oc_op *o, const double *par) {
 static int perturb_at(const oc_op *o, const double *par, oc_vec3 p, double *val,
                       oc_vec3 *g) {
   double E = par[OC_P_E], R = par[OC_P_R];
-  noisep nz = unpack_noise(par + o->nkid);
+  oc_noise nz = oc_noise_unpack(par + o->nkid);
   oc_vec3 s;
   double d, J[9];
   double rmax = rho_max(o, par);
@@ -117,8 +104,9 @@ static int perturb_at(const oc_op *o, const double *par, oc_vec3 p, double *val,
   oc_vec3 u = oc_mul(oc_sub(p, s), 1 / d);
   oc_vec3 v = oc_add(s, oc_mul(u, R));
   oc_vec3 gt;
-  double rho = R + nz.amp * oc_turb3(nz.seed, nz.oct, oc_mul(v, 1 / nz.wl),
-                                     g ? &gt : NULL);
+  double rho =
+      R + nz.amplitude * oc_turb3(nz.seed, nz.octaves,
+                                  oc_mul(v, 1 / nz.wavelength), g ? &gt : NULL);
   double x = d / rho;
   *val = E * oc_falloff(x);
   if (!g) return 1;
@@ -131,7 +119,7 @@ static int perturb_at(const oc_op *o, const double *par, oc_vec3 p, double *val,
                      J[3] * w.x + J[4] * w.y + J[5] * w.z,
                      J[6] * w.x + J[7] * w.y + J[8] * w.z);
   oc_vec3 jt = oc_add(Sg, oc_mul(oc_sub(w, Sw), R / d));
-  oc_vec3 grho = oc_mul(jt, nz.amp / nz.wl);
+  oc_vec3 grho = oc_mul(jt, nz.amplitude / nz.wavelength);
   double k = E * oc_falloff_d(x);
   *g = oc_mul(oc_sub(oc_mul(u, 1 / rho), oc_mul(grho, d / (rho * rho))), k);
   return 1;
@@ -204,37 +192,29 @@ static double group(const oc_program *P, const oc_op *o, oc_vec3 p,
     TAKE(g ? evg(P, ki, p, &gk) : ev(P, ki, p));
   }
   const oc_ent *ent = P->ent;
+#define TAKE_ENT(j)                                                            \
+  do {                                                                         \
+    int hit;                                                                   \
+    gk = oc_v3(0, 0, 0);                                                       \
+    double v = ent_eval(P, &ent[j], p, g ? &gk : NULL, &hit);                  \
+    if (hit) TAKE(v);                                                          \
+  } while (0)
   if (o->nent && (o->nobvh || o->bvh == OC_NONE)) {
-    for (uint32_t j = o->ent; j < o->ent + o->nent; j++) {
-      int hit;
-      gk = oc_v3(0, 0, 0);
-      double v = ent_eval(P, &ent[j], p, g ? &gk : NULL, &hit);
-      if (hit) TAKE(v);
-    }
+    for (uint32_t j = o->ent; j < o->ent + o->nent; j++)
+      TAKE_ENT(j);
   } else if (o->nent) {
-    /* children are tested before being pushed: misses cost no stack
-    ** traffic, and the stack only holds nodes that contain p */
-    uint32_t stack[BVH_STACK];
-    int sp = 0;
-    if (in_node(&P->bvh[o->bvh], p)) stack[sp++] = o->bvh;
-    while (sp) {
-      const oc_bvhnode *nd = &P->bvh[stack[--sp]];
-      if (nd->count) {
-        for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
-          int hit;
-          gk = oc_v3(0, 0, 0);
-          double v = ent_eval(P, &ent[j], p, g ? &gk : NULL, &hit);
-          if (hit) TAKE(v);
-        }
-        continue;
-      }
-      const oc_bvhnode *l = &P->bvh[nd->first];
-      int hr = in_node(l + 1, p), hl = in_node(l, p);
-      if (sp + 2 > BVH_STACK) continue; /* cannot happen: depth <= 32 */
-      if (hr) stack[sp++] = nd->first + 1;
-      if (hl) stack[sp++] = nd->first;
-    }
+    /* full cannot happen: compile.c refuses trees deeper than the stack
+    ** (bvhwalk.h) */
+    int full = 0;
+#define IN_P(x) in_node(x, p)
+    OC_BVH_FOREACH(P->bvh, o->bvh, nd, IN_P, full, {
+      for (uint32_t j = nd->first; j < nd->first + nd->count; j++)
+        TAKE_ENT(j);
+    });
+#undef IN_P
+    (void)full;
   }
+#undef TAKE_ENT
 #undef TAKE
   /* children not visited are exactly 0 here */
   if (uni && visited < o->ntotal && acc < 0) {
@@ -311,20 +291,21 @@ static double smooth(int uni, double a, double b, double r, double T,
 
 /* Displacement delta(p) = A (t_i(p / wl) - tmax/2), i = 1..3; with jac
 ** (when not NULL) its Jacobian rows. */
-static oc_vec3 displacement(const noisep *nz, oc_vec3 p, oc_vec3 jac[3]) {
-  oc_vec3 q = oc_mul(p, 1 / nz->wl);
-  double half = oc_turb3_max(nz->oct) / 2, d[3];
+static oc_vec3 displacement(const oc_noise *nz, oc_vec3 p, oc_vec3 jac[3]) {
+  oc_vec3 q = oc_mul(p, 1 / nz->wavelength);
+  double half = oc_turb3_max(nz->octaves) / 2, d[3];
   for (int i = 0; i < 3; i++) {
     uint64_t seed = oc_mix64(nz->seed + 0x9e3779b97f4a7c15ull * (i + 1));
     oc_vec3 gr;
-    d[i] = nz->amp * (oc_turb3(seed, nz->oct, q, jac ? &gr : NULL) - half);
-    if (jac) jac[i] = oc_mul(gr, nz->amp / nz->wl);
+    d[i] = nz->amplitude *
+           (oc_turb3(seed, nz->octaves, q, jac ? &gr : NULL) - half);
+    if (jac) jac[i] = oc_mul(gr, nz->amplitude / nz->wavelength);
   }
   return oc_v3(d[0], d[1], d[2]);
 }
 
 static double warp(const oc_program *P, const oc_op *o, oc_vec3 p, oc_vec3 *g) {
-  noisep nz = unpack_noise(P->par + o->par);
+  oc_noise nz = oc_noise_unpack(P->par + o->par);
   uint32_t child = P->kids[o->kid];
   double w = 1;
   oc_vec3 gw = oc_v3(0, 0, 0);
@@ -372,9 +353,10 @@ static double ev(const oc_program *P, uint32_t i, oc_vec3 p) {
   case OC_K_UNION:
     return group(P, o, p, NULL);
   case OC_K_TURB: {
-    noisep nz = unpack_noise(par);
-    return nz.off +
-           nz.amp * oc_turb3(nz.seed, nz.oct, oc_mul(p, 1 / nz.wl), NULL);
+    oc_noise nz = oc_noise_unpack(par);
+    return nz.offset + nz.amplitude * oc_turb3(nz.seed, nz.octaves,
+                                               oc_mul(p, 1 / nz.wavelength),
+                                               NULL);
   }
   case OC_K_INTER: {
     double m = INFINITY;
@@ -419,11 +401,11 @@ static double evg(const oc_program *P, uint32_t i, oc_vec3 p, oc_vec3 *g) {
   case OC_K_UNION:
     return group(P, o, p, g);
   case OC_K_TURB: {
-    noisep nz = unpack_noise(par);
+    oc_noise nz = oc_noise_unpack(par);
     oc_vec3 gt;
-    double t = oc_turb3(nz.seed, nz.oct, oc_mul(p, 1 / nz.wl), &gt);
-    *g = oc_mul(gt, nz.amp / nz.wl);
-    return nz.off + nz.amp * t;
+    double t = oc_turb3(nz.seed, nz.octaves, oc_mul(p, 1 / nz.wavelength), &gt);
+    *g = oc_mul(gt, nz.amplitude / nz.wavelength);
+    return nz.offset + nz.amplitude * t;
   }
   case OC_K_INTER: {
     double m = INFINITY;

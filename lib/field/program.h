@@ -83,10 +83,12 @@ struct oc_program {
 };
 
 /* BVH construction over n boxes; fills nodes (capacity 2n) and the entry
-** order perm (n). Returns the node count. Leaves hold <= OC_BVH_LEAF. */
+** order perm (n), and tells the tree's depth in levels (a lone leaf is
+** 1; see bvhwalk.h for its bound). Returns the node count. Leaves hold
+** <= OC_BVH_LEAF. */
 #define OC_BVH_LEAF 8
 size_t oc_bvh_build(const oc_aabb *boxes, size_t n, oc_bvhnode *nodes,
-                    uint32_t *perm);
+                    uint32_t *perm, int *levels);
 
 /* The local Lipschitz bound of op `op` inside box b (query.c): what
 ** oc_program_lipschitz_in answers for the root. */

@@ -12,12 +12,12 @@
 #include "core/spanset.h"
 #include "core/noise.h"
 #include "core/vec.h"
+#include "field/bvhwalk.h"
 #include "field/prim.h"
 #include "field/program.h"
 #include "field/query.h"
 
 #define SPAN_CAP 64
-#define BVH_STACK 64
 
 /* ---- span sets ---------------------------------------------------------- */
 
@@ -147,6 +147,37 @@ static void plane_spans(const double *par, const foot *f, spans *S) {
 static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
                      int depth, int direct);
 
+/* A column query's walk under a group's BVH. */
+typedef struct spanwalk {
+  const oc_program *P;
+  const foot *f;
+  spans *S;
+  int depth, direct;
+} spanwalk;
+
+static int spans_meets(const oc_bvhnode *nd, void *q) {
+  return foot_meets(nd->lo, nd->hi, ((const spanwalk *)q)->f);
+}
+
+static int spans_leaf(const oc_bvhnode *nd, void *q) {
+  spanwalk *w = q;
+  const foot *f = w->f;
+  for (uint32_t j = nd->first; j < nd->first + nd->count && !w->S->all; j++) {
+    const oc_ent *e = &w->P->ent[j];
+    if (e->ref != OC_NONE) {
+      op_spans(w->P, e->ref, f, w->S, w->depth + 1, w->direct);
+      continue;
+    }
+    double R = 1.0 / sqrt((double)e->ir2) * (1 + 1e-6);
+    if (e->c[0] - R > f->x1 || e->c[0] + R < f->x0 || e->c[1] - R > f->y1 ||
+        e->c[1] + R < f->y0)
+      continue;
+    w->S->nleaf++;
+    span_add(w->S, e->c[2] - R, e->c[2] + R);
+  }
+  return w->S->all;
+}
+
 /* `direct`: every operator above is a blend or a union, whose value is
 ** the child's own where the other children are 0. */
 static void group_spans(const oc_program *P, const oc_op *o, const foot *f,
@@ -154,31 +185,10 @@ static void group_spans(const oc_program *P, const oc_op *o, const foot *f,
   for (uint32_t k = 0; k < o->nkid && !S->all; k++)
     op_spans(P, P->kids[o->kid + k], f, S, depth + 1, direct);
   if (!o->nent || S->all) return;
-  uint32_t stack[BVH_STACK];
-  int sp = 0;
-  stack[sp++] = o->bvh;
-  while (sp && !S->all) {
-    const oc_bvhnode *nd = &P->bvh[stack[--sp]];
-    if (!foot_meets(nd->lo, nd->hi, f)) continue;
-    if (nd->count) {
-      for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
-        const oc_ent *e = &P->ent[j];
-        if (e->ref != OC_NONE) {
-          op_spans(P, e->ref, f, S, depth + 1, direct);
-          continue;
-        }
-        double R = 1.0 / sqrt((double)e->ir2) * (1 + 1e-6);
-        if (e->c[0] - R > f->x1 || e->c[0] + R < f->x0 || e->c[1] - R > f->y1 ||
-            e->c[1] + R < f->y0)
-          continue;
-        S->nleaf++;
-        span_add(S, e->c[2] - R, e->c[2] + R);
-      }
-    } else if (sp + 2 <= BVH_STACK) {
-      stack[sp++] = nd->first + 1;
-      stack[sp++] = nd->first;
-    }
-  }
+  spanwalk w = {P, f, S, depth, direct};
+  /* a subtree left out: the whole column */
+  if (oc_bvh_walk(P->bvh, o->bvh, spans_meets, spans_leaf, &w) == OC_WALK_FULL)
+    S->all = 1;
 }
 
 /* A transform keeps columns when it maps z to z and xy to xy. */
@@ -239,7 +249,8 @@ static void op_spans(const oc_program *P, uint32_t i, const foot *f, spans *S,
   case OC_K_WARP: {
     /* the child's spans around the displaced column, grown by the
     ** largest displacement */
-    double A = fabs(par[1]) * oc_turb3_max((int)par[3]) / 2;
+    oc_noise nz = oc_noise_unpack(par);
+    double A = fabs(nz.amplitude) * oc_turb3_max(nz.octaves) / 2;
     foot g = {f->x0 - A, f->y0 - A, f->x1 + A, f->y1 + A};
     spans C;
     C.n = C.nt = C.nz = C.wz = C.all = C.nleaf = 0;
@@ -319,19 +330,7 @@ void oc_child_spans(const oc_kctx *k, size_t i, const oc_foot *f, oc_colq *q) {
 /* Closes the smallest gaps of set s (n spans) until at most max remain,
 ** and copies it to out. */
 static int reduce(oc_zspan *s, int n, oc_zspan *out, int max) {
-  while (n > max) {
-    int best = 0;
-    double gap = INFINITY;
-    for (int k = 0; k + 1 < n; k++)
-      if (s[k + 1].lo - s[k].hi < gap) {
-        gap = s[k + 1].lo - s[k].hi;
-        best = k;
-      }
-    s[best].hi = s[best + 1].hi;
-    for (int k = best + 1; k + 1 < n; k++)
-      s[k] = s[k + 1];
-    n--;
-  }
+  oc_spanset_reduce(s, &n, max);
   for (int k = 0; k < n; k++)
     out[k] = s[k];
   return n;
@@ -409,6 +408,60 @@ int oc_child_zero_in(const oc_kctx *k, size_t i, const oc_aabb *b) {
          op_zero(P, P->kids[P->ops[k->op_].kid + i], b, k->depth_ + 1);
 }
 
+/* A box query's walk under a group's BVH (local bounds, zero tests). */
+typedef struct lipwalk {
+  const oc_program *P;
+  const oc_aabb *b;
+  int depth, uni;
+  double acc; /* the bound so far; for zero tests, 1 while all zero */
+} lipwalk;
+
+static int box_meets_nd(const oc_bvhnode *nd, void *q) {
+  return box_meets(nd->lo, nd->hi, ((const lipwalk *)q)->b);
+}
+
+static int lip_leaf(const oc_bvhnode *nd, void *q) {
+  lipwalk *w = q;
+  const oc_aabb *b = w->b;
+  for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
+    const oc_ent *e = &w->P->ent[j];
+    double l;
+    if (e->ref != OC_NONE) {
+      l = op_lip(w->P, e->ref, b, w->depth + 1);
+    } else {
+      double R = 1.0 / sqrt((double)e->ir2);
+      double Rp = R * (1 + 1e-6);
+      if (box_d2(b, e->c[0], e->c[1], e->c[2]) >= Rp * Rp) continue;
+      l = fabs((double)e->e) * OC_FALLOFF_LIPSCHITZ / R * (1 + 1e-6);
+    }
+    w->acc = w->uni ? fmax(w->acc, l) : w->acc + l;
+  }
+  return 0;
+}
+
+static int op_zero(const oc_program *P, uint32_t i, const oc_aabb *b,
+                   int depth);
+
+/* Ends the walk at the first entry that may be non-zero in the box. */
+static int zero_leaf(const oc_bvhnode *nd, void *q) {
+  lipwalk *w = q;
+  for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
+    const oc_ent *e = &w->P->ent[j];
+    int zero;
+    if (e->ref != OC_NONE) {
+      zero = op_zero(w->P, e->ref, w->b, w->depth + 1);
+    } else {
+      double Rp = 1.0 / sqrt((double)e->ir2) * (1 + 1e-6);
+      zero = box_d2(w->b, e->c[0], e->c[1], e->c[2]) >= Rp * Rp;
+    }
+    if (!zero) {
+      w->acc = 0;
+      return 1;
+    }
+  }
+  return 0;
+}
+
 static double op_lip(const oc_program *P, uint32_t i, const oc_aabb *b,
                      int depth) {
   const oc_op *o = &P->ops[i];
@@ -425,31 +478,11 @@ static double op_lip(const oc_program *P, uint32_t i, const oc_aabb *b,
       acc = uni ? fmax(acc, l) : acc + l;
     }
     if (!o->nent) return acc;
-    uint32_t stack[BVH_STACK];
-    int sp = 0;
-    stack[sp++] = o->bvh;
-    while (sp) {
-      const oc_bvhnode *nd = &P->bvh[stack[--sp]];
-      if (!box_meets(nd->lo, nd->hi, b)) continue;
-      if (nd->count) {
-        for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
-          const oc_ent *e = &P->ent[j];
-          double l;
-          if (e->ref != OC_NONE) {
-            l = op_lip(P, e->ref, b, depth + 1);
-          } else {
-            double R = 1.0 / sqrt((double)e->ir2);
-            double Rp = R * (1 + 1e-6);
-            if (box_d2(b, e->c[0], e->c[1], e->c[2]) >= Rp * Rp) continue;
-            l = fabs((double)e->e) * OC_FALLOFF_LIPSCHITZ / R * (1 + 1e-6);
-          }
-          acc = uni ? fmax(acc, l) : acc + l;
-        }
-      } else if (sp + 2 <= BVH_STACK) {
-        stack[sp++] = nd->first + 1;
-        stack[sp++] = nd->first;
-      }
-    }
+    lipwalk w = {P, b, depth, uni, acc};
+    /* a subtree left out: the group's global bound (none across a jump) */
+    if (oc_bvh_walk(P->bvh, o->bvh, box_meets_nd, lip_leaf, &w) == OC_WALK_FULL)
+      return P->njump ? INFINITY : o->lip;
+    acc = w.acc;
     /* (the group's own bound holds off jumps only) */
     return isinf(acc) ? acc : fmin(acc, o->lip);
   }
@@ -520,29 +553,12 @@ static int op_zero(const oc_program *P, uint32_t i, const oc_aabb *b,
   for (uint32_t k = 0; k < o->nkid; k++)
     if (!op_zero(P, P->kids[o->kid + k], b, depth + 1)) return 0;
   if (!o->nent) return 1;
-  uint32_t stack[BVH_STACK];
-  int sp = 0;
-  stack[sp++] = o->bvh;
-  while (sp) {
-    const oc_bvhnode *nd = &P->bvh[stack[--sp]];
-    if (!box_meets(nd->lo, nd->hi, b)) continue;
-    if (!nd->count) {
-      if (sp + 2 > BVH_STACK) return 0;
-      stack[sp++] = nd->first + 1;
-      stack[sp++] = nd->first;
-      continue;
-    }
-    for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
-      const oc_ent *e = &P->ent[j];
-      if (e->ref != OC_NONE) {
-        if (!op_zero(P, e->ref, b, depth + 1)) return 0;
-        continue;
-      }
-      double Rp = 1.0 / sqrt((double)e->ir2) * (1 + 1e-6);
-      if (box_d2(b, e->c[0], e->c[1], e->c[2]) < Rp * Rp) return 0;
-    }
-  }
-  return 1;
+  lipwalk w = {P, b, depth, 0, 1};
+  /* a subtree left out: "not zero" */
+  return oc_bvh_walk(P->bvh, o->bvh, box_meets_nd, zero_leaf, &w) ==
+                 OC_WALK_FULL
+             ? 0
+             : w.acc != 0;
 }
 
 int oc_op_zero_in(const oc_program *P, uint32_t op, const oc_aabb *b) {

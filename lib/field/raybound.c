@@ -12,11 +12,11 @@
 #include "core/falloff.h"
 #include "core/spanset.h"
 #include "core/vec.h"
+#include "field/bvhwalk.h"
 #include "field/prim.h"
 #include "field/program.h"
 #include "field/raybound.h"
 
-#define BVH_STACK 64
 #define IV_CAP 64
 /* Rounding slack: bounds are inflated, intervals widened, by this much. */
 #define REL 1e-6
@@ -107,6 +107,14 @@ static void point_db(const oc_ray *r, double cx, double cy, double cz,
 static void op_db(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
                   double t1, double *lo, double *hi, int depth);
 
+/* Whether the ray's segment [t0, t1] meets node nd. A leaf passes here
+** and is clipped by its visit, which needs its part of the segment: each
+** node is clipped once. */
+static inline int ray_meets(const oc_ray *r, const oc_bvhnode *nd, double t0,
+                            double t1) {
+  return nd->count || oc_ray_clip(r, nd->lo, nd->hi, &t0, &t1);
+}
+
 static void group_db(const oc_program *P, const oc_op *o, const oc_ray *r,
                      double t0, double t1, double *lo, double *hi, int depth) {
   int uni = o->kind == OC_K_UNION;
@@ -122,47 +130,45 @@ static void group_db(const oc_program *P, const oc_op *o, const oc_ray *r,
       H += h;                                                                  \
     }                                                                          \
   } while (0)
+  /* entry j over [a, b] */
+#define ENT_DB(j, a, b)                                                        \
+  do {                                                                         \
+    const oc_ent *e = &P->ent[j];                                              \
+    double l = 0, h = 0;                                                       \
+    if (e->ref != OC_NONE)                                                     \
+      op_db(P, e->ref, r, a, b, &l, &h, depth + 1);                            \
+    else                                                                       \
+      point_db(r, e->c[0], e->c[1], e->c[2], e->ir2, e->e, a, b, &l, &h);      \
+    ACC(l, h);                                                                 \
+  } while (0)
   for (uint32_t k = 0; k < o->nkid; k++) {
     double l = 0, h = 0;
     op_db(P, P->kids[o->kid + k], r, t0, t1, &l, &h, depth + 1);
     ACC(l, h);
   }
-  if (o->nent) {
-    uint32_t stack[BVH_STACK];
-    int sp = 0;
-    if (o->nobvh || o->bvh == OC_NONE) {
-      for (uint32_t j = o->ent; j < o->ent + o->nent; j++) {
-        const oc_ent *e = &P->ent[j];
-        double l = 0, h = 0;
-        if (e->ref != OC_NONE)
-          op_db(P, e->ref, r, t0, t1, &l, &h, depth + 1);
-        else
-          point_db(r, e->c[0], e->c[1], e->c[2], e->ir2, e->e, t0, t1, &l, &h);
-        ACC(l, h);
-      }
-    } else {
-      stack[sp++] = o->bvh;
-    }
-    while (sp) {
-      const oc_bvhnode *nd = &P->bvh[stack[--sp]];
+  if (o->nent && (o->nobvh || o->bvh == OC_NONE)) {
+    for (uint32_t j = o->ent; j < o->ent + o->nent; j++)
+      ENT_DB(j, t0, t1);
+  } else if (o->nent) {
+    int full = 0;
+#define MEETS(x) ray_meets(r, x, t0, t1)
+    OC_BVH_FOREACH(P->bvh, o->bvh, nd, MEETS, full, {
       double a = t0, b = t1;
-      if (!oc_ray_clip(r, nd->lo, nd->hi, &a, &b)) continue;
-      if (nd->count) {
-        for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
-          const oc_ent *e = &P->ent[j];
-          double l = 0, h = 0;
-          if (e->ref != OC_NONE)
-            op_db(P, e->ref, r, a, b, &l, &h, depth + 1);
-          else
-            point_db(r, e->c[0], e->c[1], e->c[2], e->ir2, e->e, a, b, &l, &h);
-          ACC(l, h);
-        }
-      } else if (sp + 2 <= BVH_STACK) {
-        stack[sp++] = nd->first + 1;
-        stack[sp++] = nd->first;
-      }
+      if (oc_ray_clip(r, nd->lo, nd->hi, &a, &b))
+        for (uint32_t j = nd->first; j < nd->first + nd->count; j++)
+          ENT_DB(j, a, b);
+    });
+#undef MEETS
+    if (full) {
+      /* a subtree left out: the group's global bound (none across a
+      ** jump) */
+      double k = P->njump ? INFINITY : o->lip;
+      *lo -= k;
+      *hi += k;
+      return;
     }
   }
+#undef ENT_DB
 #undef ACC
   /* never looser than the group's own bound, which holds off jumps
   ** only: an infinite child's stays infinite */
@@ -314,6 +320,9 @@ static void iv_add(ivset *S, double lo, double hi) {
 }
 
 static void op_sup(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
+                   double t1, ivset *S, int depth);
+
+static void op_sup(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
                    double t1, ivset *S, int depth) {
   const oc_op *o = &P->ops[i];
   if (!oc_ray_clip(r, o->lo, o->hi, &t0, &t1)) return;
@@ -332,31 +341,23 @@ static void op_sup(const oc_program *P, uint32_t i, const oc_ray *r, double t0,
       return;
     }
     {
-      uint32_t stack[BVH_STACK];
-      int sp = 0;
-      stack[sp++] = o->bvh;
-      while (sp) {
-        const oc_bvhnode *nd = &P->bvh[stack[--sp]];
+      int full = 0;
+#define MEETS(x) ray_meets(r, x, t0, t1)
+      OC_BVH_FOREACH(P->bvh, o->bvh, nd, MEETS, full, {
         double ta = t0, tb = t1;
-        if (!oc_ray_clip(r, nd->lo, nd->hi, &ta, &tb)) continue;
-        if (!nd->count) {
-          if (sp + 2 <= BVH_STACK) {
-            stack[sp++] = nd->first + 1;
-            stack[sp++] = nd->first;
-          } else {
-            iv_add(S, ta, tb);
+        if (oc_ray_clip(r, nd->lo, nd->hi, &ta, &tb))
+          for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
+            const oc_ent *e = &P->ent[j];
+            if (e->ref != OC_NONE)
+              op_sup(P, e->ref, r, ta, tb, S, depth + 1);
+            else if (ball_chord(r, e->c[0], e->c[1], e->c[2], e->ir2, ta, tb,
+                                &tc, &a, &s0, &s1))
+              iv_add(S, tc + s0, tc + s1);
           }
-          continue;
-        }
-        for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
-          const oc_ent *e = &P->ent[j];
-          if (e->ref != OC_NONE)
-            op_sup(P, e->ref, r, ta, tb, S, depth + 1);
-          else if (ball_chord(r, e->c[0], e->c[1], e->c[2], e->ir2, ta, tb, &tc,
-                              &a, &s0, &s1))
-            iv_add(S, tc + s0, tc + s1);
-        }
-      }
+      });
+#undef MEETS
+      /* a subtree left out: the group's whole segment */
+      if (full) iv_add(S, t0, t1);
     }
     return;
   case OC_K_POINT:
@@ -379,19 +380,7 @@ int oc_ray_supports(const oc_program *P, const oc_ray *r, double t0, double t1,
   ivset S;
   S.n = 0;
   op_sup(P, P->root, r, t0, t1, &S, 0);
-  while (S.n > max) {
-    int best = 0;
-    double gap = INFINITY;
-    for (int k = 0; k + 1 < S.n; k++)
-      if (S.s[k + 1].lo - S.s[k].hi < gap) {
-        gap = S.s[k + 1].lo - S.s[k].hi;
-        best = k;
-      }
-    S.s[best].hi = S.s[best + 1].hi;
-    for (int k = best + 1; k + 1 < S.n; k++)
-      S.s[k] = S.s[k + 1];
-    S.n--;
-  }
+  oc_spanset_reduce(S.s, &S.n, max);
   for (int k = 0; k < S.n; k++) {
     out[k].lo = fmax(S.s[k].lo, t0);
     out[k].hi = fmin(S.s[k].hi, t1);

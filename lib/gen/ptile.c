@@ -16,6 +16,7 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "core/grow.h"
 #include "gen/poisson.h"
 
 /* Darts per open box at each level of gap filling. */
@@ -137,14 +138,7 @@ void oc_ptile_darts(oc_pgrid *g, const int t[3], oc_rng *rng, size_t throws) {
 }
 
 static int reserve(oc_psub **v, size_t *cap, size_t n) {
-  if (n <= *cap) return 0;
-  size_t c = *cap ? *cap : 1024;
-  while (c < n)
-    c *= 2;
-  oc_psub *p = realloc(*v, c * sizeof *p);
-  if (!p) return OC_ENOMEM;
-  *v = p, *cap = c;
-  return 0;
+  return oc_grow(v, cap, n, sizeof **v, 1024) ? OC_ENOMEM : 0;
 }
 
 void oc_pwork_free(oc_pwork *w) {

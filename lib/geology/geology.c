@@ -17,22 +17,11 @@
 
 static const oc_kind_def strata_kind, clamp_kind, taper_kind, fault_kind;
 
-/* Turbulence parameters: wavelength, amplitude, offset, octaves, seed (as
-** two 32-bit halves so it survives a double). */
-static void pack_noise(const oc_noise *nz, double *v) {
-  v[0] = nz->wavelength;
-  v[1] = nz->amplitude;
-  v[2] = nz->offset;
-  v[3] = (double)nz->octaves;
-  v[4] = (double)(nz->seed >> 32);
-  v[5] = (double)(nz->seed & 0xffffffffu);
-}
-
 oc_node *oc_strata(const oc_noise *noise, oc_error *err) {
-  double par[OC_GP_NNOISE];
+  double par[OC_NOISE_NPAR];
   if (!oc_check_noise(noise, err)) return NULL;
-  pack_noise(noise, par);
-  return oc_kind_node(&strata_kind, NULL, 0, par, OC_GP_NNOISE, NULL, err);
+  oc_noise_pack(noise, par);
+  return oc_kind_node(&strata_kind, NULL, 0, par, OC_NOISE_NPAR, NULL, err);
 }
 
 oc_node *oc_clamp(oc_node *child, double lo, double hi, oc_error *err) {
@@ -196,9 +185,9 @@ static oc_aabb shifted(oc_aabb b, oc_vec3 d) {
 }
 
 static int strata_compile(oc_kcompile *c, oc_error *err) {
-  const double *v = c->node_par;
-  double wl = v[0], A = v[1], off = v[2];
-  int oct = (int)v[3];
+  oc_noise nz = oc_noise_unpack(c->node_par);
+  double wl = nz.wavelength, A = nz.amplitude, off = nz.offset;
+  int oct = nz.octaves;
   (void)err;
   copy_par(c);
   c->info.box = oc_aabb_all();
@@ -265,10 +254,10 @@ static int fault_compile(oc_kcompile *c, oc_error *err) {
 /* ---- evaluation -------------------------------------------------------- */
 
 static double strata_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
-  const double *par = k->par;
-  double wl = par[0], A = par[1], off = par[2];
-  int oct = (int)par[3];
-  uint64_t seed = ((uint64_t)par[4] << 32) | (uint64_t)par[5];
+  oc_noise nz = oc_noise_unpack(k->par);
+  double wl = nz.wavelength, A = nz.amplitude, off = nz.offset;
+  int oct = nz.octaves;
+  uint64_t seed = nz.seed;
   double kk = A / oc_turb3_max(oct);
   oc_vec3 gt;
   double t = oc_turb3(seed, oct, oc_v3(OC_STRATA_X, OC_STRATA_Y, p.z / wl),

@@ -20,8 +20,7 @@
 /* Parameter slots, in the node and (same order) in the compiled op. */
 enum {
   /* strata: the noise, packed as 6 doubles */
-  OC_GP_NOISE = 0,
-  OC_GP_NNOISE = 6,
+  OC_GP_NOISE = 0, /* OC_NOISE_NPAR of them (core/noise.h) */
   /* clamp */
   OC_GP_LO = 0,
   OC_GP_HI = 1,

@@ -5,20 +5,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/grow.h"
 #include "mesh/mcwork.h"
 
 int oc_mc_grow(void *pp, size_t *cap, size_t need, size_t elem) {
-  if (need <= *cap) return 0;
-  size_t c = *cap ? *cap : 64;
-  while (c < need) {
-    if (c > SIZE_MAX / 2 / elem) return -1;
-    c *= 2;
-  }
-  void *p = realloc(*(void **)pp, c * elem);
-  if (!p) return -1;
-  *(void **)pp = p;
-  *cap = c;
-  return 0;
+  return oc_grow(pp, cap, need, elem, 64);
 }
 
 int oc_mc_rlist_columns(oc_mc_rlist *l, size_t ncol) {

@@ -9,8 +9,10 @@
 */
 #include <stdlib.h>
 
+#include "field/bvhwalk.h"
 #include "field/hfsurf.h"
 #include "field/query.h"
+#include "field/raybound.h"
 #include "ocheck.h"
 
 /* A terrain-like scene: a ground plane (optionally tilted), carved and
@@ -281,6 +283,113 @@ START_TEST(local_lipschitz_zero_far_away) {
 }
 END_TEST
 
+/* A blend of inline points under a hand-built BVH skewed to the left, d
+** interior nodes deep: every node's box holds every query, each right
+** child is a leaf with a far point, and the deepest leaf holds the one
+** point that matters (at the origin, radius 1, energy 1). A walk stacks
+** one right sibling per level, so past OC_BVH_STACK levels the deepest
+** leaf is out of reach; compile.c never builds such a tree (bvh.c's are
+** at most 30 levels deep). */
+#define DEEP_LIP 1.75 /* the op's global bound (>= OCT_LG) */
+
+static oc_program *deep_bvh(int d) {
+  oc_program *P = calloc(1, sizeof *P);
+  ck_assert(P != NULL);
+  P->nops = 1;
+  P->ops = calloc(1, sizeof *P->ops);
+  P->npar = 1;
+  P->par = calloc(1, sizeof *P->par);
+  P->nent = (size_t)d + 1;
+  P->ent = calloc(P->nent, sizeof *P->ent);
+  P->nbvh = 2 * (size_t)d + 1;
+  P->bvh = calloc(P->nbvh, sizeof *P->bvh);
+  ck_assert(P->ops && P->par && P->ent && P->bvh);
+  for (size_t i = 0; i < P->nent; i++) {
+    oc_ent *e = &P->ent[i];
+    e->c[0] = i < (size_t)d ? 1000.0f + 10.0f * (float)i : 0;
+    e->ir2 = 1;
+    e->e = 1;
+    e->ref = OC_NONE;
+  }
+  for (size_t i = 0; i < P->nbvh; i++)
+    for (int a = 0; a < 3; a++) {
+      P->bvh[i].lo[a] = -2000;
+      P->bvh[i].hi[a] = 2000;
+    }
+  /* interior node k at index 0 (k = 0) or 2k - 1; its children at 2k + 1
+  ** (the next interior node, or the deepest leaf) and 2k + 2 (a leaf) */
+  for (int k = 0; k < d; k++) {
+    oc_bvhnode *nd = &P->bvh[k ? 2 * k - 1 : 0];
+    nd->first = 2 * (uint32_t)k + 1;
+    nd->count = 0;
+    P->bvh[2 * k + 2].first = (uint32_t)k;
+    P->bvh[2 * k + 2].count = 1;
+  }
+  P->bvh[2 * d - 1].first = (uint32_t)d;
+  P->bvh[2 * d - 1].count = 1;
+  oc_op *o = &P->ops[0];
+  o->kind = OC_K_BLEND;
+  o->nent = (uint32_t)P->nent;
+  o->ntotal = o->nent;
+  o->bvh = 0;
+  o->lip = DEEP_LIP;
+  for (int a = 0; a < 3; a++) {
+    o->lo[a] = -2000;
+    o->hi[a] = 2000;
+  }
+  P->T = 0.5;
+  P->lip = DEEP_LIP;
+  P->bounds = (oc_aabb){oct_v(-2000, -2000, -2000), oct_v(2000, 2000, 2000)};
+  return P;
+}
+
+static void deep_free(oc_program *P) {
+  free(P->ops);
+  free(P->par);
+  free(P->ent);
+  free(P->bvh);
+  free(P);
+}
+
+/* Within the stack, the walks reach the deepest leaf: exact answers. */
+START_TEST(bvh_walk_reaches_deep_leaf) {
+  oc_program *P = deep_bvh(OC_BVH_STACK - 1);
+  oc_aabb near = {oct_v(-0.5, -0.5, -0.5), oct_v(0.5, 0.5, 0.5)};
+  ck_assert_double_eq_tol(oc_program_eval(P, oct_v(0, 0, 0)), 1, 1e-12);
+  double l = oc_program_lipschitz_in(P, near);
+  ck_assert_msg(l >= OCT_LG && l < DEEP_LIP, "local bound %g", l);
+  oc_zspan s[4];
+  int n = oc_program_column_spans(P, -0.5, -0.5, 0.5, 0.5, s, 4);
+  ck_assert_int_eq(n, 1);
+  ck_assert(s[0].lo <= -0.8 && s[0].hi >= 0.8 && s[0].hi < 1.1);
+  deep_free(P);
+}
+END_TEST
+
+/* Past the stack, every query answers its conservative bound instead of
+** dropping the subtree it cannot reach. */
+START_TEST(bvh_full_stack_is_conservative) {
+  oc_program *P = deep_bvh(OC_BVH_STACK + 16);
+  oc_aabb near = {oct_v(-0.5, -0.5, -0.5), oct_v(0.5, 0.5, 0.5)};
+  ck_assert_double_eq(oc_program_lipschitz_in(P, near), DEEP_LIP);
+  ck_assert_int_eq(oc_op_zero_in(P, 0, &near), 0);
+  oc_zspan s[4];
+  ck_assert_int_eq(oc_program_column_spans(P, -0.5, -0.5, 0.5, 0.5, s, 4), -1);
+  /* along x through the point, whose derivative reaches +-OCT_LG */
+  oc_ray r = oc_ray_make(oct_v(-5, 0, 0), oct_v(1, 0, 0));
+  double lo, hi;
+  oc_ray_dbound(P, &r, 0, 10, &lo, &hi);
+  ck_assert_msg(lo <= -OCT_LG && hi >= OCT_LG, "derivative in [%g, %g]", lo,
+                hi);
+  int m = oc_ray_supports(P, &r, 0, 10, s, 4);
+  int covered = 0;
+  for (int k = 0; k < m; k++)
+    covered |= s[k].lo <= 4 && s[k].hi >= 6;
+  ck_assert_msg(covered, "the point's chord [4, 6] is not covered");
+  deep_free(P);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("query");
   TCase *tc = tcase_create("query");
@@ -292,6 +401,8 @@ int main(void) {
   tcase_add_test(tc, spans_merge_to_max);
   tcase_add_test(tc, local_lipschitz_holds);
   tcase_add_test(tc, local_lipschitz_zero_far_away);
+  tcase_add_test(tc, bvh_walk_reaches_deep_leaf);
+  tcase_add_test(tc, bvh_full_stack_is_conservative);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }
