@@ -104,12 +104,12 @@ bin() { [ "$1" = old ] && echo "$T/old/build/release" || echo "$NEWT/build/relea
 # ---- outputs -------------------------------------------------------------
 failed=0
 run_scene() { # side name script [options]
-  local side=$1 name=$2 script=$3 out="$T/out/$1/$2"
+  local side=$1 name=$2 script=$3 out="$T/out/$1/$2" log="$T/logs/$1.${2//\//_}.log"
   shift 3
-  mkdir -p "$out"
+  mkdir -p "$out" "$T/logs"
   if ! (cd "$NEWT" && "$(bin "$side")/outcrop" run "$script" "$@" --out "$out" \
-        >"$T/out/$side.$name.log" 2>&1); then
-    echo "FAILED ($side) $name: $(tail -1 "$T/out/$side.$name.log")"
+        >"$log" 2>&1); then
+    echo "FAILED ($side) $name: $(tail -1 "$log")"
     failed=1
   fi
 }
@@ -131,6 +131,7 @@ only() { # bench -> its parts
   *) echo "" ;;
   esac
 }
+mkdir -p "$T/logs"
 for r in $(seq "$ROUNDS"); do
   log "benchmarks, round $r of $ROUNDS"
   for b in $BENCHES; do
@@ -140,8 +141,8 @@ for r in $(seq "$ROUNDS"); do
         keep="$T/out/$side/bench/$b" && mkdir -p "$keep"
       fi
       if ! OUTCROP_BENCH_OUT=$keep OUTCROP_BENCH_ONLY=$(only "$b") \
-           "$(bin "$side")/bench/$b" >"$T/bench.$side.$r.$b.txt" 2>&1; then
-        echo "FAILED ($side) $b round $r: $(tail -1 "$T/bench.$side.$r.$b.txt")"
+           "$(bin "$side")/bench/$b" >"$T/logs/bench.$side.$r.$b.txt" 2>&1; then
+        echo "FAILED ($side) $b round $r: $(tail -1 "$T/logs/bench.$side.$r.$b.txt")"
         failed=1
       fi
     done
@@ -171,7 +172,7 @@ echo "outputs: $nsame same, $ndiff different"
 # come from its '# cell 0.5 m' line (full grid, surface bounds + direct).
 figure() { # side bench name -> values, one a line
   local f
-  for f in "$T"/bench."$1".*."$2".txt; do
+  for f in "$T"/logs/bench."$1".*."$2".txt; do
     case $3 in
     full_grid_seconds)
       sed -nE 's/^# cell 0\.5 m.*full grid ([0-9.]+) s.*/\1/p' "$f" ;;
