@@ -73,10 +73,14 @@ BENCHES="bench_eval bench_mesh bench_render"
 # Each tree gets NEW's benchmark sources (OLD's own are kept in bench.own).
 cp -r "$T/old/scripts/bench" "$T/old/scripts/bench.own"
 cp "$NEWT"/scripts/bench/*.c "$NEWT"/scripts/bench/*.h "$T/old/scripts/bench/"
-# Names NEW uses that OLD's header has only under the oc_hf_ prefix.
-for n in $(grep -ohE '\boc_heightfield_[A-Za-z0-9_]+' "$T"/old/scripts/bench/*.[ch] | sort -u); do
-  short=oc_hf_${n#oc_heightfield_}
-  if ! grep -qw "$n" "$T/old/lib/outcrop.h" && grep -qw "$short" "$T/old/lib/outcrop.h"; then
+# Names NEW uses that OLD's headers have only under the oc_hf_ (OC_HF_)
+# prefix: renamed back in OLD's copy.
+for n in $(grep -ohE '\b(oc_heightfield|OC_HEIGHTFIELD)_[A-Za-z0-9_]+' "$T"/old/scripts/bench/*.[ch] | sort -u); do
+  case $n in
+  oc_*) short=oc_hf_${n#oc_heightfield_} ;;
+  *) short=OC_HF_${n#OC_HEIGHTFIELD_} ;;
+  esac
+  if ! grep -rqw "$n" "$T/old/lib" --include='*.h' && grep -rqw "$short" "$T/old/lib" --include='*.h'; then
     sed -i "s/\b$n\b/$short/g" "$T"/old/scripts/bench/*.[ch]
   fi
 done
