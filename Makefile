@@ -7,6 +7,10 @@
 #   make pictures  build, run the examples that make the README's pictures,
 #                copy those into docs/ (PICTURES below says which is which)
 #   make bench   deps, build, run scripts/bench/ (prints `name: value unit`)
+#   make compare-revisions OLD=rev [NEW=rev]  build an earlier commit and
+#                the working tree (or NEW) side by side, compare every
+#                output byte for byte and the benchmark figures
+#                (scripts/compare_revisions.sh)
 #   make fuzz    the scene fuzzer, long run (FUZZ_TIME seconds; fuzz-smoke:
 #                about 2 minutes, part of make test)
 #
@@ -89,7 +93,7 @@ BIN := $(B)/outcrop
 GLUE := $(B)/liboutcrop_oiio.so
 
 .PHONY: bench-peer-deps all deps test check-c check-lua check-lua-gc check-runtime check-asan demo bench \
-        clean format tests-bin pictures
+        clean format tests-bin pictures compare-revisions
 .DEFAULT_GOAL := all
 
 all: $(LIBA) $(LIBSO) $(MODULE) $(BIN) $(GLUE)
@@ -279,6 +283,12 @@ bench: deps
 	@$(MAKE) --no-print-directory all $(BENCH_BIN) $(PEER_BIN)
 	@OUTCROP=$(abspath $(BIN)) BENCH_BIN="$(abspath $(BENCH_BIN) $(PEER_BIN))" \
 	  bash scripts/bench/run.sh
+
+# Outputs (examples, golden scenes, benchmark meshes) and benchmark
+# figures of OLD against the working tree or NEW, in one run.
+compare-revisions:
+	@test -n "$(OLD)" || { echo "usage: make compare-revisions OLD=rev [NEW=rev]" >&2; exit 2; }
+	@bash scripts/compare_revisions.sh $(OLD) $(NEW)
 
 # ---- fuzzing (tests/fuzz, tests/corpus) ------------------------------
 .PHONY: fuzz fuzz-smoke fuzz-pending fuzz-deps fuzz-bin check-corpus \

@@ -52,7 +52,7 @@ int main(int argc, char **argv) {
   oc_heightfield *hf = plateau();
   oc_elevation src;
   if (oc_heightfield_elevation(hf, &src, &err)) die(&err);
-  oc_terrain_params tp = {4 * CELL, 2, 0, 0, NULL};
+  oc_terrain_params tp = {.falloff = 4 * CELL, .transition = 2};
   oc_node *terr = oc_terrain(&src, &tp, &err);
   src.release(src.ud);
   if (!terr) die(&err);

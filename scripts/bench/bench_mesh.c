@@ -15,7 +15,9 @@
 ** 3. 1000 spheres blended with a ground plane at cell 0.25.
 ** 4. A 2048 x 2048 fBm DEM implicitized and meshed at its cell, with
 **    direct elevation extraction and without (issue 5).
-** Prints `name: value unit` lines; '#' lines are context.
+** Prints `name: value unit` lines; '#' lines are context. The parts
+** (band, speedup, spheres1000, direct) can be chosen and their meshes
+** kept (scripts/bench/benchout.h).
 */
 #define _GNU_SOURCE
 #include <math.h>
@@ -28,6 +30,7 @@
 #include <unistd.h>
 
 #include "core/rng.h"
+#include "benchout.h"
 #include "meshcmp.h"
 #include "outcrop.h"
 
@@ -56,7 +59,7 @@ static oc_node *fbm_terrain(int n, double a, uint64_t seed,
     fprintf(stderr, "bench_mesh: %s\n", err.msg);
     exit(1);
   }
-  oc_terrain_params tp = {4, 1, 0, 0, NULL};
+  oc_terrain_params tp = {.falloff = 4, .transition = 1};
   oc_node *t = must(oc_terrain(&src, &tp, &err), &err);
   src.release(src.ud);
   return t;
@@ -154,6 +157,9 @@ static int speedup_at(const oc_program *p, oc_aabb box, double cell,
          same ? "same triangles on the same edges" : "DIFFERENT TRIANGLES", dev,
          sr, sf / sr, same_bits ? "same mesh to the bit" : "DIFFERENT MESH");
   if (figures) {
+    bench_keep_mesh("bench_mesh", "terrain_full_grid.ply", mf);
+    bench_keep_mesh("bench_mesh", "terrain_bounds_direct.ply", mb);
+    bench_keep_mesh("bench_mesh", "terrain_bounds_root.ply", mr);
     printf("mesh.bounds_speedup: %.1f x\n", sf / sb);
     printf("mesh.field_call_ratio: %.1f x\n",
            (double)stf.field_calls / (double)stb.field_calls);
@@ -223,6 +229,7 @@ static void direct_speedup(void) {
          "%.2f s (%zu triangles, %zu field calls)\n",
          b.hi.z - b.lo.z, (box.hi.z - box.lo.z), sd, std.triangles,
          std.field_calls, sr, str.triangles, str.field_calls);
+  bench_keep_mesh("bench_mesh", "dem2048_direct.ply", md);
   printf("mesh.direct_elevation_speedup: %.2f x\n", sr / sd);
   oc_mesh_free(md);
   oc_mesh_free(mr);
@@ -303,6 +310,7 @@ static void spheres1000(void) {
   printf("# 1000 spheres + ground, cell 0.25: %zu triangles, %zu field "
          "calls; 1 thread %.2f s; 1 and 2 threads %s\n",
          st.triangles, st.field_calls, s1, same ? "byte-identical" : "DIFFER");
+  bench_keep_mesh("bench_mesh", "spheres1000.ply", m2);
   printf("mesh.spheres1000_seconds_2t: %.2f s\n", s2);
   printf("mesh.spheres1000_triangles: %zu triangles\n", st.triangles);
   oc_mesh_free(m1);
@@ -318,10 +326,12 @@ int main(void) {
          "mesh.direct_elevation_speedup >= 1.5\n");
   /* the child first: libgomp cannot run parallel regions in a child
   ** forked after the parent has used them */
-  double peak = child_peak_mb(band_run);
-  printf("mesh.peak_mb: %.0f MB\n", peak);
-  terrain_speedup();
-  spheres1000();
-  direct_speedup();
+  if (bench_wanted("band")) {
+    double peak = child_peak_mb(band_run);
+    printf("mesh.peak_mb: %.0f MB\n", peak);
+  }
+  if (bench_wanted("speedup")) terrain_speedup();
+  if (bench_wanted("spheres1000")) spheres1000();
+  if (bench_wanted("direct")) direct_speedup();
   return 0;
 }

@@ -15,13 +15,16 @@
 **    mean steps per pixel of primary rays (evaluations before the hit is
 **    located), segment tracer on every pixel, plain sphere tracing on a
 **    subsample.
-** Prints `name: value unit` lines; '#' lines are context.
+** Prints `name: value unit` lines; '#' lines are context. The parts
+** (hd, blob1000) can be chosen and the HD image kept
+** (scripts/bench/benchout.h).
 */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "benchout.h"
 #include "core/rng.h"
 #include "outcrop.h"
 #include "render/trace.h"
@@ -145,6 +148,7 @@ static void hd(void) {
   oc_image *img = oc_render(p, &rp, &err);
   double secs = omp_get_wtime() - t0;
   if (!img) die("render", &err);
+  bench_keep_image("bench_render", "hd.exr", img);
   oc_image_free(img);
   t0 = omp_get_wtime();
   oc_image *g = oc_render_geometry(p, &rp, &err);
@@ -217,7 +221,7 @@ static void blob1000(void) {
 }
 
 int main(void) {
-  hd();
-  blob1000();
+  if (bench_wanted("hd")) hd();
+  if (bench_wanted("blob1000")) blob1000();
   return 0;
 }

@@ -117,19 +117,26 @@ describe("deep chains", function()
     R.close(n:eval(5000.5, 0, 0), 1, 1e-12)
   end)
 
-  it("chains that cannot flatten fail cleanly, never crash", function()
-    local n = p
-    for _ = 1, 5000 do n = oc.transform(n, {translate = {0, 0, 0}}) end
-    local ok, err = pcall(function() return n:eval(0, 0, 0) end)
-    if not ok then
-      assert.matches("gc_spec%.lua:%d+: node:eval: ", err)
-    else
-      R.close(err, 1, 1e-12)
+  -- The limit is 512 nested operators (OC_MAX_DEPTH): a chain of 500
+  -- evaluates, one of 5000 is refused by the compiler, never a crash.
+  it("chains that cannot flatten evaluate up to the limit, then fail cleanly", function()
+    local function chain(n, wrap)
+      local c = p
+      for _ = 1, n do c = wrap(c) end
+      return c
     end
-    local m = p
-    for _ = 1, 5000 do m = -m end
+    local function moved(c) return oc.transform(c, {translate = {0, 0, 0}}) end
+    local function negated(c) return -c end
+    R.close(chain(500, moved):eval(0, 0, 0), 1, 1e-12)
+    R.close(chain(500, negated):eval(0, 0, 0), 1, 1e-12)
+    local deep = "gc_spec%.lua:%d+: node:eval: tree too deep: more than 512 nested operators"
+    local n, m = chain(5000, moved), chain(5000, negated)
+    local ok, err = pcall(function() return n:eval(0, 0, 0) end)
+    assert.is_false(ok)
+    assert.matches(deep, err)
     ok, err = pcall(function() return m:eval(0, 0, 0) end)
-    if ok then R.close(err, 1, 1e-12) else assert.matches("node:eval", err) end
+    assert.is_false(ok)
+    assert.matches(deep, err)
     n, m = nil, nil
     collectgarbage()
   end)
