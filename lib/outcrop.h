@@ -668,7 +668,7 @@ const double *oc_samples_data(const oc_samples *s);
 typedef struct oc_heightfield oc_heightfield;
 
 /* Samples of a grid at most (1 GiB of floats). */
-#define OC_HF_MAX_SAMPLES (1ull << 28)
+#define OC_HEIGHTFIELD_MAX_SAMPLES (1ull << 28)
 
 /* nx, ny in 2 .. 65535 and nx ny <= 2^28; cell > 0; finite origin. `z`
 ** (nx ny floats, all finite) is copied, or the grid starts at 0 when NULL. */
@@ -690,31 +690,31 @@ void oc_heightfield_minmax(const oc_heightfield *hf, double *lo, double *hi);
 ** and its analytic gradient, stored in grad[0..1] when grad is not NULL.
 ** Outside the grid the position is clamped to it. Thread-safe. Between
 ** samples the value may leave the range of the 4 x 4 samples around by
-** at most OC_HF_OVERSHOOT times their spread. */
-#define OC_HF_OVERSHOOT 0.28125
+** at most OC_HEIGHTFIELD_OVERSHOOT times their spread. */
+#define OC_HEIGHTFIELD_OVERSHOOT 0.28125
 double oc_heightfield_height(const oc_heightfield *hf, double x, double y,
                              double grad[2]);
 
 /* -- heightfield files (terrain/hf_io.c) -- */
 
-/* The fields of oc_hf_load_params the caller gives; the others come from
-** the file's metadata (outcrop:cell, outcrop:x0, outcrop:y0,
+/* The fields of oc_heightfield_load_params the caller gives; the others
+** come from the file's metadata (outcrop:cell, outcrop:x0, outcrop:y0,
 ** outcrop:scale, outcrop:offset, as oc_heightfield_save writes them),
 ** else default to cell 1, scale 1, offset 0, origin (0, 0). */
 enum {
-  OC_HF_GIVE_CELL = 1,
-  OC_HF_GIVE_SCALE = 2,
-  OC_HF_GIVE_OFFSET = 4,
-  OC_HF_GIVE_ORIGIN = 8
+  OC_HEIGHTFIELD_GIVE_CELL = 1,
+  OC_HEIGHTFIELD_GIVE_SCALE = 2,
+  OC_HEIGHTFIELD_GIVE_OFFSET = 4,
+  OC_HEIGHTFIELD_GIVE_ORIGIN = 8
 };
 
-typedef struct oc_hf_load_params {
-  unsigned given;       /* OC_HF_GIVE_* bits */
+typedef struct oc_heightfield_load_params {
+  unsigned given;       /* OC_HEIGHTFIELD_GIVE_* bits */
   double cell;          /* > 0 */
   double scale, offset; /* elevation = stored value * scale + offset */
   double x0, y0;        /* position of sample (0, 0) */
   oc_progress progress; /* polled while reading; may be {NULL, NULL} */
-} oc_hf_load_params;
+} oc_heightfield_load_params;
 
 /* Reads the first channel of an image file into a new grid. The format
 ** (PNG, TIFF, EXR or JPEG) is told by the file's signature, not its name;
@@ -729,7 +729,8 @@ typedef struct oc_hf_load_params {
 ** elevation, OC_ENOMEM (before allocating) for images over the size
 ** limit of oc_heightfield_new, OC_ECANCEL when p->progress stops it. */
 oc_heightfield *oc_heightfield_load(const char *path,
-                                    const oc_hf_load_params *p, oc_error *err);
+                                    const oc_heightfield_load_params *p,
+                                    oc_error *err);
 
 /* A RAW 16-bit heightmap (.r16 / .raw, as Unity and Unreal read them):
 ** nx x ny little-endian uint16, no header, rows in image order (the first
@@ -740,10 +741,10 @@ oc_heightfield *oc_heightfield_load(const char *path,
 ** files are read. New grid or NULL with err (OC_EIO for unreadable files,
 ** OC_EINVAL for a size that does not match the file's bytes). */
 oc_heightfield *oc_heightfield_load_raw(const char *path, int nx, int ny,
-                                        const oc_hf_load_params *p,
+                                        const oc_heightfield_load_params *p,
                                         oc_error *err);
 
-typedef struct oc_hf_save_params {
+typedef struct oc_heightfield_save_params {
   /* 0: the format's default: 16 for PNG, 32 (float) for TIFF and EXR.
   ** PNG takes 8 or 16, TIFF 16 or 32, EXR 16 (half) or 32. */
   int bits;
@@ -762,74 +763,82 @@ typedef struct oc_hf_save_params {
   ** takes them); bits, fixed, scale and offset do not apply. */
   const double *stops;
   int nstops;
-} oc_hf_save_params;
+} oc_heightfield_save_params;
 
 /* Writes the grid by extension (.png, .tif, .tiff, .exr; .r16 and .raw:
 ** RAW 16-bit, as oc_heightfield_load_raw reads it, with no metadata) as
 ** one channel "Y", north up as oc_heightfield_load reads it, integer
 ** formats holding floor((z - offset) / scale + 0.5). The cell, origin, scale
-*and offset go into
+** and offset go into
 ** the file as metadata (numbers with 17 significant digits, so they read
 ** back exactly). used[0], used[1] (when used is not NULL) get the scale
 ** and offset (1 and 0 for float formats). Loading a saved 16-bit PNG gives
 ** the quantized elevations, and saving those again gives the same file.
 ** Atomic; returns OC_OK or an error code with `err`. */
 int oc_heightfield_save(const oc_heightfield *hf, const char *path,
-                        const oc_hf_save_params *p, double used[2],
+                        const oc_heightfield_save_params *p, double used[2],
                         oc_error *err);
 /* oc_heightfield_save relative to a directory descriptor (see
 ** oc_mesh_write_at). */
 int oc_heightfield_save_at(const oc_heightfield *hf, int dirfd,
-                           const char *path, const oc_hf_save_params *p,
-                           double used[2], oc_error *err);
+                           const char *path,
+                           const oc_heightfield_save_params *p, double used[2],
+                           oc_error *err);
 
 /* -- grid arithmetic (terrain/hf_math.c) -- */
 
 /* Sample by sample: a + b, a - b, b - a, a * b. */
-typedef enum oc_hf_op { OC_HF_ADD, OC_HF_SUB, OC_HF_RSUB, OC_HF_MUL } oc_hf_op;
+typedef enum oc_heightfield_op {
+  OC_HEIGHTFIELD_ADD,
+  OC_HEIGHTFIELD_SUB,
+  OC_HEIGHTFIELD_RSUB,
+  OC_HEIGHTFIELD_MUL
+} oc_heightfield_op;
 
 /* a op b over two grids of the same layout (size, cell and origin equal,
 ** else OC_EINVAL saying how they differ). A new grid (caller releases),
 ** or NULL with err: also when a sample leaves float range, named. */
 oc_heightfield *oc_heightfield_combine(const oc_heightfield *a,
-                                       const oc_heightfield *b, oc_hf_op op,
-                                       oc_error *err);
+                                       const oc_heightfield *b,
+                                       oc_heightfield_op op, oc_error *err);
 /* a op k, k finite (RSUB: k - a). New grid or NULL with err. */
 oc_heightfield *oc_heightfield_scalar(const oc_heightfield *a, double k,
-                                      oc_hf_op op, oc_error *err);
+                                      oc_heightfield_op op, oc_error *err);
 /* Samples clamped to [lo, hi] (lo <= hi, no NaN; either may be infinite).
 ** New grid or NULL with err. */
 oc_heightfield *oc_heightfield_clamp(const oc_heightfield *a, double lo,
                                      double hi, oc_error *err);
 
-typedef struct oc_hf_mask_params {
+typedef struct oc_heightfield_mask_params {
   int has_above, has_below;
   double above, below; /* finite levels */
   /* >= 0; 0: a 0/1 mask (1 where z >= above and z <= below), else a
   ** linear ramp through 1/2 at each level, falloff wide */
   double falloff;
-} oc_hf_mask_params;
+} oc_heightfield_mask_params;
 /* A mask grid of values in [0, 1] on the same layout: the product of
 ** the ramps of the levels given; mask >= 0.5 where the hard mask is 1, as
 ** oc_terrain_params.mask reads it. New grid or NULL with err. */
 oc_heightfield *oc_heightfield_mask(const oc_heightfield *a,
-                                    const oc_hf_mask_params *p, oc_error *err);
+                                    const oc_heightfield_mask_params *p,
+                                    oc_error *err);
 
 /* -- procedural grids (terrain/hf_make.c) -- */
 
 /* Where the samples of a grid to be made lie: sample (i, j) at
 ** (x0 + i cell, y0 + j cell); the limits of oc_heightfield_new apply. */
-typedef struct oc_hf_grid {
+typedef struct oc_heightfield_grid {
   int nx, ny;
   double cell, x0, y0;
-} oc_hf_grid;
+} oc_heightfield_grid;
 
 /* fBm: z(x, y) = offset + amplitude t((x, y, 0) / wavelength), the
 ** turbulence primitive of the same noise on the plane z = 0 (so the grid
 ** samples an oc_turbulence node). Rows in parallel; byte-identical for any
 ** thread count; cancellable through `progress` (OC_ECANCEL). */
-oc_heightfield *oc_heightfield_fbm(const oc_hf_grid *g, const oc_noise *noise,
-                                   oc_progress progress, oc_error *err);
+oc_heightfield *oc_heightfield_fbm(const oc_heightfield_grid *g,
+                                   const oc_noise *noise, oc_progress progress,
+                                   oc_error *err);
 
 /* The surface of a field seen from above: at each sample, the highest z in
 ** [z0, z1] where f goes from f <= T above to f > T below (T = threshold,
@@ -840,11 +849,9 @@ oc_heightfield *oc_heightfield_fbm(const oc_hf_grid *g, const oc_noise *noise,
 ** stepped over; in a column whose bounds are so loose that it took 1024
 ** steps, those thinner than (z1 - z0) / 1024 (so a sample costs at most
 ** about 2048 evaluations). Parallel, deterministic, cancellable. */
-oc_heightfield *oc_heightfield_from_program(const oc_program *prog,
-                                            const oc_hf_grid *g, double z0,
-                                            double z1, double threshold,
-                                            oc_progress progress,
-                                            oc_error *err);
+oc_heightfield *oc_heightfield_from_program(
+    const oc_program *prog, const oc_heightfield_grid *g, double z0, double z1,
+    double threshold, oc_progress progress, oc_error *err);
 
 /* The grid sampled on another grid g (positions outside hf are clamped to
 ** it): the Catmull-Rom interpolant where g->cell <= the cell of hf; where
@@ -852,7 +859,7 @@ oc_heightfield *oc_heightfield_from_program(const oc_program *prog,
 ** g->cell (so downsampling does not alias). Parallel, deterministic,
 ** cancellable. */
 oc_heightfield *oc_heightfield_resample(const oc_heightfield *hf,
-                                        const oc_hf_grid *g,
+                                        const oc_heightfield_grid *g,
                                         oc_progress progress, oc_error *err);
 
 /* The samples i0..i1, j0..j1 (0-based, inclusive; at least 2 x 2) as a new
@@ -869,7 +876,7 @@ oc_heightfield *oc_heightfield_crop(const oc_heightfield *hf, int i0, int j0,
 ** OC_EINVAL naming 'cell' or 'size' when neither or both are given, or
 ** the grid would have fewer than 2 or too many samples. */
 int oc_heightfield_resample_grid(const oc_heightfield *hf, double cell, int nx,
-                                 int ny, oc_hf_grid *g, oc_error *err);
+                                 int ny, oc_heightfield_grid *g, oc_error *err);
 /* The 0-based inclusive sample range {i0, j0, i1, j1} of the samples of
 ** hf lying in the box [x0, x1] x [y0, y1] (with a slack of 1e-9 cell);
 ** OC_EINVAL when x0 >= x1 or y0 >= y1 or the box holds fewer than 2 x 2
@@ -895,7 +902,7 @@ double oc_heightfield_sum(const oc_heightfield *hf);
 /* |grad h|, rise over run (tan of the slope angle), by central
 ** differences (the Catmull-Rom derivative at a sample), one-sided on the
 ** border. */
-oc_heightfield *oc_hf_slope(const oc_heightfield *hf, oc_error *err);
+oc_heightfield *oc_heightfield_slope(const oc_heightfield *hf, oc_error *err);
 
 /* Depression filling by Priority-Flood+epsilon (Barnes, Lehman, Mulla
 ** 2014) from the border: filled >= hf everywhere, and every interior
@@ -906,16 +913,17 @@ oc_heightfield *oc_hf_slope(const oc_heightfield *hf, oc_error *err);
 ** with a strictly descending path to the border keep their elevation
 ** (up to a few ulps where such a path meets a filled flat). Sequential
 ** (the algorithm is): about 4 s for 4096 x 4096 samples. */
-oc_heightfield *oc_hf_fill(const oc_heightfield *hf, oc_progress progress,
-                           oc_error *err);
+oc_heightfield *oc_heightfield_fill(const oc_heightfield *hf,
+                                    oc_progress progress, oc_error *err);
 
-#define OC_HF_FREEMAN_EXPONENT 1.1
+#define OC_HEIGHTFIELD_FREEMAN_EXPONENT 1.1
 
-typedef struct oc_hf_flow_params {
-  double exponent; /* Freeman's p in (0, 4]; 0: OC_HF_FREEMAN_EXPONENT */
-  int prefilled;   /* 1: hf is already filled (skip the filling) */
+typedef struct oc_heightfield_flow_params {
+  double
+      exponent;  /* Freeman's p in (0, 4]; 0: OC_HEIGHTFIELD_FREEMAN_EXPONENT */
+  int prefilled; /* 1: hf is already filled (skip the filling) */
   oc_progress progress;
-} oc_hf_flow_params;
+} oc_heightfield_flow_params;
 
 /* Upstream area in m^2 by Freeman's (1991) multiple flow directions on
 ** the filled grid: each sample holds its own cell^2 plus what its higher
@@ -924,28 +932,31 @@ typedef struct oc_hf_flow_params {
 ** lower neighbour (after filling, border samples only) keep it: it leaves
 ** the grid there, and those samples sum to nx ny cell^2. Every sample is
 ** >= cell^2. fp may be NULL. */
-oc_heightfield *oc_hf_drainage(const oc_heightfield *hf,
-                               const oc_hf_flow_params *fp, oc_error *err);
+oc_heightfield *oc_heightfield_drainage(const oc_heightfield *hf,
+                                        const oc_heightfield_flow_params *fp,
+                                        oc_error *err);
 /* Stream power A^(1/2) s (Paris et al. 2019, section 6.1): A the drainage
 ** above, s
 ** the slope of the filled grid (so filled lakes are ~0). */
-oc_heightfield *oc_hf_stream_power(const oc_heightfield *hf,
-                                   const oc_hf_flow_params *fp, oc_error *err);
+oc_heightfield *
+oc_heightfield_stream_power(const oc_heightfield *hf,
+                            const oc_heightfield_flow_params *fp,
+                            oc_error *err);
 
 /* Pits: interior samples strictly lower than all 8 neighbours (border
 ** samples never are; flat-bottomed depressions have none). Their
 ** positions (x0 + i cell, y0 + j cell, z) in row order go to a new array
 ** *out that the caller frees with free() (NULL when none), the count to
 ** *n. Returns OC_OK or an error code with err. */
-int oc_hf_sinks(const oc_heightfield *hf, oc_vec3 **out, size_t *n,
-                oc_error *err);
+int oc_heightfield_sinks(const oc_heightfield *hf, oc_vec3 **out, size_t *n,
+                         oc_error *err);
 
-typedef struct oc_hf_access_params {
+typedef struct oc_heightfield_access_params {
   int rays;        /* per sample, 1 .. 4096; 0: 64 */
   double distance; /* ray length in metres, > 0; 0: 50 cells */
   uint64_t seed;
   oc_progress progress;
-} oc_hf_access_params;
+} oc_heightfield_access_params;
 
 /* Sky visibility after Miller (1994): per sample, the fraction of `rays`
 ** directions, uniform in solid angle over the upper hemisphere about the
@@ -955,16 +966,17 @@ typedef struct oc_hf_access_params {
 ** highest sample escapes. A flat plane gives 1, a plane tilted by a gives
 ** 1 - a / pi, the bottom of a V valley with sides at a 1 - 2 a / pi. ap
 ** may be NULL. */
-oc_heightfield *oc_hf_accessibility(const oc_heightfield *hf,
-                                    const oc_hf_access_params *ap,
-                                    oc_error *err);
+oc_heightfield *
+oc_heightfield_accessibility(const oc_heightfield *hf,
+                             const oc_heightfield_access_params *ap,
+                             oc_error *err);
 
 /* Horizontal distance in metres from each sample to the nearest sample at
 ** or below `level` (0 there; unsigned), exact (Felzenszwalb-Huttenlocher
 ** Euclidean distance transform): the float of sqrt(di^2 + dj^2) cell.
 ** OC_EINVAL when no sample is at or below the level. */
-oc_heightfield *oc_hf_distance_to_level(const oc_heightfield *hf, double level,
-                                        oc_error *err);
+oc_heightfield *oc_heightfield_distance_to_level(const oc_heightfield *hf,
+                                                 double level, oc_error *err);
 
 /* ---- terrain: implicitized elevation (terrain/terrain.c) ---------------- */
 
@@ -1408,14 +1420,15 @@ typedef struct oc_karst_cavity {
 
 typedef struct oc_gen_karst_params {
   oc_heightfield *heightfield; /* required: the surface and the sinks */
-  oc_node *terrain;     /* blended with the cavities; NULL: the default terrain
-                        ** of the heightfield (oc_heightfield_terrain) */
-  int no_terrain;       /* 1 (with terrain NULL): the cavities alone */
-  oc_node *geology;     /* resistance; NULL: strata of wavelength 8 radius
-                        ** (oc_strata, 3 octaves, the seed below) */
-  const oc_vec3 *sinks; /* nsinks starting points; NULL: oc_hf_sinks of the
-                        ** heightfield. A sink higher than `cover` below the
-                        ** surface is lowered to it. */
+  oc_node *terrain; /* blended with the cavities; NULL: the default terrain
+                    ** of the heightfield (oc_heightfield_terrain) */
+  int no_terrain;   /* 1 (with terrain NULL): the cavities alone */
+  oc_node *geology; /* resistance; NULL: strata of wavelength 8 radius
+                    ** (oc_strata, 3 octaves, the seed below) */
+  const oc_vec3
+      *sinks; /* nsinks starting points; NULL: oc_heightfield_sinks of the
+              ** heightfield. A sink higher than `cover` below the
+              ** surface is lowered to it. */
   size_t nsinks;
   uint64_t seed;
   double radius;         /* R of the point primitives > 0; 0: 2 cells */
@@ -1464,7 +1477,8 @@ oc_node *oc_generate_karst(const oc_gen_karst_params *p, oc_gen_karst_stats *st,
 ** `margin`) is thinned with the probability
 **   P = probability * exp(-((s - slope) / slope_spread)^2) / (1 + A /
 **       drainage) * mask
-** (clamped to [0, 1]; s = oc_hf_slope, A = oc_hf_drainage: hoodoos favour
+** (clamped to [0, 1]; s = oc_heightfield_slope, A = oc_heightfield_drainage:
+** hoodoos favour
 ** talus and cliffs, medium slope and low drainage). Each kept sample is an
 ** axiom of the grammar of figure 20, derived upwards from the surface:
 **   A -> B;  B -> b B (p_B) | b C (1 - p_B);

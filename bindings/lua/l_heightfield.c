@@ -101,8 +101,8 @@ static void field_size(const oclua_fields *f, int *nx, int *ny) {
 }
 
 /* cell, origin and size of a grid to be made. */
-static oc_hf_grid field_grid(const oclua_fields *f) {
-  oc_hf_grid g;
+static oc_heightfield_grid field_grid(const oclua_fields *f) {
+  oc_heightfield_grid g;
   double o[2] = {0, 0};
   field_size(f, &g.nx, &g.ny);
   g.cell = oclua_field_optnumber(f, "cell", OCLUA_POSITIVE, 1);
@@ -146,7 +146,7 @@ static int l_load(lua_State *L) {
   const char *fname = "outcrop.heightfield.load";
   oclua_fields f;
   oc_error err = {OC_OK, ""};
-  oc_hf_load_params p;
+  oc_heightfield_load_params p;
   double o[2];
   memset(&p, 0, sizeof p);
   if (lua_type(L, 1) != LUA_TSTRING)
@@ -169,24 +169,27 @@ static int l_load(lua_State *L) {
   if (hasrange && !(range[0] <= range[1]))
     oclua_error(L, fname, "'range' = {lo, hi} needs lo <= hi (got {%f, %f})",
                 (LUAI_UACNUMBER)range[0], (LUAI_UACNUMBER)range[1]);
-  if (oclua_field_push(&f, "cell") != LUA_TNIL) p.given |= OC_HF_GIVE_CELL;
+  if (oclua_field_push(&f, "cell") != LUA_TNIL)
+    p.given |= OC_HEIGHTFIELD_GIVE_CELL;
   lua_pop(L, 1);
   p.cell = oclua_field_optnumber(&f, "cell", OCLUA_POSITIVE, 1);
-  if (oclua_field_push(&f, "scale") != LUA_TNIL) p.given |= OC_HF_GIVE_SCALE;
+  if (oclua_field_push(&f, "scale") != LUA_TNIL)
+    p.given |= OC_HEIGHTFIELD_GIVE_SCALE;
   lua_pop(L, 1);
   p.scale = oclua_field_optnumber(&f, "scale", OCLUA_NONZERO, 1);
-  if (oclua_field_push(&f, "offset") != LUA_TNIL) p.given |= OC_HF_GIVE_OFFSET;
+  if (oclua_field_push(&f, "offset") != LUA_TNIL)
+    p.given |= OC_HEIGHTFIELD_GIVE_OFFSET;
   lua_pop(L, 1);
   p.offset = oclua_field_optnumber(&f, "offset", OCLUA_FINITE, 0);
   if (oclua_field_numbers(&f, "origin", 2, o, "must be {x0, y0}")) {
-    p.given |= OC_HF_GIVE_ORIGIN;
+    p.given |= OC_HEIGHTFIELD_GIVE_ORIGIN;
     p.x0 = o[0];
     p.y0 = o[1];
   }
   if (hasrange) {
-    if (p.given & (OC_HF_GIVE_SCALE | OC_HF_GIVE_OFFSET))
+    if (p.given & (OC_HEIGHTFIELD_GIVE_SCALE | OC_HEIGHTFIELD_GIVE_OFFSET))
       oclua_error(L, fname, "give either 'range' or 'scale' and 'offset'");
-    p.given |= OC_HF_GIVE_SCALE | OC_HF_GIVE_OFFSET;
+    p.given |= OC_HEIGHTFIELD_GIVE_SCALE | OC_HEIGHTFIELD_GIVE_OFFSET;
     p.scale = (range[1] - range[0]) / 65535.0;
     p.offset = range[0];
   }
@@ -218,7 +221,7 @@ static int l_fbm(lua_State *L) {
                   "{size =, cell =, origin =, amplitude =, wavelength =, "
                   "octaves =, seed =, offset =}");
   oclua_fields_open(&f, L, 1, fname, NULL, known, 0);
-  oc_hf_grid g = field_grid(&f);
+  oc_heightfield_grid g = field_grid(&f);
   oclua_field_noise(&f, &nz, NAN, DEFAULT_OCTAVES, 1);
   oc_progress pr = oclua_progress_start(L, &pl, fname);
   oclua_heightfield *u = oclua_newheightfield(L);
@@ -280,7 +283,7 @@ static int l_from(lua_State *L) {
                 "node (got %s)",
                 oclua_got(L, 1));
   oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
-  oc_hf_grid g = field_grid(&f);
+  oc_heightfield_grid g = field_grid(&f);
   int hasz = oclua_field_numbers(&f, "zrange", 2, zr, "must be {z0, z1}");
   double t = oclua_field_optnumber(&f, "threshold", OCLUA_POSITIVE, 0);
   if (isfn) {
@@ -424,7 +427,7 @@ static int hf_resample(lua_State *L) {
   oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
   oclua_fields f;
   oc_error err = {OC_OK, ""};
-  oc_hf_grid g;
+  oc_heightfield_grid g;
   oclua_progress pl;
   oclua_checkargs(L, 2, fname, "{cell = or size =}");
   hf = oclua_pinheightfield(L, 1, fname);
@@ -515,7 +518,7 @@ static int hf_save(lua_State *L) {
   oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
   oclua_fields f;
   oc_error err = {OC_OK, ""};
-  oc_hf_save_params p;
+  oc_heightfield_save_params p;
   double used[2];
   memset(&p, 0, sizeof p);
   if (lua_type(L, 2) != LUA_TSTRING)
@@ -596,7 +599,7 @@ static int hf_save(lua_State *L) {
 /* ---- arithmetic, clamp, mask, map --------------------------------------- */
 
 /* hf op hf2, hf op k, k op hf: a new grid. */
-static int hf_arith(lua_State *L, oc_hf_op op, const char *fname) {
+static int hf_arith(lua_State *L, oc_heightfield_op op, const char *fname) {
   int a = oclua_isheightfield(L, 1), b = oclua_isheightfield(L, 2);
   oc_error err = {OC_OK, ""};
   for (int k = 1; k <= 2; k++)
@@ -608,7 +611,7 @@ static int hf_arith(lua_State *L, oc_hf_op op, const char *fname) {
   oc_heightfield *ha = a ? oclua_pinheightfield(L, 1, fname) : NULL;
   oc_heightfield *hb = b ? oclua_pinheightfield(L, 2, fname) : NULL;
   double k = a && b ? 0 : check_coord(L, a ? 2 : 1, fname, "the number");
-  if (!a && op == OC_HF_SUB) op = OC_HF_RSUB;
+  if (!a && op == OC_HEIGHTFIELD_SUB) op = OC_HEIGHTFIELD_RSUB;
   oclua_heightfield *u = oclua_newheightfield(L);
   oc_heightfield *out = a && b
                             ? oc_heightfield_combine(ha, hb, op, &err)
@@ -617,21 +620,22 @@ static int hf_arith(lua_State *L, oc_hf_op op, const char *fname) {
 }
 
 static int hf_add(lua_State *L) {
-  return hf_arith(L, OC_HF_ADD, "heightfield +");
+  return hf_arith(L, OC_HEIGHTFIELD_ADD, "heightfield +");
 }
 static int hf_sub(lua_State *L) {
-  return hf_arith(L, OC_HF_SUB, "heightfield -");
+  return hf_arith(L, OC_HEIGHTFIELD_SUB, "heightfield -");
 }
 static int hf_mul(lua_State *L) {
-  return hf_arith(L, OC_HF_MUL, "heightfield *");
+  return hf_arith(L, OC_HEIGHTFIELD_MUL, "heightfield *");
 }
 static int hf_unm(lua_State *L) {
   const char *fname = "heightfield unary -";
   oc_error err = {OC_OK, ""};
   oc_heightfield *hf = oclua_pinheightfield(L, 1, fname);
   oclua_heightfield *u = oclua_newheightfield(L);
-  return oclua_sethf(L, u, oc_heightfield_scalar(hf, -1, OC_HF_MUL, &err), &err,
-                     fname);
+  return oclua_sethf(L, u,
+                     oc_heightfield_scalar(hf, -1, OC_HEIGHTFIELD_MUL, &err),
+                     &err, fname);
 }
 
 /* clamp(lo, hi) or clamp{lo =, hi =}: either bound may be left out
@@ -667,7 +671,7 @@ static int hf_mask(lua_State *L) {
   oc_error err = {OC_OK, ""};
   oc_heightfield *hf = oclua_checkheightfield(L, 1, fname);
   oclua_fields f;
-  oc_hf_mask_params mp;
+  oc_heightfield_mask_params mp;
   memset(&mp, 0, sizeof mp);
   oclua_checkargs(L, 2, fname, "{above =, below =, falloff =}");
   oclua_fields_open(&f, L, 2, fname, NULL, known, 0);

@@ -45,7 +45,7 @@ static int hf_slope(lua_State *L) {
   oclua_checkargs(L, 1, fname, "()");
   oc_heightfield *hf = oclua_pinheightfield(L, 1, fname);
   oclua_heightfield *u = oclua_newheightfield(L);
-  return oclua_sethf(L, u, oc_hf_slope(hf, &err), &err, fname);
+  return oclua_sethf(L, u, oc_heightfield_slope(hf, &err), &err, fname);
 }
 
 static int hf_filled(lua_State *L) {
@@ -57,7 +57,7 @@ static int hf_filled(lua_State *L) {
   oc_heightfield *hf = oclua_pinheightfield(L, 1, fname);
   oclua_heightfield *u = oclua_newheightfield(L);
   oc_progress pr = oclua_progress_start(L, &pl, fname);
-  oc_heightfield *r = oc_hf_fill(hf, pr, &err);
+  oc_heightfield *r = oc_heightfield_fill(hf, pr, &err);
   oclua_progress_end(&pl);
   return oclua_sethf(L, u, r, &err, fname);
 }
@@ -69,16 +69,16 @@ static int flow(lua_State *L, const char *fname, int power) {
   oc_error err = {OC_OK, ""};
   oclua_fields f;
   oclua_progress pl;
-  oc_hf_flow_params fp;
+  oc_heightfield_flow_params fp;
   memset(&fp, 0, sizeof fp);
   open_options(L, &f, fname, known, "([{exponent = 1.1}])");
   oc_heightfield *hf = oclua_pinheightfield(L, 1, fname);
   fp.exponent = oclua_field_optnumber(&f, "exponent", OCLUA_POSITIVE,
-                                      OC_HF_FREEMAN_EXPONENT);
+                                      OC_HEIGHTFIELD_FREEMAN_EXPONENT);
   oclua_heightfield *u = oclua_newheightfield(L);
   fp.progress = oclua_progress_start(L, &pl, fname);
-  oc_heightfield *r =
-      power ? oc_hf_stream_power(hf, &fp, &err) : oc_hf_drainage(hf, &fp, &err);
+  oc_heightfield *r = power ? oc_heightfield_stream_power(hf, &fp, &err)
+                            : oc_heightfield_drainage(hf, &fp, &err);
   oclua_progress_end(&pl);
   return oclua_sethf(L, u, r, &err, fname);
 }
@@ -116,7 +116,8 @@ static int hf_sinks(lua_State *L) {
     lua_setfield(L, -2, "__metatable");
   }
   lua_setmetatable(L, -2);
-  if (oc_hf_sinks(hf, box, &n, &err) != OC_OK) oclua_liberror(L, fname, &err);
+  if (oc_heightfield_sinks(hf, box, &n, &err) != OC_OK)
+    oclua_liberror(L, fname, &err);
   if (n > (size_t)INT32_MAX)
     oclua_error(L, fname, "too many sinks for a Lua table (%I)",
                 (LUAI_UACINT)n);
@@ -144,7 +145,7 @@ static int hf_accessibility(lua_State *L) {
   oc_error err = {OC_OK, ""};
   oclua_fields f;
   oclua_progress pl;
-  oc_hf_access_params ap;
+  oc_heightfield_access_params ap;
   memset(&ap, 0, sizeof ap);
   open_options(L, &f, fname, known,
                "([{rays = 64, distance = 50 cells, seed = }])");
@@ -154,7 +155,7 @@ static int hf_accessibility(lua_State *L) {
   ap.seed = oclua_field_seed(&f, "seed");
   oclua_heightfield *u = oclua_newheightfield(L);
   ap.progress = oclua_progress_start(L, &pl, fname);
-  oc_heightfield *r = oc_hf_accessibility(hf, &ap, &err);
+  oc_heightfield *r = oc_heightfield_accessibility(hf, &ap, &err);
   oclua_progress_end(&pl);
   return oclua_sethf(L, u, r, &err, fname);
 }
@@ -169,7 +170,8 @@ static int hf_distance_to_level(lua_State *L) {
   oclua_checkargs(L, 2, fname, "(z)");
   oc_heightfield *hf = oclua_pinheightfield(L, 1, fname);
   oclua_heightfield *u = oclua_newheightfield(L);
-  return oclua_sethf(L, u, oc_hf_distance_to_level(hf, z, &err), &err, fname);
+  return oclua_sethf(L, u, oc_heightfield_distance_to_level(hf, z, &err), &err,
+                     fname);
 }
 
 const luaL_Reg oclua_heightfield_analysis[] = {

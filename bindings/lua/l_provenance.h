@@ -47,7 +47,7 @@
 void oclua_stamp_provenance(lua_State *L, oc_image *img);
 
 /* The same provenance for writers that take key/value pairs rather than
-** an oc_image (e.g. oc_hf_save_params.meta): pushes the values on the
+** an oc_image (e.g. oc_heightfield_save_params.meta): pushes the values on the
 ** stack (pop OCLUA_PROVENANCE_PAIRS values once the write is done: the
 ** strings live there) and stores key0, value0, key1, ... in kv. */
 #define OCLUA_PROVENANCE_PAIRS 7

@@ -182,10 +182,10 @@ static oc_samples *place(const oc_gen_hoodoos_params *p, oc_error *err) {
   }
   placement P = {p, NULL, NULL, 0, 0, 0, 0};
   phase ph;
-  oc_hf_flow_params fp = {0};
+  oc_heightfield_flow_params fp = {0};
   fp.progress = sub(&ph, p->progress, 0.05, 0.35);
-  P.slope = oc_hf_slope(hf, err);
-  if (P.slope) P.drainage = oc_hf_drainage(hf, &fp, err);
+  P.slope = oc_heightfield_slope(hf, err);
+  if (P.slope) P.drainage = oc_heightfield_drainage(hf, &fp, err);
   oc_samples *s = NULL;
   if (P.drainage) {
     pp.radius = p->radius;

@@ -361,7 +361,7 @@ static int seed_sinks(const run *r, pts *P, heap *H, grid *G, size_t *nsinks,
   const oc_vec3 *s = p->sinks;
   size_t n = p->nsinks;
   if (!s) {
-    int rc = oc_hf_sinks(r->hf, &found, &n, err);
+    int rc = oc_heightfield_sinks(r->hf, &found, &n, err);
     if (rc) return rc;
     s = found;
   }

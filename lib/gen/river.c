@@ -130,16 +130,16 @@ oc_node *oc_generate_river(const oc_gen_river_params *pin, oc_gen_sea_stats *st,
   double thr = p.power;
 
   if (!(base = oc_erode_base(hf, p.erode.terrain, err))) return NULL;
-  oc_hf_flow_params fp = {0, 0, p.erode.progress};
-  if (!(pw = oc_hf_stream_power(hf, &fp, err))) goto done;
+  oc_heightfield_flow_params fp = {0, 0, p.erode.progress};
+  if (!(pw = oc_heightfield_stream_power(hf, &fp, err))) goto done;
   if (thr == 0 &&
       quantile(oc_heightfield_samples(pw), (size_t)nx * ny, 0.95, &thr, err))
     goto done;
   if (!(thr > 0)) thr = 1e-30; /* a flat grid: anything that flows */
   if (!(sig = oc_heightfield_new(nx, ny, cell, x0, y0, NULL, err))) goto done;
   widening W = {oc_heightfield_samples(pw), thr, p.banks};
-  if (oc_hf_each_row(sig, widen_row, &W, p.erode.progress, "river erosion",
-                     err))
+  if (oc_heightfield_each_row(sig, widen_row, &W, p.erode.progress,
+                              "river erosion", err))
     goto done;
   bed B = {sig, x0, y0, cell, nx, ny};
   size_t ns = (size_t)nx * ny;

@@ -129,7 +129,7 @@ oc_node *oc_generate_sea(const oc_gen_sea_params *pin, oc_gen_sea_stats *st,
 
   if (!(base = oc_erode_base(hf, p.erode.terrain, err))) return NULL;
   /* No sample at or below the band: no cliff to reach, only the band. */
-  dist = oc_hf_distance_to_level(hf, C.hi, &e2);
+  dist = oc_heightfield_distance_to_level(hf, C.hi, &e2);
   if (!dist && e2.code != OC_EINVAL) {
     oc_seterr(err, e2.code, "%s", e2.msg);
     goto done;

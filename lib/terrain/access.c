@@ -1,5 +1,6 @@
 /*
-** access.c — oc_hf_accessibility: the fraction of the sky a sample sees,
+** access.c — oc_heightfield_accessibility: the fraction of the sky a sample
+** sees,
 ** after Miller's (1994) accessibility shading.
 **
 ** From each sample, `rays` directions are drawn uniformly over the solid
@@ -88,14 +89,15 @@ static float sample_sky(const sky *s, int i, int j) {
   return (float)((double)seen / s->rays);
 }
 
-oc_heightfield *oc_hf_accessibility(const oc_heightfield *hf,
-                                    const oc_hf_access_params *ap,
-                                    oc_error *err) {
+oc_heightfield *
+oc_heightfield_accessibility(const oc_heightfield *hf,
+                             const oc_heightfield_access_params *ap,
+                             oc_error *err) {
   if (!hf) {
     oc_seterr(err, OC_EINVAL, "accessibility needs a heightfield");
     return NULL;
   }
-  oc_hf_access_params d = {0, 0, 0, {NULL, NULL}};
+  oc_heightfield_access_params d = {0, 0, 0, {NULL, NULL}};
   if (!ap) ap = &d;
   sky s = {oc_heightfield_samples(hf),
            oc_heightfield_nx(hf),
@@ -116,10 +118,10 @@ oc_heightfield *oc_hf_accessibility(const oc_heightfield *hf,
     return NULL;
   }
   oc_heightfield_minmax(hf, NULL, &s.top);
-  oc_heightfield *out = oc_hf_like(hf, err);
+  oc_heightfield *out = oc_heightfield_like(hf, err);
   if (!out) return NULL;
   float *a = oc_heightfield_samples_mut(out);
-  oc_hf_phase ph = {ap->progress, 0, 1};
+  oc_heightfield_phase ph = {ap->progress, 0, 1};
   int stop = 0, rows = 0;
 #pragma omp parallel for schedule(dynamic, 1)
   for (int j = 0; j < s.ny; j++) {
@@ -132,12 +134,13 @@ oc_heightfield *oc_hf_accessibility(const oc_heightfield *hf,
     int done;
 #pragma omp atomic capture
     done = ++rows;
-    if (omp_get_thread_num() == 0 && oc_hf_report(&ph, 0.99 * done / s.ny)) {
+    if (omp_get_thread_num() == 0 &&
+        oc_heightfield_report(&ph, 0.99 * done / s.ny)) {
 #pragma omp atomic write
       stop = 1;
     }
   }
-  if (stop || oc_hf_report(&ph, 1.0)) {
+  if (stop || oc_heightfield_report(&ph, 1.0)) {
     oc_seterr(err, OC_ECANCEL, "accessibility cancelled");
     oc_heightfield_release(out);
     return NULL;

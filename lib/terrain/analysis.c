@@ -7,13 +7,13 @@
 #include "core/error.h"
 #include "terrain/analysis.h"
 
-const int oc_hf_di[8] = {1, 1, 0, -1, -1, -1, 0, 1};
-const int oc_hf_dj[8] = {0, 1, 1, 1, 0, -1, -1, -1};
-const double oc_hf_dist[8] = {
+const int oc_heightfield_di[8] = {1, 1, 0, -1, -1, -1, 0, 1};
+const int oc_heightfield_dj[8] = {0, 1, 1, 1, 0, -1, -1, -1};
+const double oc_heightfield_dist[8] = {
     1, 1.41421356237309504880, 1, 1.41421356237309504880,
     1, 1.41421356237309504880, 1, 1.41421356237309504880};
 
-oc_heightfield *oc_hf_like(const oc_heightfield *hf, oc_error *err) {
+oc_heightfield *oc_heightfield_like(const oc_heightfield *hf, oc_error *err) {
   double x0, y0;
   oc_heightfield_origin(hf, &x0, &y0);
   /* calloc'd by the grid constructor; the caller overwrites every sample */
@@ -21,8 +21,9 @@ oc_heightfield *oc_hf_like(const oc_heightfield *hf, oc_error *err) {
                             oc_heightfield_cell(hf), x0, y0, NULL, err);
 }
 
-int oc_hf_each_row(oc_heightfield *out, oc_hf_row_fn fn, const void *ctx,
-                   oc_progress pr, const char *what, oc_error *err) {
+int oc_heightfield_each_row(oc_heightfield *out, oc_heightfield_row_fn fn,
+                            const void *ctx, oc_progress pr, const char *what,
+                            oc_error *err) {
   int ny = oc_heightfield_ny(out), stop = 0, done = 0;
 #pragma omp parallel for schedule(dynamic, 1)
   for (int j = 0; j < ny; j++) {

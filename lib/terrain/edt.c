@@ -1,5 +1,6 @@
 /*
-** edt.c — oc_hf_distance_to_level: horizontal distance from each sample
+** edt.c — oc_heightfield_distance_to_level: horizontal distance from each
+** sample
 ** to the nearest sample at or below a level, by the exact Euclidean
 ** distance transform of Felzenszwalb and Huttenlocher (2012).
 **
@@ -56,8 +57,8 @@ static void envelope(const double *f, double *d, int n, int *v, double *zb) {
   }
 }
 
-oc_heightfield *oc_hf_distance_to_level(const oc_heightfield *hf, double level,
-                                        oc_error *err) {
+oc_heightfield *oc_heightfield_distance_to_level(const oc_heightfield *hf,
+                                                 double level, oc_error *err) {
   if (!hf) {
     oc_seterr(err, OC_EINVAL, "distance_to_level needs a heightfield");
     return NULL;
@@ -79,7 +80,7 @@ oc_heightfield *oc_hf_distance_to_level(const oc_heightfield *hf, double level,
   int side = nx > ny ? nx : ny;
   const float *z = oc_heightfield_samples(hf);
   double *d2 = malloc(n * sizeof *d2);
-  oc_heightfield *out = d2 ? oc_hf_like(hf, err) : NULL;
+  oc_heightfield *out = d2 ? oc_heightfield_like(hf, err) : NULL;
   if (!out) {
     if (!d2)
       oc_seterr(err, OC_ENOMEM,
@@ -117,7 +118,8 @@ oc_heightfield *oc_hf_distance_to_level(const oc_heightfield *hf, double level,
         f[j] = d2[(size_t)j * (size_t)nx + (size_t)i];
       envelope(f, d, ny, v, f + 2 * side);
       for (int j = 0; j < ny; j++)
-        o[(size_t)j * (size_t)nx + (size_t)i] = oc_hf_float(sqrt(d[j]) * cell);
+        o[(size_t)j * (size_t)nx + (size_t)i] =
+            oc_heightfield_float(sqrt(d[j]) * cell);
     }
     free(f);
     free(v);

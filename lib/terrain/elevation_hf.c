@@ -7,7 +7,8 @@
 ** (1D: p1, p1 + (p2 - p0)/6, p2 - (p3 - p1)/6, p2 along each axis) bound
 ** it (convex hull), and 3 times their largest difference along an axis
 ** bounds its derivative there; the value also stays within the 4 x 4
-** samples' range widened by OC_HF_OVERSHOOT times their spread, and the
+** samples' range widened by OC_HEIGHTFIELD_OVERSHOOT times their spread, and
+** the
 ** tighter of the two bounds is kept. Level 0 of the pyramid keeps those bounds
 ** per cell (12 bytes a cell: three times the grid), each next level per
 ** 2 x 2 blocks of the previous one; a query reads at most 4 x 4 blocks of
@@ -85,8 +86,8 @@ static void cell_bounds(const hfsrc *s, int ci, int cj, double *lo, double *hi,
     }
   /* the hull is usually tighter than the interpolation's overshoot bound,
   ** but not always: both hold, so does their intersection */
-  *lo = fmax(l, pl - OC_HF_OVERSHOOT * (ph - pl));
-  *hi = fmin(h, ph + OC_HF_OVERSHOOT * (ph - pl));
+  *lo = fmax(l, pl - OC_HEIGHTFIELD_OVERSHOOT * (ph - pl));
+  *hi = fmin(h, ph + OC_HEIGHTFIELD_OVERSHOOT * (ph - pl));
   *gs = 3 * sqrt(gu * gu + gv * gv) / s->cell * (1 + 1e-9);
 }
 

@@ -1,5 +1,5 @@
 /*
-** fill.c — oc_hf_fill: depression filling by Priority-Flood+epsilon
+** fill.c — oc_heightfield_fill: depression filling by Priority-Flood+epsilon
 ** (Barnes, Lehman and Mulla 2014, algorithm 3).
 **
 ** The flood starts from every border sample (water leaves the grid there)
@@ -67,8 +67,8 @@ static uint64_t heap_pop(heap *h) {
   return top;
 }
 
-int oc_hf_fill_samples(float *z, int nx, int ny, const oc_hf_phase *ph,
-                       oc_error *err) {
+int oc_heightfield_fill_samples(float *z, int nx, int ny,
+                                const oc_heightfield_phase *ph, oc_error *err) {
   size_t n = (size_t)nx * (size_t)ny;
   /* Each sample enters the heap or the queue once: n entries bound both.
   ** Only the flood's front is ever touched, so the pages mostly stay
@@ -108,7 +108,7 @@ int oc_hf_fill_samples(float *z, int nx, int ny, const oc_hf_phase *ph,
     if (isinf(up)) up = zc; /* at FLT_MAX there is no room above */
     int i = (int)(c % (uint32_t)nx), j = (int)(c / (uint32_t)nx);
     for (int k = 0; k < 8; k++) {
-      int a = i + oc_hf_di[k], b = j + oc_hf_dj[k];
+      int a = i + oc_heightfield_di[k], b = j + oc_heightfield_dj[k];
       if (a < 0 || b < 0 || a >= nx || b >= ny) continue;
       size_t m = (size_t)b * (size_t)nx + (size_t)a;
       if (closed[m]) continue;
@@ -119,7 +119,8 @@ int oc_hf_fill_samples(float *z, int nx, int ny, const oc_hf_phase *ph,
       } else
         heap_push(&h, key(z[m], (uint32_t)m));
     }
-    if (++done % REPORT_EVERY == 0 && oc_hf_report(ph, (double)done / n)) {
+    if (++done % REPORT_EVERY == 0 &&
+        oc_heightfield_report(ph, (double)done / n)) {
       rc = oc_seterr(err, OC_ECANCEL, "filling cancelled");
       break;
     }
@@ -130,8 +131,8 @@ int oc_hf_fill_samples(float *z, int nx, int ny, const oc_hf_phase *ph,
   return rc;
 }
 
-oc_heightfield *oc_hf_fill(const oc_heightfield *hf, oc_progress progress,
-                           oc_error *err) {
+oc_heightfield *oc_heightfield_fill(const oc_heightfield *hf,
+                                    oc_progress progress, oc_error *err) {
   if (!hf) {
     oc_seterr(err, OC_EINVAL, "filled needs a heightfield");
     return NULL;
@@ -142,11 +143,11 @@ oc_heightfield *oc_hf_fill(const oc_heightfield *hf, oc_progress progress,
       oc_heightfield_nx(hf), oc_heightfield_ny(hf), oc_heightfield_cell(hf), x0,
       y0, oc_heightfield_samples(hf), err);
   if (!out) return NULL;
-  oc_hf_phase ph = {progress, 0, 1};
-  int rc =
-      oc_hf_fill_samples(oc_heightfield_samples_mut(out), oc_heightfield_nx(hf),
-                         oc_heightfield_ny(hf), &ph, err);
-  if (rc == OC_OK && oc_hf_report(&ph, 1.0))
+  oc_heightfield_phase ph = {progress, 0, 1};
+  int rc = oc_heightfield_fill_samples(oc_heightfield_samples_mut(out),
+                                       oc_heightfield_nx(hf),
+                                       oc_heightfield_ny(hf), &ph, err);
+  if (rc == OC_OK && oc_heightfield_report(&ph, 1.0))
     rc = oc_seterr(err, OC_ECANCEL, "filling cancelled");
   if (rc != OC_OK) {
     oc_heightfield_release(out);

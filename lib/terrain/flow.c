@@ -1,5 +1,6 @@
 /*
-** flow.c — oc_hf_drainage and oc_hf_stream_power: upstream area by
+** flow.c — oc_heightfield_drainage and oc_heightfield_stream_power: upstream
+** area by
 ** Freeman's (1991) multiple-flow-direction model, on the filled grid.
 **
 ** Every sample starts with its own area, cell^2, and passes all it holds
@@ -31,10 +32,11 @@
 #define REPORT_EVERY 4096
 #define STACK0 4096
 
-static int check_params(const oc_heightfield *hf, const oc_hf_flow_params *fp,
-                        const char *what, double *p, oc_error *err) {
+static int check_params(const oc_heightfield *hf,
+                        const oc_heightfield_flow_params *fp, const char *what,
+                        double *p, oc_error *err) {
   if (!hf) return oc_seterr(err, OC_EINVAL, "%s needs a heightfield", what);
-  *p = fp && fp->exponent != 0 ? fp->exponent : OC_HF_FREEMAN_EXPONENT;
+  *p = fp && fp->exponent != 0 ? fp->exponent : OC_HEIGHTFIELD_FREEMAN_EXPONENT;
   if (!(*p > 0 && *p <= MAX_EXPONENT))
     return oc_seterr(err, OC_EINVAL, "'exponent' must be in (0, %g] (got %g)",
                      MAX_EXPONENT, *p);
@@ -46,14 +48,14 @@ static int check_params(const oc_heightfield *hf, const oc_hf_flow_params *fp,
 ** function both sides of an edge call, gives the donor and the receiver
 ** the same value. */
 static double weight(double dz, int k, double p) {
-  return exp2(p * log2(dz / oc_hf_dist[k]));
+  return exp2(p * log2(dz / oc_heightfield_dist[k]));
 }
 
 /* A sample no neighbour is strictly above: where walks start. */
 static int is_source(const float *z, int nx, int ny, int i, int j) {
   float zc = z[(size_t)j * (size_t)nx + (size_t)i];
   for (int k = 0; k < 8; k++) {
-    int a = i + oc_hf_di[k], b = j + oc_hf_dj[k];
+    int a = i + oc_heightfield_di[k], b = j + oc_heightfield_dj[k];
     if (a >= 0 && b >= 0 && a < nx && b < ny &&
         z[(size_t)b * (size_t)nx + (size_t)a] > zc)
       return 0;
@@ -79,15 +81,15 @@ static int finish(walk *w, uint32_t c, uint32_t **st, size_t *ns, size_t *cap) {
   int i = (int)(c % (uint32_t)nx), j = (int)(c / (uint32_t)nx);
   double zc = w->z[c], sum = w->own;
   for (int k = 0; k < 8; k++) {
-    int a = i + oc_hf_di[k], b = j + oc_hf_dj[k];
+    int a = i + oc_heightfield_di[k], b = j + oc_heightfield_dj[k];
     if (a < 0 || b < 0 || a >= nx || b >= ny) continue;
     size_t u = (size_t)b * (size_t)nx + (size_t)a;
     if (w->z[u] > zc) sum += w->q[u] * weight(w->z[u] - zc, k, w->p);
   }
-  w->area[c] = oc_hf_float(sum);
+  w->area[c] = oc_heightfield_float(sum);
   w->q[c] = w->q[c] > 0 ? sum / w->q[c] : 0;
   for (int k = 0; k < 8; k++) {
-    int a = i + oc_hf_di[k], b = j + oc_hf_dj[k];
+    int a = i + oc_heightfield_di[k], b = j + oc_heightfield_dj[k];
     if (a < 0 || b < 0 || a >= nx || b >= ny) continue;
     size_t m = (size_t)b * (size_t)nx + (size_t)a;
     if (!(w->z[m] < zc)) continue;
@@ -106,7 +108,7 @@ static int finish(walk *w, uint32_t c, uint32_t **st, size_t *ns, size_t *cap) {
 
 /* Upstream area of every sample of z (which must drain: filled). */
 static int drain(const float *z, int nx, int ny, double cell, double p,
-                 float *area, const oc_hf_phase *ph, oc_error *err) {
+                 float *area, const oc_heightfield_phase *ph, oc_error *err) {
   size_t n = (size_t)nx * (size_t)ny;
   walk w = {.z = z,
             .nx = nx,
@@ -130,7 +132,7 @@ static int drain(const float *z, int nx, int ny, double cell, double p,
       double zc = z[c], norm = 0;
       unsigned char up = 0;
       for (int k = 0; k < 8; k++) {
-        int a = i + oc_hf_di[k], b = j + oc_hf_dj[k];
+        int a = i + oc_heightfield_di[k], b = j + oc_heightfield_dj[k];
         if (a < 0 || b < 0 || a >= nx || b >= ny) continue;
         double zm = z[(size_t)b * (size_t)nx + (size_t)a];
         if (zm < zc) norm += weight(zc - zm, k, p);
@@ -162,7 +164,8 @@ static int drain(const float *z, int nx, int ny, double cell, double p,
 #pragma omp atomic capture
           d = w.done += mine;
           mine = 0;
-          if (omp_get_thread_num() == 0 && oc_hf_report(ph, (double)d / n)) {
+          if (omp_get_thread_num() == 0 &&
+              oc_heightfield_report(ph, (double)d / n)) {
 #pragma omp atomic write
             cancelled = 1;
 #pragma omp atomic write
@@ -177,7 +180,7 @@ static int drain(const float *z, int nx, int ny, double cell, double p,
     if (lrc > 0) {
 #pragma omp atomic write
       w.stop = 1;
-#pragma omp critical(oc_hf_drain_err)
+#pragma omp critical(oc_heightfield_drain_err)
       rc = lrc;
     }
     free(st);
@@ -195,7 +198,7 @@ static int drain(const float *z, int nx, int ny, double cell, double p,
 /* Points *z at the filled samples of hf: a copy in *copy (to free), or
 ** hf's own samples when they are prefilled. */
 static int filled(const oc_heightfield *hf, int prefilled, const float **z,
-                  float **copy, const oc_hf_phase *ph, oc_error *err) {
+                  float **copy, const oc_heightfield_phase *ph, oc_error *err) {
   int nx = oc_heightfield_nx(hf), ny = oc_heightfield_ny(hf);
   size_t n = (size_t)nx * (size_t)ny;
   *z = oc_heightfield_samples(hf);
@@ -206,7 +209,7 @@ static int filled(const oc_heightfield *hf, int prefilled, const float **z,
     return oc_seterr(err, OC_ENOMEM,
                      "out of memory filling a %d x %d heightfield", nx, ny);
   memcpy(*copy, *z, n * sizeof **copy);
-  int rc = oc_hf_fill_samples(*copy, nx, ny, ph, err);
+  int rc = oc_heightfield_fill_samples(*copy, nx, ny, ph, err);
   if (rc != OC_OK) {
     free(*copy);
     *copy = NULL;
@@ -217,14 +220,15 @@ static int filled(const oc_heightfield *hf, int prefilled, const float **z,
 
 /* Shared by both entry points: the area into `area`, and with `power`
 ** the stream power, both grids of hf's geometry. */
-static int flow(const oc_heightfield *hf, const oc_hf_flow_params *fp, double p,
-                float *area, float *power, oc_error *err) {
+static int flow(const oc_heightfield *hf, const oc_heightfield_flow_params *fp,
+                double p, float *area, float *power, oc_error *err) {
   int nx = oc_heightfield_nx(hf), ny = oc_heightfield_ny(hf);
   double cell = oc_heightfield_cell(hf);
   oc_progress cb = fp ? fp->progress : (oc_progress){NULL, NULL};
   int prefilled = fp && fp->prefilled;
   double split = prefilled ? 0 : 0.4;
-  oc_hf_phase fill_ph = {cb, 0, split}, drain_ph = {cb, split, 0.99 - split};
+  oc_heightfield_phase fill_ph = {cb, 0, split},
+                       drain_ph = {cb, split, 0.99 - split};
   float *copy;
   const float *z;
   int rc = filled(hf, prefilled, &z, &copy, &fill_ph, err);
@@ -232,10 +236,10 @@ static int flow(const oc_heightfield *hf, const oc_hf_flow_params *fp, double p,
   rc = drain(z, nx, ny, cell, p, area, &drain_ph, err);
   if (rc == OC_OK && power) {
     size_t n = (size_t)nx * (size_t)ny;
-    oc_hf_slope_samples(z, nx, ny, cell, power);
+    oc_heightfield_slope_samples(z, nx, ny, cell, power);
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < n; k++)
-      power[k] = oc_hf_float(sqrt((double)area[k]) * power[k]);
+      power[k] = oc_heightfield_float(sqrt((double)area[k]) * power[k]);
   }
   free(copy);
   if (rc == OC_OK && cb.fn && cb.fn(cb.ud, 1.0))
@@ -243,11 +247,12 @@ static int flow(const oc_heightfield *hf, const oc_hf_flow_params *fp, double p,
   return rc;
 }
 
-oc_heightfield *oc_hf_drainage(const oc_heightfield *hf,
-                               const oc_hf_flow_params *fp, oc_error *err) {
+oc_heightfield *oc_heightfield_drainage(const oc_heightfield *hf,
+                                        const oc_heightfield_flow_params *fp,
+                                        oc_error *err) {
   double p;
   if (check_params(hf, fp, "drainage", &p, err)) return NULL;
-  oc_heightfield *out = oc_hf_like(hf, err);
+  oc_heightfield *out = oc_heightfield_like(hf, err);
   if (!out) return NULL;
   if (flow(hf, fp, p, oc_heightfield_samples_mut(out), NULL, err) != OC_OK) {
     oc_heightfield_release(out);
@@ -256,11 +261,13 @@ oc_heightfield *oc_hf_drainage(const oc_heightfield *hf,
   return out;
 }
 
-oc_heightfield *oc_hf_stream_power(const oc_heightfield *hf,
-                                   const oc_hf_flow_params *fp, oc_error *err) {
+oc_heightfield *
+oc_heightfield_stream_power(const oc_heightfield *hf,
+                            const oc_heightfield_flow_params *fp,
+                            oc_error *err) {
   double p;
   if (check_params(hf, fp, "stream_power", &p, err)) return NULL;
-  oc_heightfield *out = oc_hf_like(hf, err);
+  oc_heightfield *out = oc_heightfield_like(hf, err);
   if (!out) return NULL;
   size_t n = (size_t)oc_heightfield_nx(hf) * (size_t)oc_heightfield_ny(hf);
   float *area = malloc(n * sizeof *area);

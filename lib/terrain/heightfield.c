@@ -33,12 +33,12 @@ oc_heightfield *oc_heightfield_new(int nx, int ny, double cell, double x0,
     return NULL;
   }
   unsigned long long n = (unsigned long long)nx * (unsigned long long)ny;
-  if (n > OC_HF_MAX_SAMPLES) {
+  if (n > OC_HEIGHTFIELD_MAX_SAMPLES) {
     oc_seterr(err, OC_ENOMEM,
               "'size' %d x %d is %llu samples (%llu MiB), over the limit of "
               "%llu (%llu MiB)",
-              nx, ny, n, (n * sizeof(float)) >> 20, OC_HF_MAX_SAMPLES,
-              (OC_HF_MAX_SAMPLES * sizeof(float)) >> 20);
+              nx, ny, n, (n * sizeof(float)) >> 20, OC_HEIGHTFIELD_MAX_SAMPLES,
+              (OC_HEIGHTFIELD_MAX_SAMPLES * sizeof(float)) >> 20);
     return NULL;
   }
   /* a subnormal cell has no half (0.5 * 5e-324 == 0) and no finite

@@ -37,7 +37,7 @@ static const char *const keys[NKEYS] = {"outcrop:cell", "outcrop:x0",
 
 typedef struct loader {
   const char *path;
-  oc_hf_load_params p; /* what the caller gave */
+  oc_heightfield_load_params p; /* what the caller gave */
   /* values found in the file: [0] as attributes of their own, [1] as
   ** lines of the ImageDescription (TIFF), used only when [0] lacks them */
   double meta[2][NKEYS];
@@ -106,9 +106,9 @@ static float *on_begin(void *ud, int w, int h, int channels, const char *type,
               ld->path, w, h);
     return NULL;
   }
-  double cell = pick(ld, OC_HF_GIVE_CELL, ld->p.cell, M_CELL, 1);
-  double x0 = pick(ld, OC_HF_GIVE_ORIGIN, ld->p.x0, M_X0, 0);
-  double y0 = pick(ld, OC_HF_GIVE_ORIGIN, ld->p.y0, M_Y0, 0);
+  double cell = pick(ld, OC_HEIGHTFIELD_GIVE_CELL, ld->p.cell, M_CELL, 1);
+  double x0 = pick(ld, OC_HEIGHTFIELD_GIVE_ORIGIN, ld->p.x0, M_X0, 0);
+  double y0 = pick(ld, OC_HEIGHTFIELD_GIVE_ORIGIN, ld->p.y0, M_Y0, 0);
   oc_error e = {OC_OK, ""};
   ld->hf = oc_heightfield_new(w, h, cell, x0, y0, NULL, &e);
   if (!ld->hf) {
@@ -132,8 +132,9 @@ static int finish_load(loader *ld, oc_error *err) {
       rb[i] = t;
     }
   }
-  double scale = pick(ld, OC_HF_GIVE_SCALE, ld->p.scale, M_SCALE, 1);
-  double offset = pick(ld, OC_HF_GIVE_OFFSET, ld->p.offset, M_OFFSET, 0);
+  double scale = pick(ld, OC_HEIGHTFIELD_GIVE_SCALE, ld->p.scale, M_SCALE, 1);
+  double offset =
+      pick(ld, OC_HEIGHTFIELD_GIVE_OFFSET, ld->p.offset, M_OFFSET, 0);
   if (!isfinite(scale) || !isfinite(offset))
     return oc_seterr(err, OC_EINVAL,
                      "cannot load '%s': 'scale' and 'offset' must be finite",
@@ -154,7 +155,8 @@ static int finish_load(loader *ld, oc_error *err) {
 }
 
 oc_heightfield *oc_heightfield_load(const char *path,
-                                    const oc_hf_load_params *p, oc_error *err) {
+                                    const oc_heightfield_load_params *p,
+                                    oc_error *err) {
   if (!path || !*path) {
     oc_seterr(err, OC_EINVAL, "'path' must be a non-empty file name");
     return NULL;
@@ -163,7 +165,7 @@ oc_heightfield *oc_heightfield_load(const char *path,
   memset(&ld, 0, sizeof ld);
   ld.path = path;
   if (p) ld.p = *p;
-  if ((ld.p.given & OC_HF_GIVE_CELL) &&
+  if ((ld.p.given & OC_HEIGHTFIELD_GIVE_CELL) &&
       (!(ld.p.cell > 0) || !isfinite(ld.p.cell))) {
     oc_seterr(err, OC_EINVAL, "'cell' must be > 0 (got %g)", ld.p.cell);
     return NULL;
@@ -181,19 +183,19 @@ oc_heightfield *oc_heightfield_load(const char *path,
 /* ---- RAW ----------------------------------------------------------------- */
 
 oc_heightfield *oc_heightfield_load_raw(const char *path, int nx, int ny,
-                                        const oc_hf_load_params *p,
+                                        const oc_heightfield_load_params *p,
                                         oc_error *err) {
-  oc_hf_load_params d = {0, 1, 1, 0, 0, 0, {NULL, NULL}};
+  oc_heightfield_load_params d = {0, 1, 1, 0, 0, 0, {NULL, NULL}};
   if (!p) p = &d;
   if (!path || !*path) {
     oc_seterr(err, OC_EINVAL, "'path' must be a non-empty file name");
     return NULL;
   }
-  double cell = p->given & OC_HF_GIVE_CELL ? p->cell : 1;
-  double scale = p->given & OC_HF_GIVE_SCALE ? p->scale : 1;
-  double offset = p->given & OC_HF_GIVE_OFFSET ? p->offset : 0;
-  double x0 = p->given & OC_HF_GIVE_ORIGIN ? p->x0 : 0;
-  double y0 = p->given & OC_HF_GIVE_ORIGIN ? p->y0 : 0;
+  double cell = p->given & OC_HEIGHTFIELD_GIVE_CELL ? p->cell : 1;
+  double scale = p->given & OC_HEIGHTFIELD_GIVE_SCALE ? p->scale : 1;
+  double offset = p->given & OC_HEIGHTFIELD_GIVE_OFFSET ? p->offset : 0;
+  double x0 = p->given & OC_HEIGHTFIELD_GIVE_ORIGIN ? p->x0 : 0;
+  double y0 = p->given & OC_HEIGHTFIELD_GIVE_ORIGIN ? p->y0 : 0;
   if (!isfinite(scale) || !isfinite(offset)) {
     oc_seterr(err, OC_EINVAL,
               "cannot load '%s': 'scale' and 'offset' must be finite", path);
@@ -404,7 +406,8 @@ static int is_ours(const char *key) {
 /* The colour picture of the grid through a palette: 8-bit RGB, north up,
 ** with the caller's metadata only (it is no heightfield file). */
 static int save_colors(const oc_heightfield *hf, int dir, const char *path,
-                       int k, const oc_hf_save_params *p, oc_error *err) {
+                       int k, const oc_heightfield_save_params *p,
+                       oc_error *err) {
   if (k != PNG && k != TIFF)
     return oc_seterr(err, OC_EINVAL,
                      "cannot write '%s': a palette picture must be .png or "
@@ -465,15 +468,16 @@ static int write_raw(const uint16_t *q, size_t n, int dir, const char *path,
 }
 
 int oc_heightfield_save(const oc_heightfield *hf, const char *path,
-                        const oc_hf_save_params *p, double used[2],
+                        const oc_heightfield_save_params *p, double used[2],
                         oc_error *err) {
   return oc_heightfield_save_at(hf, AT_FDCWD, path, p, used, err);
 }
 
 int oc_heightfield_save_at(const oc_heightfield *hf, int dir, const char *path,
-                           const oc_hf_save_params *p, double used[2],
+                           const oc_heightfield_save_params *p, double used[2],
                            oc_error *err) {
-  static const oc_hf_save_params defaults = {0, 0, 1, 0, NULL, 0, NULL, 0};
+  static const oc_heightfield_save_params defaults = {0,    0, 1,    0,
+                                                      NULL, 0, NULL, 0};
   if (!hf) return oc_seterr(err, OC_EINVAL, "the heightfield is NULL");
   if (!path || !*path)
     return oc_seterr(err, OC_EINVAL, "'path' must be a non-empty file name");

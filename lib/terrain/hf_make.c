@@ -17,7 +17,7 @@
 #include "outcrop.h"
 #include "terrain/analysis.h"
 
-static oc_heightfield *new_grid(const oc_hf_grid *g, oc_error *err) {
+static oc_heightfield *new_grid(const oc_heightfield_grid *g, oc_error *err) {
   if (!g) {
     oc_seterr(err, OC_EINVAL, "the grid layout is NULL");
     return NULL;
@@ -25,10 +25,10 @@ static oc_heightfield *new_grid(const oc_hf_grid *g, oc_error *err) {
   return oc_heightfield_new(g->nx, g->ny, g->cell, g->x0, g->y0, NULL, err);
 }
 
-static oc_heightfield *run(oc_heightfield *out, oc_hf_row_fn fn,
+static oc_heightfield *run(oc_heightfield *out, oc_heightfield_row_fn fn,
                            const void *ctx, oc_progress pr, const char *what,
                            oc_error *err) {
-  if (out && oc_hf_each_row(out, fn, ctx, pr, what, err) != OC_OK) {
+  if (out && oc_heightfield_each_row(out, fn, ctx, pr, what, err) != OC_OK) {
     oc_heightfield_release(out);
     return NULL;
   }
@@ -58,8 +58,9 @@ static void fbm_row(const void *ctx, oc_heightfield *out, int j) {
   }
 }
 
-oc_heightfield *oc_heightfield_fbm(const oc_hf_grid *g, const oc_noise *noise,
-                                   oc_progress progress, oc_error *err) {
+oc_heightfield *oc_heightfield_fbm(const oc_heightfield_grid *g,
+                                   const oc_noise *noise, oc_progress progress,
+                                   oc_error *err) {
   if (!oc_check_noise(noise, err)) return NULL;
   double hmax = fabs(noise->offset) +
                 fabs(noise->amplitude) * oc_turb3_max(noise->octaves);
@@ -178,11 +179,9 @@ static void surf_row(const void *ctx, oc_heightfield *out, int j) {
     row[i] = (float)surface(c, c->x0 + i * c->cell, y);
 }
 
-oc_heightfield *oc_heightfield_from_program(const oc_program *prog,
-                                            const oc_hf_grid *g, double z0,
-                                            double z1, double threshold,
-                                            oc_progress progress,
-                                            oc_error *err) {
+oc_heightfield *oc_heightfield_from_program(
+    const oc_program *prog, const oc_heightfield_grid *g, double z0, double z1,
+    double threshold, oc_progress progress, oc_error *err) {
   if (!prog) {
     oc_seterr(err, OC_EINVAL, "the program is NULL");
     return NULL;
@@ -277,7 +276,7 @@ static void resample_row(const void *ctx, oc_heightfield *out, int j) {
 }
 
 oc_heightfield *oc_heightfield_resample(const oc_heightfield *hf,
-                                        const oc_hf_grid *g,
+                                        const oc_heightfield_grid *g,
                                         oc_progress progress, oc_error *err) {
   if (!hf) {
     oc_seterr(err, OC_EINVAL, "the heightfield is NULL");

@@ -35,15 +35,15 @@ static int put(oc_heightfield *out, size_t k, double v, const char *what,
   return OC_OK;
 }
 
-static double apply(oc_hf_op op, double a, double b) {
+static double apply(oc_heightfield_op op, double a, double b) {
   switch (op) {
-  case OC_HF_ADD:
+  case OC_HEIGHTFIELD_ADD:
     return a + b;
-  case OC_HF_SUB:
+  case OC_HEIGHTFIELD_SUB:
     return a - b;
-  case OC_HF_RSUB:
+  case OC_HEIGHTFIELD_RSUB:
     return b - a;
-  case OC_HF_MUL:
+  case OC_HEIGHTFIELD_MUL:
     return a * b;
   }
   return NAN;
@@ -55,7 +55,7 @@ static const char *const op_names[] = {"the sum", "the difference",
 /* A new grid like a holding op of a's samples and zb's (or of k when zb
 ** is NULL), sample by sample; NULL when a result is not a finite float. */
 static oc_heightfield *combine(const oc_heightfield *a, const float *zb,
-                               double k, oc_hf_op op, oc_error *err) {
+                               double k, oc_heightfield_op op, oc_error *err) {
   oc_heightfield *out = like(a, err);
   if (!out) return NULL;
   const float *za = oc_heightfield_samples(a);
@@ -68,15 +68,15 @@ static oc_heightfield *combine(const oc_heightfield *a, const float *zb,
   return out;
 }
 
-static int check_op(oc_hf_op op, oc_error *err) {
-  if (op < OC_HF_ADD || op > OC_HF_MUL)
+static int check_op(oc_heightfield_op op, oc_error *err) {
+  if (op < OC_HEIGHTFIELD_ADD || op > OC_HEIGHTFIELD_MUL)
     return oc_seterr(err, OC_EINVAL, "unknown grid operation %d", (int)op);
   return OC_OK;
 }
 
 oc_heightfield *oc_heightfield_combine(const oc_heightfield *a,
-                                       const oc_heightfield *b, oc_hf_op op,
-                                       oc_error *err) {
+                                       const oc_heightfield *b,
+                                       oc_heightfield_op op, oc_error *err) {
   if (!a || !b) {
     oc_seterr(err, OC_EINVAL, "the heightfield is NULL");
     return NULL;
@@ -101,7 +101,7 @@ oc_heightfield *oc_heightfield_combine(const oc_heightfield *a,
 }
 
 oc_heightfield *oc_heightfield_scalar(const oc_heightfield *a, double k,
-                                      oc_hf_op op, oc_error *err) {
+                                      oc_heightfield_op op, oc_error *err) {
   if (!a) {
     oc_seterr(err, OC_EINVAL, "the heightfield is NULL");
     return NULL;
@@ -148,7 +148,8 @@ static double ramp(double d, double w) {
 }
 
 oc_heightfield *oc_heightfield_mask(const oc_heightfield *a,
-                                    const oc_hf_mask_params *p, oc_error *err) {
+                                    const oc_heightfield_mask_params *p,
+                                    oc_error *err) {
   if (!a || !p) {
     oc_seterr(err, OC_EINVAL,
               "the heightfield or the mask parameters are "

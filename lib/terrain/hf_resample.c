@@ -20,7 +20,8 @@ static double count_samples(double w, double c) {
 }
 
 int oc_heightfield_resample_grid(const oc_heightfield *hf, double cell, int nx,
-                                 int ny, oc_hf_grid *g, oc_error *err) {
+                                 int ny, oc_heightfield_grid *g,
+                                 oc_error *err) {
   char a[OC_NUMSTR], b[OC_NUMSTR], c[OC_NUMSTR];
   if (!hf || !g) return oc_seterr(err, OC_EINVAL, "the heightfield is NULL");
   int bysize = nx != 0 || ny != 0;
@@ -29,7 +30,7 @@ int oc_heightfield_resample_grid(const oc_heightfield *hf, double cell, int nx,
   double sc = oc_heightfield_cell(hf);
   double wx = (oc_heightfield_nx(hf) - 1) * sc,
          wy = (oc_heightfield_ny(hf) - 1) * sc;
-  oc_hf_grid out;
+  oc_heightfield_grid out;
   oc_heightfield_origin(hf, &out.x0, &out.y0);
   if (bysize) {
     if (nx < 2 || nx > MAX_SIDE || ny < 2 || ny > MAX_SIDE)
@@ -61,12 +62,12 @@ int oc_heightfield_resample_grid(const oc_heightfield *hf, double cell, int nx,
                        "side)",
                        oc_numstr(cell, a), (long long)fmin(fx, 1e18),
                        (long long)fmin(fy, 1e18), MAX_SIDE);
-    if (fx * fy > (double)OC_HF_MAX_SAMPLES)
+    if (fx * fy > (double)OC_HEIGHTFIELD_MAX_SAMPLES)
       return oc_seterr(err, OC_EINVAL,
                        "'cell' %s gives %lld x %lld samples, over the limit "
                        "of %lld",
                        oc_numstr(cell, a), (long long)fx, (long long)fy,
-                       (long long)OC_HF_MAX_SAMPLES);
+                       (long long)OC_HEIGHTFIELD_MAX_SAMPLES);
     out.nx = (int)fx, out.ny = (int)fy, out.cell = cell;
   }
   *g = out;

@@ -1,5 +1,5 @@
 /*
-** sinks.c — oc_hf_sinks: the pits of a grid, interior samples strictly
+** sinks.c — oc_heightfield_sinks: the pits of a grid, interior samples strictly
 ** lower than all eight neighbours.
 **
 ** Border samples are never pits: water can leave the grid there, which is
@@ -16,12 +16,14 @@
 static int is_pit(const float *z, int nx, int i, int j) {
   const float *c = z + (size_t)j * (size_t)nx + (size_t)i;
   for (int k = 0; k < 8; k++)
-    if (!(c[0] < c[oc_hf_dj[k] * (ptrdiff_t)nx + oc_hf_di[k]])) return 0;
+    if (!(c[0] <
+          c[oc_heightfield_dj[k] * (ptrdiff_t)nx + oc_heightfield_di[k]]))
+      return 0;
   return 1;
 }
 
-int oc_hf_sinks(const oc_heightfield *hf, oc_vec3 **out, size_t *n,
-                oc_error *err) {
+int oc_heightfield_sinks(const oc_heightfield *hf, oc_vec3 **out, size_t *n,
+                         oc_error *err) {
   if (!out || !n) return oc_seterr(err, OC_EINVAL, "sinks needs out and n");
   *out = NULL;
   *n = 0;

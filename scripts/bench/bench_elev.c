@@ -35,7 +35,7 @@ static double primary_calls(const oc_image *g, double *hits) {
 
 int main(void) {
   oc_error err;
-  oc_hf_grid grid = {1025, 1025, 2, -1024, -1024};
+  oc_heightfield_grid grid = {1025, 1025, 2, -1024, -1024};
   oc_noise nz = {600, 300, 0, 8, 14};
   oc_progress none = {0};
   oc_heightfield *hf = oc_heightfield_fbm(&grid, &nz, none, &err);

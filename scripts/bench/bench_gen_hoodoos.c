@@ -13,7 +13,7 @@
 
 int main(void) {
   oc_error err = {OC_OK, ""};
-  oc_hf_grid g = {257, 257, 1.4, 0, 0};
+  oc_heightfield_grid g = {257, 257, 1.4, 0, 0};
   oc_noise nz = {120, 60, 0, 6, 3};
   oc_progress none = {NULL, NULL};
   oc_heightfield *hf = oc_heightfield_fbm(&g, &nz, none, &err);

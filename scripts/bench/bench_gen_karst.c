@@ -29,7 +29,7 @@ static void die(const oc_error *err) {
 
 static oc_heightfield *plateau(void) {
   oc_error err;
-  oc_hf_grid g = {N, N, CELL, 0, 0};
+  oc_heightfield_grid g = {N, N, CELL, 0, 0};
   oc_noise nz = {400, 30, 0, 6, 5};
   oc_heightfield *hf = oc_heightfield_fbm(&g, &nz, (oc_progress){0}, &err);
   if (!hf) die(&err);

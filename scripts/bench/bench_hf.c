@@ -2,7 +2,8 @@
 ** bench_hf.c — heightfield flow analysis speed (issue 5).
 **
 ** hf.flow_4k_seconds_2t: filling, drainage and stream power (one
-** oc_hf_stream_power call on the raw grid) of a 4096 x 4096 fBm grid on
+** oc_heightfield_stream_power call on the raw grid) of a 4096 x 4096 fBm grid
+** on
 ** 2 threads; target <= 15 s. The grid is made here with lib/core/noise.h
 ** so the bench depends on nothing but the analysis. Also reports, as
 ** context, the phases alone and the 1-thread time, and checks that both
@@ -48,7 +49,7 @@ static double timed_power(const oc_heightfield *hf, int threads,
   oc_error err;
   omp_set_num_threads(threads);
   double t0 = omp_get_wtime();
-  *out = must(oc_hf_stream_power(hf, NULL, &err), &err);
+  *out = must(oc_heightfield_stream_power(hf, NULL, &err), &err);
   return omp_get_wtime() - t0;
 }
 
@@ -57,11 +58,12 @@ int main(void) {
   oc_heightfield *hf = terrain();
   omp_set_num_threads(2);
   double t0 = omp_get_wtime();
-  oc_heightfield *f = must(oc_hf_fill(hf, (oc_progress){0}, &err), &err);
+  oc_heightfield *f =
+      must(oc_heightfield_fill(hf, (oc_progress){0}, &err), &err);
   double t_fill = omp_get_wtime() - t0;
-  oc_hf_flow_params fp = {0, 1, {0}};
+  oc_heightfield_flow_params fp = {0, 1, {0}};
   t0 = omp_get_wtime();
-  oc_heightfield *a = must(oc_hf_drainage(f, &fp, &err), &err);
+  oc_heightfield *a = must(oc_heightfield_drainage(f, &fp, &err), &err);
   double t_drain = omp_get_wtime() - t0;
   printf("# %d x %d fBm: fill %.2f s (sequential), drainage %.2f s "
          "(2 threads)\n",

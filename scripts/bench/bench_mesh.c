@@ -47,7 +47,7 @@ static oc_node *must(oc_node *n, const oc_error *err) {
 static oc_node *fbm_terrain(int n, double a, uint64_t seed,
                             oc_heightfield **hf) {
   oc_error err;
-  oc_hf_grid g = {n, n, 1, 0, 0};
+  oc_heightfield_grid g = {n, n, 1, 0, 0};
   oc_noise nz = {150, a, -a * 0.75, 5, seed};
   *hf = oc_heightfield_fbm(&g, &nz, (oc_progress){0}, &err);
   if (!*hf) {

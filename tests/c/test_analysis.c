@@ -199,7 +199,7 @@ START_TEST(slope_plane_exact) {
   double k[2] = {0.3, -0.4};
   oc_heightfield *h = grid(17, 13, 2.0, -5, 3, plane, k);
   oc_error e = {0};
-  oc_heightfield *s = ok(oc_hf_slope(h, &e), &e);
+  oc_heightfield *s = ok(oc_heightfield_slope(h, &e), &e);
   for (int j = 0; j < 13; j++)
     for (int i = 0; i < 17; i++) /* borders included (one-sided) */
       ck_assert_double_eq_tol(AT(s, i, j), 0.5, 1e-5);
@@ -214,7 +214,7 @@ START_TEST(slope_cone_constant) {
   double k[4] = {0, 0, 50, -0.7}, cell = 1.5;
   oc_heightfield *h = grid(41, 41, cell, -20 * cell, -20 * cell, cone, k);
   oc_error e = {0};
-  oc_heightfield *s = ok(oc_hf_slope(h, &e), &e);
+  oc_heightfield *s = ok(oc_heightfield_slope(h, &e), &e);
   int checked = 0;
   for (int j = 1; j < 40; j++)
     for (int i = 1; i < 40; i++) {
@@ -242,7 +242,7 @@ START_TEST(fill_fbm_with_pits) {
     double k[4] = {40, 30, 7 + q, q ? 0.5 : 0};
     oc_heightfield *h = grid(97, 83, 1.0, 0, 0, fbm, k);
     oc_error e = {0};
-    oc_heightfield *g = ok(oc_hf_fill(h, (oc_progress){0}, &e), &e);
+    oc_heightfield *g = ok(oc_heightfield_fill(h, (oc_progress){0}, &e), &e);
     check_filled(h, g);
     /* fBm of this size has depressions: filling must have raised some */
     size_t raised = 0, n = 97 * 83;
@@ -250,7 +250,7 @@ START_TEST(fill_fbm_with_pits) {
       raised += oc_heightfield_samples(g)[c] > oc_heightfield_samples(h)[c];
     ck_assert_uint_gt(raised, 10);
     /* filling a filled grid changes nothing */
-    oc_heightfield *g2 = ok(oc_hf_fill(g, (oc_progress){0}, &e), &e);
+    oc_heightfield *g2 = ok(oc_heightfield_fill(g, (oc_progress){0}, &e), &e);
     ck_assert(memcmp(oc_heightfield_samples(g), oc_heightfield_samples(g2),
                      n * sizeof(float)) == 0);
     oc_heightfield_release(g2);
@@ -267,7 +267,7 @@ START_TEST(fill_bowl_flat_at_rim) {
   double k[3] = {20, 20, 0.01};
   oc_heightfield *h = grid(41, 41, 1.0, 0, 0, bowl, k);
   oc_error e = {0};
-  oc_heightfield *g = ok(oc_hf_fill(h, (oc_progress){0}, &e), &e);
+  oc_heightfield *g = ok(oc_heightfield_fill(h, (oc_progress){0}, &e), &e);
   check_filled(h, g);
   float rim = (float)(0.01 * 400);
   float ulp = nextafterf(rim, INFINITY) - rim;
@@ -300,7 +300,7 @@ START_TEST(fill_pit_chain_exact) {
   z[1 * 7 + 4] = 1; /* hole: lower than its neighbours 3 and 5 */
   oc_error e = {0};
   oc_heightfield *h = oc_heightfield_new(7, 3, 1, 0, 0, z, &e);
-  oc_heightfield *g = ok(oc_hf_fill(h, (oc_progress){0}, &e), &e);
+  oc_heightfield *g = ok(oc_heightfield_fill(h, (oc_progress){0}, &e), &e);
   ck_assert(AT(g, 4, 1) == nextafterf(3, INFINITY));
   for (int i = 0; i < 7; i++)
     if (i != 4) ck_assert(AT(g, i, 1) == AT(h, i, 1));
@@ -333,8 +333,8 @@ START_TEST(drainage_conserves_area) {
   const double cell = 2.5;
   oc_heightfield *h = grid(120, 90, cell, 0, 0, fbm, k);
   oc_error e = {0};
-  oc_heightfield *g = ok(oc_hf_fill(h, (oc_progress){0}, &e), &e);
-  oc_heightfield *a = ok(oc_hf_drainage(h, NULL, &e), &e);
+  oc_heightfield *g = ok(oc_heightfield_fill(h, (oc_progress){0}, &e), &e);
+  oc_heightfield *a = ok(oc_heightfield_drainage(h, NULL, &e), &e);
   double total = 120.0 * 90 * cell * cell;
   ck_assert_double_eq_tol(outflow(g, a) / total, 1, 1e-6);
   /* the largest value is a big share of the total: flow does gather */
@@ -343,13 +343,13 @@ START_TEST(drainage_conserves_area) {
   ck_assert_double_eq(lo, cell * cell); /* ridge tops receive nothing */
   ck_assert_double_gt(hi, 0.02 * total);
   /* prefilled on the filled grid gives the same bytes */
-  oc_hf_flow_params fp = {0, 1, {0}};
-  oc_heightfield *a2 = ok(oc_hf_drainage(g, &fp, &e), &e);
+  oc_heightfield_flow_params fp = {0, 1, {0}};
+  oc_heightfield *a2 = ok(oc_heightfield_drainage(g, &fp, &e), &e);
   ck_assert(memcmp(oc_heightfield_samples(a), oc_heightfield_samples(a2),
                    120 * 90 * sizeof(float)) == 0);
   /* another exponent routes differently but conserves too */
   fp.exponent = 3;
-  oc_heightfield *a3 = ok(oc_hf_drainage(g, &fp, &e), &e);
+  oc_heightfield *a3 = ok(oc_heightfield_drainage(g, &fp, &e), &e);
   ck_assert_double_eq_tol(outflow(g, a3) / total, 1, 1e-6);
   ck_assert(memcmp(oc_heightfield_samples(a), oc_heightfield_samples(a3),
                    120 * 90 * sizeof(float)) != 0);
@@ -371,8 +371,8 @@ START_TEST(drainage_tilted_plane_linear) {
   double k[2] = {0.2, 0};
   oc_heightfield *h = grid(nx, ny, cell, 0, 0, plane, k);
   oc_error e = {0};
-  oc_heightfield *a = ok(oc_hf_drainage(h, NULL, &e), &e);
-  oc_heightfield *sp = ok(oc_hf_stream_power(h, NULL, &e), &e);
+  oc_heightfield *a = ok(oc_heightfield_drainage(h, NULL, &e), &e);
+  oc_heightfield *sp = ok(oc_heightfield_stream_power(h, NULL, &e), &e);
   for (int i = 0; i < nx; i++) {
     double col = 0, want = (nx - i) * cell * cell;
     for (int j = 0; j < ny; j++)
@@ -400,7 +400,7 @@ START_TEST(drainage_cone_grows_with_r) {
   double k[4] = {0, 0, 200, -0.5};
   oc_heightfield *h = grid(n, n, cell, -m * cell, -m * cell, cone, k);
   oc_error e = {0};
-  oc_heightfield *a = ok(oc_hf_drainage(h, NULL, &e), &e);
+  oc_heightfield *a = ok(oc_heightfield_drainage(h, NULL, &e), &e);
   double mean[4];
   for (int q = 0; q < 4; q++) {
     double R = 10 + 14 * q, sum = 0;
@@ -433,15 +433,15 @@ START_TEST(sinks_of_pits) {
   oc_error e = {0};
   oc_vec3 *p;
   size_t n;
-  ck_assert_int_eq(oc_hf_sinks(h, &p, &n, &e), OC_OK);
+  ck_assert_int_eq(oc_heightfield_sinks(h, &p, &n, &e), OC_OK);
   ck_assert_uint_eq(n, 1);
   ck_assert_double_eq(p[0].x, 3);
   ck_assert_double_eq(p[0].y, -2);
   ck_assert_double_eq(p[0].z, 10);
   free(p);
   /* its filled version has none */
-  oc_heightfield *g = ok(oc_hf_fill(h, (oc_progress){0}, &e), &e);
-  ck_assert_int_eq(oc_hf_sinks(g, &p, &n, &e), OC_OK);
+  oc_heightfield *g = ok(oc_heightfield_fill(h, (oc_progress){0}, &e), &e);
+  ck_assert_int_eq(oc_heightfield_sinks(g, &p, &n, &e), OC_OK);
   ck_assert_uint_eq(n, 0);
   ck_assert_ptr_null(p);
   oc_heightfield_release(g);
@@ -450,7 +450,7 @@ START_TEST(sinks_of_pits) {
   /* a bowl: one sink at the centre */
   double b[3] = {10, 10, 0.05};
   h = grid(21, 21, 1, 0, 0, bowl, b);
-  ck_assert_int_eq(oc_hf_sinks(h, &p, &n, &e), OC_OK);
+  ck_assert_int_eq(oc_heightfield_sinks(h, &p, &n, &e), OC_OK);
   ck_assert_uint_eq(n, 1);
   ck_assert(p[0].x == 10 && p[0].y == 10 && p[0].z == 0);
   free(p);
@@ -465,7 +465,7 @@ START_TEST(sinks_of_pits) {
   z[2 * 20 + 15] = -4;                /* pit at (15, 2) */
   z[0 * 20 + 4] = -5;                 /* border */
   z[7 * 20 + 2] = z[7 * 20 + 3] = -6; /* flat bottom */
-  ck_assert_int_eq(oc_hf_sinks(h, &p, &n, &e), OC_OK);
+  ck_assert_int_eq(oc_heightfield_sinks(h, &p, &n, &e), OC_OK);
   ck_assert_uint_eq(n, 2);
   ck_assert(p[0].x == 15 && p[0].y == 2 && p[0].z == -4);
   ck_assert(p[1].x == 7 && p[1].y == 5 && p[1].z == -3);
@@ -480,8 +480,8 @@ START_TEST(access_flat_plane_is_one) {
   double k[2] = {0, 0};
   oc_heightfield *h = grid(30, 20, 1, 0, 0, plane, k);
   oc_error e = {0};
-  oc_hf_access_params ap = {128, 20, 5, {0}};
-  oc_heightfield *a = ok(oc_hf_accessibility(h, &ap, &e), &e);
+  oc_heightfield_access_params ap = {128, 20, 5, {0}};
+  oc_heightfield *a = ok(oc_heightfield_accessibility(h, &ap, &e), &e);
   double lo, hi;
   oc_heightfield_minmax(a, &lo, &hi);
   ck_assert(lo == 1 && hi == 1);
@@ -500,10 +500,10 @@ START_TEST(access_tilted_and_valley) {
   oc_heightfield *v = grid(41, 21, 1, 0, 0, vee, vk);
   oc_heightfield *r = grid(41, 21, 1, 0, 0, vee, rk);
   oc_error e = {0};
-  oc_hf_access_params ap = {2048, 15, 9, {0}};
-  oc_heightfield *ap_p = ok(oc_hf_accessibility(p, &ap, &e), &e);
-  oc_heightfield *ap_v = ok(oc_hf_accessibility(v, &ap, &e), &e);
-  oc_heightfield *ap_r = ok(oc_hf_accessibility(r, &ap, &e), &e);
+  oc_heightfield_access_params ap = {2048, 15, 9, {0}};
+  oc_heightfield *ap_p = ok(oc_heightfield_accessibility(p, &ap, &e), &e);
+  oc_heightfield *ap_v = ok(oc_heightfield_accessibility(v, &ap, &e), &e);
+  oc_heightfield *ap_r = ok(oc_heightfield_accessibility(r, &ap, &e), &e);
   for (int j = 5; j <= 15; j += 5) {
     ck_assert_double_eq_tol(AT(ap_p, 20, j), 1 - a / PI, 0.01);
     ck_assert_double_eq_tol(AT(ap_v, 20, j), 1 - 2 * a / PI, 0.01);
@@ -516,9 +516,9 @@ START_TEST(access_tilted_and_valley) {
   double ck[3] = {20, 3, 8};
   oc_heightfield *u = grid(41, 21, 1, 0, 0, canyon, ck);
   ap.distance = 7;
-  oc_heightfield *shortr = ok(oc_hf_accessibility(u, &ap, &e), &e);
+  oc_heightfield *shortr = ok(oc_heightfield_accessibility(u, &ap, &e), &e);
   ap.distance = 40;
-  oc_heightfield *longr = ok(oc_hf_accessibility(u, &ap, &e), &e);
+  oc_heightfield *longr = ok(oc_heightfield_accessibility(u, &ap, &e), &e);
   ck_assert(AT(shortr, 20, 10) == 1);
   ck_assert_double_lt(AT(longr, 20, 10), 0.9);
   oc_heightfield_release(longr);
@@ -540,7 +540,7 @@ START_TEST(distance_exact) {
   double k[4] = {0, 0, 5, 1};
   oc_heightfield *h = grid(9, 7, 0.5, 0, 0, cone, k); /* min 5 at (0, 0) */
   oc_error e = {0};
-  oc_heightfield *d = ok(oc_hf_distance_to_level(h, 5, &e), &e);
+  oc_heightfield *d = ok(oc_heightfield_distance_to_level(h, 5, &e), &e);
   for (int j = 0; j < 7; j++)
     for (int i = 0; i < 9; i++)
       ck_assert(AT(d, i, j) == (float)(sqrt((double)(i * i + j * j)) * 0.5));
@@ -553,7 +553,7 @@ START_TEST(distance_exact) {
   double lo, hi;
   oc_heightfield_minmax(h, &lo, &hi);
   double level = lo + 0.3 * (hi - lo);
-  d = ok(oc_hf_distance_to_level(h, level, &e), &e);
+  d = ok(oc_heightfield_distance_to_level(h, level, &e), &e);
   int wet = 0;
   for (int j = 0; j < 41; j++)
     for (int i = 0; i < 53; i++) {
@@ -581,23 +581,23 @@ END_TEST
 typedef oc_heightfield *(*analysis_fn)(const oc_heightfield *hf);
 
 static oc_heightfield *run_slope(const oc_heightfield *h) {
-  return oc_hf_slope(h, NULL);
+  return oc_heightfield_slope(h, NULL);
 }
 static oc_heightfield *run_fill(const oc_heightfield *h) {
-  return oc_hf_fill(h, (oc_progress){0}, NULL);
+  return oc_heightfield_fill(h, (oc_progress){0}, NULL);
 }
 static oc_heightfield *run_drainage(const oc_heightfield *h) {
-  return oc_hf_drainage(h, NULL, NULL);
+  return oc_heightfield_drainage(h, NULL, NULL);
 }
 static oc_heightfield *run_power(const oc_heightfield *h) {
-  return oc_hf_stream_power(h, NULL, NULL);
+  return oc_heightfield_stream_power(h, NULL, NULL);
 }
 static oc_heightfield *run_access(const oc_heightfield *h) {
-  oc_hf_access_params ap = {16, 30, 3, {0}};
-  return oc_hf_accessibility(h, &ap, NULL);
+  oc_heightfield_access_params ap = {16, 30, 3, {0}};
+  return oc_heightfield_accessibility(h, &ap, NULL);
 }
 static oc_heightfield *run_distance(const oc_heightfield *h) {
-  return oc_hf_distance_to_level(h, 20, NULL);
+  return oc_heightfield_distance_to_level(h, 20, NULL);
 }
 
 START_TEST(same_bytes_any_threads) {
@@ -647,37 +647,37 @@ START_TEST(bad_parameters) {
   oc_error e = {0};
   const double bad_p[] = {-1, 4.5, NAN, INFINITY};
   for (int t = 0; t < 4; t++) {
-    oc_hf_flow_params fp = {bad_p[t], 0, {0}};
-    expect_einval(oc_hf_drainage(h, &fp, &e), &e, "exponent");
-    expect_einval(oc_hf_stream_power(h, &fp, &e), &e, "exponent");
+    oc_heightfield_flow_params fp = {bad_p[t], 0, {0}};
+    expect_einval(oc_heightfield_drainage(h, &fp, &e), &e, "exponent");
+    expect_einval(oc_heightfield_stream_power(h, &fp, &e), &e, "exponent");
   }
   const int bad_rays[] = {-1, 4097};
   for (int t = 0; t < 2; t++) {
-    oc_hf_access_params ap = {bad_rays[t], 0, 0, {0}};
-    expect_einval(oc_hf_accessibility(h, &ap, &e), &e, "rays");
+    oc_heightfield_access_params ap = {bad_rays[t], 0, 0, {0}};
+    expect_einval(oc_heightfield_accessibility(h, &ap, &e), &e, "rays");
   }
   const double bad_d[] = {-1, NAN, INFINITY};
   for (int t = 0; t < 3; t++) {
-    oc_hf_access_params ap = {0, bad_d[t], 0, {0}};
-    expect_einval(oc_hf_accessibility(h, &ap, &e), &e, "distance");
+    oc_heightfield_access_params ap = {0, bad_d[t], 0, {0}};
+    expect_einval(oc_heightfield_accessibility(h, &ap, &e), &e, "distance");
   }
-  expect_einval(oc_hf_distance_to_level(h, NAN, &e), &e, "z");
-  expect_einval(oc_hf_distance_to_level(h, -0.5, &e), &e, "z");
+  expect_einval(oc_heightfield_distance_to_level(h, NAN, &e), &e, "z");
+  expect_einval(oc_heightfield_distance_to_level(h, -0.5, &e), &e, "z");
   /* NULL grids are refused, not dereferenced */
-  ck_assert_ptr_null(oc_hf_slope(NULL, &e));
+  ck_assert_ptr_null(oc_heightfield_slope(NULL, &e));
   ck_assert_int_eq(e.code, OC_EINVAL);
-  ck_assert_ptr_null(oc_hf_fill(NULL, (oc_progress){0}, &e));
-  ck_assert_ptr_null(oc_hf_drainage(NULL, NULL, &e));
-  ck_assert_ptr_null(oc_hf_accessibility(NULL, NULL, &e));
+  ck_assert_ptr_null(oc_heightfield_fill(NULL, (oc_progress){0}, &e));
+  ck_assert_ptr_null(oc_heightfield_drainage(NULL, NULL, &e));
+  ck_assert_ptr_null(oc_heightfield_accessibility(NULL, NULL, &e));
   oc_vec3 *p = (oc_vec3 *)&e;
   size_t n = 7;
-  ck_assert_int_eq(oc_hf_sinks(NULL, &p, &n, &e), OC_EINVAL);
+  ck_assert_int_eq(oc_heightfield_sinks(NULL, &p, &n, &e), OC_EINVAL);
   ck_assert_ptr_null(p);
   ck_assert_uint_eq(n, 0);
   /* defaults: exponent 0 is Freeman's 1.1 */
-  oc_hf_flow_params d0 = {0, 0, {0}}, d1 = {1.1, 0, {0}};
-  oc_heightfield *a = ok(oc_hf_drainage(h, &d0, &e), &e);
-  oc_heightfield *b = ok(oc_hf_drainage(h, &d1, &e), &e);
+  oc_heightfield_flow_params d0 = {0, 0, {0}}, d1 = {1.1, 0, {0}};
+  oc_heightfield *a = ok(oc_heightfield_drainage(h, &d0, &e), &e);
+  oc_heightfield *b = ok(oc_heightfield_drainage(h, &d1, &e), &e);
   ck_assert(memcmp(oc_heightfield_samples(a), oc_heightfield_samples(b),
                    100 * sizeof(float)) == 0);
   oc_heightfield_release(a);
@@ -705,24 +705,25 @@ START_TEST(progress_and_cancel) {
   oc_error e = {0};
   /* reported, monotone, ending at 1 */
   counter c = {0, 1 << 30, 0, 1};
-  oc_hf_flow_params fp = {0, 0, {count_progress, &c}};
-  oc_heightfield *s = ok(oc_hf_stream_power(h, &fp, &e), &e);
+  oc_heightfield_flow_params fp = {0, 0, {count_progress, &c}};
+  oc_heightfield *s = ok(oc_heightfield_stream_power(h, &fp, &e), &e);
   ck_assert_int_gt(c.calls, 3);
   ck_assert(c.monotone && c.last == 1);
   oc_heightfield_release(s);
   /* cancelled at the first report, in each phase */
   counter c1 = {0, 1, 0, 1};
-  ck_assert_ptr_null(oc_hf_fill(h, (oc_progress){count_progress, &c1}, &e));
+  ck_assert_ptr_null(
+      oc_heightfield_fill(h, (oc_progress){count_progress, &c1}, &e));
   ck_assert_int_eq(e.code, OC_ECANCEL);
   for (int stop = 1; stop <= 4; stop++) {
     counter c2 = {0, stop, 0, 1};
     fp.progress.ud = &c2;
-    ck_assert_ptr_null(oc_hf_drainage(h, &fp, &e));
+    ck_assert_ptr_null(oc_heightfield_drainage(h, &fp, &e));
     ck_assert_int_eq(e.code, OC_ECANCEL);
   }
   counter c3 = {0, 1, 0, 1};
-  oc_hf_access_params ap = {4, 5, 1, {count_progress, &c3}};
-  ck_assert_ptr_null(oc_hf_accessibility(h, &ap, &e));
+  oc_heightfield_access_params ap = {4, 5, 1, {count_progress, &c3}};
+  ck_assert_ptr_null(oc_heightfield_accessibility(h, &ap, &e));
   ck_assert_int_eq(e.code, OC_ECANCEL);
   oc_heightfield_release(h);
 }

@@ -240,7 +240,7 @@ END_TEST
 
 START_TEST(resample_grid_crop_sum) {
   oc_heightfield *hf = ramp(101, 51, 1, 5, -3, 0, 1); /* 100 x 50 m */
-  oc_hf_grid g;
+  oc_heightfield_grid g;
   oc_error e = {0};
   ck_assert_int_eq(oc_heightfield_resample_grid(hf, 0.1, 0, 0, &g, &e), OC_OK);
   ck_assert_int_eq(g.nx, 1001); /* 100 / 0.1 with the slack */

@@ -63,7 +63,7 @@ static oc_elevation wave_source(void) {
 /* ---- an fBm heightfield ------------------------------------------------ */
 
 static oc_heightfield *fbm_grid(void) {
-  oc_hf_grid g = {257, 257, 4, 0, 0};
+  oc_heightfield_grid g = {257, 257, 4, 0, 0};
   oc_noise nz = {300, 120, 0, 6, 7};
   oc_progress none = {0};
   oc_error e;

@@ -33,7 +33,7 @@ static oc_heightfield *plane(int n, double k) {
 
 /* A bumpy grid: hills with slopes of every steepness. */
 static oc_heightfield *hills(int n) {
-  oc_hf_grid g = {n, n, 1, 0, 0};
+  oc_heightfield_grid g = {n, n, 1, 0, 0};
   oc_noise nz = {30, 25, 0, 4, 7};
   oc_progress none = {NULL, NULL};
   oc_heightfield *hf = oc_heightfield_fbm(&g, &nz, none, NULL);

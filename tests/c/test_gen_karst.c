@@ -86,7 +86,8 @@ START_TEST(invariants) {
   oc_gen_karst_stats st;
   size_t n;
   oc_karst_cavity *c = run(&p, &n, &st);
-  ck_assert_uint_eq(st.sinks, 4); /* the dimples, found by oc_hf_sinks */
+  ck_assert_uint_eq(st.sinks,
+                    4); /* the dimples, found by oc_heightfield_sinks */
   ck_assert_uint_gt(n, 200);
   ck_assert_uint_le(n, p.max_primitives);
   ck_assert_uint_eq(st.primitives, n);

@@ -198,7 +198,7 @@ static int cmpf(const void *a, const void *b) {
 START_TEST(river_follows_stream_power) {
   oc_error err;
   oc_heightfield *hf = valley();
-  oc_heightfield *pw = oc_hf_stream_power(hf, NULL, &err);
+  oc_heightfield *pw = oc_heightfield_stream_power(hf, NULL, &err);
   ck_assert_ptr_nonnull(pw);
   /* the bed: the 95th percentile of the stream power, as documented */
   float *v = malloc(NX * NY * sizeof *v);

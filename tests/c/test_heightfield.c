@@ -69,7 +69,8 @@ static int same_samples(const oc_heightfield *a, const oc_heightfield *b) {
                 n * sizeof(float)) == 0;
 }
 
-static oc_heightfield *load_ok(const char *path, const oc_hf_load_params *p) {
+static oc_heightfield *load_ok(const char *path,
+                               const oc_heightfield_load_params *p) {
   oc_error e = {0};
   oc_heightfield *hf = oc_heightfield_load(path, p, &e);
   ck_assert_msg(hf != NULL, "loading %s: %s", path, e.msg);
@@ -77,7 +78,7 @@ static oc_heightfield *load_ok(const char *path, const oc_hf_load_params *p) {
 }
 
 static void save_ok(const oc_heightfield *hf, const char *path,
-                    const oc_hf_save_params *p, double used[2]) {
+                    const oc_heightfield_save_params *p, double used[2]) {
   oc_error e = {0};
   int rc = oc_heightfield_save(hf, path, p, used, &e);
   ck_assert_msg(rc == OC_OK, "saving %s: %s", path, e.msg);
@@ -265,7 +266,7 @@ START_TEST(png16_exact_lattice) {
   oc_heightfield *h1 = load_ok(p, NULL);
   ck_assert(same_samples(hf, h1));
   /* fixed scale and offset give the same file */
-  oc_hf_save_params sp = {16, 1, 0.25, 100, NULL, 0, NULL, 0};
+  oc_heightfield_save_params sp = {16, 1, 0.25, 100, NULL, 0, NULL, 0};
   const char *q = oct_in_dir(dir, "fixed.png");
   save_ok(hf, q, &sp, used);
   ck_assert(same_file(p, q));
@@ -308,7 +309,7 @@ END_TEST
 
 START_TEST(tiff16_and_half) {
   oc_heightfield *hf = wavy(33, 21, 1, 10);
-  oc_hf_save_params sp = {16, 0, 0, 0, NULL, 0, NULL, 0};
+  oc_heightfield_save_params sp = {16, 0, 0, 0, NULL, 0, NULL, 0};
   double used[2];
   save_ok(hf, oct_in_dir(dir, "h16.tif"), &sp, used);
   oc_heightfield *a = load_ok(oct_in_dir(dir, "h16.tif"), NULL);
@@ -360,8 +361,14 @@ START_TEST(png8_and_png16_counts) {
   p16[0] = 65535;
   write_counts(oct_in_dir(dir, "c8.png"), w, h, 8, p8);
   write_counts(oct_in_dir(dir, "c16.png"), w, h, 16, p16);
-  oc_hf_load_params lp = {
-      OC_HF_GIVE_SCALE | OC_HF_GIVE_OFFSET, 0, 0.5, -10, 0, 0, {0}};
+  oc_heightfield_load_params lp = {
+      OC_HEIGHTFIELD_GIVE_SCALE | OC_HEIGHTFIELD_GIVE_OFFSET,
+      0,
+      0.5,
+      -10,
+      0,
+      0,
+      {0}};
   oc_heightfield *a = load_ok(oct_in_dir(dir, "c8.png"), &lp);
   oc_heightfield *b = load_ok(oct_in_dir(dir, "c16.png"), NULL);
   geometry_is(a, w, h, 1, 0, 0);
@@ -448,8 +455,14 @@ START_TEST(geotiff_float32) {
   px[3] = -0.0f;
   const char *p = oct_in_dir(dir, "dem.tif");
   write_geotiff(p, w, h, 32, px);
-  oc_hf_load_params lp = {
-      OC_HF_GIVE_CELL | OC_HF_GIVE_ORIGIN, 30, 1, 0, 500015, 3950015, {0}};
+  oc_heightfield_load_params lp = {OC_HEIGHTFIELD_GIVE_CELL |
+                                       OC_HEIGHTFIELD_GIVE_ORIGIN,
+                                   30,
+                                   1,
+                                   0,
+                                   500015,
+                                   3950015,
+                                   {0}};
   oc_heightfield *hf = load_ok(p, &lp);
   geometry_is(hf, 9, 6, 30, 500015, 3950015);
   const float *z = oc_heightfield_samples(hf);
@@ -466,11 +479,18 @@ START_TEST(metadata_and_overrides) {
   const char *p = oct_in_dir(dir, "m.png");
   double used[2];
   save_ok(hf, p, NULL, used);
-  oc_hf_load_params lp = {OC_HF_GIVE_CELL, 4, 0, 0, 0, 0, {0}};
+  oc_heightfield_load_params lp = {
+      OC_HEIGHTFIELD_GIVE_CELL, 4, 0, 0, 0, 0, {0}};
   oc_heightfield *a = load_ok(p, &lp);
   geometry_is(a, 10, 8, 4, -3.5, 12.25);
-  oc_hf_load_params lq = {
-      OC_HF_GIVE_ORIGIN | OC_HF_GIVE_SCALE, 0, 2, 0, 1, 2, {0}};
+  oc_heightfield_load_params lq = {
+      OC_HEIGHTFIELD_GIVE_ORIGIN | OC_HEIGHTFIELD_GIVE_SCALE,
+      0,
+      2,
+      0,
+      1,
+      2,
+      {0}};
   oc_heightfield *b = load_ok(p, &lq);
   geometry_is(b, 10, 8, 2.5, 1, 2);
   double lo, hi;
@@ -479,7 +499,7 @@ START_TEST(metadata_and_overrides) {
   ck_assert(hi == (float)(65535 * 2 + used[1]));
   /* provenance-style pairs land in the file next to ours */
   const char *meta[] = {"outcrop:seed", "42", "outcrop:scale", "999"};
-  oc_hf_save_params sp = {0, 0, 0, 0, meta, 2, NULL, 0};
+  oc_heightfield_save_params sp = {0, 0, 0, 0, meta, 2, NULL, 0};
   save_ok(hf, oct_in_dir(dir, "n.exr"), &sp, used);
   oc_error e = {0};
   oc_image *img = oc_oiio_read(oct_in_dir(dir, "n.exr"), &e);
@@ -535,11 +555,13 @@ START_TEST(file_errors) {
   ck_assert_ptr_nonnull(strstr(e.msg, "2 x 2"));
   oc_heightfield_samples_mut(hf)[5] = 1e30f;
   save_ok(hf, oct_in_dir(dir, "big.exr"), NULL, NULL);
-  oc_hf_load_params lp = {OC_HF_GIVE_SCALE, 0, 1e10, 0, 0, 0, {0}};
+  oc_heightfield_load_params lp = {
+      OC_HEIGHTFIELD_GIVE_SCALE, 0, 1e10, 0, 0, 0, {0}};
   ck_assert_ptr_null(oc_heightfield_load(oct_in_dir(dir, "big.exr"), &lp, &e));
   ck_assert_int_eq(e.code, OC_EINVAL);
   ck_assert_ptr_nonnull(strstr(e.msg, "not finite"));
-  lp = (oc_hf_load_params){OC_HF_GIVE_CELL, -1, 0, 0, 0, 0, {0}};
+  lp = (oc_heightfield_load_params){
+      OC_HEIGHTFIELD_GIVE_CELL, -1, 0, 0, 0, 0, {0}};
   ck_assert_ptr_null(oc_heightfield_load(oct_in_dir(dir, "big.exr"), &lp, &e));
   ck_assert_ptr_nonnull(strstr(e.msg, "'cell'"));
 
@@ -555,18 +577,18 @@ START_TEST(file_errors) {
       oc_heightfield_save(hf, oct_in_dir(dir, "h.jpg"), NULL, NULL, &e),
       OC_EINVAL);
   ck_assert_ptr_nonnull(strstr(e.msg, ".png"));
-  oc_hf_save_params sp = {12, 0, 0, 0, NULL, 0, NULL, 0};
+  oc_heightfield_save_params sp = {12, 0, 0, 0, NULL, 0, NULL, 0};
   ck_assert_int_eq(
       oc_heightfield_save(hf, oct_in_dir(dir, "h.png"), &sp, NULL, &e),
       OC_EINVAL);
   ck_assert_ptr_nonnull(strstr(e.msg, "'bits'"));
-  sp = (oc_hf_save_params){16,   1, 1,    0,
-                           NULL, 0, NULL, 0}; /* 1e30 does not fit */
+  sp = (oc_heightfield_save_params){16,   1, 1,    0,
+                                    NULL, 0, NULL, 0}; /* 1e30 does not fit */
   ck_assert_int_eq(
       oc_heightfield_save(hf, oct_in_dir(dir, "h.png"), &sp, NULL, &e),
       OC_EINVAL);
   ck_assert_ptr_nonnull(strstr(e.msg, "outside"));
-  sp = (oc_hf_save_params){0, 1, 1, 0, NULL, 0, NULL, 0};
+  sp = (oc_heightfield_save_params){0, 1, 1, 0, NULL, 0, NULL, 0};
   ck_assert_int_eq(
       oc_heightfield_save(hf, oct_in_dir(dir, "h.exr"), &sp, NULL, &e),
       OC_EINVAL);
@@ -584,7 +606,7 @@ START_TEST(metadata_cannot_forge_lines) {
   oc_heightfield *hf = wavy(5, 4, 2.5, 21);
   const char *meta[] = {"note", "a\noutcrop:cell=99\noutcrop:x0=7",
                         "ImageDescription", "outcrop:y0=8"};
-  oc_hf_save_params sp = {0, 0, 1, 0, meta, 2, NULL, 0};
+  oc_heightfield_save_params sp = {0, 0, 1, 0, meta, 2, NULL, 0};
   const char *p = oct_in_dir(dir, "forge.tif");
   save_ok(hf, p, &sp, NULL);
   oc_heightfield *back = load_ok(p, NULL);
@@ -731,7 +753,7 @@ START_TEST(hostile_files) {
   oc_heightfield_release(back);
 
   /* reading polls for cancellation */
-  oc_hf_load_params lp = {0};
+  oc_heightfield_load_params lp = {0};
   lp.progress.fn = cancel_always;
   oc_error e = {0};
   ck_assert_ptr_null(oc_heightfield_load(named, &lp, &e));
@@ -770,21 +792,22 @@ START_TEST(raw16_round_trip) {
                      oc_heightfield_samples(p16)[(22 - r) * 37 + i]) < 1e-3);
     }
   free(b);
-  oc_hf_load_params lp = {OC_HF_GIVE_SCALE | OC_HF_GIVE_OFFSET |
-                              OC_HF_GIVE_CELL,
-                          2,
-                          used[0],
-                          used[1],
-                          0,
-                          0,
-                          {NULL, NULL}};
+  oc_heightfield_load_params lp = {OC_HEIGHTFIELD_GIVE_SCALE |
+                                       OC_HEIGHTFIELD_GIVE_OFFSET |
+                                       OC_HEIGHTFIELD_GIVE_CELL,
+                                   2,
+                                   used[0],
+                                   used[1],
+                                   0,
+                                   0,
+                                   {NULL, NULL}};
   oc_error e = {0};
   oc_heightfield *back = oc_heightfield_load_raw(raw, 37, 23, &lp, &e);
   ck_assert_msg(back != NULL, "%s", e.msg);
   for (size_t k = 0; k < 37 * 23; k++)
     ck_assert(fabs(oc_heightfield_samples(back)[k] - z[k]) <= used[0]);
   /* saved again with the same range: the same bytes */
-  oc_hf_save_params fixed = {0, 1, used[0], used[1], NULL, 0, NULL, 0};
+  oc_heightfield_save_params fixed = {0, 1, used[0], used[1], NULL, 0, NULL, 0};
   const char *raw2 = oct_in_dir(dir, "again.raw");
   save_ok(back, raw2, &fixed, NULL);
   size_t n1, n2;
@@ -802,7 +825,7 @@ START_TEST(raw16_round_trip) {
   lp.scale = NAN;
   ck_assert(oc_heightfield_load_raw(raw, 37, 23, &lp, &e) == NULL);
   ck_assert(e.code == OC_EINVAL && strstr(e.msg, "scale"));
-  oc_hf_save_params b8 = {8, 0, 1, 0, NULL, 0, NULL, 0};
+  oc_heightfield_save_params b8 = {8, 0, 1, 0, NULL, 0, NULL, 0};
   ck_assert_int_eq(oc_heightfield_save(hf, raw2, &b8, NULL, &e), OC_EINVAL);
   ck_assert(strstr(e.msg, "'bits'"));
   /* a square: inferred */
@@ -825,9 +848,10 @@ START_TEST(grid_arithmetic) {
   oc_heightfield *a = wavy(9, 7, 1.5, 3), *b = wavy(9, 7, 1.5, 4);
   oc_error e = {0};
   const float *za = oc_heightfield_samples(a), *zb = oc_heightfield_samples(b);
-  for (int op = OC_HF_ADD; op <= OC_HF_MUL; op++) {
-    oc_heightfield *c = oc_heightfield_combine(a, b, (oc_hf_op)op, &e);
-    oc_heightfield *d = oc_heightfield_scalar(a, 2.5, (oc_hf_op)op, &e);
+  for (int op = OC_HEIGHTFIELD_ADD; op <= OC_HEIGHTFIELD_MUL; op++) {
+    oc_heightfield *c = oc_heightfield_combine(a, b, (oc_heightfield_op)op, &e);
+    oc_heightfield *d =
+        oc_heightfield_scalar(a, 2.5, (oc_heightfield_op)op, &e);
     ck_assert(c && d);
     for (size_t k = 0; k < 63; k++) {
       double x = za[k], y = zb[k];
@@ -840,11 +864,11 @@ START_TEST(grid_arithmetic) {
     oc_heightfield_release(d);
   }
   oc_heightfield *moved = grid_ok(9, 7, 1.5, 0, 0, NULL);
-  ck_assert(oc_heightfield_combine(a, moved, OC_HF_ADD, &e) == NULL);
+  ck_assert(oc_heightfield_combine(a, moved, OC_HEIGHTFIELD_ADD, &e) == NULL);
   ck_assert(e.code == OC_EINVAL && strstr(e.msg, "grids differ"));
-  ck_assert(oc_heightfield_scalar(a, INFINITY, OC_HF_MUL, &e) == NULL);
+  ck_assert(oc_heightfield_scalar(a, INFINITY, OC_HEIGHTFIELD_MUL, &e) == NULL);
   ck_assert(strstr(e.msg, "finite"));
-  ck_assert(oc_heightfield_scalar(a, 1e38, OC_HF_MUL, &e) == NULL);
+  ck_assert(oc_heightfield_scalar(a, 1e38, OC_HEIGHTFIELD_MUL, &e) == NULL);
   ck_assert(strstr(e.msg, "sample (1, 1)"));
   oc_heightfield *cl = oc_heightfield_clamp(a, 35, 45, &e);
   for (size_t k = 0; k < 63; k++)
@@ -853,7 +877,7 @@ START_TEST(grid_arithmetic) {
   oc_heightfield_release(cl);
   ck_assert(oc_heightfield_clamp(a, 5, 1, &e) == NULL);
   ck_assert(oc_heightfield_clamp(a, NAN, 1, &e) == NULL);
-  oc_hf_mask_params mp = {1, 1, 38, 44, 0};
+  oc_heightfield_mask_params mp = {1, 1, 38, 44, 0};
   oc_heightfield *m = oc_heightfield_mask(a, &mp, &e);
   for (size_t k = 0; k < 63; k++)
     ck_assert(oc_heightfield_samples(m)[k] == (za[k] >= 38 && za[k] <= 44));
@@ -891,11 +915,11 @@ START_TEST(disk_full) {
     z[i] = (float)oct_unif(&r, 0, 1000);
   oc_heightfield *small = wavy(4, 4, 1, 3);
   const double stops[] = {0, 0, 0, 0, 1000, 1, 1, 1};
-  const oc_hf_save_params colours = {0, 0, 1, 0, NULL, 0, stops, 2};
+  const oc_heightfield_save_params colours = {0, 0, 1, 0, NULL, 0, stops, 2};
   const char *files[] = {"h.png", "h.tif", "h.exr", "c.png", "h.r16"};
   for (int k = 0; k < 5; k++) {
     const char *p = oct_in_dir(fs, files[k]);
-    const oc_hf_save_params *sp = k == 3 ? &colours : NULL;
+    const oc_heightfield_save_params *sp = k == 3 ? &colours : NULL;
     /* 400 x 400 x 2 bytes: over the 64 KiB */
     oc_error e = {0};
     int rc = oc_heightfield_save(big, p, sp, NULL, &e);
@@ -930,7 +954,7 @@ static int cancel_at_once(void *ud, double fraction) {
 
 START_TEST(fbm_is_the_turbulence_node) {
   oc_noise nz = {37.5, 12, -3, 5, 77};
-  oc_hf_grid g = {48, 40, 1.25, -20, 7};
+  oc_heightfield_grid g = {48, 40, 1.25, -20, 7};
   oc_error e = {0};
   oc_progress none = {NULL, NULL};
   oc_heightfield *hf = oc_heightfield_fbm(&g, &nz, none, &e);
@@ -959,13 +983,14 @@ END_TEST
 
 START_TEST(same_bytes_for_any_thread_count) {
   oc_noise nz = {50, 20, 0, 6, 5};
-  oc_hf_grid g = {301, 257, 0.5, 0, 0};
+  oc_heightfield_grid g = {301, 257, 0.5, 0, 0};
   oc_error e = {0};
   oc_progress none = {NULL, NULL};
   oc_program *pr =
       oct_compile(OCT_OK(oc_sphere(oct_v(70, 60, 0), 30, 10, 1, &e)), 0, 0);
   oc_heightfield *src = wavy(97, 83, 1.5, 14);
-  oc_hf_grid up = {300, 250, 0.4, -3, 12}, down = {40, 30, 3.7, -3.5, 12.25};
+  oc_heightfield_grid up = {300, 250, 0.4, -3, 12},
+                      down = {40, 30, 3.7, -3.5, 12.25};
   int nt0 = omp_get_max_threads();
   oc_heightfield *r[3][4];
   for (int t = 0; t < 3; t++) {
@@ -995,7 +1020,7 @@ START_TEST(cancel_and_bad_parameters) {
   int calls = 0;
   oc_progress stop = {cancel_at_once, &calls};
   oc_noise nz = {10, 1, 0, 3, 1};
-  oc_hf_grid g = {64, 64, 1, 0, 0};
+  oc_heightfield_grid g = {64, 64, 1, 0, 0};
   ck_assert_ptr_null(oc_heightfield_fbm(&g, &nz, stop, &e));
   ck_assert_int_eq(e.code, OC_ECANCEL);
   ck_assert_int_ge(calls, 1);
@@ -1014,7 +1039,7 @@ START_TEST(cancel_and_bad_parameters) {
   g.nx = 60000, g.ny = 60000; /* 13 GiB: refused before allocating */
   ck_assert_ptr_null(oc_heightfield_fbm(&g, &nz, none, &e));
   ck_assert_int_eq(e.code, OC_ENOMEM);
-  g = (oc_hf_grid){8, 8, NAN, 0, 0};
+  g = (oc_heightfield_grid){8, 8, NAN, 0, 0};
   ck_assert_ptr_null(oc_heightfield_fbm(&g, &nz, none, &e));
   ck_assert_ptr_nonnull(strstr(e.msg, "'cell'"));
   g.cell = 1;
@@ -1044,7 +1069,7 @@ START_TEST(surface_of_a_sphere) {
   oc_program *pr =
       oct_compile(OCT_OK(oc_sphere(oct_v(cx, cy, cz), r, R, 1, &e)), 0, 0);
   double rad = r + R * oct_ginv(0.5);
-  oc_hf_grid g = {45, 41, 0.5, cx - 11, cy - 10};
+  oc_heightfield_grid g = {45, 41, 0.5, cx - 11, cy - 10};
   oc_heightfield *hf =
       oc_heightfield_from_program(pr, &g, -20, 30, 0, none, &e);
   ck_assert_msg(hf != NULL, "%s", e.msg);
@@ -1064,7 +1089,7 @@ START_TEST(surface_of_a_sphere) {
   ck_assert_int_gt(hits, 400);
   oc_heightfield_release(hf);
   /* a zrange topping out inside the ball */
-  oc_hf_grid one = {2, 2, 0.1, cx, cy};
+  oc_heightfield_grid one = {2, 2, 0.1, cx, cy};
   hf = oc_heightfield_from_program(pr, &one, -20, cz + 1, 0, none, &e);
   ck_assert(oc_heightfield_samples(hf)[0] == (float)(cz + 1));
   oc_heightfield_release(hf);
@@ -1091,8 +1116,9 @@ START_TEST(loose_bounds_budget) {
   oc_node *tn = OCT_OK(oc_taper(st, &tp, &e));
   oc_node_release(st);
   oc_program *pr = oct_compile(tn, 0, 0);
-  oc_hf_grid g = {24, 24, 1, 0, 0};
-  oc_heightfield *hf = oc_heightfield_from_program(pr, &g, -20, 20, 0, none, &e);
+  oc_heightfield_grid g = {24, 24, 1, 0, 0};
+  oc_heightfield *hf =
+      oc_heightfield_from_program(pr, &g, -20, 20, 0, none, &e);
   ck_assert_msg(hf != NULL, "%s", e.msg);
   /* resistance stays below T = 1/2 in every column: z0 everywhere */
   const float *z = oc_heightfield_samples(hf);
@@ -1110,7 +1136,7 @@ START_TEST(surface_of_a_plane) {
   oc_progress none = {NULL, NULL};
   oc_program *pr = oct_compile(
       OCT_OK(oc_plane(oct_v(0, 0, 2.5), oct_v(0, 0, 1), 3, 1, &e)), 0.3, 0);
-  oc_hf_grid g = {5, 4, 10, -20, -20};
+  oc_heightfield_grid g = {5, 4, 10, -20, -20};
   oc_heightfield *hf =
       oc_heightfield_from_program(pr, &g, -100, 100, 0.7, none, &e);
   ck_assert_msg(hf != NULL, "%s", e.msg);
@@ -1127,12 +1153,12 @@ START_TEST(resample_and_crop) {
   oc_progress none = {NULL, NULL};
   oc_heightfield *hf = wavy(41, 33, 2, 15);
   /* the same grid: identical */
-  oc_hf_grid same = {41, 33, 2, -3.5, 12.25};
+  oc_heightfield_grid same = {41, 33, 2, -3.5, 12.25};
   oc_heightfield *a = oc_heightfield_resample(hf, &same, none, &e);
   ck_assert(same_samples(hf, a));
   oc_heightfield_release(a);
   /* finer: the interpolant at the new samples */
-  oc_hf_grid fine = {161, 129, 0.5, -3.5, 12.25};
+  oc_heightfield_grid fine = {161, 129, 0.5, -3.5, 12.25};
   a = oc_heightfield_resample(hf, &fine, none, &e);
   for (int j = 0; j < 129; j += 7)
     for (int i = 0; i < 161; i += 5)
@@ -1148,7 +1174,7 @@ START_TEST(resample_and_crop) {
     for (int i = 0; i < n; i++)
       z[j * n + i] = (float)(10 + ((i + j) % 2 ? 1 : -1) + 0.5 * i);
   oc_heightfield *chk = grid_ok(n, n, 1, 0, 0, z);
-  oc_hf_grid half = {32, 32, 2, 0, 0};
+  oc_heightfield_grid half = {32, 32, 2, 0, 0};
   a = oc_heightfield_resample(chk, &half, none, &e);
   for (int j = 1; j < 31; j++)
     for (int i = 1; i < 31; i++)

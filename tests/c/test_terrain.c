@@ -428,7 +428,7 @@ START_TEST(source_ranges_and_slopes) {
           plo = fmin(plo, zs[jj * 70 + ii]);
           phi = fmax(phi, zs[jj * 70 + ii]);
         }
-      double over = OC_HF_OVERSHOOT * (phi - plo) + 1e-6;
+      double over = OC_HEIGHTFIELD_OVERSHOOT * (phi - plo) + 1e-6;
       ck_assert_msg(lo >= plo - over && hi <= phi + over,
                     "range %g .. %g for samples %g .. %g", lo, hi, plo, phi);
       tight++;
@@ -791,7 +791,7 @@ START_TEST(open_edges) {
     }
     /* the grid back from the terrain, border samples included */
     if (!inv) {
-      oc_hf_grid g = {61, 49, 1.5, 3, -2};
+      oc_heightfield_grid g = {61, 49, 1.5, 3, -2};
       oc_heightfield *back = oc_heightfield_from_program(
           pr, &g, b.lo.z, b.hi.z, 0, (oc_progress){0}, &e);
       ck_assert_msg(back != NULL, "%s", e.msg);
