@@ -417,23 +417,25 @@ static void point(lua_State *L, const char *fname, double *x, double *y) {
   *y = lua_tonumber(L, 3);
 }
 
-static int e_eval(lua_State *L) {
+/* self:<what>(x, y): the sample there. */
+static void sample(lua_State *L, const char *fname, oc_enode_sample *s) {
   double x, y;
-  oc_enode *e = self(L, "elevation:eval");
-  point(L, "elevation:eval", &x, &y);
+  oc_enode *e = self(L, fname);
+  point(L, fname, &x, &y);
+  oc_enode_eval(e, x, y, s);
+}
+
+static int e_eval(lua_State *L) {
   oc_enode_sample s;
-  oc_enode_eval(e, x, y, &s);
+  sample(L, "elevation:eval", &s);
   lua_pushnumber(L, s.f);
   lua_pushnumber(L, s.a);
   return 2;
 }
 
 static int e_gradient(lua_State *L) {
-  double x, y;
-  oc_enode *e = self(L, "elevation:gradient");
-  point(L, "elevation:gradient", &x, &y);
   oc_enode_sample s;
-  oc_enode_eval(e, x, y, &s);
+  sample(L, "elevation:gradient", &s);
   lua_pushnumber(L, s.fx);
   lua_pushnumber(L, s.fy);
   return 2;

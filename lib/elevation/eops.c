@@ -49,6 +49,12 @@ enum {
   P_WLIP = 1
 };
 
+static oc_erect rect_union(oc_erect a, oc_erect b) {
+  oc_erect r = {fmin(a.x0, b.x0), fmin(a.y0, b.y0), fmax(a.x1, b.x1),
+                fmax(a.y1, b.y1)};
+  return r;
+}
+
 static double clamp01(double v, int *inside) {
   *inside = v > 0 && v < 1;
   return v <= 0 ? 0 : v >= 1 ? 1 : v; /* (NaN stays NaN) */
@@ -171,11 +177,7 @@ oc_enode *oc_enode_blend(oc_enode *const *kids, size_t n, oc_error *err) {
   e->box = kids[0]->box;
   for (size_t i = 0; i < n; i++) {
     kb[i] = kids[i]->glob;
-    oc_erect c = kids[i]->box;
-    e->box.x0 = fmin(e->box.x0, c.x0);
-    e->box.y0 = fmin(e->box.y0, c.y0);
-    e->box.x1 = fmax(e->box.x1, c.x1);
-    e->box.y1 = fmax(e->box.y1, c.y1);
+    e->box = rect_union(e->box, kids[i]->box);
   }
   /* over the whole plane, some points are outside every support */
   for (size_t i = 0; i < n; i++)
@@ -250,14 +252,6 @@ static void replace_combine(const oc_enode *n, const oc_ebound *A,
   }
 }
 
-static void replace_bound_in(const oc_enode *n, const oc_erect *b,
-                             oc_ebound *o) {
-  oc_ebound A, B;
-  oc_enode_bnd(n->kids[0], b, &A);
-  int meets = oc_erect_meets(&n->kids[1]->box, b);
-  if (meets) oc_enode_bnd(n->kids[1], b, &B);
-  replace_combine(n, &A, &B, meets, o);
-}
 
 static oc_enode *binary(oc_ekind kind, oc_enode *a, oc_enode *b,
                         oc_error *err) {
@@ -274,13 +268,8 @@ oc_enode *oc_enode_replace(oc_enode *a, oc_enode *b, int lerp, oc_error *err) {
   oc_enode *n = binary(OC_E_REPLACE, a, b, err);
   if (!n) return NULL;
   n->par[P_LERP] = lerp != 0;
-  n->box = a->box;
-  if (lerp) { /* alpha = w^2 where B alone is */
-    n->box.x0 = fmin(a->box.x0, b->box.x0);
-    n->box.y0 = fmin(a->box.y0, b->box.y0);
-    n->box.x1 = fmax(a->box.x1, b->box.x1);
-    n->box.y1 = fmax(a->box.y1, b->box.y1);
-  }
+  /* alpha may be > 0 where B alone is, with the summed or lerped weight */
+  n->box = lerp ? rect_union(a->box, b->box) : a->box;
   oc_ebound B = b->glob;
   B.alo = 0;
   replace_combine(n, &a->glob, &B, 1, &n->glob);
@@ -361,12 +350,17 @@ static void add_combine(const oc_enode *n, const oc_ebound *A,
   }
 }
 
-static void add_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+/* Replace and add in box b: A's and (where its box meets b) B's bounds,
+** combined by the operator. */
+typedef void (*combine_fn)(const oc_enode *n, const oc_ebound *A,
+                           const oc_ebound *B, int bmeets, oc_ebound *o);
+static void binary_bound_in(const oc_enode *n, const oc_erect *b,
+                            combine_fn combine, oc_ebound *o) {
   oc_ebound A, B;
   oc_enode_bnd(n->kids[0], b, &A);
   int meets = oc_erect_meets(&n->kids[1]->box, b);
   if (meets) oc_enode_bnd(n->kids[1], b, &B);
-  add_combine(n, &A, &B, meets, o);
+  combine(n, &A, &B, meets, o);
 }
 
 oc_enode *oc_enode_add(oc_enode *a, oc_enode *b, const oc_enode_add_params *p,
@@ -391,13 +385,8 @@ oc_enode *oc_enode_add(oc_enode *a, oc_enode *b, const oc_enode_add_params *p,
   n->par[P_BELOW] = p->below != 0;
   n->par[P_BZ] = p->below_z;
   n->par[P_FADE] = p->fade;
-  n->box = a->box;
-  if (p->sum_weight) {
-    n->box.x0 = fmin(a->box.x0, b->box.x0);
-    n->box.y0 = fmin(a->box.y0, b->box.y0);
-    n->box.x1 = fmax(a->box.x1, b->box.x1);
-    n->box.y1 = fmax(a->box.y1, b->box.y1);
-  }
+  /* alpha may be > 0 where B alone is, with the summed or lerped weight */
+  n->box = p->sum_weight ? rect_union(a->box, b->box) : a->box;
   oc_ebound B = b->glob;
   B.alo = 0;
   add_combine(n, &a->glob, &B, 1, &n->glob);
@@ -671,10 +660,10 @@ void oc_eop_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
     blend_bound_in(n, b, o);
     return;
   case OC_E_REPLACE:
-    replace_bound_in(n, b, o);
+    binary_bound_in(n, b, replace_combine, o);
     return;
   case OC_E_ADD:
-    add_bound_in(n, b, o);
+    binary_bound_in(n, b, add_combine, o);
     return;
   case OC_E_XFORM:
     xform_bound_in(n, b, o);
