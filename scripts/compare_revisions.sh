@@ -7,7 +7,9 @@
 #      (scripts/compare/golden.lua) and the benchmarks' meshes, image and
 #      query values (scripts/bench, kept through OUTCROP_BENCH_OUT) with
 #      both builds, and compares every output file byte for byte (sha256):
-#      one line `same|DIFFERENT|ONLY-OLD|ONLY-NEW path` per file, a total;
+#      one line `same|DIFFERENT|ONLY-OLD|ONLY-NEW path` per file, a total
+#      (an example OLD does not have runs with the new build only, its
+#      files listed as NEW-EXAMPLE and not compared);
 #   2. times the benchmarks of both builds interleaved (old, new, old,
 #      new… so that machine drift falls on both alike), ROUNDS rounds (3),
 #      and prints the median of each figure as `name: old new ratio`, the
@@ -124,7 +126,13 @@ for e in "$NEWT"/examples/*.lua; do
   name=$(basename "$e" .lua)
   opts=()
   [ "$name" = sea_cliffs ] && opts=(--set render=false)
-  for side in old new; do run_scene "$side" "examples/$name" "examples/$name.lua" "${opts[@]}"; done
+  sides="old new"
+  # an example OLD does not have may use what OLD lacks: new build only
+  if [ ! -e "$T/old/examples/$name.lua" ]; then
+    sides=new
+    echo "examples/$name" >>"$T/new-examples"
+  fi
+  for side in $sides; do run_scene "$side" "examples/$name" "examples/$name.lua" "${opts[@]}"; done
 done
 for side in old new; do run_scene "$side" golden scripts/compare/golden.lua; done
 
@@ -159,10 +167,13 @@ done
 echo "== outputs (sha256, old against new)"
 (cd "$T/out/old" && find . -type f | sort) >"$T/files.old"
 (cd "$T/out/new" && find . -type f | sort) >"$T/files.new"
-nsame=0 ndiff=0
+nsame=0 ndiff=0 nnew=0
+touch "$T/new-examples"
 while read -r f; do
   f=${f#./}
-  if [ ! -e "$T/out/old/$f" ]; then
+  if grep -qxF "$(dirname "$f")" "$T/new-examples"; then
+    echo "NEW-EXAMPLE $f"; nnew=$((nnew + 1))
+  elif [ ! -e "$T/out/old/$f" ]; then
     echo "ONLY-NEW $f"; ndiff=$((ndiff + 1))
   elif [ ! -e "$T/out/new/$f" ]; then
     echo "ONLY-OLD $f"; ndiff=$((ndiff + 1))
@@ -172,7 +183,7 @@ while read -r f; do
     echo "DIFFERENT $f"; ndiff=$((ndiff + 1))
   fi
 done < <(sort -u "$T/files.old" "$T/files.new")
-echo "outputs: $nsame same, $ndiff different"
+echo "outputs: $nsame same, $ndiff different, $nnew of examples OLD has not (not compared)"
 
 # Figures: the median of the rounds of each side. The times of the speedup
 # come from its '# cell 0.5 m' line (full grid, surface bounds + direct).
