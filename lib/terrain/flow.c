@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/grow.h"
 #include "terrain/analysis.h"
 
 #define MAX_EXPONENT 4.0
@@ -96,11 +97,7 @@ static int finish(walk *w, uint32_t c, uint32_t **st, size_t *ns, size_t *cap) {
     /* release: our q[c] is seen by whoever takes m; acquire: we see the
     ** q of every other higher neighbour of m */
     if (__atomic_sub_fetch(&w->up[m], 1, __ATOMIC_ACQ_REL) != 0) continue;
-    if (*ns == *cap) {
-      uint32_t *g = realloc(*st, 2 * *cap * sizeof *g);
-      if (!g) return OC_ENOMEM;
-      *st = g, *cap *= 2;
-    }
+    if (!OC_GROW(*st, *ns, *cap, 1)) return OC_ENOMEM;
     (*st)[(*ns)++] = (uint32_t)m;
   }
   return OC_OK;
