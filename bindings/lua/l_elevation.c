@@ -466,13 +466,7 @@ static int e_stats(lua_State *L) {
   oclua_checkargs(L, 1, "elevation:stats", "()");
   if (oc_enode_get_stats(self(L, "elevation:stats"), &st, &err))
     return oclua_liberror(L, "elevation:stats", &err);
-  lua_createtable(L, 0, 3);
-  lua_pushinteger(L, (lua_Integer)st.nodes);
-  lua_setfield(L, -2, "nodes");
-  lua_pushinteger(L, (lua_Integer)st.primitives);
-  lua_setfield(L, -2, "primitives");
-  lua_pushinteger(L, (lua_Integer)st.bytes);
-  lua_setfield(L, -2, "bytes");
+  oclua_pushstats(L, st.nodes, st.primitives, st.bytes);
   return 1;
 }
 

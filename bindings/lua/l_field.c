@@ -187,13 +187,7 @@ static int node_stats(lua_State *L) {
   oc_program_stats st = {0, 0, 0};
   checkself(L, "node:stats");
   oc_program_get_stats(oclua_program(L, 1, "node:stats"), &st);
-  lua_createtable(L, 0, 3);
-  lua_pushinteger(L, (lua_Integer)st.nodes);
-  lua_setfield(L, -2, "nodes");
-  lua_pushinteger(L, (lua_Integer)st.primitives);
-  lua_setfield(L, -2, "primitives");
-  lua_pushinteger(L, (lua_Integer)st.bytes);
-  lua_setfield(L, -2, "bytes");
+  oclua_pushstats(L, st.nodes, st.primitives, st.bytes);
   return 1;
 }
 

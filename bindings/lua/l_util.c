@@ -474,6 +474,17 @@ void oclua_checkargs(lua_State *L, int n, const char *fname,
     oclua_error(L, fname, "too many arguments (%d; usage: %s)", top, usage);
 }
 
+void oclua_pushstats(lua_State *L, size_t nodes, size_t primitives,
+                     size_t bytes) {
+  lua_createtable(L, 0, 3);
+  lua_pushinteger(L, (lua_Integer)nodes);
+  lua_setfield(L, -2, "nodes");
+  lua_pushinteger(L, (lua_Integer)primitives);
+  lua_setfield(L, -2, "primitives");
+  lua_pushinteger(L, (lua_Integer)bytes);
+  lua_setfield(L, -2, "bytes");
+}
+
 /* Reads an array of exactly n finite numbers. Returns 0 when absent. */
 int oclua_field_numbers(const oclua_fields *f, const char *name, int n,
                         double *out, const char *what) {

@@ -104,6 +104,11 @@ void oclua_state(lua_State *L);
 /* Raises unless the call has at most `n` arguments. */
 void oclua_checkargs(lua_State *L, int n, const char *fname, const char *usage);
 
+/* Pushes {nodes =, primitives =, bytes =}: what :stats() returns for a
+** 3D tree and for an elevation tree alike. */
+void oclua_pushstats(lua_State *L, size_t nodes, size_t primitives,
+                     size_t bytes);
+
 /* Reads the palette at stack index idx (an array of {value, {r, g, b}},
 ** values ascending, components in [0, 1]) into a Lua-owned array of stops
 ** (value, r, g, b), pushed on the stack; `label` names the field in the
