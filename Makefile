@@ -244,7 +244,11 @@ PICTURES := demo_arch_render.png:demo:arch_render.png \
   example_hoodoos.png:hoodoos:hoodoos.png \
   example_karst.png:karst:karst_network.png \
   example_karst_cut.png:karst:karst.png \
-  example_sea_cliffs.png:sea_cliffs:sea_cliffs.png
+  example_sea_cliffs.png:sea_cliffs:sea_cliffs.png \
+  example_elev_river.png:elev_river:elev_river.png \
+  example_elev_dunes.png:elev_dunes:elev_dunes.png \
+  example_elev_instances.png:elev_instances:elev_instances.png \
+  example_elev_road.png:elev_road:elev_road.png
 PICTURE_SCENES := $(sort $(foreach p,$(PICTURES),$(word 2,$(subst :, ,$(p)))))
 
 pictures: all

@@ -7,6 +7,11 @@
 # sea-arch: examples/sea_cliffs.lua at its own cell (0.8), picture left
 # out (--set render=false): its mesh is one closed component (specks of a
 # few vertices dropped) with a through-hole, genus >= 1 (topology.lua).
+#
+# elev-*: the elevation-tree examples at 96 x 54 (--set size=96), run
+# with one thread and with two: the same PNG bytes both times; the dunes
+# leave the peak's elevation as it was and raise the desert floor; the
+# thirty instances share the patch (37 nodes, not 182).
 
 set -u
 
@@ -32,6 +37,35 @@ grep -qE 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$T/err" &&
 grep -q '^topology: 1 component' "$T/out" || because "no single component reported"
 tally "$T/out" "$T/err"
 grep "^topology" "$T/out" | sed "s/^/     /"
+
+for ex in elev_river elev_dunes elev_instances elev_road; do
+  name=elev-${ex#elev_}
+  why=
+  mkdir -p "$T/$name/1" "$T/$name/2"
+  for n in 1 2; do
+    "$OUTCROP" run "$ROOT/examples/$ex.lua" --set size=96 --threads $n \
+      --out "$T/$name/$n" >"$T/out$n" 2>"$T/err" ||
+      because "$(grep -m1 -E 'outcrop:|assert' "$T/err" || echo "exit status $?")"
+  done
+  if [ -f "$T/$name/1/$ex.png" ] && [ -f "$T/$name/2/$ex.png" ]; then
+    cmp -s "$T/$name/1/$ex.png" "$T/$name/2/$ex.png" ||
+      because "$ex.png differs between --threads 1 and 2"
+  else
+    because "no $ex.png written"
+  fi
+  case $ex in
+  elev_dunes)
+    # desert floor A m -> B m with dunes; peak C m -> D m: B > A, D = C
+    awk '/desert floor/ { ok = ($7 > $4 + 1 && $12 == $15) } END { exit !ok }' \
+      FS='[ ]+' "$T/out1" || because "the dunes did not keep to the low ground"
+    ;;
+  elev_instances)
+    grep -q '30 instances: 37 nodes, 5 primitives' "$T/out1" ||
+      because "the instances do not share the patch"
+    ;;
+  esac
+  tally "$T/out1" "$T/err"
+done
 
 echo "example tests: $npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]
