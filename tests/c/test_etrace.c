@@ -56,7 +56,8 @@ static wave WAVE = {40, 10, 60};
 
 static oc_elevation wave_source(void) {
   oc_elevation e = {wave_h, wave_range, wave_slope, NULL, NULL,
-                    &WAVE,  -500,       -500,       500,  500};
+                    &WAVE,  -500,       -500,       500,  500,
+                    NULL,   NULL}; /* no weight: a surface everywhere */
   return e;
 }
 
