@@ -8,11 +8,14 @@
 ** column spans.
 **
 ** A source with a weight alpha (elevation trees) adds a third term:
-** f = min(f_T, f_P, f_W), f_W = 2T clamp(alpha, 0, 1), so f_W >= T
-** exactly on Omega_T = {alpha >= 1/2}: there the surface is z = h, and
-** where alpha < 1/2 nothing is solid (the solid ends in vertical walls
-** along alpha = 1/2). f_W is constant along columns: column spans and
-** direct extraction are those of the prism wherever alpha > 1/2.
+** f = min(f_T, f_P, f_W), f_W = 2T clamp(1/2 + K (alpha - 1/2), 0, 1)
+** with K = WEIGHT_GAIN, so f_W >= T exactly on Omega_T = {alpha >= 1/2}:
+** there the surface is z = h, and where alpha < 1/2 nothing is solid (the
+** solid ends in vertical walls along alpha = 1/2). f_W is constant along
+** columns: column spans and direct extraction are those of the prism
+** wherever alpha > 1/2. The gain makes f exactly 0 where alpha <= 1/2 -
+** 1/(2K), so the mesher and the tracers skip most of the holes of the
+** tree at the price of a K times steeper wall.
 **
 ** sigma is the paper's piecewise odd cubic around (0, T): sigma(0) = T,
 ** sigma(+-W) = 2T or 0, flat beyond. With s = sigma'(0) W / T = k, on
@@ -33,6 +36,10 @@
 /* g(x) = 1/2: where f_P = 2T g crosses T. sqrt(1 - 2^(-1/3)). */
 #define X_HALF 0.45420201894740647
 #define DEFAULT_W 1.0
+/* K of the weight term: f_W is 0 below alpha = 3/8, 2T above 5/8 */
+#define WEIGHT_GAIN 4.0
+#define WEIGHT_ZERO (0.5 - 0.5 / WEIGHT_GAIN)
+#define WEIGHT_FULL (0.5 + 0.5 / WEIGHT_GAIN)
 
 /* ---- sigma ------------------------------------------------------------ */
 
@@ -139,11 +146,13 @@ double oc_terrain_eval(const oc_tdata *t, const double *par, oc_vec3 p,
                  : t->src.height(t->src.ud, p.x, p.y, g ? gh : NULL);
   double v = t->invert ? p.z - h : h - p.z, ds;
   double ft = sigma(par, v, &ds);
-  /* f_W = 2T clamp(alpha, 0, 1) (no weight: 2T, never below the rest) */
-  double fw = a >= 1 ? T2 : a > 0 ? T2 * a : 0;
+  /* f_W (no weight: alpha = 1, f_W = 2T, never below the rest) */
+  double fw = a >= WEIGHT_FULL  ? T2
+              : a > WEIGHT_ZERO ? T2 * (0.5 + WEIGHT_GAIN * (a - 0.5))
+                                : 0;
   if (fw < ft && fw < fp) {
     if (g) {
-      double k = a > 0 && a < 1 ? T2 : 0;
+      double k = a > WEIGHT_ZERO && a < WEIGHT_FULL ? T2 * WEIGHT_GAIN : 0;
       *g = (oc_vec3){k * ga[0], k * ga[1], 0};
     }
     return fw;
@@ -198,13 +207,13 @@ static double lip_surface(const double *par, double slope) {
 
 double oc_terrain_lipschitz(const oc_tdata *t, const double *par) {
   return fmax(fmax(lip_surface(par, t->slope), lip_prism(t, par)),
-              2 * par[OC_TPAR_T] * t->wlip);
+              2 * par[OC_TPAR_T] * WEIGHT_GAIN * t->wlip);
 }
 
 /* A weighted source on the footprint: *zero when f_W is 0 there (alpha
-** <= 0), *full when alpha > 1/2 throughout (f_W > T: the surface and the
-** sign of f - T are those without it), and the Lipschitz bound of f_W
-** (0 where alpha >= 1, f_W = 2T). Without a weight: full, bound 0. */
+** <= WEIGHT_ZERO), *full when alpha > 1/2 throughout (f_W > T: the
+** surface and the sign of f - T are those without it), and the Lipschitz
+** bound of f_W (0 where it is 2T). Without a weight: full, bound 0. */
 static double foot_weight(const oc_tdata *t, const double *par, double x0,
                           double y0, double x1, double y1, int *zero,
                           int *full) {
@@ -213,9 +222,10 @@ static double foot_weight(const oc_tdata *t, const double *par, double x0,
   if (!t->src.weight_range) return 0;
   double lo, hi, lip;
   t->src.weight_range(t->src.ud, x0, y0, x1, y1, &lo, &hi, &lip);
-  *zero = hi <= 0;
+  *zero = hi <= WEIGHT_ZERO;
   *full = lo > 0.5;
-  return lo >= 1 || *zero ? 0 : 2 * par[OC_TPAR_T] * lip;
+  return lo >= WEIGHT_FULL || *zero ? 0
+                                    : 2 * par[OC_TPAR_T] * WEIGHT_GAIN * lip;
 }
 
 /* Whether f_P is 2T over the whole footprint between zlo and zhi (the
