@@ -109,8 +109,7 @@ static int l_terrain(lua_State *L) {
   if (tree) return tree_terrain(L, tree, fname); /* immutable: on the stack */
   if (!oclua_isheightfield(L, 1))
     oclua_error(L, fname,
-                "argument #1 must be a heightfield or an elevation tree "
-                "(got %s)",
+                "expected a heightfield or an elevation tree (got %s)",
                 oclua_got(L, 1));
   oclua_checkheightfield(L, 1, fname);
   /* pinned: the options' metamethods and finalizers may close it */
