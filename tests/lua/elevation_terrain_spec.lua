@@ -5,7 +5,7 @@
 -- outcrop.heightfield.from(e) gives e:eval's f at every sample (as
 -- floats), holes where asked, the same bytes on 1 and 2 threads;
 -- outcrop.polygonize meshes it with its top on f; bad input names the
--- field and the script line.
+-- field and the script line; hoodoos and karst grow on a tree too.
 local oc = require "outcrop"
 local R = require "helpers.ref"
 
@@ -259,5 +259,41 @@ describe("the sea-erosion generator on an implicitized tree", function()
       end
     end
     assert.is_true(carved > 5, carved .. " carved")
+  end)
+end)
+
+describe("hoodoos and karst on an implicitized tree", function()
+  -- a plateau 40 m up (the blend of 20 and 60), its edge where the
+  -- weights fall below 1/2
+  local plateau = E.blend{E.disc{center = {0, 0}, radius = 300, height = 20},
+                          E.disc{center = {0, 0}, radius = 200, height = 60,
+                                 noise = {amplitude = 6, wavelength = 40}}}
+  local t = oc.terrain(plateau)
+  local hf = oc.heightfield.from(plateau, {cell = 2})
+
+  it("grows hoodoos on it, adding to the ground only", function()
+    local n, info = oc.generate.hoodoos{heightfield = hf, terrain = t, seed = 3}
+    assert.is_true(info.hoodoos > 3, info.hoodoos .. " hoodoos")
+    assert.are.equal(info.primitives + 1, n:stats().primitives)
+    local grew = 0
+    for _ = 1, 3000 do
+      local p = {rand(-130, 130), rand(-130, 130), rand(10, 70)}
+      local fn, ft = n:eval(p), t:eval(p)
+      assert.is_true(fn >= ft - 1e-12)
+      if fn > 0.5 and ft <= 0.5 then grew = grew + 1 end
+    end
+    assert.is_true(grew > 0)
+  end)
+
+  it("carves karst under its surface", function()
+    local geo = oc.geology.layer{origin = {0, 0, 35}, normal = {0, 0, 1},
+                                 radius = 8, resistance = -0.6,
+                                 noise = {wavelength = 10, amplitude = 0.2,
+                                          offset = 0.7, octaves = 3, seed = 11}}
+    local k, info = oc.generate.karst{heightfield = hf, terrain = t,
+                                      geology = geo, radius = 4,
+                                      sinks = {{0, 0, 35}}, max_primitives = 60}
+    assert.is_true(info.primitives > 10, info.primitives .. " cavities")
+    assert.is_true(k:eval{0, 0, 35} < 0.5 and t:eval{0, 0, 35} > 0.5)
   end)
 end)
