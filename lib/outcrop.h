@@ -1338,8 +1338,7 @@ int oc_enode_elevation(oc_enode *e, const double *domain, oc_elevation *src,
 /* The default terrain parameters for a source without a grid (a tree's):
 ** falloff 1/100 of the domain's longer side, transition 1 (metre), no
 ** mask, open edges, not inverted, thickness 0. */
-void oc_terrain_defaults_source(const oc_elevation *src,
-                                oc_terrain_params *tp);
+void oc_terrain_defaults_source(const oc_elevation *src, oc_terrain_params *tp);
 /* The terrain node of tree e over domain (NULL: oc_enode_terrain_box)
 ** with tp (NULL: oc_terrain_defaults_source): solid below f where alpha
 ** >= 1/2, nothing where alpha < 1/2 (oc_terrain, the weight term). New

@@ -274,8 +274,7 @@ static void from_function(lua_State *L, int fn, oc_heightfield *hf,
 ** grid covering the tree's terrain box where size/cell/origin are
 ** missing (oc_elevation_grid); holes = z puts z where alpha < 1/2. */
 static int from_tree(lua_State *L, oc_enode *e, const char *fname) {
-  static const char *const known[] = {"size", "cell", "origin", "holes",
-                                      NULL};
+  static const char *const known[] = {"size", "cell", "origin", "holes", NULL};
   opt_table(L, 2);
   oclua_fields f;
   oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
