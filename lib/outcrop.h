@@ -1000,6 +1000,16 @@ typedef struct oc_elevation {
   void (*release)(void *ud);
   void *ud;
   double x0, y0, x1, y1; /* the domain: finite, x0 < x1, y0 < y1 */
+  /* Optional (NULL for grids: the surface covers the domain): a weight
+  ** alpha(x, y) saying where the surface exists, alpha >= 1/2 (the
+  ** elevation trees' Omega_T). height_weight returns h as height does and
+  ** puts alpha in *alpha (its gradient in agrad when not NULL), in one
+  ** traversal; weight_range gives alo <= alpha <= ahi on the box and a
+  ** Lipschitz bound of alpha there. Both or neither. */
+  double (*height_weight)(void *ud, double x, double y, double grad[2],
+                          double *alpha, double agrad[2]);
+  void (*weight_range)(void *ud, double x0, double y0, double x1, double y1,
+                       double *alo, double *ahi, double *alip);
 } oc_elevation;
 
 /* The source of a heightfield: its Catmull-Rom interpolant over the grid's
@@ -1322,6 +1332,38 @@ int oc_enode_terrain_box(const oc_enode *e, double box[4]);
 ** e. OC_OK, or OC_EINVAL with err for an empty or infinite domain. */
 int oc_enode_elevation(oc_enode *e, const double *domain, oc_elevation *src,
                        oc_error *err);
+
+/* -- elevation trees as terrains and grids (terrain/elevation_tree.c) -- */
+
+/* The default terrain parameters for a source without a grid (a tree's):
+** falloff 1/100 of the domain's longer side, transition 1 (metre), no
+** mask, open edges, not inverted, thickness 0. */
+void oc_terrain_defaults_source(const oc_elevation *src, oc_terrain_params *tp);
+/* The terrain node of tree e over domain (NULL: oc_enode_terrain_box)
+** with tp (NULL: oc_terrain_defaults_source): solid below f where alpha
+** >= 1/2, nothing where alpha < 1/2 (oc_terrain, the weight term). New
+** reference or NULL with err (OC_EINVAL for a tree without terrain). */
+oc_node *oc_enode_terrain(oc_enode *e, const double *domain,
+                          const oc_terrain_params *tp, oc_error *err);
+/* The grid over src's domain, filling what is missing (nx = ny = 0: no
+** size; cell = 0: none; origin NULL: the domain's corner (x0, y0)):
+** neither size nor cell: 513 samples along the longer side and enough
+** along the other to cover it; a size alone: the smallest cell with which
+** it covers the domain; a cell alone: the samples that cover it. OC_OK,
+** or OC_EINVAL with err naming the field. */
+int oc_elevation_grid(const oc_elevation *src, int nx, int ny, double cell,
+                      const double *origin, oc_heightfield_grid *g,
+                      oc_error *err);
+/* src sampled at every node of g: one height_weight (else height) call
+** per sample, f stored as a float; with holes set, the samples where
+** alpha < 1/2 (off Omega_T) get hole_value instead. Rows on all cores,
+** byte-identical for any thread count, cancellable through progress
+** (OC_ECANCEL). New grid, or NULL with err. */
+oc_heightfield *oc_heightfield_from_elevation(const oc_elevation *src,
+                                              const oc_heightfield_grid *g,
+                                              int holes, double hole_value,
+                                              oc_progress progress,
+                                              oc_error *err);
 
 /* ---- geology: resistance trees and the erosion node ----- */
 

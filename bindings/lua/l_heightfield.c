@@ -10,7 +10,9 @@
 ** j = ny). Defaults: cell 1, origin {0, 0}; load: scale 1, offset 0 unless
 ** the file says otherwise (files saved by hf:save do); fbm: octaves 6,
 ** offset 0, seed the scene seed; from: zrange the node's z bounds,
-** threshold outcrop.threshold.
+** threshold outcrop.threshold; from an elevation tree: the grid over its
+** terrain box (513 samples along the longer side), f kept where alpha <
+** 1/2 unless holes = z.
 */
 #include <math.h>
 #include <signal.h>
@@ -20,6 +22,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "l_elevation.h"
 #include "l_field.h"
 #include "l_heightfield.h"
 #include "l_progress.h"
@@ -266,6 +269,42 @@ static void from_function(lua_State *L, int fn, oc_heightfield *hf,
     }
 }
 
+/* outcrop.heightfield.from(e, {size=, cell=, origin=, holes=}) for an
+** elevation tree e at 1: f at every sample (one evaluation each), the
+** grid covering the tree's terrain box where size/cell/origin are
+** missing (oc_elevation_grid); holes = z puts z where alpha < 1/2. */
+static int from_tree(lua_State *L, oc_enode *e, const char *fname) {
+  static const char *const known[] = {"size", "cell", "origin", "holes", NULL};
+  opt_table(L, 2);
+  oclua_fields f;
+  oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
+  int nx = 0, ny = 0;
+  if (oclua_field_push(&f, "size") != LUA_TNIL) field_size(&f, &nx, &ny);
+  lua_pop(L, 1);
+  double cell = oclua_field_optnumber(&f, "cell", OCLUA_POSITIVE, 0), o[2];
+  int haso = oclua_field_numbers(&f, "origin", 2, o, "must be {x0, y0}");
+  int holes = oclua_field_push(&f, "holes") != LUA_TNIL;
+  lua_pop(L, 1);
+  double hole = oclua_field_optnumber(&f, "holes", OCLUA_FINITE, 0);
+  oc_error err = {OC_OK, ""};
+  oc_elevation src;
+  oc_heightfield_grid g;
+  if (oc_enode_elevation(e, NULL, &src, &err) != OC_OK)
+    return oclua_liberror(L, fname, &err);
+  if (oc_elevation_grid(&src, nx, ny, cell, haso ? o : NULL, &g, &err)) {
+    src.release(src.ud);
+    return oclua_liberror(L, fname, &err);
+  }
+  oclua_progress pl;
+  oc_progress pr = oclua_progress_start(L, &pl, fname);
+  oclua_heightfield *u = oclua_newheightfield(L);
+  oc_heightfield *hf =
+      oc_heightfield_from_elevation(&src, &g, holes, hole, pr, &err);
+  oclua_progress_end(&pl);
+  src.release(src.ud);
+  return oclua_sethf(L, u, hf, &err, fname);
+}
+
 static int l_from(lua_State *L) {
   static const char *const known[] = {"size",   "cell",      "origin",
                                       "zrange", "threshold", NULL};
@@ -276,11 +315,13 @@ static int l_from(lua_State *L) {
   oclua_checkargs(L, 2, fname,
                   "(function or node, {size =, cell =, origin =, zrange =, "
                   "threshold =})");
+  oc_enode *tree = oclua_testenode(L, 1);
+  if (tree) return from_tree(L, tree, fname); /* immutable: on the stack */
   int isfn = lua_type(L, 1) == LUA_TFUNCTION;
   if (!isfn && oclua_testnode(L, 1) == NULL)
     oclua_error(L, fname,
-                "argument #1 must be a function (x, y) -> z or an outcrop "
-                "node (got %s)",
+                "argument #1 must be a function (x, y) -> z, an outcrop "
+                "node or an elevation tree (got %s)",
                 oclua_got(L, 1));
   oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
   oc_heightfield_grid g = field_grid(&f);

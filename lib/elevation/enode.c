@@ -228,6 +228,27 @@ static double src_slope(void *ud, double x0, double y0, double x1, double y1) {
   return b.lf;
 }
 
+static double src_height_weight(void *ud, double x, double y, double grad[2],
+                                double *alpha, double agrad[2]) {
+  oc_enode_sample s;
+  oc_enode_ev(ud, x, y, grad || agrad ? OC_EV_GRAD : 0, &s);
+  if (grad) grad[0] = s.fx, grad[1] = s.fy;
+  if (agrad) agrad[0] = s.ax, agrad[1] = s.ay;
+  *alpha = s.a;
+  return s.f;
+}
+
+static void src_weight_range(void *ud, double x0, double y0, double x1,
+                             double y1, double *alo, double *ahi,
+                             double *alip) {
+  oc_ebound b;
+  oc_erect r = {x0, y0, x1, y1};
+  oc_enode_bnd(ud, &r, &b);
+  *alo = b.alo;
+  *ahi = b.ahi;
+  *alip = b.la;
+}
+
 static void src_retain(void *ud) {
   oc_enode_retain(ud);
 }
@@ -256,6 +277,8 @@ int oc_enode_elevation(oc_enode *e, const double *domain, oc_elevation *src,
   src->slope = src_slope;
   src->retain = src_retain;
   src->release = src_release;
+  src->height_weight = src_height_weight; /* Omega_T: where alpha >= 1/2 */
+  src->weight_range = src_weight_range;
   src->ud = e;
   src->x0 = d[0];
   src->y0 = d[1];

@@ -261,6 +261,8 @@ int oc_heightfield_elevation(oc_heightfield *hf, oc_elevation *src,
   src->slope = hf_slope;
   src->retain = hf_retain;
   src->release = hf_release;
+  src->height_weight = NULL; /* a grid's surface covers its domain */
+  src->weight_range = NULL;
   src->ud = s;
   src->x0 = s->x0;
   src->y0 = s->y0;

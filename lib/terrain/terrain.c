@@ -7,6 +7,16 @@
 ** [zlo, zhi]. Constructor, value, gradient, support, Lipschitz bounds and
 ** column spans.
 **
+** A source with a weight alpha (elevation trees) adds a third term:
+** f = min(f_T, f_P, f_W), f_W = 2T clamp(1/2 + K (alpha - 1/2), 0, 1)
+** with K = WEIGHT_GAIN, so f_W >= T exactly on Omega_T = {alpha >= 1/2}:
+** there the surface is z = h, and where alpha < 1/2 nothing is solid (the
+** solid ends in vertical walls along alpha = 1/2). f_W is constant along
+** columns: column spans and direct extraction are those of the prism
+** wherever alpha > 1/2. The gain makes f exactly 0 where alpha <= 1/2 -
+** 1/(2K), so the mesher and the tracers skip most of the holes of the
+** tree at the price of a K times steeper wall.
+**
 ** sigma is the paper's piecewise odd cubic around (0, T): sigma(0) = T,
 ** sigma(+-W) = 2T or 0, flat beyond. With s = sigma'(0) W / T = k, on
 ** u = |v| / W in [0, 1]: sigma = T +- T (k u + (3 - 2k) u^2 + (k - 2) u^3).
@@ -26,6 +36,10 @@
 /* g(x) = 1/2: where f_P = 2T g crosses T. sqrt(1 - 2^(-1/3)). */
 #define X_HALF 0.45420201894740647
 #define DEFAULT_W 1.0
+/* K of the weight term: f_W is 0 below alpha = 3/8, 2T above 5/8 */
+#define WEIGHT_GAIN 4.0
+#define WEIGHT_ZERO (0.5 - 0.5 / WEIGHT_GAIN)
+#define WEIGHT_FULL (0.5 + 0.5 / WEIGHT_GAIN)
 
 /* ---- sigma ------------------------------------------------------------ */
 
@@ -125,10 +139,24 @@ double oc_terrain_eval(const oc_tdata *t, const double *par, oc_vec3 p,
   if (!(d < t->R)) return 0;
   double x = d / t->R;
   double fp = T2 * oc_falloff(x);
-  double gh[2];
-  double h = t->src.height(t->src.ud, p.x, p.y, g ? gh : NULL);
+  double gh[2], a = 1, ga[2] = {0, 0};
+  double h = t->src.height_weight
+                 ? t->src.height_weight(t->src.ud, p.x, p.y, g ? gh : NULL, &a,
+                                        g ? ga : NULL)
+                 : t->src.height(t->src.ud, p.x, p.y, g ? gh : NULL);
   double v = t->invert ? p.z - h : h - p.z, ds;
   double ft = sigma(par, v, &ds);
+  /* f_W (no weight: alpha = 1, f_W = 2T, never below the rest) */
+  double fw = a >= WEIGHT_FULL  ? T2
+              : a > WEIGHT_ZERO ? T2 * (0.5 + WEIGHT_GAIN * (a - 0.5))
+                                : 0;
+  if (fw < ft && fw < fp) {
+    if (g) {
+      double k = a > WEIGHT_ZERO && a < WEIGHT_FULL ? T2 * WEIGHT_GAIN : 0;
+      *g = (oc_vec3){k * ga[0], k * ga[1], 0};
+    }
+    return fw;
+  }
   if (ft <= fp || isnan(ft)) {
     if (g) {
       double s = t->invert ? -ds : ds;
@@ -178,7 +206,26 @@ static double lip_surface(const double *par, double slope) {
 }
 
 double oc_terrain_lipschitz(const oc_tdata *t, const double *par) {
-  return fmax(lip_surface(par, t->slope), lip_prism(t, par));
+  return fmax(fmax(lip_surface(par, t->slope), lip_prism(t, par)),
+              2 * par[OC_TPAR_T] * WEIGHT_GAIN * t->wlip);
+}
+
+/* A weighted source on the footprint: *zero when f_W is 0 there (alpha
+** <= WEIGHT_ZERO), *full when alpha > 1/2 throughout (f_W > T: the
+** surface and the sign of f - T are those without it), and the Lipschitz
+** bound of f_W (0 where it is 2T). Without a weight: full, bound 0. */
+static double foot_weight(const oc_tdata *t, const double *par, double x0,
+                          double y0, double x1, double y1, int *zero,
+                          int *full) {
+  *zero = 0;
+  *full = 1;
+  if (!t->src.weight_range) return 0;
+  double lo, hi, lip;
+  t->src.weight_range(t->src.ud, x0, y0, x1, y1, &lo, &hi, &lip);
+  *zero = hi <= WEIGHT_ZERO;
+  *full = lo > 0.5;
+  return lo >= WEIGHT_FULL || *zero ? 0
+                                    : 2 * par[OC_TPAR_T] * WEIGHT_GAIN * lip;
 }
 
 /* Whether f_P is 2T over the whole footprint between zlo and zhi (the
@@ -203,9 +250,12 @@ static void foot_prism(const oc_tdata *t, double x0, double y0, double x1,
 double oc_terrain_lipschitz_in(const oc_tdata *t, const double *par,
                                const oc_aabb *b) {
   double W = par[OC_TPAR_W];
-  int inside, outside;
+  int inside, outside, wzero, wfull;
   foot_prism(t, b->lo.x, b->lo.y, b->hi.x, b->hi.y, &inside, &outside);
   if (outside) return 0;
+  double lw =
+      foot_weight(t, par, b->lo.x, b->lo.y, b->hi.x, b->hi.y, &wzero, &wfull);
+  if (wzero) return 0;
   double hlo, hhi;
   t->src.range(t->src.ud, b->lo.x, b->lo.y, b->hi.x, b->hi.y, &hlo, &hhi);
   /* f_T is 0 on the whole box: so is f */
@@ -223,16 +273,21 @@ double oc_terrain_lipschitz_in(const oc_tdata *t, const double *par,
         par, t->src.slope(t->src.ud, b->lo.x, b->lo.y, b->hi.x, b->hi.y));
   if (!(inside && b->lo.z >= t->zlo && b->hi.z <= t->zhi))
     lp = lip_prism(t, par);
-  return fmax(lt, lp);
+  return fmax(fmax(lt, lp), lw);
 }
 
 int oc_terrain_spans(const oc_tdata *t, const double *par, double x0, double y0,
                      double x1, double y1, int zvar,
                      void (*add)(void *, double, double), void *S) {
   double W = par[OC_TPAR_W], R = t->R;
-  int inside, outside;
+  int inside, outside, wzero, wfull;
   foot_prism(t, x0, y0, x1, y1, &inside, &outside);
   if (outside) return 0;
+  foot_weight(t, par, x0, y0, x1, y1, &wzero, &wfull);
+  if (wzero) return 0;
+  /* where alpha may be <= 1/2, f_W varies across the footprint at every
+  ** z where f may be > 0: no direct case */
+  inside = inside && wfull;
   double hlo, hhi;
   t->src.range(t->src.ud, x0, y0, x1, y1, &hlo, &hhi);
   /* margin for the rounding of v = h - z and of u = v / W */
@@ -365,6 +420,10 @@ static int check_source(const oc_elevation *s, oc_error *err) {
   if (!s || !s->height || !s->range || !s->slope)
     return oc_seterr(err, OC_EINVAL,
                      "the elevation source needs height, range and slope");
+  if (!s->height_weight != !s->weight_range)
+    return oc_seterr(err, OC_EINVAL,
+                     "the elevation source needs both height_weight and "
+                     "weight_range, or neither");
   if (!isfinite(s->x0) || !isfinite(s->y0) || !isfinite(s->x1) ||
       !isfinite(s->y1) || !(s->x0 < s->x1) || !(s->y0 < s->y1))
     return oc_seterr(err, OC_EINVAL,
@@ -436,6 +495,19 @@ oc_node *oc_terrain(const oc_elevation *src, const oc_terrain_params *tp,
   t->zhi = t->invert ? hi + tp->thickness : hi;
   t->slope = slope;
   t->open = open;
+  if (src->height_weight) {
+    double alo, ahi;
+    src->weight_range(src->ud, src->x0, src->y0, src->x1, src->y1, &alo, &ahi,
+                      &t->wlip);
+    if (!(t->wlip >= 0) || !isfinite(t->wlip)) {
+      oc_seterr(err, OC_EINVAL,
+                "the elevation source reports a weight slope %g: it must be "
+                "finite",
+                t->wlip);
+      free(t);
+      return NULL;
+    }
+  }
   double in = open ? 0 : R;
   t->ix0 = src->x0 + in;
   t->iy0 = src->y0 + in;

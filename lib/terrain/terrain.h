@@ -24,6 +24,7 @@ typedef struct oc_tdata {
   double ix0, iy0, ix1, iy1; /* no mask: Omega shrunk by R (open: Omega) */
   double sx0, sy0, sx1, sy1; /* where f_P may be > 0 */
   double slope;              /* bound of |grad h| over the domain */
+  double wlip;               /* weighted sources: alpha's Lipschitz bound */
   float *dist;               /* mask: distance to Omega shrunk by R */
   int mnx, mny;              /* mask grid */
   double mcell, mx0, my0;
