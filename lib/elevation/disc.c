@@ -130,6 +130,7 @@ void oc_edisc_ev(const oc_enode *n, double x, double y, int want,
       return;
     }
   }
+  if (want & OC_EV_ALPHA) return;
   double g[2] = {0, 0};
   s->f = p[3] + (n->noise.kind == OC_ENOISE_NONE
                      ? 0

@@ -82,6 +82,7 @@ void oc_ecurve_ev(const oc_enode *n, double x, double y, int want,
   int grad = want & OC_EV_GRAD, lazy = want & OC_EV_LAZY;
   oc_curve_point pt;
   s->ax = s->ay = s->fx = s->fy = 0;
+  if (want & OC_EV_ALPHA) lazy = 1; /* no f: only the nearby curve */
   if (!oc_curve_closest(d->c, x, y, lazy ? d->R : INFINITY, &pt)) {
     s->a = s->f = 0;
     return;
@@ -104,6 +105,7 @@ void oc_ecurve_ev(const oc_enode *n, double x, double y, int want,
       return;
     }
   }
+  if (want & OC_EV_ALPHA) return;
   /* f: the lateral coordinate and the gradients of s and of it */
   double dl, gsx = 0, gsy = 0, gz = 0;
   if (pt.end) {

@@ -106,7 +106,7 @@ void oc_enode_eval(const oc_enode *e, double x, double y, oc_enode_sample *s) {
 double oc_enode_weight(const oc_enode *e, double x, double y) {
   if (!isfinite(x) || !isfinite(y)) return NAN;
   oc_enode_sample s;
-  oc_enode_ev(e, x, y, OC_EV_LAZY, &s);
+  oc_enode_ev(e, x, y, OC_EV_ALPHA, &s);
   return s.a;
 }
 

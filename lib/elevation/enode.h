@@ -22,7 +22,6 @@
 
 #include "outcrop.h"
 
-
 typedef enum oc_ekind {
   OC_E_DISC,
   OC_E_CURVE,
@@ -66,6 +65,9 @@ struct oc_enode {
 /* What a caller asks of eval. */
 #define OC_EV_GRAD 1 /* gradients too */
 #define OC_EV_LAZY 2 /* f may be left 0 where alpha = 0 (blend children) */
+/* alpha and nothing else (f and the gradients left unset): no operator's
+** alpha depends on an f, so a weight query skips every noise sum */
+#define OC_EV_ALPHA 4
 
 void oc_enode_ev(const oc_enode *n, double x, double y, int want,
                  oc_enode_sample *s);

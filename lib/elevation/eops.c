@@ -64,14 +64,18 @@ static double clamp01(double v, int *inside) {
 
 static void blend_ev(const oc_enode *n, double x, double y, int want,
                      oc_enode_sample *s) {
-  int grad = want & OC_EV_GRAD;
+  int grad = want & OC_EV_GRAD, only = want & OC_EV_ALPHA;
   double N = 0, S = 0, nx = 0, ny = 0, sx = 0, sy = 0;
   for (size_t i = 0; i < n->nkids; i++) {
     const oc_enode *k = n->kids[i];
     if (!(x >= k->box.x0 && x <= k->box.x1 && y >= k->box.y0 && y <= k->box.y1))
       continue; /* alpha = 0 there: no contribution */
     oc_enode_sample c;
-    oc_enode_ev(k, x, y, grad | OC_EV_LAZY, &c);
+    oc_enode_ev(k, x, y, grad | OC_EV_LAZY | only, &c);
+    if (only) {
+      S += c.a;
+      continue;
+    }
     if (c.a == 0) continue;
     N += c.a * c.f;
     S += c.a;
@@ -85,6 +89,7 @@ static void blend_ev(const oc_enode *n, double x, double y, int want,
   s->a = S;
   s->ax = sx;
   s->ay = sy;
+  if (only) return;
   if (x != x || y != y) { /* NaN fails every box test */
     s->f = s->a = NAN;
     s->fx = s->fy = s->ax = s->ay = NAN;
@@ -194,13 +199,25 @@ static void replace_ev(const oc_enode *n, double x, double y, int want,
   int grad = want & OC_EV_GRAD, in;
   const oc_enode *A = n->kids[0], *B = n->kids[1];
   oc_enode_sample a, b;
+  int lerp = n->par[P_LERP] != 0;
+  if (want & OC_EV_ALPHA) { /* alpha_A, or lerped with B's */
+    oc_enode_ev(A, x, y, OC_EV_ALPHA, &a);
+    s->a = a.a;
+    if (lerp) {
+      b.a = 0;
+      if (x >= B->box.x0 && x <= B->box.x1 && y >= B->box.y0 && y <= B->box.y1)
+        oc_enode_ev(B, x, y, OC_EV_ALPHA, &b);
+      double w = clamp01(b.a, &in);
+      s->a = (1 - w) * a.a + w * w;
+    }
+    return;
+  }
   b.a = b.f = b.fx = b.fy = b.ax = b.ay = 0;
   if (x >= B->box.x0 && x <= B->box.x1 && y >= B->box.y0 && y <= B->box.y1)
     oc_enode_ev(B, x, y, grad | OC_EV_LAZY, &b);
   double w = clamp01(b.a, &in);
   /* A's f is not needed where B replaces it wholly, nor, for a lazy
   ** caller, where A's weight (the node's, unless lerped) is 0 */
-  int lerp = n->par[P_LERP] != 0;
   int alazy = w >= 1 || (!lerp && (want & OC_EV_LAZY));
   oc_enode_ev(A, x, y, grad | (alazy ? OC_EV_LAZY : 0), &a);
   if (w >= 1) {
@@ -252,7 +269,6 @@ static void replace_combine(const oc_enode *n, const oc_ebound *A,
   }
 }
 
-
 static oc_enode *binary(oc_ekind kind, oc_enode *a, oc_enode *b,
                         oc_error *err) {
   if (!a || !b) {
@@ -296,6 +312,18 @@ static void add_ev(const oc_enode *n, double x, double y, int want,
   const oc_enode *A = n->kids[0], *B = n->kids[1];
   oc_enode_sample a, b;
   int sumw = n->par[P_SUMW] != 0;
+  if (want & OC_EV_ALPHA) { /* alpha_A, or plus w_B^2 */
+    oc_enode_ev(A, x, y, OC_EV_ALPHA, &a);
+    s->a = a.a;
+    if (sumw) {
+      b.a = 0;
+      if (x >= B->box.x0 && x <= B->box.x1 && y >= B->box.y0 && y <= B->box.y1)
+        oc_enode_ev(B, x, y, OC_EV_ALPHA, &b);
+      double c = clamp01(b.a, &in);
+      s->a += c * c;
+    }
+    return;
+  }
   /* alpha_A + w^2 may be > 0 where alpha_A = 0: then f_A is needed */
   oc_enode_ev(A, x, y, sumw ? grad : want, &a);
   if (want & OC_EV_LAZY && a.a == 0 && !sumw) {
@@ -403,6 +431,7 @@ static void xform_ev(const oc_enode *n, double x, double y, int want,
   oc_enode_ev(n->kids[0], m[0] * u + m[1] * v, m[2] * u + m[3] * v, want, &c);
   double vs = n->par[P_VS];
   s->a = c.a;
+  if (want & OC_EV_ALPHA) return;
   if (want & OC_EV_LAZY && c.a == 0)
     s->f = 0;
   else
