@@ -1000,6 +1000,11 @@ typedef struct oc_elevation {
   void (*release)(void *ud);
   void *ud;
   double x0, y0, x1, y1; /* the domain: finite, x0 < x1, y0 < y1 */
+  /* Optional (NULL: range then slope): both at once, from one traversal
+  ** of a source's hierarchy (elevation trees); the tracer asks for both
+  ** on every segment. */
+  void (*bound)(void *ud, double x0, double y0, double x1, double y1,
+                double *lo, double *hi, double *slope);
 } oc_elevation;
 
 /* The source of a heightfield: its Catmull-Rom interpolant over the grid's

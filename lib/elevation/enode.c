@@ -228,6 +228,16 @@ static double src_slope(void *ud, double x0, double y0, double x1, double y1) {
   return b.lf;
 }
 
+static void src_bound(void *ud, double x0, double y0, double x1, double y1,
+                      double *lo, double *hi, double *slope) {
+  oc_ebound b;
+  oc_erect r = {x0, y0, x1, y1};
+  oc_enode_bnd(ud, &r, &b);
+  *lo = b.flo;
+  *hi = b.fhi;
+  *slope = b.lf;
+}
+
 static void src_retain(void *ud) {
   oc_enode_retain(ud);
 }
@@ -254,6 +264,7 @@ int oc_enode_elevation(oc_enode *e, const double *domain, oc_elevation *src,
   src->height = src_height;
   src->range = src_range;
   src->slope = src_slope;
+  src->bound = src_bound;
   src->retain = src_retain;
   src->release = src_release;
   src->ud = e;

@@ -158,12 +158,16 @@ static int march(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
       oc_vec3 q = at(o, u, t + e);
       double x0 = lesser(p.x, q.x), x1 = greater(p.x, q.x);
       double y0 = lesser(p.y, q.y), y1 = greater(p.y, q.y);
-      double lo, hi;
-      src->range(src->ud, x0, y0, x1, y1, &lo, &hi);
+      double lo, hi, lam = -1;
+      if (src->bound)
+        src->bound(src->ud, x0, y0, x1, y1, &lo, &hi, &lam);
+      else
+        src->range(src->ud, x0, y0, x1, y1, &lo, &hi);
       if (lesser(p.z, q.z) > hi) {
         s = e; /* above everything the segment's box holds */
       } else {
-        s = safe_step(h, u.z, uxy, src->slope(src->ud, x0, y0, x1, y1), e);
+        if (lam < 0) lam = src->slope(src->ud, x0, y0, x1, y1);
+        s = safe_step(h, u.z, uxy, lam, e);
         /* a descending ray is free, too, until it comes down to hi (the
         ** candidate grows from the slope's step: the range's may end
         ** right above a slope) */

@@ -261,6 +261,7 @@ int oc_heightfield_elevation(oc_heightfield *hf, oc_elevation *src,
   src->slope = hf_slope;
   src->retain = hf_retain;
   src->release = hf_release;
+  src->bound = NULL; /* range and slope, each from the pyramid */
   src->ud = s;
   src->x0 = s->x0;
   src->y0 = s->y0;

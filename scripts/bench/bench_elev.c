@@ -441,6 +441,10 @@ static void run_scene(const char *name, void (*build)(scene *), int prims,
          "AO\n",
          name, s.what[0] == '#' ? s.what + 2 : s.what, s.prims, s.ops,
          es_st.nodes, 100 * st.hits / n, cpu, st.calls_total_per_pixel);
+  double box[4], flo, fhi;
+  oc_enode_get_bounds(s.root, box, &flo, &fhi);
+  printf("# %s: f in [%.0f, %.0f] m, Lipschitz bound %.3g\n", name, flo, fhi,
+         oc_enode_lipschitz(s.root));
   printf("elev.calls_per_pixel.%s: %.1f calls\n", name, st.calls_per_pixel);
   printf("elev.render_hd_seconds_2t.%s: %.2f s\n", name, secs);
   printf("elev.bytes.%s: %zu B\n", name, es_st.bytes);
@@ -478,6 +482,7 @@ int main(int argc, char **argv) {
                 {"fig21", fig21, 50, 25}, {"fig22", fig22, 148, 9}};
   /* bench_elev [scene...]: only those (hf for the heightfield) */
   if (argc > 1 && !strcmp(argv[1], "-q")) shrink = 4, argc--, argv++;
+  if (argc > 1 && !strcmp(argv[1], "-qq")) shrink = 8, argc--, argv++;
   int hf = argc < 2;
   for (int a = 1; a < argc; a++)
     hf |= !strcmp(argv[a], "hf");

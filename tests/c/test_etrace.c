@@ -55,8 +55,8 @@ static double wave_slope(void *ud, double x0, double y0, double x1, double y1) {
 static wave WAVE = {40, 10, 60};
 
 static oc_elevation wave_source(void) {
-  oc_elevation e = {wave_h, wave_range, wave_slope, NULL, NULL,
-                    &WAVE,  -500,       -500,       500,  500};
+  oc_elevation e = {wave_h, wave_range, wave_slope, NULL, NULL, &WAVE,
+                    -500,   -500,       500,        500,  NULL};
   return e;
 }
 
