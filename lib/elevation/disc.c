@@ -167,6 +167,16 @@ void oc_edisc_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
   /* rounding: alpha's bounds a hair wider than the formula */
   o->alo = fmax(0, wyvill(dmax / r) * (1 - 1e-12) - 1e-300);
   o->ahi = fmin(1, wyvill(dmin / r) * (1 + 1e-12));
+  /* |grad alpha| = 6 x (1 - x^2)^2 / r at x = d / r rises up to x =
+  ** 1/sqrt(5) (the global bound) and falls after: its largest value on
+  ** [dmin, dmax] is there or at the end nearer to it */
+  double x0 = dmin / r, x1 = fmin(dmax / r, 1), xs = 1 / sqrt(5.0);
+  if (x0 >= 1) {
+    o->la = 0; /* outside the disc: alpha = 0 on the whole box */
+  } else if (x1 < xs || x0 > xs) {
+    double x = x1 < xs ? x1 : x0, k = 1 - x * x;
+    o->la = fmin(o->la, 6 * x * k * k / r * (1 + 1e-12));
+  }
 }
 
 static int check_noise(const oc_enode_noise *nz, oc_enoise *out,
