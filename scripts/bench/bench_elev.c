@@ -230,7 +230,7 @@ static void fig1(scene *s) {
   s->half = 1000;
   int n = 0;
   k[n++] = base(s, 60, OC_ENOISE_PLAIN, 40, 700, 7);
-  n += hills(s, k + n, 48, 150, 400, 40, 220, OC_ENOISE_RIDGED, 0.8, 6);
+  n += hills(s, k + n, 48, 150, 400, 40, 220, OC_ENOISE_PLAIN, 1.0, 5);
   oc_enode *t = blend(s, k, n);
   int m = hills(s, b, 12, 60, 150, 8, 25, OC_ENOISE_PLAIN, 1, 4);
   t = add(s, t, blend(s, b, m), 0, 0);
@@ -257,14 +257,14 @@ static void fig3(scene *s) {
   s->half = 500;
   int n = 0;
   k[n++] = base(s, 40, OC_ENOISE_PLAIN, 25, 400, 7);
-  n += hills(s, k + n, 16, 100, 260, 30, 140, OC_ENOISE_RIDGED, 0.7, 6);
+  n += hills(s, k + n, 16, 100, 260, 30, 140, OC_ENOISE_PLAIN, 1.0, 5);
   k[n++] = disc(s, -200, 250, 150, 12, OC_ENOISE_TURBULENCE, 8, 80, 5);
   oc_enode *t = blend(s, k, n);
   t = add(s, t, disc(s, 250, -200, 130, 10, OC_ENOISE_TURBULENCE, 7, 70, 5), 0,
           0);
   path(s, p, 12, -500, -350, 500, 350, 30, 20, 80, 1.5);
   s->root = replace(s, t, river(s, p, 12, OC_RIVER_RIVER));
-  s->what = "a river in ridged hills, turbulent rocks added";
+  s->what = "a river in hills, turbulent rocks added";
   s->eye = (oc_vec3){-700, -750, 300};
   s->target = (oc_vec3){50, 50, 40};
   s->fov = 45;
@@ -300,8 +300,8 @@ static void fig20(scene *s) {
   oc_vec3 p[4][12];
   s->half = 1000;
   int n = 0;
-  k[n++] = base(s, 80, OC_ENOISE_RIDGED, 60, 900, 7);
-  n += hills(s, k + n, 47, 120, 380, 60, 260, OC_ENOISE_RIDGED, 0.8, 6);
+  k[n++] = base(s, 80, OC_ENOISE_PLAIN, 60, 900, 7);
+  n += hills(s, k + n, 47, 120, 380, 60, 260, OC_ENOISE_PLAIN, 1.0, 5);
   oc_enode *t = blend(s, k, n);
   for (int j = 0; j < 2; j++) { /* rocks */
     int m = hills(s, b, 10, 50, 120, 5, 20, OC_ENOISE_TURBULENCE, 1, 4);
@@ -317,7 +317,7 @@ static void fig20(scene *s) {
   t = replace(s, t, river(s, p[0], 12, OC_RIVER_RIVER));
   t = replace(s, t, river(s, p[1], 10, OC_RIVER_STREAM));
   s->root = replace(s, t, road(s, p[2], 10));
-  s->what = "ridged hills, rocks, seven terraces, two streams, a road";
+  s->what = "hills, rocks, seven terraces, two streams, a road";
   s->eye = (oc_vec3){1400, -1500, 700};
   s->target = (oc_vec3){-50, 80, 80};
   s->fov = 45;
@@ -365,7 +365,7 @@ static void fig22(scene *s) {
     double y = urand(s, -300, 300);
     k[n++] =
         disc(s, urand(s, -300, 300), y, urand(s, 80, 160),
-             90 + 0.25 * y + urand(s, -10, 10), OC_ENOISE_RIDGED, 12, 90, 5);
+             90 + 0.25 * y + urand(s, -10, 10), OC_ENOISE_PLAIN, 12, 120, 5);
   }
   oc_enode *h = blend(s, k, n);
   int m = hills(s, b, 60, 6, 20, 1, 4, OC_ENOISE_PLAIN, 1, 3);
