@@ -156,11 +156,54 @@ static double wyvill(double x) {
   return k * k * k;
 }
 
+/* The range of a plain or turbulent noise sum on a box of centre (u, v)
+** and half-diagonal rho (relative to the disc's centre): each octave's
+** value at the centre, give or take its Lipschitz bound times rho, within
+** its own range. Octaves whose wavelength is below rho keep their whole
+** range; 0 when the first octave already does (nothing to gain). */
+static int noise_range_in(const oc_enoise *nz, double u, double v, double rho,
+                          double *lo, double *hi) {
+  double le = 2 * oc_noise3_lipschitz, a = nz->amplitude,
+         s = 1 / nz->wavelength;
+  if (!(le * s * rho < 1)) return 0;
+  double l = 0, h = 0;
+  for (int i = 0; i < nz->octaves; i++) {
+    double d = le * s * rho;
+    if (d >= 1) { /* this one and the finer ones: their whole range */
+      for (; i < nz->octaves; i++, a *= nz->gain)
+        l -= nz->kind == OC_ENOISE_PLAIN ? a : 0, h += a;
+      break;
+    }
+    double e = oc_eta(octave_seed(nz->seed, i), s * u, s * v, NULL);
+    if (nz->kind == OC_ENOISE_TURBULENCE) {
+      e = fabs(e); /* |eta| is as Lipschitz as eta */
+      l += a * fmax(0, e - d), h += a * fmin(1, e + d);
+    } else {
+      l += a * fmax(-1, e - d), h += a * fmin(1, e + d);
+    }
+    a *= nz->gain;
+    s *= nz->lacunarity;
+  }
+  /* rounding of the sums: a relative hair */
+  double pad = 1e-12 * (fabs(l) + fabs(h) + nz->amplitude);
+  *lo = l - pad, *hi = h + pad;
+  return 1;
+}
+
 void oc_edisc_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
   *o = n->glob;
   if (!oc_erect_meets(&n->box, b)) {
     o->alo = o->ahi = o->la = 0;
     return;
+  }
+  double nlo, nhi;
+  if ((n->noise.kind == OC_ENOISE_PLAIN ||
+       n->noise.kind == OC_ENOISE_TURBULENCE) &&
+      noise_range_in(&n->noise, 0.5 * (b->x0 + b->x1) - n->par[0],
+                     0.5 * (b->y0 + b->y1) - n->par[1],
+                     0.5 * hypot(b->x1 - b->x0, b->y1 - b->y0), &nlo, &nhi)) {
+    o->flo = fmax(o->flo, n->par[3] + nlo);
+    o->fhi = fmin(o->fhi, n->par[3] + nhi);
   }
   double dmin, dmax, r = n->par[2];
   rect_dist(b, n->par[0], n->par[1], &dmin, &dmax);

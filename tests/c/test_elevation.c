@@ -149,6 +149,22 @@ START_TEST(disc_noises) {
     for (int i = 0; i < 100; i++)
       check_gradient(d, oct_unif(&r, -90, 90), oct_unif(&r, -90, 90), 2e-4);
     check_bounds(d, 0, 0, 100);
+    /* in a box much smaller than the wavelength, plain and turbulent sums
+    ** are bounded from the octaves' values at its centre: the range is a
+    ** fraction of the whole plane's (2 lambda rho for the first octave) */
+    oc_enode_bound b;
+    oc_enode_bound_in(d, 10, 10, 11, 11, &b);
+    if (kinds[k] != OC_ENOISE_RIDGED)
+      ck_assert_msg(b.fhi - b.flo < 0.7 * (hi - lo), "%s: [%g, %g] in [%g, %g]",
+                    oc_enode_kind(d), b.flo, b.fhi, lo, hi);
+    /* alpha's slope: 0 on a box of the square outside the circle, below
+    ** the global bound near the centre (x < 1/sqrt(5)) */
+    oc_enode_bound_in(d, 80, 80, 99, 99, &b);
+    ck_assert(b.la == 0 && b.ahi == 0);
+    oc_enode_bound_in(d, -10, -10, 10, 10, &b);
+    double x = hypot(10, 10) / 100, kk = 1 - x * x;
+    ck_assert_double_eq_tol(b.la, 6 * x * kk * kk / 100, 1e-12);
+    ck_assert(b.la < 0.9 * 1.7173002067198386 / 100);
     oc_enode_release(d);
   }
 }
