@@ -153,8 +153,12 @@ static void blend_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
   }
   size_t m = 0;
   for (size_t i = 0; i < n->nkids; i++)
-    if (oc_erect_meets(&n->kids[i]->box, b))
-      oc_enode_bnd(n->kids[i], b, &kb[m++]);
+    if (oc_erect_meets(&n->kids[i]->box, b)) {
+      oc_enode_bnd(n->kids[i], b, &kb[m]);
+      /* alpha = 0 on the whole box: neither the child's f nor its
+      ** weight's slope counts there */
+      m += kb[m].ahi > 0;
+    }
   blend_combine(kb, m, o);
   if (kb != stack) free(kb);
 }
