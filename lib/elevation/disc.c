@@ -20,6 +20,11 @@
 /* Ridged octaves: w_i = clamp(RIDGE_GAIN s_(i-1), 0, 1). */
 #define RIDGE_GAIN 2.0
 
+/* Ranges in a box evaluate at most this many octaves at its centre: the
+** first ones hold most of the amplitude (gain^i), and each costs as much
+** as in a height call. */
+#define RANGE_OCTAVES 3
+
 double oc_eta(uint64_t seed, double x, double y, double g[2]) {
   oc_vec3 gr;
   double n = oc_noise3(seed, oc_v3(x, y, 0), g ? &gr : NULL);
@@ -169,7 +174,7 @@ static int noise_range_in(const oc_enoise *nz, double u, double v, double rho,
   double l = 0, h = 0;
   for (int i = 0; i < nz->octaves; i++) {
     double d = le * s * rho;
-    if (d >= 1) { /* this one and the finer ones: their whole range */
+    if (d >= 1 || i >= RANGE_OCTAVES) { /* the finer ones: whole ranges */
       for (; i < nz->octaves; i++, a *= nz->gain)
         l -= nz->kind == OC_ENOISE_PLAIN ? a : 0, h += a;
       break;
