@@ -5,6 +5,7 @@
 ** sampling, rendering).
 */
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -16,9 +17,27 @@
 static const char *const kind_names[OC_E_COUNT] = {
     "disc", "curve", "blend", "replace", "add", "transform", "warp"};
 
+/* 1 + the parameters each kind stores (disc.c, ecurve.c, eops.c); 0, a
+** kind not listed: OC_ENODE_NPAR. */
+static const unsigned char par_counts[OC_E_COUNT] = {
+    [OC_E_DISC] = 1 + 4,    [OC_E_CURVE] = 1 + 2, [OC_E_BLEND] = 1 + 0,
+    [OC_E_REPLACE] = 1 + 1, [OC_E_ADD] = 1 + 4,   [OC_E_XFORM] = 1 + 11,
+    [OC_E_WARP] = 1 + 2};
+
+static size_t par_count(oc_ekind kind) {
+  unsigned c = (unsigned)kind < OC_E_COUNT ? par_counts[kind] : 0;
+  return c ? c - 1 : OC_ENODE_NPAR;
+}
+
+size_t oc_enode_size(const oc_enode *n) {
+  return offsetof(oc_enode, par) + par_count(n->kind) * sizeof(double) +
+         (n->kids != n->inl ? n->nkids * sizeof *n->kids : 0);
+}
+
 oc_enode *oc_enode_alloc(oc_ekind kind, oc_enode *const *kids, size_t nkids,
                          oc_error *err) {
-  oc_enode *n = calloc(1, sizeof *n);
+  oc_enode *n =
+      calloc(1, offsetof(oc_enode, par) + par_count(kind) * sizeof(double));
   if (!n) {
     oc_seterr(err, OC_ENOMEM, "out of memory");
     return NULL;
@@ -149,8 +168,7 @@ int oc_enode_get_stats(const oc_enode *e, oc_enode_stats *st, oc_error *err) {
     const oc_enode *x = stack[--n];
     st->nodes++;
     st->primitives += x->kind == OC_E_DISC || x->kind == OC_E_CURVE;
-    st->bytes +=
-        sizeof *x + (x->kids != x->inl ? x->nkids * sizeof *x->kids : 0);
+    st->bytes += oc_enode_size(x);
     for (size_t i = 0; i < x->nkids; i++) {
       const oc_enode *k = x->kids[i];
       if (oc_pmap_slot(&seen, k, 0)) continue;

@@ -57,10 +57,17 @@ struct oc_enode {
   oc_enode *inl[2];
   oc_erect box;   /* Omega_0 lies inside */
   oc_ebound glob; /* over the whole plane */
-  double par[12];
   oc_enoise noise;
   void *data; /* curve: skeleton and profiles (ecurve.c), owned */
+  /* Parameters, as many as the kind uses (enode.c, par_count): a blend
+  ** stores none, a transform 11; kinds not in that table get
+  ** OC_ENODE_NPAR. Last, so that each node is allocated at its size. */
+  double par[];
 };
+#define OC_ENODE_NPAR 12
+
+/* The bytes of n, its children's array included. */
+size_t oc_enode_size(const oc_enode *n);
 
 /* What a caller asks of eval. */
 #define OC_EV_GRAD 1 /* gradients too */
