@@ -130,7 +130,12 @@ static void blend_combine(const oc_ebound *kb, size_t n, oc_ebound *o) {
     M += kb[i].la * fmax(fabs(kb[i].flo), fabs(kb[i].fhi));
   }
   double lam = fmin(lasum, (double)(n - 1) * lamax);
-  o->lf = lmax + lam * (fhi - flo) / fmax(slo, T);
+  /* sum |grad alpha_i| |f_i - f| with f in [flo, fhi]: each child's own
+  ** distance to that range is often far below its width */
+  double dev = 0;
+  for (size_t i = 0; i < n; i++)
+    dev += kb[i].la * fmax(kb[i].fhi - flo, fhi - kb[i].flo);
+  o->lf = lmax + fmin(lam * (fhi - flo), dev) / fmax(slo, T);
   if (slo < T) { /* f fades towards 0 where sum alpha < T */
     o->lf = fmax(o->lf, lmax + M / T);
     flo = fmin(flo, 0);
@@ -361,9 +366,15 @@ static void add_combine(const oc_enode *n, const oc_ebound *A,
   double chi = bmeets ? fmin(fmax(B->ahi, 0), 1) : 0;
   double lc = bmeets ? B->la : 0;
   *o = *A;
-  if (chi > 0) {
-    double wlo = clo, whi = chi, lw = lc;
-    if (n->par[P_BELOW] != 0) {
+  /* the altitude weight is 0 on the region where f_A >= below_z, 1
+  ** where f_A <= below_z - fade (with a hair for the rounding of t) */
+  int below = n->par[P_BELOW] != 0;
+  double bz = n->par[P_BZ], fade = n->par[P_FADE], fchi = chi;
+  if (below && A->flo >= bz) fchi = 0;
+  if (below && A->fhi < bz - fade * (1 + 1e-9) - 1e-9 * fabs(bz)) below = 0;
+  if (fchi > 0) {
+    double wlo = clo, whi = fchi, lw = lc;
+    if (below) {
       wlo = 0; /* the altitude weight may be 0 */
       lw = lc + 1.5 / n->par[P_FADE] * A->lf;
     }

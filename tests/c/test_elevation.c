@@ -252,6 +252,31 @@ START_TEST(replace_and_add_formulas) {
   check_bounds(lerp, 5, 5, 30);
   check_bounds(add, 5, 5, 30);
   check_bounds(addb, 5, 5, 30);
+  /* in boxes where f_A >= below_z, the altitude weight is 0: addb is A
+  ** there; where f_A <= below_z - fade, it is 1: addc (below 16) is add */
+  oc_enode_add_params cp = {1, 1, 16, 3}, sp = {1, 0, 0, 0};
+  oc_enode *addc = EOK(oc_enode_add(a, b, &cp, &err));
+  oc_enode *adds = EOK(oc_enode_add(a, b, &sp, &err));
+  int above = 0, under = 0;
+  for (int i = 0; i < 400; i++) {
+    double x0 = oct_unif(&r, -6, 16), y0 = oct_unif(&r, -6, 16);
+    oc_enode_bound ba, bb, bc, bd;
+    oc_enode_bound_in(a, x0, y0, x0 + 0.2, y0 + 0.2, &ba);
+    oc_enode_bound_in(addb, x0, y0, x0 + 0.2, y0 + 0.2, &bb);
+    oc_enode_bound_in(addc, x0, y0, x0 + 0.2, y0 + 0.2, &bc);
+    oc_enode_bound_in(adds, x0, y0, x0 + 0.2, y0 + 0.2, &bd);
+    if (ba.flo >= 9) {
+      above++;
+      ck_assert(bb.lf == ba.lf && bb.flo == ba.flo && bb.fhi == ba.fhi);
+    }
+    if (ba.fhi < 13 - 1e-6) {
+      under++;
+      ck_assert(bc.lf == bd.lf && bc.flo == bd.flo && bc.fhi == bd.fhi);
+    }
+  }
+  ck_assert_msg(above > 0 && under > 0, "above %d, under %d", above, under);
+  oc_enode_release(addc);
+  oc_enode_release(adds);
   oc_enode *all[6] = {a, b, rep, lerp, add, addb};
   for (int i = 0; i < 6; i++)
     oc_enode_release(all[i]);
