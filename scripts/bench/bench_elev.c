@@ -14,6 +14,15 @@
 ** (geometry pass only; figure 1's at a quarter of the size in each axis,
 ** since sphere tracing there takes minutes). Prints `name: value unit`
 ** lines; '#' lines are context.
+**
+** The scenes are plausible terrains, not copies of the paper's: a base
+** disc covering the scene (alpha >= 1/2 everywhere), noisy hills, rocks
+** added, rivers and roads replaced in; counts are checked against Table
+** 1. Calls count height calls only (the tracer's range and slope
+** queries, one per step, are not counted, as the paper counts calls of
+** f). `bench_elev [-q | -qq] [hf] [fig1 ...]`: those scenes only, every
+** image 4 or 8 times smaller in each axis with -q and -qq (for work on
+** the code: the figures then are not the HD ones).
 */
 #include <math.h>
 #include <omp.h>
