@@ -80,13 +80,17 @@ static int clip(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double *t0,
   return 1;
 }
 
-/* h at p, one height call; *solid: the weight allows a surface there. */
+/* h at p, one height call; with solid, *solid: the weight allows a
+** surface there, asked only under the surface (h <= 0 or NaN), the one
+** place where a caller reads it. */
 static double height_above(const oc_etracer *tr, oc_vec3 p, int *solid,
                            double *n) {
   const oc_esurface *s = tr->s;
   (*n)++;
-  *solid = !s->weight || s->weight(s->wud, p.x, p.y) >= s->T;
-  return p.z - s->src->height(s->src->ud, p.x, p.y, NULL);
+  double h = p.z - s->src->height(s->src->ud, p.x, p.y, NULL);
+  if (solid)
+    *solid = h > 0 || !s->weight || s->weight(s->wud, p.x, p.y) >= s->T;
+  return h;
 }
 
 /* h(a) = ha > 0 >= h(b) = hb: regula falsi (Illinois), down to a small
@@ -94,11 +98,11 @@ static double height_above(const oc_etracer *tr, oc_vec3 p, int *solid,
 static double refine(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double a,
                      double ha, double b, double hb, double d0, double *n) {
   double stop = 1e-3 * tol(tr, d0, a);
-  int side = 0, solid;
+  int side = 0;
   for (int k = 0; k < 24 && b - a > stop; k++) {
     double m = a + (b - a) * (ha / (ha - hb));
     if (!(m > a && m < b) || k % 4 == 3) m = 0.5 * (a + b);
-    double h = height_above(tr, at(o, u, m), &solid, n);
+    double h = height_above(tr, at(o, u, m), NULL, n);
     if (h > 0) {
       a = m, ha = h;
       if (side == -1) hb *= 0.5;
