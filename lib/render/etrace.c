@@ -30,6 +30,14 @@
 #include "render/trace.h"
 
 #define GROW 2.0 /* candidate step after a step s: GROW s */
+/* Over-relaxation of slope-limited steps (Keinert et al. 2014): a step of
+** RELAX s is kept when the free stretch before its sample (h over the
+** slope backwards) meets the stretch s proved free after the last one,
+** else the ray goes back to the plain step. */
+#define RELAX 1.6
+/* A ray whose relaxed steps failed this often (the slope bound is tight
+** there) goes on with plain steps. */
+#define MAX_FAILS 1
 
 void oc_etracer_init(oc_etracer *tr, const oc_esurface *s,
                      oc_render_tracer mode, double eps_k, double eps_min) {
@@ -142,12 +150,26 @@ static int march(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
                  double t1, double d0, double *thit, double *n) {
   const oc_elevation *src = tr->s->src;
   double uxy = hypot(u.x, u.y), delta = (t1 - t) / 16, prev = t, hp = 0;
-  int accel = tr->mode == OC_TRACE_SEGMENT, have_prev = 0;
+  int accel = tr->mode == OC_TRACE_SEGMENT, have_prev = 0, relaxed = 0;
+  double rsafe = 0, rlam = 0; /* a relaxed step's plain step and slope */
+  int fails = 0;              /* of relaxed steps on this ray */
   for (long k = 0; k < OC_TRACE_MAX_STEPS; k++) {
     oc_vec3 p = at(o, u, t);
     int solid;
     double h = height_above(tr, p, &solid, n);
     if (h != h) return 0; /* NaN: no surface can be located */
+    if (relaxed) {
+      /* from t back to prev + rsafe the ray is free when h > 0 and
+      ** h / (u_z + |u_xy| lambda) reaches there (the slope holds on the
+      ** box of the whole candidate) */
+      double kb = u.z + uxy * rlam;
+      relaxed = 0;
+      if (!(h > 0 && (kb <= 0 || prev + rsafe + h / kb >= t))) {
+        t = prev + rsafe; /* not proved: the plain step */
+        fails++;
+        continue;
+      }
+    }
     if (solid && h <= 0) {
       if (!(have_prev && hp > 0)) {
         *thit = t; /* through a side of the domain or of a hole */
@@ -156,7 +178,7 @@ static int march(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
       *thit = tr->refine ? refine(tr, o, u, prev, hp, t, h, d0, n) : t;
       return 1;
     }
-    double s, grow = -1;
+    double s, grow = -1, rlam_of_step = 0;
     if (accel) {
       double e = lesser(delta, t1 - t);
       oc_vec3 q = at(o, u, t + e);
@@ -172,6 +194,7 @@ static int march(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
       } else {
         if (lam < 0) lam = src->slope(src->ud, x0, y0, x1, y1);
         s = safe_step(h, u.z, uxy, lam, e);
+        rlam_of_step = lam;
         /* a descending ray is free, too, until it comes down to hi (the
         ** candidate grows from the slope's step: the range's may end
         ** right above a slope) */
@@ -184,6 +207,14 @@ static int march(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
     s = greater(s, tol(tr, d0, t));
     if (t + s > t1 || t + s == t) return 0; /* left the box */
     prev = t, hp = h, have_prev = 1;
+    if (accel && fails < MAX_FAILS && grow >= 0 && h > 0 && s == grow) {
+      /* limited by the slope: try a longer step within the candidate */
+      double e = lesser(delta, t1 - t), r = lesser(RELAX * s, e);
+      if (r > s) {
+        relaxed = 1, rsafe = s, rlam = rlam_of_step;
+        s = r;
+      }
+    }
     t += s;
     delta = GROW * (grow >= 0 ? greater(grow, tol(tr, d0, t)) : s);
   }
