@@ -9,6 +9,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "elevation/enode.h"
 #include "ocheck.h"
 
 #define PI 3.14159265358979323846
@@ -348,7 +349,14 @@ START_TEST(dag_stats_and_source) {
   ck_assert_int_eq(oc_enode_get_stats(e, &st, &err), OC_OK);
   ck_assert_uint_eq(st.nodes, 4); /* hill shared */
   ck_assert_uint_eq(st.primitives, 2);
+  /* nodes are allocated at their kind's size: a disc stores 4
+  ** parameters, a transform 11, a blend none but its 3 children */
   ck_assert(st.bytes > 0 && st.bytes <= 4 * 400);
+  size_t head = oc_enode_size(e) - 3 * sizeof(oc_enode *);
+  ck_assert_uint_eq(oc_enode_size(base), head + 4 * sizeof(double));
+  ck_assert_uint_eq(oc_enode_size(moved), head + 11 * sizeof(double));
+  ck_assert_uint_eq(st.bytes, head * 4 + 3 * sizeof(oc_enode *) +
+                                  (4 + 4 + 11) * sizeof(double));
   /* the source answers the tree's own values and bounds */
   oc_elevation src;
   ck_assert_int_eq(oc_enode_elevation(e, NULL, &src, &err), OC_OK);
@@ -365,6 +373,11 @@ START_TEST(dag_stats_and_source) {
   oc_enode_bound_in(e, 50, -50, 150, 50, &b);
   ck_assert(lo == b.flo && hi == b.fhi);
   ck_assert(src.slope(src.ud, 50, -50, 150, 50) == b.lf);
+  /* the joint callback: the same range and slope from one traversal */
+  double blo, bhi, bl;
+  ck_assert(src.bound != NULL);
+  src.bound(src.ud, 50, -50, 150, 50, &blo, &bhi, &bl);
+  ck_assert(blo == b.flo && bhi == b.fhi && bl == b.lf);
   /* a terrain over it: its surface is f where the base covers */
   oc_terrain_params tp = {0};
   tp.falloff = 20;
