@@ -12,7 +12,10 @@
 **    range (and, descending, up to where it comes down to the range's
 **    top, when that is farther than the slope's step), and doubles the
 **    candidate delta after each step, so that it strides over flat ground
-**    and far from the surface.
+**    and far from the surface. A step the slope limits is over-relaxed
+**    (kept only when the slope proves the stretch behind its sample free
+**    too), and the range and slope come from one query (oc_elevation's
+**    bound, when the source has it).
 **  - Sphere tracing (`OC_TRACE_SPHERE`, section 7.1) uses the slope bound of
 **    the whole domain for every step: the baseline the paper compares to.
 ** Both clip the ray to the domain x [min f, max f] first, never step below
