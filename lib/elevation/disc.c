@@ -108,8 +108,9 @@ static void noise_bounds(const oc_enoise *nz, double *lo, double *hi,
   *lip = l;
 }
 
-void oc_edisc_ev(const oc_enode *n, double x, double y, int want,
-                 oc_enode_sample *s) {
+void oc_edisc_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                 int want, oc_enode_sample *s) {
+  (void)ft;
   const double *p = n->par; /* cx, cy, r, height */
   double u = x - p[0], v = y - p[1], r = p[2];
   double q = (u * u + v * v) / (r * r);
@@ -155,7 +156,9 @@ static double wyvill(double x) {
   return k * k * k;
 }
 
-void oc_edisc_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+void oc_edisc_bound_in(const oc_enode *n, const oc_erect *b,
+                       const oc_efootb *fb, oc_ebound *o) {
+  (void)fb;
   *o = n->glob;
   if (!oc_erect_meets(&n->box, b)) {
     o->alo = o->ahi = o->la = 0;

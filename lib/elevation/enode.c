@@ -74,23 +74,24 @@ const char *oc_enode_kind(const oc_enode *e) {
   return e && (unsigned)e->kind < OC_E_COUNT ? kind_names[e->kind] : "?";
 }
 
-void oc_enode_ev(const oc_enode *n, double x, double y, int want,
-                 oc_enode_sample *s) {
+void oc_enode_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                 int want, oc_enode_sample *s) {
   if (n->kind == OC_E_DISC)
-    oc_edisc_ev(n, x, y, want, s);
+    oc_edisc_ev(n, x, y, ft, want, s);
   else if (n->kind == OC_E_CURVE)
-    oc_ecurve_ev(n, x, y, want, s);
+    oc_ecurve_ev(n, x, y, ft, want, s);
   else
-    oc_eop_ev(n, x, y, want, s);
+    oc_eop_ev(n, x, y, ft, want, s);
 }
 
-void oc_enode_bnd(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+void oc_enode_bnd(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
+                  oc_ebound *o) {
   if (n->kind == OC_E_DISC)
-    oc_edisc_bound_in(n, b, o);
+    oc_edisc_bound_in(n, b, fb, o);
   else if (n->kind == OC_E_CURVE)
-    oc_ecurve_bound_in(n, b, o);
+    oc_ecurve_bound_in(n, b, fb, o);
   else
-    oc_eop_bound_in(n, b, o);
+    oc_eop_bound_in(n, b, fb, o);
 }
 
 /* ---- public queries --------------------------------------------------- */
@@ -100,13 +101,13 @@ void oc_enode_eval(const oc_enode *e, double x, double y, oc_enode_sample *s) {
     s->f = s->a = s->fx = s->fy = s->ax = s->ay = NAN;
     return;
   }
-  oc_enode_ev(e, x, y, OC_EV_GRAD, s);
+  oc_enode_ev(e, x, y, NULL, OC_EV_GRAD, s);
 }
 
 double oc_enode_weight(const oc_enode *e, double x, double y) {
   if (!isfinite(x) || !isfinite(y)) return NAN;
   oc_enode_sample s;
-  oc_enode_ev(e, x, y, OC_EV_LAZY, &s);
+  oc_enode_ev(e, x, y, NULL, OC_EV_LAZY, &s);
   return s.a;
 }
 
@@ -134,7 +135,7 @@ void oc_enode_bound_in(const oc_enode *e, double x0, double y0, double x1,
     b->flo = INFINITY, b->fhi = -INFINITY;
     return;
   }
-  oc_enode_bnd(e, &r, b);
+  oc_enode_bnd(e, &r, NULL, b);
 }
 
 int oc_enode_get_stats(const oc_enode *e, oc_enode_stats *st, oc_error *err) {
@@ -174,7 +175,7 @@ done:
 static void terrain_cells(const oc_enode *e, oc_erect r, int depth,
                           oc_erect *acc) {
   oc_ebound b;
-  oc_enode_bnd(e, &r, &b);
+  oc_enode_bnd(e, &r, NULL, &b);
   if (!(b.ahi >= OC_ENODE_T)) return;
   if (depth == 0 || b.alo >= OC_ENODE_T) {
     acc->x0 = fmin(acc->x0, r.x0);
@@ -204,7 +205,7 @@ int oc_enode_terrain_box(const oc_enode *e, double box[4]) {
 
 static double src_height(void *ud, double x, double y, double grad[2]) {
   oc_enode_sample s;
-  oc_enode_ev(ud, x, y, grad ? OC_EV_GRAD : 0, &s);
+  oc_enode_ev(ud, x, y, NULL, grad ? OC_EV_GRAD : 0, &s);
   if (grad) {
     grad[0] = s.fx;
     grad[1] = s.fy;
@@ -216,7 +217,7 @@ static void src_range(void *ud, double x0, double y0, double x1, double y1,
                       double *lo, double *hi) {
   oc_ebound b;
   oc_erect r = {x0, y0, x1, y1};
-  oc_enode_bnd(ud, &r, &b);
+  oc_enode_bnd(ud, &r, NULL, &b);
   *lo = b.flo;
   *hi = b.fhi;
 }
@@ -224,7 +225,7 @@ static void src_range(void *ud, double x0, double y0, double x1, double y1,
 static double src_slope(void *ud, double x0, double y0, double x1, double y1) {
   oc_ebound b;
   oc_erect r = {x0, y0, x1, y1};
-  oc_enode_bnd(ud, &r, &b);
+  oc_enode_bnd(ud, &r, NULL, &b);
   return b.lf;
 }
 

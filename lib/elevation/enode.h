@@ -22,7 +22,6 @@
 
 #include "outcrop.h"
 
-
 typedef enum oc_ekind {
   OC_E_DISC,
   OC_E_CURVE,
@@ -63,31 +62,50 @@ struct oc_enode {
   void *data; /* curve: skeleton and profiles (ecurve.c), owned */
 };
 
+/* Level of detail (lod.c): the pixel footprint where a node is evaluated,
+** in the node's local units (a transform divides it by its scale), with
+** its gradient there, so that a tree under a view is a genuine C1
+** function of p whose gradients include the footprint's terms. NULL (or
+** v = 0): full detail. */
+typedef struct oc_efoot {
+  double v, gx, gy;
+} oc_efoot;
+
+/* The footprint over a box: its range and a Lipschitz bound k of it
+** there. NULL: full detail. */
+typedef struct oc_efootb {
+  double lo, hi, k;
+} oc_efootb;
+
 /* What a caller asks of eval. */
 #define OC_EV_GRAD 1 /* gradients too */
 #define OC_EV_LAZY 2 /* f may be left 0 where alpha = 0 (blend children) */
 
-void oc_enode_ev(const oc_enode *n, double x, double y, int want,
-                 oc_enode_sample *s);
+void oc_enode_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                 int want, oc_enode_sample *s);
 
 /* Allocation (refs = 1) with nkids children retained from kids. */
 oc_enode *oc_enode_alloc(oc_ekind kind, oc_enode *const *kids, size_t nkids,
                          oc_error *err);
 
 /* Kinds' parts (disc.c, eops.c): evaluation and bounds in a box. */
-void oc_edisc_ev(const oc_enode *n, double x, double y, int want,
-                 oc_enode_sample *s);
-void oc_edisc_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o);
-void oc_ecurve_ev(const oc_enode *n, double x, double y, int want,
-                  oc_enode_sample *s);
-void oc_ecurve_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o);
+void oc_edisc_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                 int want, oc_enode_sample *s);
+void oc_edisc_bound_in(const oc_enode *n, const oc_erect *b,
+                       const oc_efootb *fb, oc_ebound *o);
+void oc_ecurve_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                  int want, oc_enode_sample *s);
+void oc_ecurve_bound_in(const oc_enode *n, const oc_erect *b,
+                        const oc_efootb *fb, oc_ebound *o);
 void oc_ecurve_free(void *data);
-void oc_eop_ev(const oc_enode *n, double x, double y, int want,
-               oc_enode_sample *s);
-void oc_eop_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o);
+void oc_eop_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+               int want, oc_enode_sample *s);
+void oc_eop_bound_in(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
+                     oc_ebound *o);
 
-/* The bound of n in box b (dispatch). */
-void oc_enode_bnd(const oc_enode *n, const oc_erect *b, oc_ebound *o);
+/* The bound of n in box b (dispatch), under the footprint fb. */
+void oc_enode_bnd(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
+                  oc_ebound *o);
 
 static inline int oc_erect_meets(const oc_erect *a, const oc_erect *b) {
   return a->x0 <= b->x1 && a->x1 >= b->x0 && a->y0 <= b->y1 && a->y1 >= b->y0;
