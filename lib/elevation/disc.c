@@ -34,22 +34,41 @@ static uint64_t octave_seed(uint64_t seed, int i) {
   return oc_mix64(seed + 0x9e3779b97f4a7c15ull * (uint64_t)(i + 1));
 }
 
-/* The noise sum at (u, v) = p - c, and its gradient in g when not NULL. */
-static double noise_sum(const oc_enoise *nz, double u, double v, double g[2]) {
+/* Continuous level of detail (lod.c): octave i weighted b(t_i), t_i =
+** log2(w_i / foot) = t0 - i dt, all with the gradient (gx, gy) of t. */
+typedef struct octlod {
+  double t0, dt, gx, gy;
+} octlod;
+
+/* The noise sum at (u, v) = p - c, and its gradient in g when not NULL;
+** under lod, octaves filtered (the term of octave i times b_i, plus the
+** term times grad b_i in g), and none evaluated past the first whose
+** weight is 0 (wavelengths only shrink). Without it, or where every b_i
+** is 1, the sum is bit for bit the unfiltered one. */
+static double noise_sum(const oc_enoise *nz, double u, double v, double g[2],
+                        const octlod *lod) {
   double sum = 0, a = nz->amplitude, s = 1 / nz->wavelength;
   double prev = 1, gprev[2] = {0, 0}; /* ridged: s_(i-1) and its gradient */
   if (g) g[0] = g[1] = 0;
   for (int i = 0; i < nz->octaves; i++) {
-    double ge[2];
+    double ge[2], bw = 1, db = 0, a0 = a;
+    if (lod) {
+      bw = oc_elod_b(lod->t0 - i * lod->dt, &db);
+      if (bw == 0) break;
+      a = a0 * bw;
+    }
     double e = oc_eta(octave_seed(nz->seed, i), s * u, s * v, g ? ge : NULL);
+    double term = 0; /* the octave's unfiltered term, where db != 0 */
     switch (nz->kind) {
     case OC_ENOISE_PLAIN:
       sum += a * e;
+      term = e;
       if (g) g[0] += a * s * ge[0], g[1] += a * s * ge[1];
       break;
     case OC_ENOISE_TURBULENCE: {
       double sg = e < 0 ? -1 : 1;
       sum += a * fabs(e);
+      term = fabs(e);
       if (g) g[0] += a * s * sg * ge[0], g[1] += a * s * sg * ge[1];
       break;
     }
@@ -69,6 +88,7 @@ static double noise_sum(const oc_enoise *nz, double u, double v, double g[2]) {
       }
       double t = w * r * r;
       sum += a * t;
+      term = t;
       if (g) {
         /* grad t = r^2 grad w - 2 w r sign(e) s grad eta */
         double k = -2 * w * r * sg * s;
@@ -77,28 +97,37 @@ static double noise_sum(const oc_enoise *nz, double u, double v, double g[2]) {
         g[0] += a * gprev[0];
         g[1] += a * gprev[1];
       }
-      prev = t;
+      prev = t; /* the chain runs on the unfiltered terms */
     }
     }
-    a *= nz->gain;
+    if (g && db != 0) {
+      g[0] += a0 * term * db * lod->gx;
+      g[1] += a0 * term * db * lod->gy;
+    }
+    a = a0 * nz->gain;
     s *= nz->lacunarity;
   }
   return sum;
 }
 
-/* Range and Lipschitz bound of the noise sum. */
-static void noise_bounds(const oc_enoise *nz, double *lo, double *hi,
-                         double *lip) {
+/* Range and Lipschitz bound of the noise sum, under footprints fb (NULL:
+** full detail): octave i weighted b_i in [0, bh], |grad b_i| <= lb, its
+** term (|term| <= 1) contributing a (bh lambda_term + lb). */
+static void noise_bounds(const oc_enoise *nz, const oc_efootb *fb, double *lo,
+                         double *hi, double *lip) {
   double a = nz->amplitude, s = 1 / nz->wavelength, asum = 0, l = 0, lr = 0;
   double le = 2 * oc_noise3_lipschitz;
   for (int i = 0; i < nz->octaves; i++) {
-    asum += a;
+    double bh = 1, lb = 0, bl;
+    if (fb) oc_elod_kappa_bound(1 / s, fb, &bl, &bh, &lb);
+    if (bh == 0) break;
+    asum += a * bh;
     if (nz->kind == OC_ENOISE_RIDGED) {
       /* |grad s_i| <= G |grad s_(i-1)| + 2 lambda_eta s_i */
       lr = (i ? RIDGE_GAIN * lr : 0) + 2 * le * s;
-      l += a * lr;
+      l += a * lr * bh + a * lb;
     } else {
-      l += a * le * s;
+      l += a * le * s * bh + a * lb;
     }
     a *= nz->gain;
     s *= nz->lacunarity;
@@ -110,7 +139,6 @@ static void noise_bounds(const oc_enoise *nz, double *lo, double *hi,
 
 void oc_edisc_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                  int want, oc_enode_sample *s) {
-  (void)ft;
   const double *p = n->par; /* cx, cy, r, height */
   double u = x - p[0], v = y - p[1], r = p[2];
   double q = (u * u + v * v) / (r * r);
@@ -132,9 +160,16 @@ void oc_edisc_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
     }
   }
   double g[2] = {0, 0};
+  octlod lod, *lp = NULL;
+  if (ft && ft->v > 0 && n->noise.kind != OC_ENOISE_NONE) {
+    double c = -1 / (ft->v * 0.69314718055994530942);
+    lod = (octlod){log2(n->noise.wavelength / ft->v), log2(n->noise.lacunarity),
+                   c * ft->gx, c * ft->gy};
+    lp = &lod;
+  }
   s->f = p[3] + (n->noise.kind == OC_ENOISE_NONE
                      ? 0
-                     : noise_sum(&n->noise, u, v, grad ? g : NULL));
+                     : noise_sum(&n->noise, u, v, grad ? g : NULL, lp));
   s->fx = g[0];
   s->fy = g[1];
 }
@@ -158,8 +193,15 @@ static double wyvill(double x) {
 
 void oc_edisc_bound_in(const oc_enode *n, const oc_erect *b,
                        const oc_efootb *fb, oc_ebound *o) {
-  (void)fb;
   *o = n->glob;
+  if (fb && fb->hi > 0 && n->noise.kind != OC_ENOISE_NONE) {
+    /* the octaves the footprints keep */
+    double lo, hi, lip;
+    noise_bounds(&n->noise, fb, &lo, &hi, &lip);
+    o->flo = n->par[3] + lo;
+    o->fhi = n->par[3] + hi;
+    o->lf = lip;
+  }
   if (!oc_erect_meets(&n->box, b)) {
     o->alo = o->ahi = o->la = 0;
     return;
@@ -228,7 +270,7 @@ oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err) {
   }
   if (check_noise(&p->noise, &nz, err)) return NULL;
   double lo = 0, hi = 0, lip = 0;
-  if (nz.kind != OC_ENOISE_NONE) noise_bounds(&nz, &lo, &hi, &lip);
+  if (nz.kind != OC_ENOISE_NONE) noise_bounds(&nz, NULL, &lo, &hi, &lip);
   oc_erect box = {p->cx - p->radius, p->cy - p->radius, p->cx + p->radius,
                   p->cy + p->radius};
   if (!isfinite(p->height + lo) || !isfinite(p->height + hi) ||

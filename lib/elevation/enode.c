@@ -14,7 +14,7 @@
 #include "elevation/enode.h"
 
 static const char *const kind_names[OC_E_COUNT] = {
-    "disc", "curve", "blend", "replace", "add", "transform", "warp"};
+    "disc", "curve", "blend", "replace", "add", "transform", "warp", "lod"};
 
 oc_enode *oc_enode_alloc(oc_ekind kind, oc_enode *const *kids, size_t nkids,
                          oc_error *err) {
@@ -80,6 +80,8 @@ void oc_enode_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
     oc_edisc_ev(n, x, y, ft, want, s);
   else if (n->kind == OC_E_CURVE)
     oc_ecurve_ev(n, x, y, ft, want, s);
+  else if (n->kind == OC_E_LOD)
+    oc_elod_ev(n, x, y, ft, want, s);
   else
     oc_eop_ev(n, x, y, ft, want, s);
 }
@@ -90,6 +92,8 @@ void oc_enode_bnd(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
     oc_edisc_bound_in(n, b, fb, o);
   else if (n->kind == OC_E_CURVE)
     oc_ecurve_bound_in(n, b, fb, o);
+  else if (n->kind == OC_E_LOD)
+    oc_elod_bound_in(n, b, fb, o);
   else
     oc_eop_bound_in(n, b, fb, o);
 }
@@ -172,10 +176,12 @@ done:
 
 /* Grows *acc by the parts of r where alpha may reach T, splitting r in four
 ** down to depth 0. */
-static void terrain_cells(const oc_enode *e, oc_erect r, int depth,
-                          oc_erect *acc) {
+static void terrain_cells(const oc_enode *e, const oc_eview *v, oc_erect r,
+                          int depth, oc_erect *acc) {
   oc_ebound b;
-  oc_enode_bnd(e, &r, NULL, &b);
+  oc_efootb fb;
+  if (v) oc_eview_footb(v, &r, &fb);
+  oc_enode_bnd(e, &r, v ? &fb : NULL, &b);
   if (!(b.ahi >= OC_ENODE_T)) return;
   if (depth == 0 || b.alo >= OC_ENODE_T) {
     acc->x0 = fmin(acc->x0, r.x0);
@@ -190,15 +196,20 @@ static void terrain_cells(const oc_enode *e, oc_erect r, int depth,
                    {r.x0, my, mx, r.y1},
                    {mx, my, r.x1, r.y1}};
   for (int k = 0; k < 4; k++)
-    terrain_cells(e, q[k], depth - 1, acc);
+    terrain_cells(e, v, q[k], depth - 1, acc);
 }
 
-int oc_enode_terrain_box(const oc_enode *e, double box[4]) {
+int oc_enode_terrain_box_in(const oc_enode *e, const oc_eview *v,
+                            double box[4]) {
   oc_erect acc = {INFINITY, INFINITY, -INFINITY, -INFINITY};
-  terrain_cells(e, e->box, 7, &acc);
+  terrain_cells(e, v, e->box, 7, &acc);
   if (!(acc.x0 < acc.x1 && acc.y0 < acc.y1)) return 0;
   box[0] = acc.x0, box[1] = acc.y0, box[2] = acc.x1, box[3] = acc.y1;
   return 1;
+}
+
+int oc_enode_terrain_box(const oc_enode *e, double box[4]) {
+  return oc_enode_terrain_box_in(e, NULL, box);
 }
 
 /* ---- the elevation source --------------------------------------------- */
@@ -236,12 +247,11 @@ static void src_release(void *ud) {
   oc_enode_release(ud);
 }
 
-int oc_enode_elevation(oc_enode *e, const double *domain, oc_elevation *src,
-                       oc_error *err) {
-  double d[4] = {e->box.x0, e->box.y0, e->box.x1, e->box.y1};
+int oc_enode_domain(const oc_enode *e, const oc_eview *v, const double *domain,
+                    double d[4], oc_error *err) {
   if (domain)
-    memcpy(d, domain, sizeof d);
-  else if (!oc_enode_terrain_box(e, d))
+    memcpy(d, domain, 4 * sizeof *d);
+  else if (!oc_enode_terrain_box_in(e, v, d))
     return oc_seterr(err, OC_EINVAL,
                      "the tree has no terrain (its weight never reaches "
                      "1/2): add a base primitive that covers the scene");
@@ -251,6 +261,14 @@ int oc_enode_elevation(oc_enode *e, const double *domain, oc_elevation *src,
                      "the elevation domain [%g, %g] x [%g, %g] must be "
                      "finite and not empty",
                      d[0], d[2], d[1], d[3]);
+  return OC_OK;
+}
+
+int oc_enode_elevation(oc_enode *e, const double *domain, oc_elevation *src,
+                       oc_error *err) {
+  double d[4];
+  int rc = oc_enode_domain(e, NULL, domain, d, err);
+  if (rc) return rc;
   memset(src, 0, sizeof *src);
   src->height = src_height;
   src->range = src_range;

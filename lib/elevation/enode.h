@@ -30,6 +30,7 @@ typedef enum oc_ekind {
   OC_E_ADD,
   OC_E_XFORM,
   OC_E_WARP,
+  OC_E_LOD,
   OC_E_COUNT
 } oc_ekind;
 
@@ -110,6 +111,47 @@ void oc_enode_bnd(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
 static inline int oc_erect_meets(const oc_erect *a, const oc_erect *b) {
   return a->x0 <= b->x1 && a->x1 >= b->x0 && a->y0 <= b->y1 && a->y1 >= b->y0;
 }
+
+/* ---- level of detail (lod.c) ---- */
+
+/* A view: the footprint at p is k sqrt(|p - e_xy|^2 + dz^2), dz the eye's
+** height above the tree's mid elevation (fixed, so the footprint is C1
+** and k-Lipschitz). */
+typedef struct oc_eview {
+  double ex, ey, dz, k;
+} oc_eview;
+
+void oc_eview_foot(const oc_eview *v, double x, double y, oc_efoot *ft);
+void oc_eview_footb(const oc_eview *v, const oc_erect *b, oc_efootb *fb);
+
+/* The octave filter b(t) = 1 - (1 - t^2)^3 of t clamped to [0, 1]
+** (Génevaux et al. 2015, the increasing form) and its derivative. */
+static inline double oc_elod_b(double t, double *db) {
+  if (t <= 0 || t >= 1) {
+    *db = 0;
+    return t >= 1 ? 1 : 0;
+  }
+  double q = 1 - t * t;
+  *db = 6 * t * q * q;
+  return 1 - q * q * q;
+}
+
+/* For a detail of wavelength w under footprints in fb: the range of
+** kappa = b(log2(w / foot)) and its Lipschitz bound. */
+void oc_elod_kappa_bound(double w, const oc_efootb *fb, double *lo, double *hi,
+                         double *lip);
+
+/* The box of Omega_T under view v (NULL: none), as oc_enode_terrain_box;
+** and the domain of a source: domain, or that box, checked. */
+int oc_enode_terrain_box_in(const oc_enode *e, const oc_eview *v,
+                            double box[4]);
+int oc_enode_domain(const oc_enode *e, const oc_eview *v, const double *domain,
+                    double d[4], oc_error *err);
+
+void oc_elod_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                int want, oc_enode_sample *s);
+void oc_elod_bound_in(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
+                      oc_ebound *o);
 
 /* Noise: eta on z = 0 remapped to [-1, 1], and its Lipschitz bound. */
 double oc_eta(uint64_t seed, double x, double y, double g[2]);
