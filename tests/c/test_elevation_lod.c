@@ -111,6 +111,21 @@ static oc_enode *step_tree(void) {
   return l;
 }
 
+/* The step tree as an instance, scaled, rotated and warped: the
+** footprint's units and slope change on the way down, and all the slope
+** is theirs. */
+static oc_enode *step_instance(void) {
+  oc_error err;
+  oc_enode *st = step_tree();
+  oc_enode_xform x = {-200, 100, 40, 3, 1, 0};
+  oc_enode *t = EOK(oc_enode_transform(st, &x, &err));
+  oc_enode_warp_params wp = {40, 900, 2, 3};
+  oc_enode *w = EOK(oc_enode_warp(t, &wp, &err));
+  oc_enode_release(st);
+  oc_enode_release(t);
+  return w;
+}
+
 START_TEST(footprint_zero_is_full_detail) {
   oc_enode *e = scene();
   oc_enode_view v0 = {{100, -200, 900}, 0};
@@ -259,18 +274,18 @@ END_TEST
 ** step's box times its length. */
 START_TEST(continuous_across_thresholds) {
   oc_error err;
-  oc_enode *e = scene(), *st = step_tree();
+  oc_enode *e = scene(), *st = step_tree(), *si = step_instance();
   oc_enode *a = disc(0, 0, 9000, 10, OC_ENOISE_NONE, 0, 1, 1);
   oc_enode *b = disc(0, 0, 9000, 10, OC_ENOISE_PLAIN, 50, 300, 6);
   oc_enode_lod_params p = {300, 0.2, 0.7};
   oc_enode *l = EOK(oc_enode_lod(a, b, &p, &err));
-  oc_enode *trees[] = {e, l, st};
+  oc_enode *trees[] = {e, l, st, si};
   /* the step tree's ramp (foot from 150 to 300) crosses the lines */
   oc_enode_view views[] = {{{-3500, -3500, 700}, 4e-3},
                            {{-3500, -3500, 700}, 0.1}};
-  for (int q = 0; q < 3; q++) {
+  for (int q = 0; q < 4; q++) {
     const oc_enode *t = trees[q];
-    const oc_enode_view v = views[q == 2];
+    const oc_enode_view v = views[q >= 2];
     double step = 0.25, jumps = 0;
     for (int line = 0; line < 3; line++) {
       double y = -3500 + 1200 * line;
@@ -295,6 +310,7 @@ START_TEST(continuous_across_thresholds) {
   oc_enode_release(a);
   oc_enode_release(b);
   oc_enode_release(st);
+  oc_enode_release(si);
   oc_enode_release(e);
 }
 END_TEST
@@ -342,14 +358,15 @@ END_TEST
 ** unfiltered slope bound alone would not do where the ramps are steep. */
 START_TEST(bounds_with_lod) {
   oc_enode *trees[] = {scene(), step_tree(),
-                       disc(0, 0, 9000, 10, OC_ENOISE_PLAIN, 50, 300, 2)};
+                       disc(0, 0, 9000, 10, OC_ENOISE_PLAIN, 50, 300, 2),
+                       step_instance()};
   oc_enode_view views[] = {
       {{-500, 300, 900}, 3e-3}, {{3000, 0, 5000}, 0.02}, {{100, 0, 10}, 1}};
-  for (int q = 0; q < 9; q++) {
+  for (int q = 0; q < 12; q++) {
     const oc_enode_view *v = &views[q % 3];
     const oc_enode *e = trees[q / 3];
     oct_rng r = oct_rng_new(23 + q);
-    double worst = 0; /* the largest slope over its bound */
+    double worst = 0, maxlf = 0; /* the largest slope over its bound */
     for (int i = 0; i < 300; i++) {
       double w = 4000 * pow(10, oct_unif(&r, -3.5, 0.3));
       double x0 = oct_unif(&r, -4500, 4000), y0 = oct_unif(&r, -4500, 4000);
@@ -369,21 +386,22 @@ START_TEST(bounds_with_lod) {
         ck_assert_msg(hypot(p.fx, p.fy) <= b.lf * (1 + 1e-9) + m,
                       "|grad f| %g > %g", hypot(p.fx, p.fy), b.lf);
         if (b.lf > 0) worst = fmax(worst, hypot(p.fx, p.fy) / b.lf);
+        maxlf = fmax(maxlf, b.lf);
         ck_assert(hypot(p.ax, p.ay) <= b.la * (1 + 1e-9) + 1e-12);
         double d = hypot(px - qx, py - qy);
         ck_assert(fabs(p.f - s.f) <= b.lf * d * (1 + 1e-9) + m);
         ck_assert(fabs(p.a - s.a) <= b.la * d * (1 + 1e-9) + 1e-12);
       }
     }
-    /* bounds that hold but say nothing would pass the above too (the
-    ** first view's ramp lies beyond the boxes for the step tree, which
-    ** is flat there) */
-    ck_assert_msg(q == 3 || worst > 0.05,
+    /* bounds that hold but say nothing would pass the above too (where
+    ** a view's ramp lies beyond the boxes, the step tree is flat and its
+    ** bounds say so) */
+    ck_assert_msg(worst > 0.05 || maxlf == 0,
                   "tree %d view %d: slopes reach only %g of "
                   "the bounds",
                   q / 3, q % 3, worst);
   }
-  for (int q = 0; q < 3; q++)
+  for (int q = 0; q < 4; q++)
     oc_enode_release(trees[q]);
 }
 END_TEST
