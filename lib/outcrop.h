@@ -1365,6 +1365,9 @@ int oc_enode_elevation_view(oc_enode *e, const double *domain,
                             const oc_enode_view *v, oc_elevation *src,
                             oc_error *err);
 double oc_enode_view_weight(void *ud, double x, double y);
+/* The size of a pixel at unit distance on the camera's axis, 2 tan(fov /
+** 2) / height (render/render.c): a view's k is c times it. */
+double oc_render_pixel_angle(const oc_render_params *rp);
 
 /* ---- geology: resistance trees and the erosion node ----- */
 
