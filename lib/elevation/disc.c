@@ -117,9 +117,18 @@ static void noise_bounds(const oc_enoise *nz, const oc_efootb *fb, double *lo,
                          double *hi, double *lip) {
   double a = nz->amplitude, s = 1 / nz->wavelength, asum = 0, l = 0, lr = 0;
   double le = 2 * oc_noise3_lipschitz;
+  /* t_i = log2(w_i / foot) in [tmin - i dt, tmax - i dt] (one log2 each,
+  ** padded against the evaluator's rounding) */
+  double tmin = 0, tmax = 0, dt = log2(nz->lacunarity);
+  if (fb) {
+    tmin = log2(nz->wavelength / fb->hi) - 1e-12;
+    tmax = fb->lo > 0 ? log2(nz->wavelength / fb->lo) + 1e-12 : INFINITY;
+  }
   for (int i = 0; i < nz->octaves; i++) {
     double bh = 1, lb = 0, bl;
-    if (fb) oc_elod_kappa_bound(1 / s, fb, &bl, &bh, &lb);
+    if (fb)
+      oc_elod_kappa_bound_t(1 / s, tmin - i * dt, tmax - i * dt, fb, &bl, &bh,
+                            &lb);
     if (bh == 0) break;
     asum += a * bh;
     if (nz->kind == OC_ENOISE_RIDGED) {
@@ -194,7 +203,11 @@ static double wyvill(double x) {
 void oc_edisc_bound_in(const oc_enode *n, const oc_erect *b,
                        const oc_efootb *fb, oc_ebound *o) {
   *o = n->glob;
-  if (fb && fb->hi > 0 && n->noise.kind != OC_ENOISE_NONE) {
+  /* (every octave kept in the box, the finest included: the glob's) */
+  if (fb && fb->hi > 0 && n->noise.kind != OC_ENOISE_NONE &&
+      log2(n->noise.wavelength / fb->hi) - 1e-12 -
+              (n->noise.octaves - 1) * log2(n->noise.lacunarity) <
+          1) {
     /* the octaves the footprints keep */
     double lo, hi, lip;
     noise_bounds(&n->noise, fb, &lo, &hi, &lip);

@@ -140,6 +140,10 @@ static inline double oc_elod_b(double t, double *db) {
 ** kappa = b(log2(w / foot)) and its Lipschitz bound. */
 void oc_elod_kappa_bound(double w, const oc_efootb *fb, double *lo, double *hi,
                          double *lip);
+/* The same for t = log2(w / foot) known to lie in [tmin, tmax]. */
+void oc_elod_kappa_bound_t(double w, double tmin, double tmax,
+                           const oc_efootb *fb, double *lo, double *hi,
+                           double *lip);
 
 /* The box of Omega_T under view v (NULL: none), as oc_enode_terrain_box;
 ** and the domain of a source: domain, or that box, checked. */

@@ -66,17 +66,10 @@ static double bp_max(double t0, double t1) {
   return fmax(d0, d1) * (1 + 1e-12);
 }
 
-void oc_elod_kappa_bound(double w, const oc_efootb *fb, double *lo, double *hi,
-                         double *lip) {
+void oc_elod_kappa_bound_t(double w, double tmin, double tmax,
+                           const oc_efootb *fb, double *lo, double *hi,
+                           double *lip) {
   double d;
-  if (!fb || !(fb->hi > 0)) {
-    *lo = *hi = 1;
-    *lip = 0;
-    return;
-  }
-  /* t = log2(w / foot), padded against the evaluators' rounding */
-  double tmin = log2(w / fb->hi) - 1e-12;
-  double tmax = fb->lo > 0 ? log2(w / fb->lo) + 1e-12 : INFINITY;
   *lo = oc_elod_b(tmin, &d);
   *hi = oc_elod_b(tmax, &d);
   if (tmax <= 0 || tmin >= 1) {
@@ -85,6 +78,19 @@ void oc_elod_kappa_bound(double w, const oc_efootb *fb, double *lo, double *hi,
   }
   /* on the ramp foot lies in (w / 2, w): |grad t| <= k / (ln 2 foot) */
   *lip = bp_max(tmin, tmax) * fb->k / (LN2 * fmax(fb->lo, w / 2));
+}
+
+void oc_elod_kappa_bound(double w, const oc_efootb *fb, double *lo, double *hi,
+                         double *lip) {
+  if (!fb || !(fb->hi > 0)) {
+    *lo = *hi = 1;
+    *lip = 0;
+    return;
+  }
+  /* t = log2(w / foot), padded against the evaluators' rounding */
+  double tmin = log2(w / fb->hi) - 1e-12;
+  double tmax = fb->lo > 0 ? log2(w / fb->lo) + 1e-12 : INFINITY;
+  oc_elod_kappa_bound_t(w, tmin, tmax, fb, lo, hi, lip);
 }
 
 /* ---- the lod operator -------------------------------------------------- */
