@@ -207,8 +207,13 @@ static int march(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
     } else {
       s = safe_step(h, u.z, uxy, tr->L, t1 - t);
     }
+    double proved = s; /* free of the surface up to t + proved */
     s = greater(s, tol(tr, d0, t));
-    if (t + s > t1 || t + s == t) return 0; /* left the box */
+    if (t + s == t || t + proved >= t1 || t >= t1) return 0; /* left it */
+    /* the tolerance would step out of the box: sample its end, where a
+    ** floor at the box's lowest elevation is (a ray leaves through the
+    ** bottom just under it) */
+    if (t + s > t1) s = t1 - t;
     prev = t, hp = h, have_prev = 1;
     if (accel && fails < MAX_FAILS && grow >= 0 && h > 0 && s == grow) {
       /* limited by the slope: try a longer step within the candidate */

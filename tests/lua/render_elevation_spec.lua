@@ -143,3 +143,23 @@ describe("outcrop.render of a heightfield", function()
     R.check_error(function() oc.render(gone, {size = {4, 4}}) end, F, "outcrop.render", "closed")
   end)
 end)
+
+describe("outcrop.render of an elevation tree", function()
+  it("hits a floor lying at the tree's lowest elevation, with both tracers", function()
+    -- the lake's default bed is flat at level - 5, the tree's minimum: a ray
+    -- leaves the tracer's box through its bottom just under that floor
+    local E = oc.elevation
+    local e = E.replace(E.disc{center = {0, 0}, radius = 3000, height = 0},
+                        E.lake{center = {0, 0}, radius = 200, level = 0})
+    local lo = select(3, e:bounds())
+    assert.is_true(math.abs(lo + 5) < 1e-6)
+    for _, tr in ipairs{"segment", "sphere"} do
+      local img, st = oc.render(e, {size = {32, 32}, tracer = tr, shadows = false, ao = false,
+                                    camera = {eye = {0, -300, 300}, target = {0, 0, -5}}})
+      assert.are.equal(st.pixels, st.hits, tr)
+      -- the middle of the view is the lake's floor, at depth 5
+      local cx, cy = 16, 16
+      assert.are.equal(1, select(4, img:get(cx, cy)))
+    end
+  end)
+end)
