@@ -8,6 +8,8 @@
 # out (--set render=false): its mesh is one closed component (specks of a
 # few vertices dropped) with a through-hole, genus >= 1 (topology.lua).
 #
+# coast-arch: examples/elev_coast.lua the same way (the arch of a tree).
+#
 # elev-*: the elevation-tree examples at 96 x 54 (--set size=96), run
 # with one thread and with two: the same PNG bytes both times; the dunes
 # leave the peak's elevation as it was and raise the desert floor; the
@@ -38,7 +40,23 @@ grep -q '^topology: 1 component' "$T/out" || because "no single component report
 tally "$T/out" "$T/err"
 grep "^topology" "$T/out" | sed "s/^/     /"
 
-for ex in elev_river elev_dunes elev_instances elev_road; do
+# coast-arch: examples/elev_coast.lua (an elevation tree implicitized and
+# eroded by the sea) at its own cell, picture left out: one closed
+# component with a through-hole under the neck.
+name=coast-arch
+why=
+mkdir -p "$T/$name"
+if ! "$OUTCROP" run "$HERE/topology.lua" "$ROOT/examples/elev_coast.lua" 1 \
+  --set render=false --out "$T/$name" >"$T/out" 2>"$T/err"; then
+  because "$(grep -m1 -E 'outcrop:|assert' "$T/err" || echo "exit status $?")"
+fi
+grep -qE 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$T/err" &&
+  because "sanitizer report"
+grep -q '^topology: 1 component' "$T/out" || because "no single component reported"
+tally "$T/out" "$T/err"
+grep "^topology" "$T/out" | sed "s/^/     /"
+
+for ex in elev_river elev_dunes elev_instances elev_road elev_coast; do
   name=elev-${ex#elev_}
   why=
   mkdir -p "$T/$name/1" "$T/$name/2"
