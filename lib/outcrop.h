@@ -1289,6 +1289,57 @@ typedef struct oc_enode_warp_params {
 oc_enode *oc_enode_warp(oc_enode *e, const oc_enode_warp_params *p,
                         oc_error *err);
 
+/* The contour (lake) primitive (Génevaux et al. 2015, section 4, figure
+** 7): a closed shore r(theta) around the centre, a C1 periodic
+** interpolant (the shape-preserving quadratic spline of the cross-sections,
+** wrapped) of either n >= 3 radii at equal angles from +x counter-clockwise
+** (radii) or of the vertices of a polygon star-shaped around the centre
+** (contour: x, y pairs, either orientation). With delta = |p - c| -
+** r(theta) (< 0 inside), f = level + c(theta, delta), the profiles at
+** their angles (oc_enode_profile.at: degrees in [0, 360), increasing)
+** blended by a smoothstep between sectors, and alpha = 1 inside, g(delta /
+** falloff) outside. Every profile must be flat below some d_lo > -min r
+** and all at the same depth there (the lake's deepest part round the
+** centre, where theta is undefined). nprofiles = 0 gives the default bed:
+** knots (-D, -depth), (0, 0), (falloff / 4, 0), (falloff, bank) with D =
+** min(min r / 2, 20 depth); depth 0 means 5, bank < 0 means 2. */
+typedef struct oc_enode_lake_params {
+  double cx, cy;
+  const double *radii; /* nradii radii, or NULL */
+  size_t nradii;
+  const double *contour; /* ncontour (x, y) pairs, or NULL */
+  size_t ncontour;
+  double level;
+  const oc_enode_profile *profiles;
+  size_t nprofiles;
+  double falloff; /* > 0; 0: half the largest radius */
+  double depth, bank;
+} oc_enode_lake_params;
+oc_enode *oc_enode_lake(const oc_enode_lake_params *p, oc_error *err);
+
+/* The image primitive (Génevaux et al. 2015, section 4.2, figure 8): a
+** heightfield mapped on a convex counter-clockwise quadrangle quad[0..3]
+** (x, y pairs; corner k takes the grid's corner (0, 0), (1, 0), (1, 1),
+** (0, 1) in turn) by inverse bilinear mapping, or along a segment (seg,
+** with width > 0: the rectangle whose axis it is, the grid's x along it).
+** f = offset + height h(u, v) (the grid's C1 bicubic) inside, and the
+** value at the closest point of the quad outside (so f is Lipschitz on
+** the plane); alpha = clamp(weight(u, v), 0, 1) (1 without a weight grid)
+** times prod_k G(d_k / falloff), d_k the distance to edge k inside, G(x) =
+** 1 - (1 - x^2)^3 on [0, 1] (C1, 0 on the border). Both grids are
+** retained. */
+typedef struct oc_enode_image_params {
+  oc_heightfield *heightfield;
+  oc_heightfield *weight; /* or NULL */
+  int segment;            /* 1: seg and width instead of quad */
+  double quad[8];
+  double seg[4], width;
+  double height;  /* vertical scale (!= 0; 0 means 1) */
+  double offset;
+  double falloff; /* > 0; 0: a tenth of the square root of the area */
+} oc_enode_image_params;
+oc_enode *oc_enode_image(const oc_enode_image_params *p, oc_error *err);
+
 void oc_enode_retain(oc_enode *e);
 void oc_enode_release(oc_enode *e);
 const char *oc_enode_kind(const oc_enode *e);

@@ -11,6 +11,12 @@
 **   warp(e, {amplitude =, wavelength =, octaves = 3, seed =})
 **   transform(e, {translate = {x, y}, rotate = degrees, scale = 1,
 **        vscale = 1, voffset = 0})
+**   lake{center = {x, y}, radius = r | {r1, r2, ...} | contour = {{x, y},
+**        ...}, level = 0, falloff = max r / 2, depth = 5, bank = 2,
+**        profile = {{d, v}, ...} | profiles = {{angle =, knots =}, ...}}
+**   image{heightfield = hf, weight = hf2, quad = {{x, y} x 4} |
+**        segment = {{x0, y0}, {x1, y1}}, width =, height = 1, offset = 0,
+**        falloff = sqrt(area) / 10}
 **
 ** Methods: e:eval(x, y) -> f, alpha; e:gradient(x, y) -> df/dx, df/dy;
 ** e:bounds() -> x0, y0, fmin, x1, y1, fmax (the box holding the support
@@ -26,6 +32,7 @@
 
 #include "l_elevation.h"
 #include "l_handle.h"
+#include "l_heightfield.h"
 
 typedef struct oclua_enode {
   oc_enode *e; /* NULL while a constructor runs, and once collected */
@@ -401,6 +408,209 @@ static int l_transform(lua_State *L) {
   return setenode(L, u, oc_enode_transform(e, &x, &err), &err, fname);
 }
 
+/* ---- lake and image --------------------------------------------------- */
+
+/* An array of {x, y} at stack index idx, n in [lo, hi] entries, into a
+** Lua-owned array of 2 n doubles pushed on the stack (raw reads). */
+static double *read_xy(lua_State *L, int idx, const char *fname,
+                       const char *label, lua_Integer lo, lua_Integer hi,
+                       size_t *n) {
+  if (!lua_istable(L, idx))
+    oclua_error(L, fname, "'%s' must be an array of {x, y} (got %s)", label,
+                oclua_got(L, idx));
+  lua_Integer m = (lua_Integer)lua_rawlen(L, idx);
+  if (m < lo || m > hi) {
+    if (lo == hi)
+      oclua_error(L, fname, "'%s' must hold %I points {x, y} (got %I)", label,
+                  lo, m);
+    oclua_error(L, fname, "'%s' must hold %I to %I points {x, y} (got %I)",
+                label, lo, hi, m);
+  }
+  double *a = lua_newuserdatauv(L, 2 * (size_t)m * sizeof *a, 0);
+  for (lua_Integer i = 1; i <= m; i++) {
+    lua_rawgeti(L, idx, i);
+    int ok = lua_istable(L, -1) && lua_rawlen(L, -1) == 2;
+    for (int k = 1; ok && k <= 2; k++) {
+      lua_rawgeti(L, -1, k);
+      ok = lua_type(L, -1) == LUA_TNUMBER && isfinite(lua_tonumber(L, -1));
+      if (ok) a[2 * (i - 1) + (k - 1)] = lua_tonumber(L, -1);
+      lua_pop(L, 1);
+    }
+    if (!ok)
+      oclua_error(L, fname, "'%s[%I]' must be {x, y} with finite numbers",
+                  label, i);
+    lua_pop(L, 1);
+  }
+  *n = (size_t)m;
+  return a;
+}
+
+static int l_lake(lua_State *L) {
+  static const char *const known[] = {
+      "center", "radius", "contour", "level",    "falloff",
+      "depth",  "bank",   "profile", "profiles", NULL};
+  const char *fname = "outcrop.elevation.lake";
+  oclua_fields f;
+  oclua_checkargs(L, 1, fname, "a table of named fields");
+  oclua_fields_open(&f, L, 1, fname, NULL, known, 0);
+  oc_enode_lake_params p = {0};
+  double c[2];
+  if (!oclua_field_numbers(&f, "center", 2, c, "must be {x, y}"))
+    oclua_field_missing(&f, "center", "must be {x, y}");
+  p.cx = c[0];
+  p.cy = c[1];
+  int tr = oclua_field_push(&f, "radius"), ir = lua_gettop(L);
+  int tc = oclua_field_push(&f, "contour"), ic = lua_gettop(L);
+  if ((tr == LUA_TNIL) == (tc == LUA_TNIL))
+    oclua_error(L, fname,
+                "give either 'radius' = r or {r1, r2, ...} (at "
+                "equal angles from +x) or 'contour' = {{x, y}, ...}");
+  if (tr == LUA_TNUMBER) {
+    double *r = lua_newuserdatauv(L, sizeof *r, 0);
+    *r = lua_tonumber(L, ir);
+    if (!(isfinite(*r) && *r > 0))
+      oclua_field_error(&f, "radius", ir, "must be a positive number");
+    p.radii = r;
+    p.nradii = 1;
+  } else if (tr == LUA_TTABLE) {
+    lua_Integer m = (lua_Integer)lua_rawlen(L, ir);
+    if (m < 3 || m > MAX_POINTS)
+      oclua_error(L, fname,
+                  "'radius' must be a number or hold 3 to %d radii "
+                  "(got %I)",
+                  MAX_POINTS, m);
+    double *r = lua_newuserdatauv(L, (size_t)m * sizeof *r, 0);
+    for (lua_Integer i = 1; i <= m; i++) {
+      lua_rawgeti(L, ir, i);
+      r[i - 1] = lua_tonumber(L, -1);
+      if (lua_type(L, -1) != LUA_TNUMBER ||
+          !(isfinite(r[i - 1]) && r[i - 1] > 0))
+        oclua_error(L, fname, "'radius[%I]' must be a positive number (got %s)",
+                    i, oclua_got(L, -1));
+      lua_pop(L, 1);
+    }
+    p.radii = r;
+    p.nradii = (size_t)m;
+  } else if (tr != LUA_TNIL) {
+    oclua_field_error(&f, "radius", ir, "must be a number or {r1, r2, ...}");
+  } else {
+    p.contour = read_xy(L, ic, fname, "contour", 3, MAX_POINTS, &p.ncontour);
+  }
+  p.level = oclua_field_optnumber(&f, "level", OCLUA_FINITE, 0);
+  p.falloff = oclua_field_optnumber(&f, "falloff", OCLUA_POSITIVE, 0);
+  p.depth = oclua_field_optnumber(&f, "depth", OCLUA_POSITIVE, 5);
+  p.bank = oclua_field_optnumber(&f, "bank", OCLUA_FINITE, 2);
+  if (p.bank < 0) oclua_error(L, fname, "'bank' must be >= 0 (got %f)", p.bank);
+  int one = oclua_field_push(&f, "profile") != LUA_TNIL;
+  int many = oclua_field_push(&f, "profiles") != LUA_TNIL;
+  if (one && many)
+    oclua_error(L, fname,
+                "give 'profile' = {{d, v}, ...} or 'profiles' = "
+                "{{angle =, knots = {{d, v}, ...}}, ...}, not both");
+  oc_enode_profile *pr = NULL;
+  if (one) {
+    pr = lua_newuserdatauv(L, sizeof *pr, 0);
+    pr->at = 0;
+    pr->n = read_knots(L, lua_gettop(L) - 2, fname, "profile", &pr->d, &pr->v);
+    p.nprofiles = 1;
+  } else if (many) {
+    int t = lua_gettop(L);
+    if (!lua_istable(L, t))
+      oclua_field_error(&f, "profiles", t,
+                        "must be an array of {angle =, knots =}");
+    lua_Integer m = (lua_Integer)lua_rawlen(L, t);
+    if (m < 1 || m > 4096)
+      oclua_error(L, fname, "'profiles' must hold 1 to 4096 profiles (got %I)",
+                  m);
+    luaL_checkstack(L, (int)m + 8, "too many profiles");
+    pr = lua_newuserdatauv(L, (size_t)m * sizeof *pr, 0);
+    for (lua_Integer i = 1; i <= m; i++) {
+      char label[48];
+      snprintf(label, sizeof label, "profiles[%lld]", (long long)i);
+      if (lua_rawgeti(L, t, i) != LUA_TTABLE)
+        oclua_error(L, fname, "'%s' must be {angle =, knots = {{d, v}, ...}}",
+                    label);
+      lua_getfield(L, -1, "angle");
+      if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(lua_tonumber(L, -1)))
+        oclua_error(L, fname,
+                    "'%s.angle' must be a number of degrees in "
+                    "[0, 360)",
+                    label);
+      pr[i - 1].at = lua_tonumber(L, -1);
+      lua_pop(L, 1);
+      lua_getfield(L, -1, "knots");
+      snprintf(label, sizeof label, "profiles[%lld].knots", (long long)i);
+      pr[i - 1].n = read_knots(L, lua_gettop(L), fname, label, &pr[i - 1].d,
+                               &pr[i - 1].v);
+      lua_replace(L, -3); /* keep the knots' array, drop the tables */
+      lua_pop(L, 1);
+    }
+    p.nprofiles = (size_t)m;
+  }
+  p.profiles = pr;
+  oc_error err = {OC_OK, ""};
+  oclua_enode *u = newenode(L);
+  return setenode(L, u, oc_enode_lake(&p, &err), &err, fname);
+}
+
+static int l_image(lua_State *L) {
+  static const char *const known[] = {"heightfield", "weight",  "quad",
+                                      "segment",     "width",   "height",
+                                      "offset",      "falloff", NULL};
+  const char *fname = "outcrop.elevation.image";
+  oclua_fields f;
+  oclua_checkargs(L, 1, fname, "a table of named fields");
+  oclua_fields_open(&f, L, 1, fname, NULL, known, 0);
+  oc_enode_image_params p = {0};
+  /* the grids stay on the stack and pinned until the node retains them:
+  ** an option's metamethod could close them */
+  int t = oclua_field_push(&f, "heightfield"), ih = lua_gettop(L);
+  if (t == LUA_TNIL) oclua_field_missing(&f, "heightfield", "a heightfield");
+  if (!oclua_isheightfield(L, ih))
+    oclua_field_error(&f, "heightfield", ih, "must be a heightfield");
+  p.heightfield = oclua_pinheightfield(L, ih, fname);
+  t = oclua_field_push(&f, "weight");
+  int iw = lua_gettop(L);
+  if (t != LUA_TNIL) {
+    if (!oclua_isheightfield(L, iw))
+      oclua_field_error(&f, "weight", iw, "must be a heightfield");
+    p.weight = oclua_pinheightfield(L, iw, fname);
+  }
+  int tq = oclua_field_push(&f, "quad"), iq = lua_gettop(L);
+  int ts = oclua_field_push(&f, "segment"), is = lua_gettop(L);
+  if ((tq == LUA_TNIL) == (ts == LUA_TNIL))
+    oclua_error(L, fname,
+                "give either 'quad' = {{x, y} x 4} (convex, "
+                "counter-clockwise) or 'segment' = {{x0, y0}, "
+                "{x1, y1}} with 'width'");
+  size_t n;
+  if (tq != LUA_TNIL) {
+    const double *q = read_xy(L, iq, fname, "quad", 4, 4, &n);
+    for (int k = 0; k < 8; k++)
+      p.quad[k] = q[k];
+    if (oclua_field_push(&f, "width") != LUA_TNIL)
+      oclua_error(L, fname, "'width' goes with 'segment', not 'quad'");
+    lua_pop(L, 1);
+  } else {
+    const double *q = read_xy(L, is, fname, "segment", 2, 2, &n);
+    for (int k = 0; k < 4; k++)
+      p.seg[k] = q[k];
+    p.segment = 1;
+    if (oclua_field_push(&f, "width") == LUA_TNIL)
+      oclua_field_missing(&f, "width",
+                          "the rectangle's width across the "
+                          "segment");
+    lua_pop(L, 1);
+    p.width = oclua_field_number(&f, "width", OCLUA_POSITIVE);
+  }
+  p.height = oclua_field_optnumber(&f, "height", OCLUA_NONZERO, 1);
+  p.offset = oclua_field_optnumber(&f, "offset", OCLUA_FINITE, 0);
+  p.falloff = oclua_field_optnumber(&f, "falloff", OCLUA_POSITIVE, 0);
+  oc_error err = {OC_OK, ""};
+  oclua_enode *u = newenode(L);
+  return setenode(L, u, oc_enode_image(&p, &err), &err, fname);
+}
+
 /* ---- methods ---------------------------------------------------------- */
 
 static oc_enode *self(lua_State *L, const char *fname) {
@@ -515,6 +725,7 @@ void oclua_open_elevation(lua_State *L) {
       {"disc", l_disc},   {"curve", l_curve},   {"river", l_river},
       {"road", l_road},   {"blend", l_blend}, {"replace", l_replace},
       {"add", l_add},   {"warp", l_warp},   {"transform", l_transform},
+      {"lake", l_lake},   {"image", l_image},
       {NULL, NULL}};
   oclua_newmeta(L, OCLUA_ELEVATION, meta, methods);
   lua_pop(L, 1);

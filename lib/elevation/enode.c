@@ -14,7 +14,8 @@
 #include "elevation/enode.h"
 
 static const char *const kind_names[OC_E_COUNT] = {
-    "disc", "curve", "blend", "replace", "add", "transform", "warp"};
+    "disc", "curve", "blend", "replace", "add", "transform", "warp",
+    "lake", "image"};
 
 oc_enode *oc_enode_alloc(oc_ekind kind, oc_enode *const *kids, size_t nkids,
                          oc_error *err) {
@@ -63,6 +64,8 @@ void oc_enode_release(oc_enode *e) {
     }
     if (cur->kids != cur->inl) free(cur->kids);
     if (cur->kind == OC_E_CURVE) oc_ecurve_free(cur->data);
+    if (cur->kind == OC_E_LAKE) oc_elake_free(cur->data);
+    if (cur->kind == OC_E_IMAGE) oc_eimage_free(cur->data);
     free(cur);
     if (!top) break;
     cur = stack[--top];
@@ -80,6 +83,10 @@ void oc_enode_ev(const oc_enode *n, double x, double y, int want,
     oc_edisc_ev(n, x, y, want, s);
   else if (n->kind == OC_E_CURVE)
     oc_ecurve_ev(n, x, y, want, s);
+  else if (n->kind == OC_E_LAKE)
+    oc_elake_ev(n, x, y, want, s);
+  else if (n->kind == OC_E_IMAGE)
+    oc_eimage_ev(n, x, y, want, s);
   else
     oc_eop_ev(n, x, y, want, s);
 }
@@ -89,6 +96,10 @@ void oc_enode_bnd(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
     oc_edisc_bound_in(n, b, o);
   else if (n->kind == OC_E_CURVE)
     oc_ecurve_bound_in(n, b, o);
+  else if (n->kind == OC_E_LAKE)
+    oc_elake_bound_in(n, b, o);
+  else if (n->kind == OC_E_IMAGE)
+    oc_eimage_bound_in(n, b, o);
   else
     oc_eop_bound_in(n, b, o);
 }
@@ -148,7 +159,8 @@ int oc_enode_get_stats(const oc_enode *e, oc_enode_stats *st, oc_error *err) {
   while (n) {
     const oc_enode *x = stack[--n];
     st->nodes++;
-    st->primitives += x->kind == OC_E_DISC || x->kind == OC_E_CURVE;
+    st->primitives += x->kind == OC_E_DISC || x->kind == OC_E_CURVE ||
+                      x->kind == OC_E_LAKE || x->kind == OC_E_IMAGE;
     st->bytes +=
         sizeof *x + (x->kids != x->inl ? x->nkids * sizeof *x->kids : 0);
     for (size_t i = 0; i < x->nkids; i++) {

@@ -31,6 +31,8 @@ typedef enum oc_ekind {
   OC_E_ADD,
   OC_E_XFORM,
   OC_E_WARP,
+  OC_E_LAKE,
+  OC_E_IMAGE,
   OC_E_COUNT
 } oc_ekind;
 
@@ -82,6 +84,15 @@ void oc_ecurve_ev(const oc_enode *n, double x, double y, int want,
                   oc_enode_sample *s);
 void oc_ecurve_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o);
 void oc_ecurve_free(void *data);
+/* lake.c and eimage.c: the contour and image primitives (state in data). */
+void oc_elake_ev(const oc_enode *n, double x, double y, int want,
+                 oc_enode_sample *s);
+void oc_elake_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o);
+void oc_elake_free(void *data);
+void oc_eimage_ev(const oc_enode *n, double x, double y, int want,
+                  oc_enode_sample *s);
+void oc_eimage_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o);
+void oc_eimage_free(void *data);
 void oc_eop_ev(const oc_enode *n, double x, double y, int want,
                oc_enode_sample *s);
 void oc_eop_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o);

@@ -1,0 +1,527 @@
+/*
+** eimage.c — the image primitive of elevation trees (Génevaux et al. 2015,
+** section 4.2, figure 8): a heightfield, and an optional weight grid,
+** mapped on a convex quadrangle P0 P1 P2 P3 (counter-clockwise) by
+**
+**   p(u, v) = P0 + e u + f v + g u v,  e = P1 - P0, f = P3 - P0,
+**                                      g = P0 - P1 + P2 - P3,
+**
+** inverted for each point (the quadratic of the bilinear map, polished by
+** Newton steps). The grid is read through its elevation source
+** (oc_heightfield_elevation: the C1 bicubic and its min/max pyramid).
+**
+**   f = offset + height h(X(u), Y(v)) inside the quad; outside, f at the
+**       closest point of the quad (projection on a convex set is
+**       1-Lipschitz, so f keeps its bound over the plane);
+**   alpha = clamp(w(u, v), 0, 1) prod_k G(d_k / F), d_k the distance to
+**       edge k, G(x) = 1 - (1 - x^2)^3 on [0, 1] (C1: 0 with slope 0 on the
+**       border, 1 with slope 0 at F inside it).
+**
+** Bounds. With K = dp/d(X, Y), grad f = height K^-T grad h, and
+** |K^-1| <= |K|_F / det K <= sqrt(Lu^2 H^2 + Lv^2 W^2) / det J, W x H the
+** grid's extent, Lu and Lv the largest |dp/du|, |dp/dv| (|e + g v|, |f + g
+** u|: at the ends of v's and u's ranges) and det J = cross(e, f) +
+** u cross(e, g) + v cross(g, f) (affine in u and v: its least at a corner
+** of the (u, v) range, > 0 for a strictly convex quad). In a box: the
+** points whose projection matters lie in the quad within r of the box (r
+** the largest distance of a box corner to the quad); u and v have straight
+** level lines, so their extremes over that convex polygon are at its
+** vertices; the grid's pyramid gives h's range and slope over the (u, v)
+** range mapped to it.
+*/
+#include <math.h>
+#include <stdlib.h>
+
+#include "core/error.h"
+#include "core/falloff.h"
+#include "elevation/enode.h"
+
+typedef struct grid {
+  oc_elevation src; /* src.ud NULL: none (weight 1) */
+  double x0, y0, W, H;
+} grid;
+
+typedef struct eimage {
+  grid h, w;
+  double P[4][2];
+  double e[2], f[2], g[2];
+  double nrm[4][2], c[4]; /* inward unit normals: d_k = nrm_k . p - c_k */
+  double vs, off, F;
+} eimage;
+
+static double cross(const double a[2], const double b[2]) {
+  return a[0] * b[1] - a[1] * b[0];
+}
+
+void oc_eimage_free(void *data) {
+  eimage *d = data;
+  if (!d) return;
+  if (d->h.src.release) d->h.src.release(d->h.src.ud);
+  if (d->w.src.release) d->w.src.release(d->w.src.ud);
+  free(d);
+}
+
+/* p(u, v) and its partial derivatives. */
+static void bilin(const eimage *d, double u, double v, double p[2],
+                  double pu[2], double pv[2]) {
+  for (int k = 0; k < 2; k++) {
+    p[k] = d->P[0][k] + d->e[k] * u + d->f[k] * v + d->g[k] * u * v;
+    pu[k] = d->e[k] + d->g[k] * v;
+    pv[k] = d->f[k] + d->g[k] * u;
+  }
+}
+
+/* (u, v) of a point in the quad (or on its border), clamped to [0, 1]. */
+static void inverse(const eimage *d, double x, double y, double *u, double *v) {
+  double h[2] = {x - d->P[0][0], y - d->P[0][1]};
+  double k2 = cross(d->g, d->f);
+  double k1 = cross(d->e, d->f) + cross(h, d->g);
+  double k0 = cross(h, d->e);
+  double vv;
+  if (fabs(k2) <= 1e-12 * fabs(k1)) { /* a parallelogram or trapezium */
+    vv = -k0 / k1;
+  } else {
+    double disc = fmax(k1 * k1 - 4 * k0 * k2, 0);
+    double q = -0.5 * (k1 + (k1 < 0 ? -sqrt(disc) : sqrt(disc)));
+    double r1 = q / k2, r2 = q != 0 ? k0 / q : r1;
+    vv = fabs(r1 - 0.5) <= fabs(r2 - 0.5) ? r1 : r2;
+  }
+  vv = vv < 0 ? 0 : vv > 1 ? 1 : vv == vv ? vv : 0.5;
+  double a[2] = {d->e[0] + d->g[0] * vv, d->e[1] + d->g[1] * vv};
+  double b[2] = {h[0] - d->f[0] * vv, h[1] - d->f[1] * vv};
+  double uu = (a[0] * b[0] + a[1] * b[1]) / (a[0] * a[0] + a[1] * a[1]);
+  uu = uu < 0 ? 0 : uu > 1 ? 1 : uu;
+  /* Newton: p(u, v) = (x, y); the Jacobian is invertible on the quad */
+  for (int it = 0; it < 3; it++) {
+    double p[2], pu[2], pv[2];
+    bilin(d, uu, vv, p, pu, pv);
+    double rx = x - p[0], ry = y - p[1], det = cross(pu, pv);
+    double du = (rx * pv[1] - ry * pv[0]) / det;
+    double dv = (pu[0] * ry - pu[1] * rx) / det;
+    uu += du;
+    vv += dv;
+    uu = uu < 0 ? 0 : uu > 1 ? 1 : uu;
+    vv = vv < 0 ? 0 : vv > 1 ? 1 : vv;
+  }
+  *u = uu;
+  *v = vv;
+}
+
+/* The grid's value at (u, v) and its derivatives in u and v. */
+static double grid_at(const grid *G, double u, double v, int grad, double *gu,
+                      double *gv) {
+  double gr[2] = {0, 0};
+  double z = G->src.height(G->src.ud, G->x0 + u * G->W, G->y0 + v * G->H,
+                           grad ? gr : NULL);
+  *gu = gr[0] * G->W;
+  *gv = gr[1] * G->H;
+  return z;
+}
+
+/* G(x) = 1 - (1 - x^2)^3 on [0, 1], and G'. */
+static double ramp(double x, double *dg) {
+  if (x <= 0) {
+    *dg = 0;
+    return 0;
+  }
+  if (x >= 1) {
+    *dg = 0;
+    return 1;
+  }
+  *dg = -oc_falloff_d(x);
+  return 1 - oc_falloff(x);
+}
+
+void oc_eimage_ev(const oc_enode *n, double x, double y, int want,
+                  oc_enode_sample *s) {
+  const eimage *d = n->data;
+  int grad = want & OC_EV_GRAD;
+  double dk[4];
+  int inside = 1;
+  for (int k = 0; k < 4; k++) {
+    dk[k] = d->nrm[k][0] * x + d->nrm[k][1] * y - d->c[k];
+    inside &= dk[k] >= 0;
+  }
+  s->a = s->ax = s->ay = s->fx = s->fy = 0;
+  double u, v, tan[2] = {0, 0}; /* outside: the edge's direction, or 0 */
+  if (inside) {
+    inverse(d, x, y, &u, &v);
+  } else {
+    if (want & OC_EV_LAZY) {
+      s->f = 0;
+      return;
+    }
+    /* the closest point of the border; (u, v) exact on it */
+    double best = INFINITY;
+    u = v = 0;
+    for (int k = 0; k < 4; k++) {
+      const double *A = d->P[k], *B = d->P[(k + 1) & 3];
+      double E[2] = {B[0] - A[0], B[1] - A[1]}, L2 = E[0] * E[0] + E[1] * E[1];
+      double t = ((x - A[0]) * E[0] + (y - A[1]) * E[1]) / L2;
+      int mid = t > 0 && t < 1;
+      t = t < 0 ? 0 : t > 1 ? 1 : t;
+      double qx = A[0] + t * E[0] - x, qy = A[1] + t * E[1] - y;
+      double dd = qx * qx + qy * qy;
+      if (dd < best) {
+        best = dd;
+        double uv[4][2] = {{t, 0}, {1, t}, {1 - t, 1}, {0, 1 - t}};
+        u = uv[k][0];
+        v = uv[k][1];
+        double L = sqrt(L2);
+        tan[0] = mid ? E[0] / L : 0;
+        tan[1] = mid ? E[1] / L : 0;
+      }
+    }
+  }
+  double p[2], pu[2], pv[2], fu, fv;
+  bilin(d, u, v, p, pu, pv);
+  s->f = d->off + d->vs * grid_at(&d->h, u, v, grad, &fu, &fv);
+  /* grad u = (pv.y, -pv.x) / det, grad v = (-pu.y, pu.x) / det */
+  double det = cross(pu, pv);
+  double gux = pv[1] / det, guy = -pv[0] / det;
+  double gvx = -pu[1] / det, gvy = pu[0] / det;
+  if (grad) {
+    double gx = d->vs * (fu * gux + fv * gvx),
+           gy = d->vs * (fu * guy + fv * gvy);
+    if (inside) {
+      s->fx = gx;
+      s->fy = gy;
+    } else { /* through the projection: its tangential part */
+      double t = gx * tan[0] + gy * tan[1];
+      s->fx = t * tan[0];
+      s->fy = t * tan[1];
+    }
+  }
+  if (!inside) return;
+  /* alpha */
+  double G[4], dG[4], ab = 1;
+  for (int k = 0; k < 4; k++) {
+    G[k] = ramp(dk[k] / d->F, &dG[k]);
+    ab *= G[k];
+  }
+  double w = 1, wx = 0, wy = 0;
+  if (d->w.src.ud) {
+    double wu, wv;
+    w = grid_at(&d->w, u, v, grad, &wu, &wv);
+    if (w <= 0) {
+      w = 0;
+    } else if (w >= 1) {
+      w = 1;
+    } else {
+      wx = wu * gux + wv * gvx;
+      wy = wu * guy + wv * gvy;
+    }
+  }
+  s->a = w * ab;
+  if (grad && s->a != 0) {
+    double bx = 0, by = 0;
+    for (int k = 0; k < 4; k++) {
+      double o = dG[k] / d->F;
+      for (int j = 0; j < 4; j++)
+        if (j != k) o *= G[j];
+      bx += o * d->nrm[k][0];
+      by += o * d->nrm[k][1];
+    }
+    s->ax = ab * wx + w * bx;
+    s->ay = ab * wy + w * by;
+  }
+}
+
+/* ---- bounds ------------------------------------------------------------ */
+
+/* max |G'(x)| over [a, b] clipped to [0, 1] (|G'| = |g'|). */
+static double rslope(double a, double b) {
+  a = fmax(a, 0);
+  b = fmin(b, 1);
+  if (!(a <= b)) return 0;
+  double pk = 1 / sqrt(5.0);
+  if (a <= pk && pk <= b) return OC_FALLOFF_LIPSCHITZ;
+  return fmax(-oc_falloff_d(a), -oc_falloff_d(b)) * (1 + 1e-12);
+}
+
+static double dist_to_quad(const eimage *d, double x, double y) {
+  int inside = 1;
+  for (int k = 0; k < 4; k++)
+    inside &= d->nrm[k][0] * x + d->nrm[k][1] * y - d->c[k] >= 0;
+  if (inside) return 0;
+  double best = INFINITY;
+  for (int k = 0; k < 4; k++) {
+    const double *A = d->P[k], *B = d->P[(k + 1) & 3];
+    double E[2] = {B[0] - A[0], B[1] - A[1]};
+    double t =
+        ((x - A[0]) * E[0] + (y - A[1]) * E[1]) / (E[0] * E[0] + E[1] * E[1]);
+    t = t < 0 ? 0 : t > 1 ? 1 : t;
+    best = fmin(best, hypot(A[0] + t * E[0] - x, A[1] + t * E[1] - y));
+  }
+  return best;
+}
+
+/* The (u, v) range of the quad's part within the rectangle r: the
+** rectangle clipped by the quad's four half-planes (Sutherland-Hodgman),
+** its vertices inverted. 0 when nothing is left. */
+static int uv_range(const eimage *d, const oc_erect *r, double uv[4]) {
+  double P[16][2], Q[16][2];
+  int n = 4;
+  P[0][0] = r->x0, P[0][1] = r->y0;
+  P[1][0] = r->x1, P[1][1] = r->y0;
+  P[2][0] = r->x1, P[2][1] = r->y1;
+  P[3][0] = r->x0, P[3][1] = r->y1;
+  for (int k = 0; k < 4 && n > 0; k++) {
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+      const double *A = P[i], *B = P[(i + 1) % n];
+      double da = d->nrm[k][0] * A[0] + d->nrm[k][1] * A[1] - d->c[k];
+      double db = d->nrm[k][0] * B[0] + d->nrm[k][1] * B[1] - d->c[k];
+      if (da >= 0) Q[m][0] = A[0], Q[m][1] = A[1], m++;
+      if ((da >= 0) != (db >= 0)) {
+        double t = da / (da - db);
+        Q[m][0] = A[0] + t * (B[0] - A[0]);
+        Q[m][1] = A[1] + t * (B[1] - A[1]);
+        m++;
+      }
+    }
+    n = m;
+    for (int i = 0; i < n; i++)
+      P[i][0] = Q[i][0], P[i][1] = Q[i][1];
+  }
+  if (n == 0) return 0;
+  uv[0] = uv[1] = INFINITY;
+  uv[2] = uv[3] = -INFINITY;
+  for (int i = 0; i < n; i++) {
+    double u, v;
+    inverse(d, P[i][0], P[i][1], &u, &v);
+    uv[0] = fmin(uv[0], u);
+    uv[1] = fmin(uv[1], v);
+    uv[2] = fmax(uv[2], u);
+    uv[3] = fmax(uv[3], v);
+  }
+  /* the clipped vertices and their inversion round off */
+  double pad = 1e-9;
+  uv[0] = fmax(0, uv[0] - pad);
+  uv[1] = fmax(0, uv[1] - pad);
+  uv[2] = fmin(1, uv[2] + pad);
+  uv[3] = fmin(1, uv[3] + pad);
+  return 1;
+}
+
+/* Range and slope bound of a grid over the (u, v) rectangle, as a function
+** of p: the slope through |K^-1|. */
+static void grid_bound(const eimage *d, const grid *G, const double uv[4],
+                       double *lo, double *hi, double *lip) {
+  const oc_elevation *s = &G->src;
+  double X0 = G->x0 + uv[0] * G->W, X1 = G->x0 + uv[2] * G->W;
+  double Y0 = G->y0 + uv[1] * G->H, Y1 = G->y0 + uv[3] * G->H;
+  s->range(s->ud, X0, Y0, X1, Y1, lo, hi);
+  double gs = s->slope(s->ud, X0, Y0, X1, Y1);
+  double detmin = INFINITY, Lu = 0, Lv = 0;
+  for (int c = 0; c < 4; c++) {
+    double u = uv[c & 1 ? 2 : 0], v = uv[c & 2 ? 3 : 1];
+    double p[2], pu[2], pv[2];
+    bilin(d, u, v, p, pu, pv);
+    detmin = fmin(detmin, cross(d->e, d->f) + u * cross(d->e, d->g) +
+                              v * cross(d->g, d->f));
+    Lu = fmax(Lu, hypot(pu[0], pu[1]));
+    Lv = fmax(Lv, hypot(pv[0], pv[1]));
+  }
+  *lip = gs * hypot(Lu * G->H, Lv * G->W) / detmin * (1 + 1e-9);
+}
+
+void oc_eimage_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+  const eimage *d = n->data;
+  /* f: over the quad within r of b */
+  double r = 0;
+  for (int c = 0; c < 4; c++)
+    r = fmax(r, dist_to_quad(d, c & 1 ? b->x1 : b->x0, c & 2 ? b->y1 : b->y0));
+  r = r * (1 + 1e-9) + 1e-9 * (1 + fabs(b->x1 - b->x0) + fabs(b->y1 - b->y0));
+  oc_erect g = {b->x0 - r, b->y0 - r, b->x1 + r, b->y1 + r};
+  double uv[4] = {0, 0, 1, 1}, lo, hi, lh;
+  if (!uv_range(d, &g, uv)) uv[0] = uv[1] = 0, uv[2] = uv[3] = 1;
+  grid_bound(d, &d->h, uv, &lo, &hi, &lh);
+  double a = d->off + d->vs * lo, z = d->off + d->vs * hi;
+  double m = 1e-12 * (1 + fabs(a) + fabs(z));
+  o->flo = fmin(a, z) - m;
+  o->fhi = fmax(a, z) + m;
+  o->lf = fabs(d->vs) * lh;
+  /* alpha: zero unless b meets the quad */
+  o->alo = o->ahi = o->la = 0;
+  double dl[4], dh[4];
+  for (int k = 0; k < 4; k++) {
+    double v0 = d->nrm[k][0] * b->x0, v1 = d->nrm[k][0] * b->x1;
+    double w0 = d->nrm[k][1] * b->y0, w1 = d->nrm[k][1] * b->y1;
+    dl[k] = fmin(v0, v1) + fmin(w0, w1) - d->c[k];
+    dh[k] = fmax(v0, v1) + fmax(w0, w1) - d->c[k];
+    if (!(dh[k] > 0)) return;
+  }
+  if (!uv_range(d, b, uv)) return;
+  double wlo = 1, whi = 1, lw = 0;
+  if (d->w.src.ud) {
+    grid_bound(d, &d->w, uv, &wlo, &whi, &lw);
+    wlo = fmin(fmax(wlo, 0), 1);
+    whi = fmin(fmax(whi, 0), 1);
+  }
+  double blo = 1, bhi = 1, lb = 0, dg;
+  for (int k = 0; k < 4; k++) {
+    double sl = dl[k] / d->F, sh = dh[k] / d->F;
+    blo *= ramp(sl, &dg);
+    bhi *= ramp(sh, &dg);
+    lb += rslope(sl, sh) / d->F;
+  }
+  o->alo = fmax(0, wlo * blo * (1 - 1e-12) - 1e-300);
+  o->ahi = fmin(1, whi * bhi * (1 + 1e-12));
+  o->la = (bhi * lw + whi * lb) * (1 + 1e-9);
+}
+
+/* ---- construction ----------------------------------------------------- */
+
+static int take_grid(oc_heightfield *hf, grid *G, oc_error *err) {
+  if (oc_heightfield_elevation(hf, &G->src, err)) return err->code;
+  G->x0 = G->src.x0;
+  G->y0 = G->src.y0;
+  G->W = G->src.x1 - G->src.x0;
+  G->H = G->src.y1 - G->src.y0;
+  return OC_OK;
+}
+
+/* The corners of p's quad (or of its segment's rectangle); 0 or an error
+** naming the field. */
+static int corners(const oc_enode_image_params *p, double P[4][2],
+                   oc_error *err) {
+  const char *name = p->segment ? "segment" : "quad";
+  if (p->segment) {
+    for (int k = 0; k < 4; k++)
+      if (!isfinite(p->seg[k]))
+        return oc_seterr(err, OC_EINVAL,
+                         "'segment' must have finite coordinates");
+    if (!(isfinite(p->width) && p->width > 0))
+      return oc_seterr(err, OC_EINVAL,
+                       "'width' must be a positive number (got %g)", p->width);
+    double tx = p->seg[2] - p->seg[0], ty = p->seg[3] - p->seg[1];
+    double L = hypot(tx, ty);
+    if (!(L > 0) || !isfinite(L))
+      return oc_seterr(err, OC_EINVAL,
+                       "'segment' must join two distinct points");
+    double nx = -ty / L * p->width / 2, ny = tx / L * p->width / 2;
+    double c[4][2] = {{p->seg[0] - nx, p->seg[1] - ny},
+                      {p->seg[2] - nx, p->seg[3] - ny},
+                      {p->seg[2] + nx, p->seg[3] + ny},
+                      {p->seg[0] + nx, p->seg[1] + ny}};
+    for (int k = 0; k < 4; k++)
+      P[k][0] = c[k][0], P[k][1] = c[k][1];
+  } else {
+    for (int k = 0; k < 4; k++) {
+      P[k][0] = p->quad[2 * k];
+      P[k][1] = p->quad[2 * k + 1];
+      if (!isfinite(P[k][0]) || !isfinite(P[k][1]))
+        return oc_seterr(err, OC_EINVAL,
+                         "'quad[%d]' must have finite coordinates", k + 1);
+    }
+  }
+  int pos = 0, neg = 0;
+  for (int k = 0; k < 4; k++) {
+    const double *A = P[k], *B = P[(k + 1) & 3], *C = P[(k + 2) & 3];
+    double E[2] = {B[0] - A[0], B[1] - A[1]}, F[2] = {C[0] - B[0], C[1] - B[1]};
+    double le = hypot(E[0], E[1]), lf = hypot(F[0], F[1]);
+    if (!(le > 0 && lf > 0) || !isfinite(le * lf))
+      return oc_seterr(err, OC_EINVAL,
+                       "'%s' is degenerate (corners %d and %d coincide, or "
+                       "are too far apart)",
+                       name, k + 1, (k + 1) % 4 + 1);
+    double sn = cross(E, F) / (le * lf); /* the sine of the turn at B */
+    if (fabs(sn) < 1e-6)
+      return oc_seterr(err, OC_EINVAL,
+                       "'%s' is degenerate: corners %d, %d and %d are in line",
+                       name, k + 1, (k + 1) % 4 + 1, (k + 2) % 4 + 1);
+    pos += sn > 0;
+    neg += sn < 0;
+  }
+  if (neg == 4)
+    return oc_seterr(err, OC_EINVAL,
+                     "'quad' must be counter-clockwise (its corners go "
+                     "clockwise: reverse them)");
+  if (pos != 4) return oc_seterr(err, OC_EINVAL, "'%s' must be convex", name);
+  /* a convex polygon turns once: a self-crossing one turns more */
+  double ang = 0;
+  for (int k = 0; k < 4; k++) {
+    const double *A = P[k], *B = P[(k + 1) & 3], *C = P[(k + 2) & 3];
+    double E[2] = {B[0] - A[0], B[1] - A[1]}, F[2] = {C[0] - B[0], C[1] - B[1]};
+    ang += atan2(cross(E, F), E[0] * F[0] + E[1] * F[1]);
+  }
+  if (ang > 7)
+    return oc_seterr(err, OC_EINVAL, "'%s' must be convex (it crosses itself)",
+                     name);
+  return OC_OK;
+}
+
+oc_enode *oc_enode_image(const oc_enode_image_params *p, oc_error *err) {
+  if (!p || !p->heightfield) {
+    oc_seterr(err, OC_EINVAL, "image: no 'heightfield'");
+    return NULL;
+  }
+  double vs = p->height == 0 ? 1 : p->height;
+  if (!isfinite(vs)) {
+    oc_seterr(err, OC_EINVAL, "'height' must be a finite number (got %g)",
+              p->height);
+    return NULL;
+  }
+  if (!isfinite(p->offset)) {
+    oc_seterr(err, OC_EINVAL, "'offset' must be a finite number (got %g)",
+              p->offset);
+    return NULL;
+  }
+  if (!(isfinite(p->falloff) && p->falloff >= 0)) {
+    oc_seterr(err, OC_EINVAL, "'falloff' must be a positive number (got %g)",
+              p->falloff);
+    return NULL;
+  }
+  eimage *d = calloc(1, sizeof *d);
+  if (!d) {
+    oc_seterr(err, OC_ENOMEM, "out of memory");
+    return NULL;
+  }
+  if (corners(p, d->P, err)) goto fail;
+  for (int k = 0; k < 2; k++) {
+    d->e[k] = d->P[1][k] - d->P[0][k];
+    d->f[k] = d->P[3][k] - d->P[0][k];
+    d->g[k] = d->P[0][k] - d->P[1][k] + d->P[2][k] - d->P[3][k];
+  }
+  double area = 0;
+  for (int k = 0; k < 4; k++) {
+    const double *A = d->P[k], *B = d->P[(k + 1) & 3];
+    double ex = B[0] - A[0], ey = B[1] - A[1], L = hypot(ex, ey);
+    d->nrm[k][0] = -ey / L; /* left of a counter-clockwise edge: inward */
+    d->nrm[k][1] = ex / L;
+    d->c[k] = d->nrm[k][0] * A[0] + d->nrm[k][1] * A[1];
+    area += cross(A, B) / 2;
+  }
+  d->vs = vs;
+  d->off = p->offset;
+  d->F = p->falloff > 0 ? p->falloff : sqrt(area) / 10;
+  if (take_grid(p->heightfield, &d->h, err)) goto fail;
+  if (p->weight && take_grid(p->weight, &d->w, err)) goto fail;
+  oc_enode *n = oc_enode_alloc(OC_E_IMAGE, NULL, 0, err);
+  if (!n) goto fail;
+  n->data = d;
+  n->box = (oc_erect){INFINITY, INFINITY, -INFINITY, -INFINITY};
+  for (int k = 0; k < 4; k++) {
+    n->box.x0 = fmin(n->box.x0, d->P[k][0]);
+    n->box.y0 = fmin(n->box.y0, d->P[k][1]);
+    n->box.x1 = fmax(n->box.x1, d->P[k][0]);
+    n->box.y1 = fmax(n->box.y1, d->P[k][1]);
+  }
+  oc_eimage_bound_in(n, &n->box, &n->glob);
+  n->glob.alo = 0;
+  if (!isfinite(n->glob.flo) || !isfinite(n->glob.fhi) ||
+      !isfinite(n->glob.lf) || !isfinite(n->glob.la) || !isfinite(d->F) ||
+      !(d->F > 0)) {
+    oc_seterr(err, OC_EINVAL,
+              "image: its elevations or slopes overflow (height %g, offset "
+              "%g, falloff %g)",
+              vs, p->offset, d->F);
+    oc_enode_release(n);
+    return NULL;
+  }
+  return n;
+fail:
+  oc_eimage_free(d);
+  return NULL;
+}
