@@ -1010,6 +1010,11 @@ typedef struct oc_elevation {
                           double *alpha, double agrad[2]);
   void (*weight_range)(void *ud, double x0, double y0, double x1, double y1,
                        double *alo, double *ahi, double *alip);
+  /* Optional (NULL: range then slope): both at once, from one traversal
+  ** of a source's hierarchy (elevation trees); the tracer asks for both
+  ** on every segment. */
+  void (*bound)(void *ud, double x0, double y0, double x1, double y1,
+                double *lo, double *hi, double *slope);
 } oc_elevation;
 
 /* The source of a heightfield: its Catmull-Rom interpolant over the grid's

@@ -20,6 +20,11 @@
 /* Ridged octaves: w_i = clamp(RIDGE_GAIN s_(i-1), 0, 1). */
 #define RIDGE_GAIN 2.0
 
+/* Ranges in a box evaluate at most this many octaves at its centre: the
+** first ones hold most of the amplitude (gain^i), and each costs as much
+** as in a height call. */
+#define RANGE_OCTAVES 3
+
 double oc_eta(uint64_t seed, double x, double y, double g[2]) {
   oc_vec3 gr;
   double n = oc_noise3(seed, oc_v3(x, y, 0), g ? &gr : NULL);
@@ -130,6 +135,7 @@ void oc_edisc_ev(const oc_enode *n, double x, double y, int want,
       return;
     }
   }
+  if (want & OC_EV_ALPHA) return;
   double g[2] = {0, 0};
   s->f = p[3] + (n->noise.kind == OC_ENOISE_NONE
                      ? 0
@@ -155,17 +161,70 @@ static double wyvill(double x) {
   return k * k * k;
 }
 
+/* The range of a plain or turbulent noise sum on a box of centre (u, v)
+** and half-diagonal rho (relative to the disc's centre): each octave's
+** value at the centre, give or take its Lipschitz bound times rho, within
+** its own range. Octaves whose wavelength is below rho keep their whole
+** range; 0 when the first octave already does (nothing to gain). */
+static int noise_range_in(const oc_enoise *nz, double u, double v, double rho,
+                          double *lo, double *hi) {
+  double le = 2 * oc_noise3_lipschitz, a = nz->amplitude,
+         s = 1 / nz->wavelength;
+  if (!(le * s * rho < 1)) return 0;
+  double l = 0, h = 0;
+  for (int i = 0; i < nz->octaves; i++) {
+    double d = le * s * rho;
+    if (d >= 1 || i >= RANGE_OCTAVES) { /* the finer ones: whole ranges */
+      for (; i < nz->octaves; i++, a *= nz->gain)
+        l -= nz->kind == OC_ENOISE_PLAIN ? a : 0, h += a;
+      break;
+    }
+    double e = oc_eta(octave_seed(nz->seed, i), s * u, s * v, NULL);
+    if (nz->kind == OC_ENOISE_TURBULENCE) {
+      e = fabs(e); /* |eta| is as Lipschitz as eta */
+      l += a * fmax(0, e - d), h += a * fmin(1, e + d);
+    } else {
+      l += a * fmax(-1, e - d), h += a * fmin(1, e + d);
+    }
+    a *= nz->gain;
+    s *= nz->lacunarity;
+  }
+  /* rounding of the sums: a relative hair */
+  double pad = 1e-12 * (fabs(l) + fabs(h) + nz->amplitude);
+  *lo = l - pad, *hi = h + pad;
+  return 1;
+}
+
 void oc_edisc_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
   *o = n->glob;
   if (!oc_erect_meets(&n->box, b)) {
     o->alo = o->ahi = o->la = 0;
     return;
   }
+  double nlo, nhi;
+  if ((n->noise.kind == OC_ENOISE_PLAIN ||
+       n->noise.kind == OC_ENOISE_TURBULENCE) &&
+      noise_range_in(&n->noise, 0.5 * (b->x0 + b->x1) - n->par[0],
+                     0.5 * (b->y0 + b->y1) - n->par[1],
+                     0.5 * hypot(b->x1 - b->x0, b->y1 - b->y0), &nlo, &nhi)) {
+    o->flo = fmax(o->flo, n->par[3] + nlo);
+    o->fhi = fmin(o->fhi, n->par[3] + nhi);
+  }
   double dmin, dmax, r = n->par[2];
   rect_dist(b, n->par[0], n->par[1], &dmin, &dmax);
   /* rounding: alpha's bounds a hair wider than the formula */
   o->alo = fmax(0, wyvill(dmax / r) * (1 - 1e-12) - 1e-300);
   o->ahi = fmin(1, wyvill(dmin / r) * (1 + 1e-12));
+  /* |grad alpha| = 6 x (1 - x^2)^2 / r at x = d / r rises up to x =
+  ** 1/sqrt(5) (the global bound) and falls after: its largest value on
+  ** [dmin, dmax] is there or at the end nearer to it */
+  double x0 = dmin / r, x1 = fmin(dmax / r, 1), xs = 1 / sqrt(5.0);
+  if (x0 >= 1) {
+    o->la = 0; /* outside the disc: alpha = 0 on the whole box */
+  } else if (x1 < xs || x0 > xs) {
+    double x = x1 < xs ? x1 : x0, k = 1 - x * x;
+    o->la = fmin(o->la, 6 * x * k * k / r * (1 + 1e-12));
+  }
 }
 
 static int check_noise(const oc_enode_noise *nz, oc_enoise *out,

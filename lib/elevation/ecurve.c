@@ -82,6 +82,7 @@ void oc_ecurve_ev(const oc_enode *n, double x, double y, int want,
   int grad = want & OC_EV_GRAD, lazy = want & OC_EV_LAZY;
   oc_curve_point pt;
   s->ax = s->ay = s->fx = s->fy = 0;
+  if (want & OC_EV_ALPHA) lazy = 1; /* no f: only the nearby curve */
   if (!oc_curve_closest(d->c, x, y, lazy ? d->R : INFINITY, &pt)) {
     s->a = s->f = 0;
     return;
@@ -104,6 +105,7 @@ void oc_ecurve_ev(const oc_enode *n, double x, double y, int want,
       return;
     }
   }
+  if (want & OC_EV_ALPHA) return;
   /* f: the lateral coordinate and the gradients of s and of it */
   double dl, gsx = 0, gsy = 0, gz = 0;
   if (pt.end) {
@@ -137,8 +139,20 @@ void oc_ecurve_ev(const oc_enode *n, double x, double y, int want,
 }
 
 void oc_ecurve_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+  const ecurve *d = n->data;
+  oc_curve_point pt;
   *o = n->glob;
-  if (!oc_erect_meets(&n->box, b)) o->alo = o->ahi = o->la = 0;
+  if (!oc_erect_meets(&n->box, b)) {
+    o->alo = o->ahi = o->la = 0;
+    return;
+  }
+  /* alpha = 0 on the box when no point of the skeleton is within R of
+  ** it: none within R + rho of its centre, rho its half-diagonal (and a
+  ** hair for rounding) */
+  double cx = 0.5 * (b->x0 + b->x1), cy = 0.5 * (b->y0 + b->y1);
+  double rho = 0.5 * hypot(b->x1 - b->x0, b->y1 - b->y0);
+  double r = (d->R + rho) * (1 + 1e-12) + 1e-9;
+  if (!oc_curve_closest(d->c, cx, cy, r, &pt)) o->alo = o->ahi = o->la = 0;
 }
 
 oc_enode *oc_enode_curve(const oc_enode_curve_params *p, oc_error *err) {

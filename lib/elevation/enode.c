@@ -5,6 +5,7 @@
 ** sampling, rendering).
 */
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -17,9 +18,27 @@ static const char *const kind_names[OC_E_COUNT] = {
     "disc", "curve", "blend", "replace", "add", "transform", "warp",
     "lake", "image"};
 
+/* 1 + the parameters each kind stores (disc.c, ecurve.c, eops.c); 0, a
+** kind not listed: OC_ENODE_NPAR. */
+static const unsigned char par_counts[OC_E_COUNT] = {
+    [OC_E_DISC] = 1 + 4,    [OC_E_CURVE] = 1 + 2, [OC_E_BLEND] = 1 + 0,
+    [OC_E_REPLACE] = 1 + 1, [OC_E_ADD] = 1 + 4,   [OC_E_XFORM] = 1 + 11,
+    [OC_E_WARP] = 1 + 2};
+
+static size_t par_count(oc_ekind kind) {
+  unsigned c = (unsigned)kind < OC_E_COUNT ? par_counts[kind] : 0;
+  return c ? c - 1 : OC_ENODE_NPAR;
+}
+
+size_t oc_enode_size(const oc_enode *n) {
+  return offsetof(oc_enode, par) + par_count(n->kind) * sizeof(double) +
+         (n->kids != n->inl ? n->nkids * sizeof *n->kids : 0);
+}
+
 oc_enode *oc_enode_alloc(oc_ekind kind, oc_enode *const *kids, size_t nkids,
                          oc_error *err) {
-  oc_enode *n = calloc(1, sizeof *n);
+  oc_enode *n =
+      calloc(1, offsetof(oc_enode, par) + par_count(kind) * sizeof(double));
   if (!n) {
     oc_seterr(err, OC_ENOMEM, "out of memory");
     return NULL;
@@ -117,7 +136,7 @@ void oc_enode_eval(const oc_enode *e, double x, double y, oc_enode_sample *s) {
 double oc_enode_weight(const oc_enode *e, double x, double y) {
   if (!isfinite(x) || !isfinite(y)) return NAN;
   oc_enode_sample s;
-  oc_enode_ev(e, x, y, OC_EV_LAZY, &s);
+  oc_enode_ev(e, x, y, OC_EV_ALPHA, &s);
   return s.a;
 }
 
@@ -161,8 +180,7 @@ int oc_enode_get_stats(const oc_enode *e, oc_enode_stats *st, oc_error *err) {
     st->nodes++;
     st->primitives += x->kind == OC_E_DISC || x->kind == OC_E_CURVE ||
                       x->kind == OC_E_LAKE || x->kind == OC_E_IMAGE;
-    st->bytes +=
-        sizeof *x + (x->kids != x->inl ? x->nkids * sizeof *x->kids : 0);
+    st->bytes += oc_enode_size(x);
     for (size_t i = 0; i < x->nkids; i++) {
       const oc_enode *k = x->kids[i];
       if (oc_pmap_slot(&seen, k, 0)) continue;
@@ -261,6 +279,16 @@ static void src_weight_range(void *ud, double x0, double y0, double x1,
   *alip = b.la;
 }
 
+static void src_bound(void *ud, double x0, double y0, double x1, double y1,
+                      double *lo, double *hi, double *slope) {
+  oc_ebound b;
+  oc_erect r = {x0, y0, x1, y1};
+  oc_enode_bnd(ud, &r, &b);
+  *lo = b.flo;
+  *hi = b.fhi;
+  *slope = b.lf;
+}
+
 static void src_retain(void *ud) {
   oc_enode_retain(ud);
 }
@@ -287,6 +315,7 @@ int oc_enode_elevation(oc_enode *e, const double *domain, oc_elevation *src,
   src->height = src_height;
   src->range = src_range;
   src->slope = src_slope;
+  src->bound = src_bound;
   src->retain = src_retain;
   src->release = src_release;
   src->height_weight = src_height_weight; /* Omega_T: where alpha >= 1/2 */

@@ -22,7 +22,6 @@
 
 #include "outcrop.h"
 
-
 typedef enum oc_ekind {
   OC_E_DISC,
   OC_E_CURVE,
@@ -60,14 +59,24 @@ struct oc_enode {
   oc_enode *inl[2];
   oc_erect box;   /* Omega_0 lies inside */
   oc_ebound glob; /* over the whole plane */
-  double par[12];
   oc_enoise noise;
   void *data; /* curve: skeleton and profiles (ecurve.c), owned */
+  /* Parameters, as many as the kind uses (enode.c, par_count): a blend
+  ** stores none, a transform 11; kinds not in that table get
+  ** OC_ENODE_NPAR. Last, so that each node is allocated at its size. */
+  double par[];
 };
+#define OC_ENODE_NPAR 12
+
+/* The bytes of n, its children's array included. */
+size_t oc_enode_size(const oc_enode *n);
 
 /* What a caller asks of eval. */
 #define OC_EV_GRAD 1 /* gradients too */
 #define OC_EV_LAZY 2 /* f may be left 0 where alpha = 0 (blend children) */
+/* alpha and nothing else (f and the gradients left unset): no operator's
+** alpha depends on an f, so a weight query skips every noise sum */
+#define OC_EV_ALPHA 4
 
 void oc_enode_ev(const oc_enode *n, double x, double y, int want,
                  oc_enode_sample *s);

@@ -64,14 +64,18 @@ static double clamp01(double v, int *inside) {
 
 static void blend_ev(const oc_enode *n, double x, double y, int want,
                      oc_enode_sample *s) {
-  int grad = want & OC_EV_GRAD;
+  int grad = want & OC_EV_GRAD, only = want & OC_EV_ALPHA;
   double N = 0, S = 0, nx = 0, ny = 0, sx = 0, sy = 0;
   for (size_t i = 0; i < n->nkids; i++) {
     const oc_enode *k = n->kids[i];
     if (!(x >= k->box.x0 && x <= k->box.x1 && y >= k->box.y0 && y <= k->box.y1))
       continue; /* alpha = 0 there: no contribution */
     oc_enode_sample c;
-    oc_enode_ev(k, x, y, grad | OC_EV_LAZY, &c);
+    oc_enode_ev(k, x, y, grad | OC_EV_LAZY | only, &c);
+    if (only) {
+      S += c.a;
+      continue;
+    }
     if (c.a == 0) continue;
     N += c.a * c.f;
     S += c.a;
@@ -85,6 +89,7 @@ static void blend_ev(const oc_enode *n, double x, double y, int want,
   s->a = S;
   s->ax = sx;
   s->ay = sy;
+  if (only) return;
   if (x != x || y != y) { /* NaN fails every box test */
     s->f = s->a = NAN;
     s->fx = s->fy = s->ax = s->ay = NAN;
@@ -125,7 +130,12 @@ static void blend_combine(const oc_ebound *kb, size_t n, oc_ebound *o) {
     M += kb[i].la * fmax(fabs(kb[i].flo), fabs(kb[i].fhi));
   }
   double lam = fmin(lasum, (double)(n - 1) * lamax);
-  o->lf = lmax + lam * (fhi - flo) / fmax(slo, T);
+  /* sum |grad alpha_i| |f_i - f| with f in [flo, fhi]: each child's own
+  ** distance to that range is often far below its width */
+  double dev = 0;
+  for (size_t i = 0; i < n; i++)
+    dev += kb[i].la * fmax(kb[i].fhi - flo, fhi - kb[i].flo);
+  o->lf = lmax + fmin(lam * (fhi - flo), dev) / fmax(slo, T);
   if (slo < T) { /* f fades towards 0 where sum alpha < T */
     o->lf = fmax(o->lf, lmax + M / T);
     flo = fmin(flo, 0);
@@ -148,8 +158,12 @@ static void blend_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
   }
   size_t m = 0;
   for (size_t i = 0; i < n->nkids; i++)
-    if (oc_erect_meets(&n->kids[i]->box, b))
-      oc_enode_bnd(n->kids[i], b, &kb[m++]);
+    if (oc_erect_meets(&n->kids[i]->box, b)) {
+      oc_enode_bnd(n->kids[i], b, &kb[m]);
+      /* alpha = 0 on the whole box: neither the child's f nor its
+      ** weight's slope counts there */
+      m += kb[m].ahi > 0;
+    }
   blend_combine(kb, m, o);
   if (kb != stack) free(kb);
 }
@@ -194,13 +208,25 @@ static void replace_ev(const oc_enode *n, double x, double y, int want,
   int grad = want & OC_EV_GRAD, in;
   const oc_enode *A = n->kids[0], *B = n->kids[1];
   oc_enode_sample a, b;
+  int lerp = n->par[P_LERP] != 0;
+  if (want & OC_EV_ALPHA) { /* alpha_A, or lerped with B's */
+    oc_enode_ev(A, x, y, OC_EV_ALPHA, &a);
+    s->a = a.a;
+    if (lerp) {
+      b.a = 0;
+      if (x >= B->box.x0 && x <= B->box.x1 && y >= B->box.y0 && y <= B->box.y1)
+        oc_enode_ev(B, x, y, OC_EV_ALPHA, &b);
+      double w = clamp01(b.a, &in);
+      s->a = (1 - w) * a.a + w * w;
+    }
+    return;
+  }
   b.a = b.f = b.fx = b.fy = b.ax = b.ay = 0;
   if (x >= B->box.x0 && x <= B->box.x1 && y >= B->box.y0 && y <= B->box.y1)
     oc_enode_ev(B, x, y, grad | OC_EV_LAZY, &b);
   double w = clamp01(b.a, &in);
   /* A's f is not needed where B replaces it wholly, nor, for a lazy
   ** caller, where A's weight (the node's, unless lerped) is 0 */
-  int lerp = n->par[P_LERP] != 0;
   int alazy = w >= 1 || (!lerp && (want & OC_EV_LAZY));
   oc_enode_ev(A, x, y, grad | (alazy ? OC_EV_LAZY : 0), &a);
   if (w >= 1) {
@@ -252,7 +278,6 @@ static void replace_combine(const oc_enode *n, const oc_ebound *A,
   }
 }
 
-
 static oc_enode *binary(oc_ekind kind, oc_enode *a, oc_enode *b,
                         oc_error *err) {
   if (!a || !b) {
@@ -296,6 +321,18 @@ static void add_ev(const oc_enode *n, double x, double y, int want,
   const oc_enode *A = n->kids[0], *B = n->kids[1];
   oc_enode_sample a, b;
   int sumw = n->par[P_SUMW] != 0;
+  if (want & OC_EV_ALPHA) { /* alpha_A, or plus w_B^2 */
+    oc_enode_ev(A, x, y, OC_EV_ALPHA, &a);
+    s->a = a.a;
+    if (sumw) {
+      b.a = 0;
+      if (x >= B->box.x0 && x <= B->box.x1 && y >= B->box.y0 && y <= B->box.y1)
+        oc_enode_ev(B, x, y, OC_EV_ALPHA, &b);
+      double c = clamp01(b.a, &in);
+      s->a += c * c;
+    }
+    return;
+  }
   /* alpha_A + w^2 may be > 0 where alpha_A = 0: then f_A is needed */
   oc_enode_ev(A, x, y, sumw ? grad : want, &a);
   if (want & OC_EV_LAZY && a.a == 0 && !sumw) {
@@ -329,9 +366,15 @@ static void add_combine(const oc_enode *n, const oc_ebound *A,
   double chi = bmeets ? fmin(fmax(B->ahi, 0), 1) : 0;
   double lc = bmeets ? B->la : 0;
   *o = *A;
-  if (chi > 0) {
-    double wlo = clo, whi = chi, lw = lc;
-    if (n->par[P_BELOW] != 0) {
+  /* the altitude weight is 0 on the region where f_A >= below_z, 1
+  ** where f_A <= below_z - fade (with a hair for the rounding of t) */
+  int below = n->par[P_BELOW] != 0;
+  double bz = n->par[P_BZ], fade = n->par[P_FADE], fchi = chi;
+  if (below && A->flo >= bz) fchi = 0;
+  if (below && A->fhi < bz - fade * (1 + 1e-9) - 1e-9 * fabs(bz)) below = 0;
+  if (fchi > 0) {
+    double wlo = clo, whi = fchi, lw = lc;
+    if (below) {
       wlo = 0; /* the altitude weight may be 0 */
       lw = lc + 1.5 / n->par[P_FADE] * A->lf;
     }
@@ -403,6 +446,7 @@ static void xform_ev(const oc_enode *n, double x, double y, int want,
   oc_enode_ev(n->kids[0], m[0] * u + m[1] * v, m[2] * u + m[3] * v, want, &c);
   double vs = n->par[P_VS];
   s->a = c.a;
+  if (want & OC_EV_ALPHA) return;
   if (want & OC_EV_LAZY && c.a == 0)
     s->f = 0;
   else

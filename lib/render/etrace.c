@@ -12,7 +12,10 @@
 **    range (and, descending, up to where it comes down to the range's
 **    top, when that is farther than the slope's step), and doubles the
 **    candidate delta after each step, so that it strides over flat ground
-**    and far from the surface.
+**    and far from the surface. A step the slope limits is over-relaxed
+**    (kept only when the slope proves the stretch behind its sample free
+**    too), and the range and slope come from one query (oc_elevation's
+**    bound, when the source has it).
 **  - Sphere tracing (`OC_TRACE_SPHERE`, section 7.1) uses the slope bound of
 **    the whole domain for every step: the baseline the paper compares to.
 ** Both clip the ray to the domain x [min f, max f] first, never step below
@@ -30,6 +33,14 @@
 #include "render/trace.h"
 
 #define GROW 2.0 /* candidate step after a step s: GROW s */
+/* Over-relaxation of slope-limited steps (Keinert et al. 2014): a step of
+** RELAX s is kept when the free stretch before its sample (h over the
+** slope backwards) meets the stretch s proved free after the last one,
+** else the ray goes back to the plain step. */
+#define RELAX 1.6
+/* A ray whose relaxed steps failed this often (the slope bound is tight
+** there) goes on with plain steps. */
+#define MAX_FAILS 1
 
 void oc_etracer_init(oc_etracer *tr, const oc_esurface *s,
                      oc_render_tracer mode, double eps_k, double eps_min) {
@@ -80,13 +91,17 @@ static int clip(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double *t0,
   return 1;
 }
 
-/* h at p, one height call; *solid: the weight allows a surface there. */
+/* h at p, one height call; with solid, *solid: the weight allows a
+** surface there, asked only under the surface (h <= 0 or NaN), the one
+** place where a caller reads it. */
 static double height_above(const oc_etracer *tr, oc_vec3 p, int *solid,
                            double *n) {
   const oc_esurface *s = tr->s;
   (*n)++;
-  *solid = !s->weight || s->weight(s->wud, p.x, p.y) >= s->T;
-  return p.z - s->src->height(s->src->ud, p.x, p.y, NULL);
+  double h = p.z - s->src->height(s->src->ud, p.x, p.y, NULL);
+  if (solid)
+    *solid = h > 0 || !s->weight || s->weight(s->wud, p.x, p.y) >= s->T;
+  return h;
 }
 
 /* h(a) = ha > 0 >= h(b) = hb: regula falsi (Illinois), down to a small
@@ -94,11 +109,11 @@ static double height_above(const oc_etracer *tr, oc_vec3 p, int *solid,
 static double refine(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double a,
                      double ha, double b, double hb, double d0, double *n) {
   double stop = 1e-3 * tol(tr, d0, a);
-  int side = 0, solid;
+  int side = 0;
   for (int k = 0; k < 24 && b - a > stop; k++) {
     double m = a + (b - a) * (ha / (ha - hb));
     if (!(m > a && m < b) || k % 4 == 3) m = 0.5 * (a + b);
-    double h = height_above(tr, at(o, u, m), &solid, n);
+    double h = height_above(tr, at(o, u, m), NULL, n);
     if (h > 0) {
       a = m, ha = h;
       if (side == -1) hb *= 0.5;
@@ -138,12 +153,26 @@ static int march(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
                  double t1, double d0, double *thit, double *n) {
   const oc_elevation *src = tr->s->src;
   double uxy = hypot(u.x, u.y), delta = (t1 - t) / 16, prev = t, hp = 0;
-  int accel = tr->mode == OC_TRACE_SEGMENT, have_prev = 0;
+  int accel = tr->mode == OC_TRACE_SEGMENT, have_prev = 0, relaxed = 0;
+  double rsafe = 0, rlam = 0; /* a relaxed step's plain step and slope */
+  int fails = 0;              /* of relaxed steps on this ray */
   for (long k = 0; k < OC_TRACE_MAX_STEPS; k++) {
     oc_vec3 p = at(o, u, t);
     int solid;
     double h = height_above(tr, p, &solid, n);
     if (h != h) return 0; /* NaN: no surface can be located */
+    if (relaxed) {
+      /* from t back to prev + rsafe the ray is free when h > 0 and
+      ** h / (u_z + |u_xy| lambda) reaches there (the slope holds on the
+      ** box of the whole candidate) */
+      double kb = u.z + uxy * rlam;
+      relaxed = 0;
+      if (!(h > 0 && (kb <= 0 || prev + rsafe + h / kb >= t))) {
+        t = prev + rsafe; /* not proved: the plain step */
+        fails++;
+        continue;
+      }
+    }
     if (solid && h <= 0) {
       if (!(have_prev && hp > 0)) {
         *thit = t; /* through a side of the domain or of a hole */
@@ -152,18 +181,23 @@ static int march(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
       *thit = tr->refine ? refine(tr, o, u, prev, hp, t, h, d0, n) : t;
       return 1;
     }
-    double s, grow = -1;
+    double s, grow = -1, rlam_of_step = 0;
     if (accel) {
       double e = lesser(delta, t1 - t);
       oc_vec3 q = at(o, u, t + e);
       double x0 = lesser(p.x, q.x), x1 = greater(p.x, q.x);
       double y0 = lesser(p.y, q.y), y1 = greater(p.y, q.y);
-      double lo, hi;
-      src->range(src->ud, x0, y0, x1, y1, &lo, &hi);
+      double lo, hi, lam = -1;
+      if (src->bound)
+        src->bound(src->ud, x0, y0, x1, y1, &lo, &hi, &lam);
+      else
+        src->range(src->ud, x0, y0, x1, y1, &lo, &hi);
       if (lesser(p.z, q.z) > hi) {
         s = e; /* above everything the segment's box holds */
       } else {
-        s = safe_step(h, u.z, uxy, src->slope(src->ud, x0, y0, x1, y1), e);
+        if (lam < 0) lam = src->slope(src->ud, x0, y0, x1, y1);
+        s = safe_step(h, u.z, uxy, lam, e);
+        rlam_of_step = lam;
         /* a descending ray is free, too, until it comes down to hi (the
         ** candidate grows from the slope's step: the range's may end
         ** right above a slope) */
@@ -176,6 +210,14 @@ static int march(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
     s = greater(s, tol(tr, d0, t));
     if (t + s > t1 || t + s == t) return 0; /* left the box */
     prev = t, hp = h, have_prev = 1;
+    if (accel && fails < MAX_FAILS && grow >= 0 && h > 0 && s == grow) {
+      /* limited by the slope: try a longer step within the candidate */
+      double e = lesser(delta, t1 - t), r = lesser(RELAX * s, e);
+      if (r > s) {
+        relaxed = 1, rsafe = s, rlam = rlam_of_step;
+        s = r;
+      }
+    }
     t += s;
     delta = GROW * (grow >= 0 ? greater(grow, tol(tr, d0, t)) : s);
   }

@@ -9,6 +9,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "elevation/enode.h"
 #include "ocheck.h"
 
 #define PI 3.14159265358979323846
@@ -149,6 +150,22 @@ START_TEST(disc_noises) {
     for (int i = 0; i < 100; i++)
       check_gradient(d, oct_unif(&r, -90, 90), oct_unif(&r, -90, 90), 2e-4);
     check_bounds(d, 0, 0, 100);
+    /* in a box much smaller than the wavelength, plain and turbulent sums
+    ** are bounded from the octaves' values at its centre: the range is a
+    ** fraction of the whole plane's (2 lambda rho for the first octave) */
+    oc_enode_bound b;
+    oc_enode_bound_in(d, 10, 10, 11, 11, &b);
+    if (kinds[k] != OC_ENOISE_RIDGED)
+      ck_assert_msg(b.fhi - b.flo < 0.7 * (hi - lo), "%s: [%g, %g] in [%g, %g]",
+                    oc_enode_kind(d), b.flo, b.fhi, lo, hi);
+    /* alpha's slope: 0 on a box of the square outside the circle, below
+    ** the global bound near the centre (x < 1/sqrt(5)) */
+    oc_enode_bound_in(d, 80, 80, 99, 99, &b);
+    ck_assert(b.la == 0 && b.ahi == 0);
+    oc_enode_bound_in(d, -10, -10, 10, 10, &b);
+    double x = hypot(10, 10) / 100, kk = 1 - x * x;
+    ck_assert_double_eq_tol(b.la, 6 * x * kk * kk / 100, 1e-12);
+    ck_assert(b.la < 0.9 * 1.7173002067198386 / 100);
     oc_enode_release(d);
   }
 }
@@ -236,6 +253,31 @@ START_TEST(replace_and_add_formulas) {
   check_bounds(lerp, 5, 5, 30);
   check_bounds(add, 5, 5, 30);
   check_bounds(addb, 5, 5, 30);
+  /* in boxes where f_A >= below_z, the altitude weight is 0: addb is A
+  ** there; where f_A <= below_z - fade, it is 1: addc (below 16) is add */
+  oc_enode_add_params cp = {1, 1, 16, 3}, sp = {1, 0, 0, 0};
+  oc_enode *addc = EOK(oc_enode_add(a, b, &cp, &err));
+  oc_enode *adds = EOK(oc_enode_add(a, b, &sp, &err));
+  int above = 0, under = 0;
+  for (int i = 0; i < 400; i++) {
+    double x0 = oct_unif(&r, -6, 16), y0 = oct_unif(&r, -6, 16);
+    oc_enode_bound ba, bb, bc, bd;
+    oc_enode_bound_in(a, x0, y0, x0 + 0.2, y0 + 0.2, &ba);
+    oc_enode_bound_in(addb, x0, y0, x0 + 0.2, y0 + 0.2, &bb);
+    oc_enode_bound_in(addc, x0, y0, x0 + 0.2, y0 + 0.2, &bc);
+    oc_enode_bound_in(adds, x0, y0, x0 + 0.2, y0 + 0.2, &bd);
+    if (ba.flo >= 9) {
+      above++;
+      ck_assert(bb.lf == ba.lf && bb.flo == ba.flo && bb.fhi == ba.fhi);
+    }
+    if (ba.fhi < 13 - 1e-6) {
+      under++;
+      ck_assert(bc.lf == bd.lf && bc.flo == bd.flo && bc.fhi == bd.fhi);
+    }
+  }
+  ck_assert_msg(above > 0 && under > 0, "above %d, under %d", above, under);
+  oc_enode_release(addc);
+  oc_enode_release(adds);
   oc_enode *all[6] = {a, b, rep, lerp, add, addb};
   for (int i = 0; i < 6; i++)
     oc_enode_release(all[i]);
@@ -307,7 +349,14 @@ START_TEST(dag_stats_and_source) {
   ck_assert_int_eq(oc_enode_get_stats(e, &st, &err), OC_OK);
   ck_assert_uint_eq(st.nodes, 4); /* hill shared */
   ck_assert_uint_eq(st.primitives, 2);
+  /* nodes are allocated at their kind's size: a disc stores 4
+  ** parameters, a transform 11, a blend none but its 3 children */
   ck_assert(st.bytes > 0 && st.bytes <= 4 * 400);
+  size_t head = oc_enode_size(e) - 3 * sizeof(oc_enode *);
+  ck_assert_uint_eq(oc_enode_size(base), head + 4 * sizeof(double));
+  ck_assert_uint_eq(oc_enode_size(moved), head + 11 * sizeof(double));
+  ck_assert_uint_eq(st.bytes, head * 4 + 3 * sizeof(oc_enode *) +
+                                  (4 + 4 + 11) * sizeof(double));
   /* the source answers the tree's own values and bounds */
   oc_elevation src;
   ck_assert_int_eq(oc_enode_elevation(e, NULL, &src, &err), OC_OK);
@@ -324,6 +373,11 @@ START_TEST(dag_stats_and_source) {
   oc_enode_bound_in(e, 50, -50, 150, 50, &b);
   ck_assert(lo == b.flo && hi == b.fhi);
   ck_assert(src.slope(src.ud, 50, -50, 150, 50) == b.lf);
+  /* the joint callback: the same range and slope from one traversal */
+  double blo, bhi, bl;
+  ck_assert(src.bound != NULL);
+  src.bound(src.ud, 50, -50, 150, 50, &blo, &bhi, &bl);
+  ck_assert(blo == b.flo && bhi == b.fhi && bl == b.lf);
   /* a terrain over it: its surface is f where the base covers */
   oc_terrain_params tp = {0};
   tp.falloff = 20;
