@@ -13,7 +13,8 @@
 # elev-*: the elevation-tree examples at 96 x 54 (--set size=96), run
 # with one thread and with two: the same PNG bytes both times; the dunes
 # leave the peak's elevation as it was and raise the desert floor; the
-# thirty instances share the patch (37 nodes, not 182).
+# thirty instances share the patch (37 nodes, not 182); the lake's level
+# is below the land around it; a younger crater's floor is its own.
 
 set -u
 
@@ -56,7 +57,8 @@ grep -q '^topology: 1 component' "$T/out" || because "no single component report
 tally "$T/out" "$T/err"
 grep "^topology" "$T/out" | sed "s/^/     /"
 
-for ex in elev_river elev_dunes elev_instances elev_road elev_coast; do
+for ex in elev_river elev_dunes elev_instances elev_road elev_coast elev_lake \
+  elev_craters elev_multiscale; do
   name=elev-${ex#elev_}
   why=
   mkdir -p "$T/$name/1" "$T/$name/2"
@@ -80,6 +82,17 @@ for ex in elev_river elev_dunes elev_instances elev_road elev_coast; do
   elev_instances)
     grep -q '30 instances: 37 nodes, 5 primitives' "$T/out1" ||
       because "the instances do not share the patch"
+    ;;
+  elev_lake)
+    # water level A m; the land around it B to C m: A < B
+    awk '/water level/ { ok = ($4 + 0 < $13 + 0) } END { exit !ok }' \
+      FS='[ ]+' "$T/out1" || because "the lake's level is not below the land around it"
+    ;;
+  elev_craters)
+    # a younger crater over an older rim: floor F = its level L - depth D
+    awk '/cuts the rim/ { d = $18 - ($24 - $27); ok = (d < 0.11 && d > -0.11) }
+      END { exit !ok }' FS='[ ]+' "$T/out1" ||
+      because "the younger crater's floor is not its own"
     ;;
   esac
   tally "$T/out1" "$T/err"
