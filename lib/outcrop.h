@@ -1420,6 +1420,51 @@ oc_heightfield *oc_heightfield_from_elevation(const oc_elevation *src,
                                               int holes, double hole_value,
                                               oc_progress progress,
                                               oc_error *err);
+/* Level of detail (lib/elevation/lod.c; docs/fields.md, "Level of
+** detail"). A view gives every point p a pixel footprint foot(p) = k
+** sqrt(|p - eye_xy|^2 + dz^2), dz = |eye_z - the tree's mid elevation|
+** (fixed, so foot is C1 and k-Lipschitz), k the angle of a pixel (0:
+** full detail). A detail of wavelength w is weighted kappa = b(t), t =
+** clamp(log2(w / foot), 0, 1), b(t) = 1 - (1 - t^2)^3: kept while w >= 2
+** foot, dropped where w <= foot. Disc octaves are filtered so (those
+** with weight 0 are not evaluated), and lod nodes blend a coarse tree
+** into a detailed one. Under a view, a tree is a genuine C1 function of
+** p: gradients and bounds include the footprint's terms. Without a view
+** (oc_enode_eval, sampling, oc_terrain) every detail is kept: a lod node
+** is its detailed tree b. */
+typedef struct oc_enode_view {
+  double eye[3];
+  double k; /* >= 0, radians per pixel (times a quality factor) */
+} oc_enode_view;
+
+/* t = clamp((kappa - k0) / (k1 - k0), 0, 1), kappa for `wavelength` (the
+** size of the detail b adds): f = (1 - t) f_a + t f_b, alpha likewise;
+** only a is evaluated where t = 0, only b where t = 1. 0 <= k0 < k1 <= 1
+** (k0 = k1 = 0: 0 and 1). */
+typedef struct oc_enode_lod_params {
+  double wavelength; /* > 0 */
+  double k0, k1;
+} oc_enode_lod_params;
+oc_enode *oc_enode_lod(oc_enode *a, oc_enode *b, const oc_enode_lod_params *p,
+                       oc_error *err);
+
+/* oc_enode_eval under view v (NULL: oc_enode_eval). OC_OK, or OC_EINVAL
+** with err for a view that is not finite or has k < 0. */
+int oc_enode_eval_view(const oc_enode *e, double x, double y,
+                       const oc_enode_view *v, oc_enode_sample *s,
+                       oc_error *err);
+
+/* oc_enode_elevation under view v: height, ranges and slopes include the
+** footprint's terms (the domain, when NULL, is where alpha may reach T
+** under the view). The source's weight for oc_esurface is
+** oc_enode_view_weight with wud = src->ud. Holds one reference to e. */
+int oc_enode_elevation_view(oc_enode *e, const double *domain,
+                            const oc_enode_view *v, oc_elevation *src,
+                            oc_error *err);
+double oc_enode_view_weight(void *ud, double x, double y);
+/* The size of a pixel at unit distance on the camera's axis, 2 tan(fov /
+** 2) / height (render/render.c): a view's k is c times it. */
+double oc_render_pixel_angle(const oc_render_params *rp);
 
 /* ---- geology: resistance trees and the erosion node ----- */
 

@@ -17,8 +17,10 @@
 **   image{heightfield = hf, weight = hf2, quad = {{x, y} x 4} |
 **        segment = {{x0, y0}, {x1, y1}}, width =, height = 1, offset = 0,
 **        falloff = sqrt(area) / 10}
+**   lod(a, b, {wavelength =, k0 = 0, k1 = 1})  (b without a view)
 **
-** Methods: e:eval(x, y) -> f, alpha; e:gradient(x, y) -> df/dx, df/dy;
+** Methods: e:eval(x, y [, view]) -> f, alpha; e:gradient(x, y [, view])
+** -> df/dx, df/dy, view = {eye = {x, y, z}, k =} (level of detail);
 ** e:bounds() -> x0, y0, fmin, x1, y1, fmax (the box holding the support
 ** and the range of f); e:lipschitz(); e:stats() -> {nodes=, primitives=,
 ** bytes=}; e:kind().
@@ -611,6 +613,26 @@ static int l_image(lua_State *L) {
   return setenode(L, u, oc_enode_image(&p, &err), &err, fname);
 }
 
+static int l_lod(lua_State *L) {
+  static const char *const known[] = {"wavelength", "k0", "k1", NULL};
+  const char *fname = "outcrop.elevation.lod";
+  oclua_fields f;
+  oc_enode *a = oclua_checkenode(L, 1, fname, "argument #1");
+  oc_enode *b = oclua_checkenode(L, 2, fname, "argument #2");
+  options(L, &f, fname, 3, "(a, b, {wavelength =, k0 = 0, k1 = 1})", known);
+  oc_enode_lod_params p;
+  p.wavelength = oclua_field_number(&f, "wavelength", OCLUA_POSITIVE);
+  p.k0 = oclua_field_optnumber(&f, "k0", OCLUA_FINITE, 0);
+  p.k1 = oclua_field_optnumber(&f, "k1", OCLUA_FINITE, 1);
+  if (!(p.k0 >= 0 && p.k0 < p.k1 && p.k1 <= 1))
+    oclua_error(L, fname,
+                "'k0' and 'k1' must satisfy 0 <= k0 < k1 <= 1 (got %f, %f)",
+                p.k0, p.k1);
+  oc_error err = {OC_OK, ""};
+  oclua_enode *u = newenode(L);
+  return setenode(L, u, oc_enode_lod(a, b, &p, &err), &err, fname);
+}
+
 /* ---- methods ---------------------------------------------------------- */
 
 static oc_enode *self(lua_State *L, const char *fname) {
@@ -618,7 +640,7 @@ static oc_enode *self(lua_State *L, const char *fname) {
 }
 
 static void point(lua_State *L, const char *fname, double *x, double *y) {
-  oclua_checkargs(L, 3, fname, "(x, y)");
+  oclua_checkargs(L, 4, fname, "(x, y [, {eye = {x, y, z}, k =}])");
   for (int i = 2; i <= 3; i++)
     if (lua_type(L, i) != LUA_TNUMBER)
       oclua_error(L, fname, "argument #%d must be a number (got %s)", i - 1,
@@ -627,12 +649,33 @@ static void point(lua_State *L, const char *fname, double *x, double *y) {
   *y = lua_tonumber(L, 3);
 }
 
-/* self:<what>(x, y): the sample there. */
+/* The optional view at index 4: {eye = {x, y, z}, k = >= 0}. */
+static int read_view(lua_State *L, const char *fname, oc_enode_view *v) {
+  static const char *const known[] = {"eye", "k", NULL};
+  if (lua_isnoneornil(L, 4)) return 0;
+  if (!lua_istable(L, 4))
+    oclua_error(L, fname,
+                "argument #3 must be a view {eye = {x, y, z}, k =} (got %s)",
+                oclua_got(L, 4));
+  oclua_fields f;
+  oclua_fields_open(&f, L, 4, fname, NULL, known, 0);
+  oc_vec3 eye = oclua_field_vec(&f, "eye");
+  v->eye[0] = eye.x, v->eye[1] = eye.y, v->eye[2] = eye.z;
+  v->k = oclua_field_number(&f, "k", OCLUA_FINITE);
+  if (v->k < 0) oclua_error(L, fname, "'k' must be >= 0 (got %f)", v->k);
+  return 1;
+}
+
+/* self:<what>(x, y [, view]): the sample there. */
 static void sample(lua_State *L, const char *fname, oc_enode_sample *s) {
   double x, y;
+  oc_enode_view v;
   oc_enode *e = self(L, fname);
   point(L, fname, &x, &y);
-  oc_enode_eval(e, x, y, s);
+  int has = read_view(L, fname, &v);
+  oc_error err = {OC_OK, ""};
+  if (oc_enode_eval_view(e, x, y, has ? &v : NULL, s, &err))
+    oclua_liberror(L, fname, &err);
 }
 
 static int e_eval(lua_State *L) {
@@ -726,6 +769,7 @@ void oclua_open_elevation(lua_State *L) {
       {"road", l_road},   {"blend", l_blend}, {"replace", l_replace},
       {"add", l_add},   {"warp", l_warp},   {"transform", l_transform},
       {"lake", l_lake},   {"image", l_image},
+      {"lod", l_lod},
       {NULL, NULL}};
   oclua_newmeta(L, OCLUA_ELEVATION, meta, methods);
   lua_pop(L, 1);

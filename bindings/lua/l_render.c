@@ -31,6 +31,7 @@
 */
 #include <math.h>
 #include <signal.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -446,6 +447,48 @@ static const oc_esurface *surface_at(lua_State *L, int idx, double T) {
   return &s->es;
 }
 
+/* The level of detail of a tree's render: lod = true (c = 1) | false |
+** {c = > 0}; 0 when off. */
+static double read_lod(const oclua_fields *f, int tree) {
+  static const char *const known[] = {"c", NULL};
+  lua_State *L = f->L;
+  int t = oclua_field_push(f, "lod");
+  double c = 0;
+  if (t == LUA_TBOOLEAN) {
+    c = lua_toboolean(L, -1) ? 1 : 0;
+  } else if (t == LUA_TTABLE) {
+    oclua_fields g;
+    oclua_fields_open(&g, L, lua_gettop(L), f->fname, "lod.", known, 0);
+    c = oclua_field_optnumber(&g, "c", OCLUA_POSITIVE, 1);
+  } else if (t != LUA_TNIL) {
+    oclua_field_error(f, "lod", -1, "must be true, false or {c =}");
+  }
+  lua_pop(L, 1);
+  if (c > 0 && !tree)
+    oclua_error(L, f->fname,
+                "'lod' applies to elevation trees only (argument #1 is not "
+                "one)");
+  return c;
+}
+
+/* Under lod, the surface becomes the tree seen from the camera: the
+** source's footprint k = c times the pixel's angle (oc_render_pixel_angle),
+** its weight the tree's under the same view. */
+static void surface_lod(lua_State *L, int idx, const oc_esurface *es,
+                        const oc_render_params *rp, double c) {
+  lsurface *s = (lsurface *)(void *)((char *)es - offsetof(lsurface, es));
+  oc_enode_view v = {{rp->camera.eye.x, rp->camera.eye.y, rp->camera.eye.z},
+                     c * oc_render_pixel_angle(rp)};
+  oc_elevation src;
+  oc_error err = {OC_OK, ""};
+  if (oc_enode_elevation_view(oclua_testenode(L, idx), NULL, &v, &src, &err))
+    oclua_liberror(L, FNAME, &err);
+  if (s->src.release) s->src.release(s->src.ud);
+  s->src = src;
+  s->es.weight = oc_enode_view_weight;
+  s->es.wud = src.ud;
+}
+
 /* The box the default camera frames: the domain x the elevation range. */
 static oc_aabb surface_bounds(const oc_esurface *es) {
   const oc_elevation *e = es->src;
@@ -501,7 +544,7 @@ static int l_render(lua_State *L) {
       "ao",        "ao_distance",  "fog",     "color",         "palette",
       "rules",     "background",   "texture", "texture_scale", "aov",
       "threshold", "max_distance", "tracer",  "exposure",      "tone",
-      NULL};
+      "lod",       NULL};
   static const char *const tracers[] = {"segment", "sphere", NULL};
   static const char *const tones[] = {"clamp", "filmic", NULL};
   oclua_fields f;
@@ -563,6 +606,7 @@ static int l_render(lua_State *L) {
                   ? OC_TRACE_SPHERE
                   : OC_TRACE_SEGMENT;
   read_color(&f, &rp, &src);
+  double lod = read_lod(&f, tree);
   if (src.kind == SRC_FIELD && rp.stops == NULL)
     rp.stops = oc_palette_strata(&rp.nstops);
 
@@ -588,6 +632,8 @@ static int l_render(lua_State *L) {
            : oc_render_check_surface(es, &rp, &err) ||
                  oc_render_check_shade(&rp, &err))
     oclua_liberror(L, FNAME, &err);
+  /* (after the checks: the camera is known and valid) */
+  if (lod > 0) surface_lod(L, 1, es, &rp, lod);
   memset(&rp.progress, 0, sizeof rp.progress);
   rp.progress = oclua_progress_start(L, &pl, FNAME);
   char warning[300] = "";

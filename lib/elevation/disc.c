@@ -39,22 +39,41 @@ static uint64_t octave_seed(uint64_t seed, int i) {
   return oc_mix64(seed + 0x9e3779b97f4a7c15ull * (uint64_t)(i + 1));
 }
 
-/* The noise sum at (u, v) = p - c, and its gradient in g when not NULL. */
-static double noise_sum(const oc_enoise *nz, double u, double v, double g[2]) {
+/* Continuous level of detail (lod.c): octave i weighted b(t_i), t_i =
+** log2(w_i / foot) = t0 - i dt, all with the gradient (gx, gy) of t. */
+typedef struct octlod {
+  double t0, dt, gx, gy;
+} octlod;
+
+/* The noise sum at (u, v) = p - c, and its gradient in g when not NULL;
+** under lod, octaves filtered (the term of octave i times b_i, plus the
+** term times grad b_i in g), and none evaluated past the first whose
+** weight is 0 (wavelengths only shrink). Without it, or where every b_i
+** is 1, the sum is bit for bit the unfiltered one. */
+static double noise_sum(const oc_enoise *nz, double u, double v, double g[2],
+                        const octlod *lod) {
   double sum = 0, a = nz->amplitude, s = 1 / nz->wavelength;
   double prev = 1, gprev[2] = {0, 0}; /* ridged: s_(i-1) and its gradient */
   if (g) g[0] = g[1] = 0;
   for (int i = 0; i < nz->octaves; i++) {
-    double ge[2];
+    double ge[2], bw = 1, db = 0, a0 = a;
+    if (lod) {
+      bw = oc_elod_b(lod->t0 - i * lod->dt, &db);
+      if (bw == 0) break;
+      a = a0 * bw;
+    }
     double e = oc_eta(octave_seed(nz->seed, i), s * u, s * v, g ? ge : NULL);
+    double term = 0; /* the octave's unfiltered term, where db != 0 */
     switch (nz->kind) {
     case OC_ENOISE_PLAIN:
       sum += a * e;
+      term = e;
       if (g) g[0] += a * s * ge[0], g[1] += a * s * ge[1];
       break;
     case OC_ENOISE_TURBULENCE: {
       double sg = e < 0 ? -1 : 1;
       sum += a * fabs(e);
+      term = fabs(e);
       if (g) g[0] += a * s * sg * ge[0], g[1] += a * s * sg * ge[1];
       break;
     }
@@ -74,6 +93,7 @@ static double noise_sum(const oc_enoise *nz, double u, double v, double g[2]) {
       }
       double t = w * r * r;
       sum += a * t;
+      term = t;
       if (g) {
         /* grad t = r^2 grad w - 2 w r sign(e) s grad eta */
         double k = -2 * w * r * sg * s;
@@ -82,28 +102,46 @@ static double noise_sum(const oc_enoise *nz, double u, double v, double g[2]) {
         g[0] += a * gprev[0];
         g[1] += a * gprev[1];
       }
-      prev = t;
+      prev = t; /* the chain runs on the unfiltered terms */
     }
     }
-    a *= nz->gain;
+    if (g && db != 0) {
+      g[0] += a0 * term * db * lod->gx;
+      g[1] += a0 * term * db * lod->gy;
+    }
+    a = a0 * nz->gain;
     s *= nz->lacunarity;
   }
   return sum;
 }
 
-/* Range and Lipschitz bound of the noise sum. */
-static void noise_bounds(const oc_enoise *nz, double *lo, double *hi,
-                         double *lip) {
+/* Range and Lipschitz bound of the noise sum, under footprints fb (NULL:
+** full detail): octave i weighted b_i in [0, bh], |grad b_i| <= lb, its
+** term (|term| <= 1) contributing a (bh lambda_term + lb). */
+static void noise_bounds(const oc_enoise *nz, const oc_efootb *fb, double *lo,
+                         double *hi, double *lip) {
   double a = nz->amplitude, s = 1 / nz->wavelength, asum = 0, l = 0, lr = 0;
   double le = 2 * oc_noise3_lipschitz;
+  /* t_i = log2(w_i / foot) in [tmin - i dt, tmax - i dt] (one log2 each,
+  ** padded against the evaluator's rounding) */
+  double tmin = 0, tmax = 0, dt = log2(nz->lacunarity);
+  if (fb) {
+    tmin = log2(nz->wavelength / fb->hi) - 1e-12;
+    tmax = fb->lo > 0 ? log2(nz->wavelength / fb->lo) + 1e-12 : INFINITY;
+  }
   for (int i = 0; i < nz->octaves; i++) {
-    asum += a;
+    double bh = 1, lb = 0, bl;
+    if (fb)
+      oc_elod_kappa_bound_t(1 / s, tmin - i * dt, tmax - i * dt, fb, &bl, &bh,
+                            &lb);
+    if (bh == 0) break;
+    asum += a * bh;
     if (nz->kind == OC_ENOISE_RIDGED) {
       /* |grad s_i| <= G |grad s_(i-1)| + 2 lambda_eta s_i */
       lr = (i ? RIDGE_GAIN * lr : 0) + 2 * le * s;
-      l += a * lr;
+      l += a * lr * bh + a * lb;
     } else {
-      l += a * le * s;
+      l += a * le * s * bh + a * lb;
     }
     a *= nz->gain;
     s *= nz->lacunarity;
@@ -113,8 +151,8 @@ static void noise_bounds(const oc_enoise *nz, double *lo, double *hi,
   *lip = l;
 }
 
-void oc_edisc_ev(const oc_enode *n, double x, double y, int want,
-                 oc_enode_sample *s) {
+void oc_edisc_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                 int want, oc_enode_sample *s) {
   const double *p = n->par; /* cx, cy, r, height */
   double u = x - p[0], v = y - p[1], r = p[2];
   double q = (u * u + v * v) / (r * r);
@@ -137,9 +175,16 @@ void oc_edisc_ev(const oc_enode *n, double x, double y, int want,
   }
   if (want & OC_EV_ALPHA) return;
   double g[2] = {0, 0};
+  octlod lod, *lp = NULL;
+  if (ft && ft->v > 0 && n->noise.kind != OC_ENOISE_NONE) {
+    double c = -1 / (ft->v * 0.69314718055994530942);
+    lod = (octlod){log2(n->noise.wavelength / ft->v), log2(n->noise.lacunarity),
+                   c * ft->gx, c * ft->gy};
+    lp = &lod;
+  }
   s->f = p[3] + (n->noise.kind == OC_ENOISE_NONE
                      ? 0
-                     : noise_sum(&n->noise, u, v, grad ? g : NULL));
+                     : noise_sum(&n->noise, u, v, grad ? g : NULL, lp));
   s->fx = g[0];
   s->fy = g[1];
 }
@@ -195,14 +240,31 @@ static int noise_range_in(const oc_enoise *nz, double u, double v, double rho,
   return 1;
 }
 
-void oc_edisc_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+void oc_edisc_bound_in(const oc_enode *n, const oc_erect *b,
+                       const oc_efootb *fb, oc_ebound *o) {
   *o = n->glob;
+  int filtered = 0; /* some octave may be weighted below 1 in the box */
+  /* (every octave kept in the box, the finest included: the glob's) */
+  if (fb && fb->hi > 0 && n->noise.kind != OC_ENOISE_NONE &&
+      log2(n->noise.wavelength / fb->hi) - 1e-12 -
+              (n->noise.octaves - 1) * log2(n->noise.lacunarity) <
+          1) {
+    /* the octaves the footprints keep */
+    double lo, hi, lip;
+    noise_bounds(&n->noise, fb, &lo, &hi, &lip);
+    o->flo = n->par[3] + lo;
+    o->fhi = n->par[3] + hi;
+    o->lf = lip;
+    filtered = 1;
+  }
   if (!oc_erect_meets(&n->box, b)) {
     o->alo = o->ahi = o->la = 0;
     return;
   }
   double nlo, nhi;
-  if ((n->noise.kind == OC_ENOISE_PLAIN ||
+  /* the octaves' values at the centre bound the unfiltered sum only */
+  if (!filtered &&
+      (n->noise.kind == OC_ENOISE_PLAIN ||
        n->noise.kind == OC_ENOISE_TURBULENCE) &&
       noise_range_in(&n->noise, 0.5 * (b->x0 + b->x1) - n->par[0],
                      0.5 * (b->y0 + b->y1) - n->par[1],
@@ -284,7 +346,7 @@ oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err) {
   }
   if (check_noise(&p->noise, &nz, err)) return NULL;
   double lo = 0, hi = 0, lip = 0;
-  if (nz.kind != OC_ENOISE_NONE) noise_bounds(&nz, &lo, &hi, &lip);
+  if (nz.kind != OC_ENOISE_NONE) noise_bounds(&nz, NULL, &lo, &hi, &lip);
   oc_erect box = {p->cx - p->radius, p->cy - p->radius, p->cx + p->radius,
                   p->cy + p->radius};
   if (!isfinite(p->height + lo) || !isfinite(p->height + hi) ||

@@ -76,8 +76,10 @@ static size_t interval(const ecurve *d, double s, double *t, size_t *j) {
   return a;
 }
 
-void oc_ecurve_ev(const oc_enode *n, double x, double y, int want,
-                  oc_enode_sample *s) {
+/* (No scale of a curve is dropped by the level of detail: ft unused.) */
+void oc_ecurve_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                  int want, oc_enode_sample *s) {
+  (void)ft;
   const ecurve *d = n->data;
   int grad = want & OC_EV_GRAD, lazy = want & OC_EV_LAZY;
   oc_curve_point pt;
@@ -138,7 +140,9 @@ void oc_ecurve_ev(const oc_enode *n, double x, double y, int want,
   }
 }
 
-void oc_ecurve_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+void oc_ecurve_bound_in(const oc_enode *n, const oc_erect *b,
+                        const oc_efootb *fb, oc_ebound *o) {
+  (void)fb;
   const ecurve *d = n->data;
   oc_curve_point pt;
   *o = n->glob;

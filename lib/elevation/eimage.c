@@ -132,8 +132,9 @@ static double ramp(double x, double *dg) {
   return 1 - oc_falloff(x);
 }
 
-void oc_eimage_ev(const oc_enode *n, double x, double y, int want,
-                  oc_enode_sample *s) {
+void oc_eimage_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                  int want, oc_enode_sample *s) {
+  (void)ft; /* no detail to filter */
   const eimage *d = n->data;
   int grad = want & OC_EV_GRAD;
   double dk[4];
@@ -326,7 +327,9 @@ static void grid_bound(const eimage *d, const grid *G, const double uv[4],
   *lip = gs * hypot(Lu * G->H, Lv * G->W) / detmin * (1 + 1e-9);
 }
 
-void oc_eimage_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+void oc_eimage_bound_in(const oc_enode *n, const oc_erect *b,
+                        const oc_efootb *fb, oc_ebound *o) {
+  (void)fb;
   const eimage *d = n->data;
   /* f: over the quad within r of b */
   double r = 0;
@@ -508,7 +511,7 @@ oc_enode *oc_enode_image(const oc_enode_image_params *p, oc_error *err) {
     n->box.x1 = fmax(n->box.x1, d->P[k][0]);
     n->box.y1 = fmax(n->box.y1, d->P[k][1]);
   }
-  oc_eimage_bound_in(n, &n->box, &n->glob);
+  oc_eimage_bound_in(n, &n->box, NULL, &n->glob);
   n->glob.alo = 0;
   if (!isfinite(n->glob.flo) || !isfinite(n->glob.fhi) ||
       !isfinite(n->glob.lf) || !isfinite(n->glob.la) || !isfinite(d->F) ||

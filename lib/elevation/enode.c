@@ -16,14 +16,14 @@
 
 static const char *const kind_names[OC_E_COUNT] = {
     "disc", "curve", "blend", "replace", "add", "transform", "warp",
-    "lake", "image"};
+    "lake", "image", "lod"};
 
 /* 1 + the parameters each kind stores (disc.c, ecurve.c, eops.c); 0, a
 ** kind not listed: OC_ENODE_NPAR. */
 static const unsigned char par_counts[OC_E_COUNT] = {
     [OC_E_DISC] = 1 + 4,    [OC_E_CURVE] = 1 + 2, [OC_E_BLEND] = 1 + 0,
     [OC_E_REPLACE] = 1 + 1, [OC_E_ADD] = 1 + 4,   [OC_E_XFORM] = 1 + 11,
-    [OC_E_WARP] = 1 + 2};
+    [OC_E_WARP] = 1 + 2,    [OC_E_LOD] = 1 + 3};
 
 static size_t par_count(oc_ekind kind) {
   unsigned c = (unsigned)kind < OC_E_COUNT ? par_counts[kind] : 0;
@@ -96,31 +96,36 @@ const char *oc_enode_kind(const oc_enode *e) {
   return e && (unsigned)e->kind < OC_E_COUNT ? kind_names[e->kind] : "?";
 }
 
-void oc_enode_ev(const oc_enode *n, double x, double y, int want,
-                 oc_enode_sample *s) {
+void oc_enode_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                 int want, oc_enode_sample *s) {
   if (n->kind == OC_E_DISC)
-    oc_edisc_ev(n, x, y, want, s);
+    oc_edisc_ev(n, x, y, ft, want, s);
   else if (n->kind == OC_E_CURVE)
-    oc_ecurve_ev(n, x, y, want, s);
+    oc_ecurve_ev(n, x, y, ft, want, s);
   else if (n->kind == OC_E_LAKE)
-    oc_elake_ev(n, x, y, want, s);
+    oc_elake_ev(n, x, y, ft, want, s);
   else if (n->kind == OC_E_IMAGE)
-    oc_eimage_ev(n, x, y, want, s);
+    oc_eimage_ev(n, x, y, ft, want, s);
+  else if (n->kind == OC_E_LOD)
+    oc_elod_ev(n, x, y, ft, want, s);
   else
-    oc_eop_ev(n, x, y, want, s);
+    oc_eop_ev(n, x, y, ft, want, s);
 }
 
-void oc_enode_bnd(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+void oc_enode_bnd(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
+                  oc_ebound *o) {
   if (n->kind == OC_E_DISC)
-    oc_edisc_bound_in(n, b, o);
+    oc_edisc_bound_in(n, b, fb, o);
   else if (n->kind == OC_E_CURVE)
-    oc_ecurve_bound_in(n, b, o);
+    oc_ecurve_bound_in(n, b, fb, o);
   else if (n->kind == OC_E_LAKE)
-    oc_elake_bound_in(n, b, o);
+    oc_elake_bound_in(n, b, fb, o);
   else if (n->kind == OC_E_IMAGE)
-    oc_eimage_bound_in(n, b, o);
+    oc_eimage_bound_in(n, b, fb, o);
+  else if (n->kind == OC_E_LOD)
+    oc_elod_bound_in(n, b, fb, o);
   else
-    oc_eop_bound_in(n, b, o);
+    oc_eop_bound_in(n, b, fb, o);
 }
 
 /* ---- public queries --------------------------------------------------- */
@@ -130,13 +135,13 @@ void oc_enode_eval(const oc_enode *e, double x, double y, oc_enode_sample *s) {
     s->f = s->a = s->fx = s->fy = s->ax = s->ay = NAN;
     return;
   }
-  oc_enode_ev(e, x, y, OC_EV_GRAD, s);
+  oc_enode_ev(e, x, y, NULL, OC_EV_GRAD, s);
 }
 
 double oc_enode_weight(const oc_enode *e, double x, double y) {
   if (!isfinite(x) || !isfinite(y)) return NAN;
   oc_enode_sample s;
-  oc_enode_ev(e, x, y, OC_EV_ALPHA, &s);
+  oc_enode_ev(e, x, y, NULL, OC_EV_ALPHA, &s);
   return s.a;
 }
 
@@ -164,7 +169,7 @@ void oc_enode_bound_in(const oc_enode *e, double x0, double y0, double x1,
     b->flo = INFINITY, b->fhi = -INFINITY;
     return;
   }
-  oc_enode_bnd(e, &r, b);
+  oc_enode_bnd(e, &r, NULL, b);
 }
 
 int oc_enode_get_stats(const oc_enode *e, oc_enode_stats *st, oc_error *err) {
@@ -201,10 +206,12 @@ done:
 
 /* Grows *acc by the parts of r where alpha may reach T, splitting r in four
 ** down to depth 0. */
-static void terrain_cells(const oc_enode *e, oc_erect r, int depth,
-                          oc_erect *acc) {
+static void terrain_cells(const oc_enode *e, const oc_eview *v, oc_erect r,
+                          int depth, oc_erect *acc) {
   oc_ebound b;
-  oc_enode_bnd(e, &r, &b);
+  oc_efootb fb;
+  if (v) oc_eview_footb(v, &r, &fb);
+  oc_enode_bnd(e, &r, v ? &fb : NULL, &b);
   if (!(b.ahi >= OC_ENODE_T)) return;
   if (depth == 0 || b.alo >= OC_ENODE_T) {
     acc->x0 = fmin(acc->x0, r.x0);
@@ -219,22 +226,27 @@ static void terrain_cells(const oc_enode *e, oc_erect r, int depth,
                    {r.x0, my, mx, r.y1},
                    {mx, my, r.x1, r.y1}};
   for (int k = 0; k < 4; k++)
-    terrain_cells(e, q[k], depth - 1, acc);
+    terrain_cells(e, v, q[k], depth - 1, acc);
 }
 
-int oc_enode_terrain_box(const oc_enode *e, double box[4]) {
+int oc_enode_terrain_box_in(const oc_enode *e, const oc_eview *v,
+                            double box[4]) {
   oc_erect acc = {INFINITY, INFINITY, -INFINITY, -INFINITY};
-  terrain_cells(e, e->box, 7, &acc);
+  terrain_cells(e, v, e->box, 7, &acc);
   if (!(acc.x0 < acc.x1 && acc.y0 < acc.y1)) return 0;
   box[0] = acc.x0, box[1] = acc.y0, box[2] = acc.x1, box[3] = acc.y1;
   return 1;
+}
+
+int oc_enode_terrain_box(const oc_enode *e, double box[4]) {
+  return oc_enode_terrain_box_in(e, NULL, box);
 }
 
 /* ---- the elevation source --------------------------------------------- */
 
 static double src_height(void *ud, double x, double y, double grad[2]) {
   oc_enode_sample s;
-  oc_enode_ev(ud, x, y, grad ? OC_EV_GRAD : 0, &s);
+  oc_enode_ev(ud, x, y, NULL, grad ? OC_EV_GRAD : 0, &s);
   if (grad) {
     grad[0] = s.fx;
     grad[1] = s.fy;
@@ -246,7 +258,7 @@ static void src_range(void *ud, double x0, double y0, double x1, double y1,
                       double *lo, double *hi) {
   oc_ebound b;
   oc_erect r = {x0, y0, x1, y1};
-  oc_enode_bnd(ud, &r, &b);
+  oc_enode_bnd(ud, &r, NULL, &b);
   *lo = b.flo;
   *hi = b.fhi;
 }
@@ -254,14 +266,14 @@ static void src_range(void *ud, double x0, double y0, double x1, double y1,
 static double src_slope(void *ud, double x0, double y0, double x1, double y1) {
   oc_ebound b;
   oc_erect r = {x0, y0, x1, y1};
-  oc_enode_bnd(ud, &r, &b);
+  oc_enode_bnd(ud, &r, NULL, &b);
   return b.lf;
 }
 
 static double src_height_weight(void *ud, double x, double y, double grad[2],
                                 double *alpha, double agrad[2]) {
   oc_enode_sample s;
-  oc_enode_ev(ud, x, y, grad || agrad ? OC_EV_GRAD : 0, &s);
+  oc_enode_ev(ud, x, y, NULL, grad || agrad ? OC_EV_GRAD : 0, &s);
   if (grad) grad[0] = s.fx, grad[1] = s.fy;
   if (agrad) agrad[0] = s.ax, agrad[1] = s.ay;
   *alpha = s.a;
@@ -273,7 +285,7 @@ static void src_weight_range(void *ud, double x0, double y0, double x1,
                              double *alip) {
   oc_ebound b;
   oc_erect r = {x0, y0, x1, y1};
-  oc_enode_bnd(ud, &r, &b);
+  oc_enode_bnd(ud, &r, NULL, &b);
   *alo = b.alo;
   *ahi = b.ahi;
   *alip = b.la;
@@ -283,7 +295,7 @@ static void src_bound(void *ud, double x0, double y0, double x1, double y1,
                       double *lo, double *hi, double *slope) {
   oc_ebound b;
   oc_erect r = {x0, y0, x1, y1};
-  oc_enode_bnd(ud, &r, &b);
+  oc_enode_bnd(ud, &r, NULL, &b);
   *lo = b.flo;
   *hi = b.fhi;
   *slope = b.lf;
@@ -296,12 +308,11 @@ static void src_release(void *ud) {
   oc_enode_release(ud);
 }
 
-int oc_enode_elevation(oc_enode *e, const double *domain, oc_elevation *src,
-                       oc_error *err) {
-  double d[4] = {e->box.x0, e->box.y0, e->box.x1, e->box.y1};
+int oc_enode_domain(const oc_enode *e, const oc_eview *v, const double *domain,
+                    double d[4], oc_error *err) {
   if (domain)
-    memcpy(d, domain, sizeof d);
-  else if (!oc_enode_terrain_box(e, d))
+    memcpy(d, domain, 4 * sizeof *d);
+  else if (!oc_enode_terrain_box_in(e, v, d))
     return oc_seterr(err, OC_EINVAL,
                      "the tree has no terrain (its weight never reaches "
                      "1/2): add a base primitive that covers the scene");
@@ -311,6 +322,14 @@ int oc_enode_elevation(oc_enode *e, const double *domain, oc_elevation *src,
                      "the elevation domain [%g, %g] x [%g, %g] must be "
                      "finite and not empty",
                      d[0], d[2], d[1], d[3]);
+  return OC_OK;
+}
+
+int oc_enode_elevation(oc_enode *e, const double *domain, oc_elevation *src,
+                       oc_error *err) {
+  double d[4];
+  int rc = oc_enode_domain(e, NULL, domain, d, err);
+  if (rc) return rc;
   memset(src, 0, sizeof *src);
   src->height = src_height;
   src->range = src_range;

@@ -32,6 +32,7 @@ typedef enum oc_ekind {
   OC_E_WARP,
   OC_E_LAKE,
   OC_E_IMAGE,
+  OC_E_LOD,
   OC_E_COUNT
 } oc_ekind;
 
@@ -71,6 +72,21 @@ struct oc_enode {
 /* The bytes of n, its children's array included. */
 size_t oc_enode_size(const oc_enode *n);
 
+/* Level of detail (lod.c): the pixel footprint where a node is evaluated,
+** in the node's local units (a transform divides it by its scale), with
+** its gradient there, so that a tree under a view is a genuine C1
+** function of p whose gradients include the footprint's terms. NULL (or
+** v = 0): full detail. */
+typedef struct oc_efoot {
+  double v, gx, gy;
+} oc_efoot;
+
+/* The footprint over a box: its range and a Lipschitz bound k of it
+** there. NULL: full detail. */
+typedef struct oc_efootb {
+  double lo, hi, k;
+} oc_efootb;
+
 /* What a caller asks of eval. */
 #define OC_EV_GRAD 1 /* gradients too */
 #define OC_EV_LAZY 2 /* f may be left 0 where alpha = 0 (blend children) */
@@ -78,40 +94,91 @@ size_t oc_enode_size(const oc_enode *n);
 ** alpha depends on an f, so a weight query skips every noise sum */
 #define OC_EV_ALPHA 4
 
-void oc_enode_ev(const oc_enode *n, double x, double y, int want,
-                 oc_enode_sample *s);
+void oc_enode_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                 int want, oc_enode_sample *s);
 
 /* Allocation (refs = 1) with nkids children retained from kids. */
 oc_enode *oc_enode_alloc(oc_ekind kind, oc_enode *const *kids, size_t nkids,
                          oc_error *err);
 
 /* Kinds' parts (disc.c, eops.c): evaluation and bounds in a box. */
-void oc_edisc_ev(const oc_enode *n, double x, double y, int want,
-                 oc_enode_sample *s);
-void oc_edisc_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o);
-void oc_ecurve_ev(const oc_enode *n, double x, double y, int want,
-                  oc_enode_sample *s);
-void oc_ecurve_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o);
+void oc_edisc_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                 int want, oc_enode_sample *s);
+void oc_edisc_bound_in(const oc_enode *n, const oc_erect *b,
+                       const oc_efootb *fb, oc_ebound *o);
+void oc_ecurve_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                  int want, oc_enode_sample *s);
+void oc_ecurve_bound_in(const oc_enode *n, const oc_erect *b,
+                        const oc_efootb *fb, oc_ebound *o);
 void oc_ecurve_free(void *data);
 /* lake.c and eimage.c: the contour and image primitives (state in data). */
-void oc_elake_ev(const oc_enode *n, double x, double y, int want,
-                 oc_enode_sample *s);
-void oc_elake_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o);
+void oc_elake_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                 int want, oc_enode_sample *s);
+void oc_elake_bound_in(const oc_enode *n, const oc_erect *b,
+                       const oc_efootb *fb, oc_ebound *o);
 void oc_elake_free(void *data);
-void oc_eimage_ev(const oc_enode *n, double x, double y, int want,
-                  oc_enode_sample *s);
-void oc_eimage_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o);
+void oc_eimage_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                  int want, oc_enode_sample *s);
+void oc_eimage_bound_in(const oc_enode *n, const oc_erect *b,
+                        const oc_efootb *fb, oc_ebound *o);
 void oc_eimage_free(void *data);
-void oc_eop_ev(const oc_enode *n, double x, double y, int want,
-               oc_enode_sample *s);
-void oc_eop_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o);
+void oc_eop_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+               int want, oc_enode_sample *s);
+void oc_eop_bound_in(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
+                     oc_ebound *o);
 
-/* The bound of n in box b (dispatch). */
-void oc_enode_bnd(const oc_enode *n, const oc_erect *b, oc_ebound *o);
+/* The bound of n in box b (dispatch), under the footprint fb. */
+void oc_enode_bnd(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
+                  oc_ebound *o);
 
 static inline int oc_erect_meets(const oc_erect *a, const oc_erect *b) {
   return a->x0 <= b->x1 && a->x1 >= b->x0 && a->y0 <= b->y1 && a->y1 >= b->y0;
 }
+
+/* ---- level of detail (lod.c) ---- */
+
+/* A view: the footprint at p is k sqrt(|p - e_xy|^2 + dz^2), dz the eye's
+** height above the tree's mid elevation (fixed, so the footprint is C1
+** and k-Lipschitz). */
+typedef struct oc_eview {
+  double ex, ey, dz, k;
+} oc_eview;
+
+void oc_eview_foot(const oc_eview *v, double x, double y, oc_efoot *ft);
+void oc_eview_footb(const oc_eview *v, const oc_erect *b, oc_efootb *fb);
+
+/* The octave filter b(t) = 1 - (1 - t^2)^3 of t clamped to [0, 1]
+** (Génevaux et al. 2015, the increasing form) and its derivative. */
+static inline double oc_elod_b(double t, double *db) {
+  if (t <= 0 || t >= 1) {
+    *db = 0;
+    return t >= 1 ? 1 : 0;
+  }
+  double q = 1 - t * t;
+  *db = 6 * t * q * q;
+  return 1 - q * q * q;
+}
+
+/* For a detail of wavelength w under footprints in fb: the range of
+** kappa = b(log2(w / foot)) and its Lipschitz bound. */
+void oc_elod_kappa_bound(double w, const oc_efootb *fb, double *lo, double *hi,
+                         double *lip);
+/* The same for t = log2(w / foot) known to lie in [tmin, tmax]. */
+void oc_elod_kappa_bound_t(double w, double tmin, double tmax,
+                           const oc_efootb *fb, double *lo, double *hi,
+                           double *lip);
+
+/* The box of Omega_T under view v (NULL: none), as oc_enode_terrain_box;
+** and the domain of a source: domain, or that box, checked. */
+int oc_enode_terrain_box_in(const oc_enode *e, const oc_eview *v,
+                            double box[4]);
+int oc_enode_domain(const oc_enode *e, const oc_eview *v, const double *domain,
+                    double d[4], oc_error *err);
+
+void oc_elod_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                int want, oc_enode_sample *s);
+void oc_elod_bound_in(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
+                      oc_ebound *o);
 
 /* Noise: eta on z = 0 remapped to [-1, 1], and its Lipschitz bound. */
 double oc_eta(uint64_t seed, double x, double y, double g[2]);

@@ -62,8 +62,8 @@ static double clamp01(double v, int *inside) {
 
 /* ---- blend ------------------------------------------------------------ */
 
-static void blend_ev(const oc_enode *n, double x, double y, int want,
-                     oc_enode_sample *s) {
+static void blend_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                     int want, oc_enode_sample *s) {
   int grad = want & OC_EV_GRAD, only = want & OC_EV_ALPHA;
   double N = 0, S = 0, nx = 0, ny = 0, sx = 0, sy = 0;
   for (size_t i = 0; i < n->nkids; i++) {
@@ -71,7 +71,7 @@ static void blend_ev(const oc_enode *n, double x, double y, int want,
     if (!(x >= k->box.x0 && x <= k->box.x1 && y >= k->box.y0 && y <= k->box.y1))
       continue; /* alpha = 0 there: no contribution */
     oc_enode_sample c;
-    oc_enode_ev(k, x, y, grad | OC_EV_LAZY | only, &c);
+    oc_enode_ev(k, x, y, ft, grad | OC_EV_LAZY | only, &c);
     if (only) {
       S += c.a;
       continue;
@@ -150,7 +150,8 @@ static void blend_combine(const oc_ebound *kb, size_t n, oc_ebound *o) {
 
 #define KB_STACK 16
 
-static void blend_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+static void blend_bound_in(const oc_enode *n, const oc_erect *b,
+                           const oc_efootb *fb, oc_ebound *o) {
   oc_ebound stack[KB_STACK], *kb = stack;
   if (n->nkids > KB_STACK && !(kb = malloc(n->nkids * sizeof *kb))) {
     *o = n->glob; /* (conservative: the whole plane's) */
@@ -159,7 +160,7 @@ static void blend_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
   size_t m = 0;
   for (size_t i = 0; i < n->nkids; i++)
     if (oc_erect_meets(&n->kids[i]->box, b)) {
-      oc_enode_bnd(n->kids[i], b, &kb[m]);
+      oc_enode_bnd(n->kids[i], b, fb, &kb[m]);
       /* alpha = 0 on the whole box: neither the child's f nor its
       ** weight's slope counts there */
       m += kb[m].ahi > 0;
@@ -203,19 +204,19 @@ oc_enode *oc_enode_blend(oc_enode *const *kids, size_t n, oc_error *err) {
 
 /* ---- replace ---------------------------------------------------------- */
 
-static void replace_ev(const oc_enode *n, double x, double y, int want,
-                       oc_enode_sample *s) {
+static void replace_ev(const oc_enode *n, double x, double y,
+                       const oc_efoot *ft, int want, oc_enode_sample *s) {
   int grad = want & OC_EV_GRAD, in;
   const oc_enode *A = n->kids[0], *B = n->kids[1];
   oc_enode_sample a, b;
   int lerp = n->par[P_LERP] != 0;
   if (want & OC_EV_ALPHA) { /* alpha_A, or lerped with B's */
-    oc_enode_ev(A, x, y, OC_EV_ALPHA, &a);
+    oc_enode_ev(A, x, y, ft, OC_EV_ALPHA, &a);
     s->a = a.a;
     if (lerp) {
       b.a = 0;
       if (x >= B->box.x0 && x <= B->box.x1 && y >= B->box.y0 && y <= B->box.y1)
-        oc_enode_ev(B, x, y, OC_EV_ALPHA, &b);
+        oc_enode_ev(B, x, y, ft, OC_EV_ALPHA, &b);
       double w = clamp01(b.a, &in);
       s->a = (1 - w) * a.a + w * w;
     }
@@ -223,12 +224,12 @@ static void replace_ev(const oc_enode *n, double x, double y, int want,
   }
   b.a = b.f = b.fx = b.fy = b.ax = b.ay = 0;
   if (x >= B->box.x0 && x <= B->box.x1 && y >= B->box.y0 && y <= B->box.y1)
-    oc_enode_ev(B, x, y, grad | OC_EV_LAZY, &b);
+    oc_enode_ev(B, x, y, ft, grad | OC_EV_LAZY, &b);
   double w = clamp01(b.a, &in);
   /* A's f is not needed where B replaces it wholly, nor, for a lazy
   ** caller, where A's weight (the node's, unless lerped) is 0 */
   int alazy = w >= 1 || (!lerp && (want & OC_EV_LAZY));
-  oc_enode_ev(A, x, y, grad | (alazy ? OC_EV_LAZY : 0), &a);
+  oc_enode_ev(A, x, y, ft, grad | (alazy ? OC_EV_LAZY : 0), &a);
   if (w >= 1) {
     /* f = f_B; a.f may be unset only where alpha_A = 0, where the lazy
     ** caller does not read it either */
@@ -315,33 +316,33 @@ static double below_w(const double *par, double z, double *d) {
   return t * t * (3 - 2 * t);
 }
 
-static void add_ev(const oc_enode *n, double x, double y, int want,
-                   oc_enode_sample *s) {
+static void add_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                   int want, oc_enode_sample *s) {
   int grad = want & OC_EV_GRAD, in;
   const oc_enode *A = n->kids[0], *B = n->kids[1];
   oc_enode_sample a, b;
   int sumw = n->par[P_SUMW] != 0;
   if (want & OC_EV_ALPHA) { /* alpha_A, or plus w_B^2 */
-    oc_enode_ev(A, x, y, OC_EV_ALPHA, &a);
+    oc_enode_ev(A, x, y, ft, OC_EV_ALPHA, &a);
     s->a = a.a;
     if (sumw) {
       b.a = 0;
       if (x >= B->box.x0 && x <= B->box.x1 && y >= B->box.y0 && y <= B->box.y1)
-        oc_enode_ev(B, x, y, OC_EV_ALPHA, &b);
+        oc_enode_ev(B, x, y, ft, OC_EV_ALPHA, &b);
       double c = clamp01(b.a, &in);
       s->a += c * c;
     }
     return;
   }
   /* alpha_A + w^2 may be > 0 where alpha_A = 0: then f_A is needed */
-  oc_enode_ev(A, x, y, sumw ? grad : want, &a);
+  oc_enode_ev(A, x, y, ft, sumw ? grad : want, &a);
   if (want & OC_EV_LAZY && a.a == 0 && !sumw) {
     *s = a;
     return;
   }
   b.a = b.f = b.fx = b.fy = b.ax = b.ay = 0;
   if (x >= B->box.x0 && x <= B->box.x1 && y >= B->box.y0 && y <= B->box.y1)
-    oc_enode_ev(B, x, y, grad | OC_EV_LAZY, &b);
+    oc_enode_ev(B, x, y, ft, grad | OC_EV_LAZY, &b);
   double c = clamp01(b.a, &in), cx = grad && in ? b.ax : 0,
          cy = grad && in ? b.ay : 0;
   double w = c, wx = cx, wy = cy;
@@ -398,11 +399,12 @@ static void add_combine(const oc_enode *n, const oc_ebound *A,
 typedef void (*combine_fn)(const oc_enode *n, const oc_ebound *A,
                            const oc_ebound *B, int bmeets, oc_ebound *o);
 static void binary_bound_in(const oc_enode *n, const oc_erect *b,
-                            combine_fn combine, oc_ebound *o) {
+                            const oc_efootb *fb, combine_fn combine,
+                            oc_ebound *o) {
   oc_ebound A, B;
-  oc_enode_bnd(n->kids[0], b, &A);
+  oc_enode_bnd(n->kids[0], b, fb, &A);
   int meets = oc_erect_meets(&n->kids[1]->box, b);
-  if (meets) oc_enode_bnd(n->kids[1], b, &B);
+  if (meets) oc_enode_bnd(n->kids[1], b, fb, &B);
   combine(n, &A, &B, meets, o);
 }
 
@@ -438,12 +440,23 @@ oc_enode *oc_enode_add(oc_enode *a, oc_enode *b, const oc_enode_add_params *p,
 
 /* ---- affine transforms ------------------------------------------------ */
 
-static void xform_ev(const oc_enode *n, double x, double y, int want,
-                     oc_enode_sample *s) {
+static void xform_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                     int want, oc_enode_sample *s) {
   const double *m = n->par + P_MI;
   double u = x - n->par[P_TX], v = y - n->par[P_TY];
   oc_enode_sample c;
-  oc_enode_ev(n->kids[0], m[0] * u + m[1] * v, m[2] * u + m[3] * v, want, &c);
+  /* the footprint in the child's units: foot(M p' + t) / s, whose
+  ** gradient in p' is R^T grad foot = s Minv grad foot */
+  oc_efoot cf, *cft = NULL;
+  if (ft) {
+    double sc = n->par[P_SCALE];
+    cf.v = ft->v * n->par[P_ISCALE];
+    cf.gx = sc * (m[0] * ft->gx + m[1] * ft->gy);
+    cf.gy = sc * (m[2] * ft->gx + m[3] * ft->gy);
+    cft = &cf;
+  }
+  oc_enode_ev(n->kids[0], m[0] * u + m[1] * v, m[2] * u + m[3] * v, cft, want,
+              &c);
   double vs = n->par[P_VS];
   s->a = c.a;
   if (want & OC_EV_ALPHA) return;
@@ -500,10 +513,18 @@ static void xform_map_bound(const oc_enode *n, const oc_ebound *c,
   o->la = c->la * is;
 }
 
-static void xform_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+static void xform_bound_in(const oc_enode *n, const oc_erect *b,
+                           const oc_efootb *fb, oc_ebound *o) {
   oc_erect r = map_rect(n, b, 1);
   oc_ebound c;
-  oc_enode_bnd(n->kids[0], &r, &c);
+  /* a similarity keeps the footprint's Lipschitz bound, in any units */
+  oc_efootb cf, *cfb = NULL;
+  if (fb) {
+    double is = n->par[P_ISCALE];
+    cf = (oc_efootb){fb->lo * is, fb->hi * is, fb->k};
+    cfb = &cf;
+  }
+  oc_enode_bnd(n->kids[0], &r, cfb, &c);
   xform_map_bound(n, &c, o);
 }
 
@@ -601,13 +622,26 @@ static void warp_delta(const oc_enode *n, double x, double y, double d[2],
   }
 }
 
-static void warp_ev(const oc_enode *n, double x, double y, int want,
-                    oc_enode_sample *s) {
+static void warp_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                    int want, oc_enode_sample *s) {
   int grad = want & OC_EV_GRAD;
   double d[2], J[4];
   warp_delta(n, x, y, d, grad ? J : NULL);
   oc_enode_sample c;
-  oc_enode_ev(n->kids[0], x + d[0], y + d[1], want, &c);
+  /* the footprint is a function of p: in q = p + delta(p) its gradient
+  ** is (I + J)^-T grad foot (I + J is invertible: |J| < 1) */
+  oc_efoot cf, *cft = NULL;
+  if (ft) {
+    cf = (oc_efoot){ft->v, 0, 0};
+    if (grad) {
+      double a = 1 + J[0], b = J[1], c2 = J[2], e = 1 + J[3];
+      double det = a * e - b * c2;
+      cf.gx = (e * ft->gx - c2 * ft->gy) / det;
+      cf.gy = (-b * ft->gx + a * ft->gy) / det;
+    }
+    cft = &cf;
+  }
+  oc_enode_ev(n->kids[0], x + d[0], y + d[1], cft, want, &c);
   *s = c;
   if (!grad) return;
   /* grad = (I + J)^T grad_child */
@@ -617,10 +651,17 @@ static void warp_ev(const oc_enode *n, double x, double y, int want,
   s->ay = c.ay + J[1] * c.ax + J[3] * c.ay;
 }
 
-static void warp_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+static void warp_bound_in(const oc_enode *n, const oc_erect *b,
+                          const oc_efootb *fb, oc_ebound *o) {
   double m = n->par[P_WMAX], l = n->par[P_WLIP];
   oc_erect r = {b->x0 - m, b->y0 - m, b->x1 + m, b->y1 + m};
-  oc_enode_bnd(n->kids[0], &r, o);
+  /* the inverse of p -> p + delta(p) is 1 / (1 - l) Lipschitz */
+  oc_efootb cf, *cfb = NULL;
+  if (fb) {
+    cf = (oc_efootb){fb->lo, fb->hi, fb->k / (1 - l)};
+    cfb = &cf;
+  }
+  oc_enode_bnd(n->kids[0], &r, cfb, o);
   o->lf *= 1 + l;
   o->la *= 1 + l;
 }
@@ -677,43 +718,44 @@ oc_enode *oc_enode_warp(oc_enode *e, const oc_enode_warp_params *p,
 
 /* ---- dispatch --------------------------------------------------------- */
 
-void oc_eop_ev(const oc_enode *n, double x, double y, int want,
-               oc_enode_sample *s) {
+void oc_eop_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+               int want, oc_enode_sample *s) {
   switch (n->kind) {
   case OC_E_BLEND:
-    blend_ev(n, x, y, want, s);
+    blend_ev(n, x, y, ft, want, s);
     return;
   case OC_E_REPLACE:
-    replace_ev(n, x, y, want, s);
+    replace_ev(n, x, y, ft, want, s);
     return;
   case OC_E_ADD:
-    add_ev(n, x, y, want, s);
+    add_ev(n, x, y, ft, want, s);
     return;
   case OC_E_XFORM:
-    xform_ev(n, x, y, want, s);
+    xform_ev(n, x, y, ft, want, s);
     return;
   default:
-    warp_ev(n, x, y, want, s);
+    warp_ev(n, x, y, ft, want, s);
     return;
   }
 }
 
-void oc_eop_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+void oc_eop_bound_in(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
+                     oc_ebound *o) {
   switch (n->kind) {
   case OC_E_BLEND:
-    blend_bound_in(n, b, o);
+    blend_bound_in(n, b, fb, o);
     return;
   case OC_E_REPLACE:
-    binary_bound_in(n, b, replace_combine, o);
+    binary_bound_in(n, b, fb, replace_combine, o);
     return;
   case OC_E_ADD:
-    binary_bound_in(n, b, add_combine, o);
+    binary_bound_in(n, b, fb, add_combine, o);
     return;
   case OC_E_XFORM:
-    xform_bound_in(n, b, o);
+    xform_bound_in(n, b, fb, o);
     return;
   default:
-    warp_bound_in(n, b, o);
+    warp_bound_in(n, b, fb, o);
     return;
   }
 }

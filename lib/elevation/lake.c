@@ -94,8 +94,9 @@ static double gap(const elake *d, size_t i) {
                        : d->ang[0] + TAU - d->ang[i];
 }
 
-void oc_elake_ev(const oc_enode *n, double x, double y, int want,
-                 oc_enode_sample *s) {
+void oc_elake_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                 int want, oc_enode_sample *s) {
+  (void)ft; /* no detail to filter */
   const elake *d = n->data;
   int grad = want & OC_EV_GRAD;
   double u = x - d->cx, v = y - d->cy, rho = hypot(u, v), th = atan2(v, u);
@@ -193,7 +194,9 @@ static void bound_rho(const elake *d, double rl, double rh, oc_ebound *o) {
   o->la = gslope(dl / d->R, dh / d->R) / d->R * sqrt(1 + kr * kr) * (1 + 1e-9);
 }
 
-void oc_elake_bound_in(const oc_enode *n, const oc_erect *b, oc_ebound *o) {
+void oc_elake_bound_in(const oc_enode *n, const oc_erect *b,
+                       const oc_efootb *fb, oc_ebound *o) {
+  (void)fb;
   const elake *d = n->data;
   double dx = fmax(fmax(b->x0 - d->cx, d->cx - b->x1), 0);
   double dy = fmax(fmax(b->y0 - d->cy, d->cy - b->y1), 0);

@@ -490,3 +490,10 @@ oc_image *oc_render_elevation_shade(const oc_elevation *src,
   oc_esurface es = {src, NULL, NULL, 0.5};
   return oc_render_surface_shade(&es, rp, geometry, albedo, err);
 }
+
+/* The footprint rule of the level of detail (oc_enode_elevation_view)
+** uses the tracer's own measure of a pixel. */
+double oc_render_pixel_angle(const oc_render_params *rp) {
+  double th = tan(rp->camera.fov * (3.14159265358979323846 / 360));
+  return 2 * th / rp->height;
+}

@@ -1,0 +1,345 @@
+/*
+** lod.c — level of detail for elevation trees (Génevaux et al. 2015,
+** section 6): views and their pixel footprints, the octave filter kappa,
+** the lod operator that blends a coarse tree into a detailed one, and the
+** elevation source of a tree seen from a camera.
+**
+** The footprint is a function of the point p alone, foot(p) = k sqrt(|p -
+** e_xy|^2 + dz^2), not of the ray that reaches p, so the tree under a view
+** is one 2D terrain that primary and shadow rays alike see; foot is C1
+** and k-Lipschitz, so kappa(p) = b(clamp(log2(w / foot(p)), 0, 1)) is C1
+** with |grad kappa| <= max b' k / (ln 2 foot), and every bound of the
+** tree can include it (the accelerated tracer stays exact for it).
+**
+** The lod bound (the appendix, corrected): with t = clamp((kappa - k0) /
+** (k1 - k0)), f = (1 - t) f_A + t f_B,
+**   lambda <= max(lambda_A, lambda_B) + lambda_kappa sup|f_A - f_B| / (k1 -
+*k0).
+*/
+#include <math.h>
+#include <stdlib.h>
+
+#include "core/error.h"
+#include "elevation/enode.h"
+
+#define LN2 0.69314718055994530942
+/* max of b'(t) = 6 t (1 - t^2)^2 on [0, 1], at t = 1 / sqrt 5 */
+#define BP_MAX 1.7173994704548507
+#define BP_AT 0.44721359549995794
+/* par slots: wavelength, k0, k1 */
+enum { P_W = 0, P_K0 = 1, P_K1 = 2 };
+
+/* ---- views ------------------------------------------------------------- */
+
+void oc_eview_foot(const oc_eview *v, double x, double y, oc_efoot *ft) {
+  double u = x - v->ex, w = y - v->ey;
+  double r = sqrt(u * u + w * w + v->dz * v->dz);
+  ft->v = v->k * r;
+  if (r > 0) {
+    ft->gx = v->k * u / r;
+    ft->gy = v->k * w / r;
+  } else {
+    ft->gx = ft->gy = 0;
+  }
+}
+
+void oc_eview_footb(const oc_eview *v, const oc_erect *b, oc_efootb *fb) {
+  double dx = fmax(fmax(b->x0 - v->ex, v->ex - b->x1), 0);
+  double dy = fmax(fmax(b->y0 - v->ey, v->ey - b->y1), 0);
+  double fx = fmax(fabs(b->x0 - v->ex), fabs(b->x1 - v->ex));
+  double fy = fmax(fabs(b->y0 - v->ey), fabs(b->y1 - v->ey));
+  double z2 = v->dz * v->dz;
+  /* rounding: a relative hair each way */
+  fb->lo = v->k * sqrt(dx * dx + dy * dy + z2) * (1 - 1e-12);
+  fb->hi = v->k * sqrt(fx * fx + fy * fy + z2) * (1 + 1e-12);
+  fb->k = v->k;
+}
+
+/* max b' over [t0, t1] clamped to [0, 1] (b' rises to BP_AT, then falls) */
+static double bp_max(double t0, double t1) {
+  t0 = fmin(fmax(t0, 0), 1);
+  t1 = fmin(fmax(t1, 0), 1);
+  if (t0 <= BP_AT && t1 >= BP_AT) return BP_MAX;
+  double d0, d1;
+  oc_elod_b(t0, &d0);
+  oc_elod_b(t1, &d1);
+  return fmax(d0, d1) * (1 + 1e-12);
+}
+
+void oc_elod_kappa_bound_t(double w, double tmin, double tmax,
+                           const oc_efootb *fb, double *lo, double *hi,
+                           double *lip) {
+  double d;
+  *lo = oc_elod_b(tmin, &d);
+  *hi = oc_elod_b(tmax, &d);
+  if (tmax <= 0 || tmin >= 1) {
+    *lip = 0;
+    return;
+  }
+  /* on the ramp foot lies in (w / 2, w): |grad t| <= k / (ln 2 foot) */
+  *lip = bp_max(tmin, tmax) * fb->k / (LN2 * fmax(fb->lo, w / 2));
+}
+
+void oc_elod_kappa_bound(double w, const oc_efootb *fb, double *lo, double *hi,
+                         double *lip) {
+  if (!fb || !(fb->hi > 0)) {
+    *lo = *hi = 1;
+    *lip = 0;
+    return;
+  }
+  /* t = log2(w / foot), padded against the evaluators' rounding */
+  double tmin = log2(w / fb->hi) - 1e-12;
+  double tmax = fb->lo > 0 ? log2(w / fb->lo) + 1e-12 : INFINITY;
+  oc_elod_kappa_bound_t(w, tmin, tmax, fb, lo, hi, lip);
+}
+
+/* ---- the lod operator -------------------------------------------------- */
+
+/* kappa at the footprint ft and, when g, its gradient */
+static double kappa_at(double w, const oc_efoot *ft, double g[2]) {
+  double db, t = log2(w / ft->v);
+  double k = oc_elod_b(t, &db);
+  if (g) {
+    double c = -db / (ft->v * LN2);
+    g[0] = c * ft->gx;
+    g[1] = c * ft->gy;
+  }
+  return k;
+}
+
+void oc_elod_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                int want, oc_enode_sample *s) {
+  const oc_enode *A = n->kids[0], *B = n->kids[1];
+  const double *p = n->par;
+  int grad = want & OC_EV_GRAD;
+  if (!ft || !(ft->v > 0)) { /* full detail: kappa = 1, t = 1 */
+    oc_enode_ev(B, x, y, ft, want, s);
+    return;
+  }
+  double gk[2] = {0, 0};
+  double kap = kappa_at(p[P_W], ft, grad ? gk : NULL);
+  double t = (kap - p[P_K0]) / (p[P_K1] - p[P_K0]);
+  if (t >= 1) {
+    oc_enode_ev(B, x, y, ft, want, s);
+    return;
+  }
+  if (t <= 0) {
+    oc_enode_ev(A, x, y, ft, want, s);
+    return;
+  }
+  /* both: neither may leave f unset where its own weight is 0 */
+  oc_enode_sample a, b;
+  oc_enode_ev(A, x, y, ft, grad, &a);
+  oc_enode_ev(B, x, y, ft, grad, &b);
+  s->f = (1 - t) * a.f + t * b.f;
+  s->a = (1 - t) * a.a + t * b.a;
+  if (!grad) {
+    s->fx = s->fy = s->ax = s->ay = 0;
+    return;
+  }
+  double c = 1 / (p[P_K1] - p[P_K0]), tx = c * gk[0], ty = c * gk[1];
+  s->fx = (1 - t) * a.fx + t * b.fx + tx * (b.f - a.f);
+  s->fy = (1 - t) * a.fy + t * b.fy + ty * (b.f - a.f);
+  s->ax = (1 - t) * a.ax + t * b.ax + tx * (b.a - a.a);
+  s->ay = (1 - t) * a.ay + t * b.ay + ty * (b.a - a.a);
+}
+
+/* A's and B's bounds over one region, t in [tlo, thi] with Lipschitz
+** bound lt. */
+static void lod_combine(const oc_ebound *A, const oc_ebound *B, double lt,
+                        oc_ebound *o) {
+  o->flo = fmin(A->flo, B->flo);
+  o->fhi = fmax(A->fhi, B->fhi);
+  o->alo = fmin(A->alo, B->alo);
+  o->ahi = fmax(A->ahi, B->ahi);
+  o->lf = fmax(A->lf, B->lf) + lt * fmax(A->fhi - B->flo, B->fhi - A->flo);
+  o->la = fmax(A->la, B->la) + lt * fmax(A->ahi - B->alo, B->ahi - A->alo);
+}
+
+void oc_elod_bound_in(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
+                      oc_ebound *o) {
+  const double *p = n->par;
+  double klo, khi, lk;
+  oc_elod_kappa_bound(p[P_W], fb, &klo, &khi, &lk);
+  double c = 1 / (p[P_K1] - p[P_K0]);
+  double tlo = (klo - p[P_K0]) * c, thi = (khi - p[P_K0]) * c;
+  if (tlo >= 1) {
+    oc_enode_bnd(n->kids[1], b, fb, o);
+    return;
+  }
+  if (thi <= 0) {
+    oc_enode_bnd(n->kids[0], b, fb, o);
+    return;
+  }
+  oc_ebound A, B;
+  oc_enode_bnd(n->kids[0], b, fb, &A);
+  oc_enode_bnd(n->kids[1], b, fb, &B);
+  lod_combine(&A, &B, lk * c, o);
+}
+
+oc_enode *oc_enode_lod(oc_enode *a, oc_enode *b, const oc_enode_lod_params *p,
+                       oc_error *err) {
+  if (!a || !b || !p) {
+    oc_seterr(err, OC_EINVAL, "lod needs two elevation nodes and parameters");
+    return NULL;
+  }
+  double k0 = p->k0, k1 = p->k1;
+  if (k0 == 0 && k1 == 0) k1 = 1;
+  if (!(isfinite(p->wavelength) && p->wavelength > 0)) {
+    oc_seterr(err, OC_EINVAL, "'wavelength' must be a positive number (got %g)",
+              p->wavelength);
+    return NULL;
+  }
+  if (!(k0 >= 0 && k0 < k1 && k1 <= 1)) {
+    oc_seterr(err, OC_EINVAL,
+              "'k0' and 'k1' must satisfy 0 <= k0 < k1 <= 1 (got %g, %g)", k0,
+              k1);
+    return NULL;
+  }
+  oc_enode *k[2] = {a, b};
+  oc_enode *n = oc_enode_alloc(OC_E_LOD, k, 2, err);
+  if (!n) return NULL;
+  n->par[P_W] = p->wavelength;
+  n->par[P_K0] = k0;
+  n->par[P_K1] = k1;
+  /* under a view alpha may come from a: its box too */
+  n->box = (oc_erect){fmin(a->box.x0, b->box.x0), fmin(a->box.y0, b->box.y0),
+                      fmax(a->box.x1, b->box.x1), fmax(a->box.y1, b->box.y1)};
+  /* without a view the node is b (its slopes), with the ranges of both so
+  ** that those of any view lie inside */
+  n->glob = b->glob;
+  n->glob.flo = fmin(a->glob.flo, b->glob.flo);
+  n->glob.fhi = fmax(a->glob.fhi, b->glob.fhi);
+  n->glob.alo = fmin(a->glob.alo, b->glob.alo);
+  n->glob.ahi = fmax(a->glob.ahi, b->glob.ahi);
+  return n;
+}
+
+/* ---- queries and the elevation source under a view --------------------- */
+
+static int make_view(const oc_enode *e, const oc_enode_view *v, oc_eview *o,
+                     oc_error *err) {
+  if (!(isfinite(v->eye[0]) && isfinite(v->eye[1]) && isfinite(v->eye[2])))
+    return oc_seterr(err, OC_EINVAL, "'eye' must have finite coordinates");
+  if (!(isfinite(v->k) && v->k >= 0))
+    return oc_seterr(err, OC_EINVAL,
+                     "'k' must be a finite number >= 0 (got %g)", v->k);
+  o->ex = v->eye[0];
+  o->ey = v->eye[1];
+  o->dz = fabs(v->eye[2] - (e->glob.flo + e->glob.fhi) / 2);
+  o->k = v->k;
+  if (!isfinite(o->dz))
+    return oc_seterr(err, OC_EINVAL, "'eye' is too far from the terrain");
+  return OC_OK;
+}
+
+int oc_enode_eval_view(const oc_enode *e, double x, double y,
+                       const oc_enode_view *v, oc_enode_sample *s,
+                       oc_error *err) {
+  oc_eview w;
+  if (!v) {
+    oc_enode_eval(e, x, y, s);
+    return OC_OK;
+  }
+  int rc = make_view(e, v, &w, err);
+  if (rc) return rc;
+  if (!isfinite(x) || !isfinite(y)) {
+    s->f = s->a = s->fx = s->fy = s->ax = s->ay = NAN;
+    return OC_OK;
+  }
+  oc_efoot ft;
+  oc_eview_foot(&w, x, y, &ft);
+  oc_enode_ev(e, x, y, &ft, OC_EV_GRAD, s);
+  return OC_OK;
+}
+
+/* What a view source holds: the tree (retained) and the view. */
+typedef struct vsrc {
+  int refs;
+  oc_enode *e;
+  oc_eview v;
+} vsrc;
+
+static double vsrc_height(void *ud, double x, double y, double grad[2]) {
+  const vsrc *q = ud;
+  oc_enode_sample s;
+  oc_efoot ft;
+  oc_eview_foot(&q->v, x, y, &ft);
+  oc_enode_ev(q->e, x, y, &ft, grad ? OC_EV_GRAD : 0, &s);
+  if (grad) {
+    grad[0] = s.fx;
+    grad[1] = s.fy;
+  }
+  return s.f;
+}
+
+static void vsrc_bound(const vsrc *q, double x0, double y0, double x1,
+                       double y1, oc_ebound *b) {
+  oc_erect r = {x0, y0, x1, y1};
+  oc_efootb fb;
+  oc_eview_footb(&q->v, &r, &fb);
+  oc_enode_bnd(q->e, &r, &fb, b);
+}
+
+static void vsrc_range(void *ud, double x0, double y0, double x1, double y1,
+                       double *lo, double *hi) {
+  oc_ebound b;
+  vsrc_bound(ud, x0, y0, x1, y1, &b);
+  *lo = b.flo;
+  *hi = b.fhi;
+}
+
+static double vsrc_slope(void *ud, double x0, double y0, double x1, double y1) {
+  oc_ebound b;
+  vsrc_bound(ud, x0, y0, x1, y1, &b);
+  return b.lf;
+}
+
+static void vsrc_retain(void *ud) {
+  ((vsrc *)ud)->refs++;
+}
+
+static void vsrc_release(void *ud) {
+  vsrc *q = ud;
+  if (--q->refs > 0) return;
+  oc_enode_release(q->e);
+  free(q);
+}
+
+double oc_enode_view_weight(void *ud, double x, double y) {
+  const vsrc *q = ud;
+  if (!isfinite(x) || !isfinite(y)) return NAN;
+  oc_enode_sample s;
+  oc_efoot ft;
+  oc_eview_foot(&q->v, x, y, &ft);
+  oc_enode_ev(q->e, x, y, &ft, OC_EV_LAZY, &s);
+  return s.a;
+}
+
+int oc_enode_elevation_view(oc_enode *e, const double *domain,
+                            const oc_enode_view *v, oc_elevation *src,
+                            oc_error *err) {
+  oc_eview w;
+  double d[4];
+  if (!v) return oc_seterr(err, OC_EINVAL, "lod: no view");
+  int rc = make_view(e, v, &w, err);
+  if (!rc) rc = oc_enode_domain(e, &w, domain, d, err);
+  if (rc) return rc;
+  vsrc *q = malloc(sizeof *q);
+  if (!q) return oc_seterr(err, OC_ENOMEM, "out of memory");
+  q->refs = 1;
+  q->e = e;
+  q->v = w;
+  oc_enode_retain(e);
+  *src = (oc_elevation){.height = vsrc_height,
+                        .range = vsrc_range,
+                        .slope = vsrc_slope,
+                        .retain = vsrc_retain,
+                        .release = vsrc_release,
+                        .ud = q,
+                        .x0 = d[0],
+                        .y0 = d[1],
+                        .x1 = d[2],
+                        .y1 = d[3]};
+  return OC_OK;
+}

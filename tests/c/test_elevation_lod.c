@@ -1,0 +1,523 @@
+/*
+** test_elevation_lod.c — level of detail of elevation trees (Génevaux et
+** al. 2015, section 6): the footprint 0 gives the full-detail tree bit for
+** bit; continuous-LoD discs against the octave sum written here (each
+** octave's term read as the difference of two discs, its weight b(t) from
+** a footprint computed here); the lod operator against its formula; no
+** jump across the thresholds beyond the Lipschitz bound times the step;
+** gradients against central differences and the bounds never exceeded
+** with LoD on; and a LoD render against a dense march.
+*/
+#include <math.h>
+#include <omp.h>
+#include <string.h>
+
+#include "elevation/enode.h"
+#include "ocheck.h"
+#include "render/etrace.h"
+
+static oc_enode *eok_(oc_enode *e, const oc_error *err, const char *what,
+                      int line) {
+  ck_assert_msg(e != NULL, "line %d: %s failed: %s", line, what, err->msg);
+  return e;
+}
+#define EOK(expr) eok_((expr), &err, #expr, __LINE__)
+
+static oc_enode *disc(double cx, double cy, double r, double h,
+                      oc_enoise_kind kind, double amp, double wl, int oct) {
+  oc_error err;
+  oc_enode_disc_params p = {cx, cy, r, h, {kind, amp, wl, oct, 0, 0, 42}};
+  return EOK(oc_enode_disc(&p, &err));
+}
+
+/* the filter and the footprint, written independently of lib/ */
+static double bfilt(double t) {
+  if (t <= 0) return 0;
+  if (t >= 1) return 1;
+  double q = 1 - t * t;
+  return 1 - q * q * q;
+}
+
+static double foot(const oc_enode_view *v, double dz, double x, double y) {
+  double u = x - v->eye[0], w = y - v->eye[1];
+  return v->k * sqrt(u * u + w * w + dz * dz);
+}
+
+static double mid_dz(const oc_enode *e, const oc_enode_view *v) {
+  double lo, hi;
+  oc_enode_get_bounds(e, NULL, &lo, &hi);
+  return fabs(v->eye[2] - (lo + hi) / 2);
+}
+
+static void evalv(const oc_enode *e, double x, double y, const oc_enode_view *v,
+                  oc_enode_sample *s) {
+  oc_error err;
+  ck_assert_msg(oc_enode_eval_view(e, x, y, v, s, &err) == OC_OK, "%s",
+                err.msg);
+}
+
+/* The bound of e in a box under view v (internal: what the view source
+** gives the tracer). */
+static void bound_view(const oc_enode *e, const oc_enode_view *v, double x0,
+                       double y0, double x1, double y1, oc_ebound *b) {
+  oc_eview w = {v->eye[0], v->eye[1], mid_dz(e, v), v->k};
+  oc_erect r = {x0, y0, x1, y1};
+  oc_efootb fb;
+  oc_eview_footb(&w, &r, &fb);
+  oc_enode_bnd(e, &r, &fb, b);
+}
+
+/* A scene with every operator: a covering base, noisy discs of every
+** kind, an instanced patch (transformed twice, scaled and rotated), a
+** warp, a lod node, blend, replace and add. */
+static oc_enode *scene(void) {
+  oc_error err;
+  oc_enode *base = disc(0, 0, 4000, 100, OC_ENOISE_PLAIN, 60, 900, 8);
+  oc_enode *m = disc(0, 0, 300, 200, OC_ENOISE_RIDGED, 150, 250, 9);
+  oc_enode_xform x1 = {600, 200, 30, 2, 1, 0},
+                 x2 = {-700, -300, -75, 1.5, 0.8, 20};
+  oc_enode *i1 = EOK(oc_enode_transform(m, &x1, &err));
+  oc_enode *i2 = EOK(oc_enode_transform(m, &x2, &err));
+  oc_enode *t = disc(200, -800, 500, 150, OC_ENOISE_TURBULENCE, 80, 200, 8);
+  oc_enode_warp_params wp = {30, 600, 2, 7};
+  oc_enode *tw = EOK(oc_enode_warp(t, &wp, &err));
+  oc_enode *coarse = disc(-300, 900, 600, 120, OC_ENOISE_NONE, 0, 1, 1);
+  oc_enode *fine = disc(-300, 900, 600, 120, OC_ENOISE_PLAIN, 40, 60, 5);
+  oc_enode_lod_params lp = {60, 0, 1};
+  oc_enode *ld = EOK(oc_enode_lod(coarse, fine, &lp, &err));
+  oc_enode *kids[] = {base, i1, i2, tw, ld};
+  oc_enode *bl = EOK(oc_enode_blend(kids, 5, &err));
+  oc_enode *crater = disc(900, 900, 250, 40, OC_ENOISE_PLAIN, 10, 50, 6);
+  oc_enode *rp = EOK(oc_enode_replace(bl, crater, 0, &err));
+  oc_enode *dunes = disc(-900, -900, 400, 0, OC_ENOISE_RIDGED, 15, 40, 8);
+  oc_enode_add_params ap = {0, 1, 150, 30};
+  oc_enode *top = EOK(oc_enode_add(rp, dunes, &ap, &err));
+  oc_enode *all[] = {base, m,  i1, i2,     t,  tw,   coarse,
+                     fine, ld, bl, crater, rp, dunes};
+  for (size_t k = 0; k < sizeof all / sizeof *all; k++)
+    oc_enode_release(all[k]);
+  return top;
+}
+
+/* lod between two flat discs: all its slope is the footprint's term */
+static oc_enode *step_tree(void) {
+  oc_error err;
+  oc_enode *a = disc(0, 0, 9000, 10, OC_ENOISE_NONE, 0, 1, 1);
+  oc_enode *b = disc(0, 0, 9000, 60, OC_ENOISE_NONE, 0, 1, 1);
+  oc_enode_lod_params p = {300, 0.2, 0.7};
+  oc_enode *l = EOK(oc_enode_lod(a, b, &p, &err));
+  oc_enode_release(a);
+  oc_enode_release(b);
+  return l;
+}
+
+/* The step tree as an instance, scaled, rotated and warped: the
+** footprint's units and slope change on the way down, and all the slope
+** is theirs. */
+static oc_enode *step_instance(void) {
+  oc_error err;
+  oc_enode *st = step_tree();
+  oc_enode_xform x = {-200, 100, 40, 3, 1, 0};
+  oc_enode *t = EOK(oc_enode_transform(st, &x, &err));
+  oc_enode_warp_params wp = {40, 900, 2, 3};
+  oc_enode *w = EOK(oc_enode_warp(t, &wp, &err));
+  oc_enode_release(st);
+  oc_enode_release(t);
+  return w;
+}
+
+START_TEST(footprint_zero_is_full_detail) {
+  oc_enode *e = scene();
+  oc_enode_view v0 = {{100, -200, 900}, 0};
+  /* a view so close that every octave keeps full weight */
+  oc_enode_view vn = {{100, -200, 900}, 1e-9};
+  oct_rng r = oct_rng_new(3);
+  for (int i = 0; i < 4000; i++) {
+    double x = oct_unif(&r, -4000, 4000), y = oct_unif(&r, -4000, 4000);
+    oc_enode_sample a, b, c;
+    oc_enode_eval(e, x, y, &a);
+    evalv(e, x, y, &v0, &b);
+    evalv(e, x, y, &vn, &c);
+    ck_assert_msg(memcmp(&a, &b, sizeof a) == 0, "k = 0 differs at (%g, %g)", x,
+                  y);
+    /* values bit for bit; the gradients gain the filters' zero terms */
+    ck_assert_msg(a.f == c.f && a.a == c.a, "tiny k differs at (%g, %g)", x, y);
+  }
+  /* bounds too: NULL and k = 0 agree */
+  oc_ebound b0, b1;
+  oc_erect box = {-500, -500, 800, 300};
+  oc_efootb z = {0, 0, 0};
+  oc_enode_bnd(e, &box, NULL, &b0);
+  oc_enode_bnd(e, &box, &z, &b1);
+  ck_assert(memcmp(&b0, &b1, sizeof b0) == 0);
+  oc_enode_release(e);
+}
+END_TEST
+
+/* The disc's f under a view: h + sum b(t_i) term_i, term_i the
+** difference of discs with i + 1 and i octaves at full detail. */
+static void check_disc_kind(oc_enoise_kind kind) {
+  const int N = 8;
+  const double wl = 400, h = 50;
+  oc_enode *d[9];
+  for (int i = 0; i <= N; i++)
+    d[i] = disc(0, 0, 20000, h, kind, 100, wl, i ? i : 1);
+  oc_enode_view v = {{-3000, 500, 2500}, 2e-3};
+  double dz = mid_dz(d[N], &v);
+  oct_rng r = oct_rng_new(11 + kind);
+  int ramps = 0;
+  for (int k = 0; k < 3000; k++) {
+    double x = oct_unif(&r, -12000, 12000), y = oct_unif(&r, -12000, 12000);
+    double ft = foot(&v, dz, x, y), ref = h;
+    for (int i = 0; i < N; i++) {
+      oc_enode_sample a, b;
+      oc_enode_eval(d[i + 1], x, y, &a);
+      if (i) oc_enode_eval(d[i], x, y, &b);
+      double term = i ? a.f - b.f : a.f - h;
+      double t = log2(wl / pow(2, i) / ft);
+      ramps += t > 0 && t < 1;
+      ref += bfilt(t) * term;
+    }
+    oc_enode_sample s;
+    evalv(d[N], x, y, &v, &s);
+    ck_assert_msg(fabs(s.f - ref) <= 1e-9 * (1 + fabs(ref)),
+                  "kind %d at (%g, %g): %.12g, sum %.12g", kind, x, y, s.f,
+                  ref);
+    /* beyond the first octave's ramp nothing is left of the noise */
+    if (wl / ft <= 1) ck_assert(s.f == h && s.fx == 0 && s.fy == 0);
+  }
+  ck_assert_msg(ramps > 1000, "only %d samples on a ramp", ramps);
+  for (int i = 0; i <= N; i++)
+    oc_enode_release(d[i]);
+}
+
+START_TEST(disc_octaves_filtered) {
+  check_disc_kind(OC_ENOISE_PLAIN);
+  check_disc_kind(OC_ENOISE_TURBULENCE);
+  check_disc_kind(OC_ENOISE_RIDGED);
+}
+END_TEST
+
+START_TEST(lod_operator_formula) {
+  oc_error err;
+  oc_enode *a = disc(0, 0, 5000, 10, OC_ENOISE_PLAIN, 30, 700, 3);
+  oc_enode *b = disc(100, 0, 5000, 40, OC_ENOISE_RIDGED, 60, 300, 6);
+  double ks[][2] = {{0, 1}, {0.25, 0.75}, {0, 0.3}, {0.6, 1}};
+  for (int q = 0; q < 4; q++) {
+    oc_enode_lod_params p = {250, ks[q][0], ks[q][1]};
+    oc_enode *l = EOK(oc_enode_lod(a, b, &p, &err));
+    ck_assert_str_eq(oc_enode_kind(l), "lod");
+    oc_enode_view v = {{0, 0, 800}, 0.08};
+    double dz = mid_dz(l, &v);
+    oct_rng r = oct_rng_new(5 + q);
+    int mixed = 0, onlya = 0, onlyb = 0;
+    for (int k = 0; k < 2000; k++) {
+      double x = oct_unif(&r, -4000, 4000), y = oct_unif(&r, -4000, 4000);
+      double kap = bfilt(log2(250 / foot(&v, dz, x, y)));
+      double t = (kap - p.k0) / (p.k1 - p.k0);
+      t = t < 0 ? 0 : t > 1 ? 1 : t;
+      /* the children under the lod node's footprint (its dz) */
+      oc_enode_sample s, fa, fb;
+      oc_eview w = {v.eye[0], v.eye[1], dz, v.k};
+      oc_efoot ft;
+      oc_eview_foot(&w, x, y, &ft);
+      ck_assert(fabs(ft.v - foot(&v, dz, x, y)) <= 1e-12 * ft.v);
+      evalv(l, x, y, &v, &s);
+      oc_enode_ev(a, x, y, &ft, OC_EV_GRAD, &fa);
+      oc_enode_ev(b, x, y, &ft, OC_EV_GRAD, &fb);
+      if (t == 0) {
+        onlya++;
+        ck_assert(memcmp(&s, &fa, sizeof s) == 0);
+      } else if (t == 1) {
+        onlyb++;
+        ck_assert(memcmp(&s, &fb, sizeof s) == 0);
+      } else {
+        mixed++;
+        double f = (1 - t) * fa.f + t * fb.f, al = (1 - t) * fa.a + t * fb.a;
+        ck_assert_msg(fabs(s.f - f) < 1e-9 && fabs(s.a - al) < 1e-12,
+                      "t %g: f %g vs %g", t, s.f, f);
+      }
+    }
+    ck_assert_msg(mixed > 50 && onlya > 50 && onlyb > 50, "%d %d %d", mixed,
+                  onlya, onlyb);
+    /* no view: b */
+    oc_enode_sample s, sb;
+    oc_enode_eval(l, 123, 456, &s);
+    oc_enode_eval(b, 123, 456, &sb);
+    ck_assert(memcmp(&s, &sb, sizeof s) == 0);
+    ck_assert(oc_enode_lipschitz(l) == oc_enode_lipschitz(b));
+    oc_enode_release(l);
+  }
+  /* bad input names the field */
+  oc_enode_lod_params bad[] = {
+      {0, 0, 1}, {NAN, 0, 1}, {10, 0.5, 0.5}, {10, -0.1, 1}, {10, 0, 1.5}};
+  const char *field[] = {"'wavelength'", "'wavelength'", "'k0'", "'k0'",
+                         "'k1'"};
+  for (int i = 0; i < 5; i++) {
+    ck_assert(oc_enode_lod(a, b, &bad[i], &err) == NULL);
+    ck_assert_msg(strstr(err.msg, field[i]), "%s", err.msg);
+  }
+  oc_enode_view bv = {{0, NAN, 0}, 1e-3};
+  oc_enode_sample s;
+  ck_assert(oc_enode_eval_view(a, 0, 0, &bv, &s, &err) == OC_EINVAL);
+  ck_assert(strstr(err.msg, "'eye'"));
+  bv = (oc_enode_view){{0, 0, 0}, -1};
+  ck_assert(oc_enode_eval_view(a, 0, 0, &bv, &s, &err) == OC_EINVAL);
+  ck_assert(strstr(err.msg, "'k'"));
+  oc_enode_release(a);
+  oc_enode_release(b);
+}
+END_TEST
+
+/* Dense samples along lines that cross every octave ramp and the lod
+** thresholds: no step changes f (or alpha) by more than the bound of the
+** step's box times its length. */
+START_TEST(continuous_across_thresholds) {
+  oc_error err;
+  oc_enode *e = scene(), *st = step_tree(), *si = step_instance();
+  oc_enode *a = disc(0, 0, 9000, 10, OC_ENOISE_NONE, 0, 1, 1);
+  oc_enode *b = disc(0, 0, 9000, 10, OC_ENOISE_PLAIN, 50, 300, 6);
+  oc_enode_lod_params p = {300, 0.2, 0.7};
+  oc_enode *l = EOK(oc_enode_lod(a, b, &p, &err));
+  oc_enode *trees[] = {e, l, st, si};
+  /* the step tree's ramp (foot from 150 to 300) crosses the lines */
+  oc_enode_view views[] = {{{-3500, -3500, 700}, 4e-3},
+                           {{-3500, -3500, 700}, 0.1}};
+  for (int q = 0; q < 4; q++) {
+    const oc_enode *t = trees[q];
+    const oc_enode_view v = views[q >= 2];
+    double step = 0.25, jumps = 0;
+    for (int line = 0; line < 3; line++) {
+      double y = -3500 + 1200 * line;
+      oc_enode_sample s0, s1;
+      evalv(t, -3500, y, &v, &s0);
+      for (double x = -3500; x < 3500; x += step) {
+        evalv(t, x + step, y, &v, &s1);
+        oc_ebound bd;
+        bound_view(t, &v, x, y, x + step, y, &bd);
+        double df = fabs(s1.f - s0.f), da = fabs(s1.a - s0.a);
+        ck_assert_msg(df <= bd.lf * step * (1 + 1e-9) + 1e-9,
+                      "%s: jump %g at x %g > %g x %g", oc_enode_kind(t), df, x,
+                      bd.lf, step);
+        ck_assert(da <= bd.la * step * (1 + 1e-9) + 1e-12);
+        jumps = fmax(jumps, df / step);
+        s0 = s1;
+      }
+    }
+    ck_assert(jumps > 0);
+  }
+  oc_enode_release(l);
+  oc_enode_release(a);
+  oc_enode_release(b);
+  oc_enode_release(st);
+  oc_enode_release(si);
+  oc_enode_release(e);
+}
+END_TEST
+
+START_TEST(gradients_with_lod) {
+  oc_enode *e = scene();
+  oc_enode_view v = {{-500, 300, 900}, 3e-3};
+  oct_rng r = oct_rng_new(17);
+  int n = 0;
+  for (int k = 0; k < 3000; k++) {
+    double x = oct_unif(&r, -4000, 4000), y = oct_unif(&r, -4000, 4000);
+    oc_enode_sample s, a, b;
+    double h = 1e-4;
+    evalv(e, x, y, &v, &s);
+    evalv(e, x + h, y, &v, &a);
+    evalv(e, x - h, y, &v, &b);
+    double fx = (a.f - b.f) / (2 * h), ax = (a.a - b.a) / (2 * h);
+    evalv(e, x, y + h, &v, &a);
+    evalv(e, x, y - h, &v, &b);
+    double fy = (a.f - b.f) / (2 * h), ay = (a.a - b.a) / (2 * h);
+    /* turbulence and ridges have kinks, and the altitude weight's
+    ** smoothstep: skip the rare sample where the differences disagree
+    ** between step sizes */
+    oc_enode_sample c, d;
+    evalv(e, x + 2 * h, y, &v, &c);
+    evalv(e, x - 2 * h, y, &v, &d);
+    double fx2 = (c.f - d.f) / (4 * h);
+    if (fabs(fx2 - fx) > 1e-5 * (1 + fabs(fx))) continue;
+    n++;
+    double sc = 1 + fabs(fx) + fabs(fy);
+    ck_assert_msg(fabs(fx - s.fx) <= 1e-5 * sc && fabs(fy - s.fy) <= 1e-5 * sc,
+                  "grad f at (%g, %g): (%.9g, %.9g) vs fd (%.9g, %.9g)", x, y,
+                  s.fx, s.fy, fx, fy);
+    double sa = 1 + fabs(ax) + fabs(ay);
+    ck_assert_msg(fabs(ax - s.ax) <= 1e-6 * sa && fabs(ay - s.ay) <= 1e-6 * sa,
+                  "grad alpha at (%g, %g)", x, y);
+  }
+  ck_assert_msg(n > 2500, "only %d smooth samples", n);
+  oc_enode_release(e);
+}
+END_TEST
+
+/* With LoD on, the ranges and Lipschitz bounds of random boxes hold on
+** random points and pairs, and a footprint's term is in them: the
+** unfiltered slope bound alone would not do where the ramps are steep. */
+START_TEST(bounds_with_lod) {
+  oc_enode *trees[] = {scene(), step_tree(),
+                       disc(0, 0, 9000, 10, OC_ENOISE_PLAIN, 50, 300, 2),
+                       step_instance()};
+  oc_enode_view views[] = {
+      {{-500, 300, 900}, 3e-3}, {{3000, 0, 5000}, 0.02}, {{100, 0, 10}, 1}};
+  for (int q = 0; q < 12; q++) {
+    const oc_enode_view *v = &views[q % 3];
+    const oc_enode *e = trees[q / 3];
+    oct_rng r = oct_rng_new(23 + q);
+    double worst = 0, maxlf = 0; /* the largest slope over its bound */
+    for (int i = 0; i < 300; i++) {
+      double w = 4000 * pow(10, oct_unif(&r, -3.5, 0.3));
+      double x0 = oct_unif(&r, -4500, 4000), y0 = oct_unif(&r, -4500, 4000);
+      double x1 = x0 + w, y1 = y0 + w * oct_unif(&r, 0.2, 1);
+      oc_ebound b;
+      bound_view(e, v, x0, y0, x1, y1, &b);
+      for (int k = 0; k < 64; k++) {
+        double px = oct_unif(&r, x0, x1), py = oct_unif(&r, y0, y1);
+        double qx = oct_unif(&r, x0, x1), qy = oct_unif(&r, y0, y1);
+        oc_enode_sample p, s;
+        evalv(e, px, py, v, &p);
+        evalv(e, qx, qy, v, &s);
+        double m = 1e-9 * (1 + fabs(b.flo) + fabs(b.fhi));
+        ck_assert_msg(p.f >= b.flo - m && p.f <= b.fhi + m,
+                      "f %g outside [%g, %g]", p.f, b.flo, b.fhi);
+        ck_assert(p.a >= b.alo - 1e-9 && p.a <= b.ahi + 1e-9);
+        ck_assert_msg(hypot(p.fx, p.fy) <= b.lf * (1 + 1e-9) + m,
+                      "|grad f| %g > %g", hypot(p.fx, p.fy), b.lf);
+        if (b.lf > 0) worst = fmax(worst, hypot(p.fx, p.fy) / b.lf);
+        maxlf = fmax(maxlf, b.lf);
+        ck_assert(hypot(p.ax, p.ay) <= b.la * (1 + 1e-9) + 1e-12);
+        double d = hypot(px - qx, py - qy);
+        ck_assert(fabs(p.f - s.f) <= b.lf * d * (1 + 1e-9) + m);
+        ck_assert(fabs(p.a - s.a) <= b.la * d * (1 + 1e-9) + 1e-12);
+      }
+    }
+    /* bounds that hold but say nothing would pass the above too (where
+    ** a view's ramp lies beyond the boxes, the step tree is flat and its
+    ** bounds say so) */
+    ck_assert_msg(worst > 0.05 || maxlf == 0,
+                  "tree %d view %d: slopes reach only %g of "
+                  "the bounds",
+                  q / 3, q % 3, worst);
+  }
+  for (int q = 0; q < 4; q++)
+    oc_enode_release(trees[q]);
+}
+END_TEST
+
+/* ---- tracing --------------------------------------------------------- */
+
+/* First t where o + t d is on or below the surface (inside the domain,
+** where the weight allows), by fixed steps then bisection. */
+static double march(const oc_esurface *es, oc_vec3 o, oc_vec3 d, double t1,
+                    double ds) {
+  const oc_elevation *s = es->src;
+  double prev = 0, zlo, zhi;
+  s->range(s->ud, s->x0, s->y0, s->x1, s->y1, &zlo, &zhi);
+  int above = 0;
+  for (double t = 0; t <= t1; prev = t, t += ds) {
+    oc_vec3 p = oct_add(o, oct_mul(d, t));
+    if (p.x < s->x0 || p.x > s->x1 || p.y < s->y0 || p.y > s->y1 || p.z < zlo) {
+      above = 0;
+      continue;
+    }
+    double h = p.z - s->height(s->ud, p.x, p.y, NULL);
+    int hole = es->weight(es->wud, p.x, p.y) < es->T;
+    if (hole || h > 0) {
+      above = h > 0;
+      continue;
+    }
+    if (!above) return t;
+    double a = prev, b = t;
+    for (int k = 0; k < 40; k++) {
+      double m = 0.5 * (a + b);
+      oc_vec3 q = oct_add(o, oct_mul(d, m));
+      if (q.z - s->height(s->ud, q.x, q.y, NULL) > 0)
+        a = m;
+      else
+        b = m;
+    }
+    return b;
+  }
+  return INFINITY;
+}
+
+START_TEST(lod_trace_against_march) {
+  oc_error err;
+  oc_enode *e = scene();
+  oc_vec3 eye = {-2600, -2400, 1100}, target = {300, 300, 0};
+  /* a coarse pixel, so that the LoD drops octaves across the view */
+  oc_enode_view v = {{eye.x, eye.y, eye.z}, 4e-3};
+  oc_elevation src;
+  ck_assert_msg(oc_enode_elevation_view(e, NULL, &v, &src, &err) == OC_OK, "%s",
+                err.msg);
+  oc_esurface es = {&src, oc_enode_view_weight, src.ud, OC_ENODE_T};
+  oc_vec3 w = oct_sub(target, eye);
+  w = oct_mul(w, 1 / oct_len(w));
+  oc_vec3 rt = oct_cross(w, oct_v(0, 0, 1));
+  rt = oct_mul(rt, 1 / oct_len(rt));
+  oc_vec3 up = oct_cross(rt, w);
+  double eps_k = 1e-4, eps_min = 1e-4;
+  oc_etracer tr;
+  oc_etracer_init(&tr, &es, OC_TRACE_SEGMENT, eps_k, eps_min);
+  int hits = 0, differ = 0, n = 0;
+  double ev = 0;
+  for (int j = 0; j < 12; j++)
+    for (int i = 0; i < 20; i++) {
+      double x = (i + 0.5) / 20 * 2 - 1, y = ((j + 0.5) / 12 * 2 - 1) * 0.3;
+      oc_vec3 d = oct_add(w, oct_add(oct_mul(rt, 0.6 * x), oct_mul(up, y)));
+      d = oct_mul(d, 1 / oct_len(d));
+      double t, tref = march(&es, eye, d, 20000, 0.5);
+      int h = oc_etrace(&tr, eye, d, 0, 1e6, 0, &t, &ev);
+      n++;
+      if ((h != 0) != isfinite(tref)) {
+        differ++;
+        continue;
+      }
+      if (!h) continue;
+      hits++;
+      ck_assert_msg(fabs(t - tref) <= 0.5 + 4 * (eps_k * tref + eps_min),
+                    "ray %d %d: traced %.4f, march %.4f", i, j, t, tref);
+    }
+  ck_assert_msg(hits > n / 2, "%d of %d hit", hits, n);
+  ck_assert_msg(differ <= 2, "%d rays disagree", differ);
+  /* a whole render: the same image on 1 and 2 threads */
+  oc_render_params rp;
+  oc_render_defaults(&rp);
+  rp.camera.eye = eye;
+  rp.camera.target = target;
+  rp.camera.up = oct_v(0, 0, 1);
+  rp.width = 48;
+  rp.height = 32;
+  oc_image *img[2];
+  for (int k = 0; k < 2; k++) {
+    omp_set_num_threads(k + 1);
+    img[k] = oc_render_surface(&es, &rp, NULL, &err);
+    ck_assert_msg(img[k], "%s", err.msg);
+  }
+  omp_set_num_threads(2);
+  ck_assert(
+      memcmp(oc_image_cdata(img[0]), oc_image_cdata(img[1]),
+             (size_t)48 * 32 * oc_image_channels(img[0]) * sizeof(float)) == 0);
+  oc_image_free(img[0]);
+  oc_image_free(img[1]);
+  src.release(src.ud);
+  oc_enode_release(e);
+}
+END_TEST
+
+int main(void) {
+  Suite *s = suite_create("elevation_lod");
+  TCase *tc = tcase_create("lod");
+  tcase_set_timeout(tc, 120);
+  tcase_add_test(tc, footprint_zero_is_full_detail);
+  tcase_add_test(tc, disc_octaves_filtered);
+  tcase_add_test(tc, lod_operator_formula);
+  tcase_add_test(tc, continuous_across_thresholds);
+  tcase_add_test(tc, gradients_with_lod);
+  tcase_add_test(tc, bounds_with_lod);
+  tcase_add_test(tc, lod_trace_against_march);
+  suite_add_tcase(s, tc);
+  return oct_run(s);
+}
