@@ -14,7 +14,8 @@
 # with one thread and with two: the same PNG bytes both times; the dunes
 # leave the peak's elevation as it was and raise the desert floor; the
 # thirty instances share the patch (37 nodes, not 182); the lake's level
-# is below the land around it; a younger crater's floor is its own.
+# is below the land around it; a younger crater's floor is its own; the
+# LoD render takes fewer tree calls per pixel than the full-detail one.
 
 set -u
 
@@ -58,7 +59,7 @@ tally "$T/out" "$T/err"
 grep "^topology" "$T/out" | sed "s/^/     /"
 
 for ex in elev_river elev_dunes elev_instances elev_road elev_coast elev_lake \
-  elev_craters elev_multiscale; do
+  elev_craters elev_multiscale elev_lod; do
   name=elev-${ex#elev_}
   why=
   mkdir -p "$T/$name/1" "$T/$name/2"
@@ -87,6 +88,12 @@ for ex in elev_river elev_dunes elev_instances elev_road elev_coast elev_lake \
     # water level A m; the land around it B to C m: A < B
     awk '/water level/ { ok = ($4 + 0 < $13 + 0) } END { exit !ok }' \
       FS='[ ]+' "$T/out1" || because "the lake's level is not below the land around it"
+    ;;
+  elev_lod)
+    # with LoD: A tree calls per pixel; full detail: B: A < B
+    awk '/with LoD:/ { a = $4 } /full detail:/ { b = $4 }
+      END { exit !(a + 0 > 0 && a + 0 < b + 0) }' FS='[ ]+' "$T/out1" ||
+      because "the LoD render does not take fewer tree calls"
     ;;
   elev_craters)
     # a younger crater over an older rim: floor F = its level L - depth D
