@@ -248,7 +248,12 @@ PICTURES := demo_arch_render.png:demo:arch_render.png \
   example_elev_river.png:elev_river:elev_river.png \
   example_elev_dunes.png:elev_dunes:elev_dunes.png \
   example_elev_instances.png:elev_instances:elev_instances.png \
-  example_elev_road.png:elev_road:elev_road.png
+  example_elev_road.png:elev_road:elev_road.png \
+  example_elev_coast.png:elev_coast:elev_coast.png \
+  example_elev_lake.png:elev_lake:elev_lake.png \
+  example_elev_craters.png:elev_craters:elev_craters.png \
+  example_elev_multiscale.png:elev_multiscale:elev_multiscale.png \
+  example_elev_lod.png:elev_lod:elev_lod.png
 PICTURE_SCENES := $(sort $(foreach p,$(PICTURES),$(word 2,$(subst :, ,$(p)))))
 
 pictures: all

@@ -8,10 +8,14 @@
 # out (--set render=false): its mesh is one closed component (specks of a
 # few vertices dropped) with a through-hole, genus >= 1 (topology.lua).
 #
+# coast-arch: examples/elev_coast.lua the same way (the arch of a tree).
+#
 # elev-*: the elevation-tree examples at 96 x 54 (--set size=96), run
 # with one thread and with two: the same PNG bytes both times; the dunes
 # leave the peak's elevation as it was and raise the desert floor; the
-# thirty instances share the patch (37 nodes, not 182).
+# thirty instances share the patch (37 nodes, not 182); the lake's level
+# is below the land around it; a younger crater's floor is its own; the
+# LoD render takes fewer tree calls per pixel than the full-detail one.
 
 set -u
 
@@ -38,7 +42,24 @@ grep -q '^topology: 1 component' "$T/out" || because "no single component report
 tally "$T/out" "$T/err"
 grep "^topology" "$T/out" | sed "s/^/     /"
 
-for ex in elev_river elev_dunes elev_instances elev_road; do
+# coast-arch: examples/elev_coast.lua (an elevation tree implicitized and
+# eroded by the sea) at its own cell, picture left out: one closed
+# component with a through-hole under the neck.
+name=coast-arch
+why=
+mkdir -p "$T/$name"
+if ! "$OUTCROP" run "$HERE/topology.lua" "$ROOT/examples/elev_coast.lua" 1 \
+  --set render=false --out "$T/$name" >"$T/out" 2>"$T/err"; then
+  because "$(grep -m1 -E 'outcrop:|assert' "$T/err" || echo "exit status $?")"
+fi
+grep -qE 'ERROR: (Address|Leak)Sanitizer|runtime error:' "$T/err" &&
+  because "sanitizer report"
+grep -q '^topology: 1 component' "$T/out" || because "no single component reported"
+tally "$T/out" "$T/err"
+grep "^topology" "$T/out" | sed "s/^/     /"
+
+for ex in elev_river elev_dunes elev_instances elev_road elev_coast elev_lake \
+  elev_craters elev_multiscale elev_lod; do
   name=elev-${ex#elev_}
   why=
   mkdir -p "$T/$name/1" "$T/$name/2"
@@ -62,6 +83,23 @@ for ex in elev_river elev_dunes elev_instances elev_road; do
   elev_instances)
     grep -q '30 instances: 37 nodes, 5 primitives' "$T/out1" ||
       because "the instances do not share the patch"
+    ;;
+  elev_lake)
+    # water level A m; the land around it B to C m: A < B
+    awk '/water level/ { ok = ($4 + 0 < $13 + 0) } END { exit !ok }' \
+      FS='[ ]+' "$T/out1" || because "the lake's level is not below the land around it"
+    ;;
+  elev_lod)
+    # with LoD: A tree calls per pixel; full detail: B: A < B
+    awk '/with LoD:/ { a = $4 } /full detail:/ { b = $4 }
+      END { exit !(a + 0 > 0 && a + 0 < b + 0) }' FS='[ ]+' "$T/out1" ||
+      because "the LoD render does not take fewer tree calls"
+    ;;
+  elev_craters)
+    # a younger crater over an older rim: floor F = its level L - depth D
+    awk '/cuts the rim/ { d = $18 - ($24 - $27); ok = (d < 0.11 && d > -0.11) }
+      END { exit !ok }' FS='[ ]+' "$T/out1" ||
+      because "the younger crater's floor is not its own"
     ;;
   esac
   tally "$T/out1" "$T/err"
