@@ -191,8 +191,8 @@ static size_t read_knots(lua_State *L, int idx, const char *fname,
       lua_pop(L, 1);
     }
     if (!ok)
-      oclua_error(L, fname, "'%s[%I]' must be {d, v} with finite numbers", label,
-                  i);
+      oclua_error(L, fname, "'%s[%I]' must be {d, v} with finite numbers",
+                  label, i);
     lua_pop(L, 1);
   }
   *d = a;
@@ -200,8 +200,50 @@ static size_t read_knots(lua_State *L, int idx, const char *fname,
   return (size_t)m;
 }
 
+/* The array 'profiles' at the top of the stack, {KEY =, knots = {{d, v},
+** ...}} each, KEY a number (finite when `finite`) described by `what`,
+** into a Lua-owned array pushed with the knots' arrays (raw reads). */
+static oc_enode_profile *read_profiles(lua_State *L, const oclua_fields *f,
+                                       const char *key, const char *what,
+                                       int finite, size_t *n) {
+  const char *fname = f->fname;
+  int t = lua_gettop(L);
+  if (!lua_istable(L, t)) {
+    char msg[64];
+    snprintf(msg, sizeof msg, "must be an array of {%s =, knots =}", key);
+    oclua_field_error(f, "profiles", t, msg);
+  }
+  lua_Integer m = (lua_Integer)lua_rawlen(L, t);
+  if (m < 1 || m > 4096)
+    oclua_error(L, fname, "'profiles' must hold 1 to 4096 profiles (got %I)",
+                m);
+  luaL_checkstack(L, (int)m + 8, "too many profiles");
+  oc_enode_profile *pr = lua_newuserdatauv(L, (size_t)m * sizeof *pr, 0);
+  for (lua_Integer i = 1; i <= m; i++) {
+    char label[48];
+    snprintf(label, sizeof label, "profiles[%lld]", (long long)i);
+    if (lua_rawgeti(L, t, i) != LUA_TTABLE)
+      oclua_error(L, fname, "'%s' must be {%s =, knots = {{d, v}, ...}}", label,
+                  key);
+    lua_getfield(L, -1, key);
+    if (lua_type(L, -1) != LUA_TNUMBER ||
+        (finite && !isfinite(lua_tonumber(L, -1))))
+      oclua_error(L, fname, "'%s.%s' must be %s", label, key, what);
+    pr[i - 1].at = lua_tonumber(L, -1);
+    lua_pop(L, 1);
+    lua_getfield(L, -1, "knots");
+    snprintf(label, sizeof label, "profiles[%lld].knots", (long long)i);
+    pr[i - 1].n =
+        read_knots(L, lua_gettop(L), fname, label, &pr[i - 1].d, &pr[i - 1].v);
+    lua_replace(L, -3); /* keep the knots' array, drop the tables */
+    lua_pop(L, 1);
+  }
+  *n = (size_t)m;
+  return pr;
+}
+
 static int l_curve(lua_State *L) {
-  static const char *const known[] = {"points", "radius",  "core", "spline",
+  static const char *const known[] = {"points",  "radius",   "core", "spline",
                                       "profile", "profiles", NULL};
   const char *fname = "outcrop.elevation.curve";
   oclua_fields f;
@@ -215,8 +257,9 @@ static int l_curve(lua_State *L) {
   int one = oclua_field_push(&f, "profile") != LUA_TNIL;
   int many = oclua_field_push(&f, "profiles") != LUA_TNIL;
   if (one == many)
-    oclua_error(L, fname, "give either 'profile' = {{d, v}, ...} or "
-                          "'profiles' = {{at =, knots = {{d, v}, ...}}, ...}");
+    oclua_error(L, fname,
+                "give either 'profile' = {{d, v}, ...} or "
+                "'profiles' = {{at =, knots = {{d, v}, ...}}, ...}");
   oc_enode_profile *pr;
   if (one) {
     pr = lua_newuserdatauv(L, sizeof *pr, 0);
@@ -224,35 +267,7 @@ static int l_curve(lua_State *L) {
     pr->n = read_knots(L, lua_gettop(L) - 2, fname, "profile", &pr->d, &pr->v);
     p.nprofiles = 1;
   } else {
-    int t = lua_gettop(L);
-    if (!lua_istable(L, t))
-      oclua_field_error(&f, "profiles", t, "must be an array of {at =, knots =}");
-    lua_Integer m = (lua_Integer)lua_rawlen(L, t);
-    if (m < 1 || m > 4096)
-      oclua_error(L, fname, "'profiles' must hold 1 to 4096 profiles (got %I)",
-                  m);
-    luaL_checkstack(L, (int)m + 8, "too many profiles");
-    pr = lua_newuserdatauv(L, (size_t)m * sizeof *pr, 0);
-    for (lua_Integer i = 1; i <= m; i++) {
-      char label[48];
-      snprintf(label, sizeof label, "profiles[%lld]", (long long)i);
-      if (lua_rawgeti(L, t, i) != LUA_TTABLE)
-        oclua_error(L, fname, "'%s' must be {at =, knots = {{d, v}, ...}}",
-                    label);
-      lua_getfield(L, -1, "at");
-      if (lua_type(L, -1) != LUA_TNUMBER)
-        oclua_error(L, fname, "'%s.at' must be a number in [0, 1]", label);
-      pr[i - 1].at = lua_tonumber(L, -1);
-      lua_pop(L, 1);
-      lua_getfield(L, -1, "knots");
-      snprintf(label, sizeof label, "profiles[%lld].knots", (long long)i);
-      pr[i - 1].n = read_knots(L, lua_gettop(L), fname, label, &pr[i - 1].d,
-                               &pr[i - 1].v);
-      /* keep the knots' array on the stack, drop the tables above it */
-      lua_replace(L, -3);
-      lua_pop(L, 1);
-    }
-    p.nprofiles = (size_t)m;
+    pr = read_profiles(L, &f, "at", "a number in [0, 1]", 0, &p.nprofiles);
   }
   p.profiles = pr;
   oc_error err = {OC_OK, ""};
@@ -261,7 +276,7 @@ static int l_curve(lua_State *L) {
 }
 
 static int l_river(lua_State *L) {
-  static const char *const known[] = {"points", "kind",  "width", "depth",
+  static const char *const known[] = {"points", "kind",   "width", "depth",
                                       "bank",   "spline", NULL};
   static const char *const kinds[] = {"stream", "river", "meander", "main",
                                       NULL};
@@ -516,38 +531,8 @@ static int l_lake(lua_State *L) {
     pr->n = read_knots(L, lua_gettop(L) - 2, fname, "profile", &pr->d, &pr->v);
     p.nprofiles = 1;
   } else if (many) {
-    int t = lua_gettop(L);
-    if (!lua_istable(L, t))
-      oclua_field_error(&f, "profiles", t,
-                        "must be an array of {angle =, knots =}");
-    lua_Integer m = (lua_Integer)lua_rawlen(L, t);
-    if (m < 1 || m > 4096)
-      oclua_error(L, fname, "'profiles' must hold 1 to 4096 profiles (got %I)",
-                  m);
-    luaL_checkstack(L, (int)m + 8, "too many profiles");
-    pr = lua_newuserdatauv(L, (size_t)m * sizeof *pr, 0);
-    for (lua_Integer i = 1; i <= m; i++) {
-      char label[48];
-      snprintf(label, sizeof label, "profiles[%lld]", (long long)i);
-      if (lua_rawgeti(L, t, i) != LUA_TTABLE)
-        oclua_error(L, fname, "'%s' must be {angle =, knots = {{d, v}, ...}}",
-                    label);
-      lua_getfield(L, -1, "angle");
-      if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(lua_tonumber(L, -1)))
-        oclua_error(L, fname,
-                    "'%s.angle' must be a number of degrees in "
-                    "[0, 360)",
-                    label);
-      pr[i - 1].at = lua_tonumber(L, -1);
-      lua_pop(L, 1);
-      lua_getfield(L, -1, "knots");
-      snprintf(label, sizeof label, "profiles[%lld].knots", (long long)i);
-      pr[i - 1].n = read_knots(L, lua_gettop(L), fname, label, &pr[i - 1].d,
-                               &pr[i - 1].v);
-      lua_replace(L, -3); /* keep the knots' array, drop the tables */
-      lua_pop(L, 1);
-    }
-    p.nprofiles = (size_t)m;
+    pr = read_profiles(L, &f, "angle", "a number of degrees in [0, 360)", 1,
+                       &p.nprofiles);
   }
   p.profiles = pr;
   oc_error err = {OC_OK, ""};
@@ -765,11 +750,10 @@ void oclua_open_elevation(lua_State *L) {
       {"stats", e_stats},   {"kind", e_kind},
       {NULL, NULL}};
   static const luaL_Reg funcs[] = {
-      {"disc", l_disc},   {"curve", l_curve},   {"river", l_river},
-      {"road", l_road},   {"blend", l_blend}, {"replace", l_replace},
+      {"disc", l_disc}, {"curve", l_curve}, {"river", l_river},
+      {"road", l_road}, {"blend", l_blend}, {"replace", l_replace},
       {"add", l_add},   {"warp", l_warp},   {"transform", l_transform},
-      {"lake", l_lake},   {"image", l_image},
-      {"lod", l_lod},
+      {"lake", l_lake}, {"image", l_image}, {"lod", l_lod},
       {NULL, NULL}};
   oclua_newmeta(L, OCLUA_ELEVATION, meta, methods);
   lua_pop(L, 1);

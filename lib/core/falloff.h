@@ -33,5 +33,16 @@ static inline double oc_falloff_d(double x) {
   double u = 1.0 - x * x;
   return -6.0 * x * u * u;
 }
+/* max |g'(x)| over [a, b] clipped to [0, 1], a hair over for rounding:
+** |g'| rises to OC_FALLOFF_LIPSCHITZ at 1/sqrt(5), then falls. */
+static inline double oc_falloff_slope_in(double a, double b) {
+  a = a > 0.0 ? a : 0.0;
+  b = b < 1.0 ? b : 1.0;
+  if (!(a <= b)) return 0.0;
+  double pk = 0.44721359549995793928; /* 1/sqrt(5) */
+  if (a <= pk && pk <= b) return OC_FALLOFF_LIPSCHITZ;
+  double da = -oc_falloff_d(a), db = -oc_falloff_d(b);
+  return (da > db ? da : db) * (1 + 1e-12);
+}
 
 #endif

@@ -230,16 +230,6 @@ void oc_eimage_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
 
 /* ---- bounds ------------------------------------------------------------ */
 
-/* max |G'(x)| over [a, b] clipped to [0, 1] (|G'| = |g'|). */
-static double rslope(double a, double b) {
-  a = fmax(a, 0);
-  b = fmin(b, 1);
-  if (!(a <= b)) return 0;
-  double pk = 1 / sqrt(5.0);
-  if (a <= pk && pk <= b) return OC_FALLOFF_LIPSCHITZ;
-  return fmax(-oc_falloff_d(a), -oc_falloff_d(b)) * (1 + 1e-12);
-}
-
 static double dist_to_quad(const eimage *d, double x, double y) {
   int inside = 1;
   for (int k = 0; k < 4; k++)
@@ -367,7 +357,7 @@ void oc_eimage_bound_in(const oc_enode *n, const oc_erect *b,
     double sl = dl[k] / d->F, sh = dh[k] / d->F;
     blo *= ramp(sl, &dg);
     bhi *= ramp(sh, &dg);
-    lb += rslope(sl, sh) / d->F;
+    lb += oc_falloff_slope_in(sl, sh) / d->F;
   }
   o->alo = fmax(0, wlo * blo * (1 - 1e-12) - 1e-300);
   o->ahi = fmin(1, whi * bhi * (1 + 1e-12));

@@ -149,17 +149,6 @@ void oc_elake_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
   }
 }
 
-/* max |g'(x)| over [a, b] (clipped to [0, 1]): |g'| = 6 x (1 - x^2)^2
-** rises to its peak at 1 / sqrt(5), then falls. */
-static double gslope(double a, double b) {
-  a = fmax(a, 0);
-  b = fmin(b, 1);
-  if (!(a <= b)) return 0;
-  double pk = 1 / sqrt(5.0);
-  if (a <= pk && pk <= b) return OC_FALLOFF_LIPSCHITZ;
-  return fmax(-oc_falloff_d(a), -oc_falloff_d(b)) * (1 + 1e-12);
-}
-
 /* alpha as a function of delta: 1 inside, g(delta / R) outside. */
 static double wyvill_or_one(double del, double R) {
   return del <= 0 ? 1 : oc_falloff(del / R);
@@ -191,7 +180,7 @@ static void bound_rho(const elake *d, double rl, double rh, oc_ebound *o) {
   o->ahi = fmin(1, wyvill_or_one(dl, d->R) * (1 + 1e-12));
   o->alo = fmax(0, wyvill_or_one(dh, d->R) * (1 - 1e-12) - 1e-300);
   double ra = fmax(rl, d->rmin), kr = d->drmax / ra;
-  o->la = gslope(dl / d->R, dh / d->R) / d->R * sqrt(1 + kr * kr) * (1 + 1e-9);
+  o->la = oc_falloff_slope_in(dl / d->R, dh / d->R) / d->R * sqrt(1 + kr * kr) * (1 + 1e-9);
 }
 
 void oc_elake_bound_in(const oc_enode *n, const oc_erect *b,
