@@ -181,7 +181,7 @@ check-c: $(CTEST_BIN)
 LUA_SPEC_ENV = OUTCROP_TEST_BUILD=$(abspath $(B)) \
   LUA_CPATH="$(abspath $(B))/?.so;;" LUA_PATH="$(abspath tests/lua)/?.lua;;"
 
-check-lua: $(MODULE)
+check-lua: $(MODULE) $(BIN)
 	@echo "== busted specs ($(B))"
 	@cd tests/lua && $(LUA_SPEC_ENV) $(SPEC_PRELOAD) lua5.4 /usr/bin/busted \
 	  --lua=lua5.4 -o utfTerminal .
