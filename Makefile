@@ -216,7 +216,7 @@ check-asan:
 	  SPEC_PRELOAD="ASAN_OPTIONS=detect_leaks=0 LD_PRELOAD=$$(gcc -print-file-name=libasan.so):$$(gcc -print-file-name=libubsan.so)"
 	@$(MAKE) --no-print-directory SAN=1 check-lua-gc \
 	  SPEC_PRELOAD="ASAN_OPTIONS=detect_leaks=0 LD_PRELOAD=$$(gcc -print-file-name=libasan.so):$$(gcc -print-file-name=libubsan.so)"
-	@$(MAKE) --no-print-directory SAN=1 check-runtime
+	@EXAMPLES_THREADS=2 $(MAKE) --no-print-directory SAN=1 check-runtime
 	@$(MAKE) --no-print-directory SAN=1 check-corpus
 	@$(MAKE) --no-print-directory SAN=1 check-alloc
 

@@ -238,6 +238,83 @@ int oc_etrace(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0, double t1,
   return hit;
 }
 
+/* ---- beams ---------------------------------------------------------------
+** A beam's piece between depths da and db is convex (the image of the
+** polytope da <= d <= db, d x0 <= X <= d x1, d y0 <= Y <= d y1 by the
+** linear map (d, X, Y) -> o + d w + X r + Y v), so its box and lowest
+** point are those of its 8 vertices. Where the piece lies above the
+** highest elevation the source gives for that box (or outside the
+** domain), none of its rays meets the surface there: the beam strides
+** on, doubling, and halves where that fails, down to about its own width
+** (below which a box stops shrinking with the step). */
+
+static void piece_box(const oc_ebeam *b, double da, double db, double lo[3],
+                      double hi[3]) {
+  for (int k = 0; k < 3; k++)
+    lo[k] = INFINITY, hi[k] = -INFINITY;
+  for (int k = 0; k < 8; k++) {
+    double d = k & 1 ? db : da, x = k & 2 ? b->x1 : b->x0,
+           y = k & 4 ? b->y1 : b->y0;
+    oc_vec3 D = {b->w.x + x * b->r.x + y * b->v.x,
+                 b->w.y + x * b->r.y + y * b->v.y,
+                 b->w.z + x * b->r.z + y * b->v.z};
+    const double p[3] = {b->o.x + d * D.x, b->o.y + d * D.y, b->o.z + d * D.z};
+    for (int c = 0; c < 3; c++)
+      lo[c] = lesser(lo[c], p[c]), hi[c] = greater(hi[c], p[c]);
+  }
+  /* rounding of the vertices: a relative hair outward */
+  for (int c = 0; c < 3; c++) {
+    double pad = 1e-9 * (fabs(lo[c]) + fabs(hi[c]));
+    lo[c] -= pad, hi[c] += pad;
+  }
+}
+
+/* 1 when no ray of the piece whose box is lo, hi meets the surface. */
+static int piece_free(const oc_etracer *tr, const double lo[3],
+                      const double hi[3], double *bounds) {
+  double x0 = greater(lo[0], tr->lo[0]), x1 = lesser(hi[0], tr->hi[0]);
+  double y0 = greater(lo[1], tr->lo[1]), y1 = lesser(hi[1], tr->hi[1]);
+  if (!(x0 <= x1 && y0 <= y1) || lo[2] > tr->hi[2] || hi[2] < tr->lo[2])
+    return 1; /* outside the domain's box */
+  const oc_elevation *src = tr->s->src;
+  double flo, fhi, lam;
+  if (bounds) (*bounds)++;
+  if (src->bound)
+    src->bound(src->ud, x0, y0, x1, y1, &flo, &fhi, &lam);
+  else
+    src->range(src->ud, x0, y0, x1, y1, &flo, &fhi);
+  return lo[2] > fhi;
+}
+
+double oc_etrace_beam(const oc_etracer *tr, const oc_ebeam *b, double d,
+                      double dmax, double *bounds) {
+  /* past the farthest corner of the domain's box no ray is in it (a ray
+  ** at depth d is at least d from o) */
+  double far = 0;
+  for (int k = 0; k < 8; k++) {
+    double dx = (k & 1 ? tr->hi[0] : tr->lo[0]) - b->o.x;
+    double dy = (k & 2 ? tr->hi[1] : tr->lo[1]) - b->o.y;
+    double dz = (k & 4 ? tr->hi[2] : tr->lo[2]) - b->o.z;
+    far = greater(far, sqrt(dx * dx + dy * dy + dz * dz));
+  }
+  far = lesser(far * (1 + 1e-9), dmax);
+  double width = greater(b->x1 - b->x0, b->y1 - b->y0), e = (far - d) / 16;
+  for (long k = 0; k < OC_TRACE_MAX_STEPS && d < far; k++) {
+    e = lesser(e, far - d);
+    double lo[3], hi[3];
+    piece_box(b, d, d + e, lo, hi);
+    if (piece_free(tr, lo, hi, bounds)) {
+      if (d + e == d) return d;
+      d += e;
+      e *= GROW;
+      continue;
+    }
+    if (e <= greater(0.5 * width * d, tol(tr, 0, d))) return d;
+    e *= 0.5;
+  }
+  return d < far ? d : INFINITY;
+}
+
 oc_vec3 oc_etracer_wall(const oc_etracer *tr, oc_vec3 p, oc_vec3 u) {
   const double q[3] = {p.x, p.y, p.z};
   double best = INFINITY;

@@ -36,6 +36,22 @@ void oc_etracer_init(oc_etracer *tr, const oc_esurface *s,
 int oc_etrace(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0, double t1,
               double d0, double *t, double *evals);
 
+/* A beam: the rays o + d (w + x r + y v) for (x, y) in [x0, x1] x
+** [y0, y1] and depth d >= 0 (w, r, v the camera's orthonormal frame, so
+** that |w + x r + y v| >= 1). */
+typedef struct oc_ebeam {
+  oc_vec3 o, w, r, v;
+  double x0, x1, y0, y1;
+} oc_ebeam;
+
+/* The depth up to which every ray of the beam is proved free of the
+** surface, from d on: beam tracing (cone marching) with the source's
+** elevation ranges on the boxes of frustum pieces, no height call made.
+** INFINITY when every ray leaves the domain, or passes depth dmax,
+** unhit. *bounds (when not NULL) counts the range queries. */
+double oc_etrace_beam(const oc_etracer *tr, const oc_ebeam *b, double d,
+                      double dmax, double *bounds);
+
 /* The outward normal of the wall hit at p by a ray along u: the nearest
 ** face of the box, or -u for a hole's wall. */
 oc_vec3 oc_etracer_wall(const oc_etracer *tr, oc_vec3 p, oc_vec3 u);

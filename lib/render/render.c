@@ -25,6 +25,9 @@
 #include "terrain/terrain.h"
 
 #define TILE 16
+/* Beams of elevation surfaces split down to blocks this many pixels a
+** side. */
+#define BEAM_MIN 4
 #define NAOV 8
 #define GEOM_SHARE 0.7 /* oc_render's progress: tracing, then shading */
 /* Hit tolerance: this fraction of a pixel's angular size. */
@@ -57,12 +60,29 @@ static void camera_init(camera *c, const oc_render_params *rp) {
   c->aspect = (double)rp->width / rp->height;
 }
 
-/* The unit direction through the centre of pixel (i, j), row 0 on top. */
-static oc_vec3 ray_dir(const camera *c, int i, int j) {
+/* The direction w + x right + y up through the centre of pixel (i, j),
+** row 0 on top: at least 1 long (the frame is orthonormal). */
+static oc_vec3 ray_vec(const camera *c, int i, int j) {
   double x = (2 * (i + 0.5) / c->width - 1) * c->th * c->aspect;
   double y = (1 - 2 * (j + 0.5) / c->height) * c->th;
-  oc_vec3 d = oc_add(c->w, oc_add(oc_mul(c->right, x), oc_mul(c->up, y)));
+  return oc_add(c->w, oc_add(oc_mul(c->right, x), oc_mul(c->up, y)));
+}
+
+/* The unit direction through the centre of pixel (i, j). */
+static oc_vec3 ray_dir(const camera *c, int i, int j) {
+  oc_vec3 d = ray_vec(c, i, j);
   return oc_mul(d, 1 / oc_len(d));
+}
+
+/* The beam of the rays through pixels [i0, i1) x [j0, j1), to their
+** edges. */
+static void beam_for(const camera *c, int i0, int j0, int i1, int j1,
+                     oc_ebeam *b) {
+  b->o = c->eye, b->w = c->w, b->r = c->right, b->v = c->up;
+  b->x0 = (2.0 * i0 / c->width - 1) * c->th * c->aspect;
+  b->x1 = (2.0 * i1 / c->width - 1) * c->th * c->aspect;
+  b->y0 = (1 - 2.0 * j1 / c->height) * c->th;
+  b->y1 = (1 - 2.0 * j0 / c->height) * c->th;
 }
 
 static double resolve_T(const oc_program *prog, const oc_render_params *rp) {
@@ -141,12 +161,21 @@ typedef struct gctx {
   float *px;
 } gctx;
 
-static void geom_pixel(const gctx *g, int i, int j, float *out) {
-  oc_vec3 u = ray_dir(&g->cam, i, j);
-  double t, ev = 0;
+/* Pixel (i, j), its ray known free of the surface before depth d (the
+** distance along w; INFINITY: a miss). */
+static void geom_pixel(const gctx *g, int i, int j, double d, float *out) {
+  oc_vec3 D = ray_vec(&g->cam, i, j);
+  double len = oc_len(D), t, ev = 0;
+  oc_vec3 u = oc_mul(D, 1 / len);
   memset(out, 0, OC_RG_COUNT * sizeof *out);
-  int hit = g->es ? oc_etrace(&g->etr, g->cam.eye, u, 0, g->far, 0, &t, &ev)
-                  : oc_trace(&g->tr, g->cam.eye, u, 0, g->far, 0, &t, &ev);
+  int hit = 0;
+  if (d == INFINITY)
+    hit = 0;
+  else if (g->es)
+    hit = oc_etrace(&g->etr, g->cam.eye, u, d * len * (1 - 1e-12), g->far, 0,
+                    &t, &ev);
+  else
+    hit = oc_trace(&g->tr, g->cam.eye, u, 0, g->far, 0, &t, &ev);
   if (!hit) {
     out[OC_RG_Z] = INFINITY;
     out[OC_RG_EVALS] = (float)ev;
@@ -174,11 +203,46 @@ static void geom_pixel(const gctx *g, int i, int j, float *out) {
   out[OC_RG_EVALS] = (float)ev;
 }
 
+/* The pixels [i0, i1) x [j0, j1), whose rays are free before depth d:
+** the beam of the block takes them as far as it proves them free
+** together, then its quarters go on from there, down to BEAM_MIN pixels
+** a side, and each ray from where its block stopped. The blocks are the
+** same for any thread count (tiles split alike), so are the images. */
+static void beam_block(const gctx *g, int i0, int j0, int i1, int j1,
+                       double d) {
+  if (d != INFINITY) {
+    oc_ebeam b;
+    beam_for(&g->cam, i0, j0, i1, j1, &b);
+    d = oc_etrace_beam(&g->etr, &b, d, g->far, NULL);
+  }
+  int w = i1 - i0, h = j1 - j0;
+  if (d != INFINITY && (w > BEAM_MIN || h > BEAM_MIN)) {
+    int im = w > BEAM_MIN ? i0 + w / 2 : i1,
+        jm = h > BEAM_MIN ? j0 + h / 2 : j1;
+    beam_block(g, i0, j0, im, jm, d);
+    if (im < i1) beam_block(g, im, j0, i1, jm, d);
+    if (jm < j1) {
+      beam_block(g, i0, jm, im, j1, d);
+      if (im < i1) beam_block(g, im, jm, i1, j1, d);
+    }
+    return;
+  }
+  for (int j = j0; j < j1; j++)
+    for (int i = i0; i < i1; i++)
+      geom_pixel(g, i, j, d,
+                 g->px + ((size_t)j * g->cam.width + i) * OC_RG_COUNT);
+}
+
 static void geom_tile(const void *ctx, int x0, int y0, int x1, int y1) {
   const gctx *g = ctx;
+  if (g->es && g->etr.mode == OC_TRACE_SEGMENT) {
+    beam_block(g, x0, y0, x1, y1, 0);
+    return;
+  }
   for (int j = y0; j < y1; j++)
     for (int i = x0; i < x1; i++)
-      geom_pixel(g, i, j, g->px + ((size_t)j * g->cam.width + i) * OC_RG_COUNT);
+      geom_pixel(g, i, j, 0,
+                 g->px + ((size_t)j * g->cam.width + i) * OC_RG_COUNT);
 }
 
 /* A terrain thinner than the rays' tolerance shows as scattered pixels

@@ -56,8 +56,8 @@ static wave WAVE = {40, 10, 60};
 
 static oc_elevation wave_source(void) {
   /* no weight, no joint bound (the last three): a surface everywhere */
-  oc_elevation e = {wave_h, wave_range, wave_slope, NULL, NULL, &WAVE,
-                    -500,   -500,       500,        500,  NULL, NULL, NULL};
+  oc_elevation e = {wave_h, wave_range, wave_slope, NULL, NULL, &WAVE, -500,
+                    -500,   500,        500,        NULL, NULL, NULL};
   return e;
 }
 
@@ -256,6 +256,89 @@ START_TEST(weight_makes_holes) {
 }
 END_TEST
 
+/* ---- beams ------------------------------------------------------------- */
+
+/* The beam through pixels [i0, i1) x [j0, j1) of rp, as render.c makes
+** it (written independently of lib/). */
+static oc_ebeam pixel_beam(const oc_render_params *rp, int i0, int j0, int i1,
+                           int j1) {
+  oc_ebeam b;
+  oc_vec3 w = oct_sub(rp->camera.target, rp->camera.eye);
+  b.w = oct_mul(w, 1 / oct_len(w));
+  oc_vec3 r = oct_cross(b.w, rp->camera.up);
+  b.r = oct_mul(r, 1 / oct_len(r));
+  b.v = oct_cross(b.r, b.w);
+  b.o = rp->camera.eye;
+  double th = tan(rp->camera.fov * PI / 360),
+         a = (double)rp->width / rp->height;
+  b.x0 = ((double)i0 / rp->width * 2 - 1) * th * a;
+  b.x1 = ((double)i1 / rp->width * 2 - 1) * th * a;
+  b.y0 = (1 - (double)j1 / rp->height * 2) * th;
+  b.y1 = (1 - (double)j0 / rp->height * 2) * th;
+  return b;
+}
+
+/* Every ray of a beam, its corners and a grid of rays inside, meets the
+** surface (by the dense march) no nearer than the depth the beam proves
+** free; the beams go most of the way to the surface; a beam that sees
+** only sky proves every ray free. Returns the beams that stopped short. */
+static void beams_against_march(const oc_esurface *es,
+                                const oc_render_params *rp, int bs, double ds) {
+  oc_etracer tr;
+  oc_etracer_init(&tr, es, OC_TRACE_SEGMENT, 1e-4, 1e-6);
+  int beams = 0, far = 0, sky = 0;
+  for (int j0 = 0; j0 < rp->height; j0 += bs)
+    for (int i0 = 0; i0 < rp->width; i0 += bs) {
+      oc_ebeam b = pixel_beam(rp, i0, j0, i0 + bs, j0 + bs);
+      double nb = 0, d = oc_etrace_beam(&tr, &b, 0, INFINITY, &nb);
+      double tmin = INFINITY;
+      for (int v = 0; v <= 4; v++)
+        for (int u = 0; u <= 4; u++) {
+          double x = b.x0 + (b.x1 - b.x0) * u / 4;
+          double y = b.y0 + (b.y1 - b.y0) * v / 4;
+          oc_vec3 D = oct_add(b.w, oct_add(oct_mul(b.r, x), oct_mul(b.v, y)));
+          double len = oct_len(D);
+          double tref = march(es, b.o, oct_mul(D, 1 / len), 5000, ds);
+          ck_assert_msg(tref >= d * len - ds,
+                        "beam at %d %d: free to %g, a ray meets the surface "
+                        "at %g",
+                        i0, j0, d * len, tref);
+          tmin = fmin(tmin, tref);
+        }
+      beams++;
+      if (!isfinite(tmin)) {
+        sky += d == INFINITY;
+        continue;
+      }
+      ck_assert(nb > 0);
+      far += d >= 0.5 * tmin;
+    }
+  ck_assert_msg(far + sky >= beams / 2, "%d of %d beams went half way", far,
+                beams);
+  ck_assert_msg(sky > 0, "no beam sees only sky");
+}
+
+START_TEST(beams_conservative) {
+  oc_heightfield *hf = fbm_grid();
+  oc_elevation src;
+  oc_error e;
+  ck_assert_int_eq(oc_heightfield_elevation(hf, &src, &e), OC_OK);
+  oc_esurface es = {&src, NULL, NULL, 0.5};
+  oc_render_params rp =
+      view(oct_v(-150, -250, 450), oct_v(600, 500, 300), 64, 40);
+  beams_against_march(&es, &rp, 8, 0.05);
+  src.release(src.ud);
+  oc_heightfield_release(hf);
+  /* the analytic source, and the same with a hole */
+  oc_elevation w = wave_source();
+  oc_esurface ws = {&w, NULL, NULL, 0.5};
+  rp = view(oct_v(-600, -700, 300), oct_v(100, 100, 200), 48, 32);
+  beams_against_march(&ws, &rp, 4, 0.05);
+  ws.weight = half;
+  beams_against_march(&ws, &rp, 16, 0.05);
+}
+END_TEST
+
 /* ---- whole renders ----------------------------------------------------- */
 
 START_TEST(render_heightfield) {
@@ -383,6 +466,7 @@ static Suite *suite(void) {
   tcase_add_test(t, heightfield_against_march);
   tcase_add_test(t, analytic_against_march);
   tcase_add_test(t, weight_makes_holes);
+  tcase_add_test(t, beams_conservative);
   suite_add_tcase(s, t);
   t = tcase_create("rendering");
   tcase_set_timeout(t, 300);
