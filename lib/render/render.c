@@ -203,6 +203,15 @@ static void geom_pixel(const gctx *g, int i, int j, double d, float *out) {
   out[OC_RG_EVALS] = (float)ev;
 }
 
+/* The pixels [i0, i1) x [j0, j1), each ray from depth d. */
+static void geom_pixels(const gctx *g, int i0, int j0, int i1, int j1,
+                        double d) {
+  for (int j = j0; j < j1; j++)
+    for (int i = i0; i < i1; i++)
+      geom_pixel(g, i, j, d,
+                 g->px + ((size_t)j * g->cam.width + i) * OC_RG_COUNT);
+}
+
 /* The pixels [i0, i1) x [j0, j1), whose rays are free before depth d:
 ** the beam of the block takes them as far as it proves them free
 ** together, then its quarters go on from there, down to BEAM_MIN pixels
@@ -227,22 +236,15 @@ static void beam_block(const gctx *g, int i0, int j0, int i1, int j1,
     }
     return;
   }
-  for (int j = j0; j < j1; j++)
-    for (int i = i0; i < i1; i++)
-      geom_pixel(g, i, j, d,
-                 g->px + ((size_t)j * g->cam.width + i) * OC_RG_COUNT);
+  geom_pixels(g, i0, j0, i1, j1, d);
 }
 
 static void geom_tile(const void *ctx, int x0, int y0, int x1, int y1) {
   const gctx *g = ctx;
-  if (g->es && g->etr.mode == OC_TRACE_SEGMENT) {
+  if (g->es && g->etr.mode == OC_TRACE_SEGMENT)
     beam_block(g, x0, y0, x1, y1, 0);
-    return;
-  }
-  for (int j = y0; j < y1; j++)
-    for (int i = x0; i < x1; i++)
-      geom_pixel(g, i, j, 0,
-                 g->px + ((size_t)j * g->cam.width + i) * OC_RG_COUNT);
+  else
+    geom_pixels(g, x0, y0, x1, y1, 0);
 }
 
 /* A terrain thinner than the rays' tolerance shows as scattered pixels
