@@ -862,7 +862,7 @@ static uint32_t compile_ext(comp *c, const oc_node *n) {
   op = emit(c, OC_K_EXT, k, n->nkids, kc.par, kc.npar);
   if (op == OC_NONE) goto done;
   P->ops[op].ext = (uint32_t)P->next;
-  P->ext[P->next++] = (oc_pext){def, n->data};
+  P->ext[P->next++] = (oc_pext){def, n->data, {0}};
   if (kc.jump) P->njump++;
   c->inf[op].lo = kc.info.lo;
   c->inf[op].hi = kc.info.hi;
@@ -1010,8 +1010,14 @@ oc_program *oc_compile(oc_node *root, const oc_compile_options *opts,
     oc_program_free(P);
     return NULL;
   }
-  for (uint32_t i = 0; i < P->nops; i++)
-    P->ops[i].lip = c.inf[i].lip;
+  for (uint32_t i = 0; i < P->nops; i++) {
+    oc_op *o = &P->ops[i];
+    o->lip = c.inf[i].lip;
+    if (o->kind == OC_K_EXT) {
+      oc_pext *x = &P->ext[o->ext];
+      x->ev = (oc_kctx){P->par + o->par, x->data, P->T, o->lip, P, i, 0};
+    }
+  }
   P->root = r;
   P->bounds = c.inf[r].box;
   P->lip = c.inf[r].lip;

@@ -18,11 +18,10 @@ static double evg(const oc_program *P, uint32_t i, oc_vec3 p, oc_vec3 *g);
 
 /* ---- extension kinds (kind.h) ----------------------------------------- */
 
-static inline double ext(const oc_program *P, uint32_t i, const oc_op *o,
-                         oc_vec3 p, oc_vec3 *g) {
+static inline double ext(const oc_program *P, const oc_op *o, oc_vec3 p,
+                         oc_vec3 *g) {
   const oc_pext *x = &P->ext[o->ext];
-  oc_kctx k = {P->par + o->par, x->data, P->T, o->lip, P, i, 0};
-  return x->def->eval(&k, p, g);
+  return x->def->eval(&x->ev, p, g);
 }
 
 double oc_child_eval(const oc_kctx *k, size_t i, oc_vec3 p, oc_vec3 *g) {
@@ -387,7 +386,7 @@ static double ev(const oc_program *P, uint32_t i, oc_vec3 p) {
   case OC_K_PERTURB:
     return perturb(o, par, p);
   case OC_K_EXT:
-    return ext(P, i, o, p, NULL);
+    return ext(P, o, p, NULL);
   default:
     return prim((oc_kind)o->kind, par, p, NULL);
   }
@@ -468,7 +467,7 @@ static double evg(const oc_program *P, uint32_t i, oc_vec3 p, oc_vec3 *g) {
                           g);
   }
   case OC_K_EXT:
-    return ext(P, i, o, p, g);
+    return ext(P, o, p, g);
   default:
     return prim((oc_kind)o->kind, par, p, g);
   }

@@ -54,6 +54,9 @@ typedef struct oc_op {
 typedef struct oc_pext {
   const oc_kind_def *def;
   const void *data;
+  /* the context of eval, filled once compilation is over (depth 0): the
+  ** hot path hands it over as it is instead of building one a call */
+  oc_kctx ev;
 } oc_pext;
 
 struct oc_program {

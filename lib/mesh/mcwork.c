@@ -5,12 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/grow.h"
 #include "mesh/mcwork.h"
-
-int oc_mc_grow(void *pp, size_t *cap, size_t need, size_t elem) {
-  return oc_grow(pp, cap, need, elem, 64);
-}
 
 int oc_mc_rlist_columns(oc_mc_rlist *l, size_t ncol) {
   if (oc_mc_grow(&l->at, &l->capat, ncol + 1, sizeof *l->at)) return -1;

@@ -9,6 +9,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "core/grow.h"
 #include "mesh/mcgrid.h"
 
 typedef struct oc_mc_irange {
@@ -58,8 +59,11 @@ struct oc_mcwork {
 };
 
 /* Grows *pp (an array of elem-byte items, capacity *cap) to hold need
-** items, doubling; 0 or -1 when out of memory. */
-int oc_mc_grow(void *pp, size_t *cap, size_t need, size_t elem);
+** items, doubling from 64; 0 or -1 when out of memory. Inline: the mesher
+** asks at every vertex and cell, and nearly always there is room. */
+static inline int oc_mc_grow(void *pp, size_t *cap, size_t need, size_t elem) {
+  return need <= *cap ? 0 : oc_grow(pp, cap, need, elem, 64);
+}
 
 /* Starts a list of ncol columns (ranges are then added column by column,
 ** at[c + 1] set by the caller after column c). */

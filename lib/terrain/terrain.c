@@ -128,8 +128,10 @@ static double prism_dist(const oc_tdata *t, oc_vec3 p, oc_vec3 *g) {
 
 /* ---- value and gradient ------------------------------------------------- */
 
-double oc_terrain_eval(const oc_tdata *t, const double *par, oc_vec3 p,
-                       oc_vec3 *g) {
+/* The kind's eval hook (the table below). */
+static double terrain_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
+  const oc_tdata *t = k->data;
+  const double *par = k->par;
   double T2 = 2 * par[OC_TPAR_T], W = par[OC_TPAR_W];
   if (g) *g = (oc_vec3){0, 0, 0};
   /* f_T is 0 beyond the elevation range: no need to look h up */
@@ -352,10 +354,6 @@ static int terrain_compile(oc_kcompile *c, oc_error *err) {
   c->info.lip = oc_terrain_lipschitz(t, c->par);
   c->info.box = oc_terrain_box(t);
   return OC_OK;
-}
-
-static double terrain_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
-  return oc_terrain_eval(k->data, k->par, p, g);
 }
 
 /* Infinite across the sides of open edges, where f jumps: the global

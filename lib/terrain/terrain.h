@@ -41,8 +41,6 @@ enum { OC_TPAR_T, OC_TPAR_W, OC_TPAR_K, OC_TPAR_DS, OC_TPAR_N };
 void oc_tdata_free(oc_tdata *t);
 void oc_terrain_sigma(double T, double W, double par[OC_TPAR_N]);
 
-double oc_terrain_eval(const oc_tdata *t, const double *par, oc_vec3 p,
-                       oc_vec3 *g);
 oc_aabb oc_terrain_box(const oc_tdata *t);
 double oc_terrain_lipschitz(const oc_tdata *t, const double *par);
 double oc_terrain_lipschitz_in(const oc_tdata *t, const double *par,
