@@ -220,11 +220,18 @@ check-asan:
 	@$(MAKE) --no-print-directory SAN=1 check-corpus
 	@$(MAKE) --no-print-directory SAN=1 check-alloc
 
+# Each stage says how long it took (the whole must stay under 20 minutes
+# on 2 cores; see README, Tests).
+STAGE = t0=$$(date +%s); $(MAKE) --no-print-directory $(1) && \
+  echo "make test: $(1) took $$(( $$(date +%s) - t0 )) s"
+
 test: deps
-	@$(MAKE) --no-print-directory all tests-bin
-	@$(MAKE) --no-print-directory check-c check-lua check-runtime
-	@$(MAKE) --no-print-directory check-asan
-	@$(MAKE) --no-print-directory fuzz-smoke
+	@$(call STAGE,all tests-bin)
+	@$(call STAGE,check-c)
+	@$(call STAGE,check-lua)
+	@$(call STAGE,check-runtime)
+	@$(call STAGE,check-asan)
+	@$(call STAGE,fuzz-smoke)
 	@echo "make test: all tests passed"
 
 demo: deps
