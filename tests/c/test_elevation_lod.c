@@ -90,7 +90,7 @@ static oc_enode *scene(void) {
   oc_enode *crater = disc(900, 900, 250, 40, OC_ENOISE_PLAIN, 10, 50, 6);
   oc_enode *rp = EOK(oc_enode_replace(bl, crater, 0, &err));
   oc_enode *dunes = disc(-900, -900, 400, 0, OC_ENOISE_RIDGED, 15, 40, 8);
-  oc_enode_add_params ap = {0, 1, 150, 30};
+  oc_enode_add_params ap = {.below = 1, .below_z = 150, .fade = 30};
   oc_enode *top = EOK(oc_enode_add(rp, dunes, &ap, &err));
   oc_enode *all[] = {base, m,  i1, i2,     t,  tw,   coarse,
                      fine, ld, bl, crater, rp, dunes};
