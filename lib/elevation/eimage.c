@@ -160,6 +160,46 @@ static double ramp(double x, double *dg) {
   return 1 - oc_falloff(x);
 }
 
+/* alpha = clamp(w(u, v), 0, 1) prod_k G(e_k / F), from the four edge
+** coordinates e_k (distances inside) and their gradients (ex_k, ey_k),
+** with grad u = gu and grad v = gv for the weight grid's chain rule. */
+static void edge_alpha(const eimage *d, const double e[4], const double ex[4],
+                       const double ey[4], double u, double v,
+                       const double gu[2], const double gv[2], int grad,
+                       oc_enode_sample *s) {
+  double G[4], dG[4], ab = 1;
+  for (int k = 0; k < 4; k++) {
+    G[k] = ramp(e[k] / d->F, &dG[k]);
+    ab *= G[k];
+  }
+  double w = 1, wx = 0, wy = 0;
+  if (ab > 0 && d->w.src.ud) { /* (alpha = 0 whatever w is) */
+    double wu, wv;
+    w = grid_at(&d->w, u, v, grad, &wu, &wv);
+    if (w <= 0) {
+      w = 0;
+    } else if (w >= 1) {
+      w = 1;
+    } else {
+      wx = wu * gu[0] + wv * gv[0];
+      wy = wu * gu[1] + wv * gv[1];
+    }
+  }
+  s->a = w * ab;
+  if (grad && s->a != 0) {
+    double bx = 0, by = 0;
+    for (int k = 0; k < 4; k++) {
+      double o = dG[k] / d->F;
+      for (int j = 0; j < 4; j++)
+        if (j != k) o *= G[j];
+      bx += o * ex[k];
+      by += o * ey[k];
+    }
+    s->ax = ab * wx + w * bx;
+    s->ay = ab * wy + w * by;
+  }
+}
+
 /* Along a curve: (u, v) from the closest point, grad u and grad v. */
 static void curve_ev(const eimage *d, double x, double y, int want,
                      oc_enode_sample *s) {
@@ -193,37 +233,8 @@ static void curve_ev(const eimage *d, double x, double y, int want,
   double ec[4] = {pt.s, d->L - pt.s, d->hw - dl, d->hw + dl};
   double egx[4] = {gsx, -gsx, -pt.nx, pt.nx},
          egy[4] = {gsy, -gsy, -pt.ny, pt.ny};
-  double G[4], dG[4], ab = 1;
-  for (int k = 0; k < 4; k++) {
-    G[k] = ramp(ec[k] / d->F, &dG[k]);
-    ab *= G[k];
-  }
-  double w = 1, wx = 0, wy = 0;
-  if (ab > 0 && d->w.src.ud) {
-    double wu, wv;
-    w = grid_at(&d->w, u, v, grad, &wu, &wv);
-    if (w <= 0) {
-      w = 0;
-    } else if (w >= 1) {
-      w = 1;
-    } else {
-      wx = wu * gux + wv * gvx;
-      wy = wu * guy + wv * gvy;
-    }
-  }
-  s->a = w * ab;
-  if (grad && s->a != 0) {
-    double bx = 0, by = 0;
-    for (int k = 0; k < 4; k++) {
-      double o = dG[k] / d->F;
-      for (int j = 0; j < 4; j++)
-        if (j != k) o *= G[j];
-      bx += o * egx[k];
-      by += o * egy[k];
-    }
-    s->ax = ab * wx + w * bx;
-    s->ay = ab * wy + w * by;
-  }
+  double gu[2] = {gux, guy}, gv[2] = {gvx, gvy};
+  edge_alpha(d, ec, egx, egy, u, v, gu, gv, grad, s);
   if (want & OC_EV_ALPHA || (lazy && s->a == 0)) return;
   double fu, fv;
   s->f = d->off + d->vs * grid_at(&d->h, u, v, grad, &fu, &fv);
@@ -300,37 +311,10 @@ void oc_eimage_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
   }
   if (!inside) return;
   /* alpha */
-  double G[4], dG[4], ab = 1;
-  for (int k = 0; k < 4; k++) {
-    G[k] = ramp(dk[k] / d->F, &dG[k]);
-    ab *= G[k];
-  }
-  double w = 1, wx = 0, wy = 0;
-  if (d->w.src.ud) {
-    double wu, wv;
-    w = grid_at(&d->w, u, v, grad, &wu, &wv);
-    if (w <= 0) {
-      w = 0;
-    } else if (w >= 1) {
-      w = 1;
-    } else {
-      wx = wu * gux + wv * gvx;
-      wy = wu * guy + wv * gvy;
-    }
-  }
-  s->a = w * ab;
-  if (grad && s->a != 0) {
-    double bx = 0, by = 0;
-    for (int k = 0; k < 4; k++) {
-      double o = dG[k] / d->F;
-      for (int j = 0; j < 4; j++)
-        if (j != k) o *= G[j];
-      bx += o * d->nrm[k][0];
-      by += o * d->nrm[k][1];
-    }
-    s->ax = ab * wx + w * bx;
-    s->ay = ab * wy + w * by;
-  }
+  double ex[4], ey[4], gu[2] = {gux, guy}, gv[2] = {gvx, gvy};
+  for (int k = 0; k < 4; k++)
+    ex[k] = d->nrm[k][0], ey[k] = d->nrm[k][1];
+  edge_alpha(d, dk, ex, ey, u, v, gu, gv, grad, s);
 }
 
 /* ---- bounds ------------------------------------------------------------ */
