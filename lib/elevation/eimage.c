@@ -736,6 +736,10 @@ oc_enode *oc_enode_image(const oc_enode_image_params *p, oc_error *err) {
     return NULL;
   }
   double area = 0;
+  if (p->curve && p->segment) {
+    oc_seterr(err, OC_EINVAL, "image: give 'curve' or 'segment', not both");
+    goto fail;
+  }
   if (p->curve) {
     if (along_curve(d, p, &area, err)) goto fail;
   } else {
