@@ -1262,16 +1262,18 @@ oc_enode *oc_enode_blend(oc_enode *const *kids, size_t n, oc_error *err);
 oc_enode *oc_enode_replace(oc_enode *a, oc_enode *b, int lerp, oc_error *err);
 
 typedef struct oc_enode_add_params {
-  int sum_weight;    /* 1: alpha = alpha_A + w_B^2 (else alpha_A) */
-  int below;         /* 1: B only below an altitude of A: */
-  double below_z;    /* the weight is 1 where f_A <= below_z - fade, 0 where */
-  double fade;       /* f_A >= below_z, smooth between; fade > 0 */
-  int slope;         /* 1: B only where A is gentle: with theta = atan |D|, */
-  double slope_deg;  /* the weight is 1 where theta <= slope_deg (in [0, */
-  double slope_fade; /* 90)), 0 where theta >= slope_deg + slope_fade (> 0, */
-  double slope_step; /* degrees), smooth between; D = A's central */
-  /* differences of step slope_step (> 0; 0 means 5): (f_A(p + h e_x) -
-  ** f_A(p - h e_x), f_A(p + h e_y) - f_A(p - h e_y)) / 2h */
+  int sum_weight; /* 1: alpha = alpha_A + w_B^2 (else alpha_A) */
+  int below;      /* 1: B only below an altitude of A: */
+  double below_z; /* the weight is 1 where f_A <= below_z - fade, 0 where */
+  double fade;    /* f_A >= below_z, smooth between; fade > 0 */
+  /* slope = 1: B only where A is gentle. With theta = atan |D| (A's slope
+  ** angle over central differences of step h = slope_step: D = (f_A(p +
+  ** h e_x) - f_A(p - h e_x), f_A(p + h e_y) - f_A(p - h e_y)) / 2h), the
+  ** weight is 1 where theta <= slope_deg, 0 where theta >= slope_deg +
+  ** slope_fade, smooth between. Degrees: slope_deg in [0, 90), slope_fade
+  ** > 0; slope_step > 0 (0 means 5). */
+  int slope;
+  double slope_deg, slope_fade, slope_step;
 } oc_enode_add_params;
 /* w = clamp(alpha_B, 0, 1) (times the altitude and slope weights): f = f_A
 ** + w f_B. */

@@ -634,7 +634,7 @@ static int corners(const oc_enode_image_params *p, double P[4][2],
   return OC_OK;
 }
 
-#define MAX_CHORDS ((size_t)1 << 22)
+#define MAX_CHORDS ((size_t)1 << 20)
 
 /* The skeleton of an image along a curve, checked, flattened and its
 ** chords' tree built; its area in *area. 0 or an error naming the field. */
