@@ -74,6 +74,10 @@ typedef struct eimage {
   cbox *tree;
 } eimage;
 
+static const eimage *image_of(const oc_enode *n) {
+  return n->data;
+}
+
 static double cross(const double a[2], const double b[2]) {
   return a[0] * b[1] - a[1] * b[0];
 }
@@ -246,12 +250,12 @@ static void curve_ev(const eimage *d, double x, double y, int want,
 
 void oc_eimage_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                   int want, oc_enode_sample *s) {
-  (void)ft; /* no detail to filter */
-  const eimage *d = n->data;
-  if (d->cv) {
-    curve_ev(d, x, y, want, s);
+  if (image_of(n)->cv) {
+    curve_ev(image_of(n), x, y, want, s);
     return;
   }
+  (void)ft; /* no detail to filter */
+  const eimage *d = n->data;
   int grad = want & OC_EV_GRAD;
   double dk[4];
   int inside = 1;
@@ -504,12 +508,12 @@ static void curve_bound_in(const eimage *d, const oc_erect *b, oc_ebound *o) {
 
 void oc_eimage_bound_in(const oc_enode *n, const oc_erect *b,
                         const oc_efootb *fb, oc_ebound *o) {
-  (void)fb;
-  const eimage *d = n->data;
-  if (d->cv) {
-    curve_bound_in(d, b, o);
+  if (image_of(n)->cv) {
+    curve_bound_in(image_of(n), b, o);
     return;
   }
+  (void)fb;
+  const eimage *d = n->data;
   /* f: over the quad within r of b */
   double r = 0;
   for (int c = 0; c < 4; c++)

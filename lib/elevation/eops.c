@@ -31,15 +31,11 @@
 enum {
   /* replace: 1 with the lerped weight */
   P_LERP = 0,
-  /* add: sum weight, below, below_z, fade; the slope weight's angle and
-  ** fade (radians) and step (0: none) */
+  /* add: sum weight, below, below_z, fade */
   P_SUMW = 0,
   P_BELOW = 1,
   P_BZ = 2,
   P_FADE = 3,
-  P_SLOPE = 4,
-  P_SFADE = 5,
-  P_SSTEP = 6,
   /* transform: inverse 2x2 (row-major) and translation, then 1 / scale,
   ** vscale, voffset; p' = Minv (p - t) */
   P_MI = 0,
@@ -322,6 +318,10 @@ static double below_w(const double *par, double z, double *d) {
   return t * t * (3 - 2 * t);
 }
 
+/* add's par slots after P_FADE: the slope weight's angle and fade
+** (radians) and step (0: none) */
+enum { P_SLOPE = 4, P_SFADE = 5, P_SSTEP = 6 };
+
 /* The slope weight (Génevaux et al. 2015, section 5: an add weighted by
 ** the slope of A). A's slope is measured by central differences of f_A
 ** over the step h,
@@ -445,7 +445,7 @@ static void add_combine(const oc_enode *n, const oc_ebound *A,
     double wlo = clo, whi = fchi, lw = lc;
     if (below) {
       wlo = 0; /* the altitude weight may be 0 */
-      lw += 1.5 / n->par[P_FADE] * A->lf;
+      lw = lc + 1.5 / n->par[P_FADE] * A->lf;
     }
     if (slope) {
       double c0 = cos(th0);
@@ -467,16 +467,22 @@ static void add_combine(const oc_enode *n, const oc_ebound *A,
   }
 }
 
-/* Replace in box b: A's and (where its box meets b) B's bounds. */
-static void replace_bound_in(const oc_enode *n, const oc_erect *b,
-                             const oc_efootb *fb, oc_ebound *o) {
+/* Replace and add in box b: A's and (where its box meets b) B's bounds,
+** combined by the operator. */
+typedef void (*combine_fn)(const oc_enode *n, const oc_ebound *A,
+                           const oc_ebound *B, int bmeets, oc_ebound *o);
+static void binary_bound_in(const oc_enode *n, const oc_erect *b,
+                            const oc_efootb *fb, combine_fn combine,
+                            oc_ebound *o) {
   oc_ebound A, B;
   oc_enode_bnd(n->kids[0], b, fb, &A);
   int meets = oc_erect_meets(&n->kids[1]->box, b);
   if (meets) oc_enode_bnd(n->kids[1], b, fb, &B);
-  replace_combine(n, &A, &B, meets, o);
+  combine(n, &A, &B, meets, o);
 }
 
+/* Add in box b: as binary_bound_in, with A's slope over b grown by the
+** slope weight's step where that weight counts. */
 static void add_bound_in(const oc_enode *n, const oc_erect *b,
                          const oc_efootb *fb, oc_ebound *o) {
   oc_ebound A, B, G;
@@ -856,7 +862,7 @@ void oc_eop_bound_in(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
     blend_bound_in(n, b, fb, o);
     return;
   case OC_E_REPLACE:
-    replace_bound_in(n, b, fb, o);
+    binary_bound_in(n, b, fb, replace_combine, o);
     return;
   case OC_E_ADD:
     add_bound_in(n, b, fb, o);
