@@ -448,9 +448,14 @@ static void add_combine(const oc_enode *n, const oc_ebound *A,
       lw = lc + 1.5 / n->par[P_FADE] * A->lf;
     }
     if (slope) {
-      double c0 = cos(th0);
+      /* |D| <= sqrt(2) lah keeps t below tmax, where the smoothstep's
+      ** slope 6 t (1 - t) is at most its value at tmax if tmax < 1/2 */
+      double c0 = cos(th0), phi = n->par[P_SFADE];
+      double tmax = (atan(sqrt(2.0) * lah) - th0) / phi * (1 + 1e-9) + 1e-9;
+      tmax = fmax(tmax, 0);
+      double ss = tmax < 0.5 ? 6 * tmax * (1 - tmax) : 1.5;
       wlo = 0;
-      lw += 1.5 * c0 * c0 / n->par[P_SFADE] * sqrt(2.0) * lah / h * (1 + 1e-9);
+      lw += ss * c0 * c0 / phi * sqrt(2.0) * lah / h * (1 + 1e-9);
     }
     /* w f_B with w in [wlo, whi] */
     double p[4] = {wlo * B->flo, wlo * B->fhi, whi * B->flo, whi * B->fhi};
