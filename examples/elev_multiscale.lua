@@ -80,12 +80,16 @@ local function colour(x, y, z, nx, ny, nz)
   return r + (0.8 - r) * snow, g + (0.8 - g) * snow, b + (0.82 - b) * snow
 end
 
--- tracer = "sphere": the default segment tracer misses the ground on
--- a few dozen pixels of this view (white specks: rays that give up after
--- three steps), which plain sphere tracing does not.
+-- The default (segment) tracer. Against tracer = "sphere" at 640 x 360
+-- the hit masks differ on 28 of about 149 300 hits, all on the outline of
+-- the terrain's edge, and the depths on 61 pixels where a ray grazes a
+-- crest: each a sliver shorter than the pixel tolerance at its depth
+-- (150-220 m here), which one tracer samples and the other steps over,
+-- in both directions; the segment tracer takes 20 height calls per pixel
+-- where sphere tracing takes 114.
 local t = os.clock()
 local img = oc.render(scene, {
-  size = {w, h}, tracer = "sphere",
+  size = {w, h},
   camera = {eye = {-40000, -170000, 120000}, target = {0, -5000, 0}, fov = 50},
   sun = {direction = {-0.75, 0.45, 0.3}, intensity = 2.6},
   color = colour,

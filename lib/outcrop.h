@@ -1266,8 +1266,17 @@ typedef struct oc_enode_add_params {
   int below;      /* 1: B only below an altitude of A: */
   double below_z; /* the weight is 1 where f_A <= below_z - fade, 0 where */
   double fade;    /* f_A >= below_z, smooth between; fade > 0 */
+  /* slope = 1: B only where A is gentle. With theta = atan |D| (A's slope
+  ** angle over central differences of step h = slope_step: D = (f_A(p +
+  ** h e_x) - f_A(p - h e_x), f_A(p + h e_y) - f_A(p - h e_y)) / 2h), the
+  ** weight is 1 where theta <= slope_deg, 0 where theta >= slope_deg +
+  ** slope_fade, smooth between. Degrees: slope_deg in [0, 90), slope_fade
+  ** > 0; slope_step > 0 (0 means 5). */
+  int slope;
+  double slope_deg, slope_fade, slope_step;
 } oc_enode_add_params;
-/* w = clamp(alpha_B, 0, 1) (times the altitude weight): f = f_A + w f_B. */
+/* w = clamp(alpha_B, 0, 1) (times the altitude and slope weights): f = f_A
+** + w f_B. */
 oc_enode *oc_enode_add(oc_enode *a, oc_enode *b, const oc_enode_add_params *p,
                        oc_error *err);
 
@@ -1326,7 +1335,8 @@ oc_enode *oc_enode_lake(const oc_enode_lake_params *p, oc_error *err);
 ** heightfield mapped on a convex counter-clockwise quadrangle quad[0..3]
 ** (x, y pairs; corner k takes the grid's corner (0, 0), (1, 0), (1, 1),
 ** (0, 1) in turn) by inverse bilinear mapping, or along a segment (seg,
-** with width > 0: the rectangle whose axis it is, the grid's x along it).
+** with width > 0: the rectangle whose axis it is, the grid's x along it),
+** or along a curve (below).
 ** f = offset + height h(u, v) (the grid's C1 bicubic) inside, and the
 ** value at the closest point of the quad outside (so f is Lipschitz on
 ** the plane); alpha = clamp(weight(u, v), 0, 1) (1 without a weight grid)
@@ -1342,6 +1352,19 @@ typedef struct oc_enode_image_params {
   double height;  /* vertical scale (!= 0; 0 means 1) */
   double offset;
   double falloff; /* > 0; 0: a tenth of the square root of the area */
+  /* Along a curve (curve not NULL, with width): the skeleton through
+  ** ncurve points (x, y; z is ignored) as the curve primitive's, open and
+  ** without corners, width / 2 below its smallest radius of curvature.
+  ** With s the arc length of the closest point (0..length) and d the
+  ** signed distance (> 0 on the left), the grid's x goes along s and y
+  ** across, (u, v) = (s / length, (d + width / 2) / width) (so a straight
+  ** curve gives the segment's mapping); f outside the band is the value
+  ** at (s, clamped d); alpha is as on a quad with the edge distances s,
+  ** length - s and width / 2 -+ d. Its slope bounds hold where alpha >
+  ** 0, as a curve primitive's. */
+  const oc_vec3 *curve;
+  size_t ncurve;
+  oc_ecurve_spline spline;
 } oc_enode_image_params;
 oc_enode *oc_enode_image(const oc_enode_image_params *p, oc_error *err);
 

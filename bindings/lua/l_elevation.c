@@ -7,7 +7,8 @@
 **        octaves = 6, gain = 0.5, lacunarity = 2, seed = scene seed}}
 **   blend{e1, e2, ...}
 **   replace(a, b [, {weight = "a"|"lerp"}])             weight "a"
-**   add(a, b [, {weight = "a"|"sum", below =, fade = 10}])
+**   add(a, b [, {weight = "a"|"sum", below =, fade = 10, slope = degrees,
+**        slope_fade = 10, slope_step = 5}])
 **   warp(e, {amplitude =, wavelength =, octaves = 3, seed =})
 **   transform(e, {translate = {x, y}, rotate = degrees, scale = 1,
 **        vscale = 1, voffset = 0})
@@ -15,8 +16,10 @@
 **        ...}, level = 0, falloff = max r / 2, depth = 5, bank = 2,
 **        profile = {{d, v}, ...} | profiles = {{angle =, knots =}, ...}}
 **   image{heightfield = hf, weight = hf2, quad = {{x, y} x 4} |
-**        segment = {{x0, y0}, {x1, y1}}, width =, height = 1, offset = 0,
-**        falloff = sqrt(area) / 10}
+**        segment = {{x0, y0}, {x1, y1}}, width = | curve = {{x, y}, ...},
+**        spline = "catmull"|"bezier"|"linear", width =; height = 1,
+**        offset = 0, falloff = sqrt(area) / 10 (along a curve, at most a
+**        quarter of the width)}
 **   lod(a, b, {wavelength =, k0 = 0, k1 = 1})  (b without a view)
 **
 ** Methods: e:eval(x, y [, view]) -> f, alpha; e:gradient(x, y [, view])
@@ -363,20 +366,30 @@ static int l_replace(lua_State *L) {
 }
 
 static int l_add(lua_State *L) {
-  static const char *const known[] = {"weight", "below", "fade", NULL};
+  static const char *const known[] = {
+      "weight", "below", "fade", "slope", "slope_fade", "slope_step", NULL};
   static const char *const weights[] = {"a", "sum", NULL};
   const char *fname = "outcrop.elevation.add";
   oclua_fields f;
   oc_enode *a = oclua_checkenode(L, 1, fname, "argument #1");
   oc_enode *b = oclua_checkenode(L, 2, fname, "argument #2");
   options(L, &f, fname, 3,
-          "(a, b [, {weight = \"a\"|\"sum\", below =, fade =}])", known);
+          "(a, b [, {weight = \"a\"|\"sum\", below =, fade =, slope =, "
+          "slope_fade =, slope_step =}])",
+          known);
   oc_enode_add_params p = {0};
   p.sum_weight = oclua_field_optoption(&f, "weight", weights, 0);
   p.below = oclua_field_push(&f, "below") != LUA_TNIL;
   lua_pop(L, 1);
   if (p.below) p.below_z = oclua_field_number(&f, "below", OCLUA_FINITE);
   p.fade = oclua_field_optnumber(&f, "fade", OCLUA_POSITIVE, 10);
+  p.slope = oclua_field_push(&f, "slope") != LUA_TNIL;
+  lua_pop(L, 1);
+  /* the ranges (slope in [0, 90)) are checked by the library, which names
+  ** the field */
+  if (p.slope) p.slope_deg = oclua_field_number(&f, "slope", OCLUA_FINITE);
+  p.slope_fade = oclua_field_optnumber(&f, "slope_fade", OCLUA_POSITIVE, 10);
+  p.slope_step = oclua_field_optnumber(&f, "slope_step", OCLUA_POSITIVE, 5);
   oc_error err = {OC_OK, ""};
   oclua_enode *u = newenode(L);
   return setenode(L, u, oc_enode_add(a, b, &p, &err), &err, fname);
@@ -541,9 +554,9 @@ static int l_lake(lua_State *L) {
 }
 
 static int l_image(lua_State *L) {
-  static const char *const known[] = {"heightfield", "weight",  "quad",
-                                      "segment",     "width",   "height",
-                                      "offset",      "falloff", NULL};
+  static const char *const known[] = {
+      "heightfield", "weight", "quad",   "segment", "curve", "spline",
+      "width",       "height", "offset", "falloff", NULL};
   const char *fname = "outcrop.elevation.image";
   oclua_fields f;
   oclua_checkargs(L, 1, fname, "a table of named fields");
@@ -565,31 +578,47 @@ static int l_image(lua_State *L) {
   }
   int tq = oclua_field_push(&f, "quad"), iq = lua_gettop(L);
   int ts = oclua_field_push(&f, "segment"), is = lua_gettop(L);
-  if ((tq == LUA_TNIL) == (ts == LUA_TNIL))
+  int tc = oclua_field_push(&f, "curve"), ic = lua_gettop(L);
+  if ((tq != LUA_TNIL) + (ts != LUA_TNIL) + (tc != LUA_TNIL) != 1)
     oclua_error(L, fname,
-                "give either 'quad' = {{x, y} x 4} (convex, "
-                "counter-clockwise) or 'segment' = {{x0, y0}, "
-                "{x1, y1}} with 'width'");
+                "give one of 'quad' = {{x, y} x 4} (convex, "
+                "counter-clockwise), 'segment' = {{x0, y0}, {x1, y1}} with "
+                "'width', or 'curve' = {{x, y}, ...} with 'width'");
   size_t n;
   if (tq != LUA_TNIL) {
     const double *q = read_xy(L, iq, fname, "quad", 4, 4, &n);
     for (int k = 0; k < 8; k++)
       p.quad[k] = q[k];
     if (oclua_field_push(&f, "width") != LUA_TNIL)
-      oclua_error(L, fname, "'width' goes with 'segment', not 'quad'");
+      oclua_error(L, fname,
+                  "'width' goes with 'segment' or 'curve', not 'quad'");
     lua_pop(L, 1);
   } else {
-    const double *q = read_xy(L, is, fname, "segment", 2, 2, &n);
-    for (int k = 0; k < 4; k++)
-      p.seg[k] = q[k];
-    p.segment = 1;
+    if (ts != LUA_TNIL) {
+      const double *q = read_xy(L, is, fname, "segment", 2, 2, &n);
+      for (int k = 0; k < 4; k++)
+        p.seg[k] = q[k];
+      p.segment = 1;
+    } else {
+      const double *q = read_xy(L, ic, fname, "curve", 2, MAX_POINTS, &n);
+      oc_vec3 *c = lua_newuserdatauv(L, n * sizeof *c, 0);
+      for (size_t k = 0; k < n; k++)
+        c[k] = (oc_vec3){q[2 * k], q[2 * k + 1], 0};
+      p.curve = c;
+      p.ncurve = n;
+    }
     if (oclua_field_push(&f, "width") == LUA_TNIL)
       oclua_field_missing(&f, "width",
-                          "the rectangle's width across the "
-                          "segment");
+                          tc != LUA_TNIL ? "the band's width across the curve"
+                                         : "the rectangle's width across the "
+                                           "segment");
     lua_pop(L, 1);
     p.width = oclua_field_number(&f, "width", OCLUA_POSITIVE);
   }
+  if (oclua_field_push(&f, "spline") != LUA_TNIL && tc == LUA_TNIL)
+    oclua_error(L, fname, "'spline' goes with 'curve'");
+  lua_pop(L, 1);
+  p.spline = read_spline(&f);
   p.height = oclua_field_optnumber(&f, "height", OCLUA_NONZERO, 1);
   p.offset = oclua_field_optnumber(&f, "offset", OCLUA_FINITE, 0);
   p.falloff = oclua_field_optnumber(&f, "falloff", OCLUA_POSITIVE, 0);

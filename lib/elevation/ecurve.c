@@ -159,6 +159,36 @@ void oc_ecurve_bound_in(const oc_enode *n, const oc_erect *b,
   if (!oc_curve_closest(d->c, cx, cy, r, &pt)) o->alo = o->ahi = o->la = 0;
 }
 
+oc_pcurve *oc_ecurve_skeleton(const oc_vec3 *P, size_t m,
+                              oc_ecurve_spline spline, oc_error *err) {
+  if (spline != OC_ECURVE_CATMULL)
+    return oc_curve_from_points(P, m, spline == OC_ECURVE_BEZIER ? 3 : 1, err);
+  if (m < 2) {
+    oc_seterr(err, OC_EINVAL, "'points' must hold at least 2 points (got %zu)",
+              m);
+    return NULL;
+  }
+  oc_curve_piece *pc = malloc((m - 1) * sizeof *pc);
+  if (!pc) {
+    oc_seterr(err, OC_ENOMEM, "out of memory (%zu points)", m);
+    return NULL;
+  }
+  /* uniform Catmull-Rom through the points, as cubic Béziers; the ends
+  ** reflect their neighbour */
+  for (size_t i = 0; i + 1 < m; i++) {
+    oc_vec3 a = i > 0 ? P[i - 1] : oc_sub(oc_mul(P[0], 2), P[1]);
+    oc_vec3 e = i + 2 < m ? P[i + 2] : oc_sub(oc_mul(P[m - 1], 2), P[m - 2]);
+    pc[i].degree = 3;
+    pc[i].p[0] = P[i];
+    pc[i].p[1] = oc_add(P[i], oc_mul(oc_sub(P[i + 1], a), 1.0 / 6));
+    pc[i].p[2] = oc_sub(P[i + 1], oc_mul(oc_sub(e, P[i]), 1.0 / 6));
+    pc[i].p[3] = P[i + 1];
+  }
+  oc_pcurve *c = oc_curve_new(pc, m - 1, err);
+  free(pc);
+  return c;
+}
+
 oc_enode *oc_enode_curve(const oc_enode_curve_params *p, oc_error *err) {
   if (!p || !p->points) {
     oc_seterr(err, OC_EINVAL, "curve: no 'points'");
@@ -191,32 +221,7 @@ oc_enode *oc_enode_curve(const oc_enode_curve_params *p, oc_error *err) {
   }
   d->R = p->radius;
   d->core = p->core;
-  /* the skeleton */
-  if (p->spline == OC_ECURVE_CATMULL) {
-    size_t m = p->npoints;
-    oc_curve_piece *pc = malloc((m - 1) * sizeof *pc);
-    if (!pc) {
-      oc_seterr(err, OC_ENOMEM, "out of memory (%zu points)", m);
-      goto fail;
-    }
-    /* uniform Catmull-Rom through the points, as cubic Béziers; the
-    ** ends reflect their neighbour */
-    const oc_vec3 *P = p->points;
-    for (size_t i = 0; i + 1 < m; i++) {
-      oc_vec3 a = i > 0 ? P[i - 1] : oc_sub(oc_mul(P[0], 2), P[1]);
-      oc_vec3 e = i + 2 < m ? P[i + 2] : oc_sub(oc_mul(P[m - 1], 2), P[m - 2]);
-      pc[i].degree = 3;
-      pc[i].p[0] = P[i];
-      pc[i].p[1] = oc_add(P[i], oc_mul(oc_sub(P[i + 1], a), 1.0 / 6));
-      pc[i].p[2] = oc_sub(P[i + 1], oc_mul(oc_sub(e, P[i]), 1.0 / 6));
-      pc[i].p[3] = P[i + 1];
-    }
-    d->c = oc_curve_new(pc, m - 1, err);
-    free(pc);
-  } else {
-    d->c = oc_curve_from_points(p->points, p->npoints,
-                                p->spline == OC_ECURVE_BEZIER ? 3 : 1, err);
-  }
+  d->c = oc_ecurve_skeleton(p->points, p->npoints, p->spline, err);
   if (!d->c) goto fail;
   double kap = oc_curve_kappa_max(d->c), turn = oc_curve_max_turn(d->c);
   if (turn > 1e-6) {

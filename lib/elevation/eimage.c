@@ -28,10 +28,22 @@
 ** level lines, so their extremes over that convex polygon are at its
 ** vertices; the grid's pyramid gives h's range and slope over the (u, v)
 ** range mapped to it.
+**
+** Along a curve (the shared skeleton of core/curve.h: closest point, arc
+** length s, curvature), (u, v) = (s / L, (d + w/2) / w), d the signed
+** distance, w the width. grad s = t / (1 - kappa d) and grad d = n, so in
+** the band |d| <= w/2 (w/2 kappa_max < 1, checked) |grad f| <= height
+** |grad h| max(W / (L (1 - kappa_max w/2)), H / w). In a box of centre c
+** and half-diagonal rho, every point's closest point of the skeleton lies
+** within dist(c) + 2 rho of c, so its s lies in the spans of the
+** flattened skeleton (within tol of their chords, a box tree over them)
+** that come that close: u's range, and the grid's over it.
 */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 
+#include "core/curve.h"
 #include "core/error.h"
 #include "core/falloff.h"
 #include "elevation/enode.h"
@@ -41,13 +53,30 @@ typedef struct grid {
   double x0, y0, W, H;
 } grid;
 
+/* A box of the chords' tree. */
+typedef struct cbox {
+  double x0, y0, x1, y1;
+} cbox;
+
 typedef struct eimage {
   grid h, w;
   double P[4][2];
   double e[2], f[2], g[2];
   double nrm[4][2], c[4]; /* inward unit normals: d_k = nrm_k . p - c_k */
   double vs, off, F;
+  /* along a curve (cv not NULL): its length, half width, curvature
+  ** bound, and the flattened skeleton (nfl vertices within tol) with a
+  ** box tree over its chords (heap order, leaves from m) */
+  oc_pcurve *cv;
+  double L, hw, kap, tol;
+  oc_curve_vertex *fl;
+  size_t nfl, m;
+  cbox *tree;
 } eimage;
+
+static const eimage *image_of(const oc_enode *n) {
+  return n->data;
+}
 
 static double cross(const double a[2], const double b[2]) {
   return a[0] * b[1] - a[1] * b[0];
@@ -58,6 +87,9 @@ void oc_eimage_free(void *data) {
   if (!d) return;
   if (d->h.src.release) d->h.src.release(d->h.src.ud);
   if (d->w.src.release) d->w.src.release(d->w.src.ud);
+  oc_curve_free(d->cv);
+  free(d->fl);
+  free(d->tree);
   free(d);
 }
 
@@ -132,8 +164,96 @@ static double ramp(double x, double *dg) {
   return 1 - oc_falloff(x);
 }
 
+/* alpha = clamp(w(u, v), 0, 1) prod_k G(e_k / F), from the four edge
+** coordinates e_k (distances inside) and their gradients (ex_k, ey_k),
+** with grad u = gu and grad v = gv for the weight grid's chain rule. */
+static void edge_alpha(const eimage *d, const double e[4], const double ex[4],
+                       const double ey[4], double u, double v,
+                       const double gu[2], const double gv[2], int grad,
+                       oc_enode_sample *s) {
+  double G[4], dG[4], ab = 1;
+  for (int k = 0; k < 4; k++) {
+    G[k] = ramp(e[k] / d->F, &dG[k]);
+    ab *= G[k];
+  }
+  double w = 1, wx = 0, wy = 0;
+  if (ab > 0 && d->w.src.ud) { /* (alpha = 0 whatever w is) */
+    double wu, wv;
+    w = grid_at(&d->w, u, v, grad, &wu, &wv);
+    if (w <= 0) {
+      w = 0;
+    } else if (w >= 1) {
+      w = 1;
+    } else {
+      wx = wu * gu[0] + wv * gv[0];
+      wy = wu * gu[1] + wv * gv[1];
+    }
+  }
+  s->a = w * ab;
+  if (grad && s->a != 0) {
+    double bx = 0, by = 0;
+    for (int k = 0; k < 4; k++) {
+      double o = dG[k] / d->F;
+      for (int j = 0; j < 4; j++)
+        if (j != k) o *= G[j];
+      bx += o * ex[k];
+      by += o * ey[k];
+    }
+    s->ax = ab * wx + w * bx;
+    s->ay = ab * wy + w * by;
+  }
+}
+
+/* Along a curve: (u, v) from the closest point, grad u and grad v. */
+static void curve_ev(const eimage *d, double x, double y, int want,
+                     oc_enode_sample *s) {
+  int grad = want & OC_EV_GRAD, lazy = want & (OC_EV_LAZY | OC_EV_ALPHA);
+  oc_curve_point pt;
+  s->f = s->a = s->ax = s->ay = s->fx = s->fy = 0;
+  /* alpha = 0 farther than w/2: a lazy caller needs only the band */
+  if (!oc_curve_closest(d->cv, x, y, lazy ? d->hw : INFINITY, &pt)) {
+    if (!lazy) s->f = s->a = NAN;
+    return;
+  }
+  /* beyond an end: the offset along the end's normal, s constant */
+  double dl = pt.end ? (x - pt.q.x) * pt.nx + (y - pt.q.y) * pt.ny : pt.d;
+  double gsx = 0, gsy = 0;
+  if (grad && !pt.end) {
+    double den = 1 - oc_curve_curvature_at(d->cv, &pt) * dl;
+    if (den > 0) {
+      gsx = pt.tx / den;
+      gsy = pt.ty / den;
+    }
+  }
+  double u = pt.s / d->L, v = (dl + d->hw) / (2 * d->hw);
+  int vin = v > 0 && v < 1;
+  u = u < 0 ? 0 : u > 1 ? 1 : u;
+  v = v < 0 ? 0 : v > 1 ? 1 : v;
+  double gux = gsx / d->L, guy = gsy / d->L;
+  double gvx = vin ? pt.nx / (2 * d->hw) : 0,
+         gvy = vin ? pt.ny / (2 * d->hw) : 0;
+  /* alpha: the ramps of the four edge coordinates s, L - s, w/2 - d and
+  ** w/2 + d (0 at an end, where s is 0 or L) */
+  double ec[4] = {pt.s, d->L - pt.s, d->hw - dl, d->hw + dl};
+  double egx[4] = {gsx, -gsx, -pt.nx, pt.nx},
+         egy[4] = {gsy, -gsy, -pt.ny, pt.ny};
+  double gu[2] = {gux, guy}, gv[2] = {gvx, gvy};
+  edge_alpha(d, ec, egx, egy, u, v, gu, gv, grad, s);
+  if (want & OC_EV_ALPHA || (lazy && s->a == 0)) return;
+  double fu, fv;
+  s->f = d->off + d->vs * grid_at(&d->h, u, v, grad, &fu, &fv);
+  if (grad) {
+    s->fx = d->vs * (fu * gux + fv * gvx);
+    s->fy = d->vs * (fu * guy + fv * gvy);
+  }
+}
+
 void oc_eimage_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                   int want, oc_enode_sample *s) {
+  if (image_of(n)->cv) {
+    curve_ev(image_of(n), x, y, want, s);
+    return;
+  }
   (void)ft; /* no detail to filter */
   const eimage *d = n->data;
   int grad = want & OC_EV_GRAD;
@@ -195,40 +315,23 @@ void oc_eimage_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
   }
   if (!inside) return;
   /* alpha */
-  double G[4], dG[4], ab = 1;
-  for (int k = 0; k < 4; k++) {
-    G[k] = ramp(dk[k] / d->F, &dG[k]);
-    ab *= G[k];
-  }
-  double w = 1, wx = 0, wy = 0;
-  if (d->w.src.ud) {
-    double wu, wv;
-    w = grid_at(&d->w, u, v, grad, &wu, &wv);
-    if (w <= 0) {
-      w = 0;
-    } else if (w >= 1) {
-      w = 1;
-    } else {
-      wx = wu * gux + wv * gvx;
-      wy = wu * guy + wv * gvy;
-    }
-  }
-  s->a = w * ab;
-  if (grad && s->a != 0) {
-    double bx = 0, by = 0;
-    for (int k = 0; k < 4; k++) {
-      double o = dG[k] / d->F;
-      for (int j = 0; j < 4; j++)
-        if (j != k) o *= G[j];
-      bx += o * d->nrm[k][0];
-      by += o * d->nrm[k][1];
-    }
-    s->ax = ab * wx + w * bx;
-    s->ay = ab * wy + w * by;
-  }
+  double ex[4], ey[4], gu[2] = {gux, guy}, gv[2] = {gvx, gvy};
+  for (int k = 0; k < 4; k++)
+    ex[k] = d->nrm[k][0], ey[k] = d->nrm[k][1];
+  edge_alpha(d, dk, ex, ey, u, v, gu, gv, grad, s);
 }
 
 /* ---- bounds ------------------------------------------------------------ */
+
+/* The squared distance from (x, y) to the segment A B. */
+static double seg_dist2(const double A[2], const double B[2], double x,
+                        double y) {
+  double E[2] = {B[0] - A[0], B[1] - A[1]}, L2 = E[0] * E[0] + E[1] * E[1];
+  double t = L2 > 0 ? ((x - A[0]) * E[0] + (y - A[1]) * E[1]) / L2 : 0;
+  t = t < 0 ? 0 : t > 1 ? 1 : t;
+  double qx = A[0] + t * E[0] - x, qy = A[1] + t * E[1] - y;
+  return qx * qx + qy * qy;
+}
 
 static double dist_to_quad(const eimage *d, double x, double y) {
   int inside = 1;
@@ -295,15 +398,21 @@ static int uv_range(const eimage *d, const oc_erect *r, double uv[4]) {
   return 1;
 }
 
-/* Range and slope bound of a grid over the (u, v) rectangle, as a function
-** of p: the slope through |K^-1|. */
-static void grid_bound(const eimage *d, const grid *G, const double uv[4],
-                       double *lo, double *hi, double *lip) {
+/* Range of a grid over the (u, v) rectangle, and its slope bound there in
+** the grid's units. */
+static double grid_range(const grid *G, const double uv[4], double *lo,
+                         double *hi) {
   const oc_elevation *s = &G->src;
   double X0 = G->x0 + uv[0] * G->W, X1 = G->x0 + uv[2] * G->W;
   double Y0 = G->y0 + uv[1] * G->H, Y1 = G->y0 + uv[3] * G->H;
   s->range(s->ud, X0, Y0, X1, Y1, lo, hi);
-  double gs = s->slope(s->ud, X0, Y0, X1, Y1);
+  return s->slope(s->ud, X0, Y0, X1, Y1);
+}
+
+/* The same, the slope as a function of p: through |K^-1|. */
+static void grid_bound(const eimage *d, const grid *G, const double uv[4],
+                       double *lo, double *hi, double *lip) {
+  double gs = grid_range(G, uv, lo, hi);
   double detmin = INFINITY, Lu = 0, Lv = 0;
   for (int c = 0; c < 4; c++) {
     double u = uv[c & 1 ? 2 : 0], v = uv[c & 2 ? 3 : 1];
@@ -317,8 +426,92 @@ static void grid_bound(const eimage *d, const grid *G, const double uv[4],
   *lip = gs * hypot(Lu * G->H, Lv * G->W) / detmin * (1 + 1e-9);
 }
 
+/* The arc lengths [*s0, *s1] of the skeleton's spans whose chord comes
+** within r of (x, y): node k of the chords' tree holds chords [i, i +
+** len). Spans already inside [*s0, *s1] are skipped. */
+static void spans_near(const eimage *d, size_t k, size_t i, size_t len,
+                       double x, double y, double r, double *s0, double *s1) {
+  size_t nc = d->nfl - 1;
+  if (i >= nc) return;
+  const cbox *b = &d->tree[k];
+  double dx = fmax(fmax(b->x0 - x, x - b->x1), 0);
+  double dy = fmax(fmax(b->y0 - y, y - b->y1), 0);
+  if (dx * dx + dy * dy > r * r) return;
+  size_t j = i + len < nc ? i + len : nc;
+  if (d->fl[i].s >= *s0 && d->fl[j].s <= *s1) return;
+  if (len == 1) {
+    double A[2] = {d->fl[i].x, d->fl[i].y},
+           B[2] = {d->fl[i + 1].x, d->fl[i + 1].y};
+    if (seg_dist2(A, B, x, y) <= r * r) {
+      *s0 = fmin(*s0, d->fl[i].s);
+      *s1 = fmax(*s1, d->fl[i + 1].s);
+    }
+    return;
+  }
+  spans_near(d, 2 * k, i, len / 2, x, y, r, s0, s1);
+  spans_near(d, 2 * k + 1, i + len / 2, len / 2, x, y, r, s0, s1);
+}
+
+/* |grad s| in the band, bounded. */
+static double band_ds(const eimage *d) {
+  return 1 / (1 - d->kap * d->hw);
+}
+
+static void curve_bound_in(const eimage *d, const oc_erect *b, oc_ebound *o) {
+  double cx = 0.5 * (b->x0 + b->x1), cy = 0.5 * (b->y0 + b->y1);
+  double rho = 0.5 * hypot(b->x1 - b->x0, b->y1 - b->y0);
+  oc_curve_point pt;
+  double dc = INFINITY, s0 = 0, s1 = d->L;
+  if (oc_curve_closest(d->cv, cx, cy, INFINITY, &pt)) {
+    dc = hypot(cx - pt.q.x, cy - pt.q.y);
+    /* every point of b has its closest point within dc + 2 rho of c,
+    ** within tol of a chord of its span (and a hair for rounding) */
+    double r = (dc + 2 * rho) * (1 + 1e-12) + d->tol +
+               1e-12 * (d->L + fabs(cx) + fabs(cy));
+    s0 = INFINITY, s1 = -INFINITY;
+    spans_near(d, 1, 0, d->m, cx, cy, r, &s0, &s1);
+    if (!(s0 <= s1)) s0 = 0, s1 = d->L; /* (rounding: all of it) */
+  }
+  double pad = 1e-9;
+  double uv[4] = {fmax(0, s0 / d->L - pad), 0, fmin(1, s1 / d->L + pad), 1};
+  double lo, hi, ds = band_ds(d);
+  double gs = grid_range(&d->h, uv, &lo, &hi);
+  double a = d->off + d->vs * lo, z = d->off + d->vs * hi;
+  double m = 1e-12 * (1 + fabs(a) + fabs(z));
+  o->flo = fmin(a, z) - m;
+  o->fhi = fmax(a, z) + m;
+  o->lf = fabs(d->vs) * gs * fmax(d->h.W * ds / d->L, d->h.H / (2 * d->hw)) *
+          (1 + 1e-9);
+  /* alpha: 0 unless b comes within w/2 of the skeleton (|d| <= dc + rho
+  ** on b) */
+  o->alo = o->ahi = o->la = 0;
+  if (!(dc - rho < d->hw)) return;
+  double wlo = 1, whi = 1, lw = 0;
+  if (d->w.src.ud) {
+    double wg = grid_range(&d->w, uv, &wlo, &whi);
+    lw = wg * fmax(d->w.W * ds / d->L, d->w.H / (2 * d->hw));
+    whi = fmin(fmax(whi, 0), 1);
+  }
+  /* the ramps rise with their edge coordinate: s in [s0, s1], L - s in
+  ** [L - s1, L - s0], w/2 -+ d in [w/2 - dh, w/2 + dh], dh = min(w/2,
+  ** dc + rho) */
+  double F = d->F, dh = fmin(d->hw, dc + rho), dg;
+  double bhi = ramp(s1 / F, &dg) * ramp((d->L - s0) / F, &dg) *
+               ramp((d->hw - fmax(0, dc - rho)) / F, &dg);
+  double lb = (oc_falloff_slope_in(s0 / F, s1 / F) +
+               oc_falloff_slope_in((d->L - s1) / F, (d->L - s0) / F)) *
+                  ds / F +
+              2 * oc_falloff_slope_in((d->hw - dh) / F, (d->hw + dh) / F) / F;
+  o->ahi = fmin(1, whi * bhi * (1 + 1e-12));
+  o->la = (bhi * lw + whi * lb) * (1 + 1e-9);
+}
+
 void oc_eimage_bound_in(const oc_enode *n, const oc_erect *b,
                         const oc_efootb *fb, oc_ebound *o) {
+  if (image_of(n)->cv) {
+    curve_bound_in(image_of(n), b, o);
+    return;
+  }
   (void)fb;
   const eimage *d = n->data;
   /* f: over the quad within r of b */
@@ -445,6 +638,81 @@ static int corners(const oc_enode_image_params *p, double P[4][2],
   return OC_OK;
 }
 
+#define MAX_CHORDS ((size_t)1 << 20)
+
+/* The skeleton of an image along a curve, checked, flattened and its
+** chords' tree built; its area in *area. 0 or an error naming the field. */
+static int along_curve(eimage *d, const oc_enode_image_params *p, double *area,
+                       oc_error *err) {
+  if (!(isfinite(p->width) && p->width > 0))
+    return oc_seterr(err, OC_EINVAL,
+                     "'width' must be a positive number (got %g)", p->width);
+  if (p->ncurve < 2)
+    return oc_seterr(err, OC_EINVAL,
+                     "'curve' must hold at least 2 points (got %zu)",
+                     p->ncurve);
+  if ((unsigned)p->spline > OC_ECURVE_LINEAR)
+    return oc_seterr(err, OC_EINVAL, "image: unknown 'spline'");
+  if (!(d->cv = oc_ecurve_skeleton(p->curve, p->ncurve, p->spline, err))) {
+    char m[sizeof err->msg];
+    snprintf(m, sizeof m, "%s", err->msg);
+    return oc_seterr(err, err->code, "'curve': %s", m);
+  }
+  if (oc_curve_closed(d->cv))
+    return oc_seterr(err, OC_EINVAL,
+                     "'curve' must be open (its ends meet: the grid's x "
+                     "would jump there)");
+  double turn = oc_curve_max_turn(d->cv);
+  if (turn > 1e-6)
+    return oc_seterr(err, OC_EINVAL,
+                     "'curve' has a corner of %g degrees, where the closest "
+                     "point jumps: use spline = \"catmull\" (the default) "
+                     "or smooth Bézier joins",
+                     turn * 180 / 3.14159265358979323846);
+  d->hw = p->width / 2;
+  d->kap = oc_curve_kappa_max(d->cv);
+  if (!(d->kap * d->hw < 1))
+    return oc_seterr(err, OC_EINVAL,
+                     "'width' %g: its half is not below the curve's smallest "
+                     "radius of curvature %g, so the cross-sections would "
+                     "overlap (space the points out or lower 'width')",
+                     p->width, 1 / d->kap);
+  d->L = oc_curve_length(d->cv);
+  d->tol = fmax(fmin(d->hw, d->L) / 16, 2e-9 * d->L);
+  size_t nv;
+  if (oc_curve_flatten(d->cv, d->tol, NULL, 0, &nv, err)) return err->code;
+  if (nv < 2 || nv - 1 > MAX_CHORDS)
+    return oc_seterr(err, OC_EINVAL,
+                     "'curve': %zu chords to bound it within %g, at most %zu "
+                     "(a curve too long for its width)",
+                     nv - 1, d->tol, MAX_CHORDS);
+  if (!(d->fl = malloc(nv * sizeof *d->fl)))
+    return oc_seterr(err, OC_ENOMEM, "out of memory (%zu vertices)", nv);
+  if (oc_curve_flatten(d->cv, d->tol, d->fl, nv, &d->nfl, err))
+    return err->code;
+  size_t nc = d->nfl - 1;
+  for (d->m = 1; d->m < nc; d->m *= 2)
+    ;
+  if (!(d->tree = malloc(2 * d->m * sizeof *d->tree)))
+    return oc_seterr(err, OC_ENOMEM, "out of memory (%zu chords)", nc);
+  for (size_t i = 0; i < d->m; i++) {
+    cbox *b = &d->tree[d->m + i];
+    *b = (cbox){INFINITY, INFINITY, -INFINITY, -INFINITY};
+    if (i < nc) {
+      const oc_curve_vertex *A = &d->fl[i], *B = &d->fl[i + 1];
+      *b = (cbox){fmin(A->x, B->x), fmin(A->y, B->y), fmax(A->x, B->x),
+                  fmax(A->y, B->y)};
+    }
+  }
+  for (size_t k = d->m - 1; k >= 1; k--) {
+    const cbox *l = &d->tree[2 * k], *r = &d->tree[2 * k + 1];
+    d->tree[k] = (cbox){fmin(l->x0, r->x0), fmin(l->y0, r->y0),
+                        fmax(l->x1, r->x1), fmax(l->y1, r->y1)};
+  }
+  *area = d->L * p->width;
+  return OC_OK;
+}
+
 oc_enode *oc_enode_image(const oc_enode_image_params *p, oc_error *err) {
   if (!p || !p->heightfield) {
     oc_seterr(err, OC_EINVAL, "image: no 'heightfield'");
@@ -471,31 +739,47 @@ oc_enode *oc_enode_image(const oc_enode_image_params *p, oc_error *err) {
     oc_seterr(err, OC_ENOMEM, "out of memory");
     return NULL;
   }
-  if (corners(p, d->P, err)) goto fail;
-  for (int k = 0; k < 2; k++) {
-    d->e[k] = d->P[1][k] - d->P[0][k];
-    d->f[k] = d->P[3][k] - d->P[0][k];
-    d->g[k] = d->P[0][k] - d->P[1][k] + d->P[2][k] - d->P[3][k];
-  }
   double area = 0;
-  for (int k = 0; k < 4; k++) {
-    const double *A = d->P[k], *B = d->P[(k + 1) & 3];
-    double ex = B[0] - A[0], ey = B[1] - A[1], L = hypot(ex, ey);
-    d->nrm[k][0] = -ey / L; /* left of a counter-clockwise edge: inward */
-    d->nrm[k][1] = ex / L;
-    d->c[k] = d->nrm[k][0] * A[0] + d->nrm[k][1] * A[1];
-    area += cross(A, B) / 2;
+  if (p->curve && p->segment) {
+    oc_seterr(err, OC_EINVAL, "image: give 'curve' or 'segment', not both");
+    goto fail;
+  }
+  if (p->curve) {
+    if (along_curve(d, p, &area, err)) goto fail;
+  } else {
+    if (corners(p, d->P, err)) goto fail;
+    for (int k = 0; k < 2; k++) {
+      d->e[k] = d->P[1][k] - d->P[0][k];
+      d->f[k] = d->P[3][k] - d->P[0][k];
+      d->g[k] = d->P[0][k] - d->P[1][k] + d->P[2][k] - d->P[3][k];
+    }
+    for (int k = 0; k < 4; k++) {
+      const double *A = d->P[k], *B = d->P[(k + 1) & 3];
+      double ex = B[0] - A[0], ey = B[1] - A[1], L = hypot(ex, ey);
+      d->nrm[k][0] = -ey / L; /* left of a counter-clockwise edge: inward */
+      d->nrm[k][1] = ex / L;
+      d->c[k] = d->nrm[k][0] * A[0] + d->nrm[k][1] * A[1];
+      area += cross(A, B) / 2;
+    }
   }
   d->vs = vs;
   d->off = p->offset;
-  d->F = p->falloff > 0 ? p->falloff : sqrt(area) / 10;
+  /* (along a curve, also at most a quarter of the width: the side ramps
+  ** reach 1) */
+  d->F = p->falloff > 0 ? p->falloff
+         : d->cv        ? fmin(sqrt(area) / 10, d->hw / 2)
+                        : sqrt(area) / 10;
   if (take_grid(p->heightfield, &d->h, err)) goto fail;
   if (p->weight && take_grid(p->weight, &d->w, err)) goto fail;
   oc_enode *n = oc_enode_alloc(OC_E_IMAGE, NULL, 0, err);
   if (!n) goto fail;
   n->data = d;
   n->box = (oc_erect){INFINITY, INFINITY, -INFINITY, -INFINITY};
-  for (int k = 0; k < 4; k++) {
+  if (d->cv) {
+    oc_aabb bx = oc_curve_bounds(d->cv, d->hw);
+    n->box = (oc_erect){bx.lo.x, bx.lo.y, bx.hi.x, bx.hi.y};
+  }
+  for (int k = 0; k < 4 && !d->cv; k++) {
     n->box.x0 = fmin(n->box.x0, d->P[k][0]);
     n->box.y0 = fmin(n->box.y0, d->P[k][1]);
     n->box.x1 = fmax(n->box.x1, d->P[k][0]);

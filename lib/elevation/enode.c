@@ -22,7 +22,7 @@ static const char *const kind_names[OC_E_COUNT] = {
 ** kind not listed: OC_ENODE_NPAR. */
 static const unsigned char par_counts[OC_E_COUNT] = {
     [OC_E_DISC] = 1 + 4,    [OC_E_CURVE] = 1 + 2, [OC_E_BLEND] = 1 + 0,
-    [OC_E_REPLACE] = 1 + 1, [OC_E_ADD] = 1 + 4,   [OC_E_XFORM] = 1 + 11,
+    [OC_E_REPLACE] = 1 + 1, [OC_E_ADD] = 1 + 7,   [OC_E_XFORM] = 1 + 11,
     [OC_E_WARP] = 1 + 2,    [OC_E_LOD] = 1 + 3};
 
 static size_t par_count(oc_ekind kind) {

@@ -111,6 +111,11 @@ void oc_ecurve_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
 void oc_ecurve_bound_in(const oc_enode *n, const oc_erect *b,
                         const oc_efootb *fb, oc_ebound *o);
 void oc_ecurve_free(void *data);
+/* The skeleton through points (z carried along) as the curve primitive
+** builds it (ecurve.c): a uniform Catmull-Rom spline, cubic Bézier
+** control points or segments. The caller frees it (oc_curve_free). */
+struct oc_pcurve *oc_ecurve_skeleton(const oc_vec3 *points, size_t n,
+                                     oc_ecurve_spline spline, oc_error *err);
 /* lake.c and eimage.c: the contour and image primitives (state in data). */
 void oc_elake_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                  int want, oc_enode_sample *s);

@@ -10,7 +10,9 @@
 **           (n - 1) times the largest for n; where sum alpha may be < T,
 **           also at most max lambda_i + sum lambda_alpha_i sup|f_i| / T;
 **  replace  lambda <= max(lambda_A, lambda_B) + lambda_alphaB sup|f_A - f_B|;
-**  add      lambda <= lambda_A + lambda_w sup|f_B| + sup w lambda_B;
+**  add      lambda <= lambda_A + lambda_w sup|f_B| + sup w lambda_B, w the
+**           clamped weight times the altitude and slope weights (their
+**           Lipschitz bounds added: each factor lies in [0, 1]);
 **  warp     lambda_A (1 + lambda_delta);
 **  transform |vscale| lambda_A / scale.
 */
@@ -316,6 +318,57 @@ static double below_w(const double *par, double z, double *d) {
   return t * t * (3 - 2 * t);
 }
 
+/* add's par slots after P_FADE: the slope weight's angle and fade
+** (radians) and step (0: none) */
+enum { P_SLOPE = 4, P_SFADE = 5, P_SSTEP = 6 };
+
+/* The slope weight (Génevaux et al. 2015, section 5: an add weighted by
+** the slope of A). A's slope is measured by central differences of f_A
+** over the step h,
+**
+**   D = (f_A(p + h e_x) - f_A(p - h e_x), f_A(p + h e_y) - f_A(p - h e_y))
+**       / (2 h),   theta = atan |D|,
+**
+** and the weight is 1 where theta <= theta0, 0 where theta >= theta0 +
+** phi, 1 - smoothstep((theta - theta0) / phi) between. Measured so, the
+** weight is a C1 function of the values of f_A at four points, whose
+** exact gradient needs only the gradients of f_A there (no second
+** derivatives), and whose slope is bounded by A's own bounds: each
+** component of D is lambda_A / h Lipschitz (lambda_A over the box grown by
+** h), so |D| is sqrt(2) lambda_A / h Lipschitz, and |dW/d|D|| <= 1.5 / phi
+** cos^2 theta0 (the smoothstep's slope 1.5 / phi times atan' = 1 / (1 +
+** |D|^2), which is below cos^2 theta0 wherever the weight is not 1). As h
+** goes to 0, theta is the slope angle of A. The gradient of W in *wx,
+** *wy (want: OC_EV_GRAD or 0). */
+static double slope_w(const oc_enode *n, const oc_enode *A, double x, double y,
+                      const oc_efoot *ft, int want, double *wx, double *wy) {
+  double h = n->par[P_SSTEP];
+  oc_enode_sample e, w, no, so;
+  /* every f is needed, also where alpha_A = 0: no OC_EV_LAZY; the
+  ** footprint is p's, so each term is a function of p whose gradient the
+  ** child includes */
+  oc_enode_ev(A, x + h, y, ft, want, &e);
+  oc_enode_ev(A, x - h, y, ft, want, &w);
+  oc_enode_ev(A, x, y + h, ft, want, &no);
+  oc_enode_ev(A, x, y - h, ft, want, &so);
+  double dx = (e.f - w.f) / (2 * h), dy = (no.f - so.f) / (2 * h);
+  double s2 = dx * dx + dy * dy, s = sqrt(s2);
+  double t = (atan(s) - n->par[P_SLOPE]) / n->par[P_SFADE];
+  *wx = *wy = 0;
+  if (!(t > 0)) return t == t ? 1 : NAN;
+  if (t >= 1) return 0;
+  if (want & OC_EV_GRAD) {
+    /* dW/ds / s, then grad s = (dx grad dx + dy grad dy) / s */
+    double k = -6 * t * (1 - t) / n->par[P_SFADE] / (1 + s2) / s;
+    double i2h = 1 / (2 * h);
+    double xx = (e.fx - w.fx) * i2h, xy = (e.fy - w.fy) * i2h;
+    double yx = (no.fx - so.fx) * i2h, yy = (no.fy - so.fy) * i2h;
+    *wx = k * (dx * xx + dy * yx);
+    *wy = k * (dx * xy + dy * yy);
+  }
+  return 1 - t * t * (3 - 2 * t);
+}
+
 static void add_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                    int want, oc_enode_sample *s) {
   int grad = want & OC_EV_GRAD, in;
@@ -352,6 +405,14 @@ static void add_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
     wx = cx * W + c * dW * a.fx;
     wy = cy * W + c * dW * a.fy;
   }
+  /* where w = 0 its gradient is 0 too (c and the altitude weight reach
+  ** 0 with slope 0): the slope weight is not needed there */
+  if (n->par[P_SSTEP] != 0 && w != 0) {
+    double Sx, Sy, S = slope_w(n, A, x, y, ft, grad, &Sx, &Sy);
+    wx = wx * S + w * Sx;
+    wy = wy * S + w * Sy;
+    w *= S;
+  }
   s->f = a.f + w * b.f;
   s->fx = a.fx + wx * b.f + w * b.fx;
   s->fy = a.fy + wy * b.f + w * b.fy;
@@ -361,8 +422,11 @@ static void add_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
   if (!grad) s->fx = s->fy = s->ax = s->ay = 0;
 }
 
+/* lah: A's Lipschitz bound over the region grown by the slope step (for
+** the slope weight; unused without it). */
 static void add_combine(const oc_enode *n, const oc_ebound *A,
-                        const oc_ebound *B, int bmeets, oc_ebound *o) {
+                        const oc_ebound *B, int bmeets, double lah,
+                        oc_ebound *o) {
   double clo = bmeets ? fmin(fmax(B->alo, 0), 1) : 0;
   double chi = bmeets ? fmin(fmax(B->ahi, 0), 1) : 0;
   double lc = bmeets ? B->la : 0;
@@ -373,11 +437,25 @@ static void add_combine(const oc_enode *n, const oc_ebound *A,
   double bz = n->par[P_BZ], fade = n->par[P_FADE], fchi = chi;
   if (below && A->flo >= bz) fchi = 0;
   if (below && A->fhi < bz - fade * (1 + 1e-9) - 1e-9 * fabs(bz)) below = 0;
+  /* the slope weight is 1 on the region where |D| <= sqrt(2) lah stays
+  ** below tan theta0 (with a hair for the rounding of D and atan) */
+  double h = n->par[P_SSTEP], th0 = n->par[P_SLOPE];
+  int slope = h != 0 && !(sqrt(2.0) * lah * (1 + 1e-9) < tan(th0) * (1 - 1e-9));
   if (fchi > 0) {
     double wlo = clo, whi = fchi, lw = lc;
     if (below) {
       wlo = 0; /* the altitude weight may be 0 */
       lw = lc + 1.5 / n->par[P_FADE] * A->lf;
+    }
+    if (slope) {
+      /* |D| <= sqrt(2) lah keeps t below tmax, where the smoothstep's
+      ** slope 6 t (1 - t) is at most its value at tmax if tmax < 1/2 */
+      double c0 = cos(th0), phi = n->par[P_SFADE];
+      double tmax = (atan(sqrt(2.0) * lah) - th0) / phi * (1 + 1e-9) + 1e-9;
+      tmax = fmax(tmax, 0);
+      double ss = tmax < 0.5 ? 6 * tmax * (1 - tmax) : 1.5;
+      wlo = 0;
+      lw += ss * c0 * c0 / phi * sqrt(2.0) * lah / h * (1 + 1e-9);
     }
     /* w f_B with w in [wlo, whi] */
     double p[4] = {wlo * B->flo, wlo * B->fhi, whi * B->flo, whi * B->fhi};
@@ -408,10 +486,50 @@ static void binary_bound_in(const oc_enode *n, const oc_erect *b,
   combine(n, &A, &B, meets, o);
 }
 
+/* Add in box b: as binary_bound_in, with A's slope over b grown by the
+** slope weight's step where that weight counts. */
+static void add_bound_in(const oc_enode *n, const oc_erect *b,
+                         const oc_efootb *fb, oc_ebound *o) {
+  oc_ebound A, B, G;
+  oc_enode_bnd(n->kids[0], b, fb, &A);
+  int meets = oc_erect_meets(&n->kids[1]->box, b);
+  if (meets) oc_enode_bnd(n->kids[1], b, fb, &B);
+  double lah = 0, h = n->par[P_SSTEP];
+  /* A's slope over the stencil's reach, where the slope weight counts */
+  if (h != 0 && meets && B.ahi > 0 &&
+      !(n->par[P_BELOW] != 0 && A.flo >= n->par[P_BZ])) {
+    oc_erect g = {b->x0 - h, b->y0 - h, b->x1 + h, b->y1 + h};
+    oc_enode_bnd(n->kids[0], &g, fb, &G);
+    lah = G.lf;
+  }
+  add_combine(n, &A, &B, meets, lah, o);
+}
+
 oc_enode *oc_enode_add(oc_enode *a, oc_enode *b, const oc_enode_add_params *p,
                        oc_error *err) {
-  oc_enode_add_params d = {0, 0, 0, 0};
+  oc_enode_add_params d = {0, 0, 0, 0, 0, 0, 0, 0};
   if (!p) p = &d;
+  double step = p->slope_step == 0 ? 5 : p->slope_step;
+  if (p->slope) {
+    if (!(p->slope_deg >= 0 && p->slope_deg < 90)) {
+      oc_seterr(err, OC_EINVAL,
+                "'slope' must be an angle in degrees in [0, 90) (got %g)",
+                p->slope_deg);
+      return NULL;
+    }
+    if (!(isfinite(p->slope_fade) && p->slope_fade > 0)) {
+      oc_seterr(err, OC_EINVAL,
+                "'slope_fade' must be a positive angle in degrees (got %g)",
+                p->slope_fade);
+      return NULL;
+    }
+    if (!(isfinite(step) && step > 0)) {
+      oc_seterr(err, OC_EINVAL,
+                "'slope_step' must be a positive number (got %g)",
+                p->slope_step);
+      return NULL;
+    }
+  }
   if (p->below) {
     if (!isfinite(p->below_z)) {
       oc_seterr(err, OC_EINVAL, "'below' must be a finite number (got %g)",
@@ -430,11 +548,14 @@ oc_enode *oc_enode_add(oc_enode *a, oc_enode *b, const oc_enode_add_params *p,
   n->par[P_BELOW] = p->below != 0;
   n->par[P_BZ] = p->below_z;
   n->par[P_FADE] = p->fade;
+  n->par[P_SLOPE] = p->slope ? p->slope_deg * DEG : 0;
+  n->par[P_SFADE] = p->slope ? p->slope_fade * DEG : 0;
+  n->par[P_SSTEP] = p->slope ? step : 0;
   /* alpha may be > 0 where B alone is, with the summed or lerped weight */
   n->box = p->sum_weight ? rect_union(a->box, b->box) : a->box;
   oc_ebound B = b->glob;
   B.alo = 0;
-  add_combine(n, &a->glob, &B, 1, &n->glob);
+  add_combine(n, &a->glob, &B, 1, a->glob.lf, &n->glob);
   return n;
 }
 
@@ -749,7 +870,7 @@ void oc_eop_bound_in(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
     binary_bound_in(n, b, fb, replace_combine, o);
     return;
   case OC_E_ADD:
-    binary_bound_in(n, b, fb, add_combine, o);
+    add_bound_in(n, b, fb, o);
     return;
   case OC_E_XFORM:
     xform_bound_in(n, b, fb, o);

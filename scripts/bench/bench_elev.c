@@ -163,7 +163,7 @@ static oc_enode *replace(scene *s, oc_enode *a, oc_enode *b) {
 static oc_enode *add(scene *s, oc_enode *a, oc_enode *b, double below,
                      double fade) {
   oc_error err;
-  oc_enode_add_params p = {0, fade > 0, below, fade};
+  oc_enode_add_params p = {.below = fade > 0, .below_z = below, .fade = fade};
   return keep(s, oc_enode_add(a, b, &p, &err), 0, &err);
 }
 
@@ -221,14 +221,32 @@ static int hills(scene *s, oc_enode **k, int n, double rlo, double rhi,
   return n;
 }
 
-/*
-** The image primitive of figure 19 (a heightfield on a quadrangle) is
-** being written in another branch; until it lands, a large noisy disc of
-** the same extent stands for it. Swap this one function.
-*/
-static oc_enode *image_standin(scene *s, double cx, double cy, double r,
-                               double h) {
-  return disc(s, cx, cy, r, h, OC_ENOISE_RIDGED, 0.6 * h, r / 3, 8);
+/* The image primitive of figure 19: a 257 x 257 fBm grid mapped on a
+** quadrangle about 2 half wide round (cx, cy), turned by 20 degrees, f =
+** h + 1.2 h t (t the grid's fBm), fading over 8 km at its border. */
+static oc_enode *image(scene *s, double cx, double cy, double half, double h) {
+  oc_error err;
+  oc_heightfield_grid grid = {257, 257, 1, 0, 0};
+  oc_noise nz = {48, 1, 0, 6, 19};
+  oc_progress none = {0};
+  oc_heightfield *hf = oc_heightfield_fbm(&grid, &nz, none, &err);
+  if (!hf) die(s->name, &err);
+  oc_enode_image_params p = {0};
+  p.heightfield = hf;
+  p.height = 1.2 * h;
+  p.offset = h;
+  p.falloff = 8000;
+  double c = cos(20 * 3.14159265358979323846 / 180);
+  double sn = sin(20 * 3.14159265358979323846 / 180);
+  double corner[4][2] = {{-1, -0.9}, {1.1, -1}, {1, 1}, {-1, 0.95}};
+  for (int k = 0; k < 4; k++) {
+    double x = corner[k][0] * half, y = corner[k][1] * half;
+    p.quad[2 * k] = cx + c * x - sn * y;
+    p.quad[2 * k + 1] = cy + sn * x + c * y;
+  }
+  oc_enode *e = oc_enode_image(&p, &err);
+  oc_heightfield_release(hf); /* the node keeps it */
+  return keep(s, e, 1, &err);
 }
 
 /* Figure 1: 2 x 2 km, 70 primitives, 9 operators. Hills over a base,
@@ -287,7 +305,7 @@ static void fig19(scene *s) {
   s->half = 100000;
   int n = 0;
   k[n++] = base(s, 200, OC_ENOISE_PLAIN, 300, 60000, 9);
-  k[n++] = image_standin(s, 20000, 10000, 60000, 1800);
+  k[n++] = image(s, 20000, 10000, 40000, 1800);
   n += hills(s, k + n, 11, 10000, 30000, 500, 2500, OC_ENOISE_RIDGED, 0.6, 8);
   oc_enode *h = blend(s, k, n);
   oc_enode *pl =
@@ -295,8 +313,8 @@ static void fig19(scene *s) {
   oc_enode *t = replace(s, h, pl); /* a plain */
   path(s, p, 16, -100000, -70000, 100000, 60000, 120, 60, 12000, 2);
   s->root = replace(s, t, river(s, p, 16, OC_RIVER_MAIN));
-  s->what = "# ranges, a plain and a main-stem river; a ridged disc stands "
-            "for the image primitive";
+  s->what = "an image (an fBm grid on an 80 km quad), ranges, a plain and a "
+            "main-stem river";
   s->eye = (oc_vec3){-130000, -150000, 40000};
   s->target = (oc_vec3){10000, 10000, 500};
   s->fov = 45;

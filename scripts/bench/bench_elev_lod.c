@@ -82,7 +82,7 @@ static oc_enode *fig21(void) {
   oc_enode *r2 = ok(oc_enode_replace(r1, c2, 0, &err), &err, "replace");
   oc_enode *dunes =
       disc(-20000, -20000, 20000, 0, OC_ENOISE_RIDGED, 25, 150, 9, 90);
-  oc_enode_add_params ap = {0, 1, 300, 100};
+  oc_enode_add_params ap = {.below = 1, .below_z = 300, .fade = 100};
   oc_enode *top = ok(oc_enode_add(r2, dunes, &ap, &err), &err, "add");
   for (size_t i = 0; i < n; i++)
     oc_enode_release(all[i]);

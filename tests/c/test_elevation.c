@@ -221,7 +221,7 @@ START_TEST(replace_and_add_formulas) {
   oc_enode *b = disc(5, 5, 12, -3, OC_ENOISE_NONE, 0, 1, 1);
   oc_enode *rep = EOK(oc_enode_replace(a, b, 0, &err));
   oc_enode *lerp = EOK(oc_enode_replace(a, b, 1, &err));
-  oc_enode_add_params ap = {0, 0, 0, 0}, bp = {1, 1, 9, 4};
+  oc_enode_add_params ap = {0}, bp = {1, 1, 9, 4, 0, 0, 0, 0};
   oc_enode *add = EOK(oc_enode_add(a, b, &ap, &err));
   oc_enode *addb = EOK(oc_enode_add(a, b, &bp, &err));
   oct_rng r = oct_rng_new(6);
@@ -255,7 +255,7 @@ START_TEST(replace_and_add_formulas) {
   check_bounds(addb, 5, 5, 30);
   /* in boxes where f_A >= below_z, the altitude weight is 0: addb is A
   ** there; where f_A <= below_z - fade, it is 1: addc (below 16) is add */
-  oc_enode_add_params cp = {1, 1, 16, 3}, sp = {1, 0, 0, 0};
+  oc_enode_add_params cp = {1, 1, 16, 3, 0, 0, 0, 0}, sp = {.sum_weight = 1};
   oc_enode *addc = EOK(oc_enode_add(a, b, &cp, &err));
   oc_enode *adds = EOK(oc_enode_add(a, b, &sp, &err));
   int above = 0, under = 0;
@@ -280,6 +280,95 @@ START_TEST(replace_and_add_formulas) {
   oc_enode_release(adds);
   oc_enode *all[6] = {a, b, rep, lerp, add, addb};
   for (int i = 0; i < 6; i++)
+    oc_enode_release(all[i]);
+}
+END_TEST
+
+/* The slope weight of add: A's slope angle from central differences of
+** step h, weight 1 up to `slope`, smoothstep down to 0 over `slope_fade`. */
+static double slope_weight(const oc_enode *a, double x, double y, double deg,
+                           double fade, double h) {
+  oc_enode_sample e, w, n, s;
+  oc_enode_eval(a, x + h, y, &e);
+  oc_enode_eval(a, x - h, y, &w);
+  oc_enode_eval(a, x, y + h, &n);
+  oc_enode_eval(a, x, y - h, &s);
+  double th = atan(hypot((e.f - w.f) / (2 * h), (n.f - s.f) / (2 * h)));
+  double t = (th * 180 / PI - deg) / fade;
+  return t <= 0 ? 1 : t >= 1 ? 0 : 1 - t * t * (3 - 2 * t);
+}
+
+START_TEST(add_slope_weight) {
+  oc_error err;
+  /* slopes of A from flat to about 60 degrees; B lifts by about 6 */
+  oc_enode *a = disc(0, 0, 60, 10, OC_ENOISE_PLAIN, 6, 25, 3);
+  oc_enode *b = disc(3, -2, 40, 6, OC_ENOISE_PLAIN, 2, 9, 2);
+  oc_enode_add_params sp = {0, 0, 0, 0, 1, 25, 15, 1.5};
+  oc_enode_add_params bp = {1, 1, 14, 5, 1, 10, 20, 0.8};
+  oc_enode *add = EOK(oc_enode_add(a, b, &sp, &err));
+  oc_enode *addb = EOK(oc_enode_add(a, b, &bp, &err));
+  oct_rng r = oct_rng_new(61);
+  int one = 0, zero = 0, mid = 0;
+  for (int i = 0; i < 400; i++) {
+    double x = oct_unif(&r, -25, 25), y = oct_unif(&r, -25, 25);
+    oc_enode_sample s, sa, sb;
+    oc_enode_eval(a, x, y, &sa);
+    oc_enode_eval(b, x, y, &sb);
+    double c = fmin(fmax(sb.a, 0), 1);
+    double S = slope_weight(a, x, y, 25, 15, 1.5);
+    one += S == 1, zero += S == 0, mid += S > 0 && S < 1;
+    oc_enode_eval(add, x, y, &s);
+    ck_assert_double_eq_tol(s.f, sa.f + c * S * sb.f, 1e-9);
+    ck_assert_double_eq_tol(s.a, sa.a, 1e-15);
+    /* with the altitude weight and the summed weight */
+    double t = (14 - sa.f) / 5, W = t <= 0   ? 0
+                                    : t >= 1 ? 1
+                                             : t * t * (3 - 2 * t);
+    double S2 = slope_weight(a, x, y, 10, 20, 0.8);
+    oc_enode_eval(addb, x, y, &s);
+    ck_assert_double_eq_tol(s.f, sa.f + c * W * S2 * sb.f, 1e-9);
+    ck_assert_double_eq_tol(s.a, sa.a + c * c, 1e-12);
+    check_gradient(add, x, y, 1e-4);
+    check_gradient(addb, x, y, 1e-4);
+  }
+  /* the test sees the whole weight: 1, 0 and the fade between */
+  ck_assert_msg(one > 20 && zero > 20 && mid > 40, "%d %d %d", one, zero, mid);
+  check_bounds(add, 0, 0, 30);
+  check_bounds(addb, 0, 0, 30);
+  /* in boxes where A is gentle by its own bound, the slope weight is 1:
+  ** the bounds are those of the add without it */
+  oc_enode *a0 = disc(0, 0, 60, 10, OC_ENOISE_PLAIN, 0.5, 25, 3);
+  oc_enode_add_params gp = {0, 0, 0, 0, 1, 45, 10, 1}, pp = {0};
+  oc_enode *g = EOK(oc_enode_add(a0, b, &gp, &err));
+  oc_enode *plain = EOK(oc_enode_add(a0, b, &pp, &err));
+  oc_enode_bound bg, bpl;
+  oc_enode_bound_in(g, -5, -5, 5, 5, &bg);
+  oc_enode_bound_in(plain, -5, -5, 5, 5, &bpl);
+  ck_assert(bg.lf == bpl.lf && bg.flo == bpl.flo && bg.fhi == bpl.fhi);
+  ck_assert(oc_enode_lipschitz(g) == oc_enode_lipschitz(plain));
+  /* bad values name the field */
+  struct {
+    oc_enode_add_params p;
+    const char *field;
+  } bad[] = {
+      {{0, 0, 0, 0, 1, NAN, 10, 1}, "'slope'"},
+      {{0, 0, 0, 0, 1, -1, 10, 1}, "'slope'"},
+      {{0, 0, 0, 0, 1, 90, 10, 1}, "'slope'"},
+      {{0, 0, 0, 0, 1, INFINITY, 10, 1}, "'slope'"},
+      {{0, 0, 0, 0, 1, 30, 0, 1}, "'slope_fade'"},
+      {{0, 0, 0, 0, 1, 30, NAN, 1}, "'slope_fade'"},
+      {{0, 0, 0, 0, 1, 30, -5, 1}, "'slope_fade'"},
+      {{0, 0, 0, 0, 1, 30, 10, -1}, "'slope_step'"},
+      {{0, 0, 0, 0, 1, 30, 10, NAN}, "'slope_step'"},
+      {{0, 0, 0, 0, 1, 30, 10, INFINITY}, "'slope_step'"},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+    err.msg[0] = 0;
+    ck_assert(oc_enode_add(a, b, &bad[i].p, &err) == NULL);
+    ck_assert_msg(strstr(err.msg, bad[i].field), "%zu: %s", i, err.msg);
+  }
+  oc_enode *all[7] = {a, b, add, addb, a0, g, plain};
+  for (int i = 0; i < 7; i++)
     oc_enode_release(all[i]);
 }
 END_TEST
@@ -486,7 +575,7 @@ START_TEST(bad_input) {
   oc_enode_xform x = {0, 0, 0, -1, 1, 0};
   ck_assert_ptr_null(oc_enode_transform(d, &x, &err));
   ck_assert_ptr_nonnull(strstr(err.msg, "'scale'"));
-  oc_enode_add_params ap = {0, 1, 0, 0};
+  oc_enode_add_params ap = {.below = 1};
   ck_assert_ptr_null(oc_enode_add(d, d, &ap, &err));
   ck_assert_ptr_nonnull(strstr(err.msg, "'fade'"));
   ck_assert_ptr_null(oc_enode_blend(NULL, 0, &err));
@@ -505,6 +594,7 @@ int main(void) {
   tcase_add_test(tc, disc_noises);
   tcase_add_test(tc, blend_formula);
   tcase_add_test(tc, replace_and_add_formulas);
+  tcase_add_test(tc, add_slope_weight);
   tcase_add_test(tc, transform_concatenates);
   tcase_add_test(tc, warp_bijective_only);
   tcase_add_test(tc, dag_stats_and_source);

@@ -90,13 +90,27 @@ static oc_enode *scene(void) {
   oc_enode *crater = disc(900, 900, 250, 40, OC_ENOISE_PLAIN, 10, 50, 6);
   oc_enode *rp = EOK(oc_enode_replace(bl, crater, 0, &err));
   oc_enode *dunes = disc(-900, -900, 400, 0, OC_ENOISE_RIDGED, 15, 40, 8);
-  oc_enode_add_params ap = {0, 1, 150, 30};
+  oc_enode_add_params ap = {.below = 1, .below_z = 150, .fade = 30};
   oc_enode *top = EOK(oc_enode_add(rp, dunes, &ap, &err));
   oc_enode *all[] = {base, m,  i1, i2,     t,  tw,   coarse,
                      fine, ld, bl, crater, rp, dunes};
   for (size_t k = 0; k < sizeof all / sizeof *all; k++)
     oc_enode_release(all[k]);
   return top;
+}
+
+/* The scene with sand added where it is gentle (the slope weight): A's
+** f at four more points, each with p's footprint. */
+static oc_enode *slope_scene(void) {
+  oc_error err;
+  oc_enode *a = scene();
+  oc_enode *sand = disc(-200, 300, 1800, 2, OC_ENOISE_RIDGED, 8, 120, 6);
+  oc_enode_add_params p = {
+      .slope = 1, .slope_deg = 8, .slope_fade = 12, .slope_step = 6};
+  oc_enode *e = EOK(oc_enode_add(a, sand, &p, &err));
+  oc_enode_release(a);
+  oc_enode_release(sand);
+  return e;
 }
 
 /* lod between two flat discs: all its slope is the footprint's term */
@@ -316,7 +330,7 @@ START_TEST(continuous_across_thresholds) {
 END_TEST
 
 START_TEST(gradients_with_lod) {
-  oc_enode *e = scene();
+  oc_enode *e = _i ? slope_scene() : scene();
   oc_enode_view v = {{-500, 300, 900}, 3e-3};
   oct_rng r = oct_rng_new(17);
   int n = 0;
@@ -359,10 +373,10 @@ END_TEST
 START_TEST(bounds_with_lod) {
   oc_enode *trees[] = {scene(), step_tree(),
                        disc(0, 0, 9000, 10, OC_ENOISE_PLAIN, 50, 300, 2),
-                       step_instance()};
+                       step_instance(), slope_scene()};
   oc_enode_view views[] = {
       {{-500, 300, 900}, 3e-3}, {{3000, 0, 5000}, 0.02}, {{100, 0, 10}, 1}};
-  for (int q = 0; q < 12; q++) {
+  for (int q = 0; q < 15; q++) {
     const oc_enode_view *v = &views[q % 3];
     const oc_enode *e = trees[q / 3];
     oct_rng r = oct_rng_new(23 + q);
@@ -401,7 +415,7 @@ START_TEST(bounds_with_lod) {
                   "the bounds",
                   q / 3, q % 3, worst);
   }
-  for (int q = 0; q < 4; q++)
+  for (int q = 0; q < 5; q++)
     oc_enode_release(trees[q]);
 }
 END_TEST
@@ -445,7 +459,7 @@ static double march(const oc_esurface *es, oc_vec3 o, oc_vec3 d, double t1,
 
 START_TEST(lod_trace_against_march) {
   oc_error err;
-  oc_enode *e = scene();
+  oc_enode *e = _i ? slope_scene() : scene();
   oc_vec3 eye = {-2600, -2400, 1100}, target = {300, 300, 0};
   /* a coarse pixel, so that the LoD drops octaves across the view */
   oc_enode_view v = {{eye.x, eye.y, eye.z}, 4e-3};
@@ -515,9 +529,9 @@ int main(void) {
   tcase_add_test(tc, disc_octaves_filtered);
   tcase_add_test(tc, lod_operator_formula);
   tcase_add_test(tc, continuous_across_thresholds);
-  tcase_add_test(tc, gradients_with_lod);
+  tcase_add_loop_test(tc, gradients_with_lod, 0, 2);
   tcase_add_test(tc, bounds_with_lod);
-  tcase_add_test(tc, lod_trace_against_march);
+  tcase_add_loop_test(tc, lod_trace_against_march, 0, 2);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }

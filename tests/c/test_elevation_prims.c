@@ -13,6 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/curve.h"
+#include "elevation/enode.h"
 #include "ocheck.h"
 
 #define PI 3.14159265358979323846
@@ -463,6 +465,216 @@ START_TEST(image_segment_and_clamped_weight) {
 }
 END_TEST
 
+/* ---- image along a curve ---------------------------------------------- */
+
+/* Bounds in random boxes for a primitive whose slope bounds hold where
+** alpha > 0 (along a curve): ranges of f and alpha and alpha's slope
+** everywhere, f's slope where alpha > 0. The largest ratio of a slope
+** seen to the bound goes to *ratio. */
+static void check_band_boxes(const oc_enode *e, double cx, double cy, double R,
+                             double *ratio) {
+  oct_rng r = oct_rng_new(23);
+  int inband = 0;
+  for (int i = 0; i < 300; i++) {
+    double w = R * pow(10, oct_unif(&r, -3, 0.3));
+    double x0 = cx + oct_unif(&r, -R, R), y0 = cy + oct_unif(&r, -R, R);
+    double x1 = x0 + w, y1 = y0 + w * oct_unif(&r, 0.2, 1);
+    oc_enode_bound b;
+    oc_enode_bound_in(e, x0, y0, x1, y1, &b);
+    for (int k = 0; k < 100; k++) {
+      double px = oct_unif(&r, x0, x1), py = oct_unif(&r, y0, y1);
+      double qx = oct_unif(&r, x0, x1), qy = oct_unif(&r, y0, y1);
+      oc_enode_sample p, q;
+      oc_enode_eval(e, px, py, &p);
+      oc_enode_eval(e, qx, qy, &q);
+      double m = 1e-9 * (1 + fabs(b.flo) + fabs(b.fhi));
+      ck_assert_msg(p.f >= b.flo - m && p.f <= b.fhi + m,
+                    "f %.12g at (%g, %g) outside [%.12g, %.12g]", p.f, px, py,
+                    b.flo, b.fhi);
+      ck_assert_msg(p.a >= b.alo - 1e-12 && p.a <= b.ahi + 1e-12,
+                    "alpha %.12g at (%g, %g) outside [%.12g, %.12g]", p.a, px,
+                    py, b.alo, b.ahi);
+      ck_assert_msg(hypot(p.ax, p.ay) <= b.la * (1 + 1e-9) + 1e-12,
+                    "|grad alpha| %g > %g at (%g, %g)", hypot(p.ax, p.ay), b.la,
+                    px, py);
+      double d = hypot(px - qx, py - qy);
+      ck_assert(fabs(p.a - q.a) <= b.la * d * (1 + 1e-9) + 1e-12);
+      if (p.a > 0) {
+        inband++;
+        ck_assert_msg(hypot(p.fx, p.fy) <= b.lf * (1 + 1e-9) + 1e-12,
+                      "|grad f| %g > %g at (%g, %g)", hypot(p.fx, p.fy), b.lf,
+                      px, py);
+        *ratio = fmax(*ratio, hypot(p.fx, p.fy) / b.lf);
+      }
+    }
+  }
+  ck_assert_int_gt(inband, 3000);
+}
+
+static const oc_vec3 WIND[5] = {
+    {0, 0, 0}, {100, 60, 0}, {200, -40, 0}, {300, 50, 0}, {400, 0, 0}};
+
+START_TEST(image_curve_formula) {
+  oc_error err;
+  oc_heightfield *hf = grid(hill), *wg = grid(wfun);
+  /* a straight curve is the segment: the same f, alpha and gradients
+  ** everywhere, beyond the ends and the sides too */
+  oc_vec3 line[3] = {{0, 0, 0}, {150, 200, 0}, {300, 400, 0}};
+  oc_enode_image_params sp = {0}, cp = {0};
+  sp.heightfield = cp.heightfield = hf;
+  sp.weight = cp.weight = wg;
+  sp.segment = 1, sp.seg[2] = 300, sp.seg[3] = 400;
+  sp.width = cp.width = 140;
+  sp.falloff = cp.falloff = 20;
+  sp.height = cp.height = 1.5, sp.offset = cp.offset = 4;
+  cp.curve = line, cp.ncurve = 3, cp.spline = OC_ECURVE_CATMULL;
+  oc_enode *seg = EOK(oc_enode_image(&sp, &err));
+  oc_enode *str = EOK(oc_enode_image(&cp, &err));
+  oct_rng r = oct_rng_new(31);
+  for (int i = 0; i < 2000; i++) {
+    double x = oct_unif(&r, -100, 400), y = oct_unif(&r, -100, 500);
+    oc_enode_sample a, b;
+    oc_enode_eval(seg, x, y, &a);
+    oc_enode_eval(str, x, y, &b);
+    ck_assert_msg(fabs(a.f - b.f) < 1e-8 && fabs(a.a - b.a) < 1e-9,
+                  "(%g, %g): f %.12g vs %.12g, alpha %.12g vs %.12g", x, y, a.f,
+                  b.f, a.a, b.a);
+    ck_assert(fabs(a.fx - b.fx) < 1e-7 && fabs(a.fy - b.fy) < 1e-7);
+    ck_assert(fabs(a.ax - b.ax) < 1e-7 && fabs(a.ay - b.ay) < 1e-7);
+  }
+  /* a winding curve: the point at arc length s and offset t maps to the
+  ** grid at (s / L, t / w + 1/2) */
+  oc_enode_image_params wp = cp;
+  wp.curve = WIND, wp.ncurve = 5, wp.width = 30, wp.falloff = 0;
+  wp.weight = NULL;
+  oc_enode *e = EOK(oc_enode_image(&wp, &err));
+  oc_pcurve *c = oc_ecurve_skeleton(WIND, 5, OC_ECURVE_CATMULL, &err);
+  ck_assert_ptr_nonnull(c);
+  double L = oc_curve_length(c);
+  double F = fmin(sqrt(L * 30) / 10, 7.5); /* the default falloff */
+  int full = 0;
+  for (int i = 0; i < 2000; i++) {
+    double s = oct_unif(&r, 0, L), t = oct_unif(&r, -15, 15);
+    if (i < 4) s = (i & 1) * L, t = i & 2 ? 15 : -15;
+    oc_curve_point pt;
+    ck_assert(oc_curve_at(c, s, &pt));
+    double x = pt.q.x + t * pt.nx, y = pt.q.y + t * pt.ny;
+    oc_enode_sample q;
+    oc_enode_eval(e, x, y, &q);
+    double X = -7 + 100 * s / L, Y = 3 + 70 * (t / 30 + 0.5);
+    double want = 4 + 1.5 * oc_heightfield_height(hf, X, Y, NULL);
+    ck_assert_msg(fabs(q.f - want) < 1e-7, "(s, t) = (%g, %g): %.12g vs %.12g",
+                  s, t, q.f, want);
+    double ab = (1 - wyv(s / F)) * (1 - wyv((L - s) / F)) *
+                (1 - wyv((15 - t) / F)) * (1 - wyv((t + 15) / F));
+    ck_assert_double_eq_tol(q.a, ab, 1e-9);
+    full += q.a == 1;
+    if (i >= 4 && fabs(t) < 14.9) check_gradient(e, x, y, 1e-4);
+  }
+  ck_assert_int_gt(full, 500);
+  /* beyond the sides (within the curvature's reach): f at the clamped
+  ** offset, alpha 0; the gradient exact there too */
+  for (int i = 0; i < 400; i++) {
+    double s = oct_unif(&r, 1, L - 1), t = oct_unif(&r, 15.5, 25);
+    oc_curve_point pt;
+    ck_assert(oc_curve_at(c, s, &pt));
+    double sg = i & 1 ? 1 : -1;
+    if (1 / fabs(oc_curve_curvature_at(c, &pt)) < 30) continue;
+    double x = pt.q.x + sg * t * pt.nx, y = pt.q.y + sg * t * pt.ny;
+    oc_enode_sample q, in;
+    oc_enode_eval(e, x, y, &q);
+    oc_enode_eval(e, pt.q.x + sg * 15 * pt.nx, pt.q.y + sg * 15 * pt.ny, &in);
+    ck_assert(q.a == 0);
+    ck_assert_double_eq_tol(q.f, in.f, 1e-7);
+    check_gradient(e, x, y, 1e-4);
+  }
+  double ratio = 0;
+  check_band_boxes(e, 200, 0, 150, &ratio);
+  ck_assert_msg(ratio > 0.3, "the curve image's bounds are loose (%g)", ratio);
+  /* and with a weight grid */
+  wp.weight = wg;
+  oc_enode *ew = EOK(oc_enode_image(&wp, &err));
+  for (int i = 0; i < 300; i++) {
+    double s = oct_unif(&r, 0, L), t = oct_unif(&r, -14.9, 14.9);
+    oc_curve_point pt;
+    ck_assert(oc_curve_at(c, s, &pt));
+    check_gradient(ew, pt.q.x + t * pt.nx, pt.q.y + t * pt.ny, 1e-4);
+  }
+  ratio = 0;
+  check_band_boxes(ew, 200, 0, 150, &ratio);
+  /* a long thin grid, steep along the curve: the bound's along-curve term
+  ** 1 / (1 - kappa w/2) counts, on the inner side of the bends */
+  enum { NX = 201, NY = 5 };
+  float z[NX * NY];
+  for (int j = 0; j < NY; j++)
+    for (int i = 0; i < NX; i++)
+      z[j * NX + i] = (float)(20 * sin(i / 6.0) + j);
+  oc_heightfield *thin = oc_heightfield_new(NX, NY, 2.5, 0, 0, z, &err);
+  ck_assert_ptr_nonnull(thin);
+  wp.heightfield = thin, wp.weight = NULL;
+  oc_enode *et = EOK(oc_enode_image(&wp, &err));
+  oc_heightfield_release(thin);
+  ratio = 0;
+  check_band_boxes(et, 200, 0, 150, &ratio);
+  ck_assert_msg(ratio > 0.2, "loose along the curve (%g)", ratio);
+  /* the plane's bounds */
+  double box[4], lo, hi;
+  oc_enode_get_bounds(e, box, &lo, &hi);
+  ck_assert(box[0] <= -15 && box[2] >= 415);
+  for (int i = 0; i < 3000; i++) {
+    oc_enode_sample q;
+    oc_enode_eval(e, oct_unif(&r, -500, 900), oct_unif(&r, -500, 500), &q);
+    ck_assert(q.f >= lo - 1e-9 && q.f <= hi + 1e-9);
+    if (q.a > 0) ck_assert(hypot(q.fx, q.fy) <= oc_enode_lipschitz(e));
+  }
+  oc_curve_free(c);
+  oc_enode *all[5] = {seg, str, e, ew, et};
+  for (int i = 0; i < 5; i++)
+    oc_enode_release(all[i]);
+  oc_heightfield_release(hf);
+  oc_heightfield_release(wg);
+}
+END_TEST
+
+START_TEST(image_curve_bad_input) {
+  oc_error err;
+  oc_heightfield *hf = grid(hill);
+  oc_enode_image_params p = {0};
+  p.heightfield = hf;
+  p.curve = WIND, p.ncurve = 5, p.width = 30;
+  oc_enode *ok = EOK(oc_enode_image(&p, &err));
+  oc_enode_release(ok);
+  /* wider than the bends allow (radius of curvature about 33 here) */
+  p.width = 80;
+  ck_assert_ptr_null(oc_enode_image(&p, &err));
+  ck_assert_msg(strstr(err.msg, "'width'") && strstr(err.msg, "curvature"),
+                "%s", err.msg);
+  p.width = NAN;
+  ck_assert_ptr_null(oc_enode_image(&p, &err));
+  ck_assert_ptr_nonnull(strstr(err.msg, "'width'"));
+  p.width = 30;
+  p.ncurve = 1;
+  ck_assert_ptr_null(oc_enode_image(&p, &err));
+  ck_assert_ptr_nonnull(strstr(err.msg, "'curve'"));
+  oc_vec3 corner[3] = {{0, 0, 0}, {100, 0, 0}, {100, 100, 0}};
+  p.curve = corner, p.ncurve = 3, p.spline = OC_ECURVE_LINEAR;
+  ck_assert_ptr_null(oc_enode_image(&p, &err));
+  ck_assert_msg(strstr(err.msg, "'curve'") && strstr(err.msg, "corner"), "%s",
+                err.msg);
+  oc_vec3 nanp[3] = {{0, 0, 0}, {100, NAN, 0}, {200, 0, 0}};
+  p.curve = nanp, p.spline = OC_ECURVE_CATMULL;
+  ck_assert_ptr_null(oc_enode_image(&p, &err));
+  ck_assert_ptr_nonnull(strstr(err.msg, "'curve'"));
+  /* a closed loop: the grid's x would jump where the ends meet */
+  oc_vec3 loop[4] = {{0, 0, 0}, {100, 0, 0}, {50, 80, 0}, {0, 0, 0}};
+  p.curve = loop, p.ncurve = 4, p.spline = OC_ECURVE_BEZIER;
+  ck_assert_ptr_null(oc_enode_image(&p, &err));
+  ck_assert_msg(strstr(err.msg, "'curve'") && strstr(err.msg, "open"), "%s",
+                err.msg);
+  oc_heightfield_release(hf);
+}
+END_TEST
+
 START_TEST(image_bad_input) {
   oc_error err;
   oc_heightfield *hf = grid(hill);
@@ -565,6 +777,8 @@ int main(void) {
   tcase_add_test(tc, image_quad_formula);
   tcase_add_test(tc, image_segment_and_clamped_weight);
   tcase_add_test(tc, image_bad_input);
+  tcase_add_test(tc, image_curve_formula);
+  tcase_add_test(tc, image_curve_bad_input);
   tcase_add_test(tc, source_of_a_lake_and_image_tree);
   suite_add_tcase(s, tc);
   return oct_run(s);

@@ -222,6 +222,37 @@ describe("outcrop.elevation.image", function()
     check_lipschitz(e, 0, 100, 120)
   end)
 
+  it("lays a grid along a curve: u by arc length, v across", function()
+    local hf = grid(hill)
+    -- a straight curve is the segment, beyond its ends and sides too
+    local seg = E.image{heightfield = hf, segment = {{0, 0}, {0, 200}},
+                        width = 60, falloff = 5, height = 2}
+    local str = E.image{heightfield = hf, curve = {{0, 0}, {0, 90}, {0, 200}},
+                        spline = "linear", width = 60, falloff = 5, height = 2}
+    for _ = 1, 300 do
+      local x, y = rand(-60, 60), rand(-40, 240)
+      local f1, a1 = seg:eval(x, y)
+      local f2, a2 = str:eval(x, y)
+      assert(math.abs(f1 - f2) < 1e-8 and math.abs(a1 - a2) < 1e-9,
+             string.format("(%g, %g): %g %g vs %g %g", x, y, f1, a1, f2, a2))
+    end
+    -- a winding one: exact gradients, its slope bound where alpha > 0
+    local e = E.image{heightfield = hf, width = 20, height = 3, curve = {
+      {0, 0}, {60, 40}, {120, -20}, {180, 30}}}
+    local L, n = e:lipschitz(), 0
+    for _ = 1, 2000 do
+      local x, y = rand(-10, 190), rand(-40, 60)
+      local f, a = e:eval(x, y)
+      if a > 0 then
+        n = n + 1
+        local gx, gy = e:gradient(x, y)
+        assert(math.sqrt(gx * gx + gy * gy) <= L)
+        if a < 1 and n % 4 == 0 then check_gradient(e, x, y, 1e-4) end
+      end
+    end
+    assert(n > 100)
+  end)
+
   it("keeps its grids when Lua closes or collects them", function()
     local e, want
     do
@@ -289,5 +320,22 @@ describe("outcrop.elevation.image", function()
           fn, "'falloff'")
     check(function() E.image{heightfield = hf, quad = sq, offset = 1 / 0} end,
           fn, "'offset'")
+    local wind = {{0, 0}, {60, 40}, {120, -20}, {180, 30}}
+    check(function() E.image{heightfield = hf, curve = wind} end, fn,
+          "'width'")
+    check(function() E.image{heightfield = hf, curve = wind, width = 90} end,
+          fn, "'width'", "curvature")
+    check(function() E.image{heightfield = hf, curve = {{0, 0}}, width = 9} end,
+          fn, "'curve'")
+    check(function() E.image{heightfield = hf, curve = {{0, 0}, {1 / 0, 1}},
+                             width = 9} end, fn, "'curve[2]'")
+    check(function() E.image{heightfield = hf, curve = wind, quad = sq,
+                             width = 9} end, fn, "'curve'", "'quad'")
+    check(function() E.image{heightfield = hf, curve = wind, width = 9,
+                             spline = "nurbs"} end, fn, "'spline'")
+    check(function() E.image{heightfield = hf, quad = sq,
+                             spline = "linear"} end, fn, "'spline'")
+    check(function() E.image{heightfield = hf, width = 9, spline = "linear",
+      curve = {{0, 0}, {10, 0}, {10, 10}}} end, fn, "'curve'", "corner")
   end)
 end)

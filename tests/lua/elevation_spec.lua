@@ -98,6 +98,37 @@ describe("elevation operators", function()
     end
   end)
 
+  it("add's slope weight follows its formula, with exact gradients",
+     function()
+    local base, hill = scene()
+    local step = 4
+    local ad = E.add(base, hill, {slope = 12, slope_fade = 8, slope_step = step})
+    local n = {one = 0, zero = 0, mid = 0}
+    for _ = 1, 150 do
+      local x, y = rand(-900, 900), rand(-600, 600)
+      local fa = base:eval(x, y)
+      local fh, ah = hill:eval(x, y)
+      local c = math.min(math.max(ah, 0), 1)
+      local dx = (base:eval(x + step, y) - base:eval(x - step, y)) / (2 * step)
+      local dy = (base:eval(x, y + step) - base:eval(x, y - step)) / (2 * step)
+      local deg = math.deg(math.atan(math.sqrt(dx * dx + dy * dy)))
+      local t = math.min(math.max((deg - 12) / 8, 0), 1)
+      local S = 1 - t * t * (3 - 2 * t)
+      if S == 1 then n.one = n.one + 1 elseif S == 0 then n.zero = n.zero + 1
+      else n.mid = n.mid + 1 end
+      local f = ad:eval(x, y)
+      assert.is_true(math.abs(f - (fa + c * S * fh)) < 1e-9 * (1 + math.abs(f)))
+      local h = 1e-4
+      local gx, gy = ad:gradient(x, y)
+      local nx = (ad:eval(x + h, y) - ad:eval(x - h, y)) / (2 * h)
+      local ny = (ad:eval(x, y + h) - ad:eval(x, y - h)) / (2 * h)
+      assert.is_true(math.abs(gx - nx) < 1e-3 * (1 + math.abs(nx)))
+      assert.is_true(math.abs(gy - ny) < 1e-3 * (1 + math.abs(ny)))
+      assert.is_true(math.sqrt(gx * gx + gy * gy) <= ad:lipschitz())
+    end
+    assert.is_true(n.one > 5 and n.zero > 5 and n.mid > 5)
+  end)
+
   it("transform maps points and elevations, and concatenates", function()
     local _, hill = scene()
     local t = E.transform(hill, {translate = {1000, 0}, rotate = 90,
@@ -177,6 +208,18 @@ describe("elevation errors", function()
           "outcrop.elevation.replace", "'weight'")
     check(function() E.add(b, b, {fade = 0}) end, "outcrop.elevation.add",
           "'fade'")
+    check(function() E.add(b, b, {slope = 0 / 0}) end, "outcrop.elevation.add",
+          "'slope'")
+    check(function() E.add(b, b, {slope = -3}) end, "outcrop.elevation.add",
+          "'slope'", "[0, 90)")
+    check(function() E.add(b, b, {slope = 90}) end, "outcrop.elevation.add",
+          "'slope'", "[0, 90)")
+    check(function() E.add(b, b, {slope = 30, slope_fade = 0}) end,
+          "outcrop.elevation.add", "'slope_fade'")
+    check(function() E.add(b, b, {slope = 30, slope_step = -1}) end,
+          "outcrop.elevation.add", "'slope_step'")
+    check(function() E.add(b, b, {slope = "steep"}) end,
+          "outcrop.elevation.add", "'slope'")
     check(function() E.warp(b, {amplitude = 500, wavelength = 10}) end,
           "outcrop.elevation.warp", "bijection")
     check(function() E.transform(b, {scale = 0}) end,
