@@ -69,6 +69,13 @@ static int knots_push(knots *k, double t, double s) {
   return 1;
 }
 
+/* a, of n items of size or more, cut to n (kept as it is if realloc
+** fails or n is 0). */
+static void *shrink(void *a, size_t n, size_t size) {
+  void *b = n ? realloc(a, n * size) : NULL;
+  return b ? b : a;
+}
+
 /* Tabulates the arc length of a Bézier piece: [0, 1] is split until the
 ** 8-point rule on a span agrees with the rule on its halves to 1e-14 of
 ** the piece's scale (a span then carries ~1e-16 of error, well inside the
@@ -293,7 +300,10 @@ oc_pcurve *oc_curve_new(const oc_curve_piece *pieces, size_t n, oc_error *err) {
     s += len;
     piece_box(pc, &c->box);
   }
-  c->tt = k.t, c->ts = k.s, c->nknots = k.n;
+  /* the tables' spare capacity, given back */
+  c->tt = shrink(k.t, k.n, sizeof *k.t);
+  c->ts = shrink(k.s, k.n, sizeof *k.s);
+  c->nknots = k.n;
   c->length = s;
   for (size_t i = 0; i < c->n; i++)
     c->kappa = fmax(
@@ -301,8 +311,10 @@ oc_pcurve *oc_curve_new(const oc_curve_piece *pieces, size_t n, oc_error *err) {
   for (size_t i = 1; i < c->n; i++)
     c->turn = fmax(c->turn, turn_at(&c->pc[i - 1], &c->pc[i]));
   if (c->closed) c->turn = fmax(c->turn, turn_at(end, first));
+  /* and that of dropped pieces (first and end move) */
+  c->pc = shrink(c->pc, c->n, sizeof *c->pc);
 
-  if (!oc_mul_size(2 * c->n, sizeof(bnode), &bytes) ||
+  if (!oc_mul_size(2 * c->n - 1, sizeof(bnode), &bytes) ||
       !(c->bvh = malloc(bytes))) {
     oc_curve_free(c);
     oc_seterr(err, OC_ENOMEM, "out of memory for a curve of %zu pieces", n);
@@ -347,6 +359,12 @@ void oc_curve_free(oc_pcurve *c) {
   free(c->ts);
   free(c->bvh);
   free(c);
+}
+
+size_t oc_curve_bytes(const oc_pcurve *c) {
+  return sizeof *c + c->n * sizeof *c->pc +
+         c->nknots * (sizeof *c->tt + sizeof *c->ts) +
+         (2 * c->n - 1) * sizeof *c->bvh;
 }
 
 size_t oc_curve_npieces(const oc_pcurve *c) {

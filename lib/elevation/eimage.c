@@ -35,6 +35,7 @@
 #include "core/error.h"
 #include "core/falloff.h"
 #include "elevation/enode.h"
+#include "terrain/terrain.h"
 
 typedef struct grid {
   oc_elevation src; /* src.ud NULL: none (weight 1) */
@@ -135,7 +136,7 @@ static double ramp(double x, double *dg) {
 void oc_eimage_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                   int want, oc_enode_sample *s) {
   (void)ft; /* no detail to filter */
-  const eimage *d = n->data;
+  const eimage *d = OC_EPRIM(n)->data;
   int grad = want & OC_EV_GRAD;
   double dk[4];
   int inside = 1;
@@ -320,7 +321,7 @@ static void grid_bound(const eimage *d, const grid *G, const double uv[4],
 void oc_eimage_bound_in(const oc_enode *n, const oc_erect *b,
                         const oc_efootb *fb, oc_ebound *o) {
   (void)fb;
-  const eimage *d = n->data;
+  const eimage *d = OC_EPRIM(n)->data;
   /* f: over the quad within r of b */
   double r = 0;
   for (int c = 0; c < 4; c++)
@@ -491,7 +492,8 @@ oc_enode *oc_enode_image(const oc_enode_image_params *p, oc_error *err) {
   d->F = p->falloff > 0 ? p->falloff : sqrt(area) / 10;
   if (take_grid(p->heightfield, &d->h, err)) goto fail;
   if (p->weight && take_grid(p->weight, &d->w, err)) goto fail;
-  oc_enode *n = oc_enode_alloc(OC_E_IMAGE, NULL, 0, err);
+  oc_eprim *n =
+      (oc_eprim *)oc_enode_alloc(OC_E_IMAGE, sizeof(oc_eprim), NULL, 0, err);
   if (!n) goto fail;
   n->data = d;
   n->box = (oc_erect){INFINITY, INFINITY, -INFINITY, -INFINITY};
@@ -501,7 +503,7 @@ oc_enode *oc_enode_image(const oc_enode_image_params *p, oc_error *err) {
     n->box.x1 = fmax(n->box.x1, d->P[k][0]);
     n->box.y1 = fmax(n->box.y1, d->P[k][1]);
   }
-  oc_eimage_bound_in(n, &n->box, NULL, &n->glob);
+  oc_eimage_bound_in(&n->h, &n->box, NULL, &n->glob);
   n->glob.alo = 0;
   if (!isfinite(n->glob.flo) || !isfinite(n->glob.fhi) ||
       !isfinite(n->glob.lf) || !isfinite(n->glob.la) || !isfinite(d->F) ||
@@ -510,11 +512,27 @@ oc_enode *oc_enode_image(const oc_enode_image_params *p, oc_error *err) {
               "image: its elevations or slopes overflow (height %g, offset "
               "%g, falloff %g)",
               vs, p->offset, d->F);
-    oc_enode_release(n);
+    oc_enode_release(&n->h);
     return NULL;
   }
-  return n;
+  return &n->h;
 fail:
   oc_eimage_free(d);
   return NULL;
+}
+
+int oc_eimage_bytes(const void *data, oc_pmap *seen, size_t *bytes) {
+  const eimage *d = data;
+  const grid *gs[2] = {&d->h, &d->w};
+  *bytes = sizeof *d;
+  for (int k = 0; k < 2; k++) {
+    if (!gs[k]->src.ud) continue;
+    const oc_heightfield *hf;
+    size_t hb;
+    *bytes += oc_hfsrc_bytes(&gs[k]->src, &hf, &hb);
+    if (!hf || oc_pmap_slot(seen, hf, 0)) continue; /* counted */
+    if (!oc_pmap_slot(seen, hf, 1)) return OC_ENOMEM;
+    *bytes += hb;
+  }
+  return OC_OK;
 }
