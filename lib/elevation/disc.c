@@ -164,7 +164,10 @@ void oc_edisc_noise(const oc_enode *n, oc_enoise *nz) {
   nz->amplitude = d->amplitude;
   nz->wavelength = d->wavelength;
   nz->seed = d->seed;
-  if (n->flags & OC_EF_GLF) {
+  if (n->flags & OC_EF_GLDEF) {
+    nz->gain = 0.5;
+    nz->lacunarity = 2;
+  } else if (n->flags & OC_EF_GLF) {
     nz->gain = d->gl.f[0];
     nz->lacunarity = d->gl.f[1];
   } else {
@@ -173,20 +176,29 @@ void oc_edisc_noise(const oc_enode *n, oc_enoise *nz) {
   }
 }
 
-/* The bound over the whole plane, from the parameters (what construction
-** always computed). */
-static void disc_glob(const oc_enode *n, const oc_enoise *nz, oc_ebound *o) {
-  const double *par = OC_EDISC(n)->par;
-  double lo = 0, hi = 0, lip = 0;
-  if (nz->kind != OC_ENOISE_NONE) noise_bounds(nz, NULL, &lo, &hi, &lip);
-  *o = (oc_ebound){par[3] + lo, par[3] + hi, 0,
-                   1,           lip,         OC_FALLOFF_LIPSCHITZ / par[2]};
+size_t oc_edisc_size(int nzkind, int flags) {
+  if (nzkind == OC_ENOISE_NONE) return offsetof(oc_edisc, amplitude);
+  if (flags & OC_EF_GLDEF) return offsetof(oc_edisc, gl);
+  if (flags & OC_EF_GLF) return offsetof(oc_edisc, gl) + 2 * sizeof(float);
+  return offsetof(oc_edisc, gl) + 2 * sizeof(double);
 }
 
+/* The bound over the whole plane: the noise's, from noise_bounds at
+** construction (what it always was). */
 void oc_edisc_glob(const oc_enode *n, oc_ebound *o) {
-  oc_enoise nz;
-  oc_edisc_noise(n, &nz);
-  disc_glob(n, &nz, o);
+  const oc_edisc *d = OC_EDISC(n);
+  double lo = 0, hi = 0, lip = 0;
+  if (n->nzkind != OC_ENOISE_NONE) {
+    hi = d->nhi;
+    lo = n->nzkind == OC_ENOISE_PLAIN ? -hi : 0; /* (noise_bounds' rule) */
+    lip = d->nlip;
+  }
+  *o = (oc_ebound){d->par[3] + lo,
+                   d->par[3] + hi,
+                   0,
+                   1,
+                   lip,
+                   OC_FALLOFF_LIPSCHITZ / d->par[2]};
 }
 
 /* A disc unpacked: what its bounds read. */
@@ -201,7 +213,7 @@ static void unpack(const oc_enode *n, dview *v) {
   v->par = OC_EDISC(n)->par;
   oc_edisc_noise(n, &v->noise);
   v->box = oc_enode_box(n);
-  disc_glob(n, &v->noise, &v->glob);
+  oc_edisc_glob(n, &v->glob);
 }
 
 void oc_edisc_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
@@ -416,14 +428,15 @@ oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err) {
               p->height, p->radius, nz.amplitude, nz.wavelength);
     return NULL;
   }
-  /* gain and lacunarity as floats when they are floats exactly (the
-  ** defaults are): evaluation reads the same doubles */
-  int glf = (double)(float)nz.gain == nz.gain &&
-            (double)(float)nz.lacunarity == nz.lacunarity;
-  size_t size = nz.kind == OC_ENOISE_NONE ? offsetof(oc_edisc, amplitude)
-                : glf ? offsetof(oc_edisc, gl) + 2 * sizeof(float)
-                      : offsetof(oc_edisc, gl) + 2 * sizeof(double);
-  oc_enode *n = oc_enode_alloc(OC_E_DISC, size, NULL, 0, err);
+  /* gain and lacunarity: none stored when they are the defaults, floats
+  ** when they are floats exactly; evaluation reads the same doubles */
+  int flags = nz.gain == 0.5 && nz.lacunarity == 2 ? OC_EF_GLDEF
+              : (double)(float)nz.gain == nz.gain &&
+                      (double)(float)nz.lacunarity == nz.lacunarity
+                  ? OC_EF_GLF
+                  : 0;
+  oc_enode *n =
+      oc_enode_alloc(OC_E_DISC, oc_edisc_size(nz.kind, flags), NULL, 0, err);
   if (!n) return NULL;
   oc_edisc *d = (oc_edisc *)n;
   d->par[0] = p->cx;
@@ -436,14 +449,16 @@ oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err) {
     d->amplitude = nz.amplitude;
     d->wavelength = nz.wavelength;
     d->seed = nz.seed;
-    if (glf) {
-      n->flags |= OC_EF_GLF;
+    d->nhi = hi;
+    d->nlip = lip;
+    n->flags = (uint8_t)flags;
+    if (flags & OC_EF_GLF) {
       d->gl.f[0] = (float)nz.gain;
       d->gl.f[1] = (float)nz.lacunarity;
-    } else {
+    } else if (!flags) {
       d->gl.d[0] = nz.gain;
       d->gl.d[1] = nz.lacunarity;
     }
   }
-  return n; /* (its box and bound: oc_enode_box, disc_glob) */
+  return n; /* (its box and bound: oc_enode_box, oc_edisc_glob) */
 }

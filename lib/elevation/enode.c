@@ -21,9 +21,7 @@ static const char *const kind_names[OC_E_COUNT] = {
 size_t oc_enode_size(const oc_enode *n) {
   switch (n->kind) {
   case OC_E_DISC:
-    if (n->nzkind == OC_ENOISE_NONE) return offsetof(oc_edisc, amplitude);
-    return offsetof(oc_edisc, gl) +
-           (n->flags & OC_EF_GLF ? 2 * sizeof(float) : 2 * sizeof(double));
+    return oc_edisc_size(n->nzkind, n->flags);
   case OC_E_CURVE:
   case OC_E_LAKE:
   case OC_E_IMAGE:

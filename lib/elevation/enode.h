@@ -81,7 +81,8 @@ struct oc_enode {
 };
 
 /* Flags. */
-#define OC_EF_GLF 1 /* disc: gain and lacunarity are floats exactly */
+#define OC_EF_GLF 1   /* disc: gain and lacunarity are floats exactly */
+#define OC_EF_GLDEF 2 /* disc: they are 1/2 and 2 (not stored) */
 
 /* The parameters (doubles) operators store (eops.c, lod.c). */
 #define OC_EREPLACE_NPAR 1
@@ -98,18 +99,21 @@ typedef struct oc_eboundf {
   float flo, fhi, alo, ahi, lf, la;
 } oc_eboundf;
 
-/* disc: 40 bytes, 72 with a noise (80 when gain or lacunarity is not a
-** float). */
+/* disc: 40 bytes; with a noise 80, 88 when gain and lacunarity are not
+** the defaults but floats, 96 else. */
 typedef struct oc_edisc {
   oc_enode h;
   double par[4]; /* cx, cy, radius, height */
   /* with a noise (h.nzkind != OC_ENOISE_NONE): */
   double amplitude, wavelength;
   uint64_t seed;
+  /* the noise sum's bound over the plane (disc.c, noise_bounds): its
+  ** range [-nhi, nhi] (plain) or [0, nhi], its Lipschitz bound nlip */
+  double nhi, nlip;
   union {
     float f[2]; /* OC_EF_GLF */
     double d[2];
-  } gl; /* gain, lacunarity */
+  } gl; /* gain, lacunarity (none with OC_EF_GLDEF) */
 } oc_edisc;
 
 /* curve, lake, image: 96 bytes, and their data (skeleton, profiles,
@@ -200,32 +204,41 @@ static inline const oc_enode *oc_enode_kid(const oc_enode *n, size_t i) {
 ** curve's, lake's or image's as stored, an operator's rounded outward. */
 static inline oc_erect oc_enode_box(const oc_enode *n) {
   const oc_erectf *f;
-  switch (n->kind) {
-  case OC_E_DISC: {
+  if (n->kind == OC_E_DISC) { /* (the commonest child: tested first) */
     const double *p = OC_EDISC(n)->par;
     return (oc_erect){p[0] - p[2], p[1] - p[2], p[0] + p[2], p[1] + p[2]};
   }
-  case OC_E_CURVE:
-  case OC_E_LAKE:
-  case OC_E_IMAGE:
+  if (n->kind == OC_E_CURVE || n->kind == OC_E_LAKE || n->kind == OC_E_IMAGE)
     return OC_EPRIM(n)->box;
-  case OC_E_BLEND:
+  if (n->kind == OC_E_BLEND)
     f = &OC_EBLEND(n)->box;
-    break;
-  case OC_E_XFORM:
-  case OC_E_WARP:
+  else if (n->kind == OC_E_XFORM || n->kind == OC_E_WARP)
     f = &OC_EUN(n)->box;
-    break;
-  default:
+  else
     f = &OC_EBIN(n)->box;
-  }
   return (oc_erect){f->x0, f->y0, f->x1, f->y1};
 }
 
-/* Whether (x, y) is in n's box (NaN is not). */
+/* Whether (x, y) is in n's box (NaN is not); whether n's box meets r.
+** (A disc's tests compare as they always did, its edges computed as they
+** come.) */
 static inline int oc_enode_holds(const oc_enode *n, double x, double y) {
+  if (n->kind == OC_E_DISC) {
+    const double *p = OC_EDISC(n)->par;
+    return x >= p[0] - p[2] && x <= p[0] + p[2] && y >= p[1] - p[2] &&
+           y <= p[1] + p[2];
+  }
   oc_erect b = oc_enode_box(n);
   return x >= b.x0 && x <= b.x1 && y >= b.y0 && y <= b.y1;
+}
+static inline int oc_enode_meets(const oc_enode *n, const oc_erect *r) {
+  if (n->kind == OC_E_DISC) {
+    const double *p = OC_EDISC(n)->par;
+    return p[0] - p[2] <= r->x1 && p[0] + p[2] >= r->x0 &&
+           p[1] - p[2] <= r->y1 && p[1] + p[2] >= r->y0;
+  }
+  oc_erect b = oc_enode_box(n);
+  return b.x0 <= r->x1 && b.x1 >= r->x0 && b.y0 <= r->y1 && b.y1 >= r->y0;
 }
 
 /* The bound of n over the whole plane: exact for primitives, else from
@@ -250,8 +263,10 @@ void oc_eop_derive(const oc_enode *n, const oc_ebound *kb, const oc_erect *kbox,
 void oc_elod_derive(const oc_enode *n, const oc_ebound *kb,
                     const oc_erect *kbox, oc_ebound *glob, oc_erect *box);
 
-/* The noise of a disc, unpacked; and its whole-plane bound (disc.c). */
+/* The noise of a disc, unpacked; its bytes (with those flags); and its
+** whole-plane bound (disc.c). */
 void oc_edisc_noise(const oc_enode *n, oc_enoise *nz);
+size_t oc_edisc_size(int nzkind, int flags);
 void oc_edisc_glob(const oc_enode *n, oc_ebound *o);
 
 /* The bytes of a curve's, lake's or image's data: their skeletons,

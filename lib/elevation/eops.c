@@ -195,8 +195,7 @@ static void blend_bound_in(const oc_enode *n, const oc_erect *b,
   }
   size_t m = 0;
   for (size_t i = 0; i < bl->nkids; i++) {
-    oc_erect kbox = oc_enode_box(bl->kids[i]);
-    if (oc_erect_meets(&kbox, b)) {
+    if (oc_enode_meets(bl->kids[i], b)) {
       oc_enode_bnd(bl->kids[i], b, fb, &kb[m]);
       /* alpha = 0 on the whole box: neither the child's f nor its
       ** weight's slope counts there */
@@ -447,8 +446,7 @@ static void binary_bound_in(const oc_enode *n, const oc_erect *b,
   oc_ebound A, B;
   const oc_ebin *bn = OC_EBIN(n);
   oc_enode_bnd(bn->kids[0], b, fb, &A);
-  oc_erect bbox = oc_enode_box(bn->kids[1]);
-  int meets = oc_erect_meets(&bbox, b);
+  int meets = oc_enode_meets(bn->kids[1], b);
   if (meets) oc_enode_bnd(bn->kids[1], b, fb, &B);
   combine(n, &A, &B, meets, o);
 }

@@ -73,6 +73,7 @@ START_TEST(bytes_per_kind) {
   oc_error err;
   oc_enode *plain = disc(0, 0, 100, 10, OC_ENOISE_NONE, 0, 1);
   oc_enode *noisy = disc(10, 0, 100, 10, OC_ENOISE_RIDGED, 0, 2);
+  oc_enode *fl = disc(0, 10, 100, 10, OC_ENOISE_PLAIN, 0.375, 3);
   oc_enode *odd = disc(0, 10, 100, 10, OC_ENOISE_PLAIN, 0.45, 3);
   oc_enode *riv = river(8, 400);
   double radii[5] = {50, 60, 55, 70, 65};
@@ -97,9 +98,9 @@ START_TEST(bytes_per_kind) {
   struct {
     oc_enode *e;
     size_t bytes;
-  } want[] = {{plain, 40}, {noisy, 72}, {odd, 80},  {riv, 96},  {lake, 96},
-              {img, 96},   {bl, 72},    {rep, 72},  {lerp, 72}, {add, 96},
-              {addb, 96},  {moved, 96}, {warp, 72}, {lod, 88}};
+  } want[] = {{plain, 40}, {noisy, 80}, {fl, 88},    {odd, 96},  {riv, 96},
+              {lake, 96},  {img, 96},   {bl, 72},    {rep, 72},  {lerp, 72},
+              {add, 96},   {addb, 96},  {moved, 96}, {warp, 72}, {lod, 88}};
   for (size_t i = 0; i < sizeof want / sizeof *want; i++) {
     ck_assert_msg(oc_enode_size(want[i].e) == want[i].bytes,
                   "%s (%zu): %zu bytes, want %zu", oc_enode_kind(want[i].e), i,
@@ -123,8 +124,8 @@ START_TEST(bytes_per_kind) {
   oc_enode *bi = EOK(oc_enode_blend(ki, 3, &err));
   ck_assert_uint_eq(bytes_of(bi),
                     oc_enode_size(bi) + bytes_of(img) + bytes_of(img2) - gb);
-  oc_enode *all[] = {plain, noisy, odd,  riv,   lake, img, img2, bl,   rep,
-                     lerp,  add,   addb, moved, warp, lod, b5,   riv2, bi};
+  oc_enode *all[] = {fl,   plain, noisy, odd,   riv,  lake, img, img2, bl, rep,
+                     lerp, add,   addb,  moved, warp, lod,  b5,  riv2, bi};
   for (size_t i = 0; i < sizeof all / sizeof *all; i++)
     oc_enode_release(all[i]);
   oc_heightfield_release(hf);
@@ -266,7 +267,7 @@ START_TEST(scripts_see_exact_bounds) {
   oc_erect fb = oc_enode_box(e);
   ck_assert(fb.x0 < box[0] && fb.y0 < box[1] && fb.x1 == 401 && box[2] == 401 &&
             fb.y1 > box[3]);
-      /* (401 is a float) */ /* rounded outward */
+  /* (401 is a float) */ /* rounded outward */
   /* the Lipschitz bound: blend_combine's in doubles of the discs' */
   oc_ebound ga, gb, x;
   oc_erect xb;
