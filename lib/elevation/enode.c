@@ -121,40 +121,33 @@ void oc_enode_glob(const oc_enode *n, oc_ebound *o) {
   }
 }
 
-/* The children's exact bounds, then the node's from them; children past
-** what memory allows count with their stored (wider) bounds. */
+/* The children's exact bounds, then the node's from them. Recursive (as
+** evaluation is) with a small frame: more children than STACK take the
+** heap, and without memory the stored (wider) bounds answer. */
 void oc_enode_exact(const oc_enode *n, oc_ebound *glob, oc_erect *box) {
+  enum { STACK = 4 };
   size_t nk = oc_enode_nkids(n);
-  if (nk == 0) {
-    oc_enode_glob(n, glob);
-    *box = oc_enode_box(n);
-    return;
-  }
-  enum { STACK = 8 };
   oc_ebound kbs[STACK], *kb = kbs;
   oc_erect kboxs[STACK], *kbox = kboxs;
-  if (nk > STACK) {
-    kb = malloc(nk * sizeof *kb);
-    kbox = malloc(nk * sizeof *kbox);
+  void *heap = NULL;
+  if (nk > STACK) { /* both arrays in one block (doubles throughout) */
+    heap = malloc(nk * (sizeof *kb + sizeof *kbox));
+    kb = heap;
+    kbox = heap ? (oc_erect *)(void *)(kb + nk) : NULL;
   }
-  oc_enode *const *k = oc_enode_kids(n);
-  if (!kb || !kbox) { /* (stored bounds contain the exact ones) */
-    free(kb);
-    free(kbox);
+  if (nk == 0 || !kb) {
     oc_enode_glob(n, glob);
     *box = oc_enode_box(n);
     return;
   }
+  oc_enode *const *k = oc_enode_kids(n);
   for (size_t i = 0; i < nk; i++)
     oc_enode_exact(k[i], &kb[i], &kbox[i]);
   if (n->kind == OC_E_LOD)
     oc_elod_derive(n, kb, kbox, glob, box);
   else
     oc_eop_derive(n, kb, kbox, glob, box);
-  if (kb != kbs) {
-    free(kb);
-    free(kbox);
-  }
+  free(heap);
 }
 
 void oc_enode_retain(oc_enode *e) {
