@@ -20,7 +20,7 @@ typedef struct piece {
   const oc_vec3 *p;   /* in pts */
   double s0, len;     /* arc length at the start, and of the piece */
   double scale;       /* xy length of the control polygon */
-  uint32_t tab, ntab; /* arc-length knots tt/ts[tab .. tab + ntab] (Bézier) */
+  uint32_t tab, ntab; /* Bézier: ntab spans, their inner knots at tt/ts[tab] */
   int deg;
 } piece;
 
@@ -93,7 +93,9 @@ static void *shrink(void *a, size_t n, size_t size) {
 ** 8-point rule on a span agrees with the rule on its halves to 1e-14 of
 ** the piece's scale (a span then carries ~1e-16 of error, well inside the
 ** documented 1e-9); depth is capped at 24 (cusps, where the speed has a
-** kink). Knots are appended in order; the piece's length is returned. */
+** kink). The knots between spans are appended in order (the ends, (0, 0)
+** and (1, length), are not stored: knot_t, knot_s); the piece's length is
+** returned. */
 static int tabulate(piece *pc, knots *k, double *len) {
   struct {
     double a, b;
@@ -101,8 +103,8 @@ static int tabulate(piece *pc, knots *k, double *len) {
   } st[32];
   int top = 0;
   double s = 0, tol = 1e-14 * pc->scale;
+  uint32_t spans = 0;
   pc->tab = (uint32_t)k->n;
-  if (!knots_push(k, 0, 0)) return 0;
   st[top].a = 0, st[top].b = 1, st[top].depth = 0, top++;
   while (top > 0) {
     double a = st[top - 1].a, b = st[top - 1].b, m = 0.5 * (a + b);
@@ -113,13 +115,14 @@ static int tabulate(piece *pc, knots *k, double *len) {
                     oc_bez_arclen(pc->p, pc->deg, m, b);
     if (depth >= 24 || (depth >= 2 && fabs(whole - halves) <= tol)) {
       s += halves;
-      if (!knots_push(k, b, s)) return 0;
+      spans++;
+      if (top > 0 && !knots_push(k, b, s)) return 0; /* (the last: b = 1) */
       continue;
     }
     st[top].a = m, st[top].b = b, st[top].depth = depth + 1, top++;
     st[top].a = a, st[top].b = m, st[top].depth = depth + 1, top++;
   }
-  pc->ntab = (uint32_t)(k->n - pc->tab - 1);
+  pc->ntab = spans;
   *len = s;
   return 1;
 }
@@ -452,12 +455,21 @@ oc_aabb oc_curve_bounds(const oc_pcurve *c, double r) {
 
 /* ---- arc length <-> parameter ------------------------------------------ */
 
-/* The knot span k of a Bézier piece with tt[k] <= t < tt[k + 1]. */
+/* Knot j (0 .. ntab) of a Bézier piece: its parameter and its arc
+** length (the ends are 0 and 0, 1 and the piece's length). */
+static double knot_t(const oc_pcurve *c, const piece *pc, size_t j) {
+  return j == 0 ? 0 : j == pc->ntab ? 1 : c->tt[pc->tab + j - 1];
+}
+static double knot_s(const oc_pcurve *c, const piece *pc, size_t j) {
+  return j == 0 ? 0 : j == pc->ntab ? pc->len : c->ts[pc->tab + j - 1];
+}
+
+/* The knot span k of a Bézier piece with knot k <= t < knot k + 1. */
 static size_t span_of_t(const oc_pcurve *c, const piece *pc, double t) {
-  size_t lo = pc->tab, hi = pc->tab + pc->ntab; /* tt[lo] = 0, tt[hi] = 1 */
+  size_t lo = 0, hi = pc->ntab;
   while (hi - lo > 1) {
     size_t m = lo + (hi - lo) / 2;
-    if (c->tt[m] <= t)
+    if (knot_t(c, pc, m) <= t)
       lo = m;
     else
       hi = m;
@@ -471,7 +483,7 @@ static double s_of_t(const oc_pcurve *c, const piece *pc, double t) {
   if (t <= 0) return 0;
   if (pc->deg == 1) return t * pc->len;
   size_t k = span_of_t(c, pc, t);
-  return c->ts[k] + oc_bez_arclen(pc->p, pc->deg, c->tt[k], t);
+  return knot_s(c, pc, k) + oc_bez_arclen(pc->p, pc->deg, knot_t(c, pc, k), t);
 }
 
 /* The parameter at arc length sl from the start of the piece: Newton on
@@ -480,19 +492,19 @@ static double t_of_s(const oc_pcurve *c, const piece *pc, double sl) {
   if (sl <= 0) return 0;
   if (sl >= pc->len) return 1;
   if (pc->deg == 1) return sl / pc->len;
-  size_t lo = pc->tab, hi = pc->tab + pc->ntab;
+  size_t lo = 0, hi = pc->ntab;
   while (hi - lo > 1) {
     size_t m = lo + (hi - lo) / 2;
-    if (c->ts[m] <= sl)
+    if (knot_s(c, pc, m) <= sl)
       lo = m;
     else
       hi = m;
   }
-  double a = c->tt[lo], b = c->tt[lo + 1], s0 = c->ts[lo];
-  double ds = c->ts[lo + 1] - s0;
+  double a = knot_t(c, pc, lo), b = knot_t(c, pc, lo + 1);
+  double s0 = knot_s(c, pc, lo), ds = knot_s(c, pc, lo + 1) - s0;
   double t = ds > 0 ? a + (b - a) * (sl - s0) / ds : a;
   for (int it = 0; it < 60; it++) {
-    double g = s0 + oc_bez_arclen(pc->p, pc->deg, c->tt[lo], t) - sl;
+    double g = s0 + oc_bez_arclen(pc->p, pc->deg, knot_t(c, pc, lo), t) - sl;
     if (g == 0) break;
     if (g < 0)
       a = t;
