@@ -202,43 +202,57 @@ static inline const oc_enode *oc_enode_kid(const oc_enode *n, size_t i) {
 
 /* The box of n (Omega_0 lies inside): a disc's exactly as built, a
 ** curve's, lake's or image's as stored, an operator's rounded outward. */
+/* Curves, lakes and images keep a double box; operators a float one, at
+** the same place in each of their layouts. */
+#define OC_EPRIM_KIND(k)                                                       \
+  ((1u << (k)) & ((1u << OC_E_CURVE) | (1u << OC_E_LAKE) | (1u << OC_E_IMAGE)))
+_Static_assert(offsetof(oc_eblend, box) == offsetof(oc_ebin, box) &&
+                   offsetof(oc_eblend, box) == offsetof(oc_eun, box),
+               "operators keep their box at one offset");
+static inline const oc_erectf *oc_enode_boxf(const oc_enode *n) {
+  return &OC_EBLEND(n)->box;
+}
+
 static inline oc_erect oc_enode_box(const oc_enode *n) {
-  const oc_erectf *f;
   if (n->kind == OC_E_DISC) { /* (the commonest child: tested first) */
     const double *p = OC_EDISC(n)->par;
     return (oc_erect){p[0] - p[2], p[1] - p[2], p[0] + p[2], p[1] + p[2]};
   }
-  if (n->kind == OC_E_CURVE || n->kind == OC_E_LAKE || n->kind == OC_E_IMAGE)
-    return OC_EPRIM(n)->box;
-  if (n->kind == OC_E_BLEND)
-    f = &OC_EBLEND(n)->box;
-  else if (n->kind == OC_E_XFORM || n->kind == OC_E_WARP)
-    f = &OC_EUN(n)->box;
-  else
-    f = &OC_EBIN(n)->box;
+  if (OC_EPRIM_KIND(n->kind)) return OC_EPRIM(n)->box;
+  const oc_erectf *f = oc_enode_boxf(n);
   return (oc_erect){f->x0, f->y0, f->x1, f->y1};
 }
 
 /* Whether (x, y) is in n's box (NaN is not); whether n's box meets r.
 ** (A disc's tests compare as they always did, its edges computed as they
-** come.) */
+** come; one side at a time.) */
+static inline int oc_edisc_holds(const oc_enode *n, double x, double y) {
+  const double *p = OC_EDISC(n)->par;
+  return x >= p[0] - p[2] && x <= p[0] + p[2] && y >= p[1] - p[2] &&
+         y <= p[1] + p[2];
+}
 static inline int oc_enode_holds(const oc_enode *n, double x, double y) {
-  if (n->kind == OC_E_DISC) {
-    const double *p = OC_EDISC(n)->par;
-    return x >= p[0] - p[2] && x <= p[0] + p[2] && y >= p[1] - p[2] &&
-           y <= p[1] + p[2];
+  if (n->kind == OC_E_DISC) return oc_edisc_holds(n, x, y);
+  if (OC_EPRIM_KIND(n->kind)) {
+    const oc_erect *b = &OC_EPRIM(n)->box;
+    return x >= b->x0 && x <= b->x1 && y >= b->y0 && y <= b->y1;
   }
-  oc_erect b = oc_enode_box(n);
-  return x >= b.x0 && x <= b.x1 && y >= b.y0 && y <= b.y1;
+  const oc_erectf *f = oc_enode_boxf(n);
+  return x >= f->x0 && x <= f->x1 && y >= f->y0 && y <= f->y1;
+}
+static inline int oc_edisc_meets(const oc_enode *n, const oc_erect *r) {
+  const double *p = OC_EDISC(n)->par;
+  return p[0] - p[2] <= r->x1 && p[0] + p[2] >= r->x0 && p[1] - p[2] <= r->y1 &&
+         p[1] + p[2] >= r->y0;
 }
 static inline int oc_enode_meets(const oc_enode *n, const oc_erect *r) {
-  if (n->kind == OC_E_DISC) {
-    const double *p = OC_EDISC(n)->par;
-    return p[0] - p[2] <= r->x1 && p[0] + p[2] >= r->x0 &&
-           p[1] - p[2] <= r->y1 && p[1] + p[2] >= r->y0;
+  if (n->kind == OC_E_DISC) return oc_edisc_meets(n, r);
+  if (OC_EPRIM_KIND(n->kind)) {
+    const oc_erect *b = &OC_EPRIM(n)->box;
+    return b->x0 <= r->x1 && b->x1 >= r->x0 && b->y0 <= r->y1 && b->y1 >= r->y0;
   }
-  oc_erect b = oc_enode_box(n);
-  return b.x0 <= r->x1 && b.x1 >= r->x0 && b.y0 <= r->y1 && b.y1 >= r->y0;
+  const oc_erectf *f = oc_enode_boxf(n);
+  return f->x0 <= r->x1 && f->x1 >= r->x0 && f->y0 <= r->y1 && f->y1 >= r->y0;
 }
 
 /* The bound of n over the whole plane: exact for primitives, else from

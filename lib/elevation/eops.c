@@ -195,8 +195,9 @@ static void blend_bound_in(const oc_enode *n, const oc_erect *b,
   }
   size_t m = 0;
   for (size_t i = 0; i < bl->nkids; i++) {
-    if (oc_enode_meets(bl->kids[i], b)) {
-      oc_enode_bnd(bl->kids[i], b, fb, &kb[m]);
+    const oc_enode *k = bl->kids[i];
+    if (oc_enode_meets(k, b)) {
+      oc_enode_bnd(k, b, fb, &kb[m]);
       /* alpha = 0 on the whole box: neither the child's f nor its
       ** weight's slope counts there */
       m += kb[m].ahi > 0;
