@@ -62,9 +62,9 @@ typedef struct oc_enoise {
 ** (doubles); what only bounds read is kept as floats rounded outward
 ** (oc_erectf, oc_eboundf: never tighter than the double they round), or
 ** derived when that is cheap:
-**  - a disc's box and whole-plane bound come from its parameters, so they
-**    are the doubles they always were; a transform's and a warp's bound
-**    from their child's;
+**  - a disc's box and whole-plane bound come from its parameters (and
+**    its noise's range and slope, kept), so they are the doubles they
+**    always were; a transform's and a warp's bound from their child's;
 **  - curves, lakes and images keep theirs as doubles (their data dwarfs
 **    them);
 **  - operators keep both as floats. The exact doubles (what construction
