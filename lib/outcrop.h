@@ -1395,7 +1395,8 @@ void oc_enode_bound_in(const oc_enode *e, double x0, double y0, double x1,
 typedef struct oc_enode_stats {
   size_t nodes;      /* distinct nodes of the DAG */
   size_t primitives; /* distinct primitives */
-  size_t bytes;      /* their memory */
+  size_t bytes;      /* their memory, with the data of curves, lakes and
+                     ** images (skeletons, profiles, grids: each once) */
 } oc_enode_stats;
 /* OC_OK, or OC_ENOMEM with err. */
 int oc_enode_get_stats(const oc_enode *e, oc_enode_stats *st, oc_error *err);

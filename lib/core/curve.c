@@ -4,6 +4,7 @@
 ** query, frames, curvature and turning bounds, flattening.
 */
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -13,24 +14,35 @@
 #include "core/error.h"
 #include "core/vec.h"
 
+/* A piece's control points are deg + 1 consecutive points of the curve's
+** pts, its first the previous piece's last (so each is stored once). */
 typedef struct piece {
+  const oc_vec3 *p;   /* in pts */
+  double s0, len;     /* arc length at the start, and of the piece */
+  double scale;       /* xy length of the control polygon */
+  uint32_t tab, ntab; /* Bézier: ntab spans, their inner knots at tt/ts[tab] */
   int deg;
-  oc_vec3 p[4];
-  double s0, len;   /* arc length at the start, and of the piece */
-  double scale;     /* xy length of the control polygon */
-  size_t tab, ntab; /* arc-length knots tt/ts[tab .. tab + ntab] (Bézier) */
 } piece;
 
-/* Box tree node over pieces [lo, hi); its left child follows it, `right`
-** is the index of the right child. */
+/* Box tree node: a leaf (right = 0) holds piece `piece`; else its left
+** child follows it and `right` is the index of the right child. */
 typedef struct bnode {
   double x0, y0, x1, y1;
-  size_t lo, hi, right;
+  uint32_t right, piece;
 } bnode;
+
+/* A piece while the curve is built. */
+typedef struct rawpiece {
+  int deg;
+  oc_vec3 p[4];
+  double scale;
+} rawpiece;
 
 struct oc_pcurve {
   size_t n;
   piece *pc;
+  oc_vec3 *pts; /* the pieces' control points, shared ends once */
+  size_t npts;
   double *tt, *ts; /* knots: parameter and arc length from the piece start */
   size_t nknots;
   bnode *bvh;
@@ -54,6 +66,7 @@ typedef struct knots {
 } knots;
 
 static int knots_push(knots *k, double t, double s) {
+  if (k->n >= UINT32_MAX) return 0; /* (piece.tab's range) */
   if (k->n == k->cap) {
     size_t cap = k->cap ? 2 * k->cap : 64, bytes;
     if (!oc_mul_size(cap, sizeof(double), &bytes)) return 0;
@@ -69,11 +82,20 @@ static int knots_push(knots *k, double t, double s) {
   return 1;
 }
 
+/* a, of n items of size or more, cut to n (kept as it is if realloc
+** fails or n is 0). */
+static void *shrink(void *a, size_t n, size_t size) {
+  void *b = n ? realloc(a, n * size) : NULL;
+  return b ? b : a;
+}
+
 /* Tabulates the arc length of a Bézier piece: [0, 1] is split until the
 ** 8-point rule on a span agrees with the rule on its halves to 1e-14 of
 ** the piece's scale (a span then carries ~1e-16 of error, well inside the
 ** documented 1e-9); depth is capped at 24 (cusps, where the speed has a
-** kink). Knots are appended in order; the piece's length is returned. */
+** kink). The knots between spans are appended in order (the ends, (0, 0)
+** and (1, length), are not stored: knot_t, knot_s); the piece's length is
+** returned. */
 static int tabulate(piece *pc, knots *k, double *len) {
   struct {
     double a, b;
@@ -81,8 +103,8 @@ static int tabulate(piece *pc, knots *k, double *len) {
   } st[32];
   int top = 0;
   double s = 0, tol = 1e-14 * pc->scale;
-  pc->tab = k->n;
-  if (!knots_push(k, 0, 0)) return 0;
+  uint32_t spans = 0;
+  pc->tab = (uint32_t)k->n;
   st[top].a = 0, st[top].b = 1, st[top].depth = 0, top++;
   while (top > 0) {
     double a = st[top - 1].a, b = st[top - 1].b, m = 0.5 * (a + b);
@@ -93,13 +115,14 @@ static int tabulate(piece *pc, knots *k, double *len) {
                     oc_bez_arclen(pc->p, pc->deg, m, b);
     if (depth >= 24 || (depth >= 2 && fabs(whole - halves) <= tol)) {
       s += halves;
-      if (!knots_push(k, b, s)) return 0;
+      spans++;
+      if (top > 0 && !knots_push(k, b, s)) return 0; /* (the last: b = 1) */
       continue;
     }
     st[top].a = m, st[top].b = b, st[top].depth = depth + 1, top++;
     st[top].a = a, st[top].b = m, st[top].depth = depth + 1, top++;
   }
-  pc->ntab = k->n - pc->tab - 1;
+  pc->ntab = spans;
   *len = s;
   return 1;
 }
@@ -167,7 +190,7 @@ static void piece_box(const piece *pc, oc_aabb *box) {
 static size_t build_bvh(oc_pcurve *c, size_t lo, size_t hi, size_t *next) {
   size_t i = (*next)++;
   bnode *b = &c->bvh[i];
-  b->lo = lo, b->hi = hi, b->right = 0;
+  b->right = 0, b->piece = (uint32_t)lo;
   if (hi - lo == 1) {
     const piece *pc = &c->pc[lo];
     b->x0 = b->x1 = pc->p[0].x, b->y0 = b->y1 = pc->p[0].y;
@@ -180,7 +203,7 @@ static size_t build_bvh(oc_pcurve *c, size_t lo, size_t hi, size_t *next) {
   size_t mid = lo + (hi - lo) / 2;
   size_t l = build_bvh(c, lo, mid, next), r = build_bvh(c, mid, hi, next);
   b = &c->bvh[i];
-  b->right = r;
+  b->right = (uint32_t)r;
   b->x0 = fmin(c->bvh[l].x0, c->bvh[r].x0);
   b->y0 = fmin(c->bvh[l].y0, c->bvh[r].y0);
   b->x1 = fmax(c->bvh[l].x1, c->bvh[r].x1);
@@ -234,24 +257,27 @@ oc_pcurve *oc_curve_new(const oc_curve_piece *pieces, size_t n, oc_error *err) {
     }
   }
   oc_pcurve *c = calloc(1, sizeof *c);
-  size_t bytes;
-  if (!c || !oc_mul_size(n, sizeof(piece), &bytes) ||
-      !(c->pc = malloc(bytes))) {
+  rawpiece *raw = NULL;
+  size_t bytes, nraw = 0;
+  if (!c || !oc_mul_size(n, sizeof *raw, &bytes) || !(raw = malloc(bytes))) {
     free(c);
     oc_seterr(err, OC_ENOMEM, "out of memory for a curve of %zu pieces", n);
     return NULL;
   }
   oc_vec3 last = pieces[0].p[0];
   for (size_t i = 0; i < n; i++) {
-    piece pc = {0};
+    rawpiece pc = {0};
     pc.deg = pieces[i].degree;
     memcpy(pc.p, pieces[i].p, sizeof pc.p);
     pc.p[0] = last; /* snap to the previous end */
     pc.scale = poly_len_xy(pc.p, pc.deg);
     last = pc.p[pc.deg];
     if (pc.scale == 0) {
+      /* (all its points are then the previous end: dropping it leaves the
+      ** next piece starting where the one before ends) */
       for (int k = 1; k <= pc.deg; k++)
         if (pc.p[k].z != pc.p[0].z) {
+          free(raw);
           oc_curve_free(c);
           oc_seterr(err, OC_EINVAL,
                     "piece %zu has no length in xy but its z changes", i);
@@ -259,20 +285,47 @@ oc_pcurve *oc_curve_new(const oc_curve_piece *pieces, size_t n, oc_error *err) {
         }
       continue;
     }
-    c->pc[c->n++] = pc;
+    raw[nraw++] = pc;
   }
-  if (c->n == 0) {
+  if (nraw == 0) {
+    free(raw);
     oc_curve_free(c);
     oc_seterr(err, OC_EINVAL,
               "the curve has no length (every piece is a point in xy)");
     return NULL;
   }
-  piece *first = &c->pc[0], *end = &c->pc[c->n - 1];
-  if (same_point(end->p[end->deg], first->p[0], jtol) &&
-      (c->n > 1 || end->deg > 1)) {
+  rawpiece *rfirst = &raw[0], *rend = &raw[nraw - 1];
+  if (same_point(rend->p[rend->deg], rfirst->p[0], jtol) &&
+      (nraw > 1 || rend->deg > 1)) {
     c->closed = 1;
-    end->p[end->deg] = first->p[0];
+    rend->p[rend->deg] = rfirst->p[0];
   }
+  /* the points, each shared end once, and the pieces on them */
+  c->npts = 1;
+  for (size_t i = 0; i < nraw; i++)
+    c->npts += (size_t)raw[i].deg;
+  if (!(c->pc = malloc(nraw * sizeof *c->pc)) ||
+      !(c->pts = malloc(c->npts * sizeof *c->pts))) {
+    free(raw);
+    oc_curve_free(c);
+    oc_seterr(err, OC_ENOMEM, "out of memory for a curve of %zu pieces", n);
+    return NULL;
+  }
+  size_t at = 0;
+  c->pts[0] = raw[0].p[0];
+  for (size_t i = 0; i < nraw; i++) {
+    piece *pc = &c->pc[i];
+    memset(pc, 0, sizeof *pc);
+    pc->deg = raw[i].deg;
+    pc->scale = raw[i].scale;
+    pc->p = &c->pts[at];
+    for (int k = 1; k <= pc->deg; k++)
+      c->pts[at + (size_t)k] = raw[i].p[k];
+    at += (size_t)pc->deg;
+  }
+  c->n = nraw;
+  free(raw);
+  piece *first = &c->pc[0], *end = &c->pc[c->n - 1];
 
   knots k = {0};
   double s = 0;
@@ -293,7 +346,10 @@ oc_pcurve *oc_curve_new(const oc_curve_piece *pieces, size_t n, oc_error *err) {
     s += len;
     piece_box(pc, &c->box);
   }
-  c->tt = k.t, c->ts = k.s, c->nknots = k.n;
+  /* the tables' spare capacity, given back */
+  c->tt = shrink(k.t, k.n, sizeof *k.t);
+  c->ts = shrink(k.s, k.n, sizeof *k.s);
+  c->nknots = k.n;
   c->length = s;
   for (size_t i = 0; i < c->n; i++)
     c->kappa = fmax(
@@ -302,7 +358,7 @@ oc_pcurve *oc_curve_new(const oc_curve_piece *pieces, size_t n, oc_error *err) {
     c->turn = fmax(c->turn, turn_at(&c->pc[i - 1], &c->pc[i]));
   if (c->closed) c->turn = fmax(c->turn, turn_at(end, first));
 
-  if (!oc_mul_size(2 * c->n, sizeof(bnode), &bytes) ||
+  if (!oc_mul_size(2 * c->n - 1, sizeof(bnode), &bytes) ||
       !(c->bvh = malloc(bytes))) {
     oc_curve_free(c);
     oc_seterr(err, OC_ENOMEM, "out of memory for a curve of %zu pieces", n);
@@ -343,10 +399,17 @@ oc_pcurve *oc_curve_from_points(const oc_vec3 *pts, size_t n, int degree,
 void oc_curve_free(oc_pcurve *c) {
   if (!c) return;
   free(c->pc);
+  free(c->pts);
   free(c->tt);
   free(c->ts);
   free(c->bvh);
   free(c);
+}
+
+size_t oc_curve_bytes(const oc_pcurve *c) {
+  return sizeof *c + c->n * sizeof *c->pc + c->npts * sizeof *c->pts +
+         c->nknots * (sizeof *c->tt + sizeof *c->ts) +
+         (2 * c->n - 1) * sizeof *c->bvh;
 }
 
 size_t oc_curve_npieces(const oc_pcurve *c) {
@@ -392,12 +455,21 @@ oc_aabb oc_curve_bounds(const oc_pcurve *c, double r) {
 
 /* ---- arc length <-> parameter ------------------------------------------ */
 
-/* The knot span k of a Bézier piece with tt[k] <= t < tt[k + 1]. */
+/* Knot j (0 .. ntab) of a Bézier piece: its parameter and its arc
+** length (the ends are 0 and 0, 1 and the piece's length). */
+static double knot_t(const oc_pcurve *c, const piece *pc, size_t j) {
+  return j == 0 ? 0 : j == pc->ntab ? 1 : c->tt[pc->tab + j - 1];
+}
+static double knot_s(const oc_pcurve *c, const piece *pc, size_t j) {
+  return j == 0 ? 0 : j == pc->ntab ? pc->len : c->ts[pc->tab + j - 1];
+}
+
+/* The knot span k of a Bézier piece with knot k <= t < knot k + 1. */
 static size_t span_of_t(const oc_pcurve *c, const piece *pc, double t) {
-  size_t lo = pc->tab, hi = pc->tab + pc->ntab; /* tt[lo] = 0, tt[hi] = 1 */
+  size_t lo = 0, hi = pc->ntab;
   while (hi - lo > 1) {
     size_t m = lo + (hi - lo) / 2;
-    if (c->tt[m] <= t)
+    if (knot_t(c, pc, m) <= t)
       lo = m;
     else
       hi = m;
@@ -411,7 +483,7 @@ static double s_of_t(const oc_pcurve *c, const piece *pc, double t) {
   if (t <= 0) return 0;
   if (pc->deg == 1) return t * pc->len;
   size_t k = span_of_t(c, pc, t);
-  return c->ts[k] + oc_bez_arclen(pc->p, pc->deg, c->tt[k], t);
+  return knot_s(c, pc, k) + oc_bez_arclen(pc->p, pc->deg, knot_t(c, pc, k), t);
 }
 
 /* The parameter at arc length sl from the start of the piece: Newton on
@@ -420,19 +492,19 @@ static double t_of_s(const oc_pcurve *c, const piece *pc, double sl) {
   if (sl <= 0) return 0;
   if (sl >= pc->len) return 1;
   if (pc->deg == 1) return sl / pc->len;
-  size_t lo = pc->tab, hi = pc->tab + pc->ntab;
+  size_t lo = 0, hi = pc->ntab;
   while (hi - lo > 1) {
     size_t m = lo + (hi - lo) / 2;
-    if (c->ts[m] <= sl)
+    if (knot_s(c, pc, m) <= sl)
       lo = m;
     else
       hi = m;
   }
-  double a = c->tt[lo], b = c->tt[lo + 1], s0 = c->ts[lo];
-  double ds = c->ts[lo + 1] - s0;
+  double a = knot_t(c, pc, lo), b = knot_t(c, pc, lo + 1);
+  double s0 = knot_s(c, pc, lo), ds = knot_s(c, pc, lo + 1) - s0;
   double t = ds > 0 ? a + (b - a) * (sl - s0) / ds : a;
   for (int it = 0; it < 60; it++) {
-    double g = s0 + oc_bez_arclen(pc->p, pc->deg, c->tt[lo], t) - sl;
+    double g = s0 + oc_bez_arclen(pc->p, pc->deg, knot_t(c, pc, lo), t) - sl;
     if (g == 0) break;
     if (g < 0)
       a = t;
@@ -518,10 +590,10 @@ int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
   while (top > 0) {
     const bnode *b = &c->bvh[st[--top]];
     if (box_d2(b, x, y) >= best) continue;
-    if (b->hi - b->lo == 1) {
-      const piece *pc = &c->pc[b->lo];
+    if (!b->right) {
+      const piece *pc = &c->pc[b->piece];
       double t, d2 = oc_bez_closest(pc->p, pc->deg, x, y, best, &t);
-      if (d2 < best) best = d2, bp = b->lo, bt = t, found = 1;
+      if (d2 < best) best = d2, bp = b->piece, bt = t, found = 1;
       continue;
     }
     size_t l = (size_t)(b - c->bvh) + 1, rr = b->right;

@@ -61,6 +61,7 @@ oc_pcurve *oc_curve_from_points(const oc_vec3 *pts, size_t n, int degree,
 void oc_curve_free(oc_pcurve *c);
 
 size_t oc_curve_npieces(const oc_pcurve *c); /* pieces kept */
+size_t oc_curve_bytes(const oc_pcurve *c);   /* the memory it holds */
 int oc_curve_closed(const oc_pcurve *c);
 /* Total xy arc length. Each Bézier piece's arc length is tabulated at
 ** build (adaptive Gauss–Legendre); the length and every s below are

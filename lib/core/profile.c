@@ -55,6 +55,12 @@ static void interval(oc_profile *p, double a, double b, double va, double vb,
   set_piece(p, xi, va + (xi - a) * 0.5 * (sa + sbar), sbar, sb, b);
 }
 
+/* a, of n doubles or more, cut to n (kept as it is if realloc fails). */
+static double *shrink(double *a, size_t n) {
+  double *b = realloc(a, n * sizeof *a);
+  return b ? b : a;
+}
+
 oc_profile *oc_profile_new(const double *x, const double *v, size_t n,
                            oc_error *err) {
   if (n < 2 || !x || !v) {
@@ -104,6 +110,11 @@ oc_profile *oc_profile_new(const double *x, const double *v, size_t n,
     sprev = snext;
   }
   p->bx[p->np] = x[n - 1];
+  /* the capacity of breakpoints not inserted, given back */
+  p->bx = shrink(p->bx, p->np + 1);
+  p->pv = shrink(p->pv, p->np + 1);
+  p->ps = shrink(p->ps, p->np + 1);
+  p->pc = shrink(p->pc, p->np + 1);
   p->vfirst = v[0], p->vlast = v[n - 1];
   /* flat runs of equal values at the ends are exactly constant */
   size_t j = 0, k = n - 1;
@@ -125,6 +136,10 @@ void oc_profile_free(oc_profile *p) {
   free(p->ps);
   free(p->pc);
   free(p);
+}
+
+size_t oc_profile_bytes(const oc_profile *p) {
+  return sizeof *p + 4 * (p->np + 1) * sizeof(double);
 }
 
 size_t oc_profile_nbreaks(const oc_profile *p) {

@@ -52,6 +52,9 @@ double oc_profile_max_slope(const oc_profile *p, double a, double b);
 void oc_profile_support(const oc_profile *p, double *lo, double *hi);
 double oc_profile_half_width(const oc_profile *p);
 
+/* The bytes p holds. */
+size_t oc_profile_bytes(const oc_profile *p);
+
 /* Breakpoints of the spline (knots plus inserted points), for tests. */
 size_t oc_profile_nbreaks(const oc_profile *p);
 

@@ -9,6 +9,7 @@
 ** prints a_i lambda_eta / s_i).
 */
 #include <math.h>
+#include <stddef.h>
 
 #include "core/error.h"
 #include "core/falloff.h"
@@ -151,9 +152,73 @@ static void noise_bounds(const oc_enoise *nz, const oc_efootb *fb, double *lo,
   *lip = l;
 }
 
+void oc_edisc_noise(const oc_enode *n, oc_enoise *nz) {
+  const oc_edisc *d = OC_EDISC(n);
+  nz->kind = n->nzkind;
+  nz->octaves = n->octaves;
+  if (n->nzkind == OC_ENOISE_NONE) {
+    nz->amplitude = nz->wavelength = nz->gain = nz->lacunarity = 0;
+    nz->seed = 0;
+    return;
+  }
+  nz->amplitude = d->amplitude;
+  nz->wavelength = d->wavelength;
+  nz->seed = d->seed;
+  if (n->flags & OC_EF_GLDEF) {
+    nz->gain = 0.5;
+    nz->lacunarity = 2;
+  } else if (n->flags & OC_EF_GLF) {
+    nz->gain = d->gl.f[0];
+    nz->lacunarity = d->gl.f[1];
+  } else {
+    nz->gain = d->gl.d[0];
+    nz->lacunarity = d->gl.d[1];
+  }
+}
+
+size_t oc_edisc_size(int nzkind, int flags) {
+  if (nzkind == OC_ENOISE_NONE) return offsetof(oc_edisc, amplitude);
+  if (flags & OC_EF_GLDEF) return offsetof(oc_edisc, gl);
+  if (flags & OC_EF_GLF) return offsetof(oc_edisc, gl) + 2 * sizeof(float);
+  return offsetof(oc_edisc, gl) + 2 * sizeof(double);
+}
+
+/* The bound over the whole plane: the noise's, from noise_bounds at
+** construction (what it always was). */
+void oc_edisc_glob(const oc_enode *n, oc_ebound *o) {
+  const oc_edisc *d = OC_EDISC(n);
+  double lo = 0, hi = 0, lip = 0;
+  if (n->nzkind != OC_ENOISE_NONE) {
+    hi = d->nhi;
+    lo = n->nzkind == OC_ENOISE_PLAIN ? -hi : 0; /* (noise_bounds' rule) */
+    lip = d->nlip;
+  }
+  *o = (oc_ebound){d->par[3] + lo,
+                   d->par[3] + hi,
+                   0,
+                   1,
+                   lip,
+                   OC_FALLOFF_LIPSCHITZ / d->par[2]};
+}
+
+/* A disc unpacked: what its bounds read. */
+typedef struct dview {
+  const double *par; /* cx, cy, r, height */
+  oc_enoise noise;
+  oc_erect box;   /* Omega_0 lies inside */
+  oc_ebound glob; /* over the whole plane */
+} dview;
+
+static void unpack(const oc_enode *n, dview *v) {
+  v->par = OC_EDISC(n)->par;
+  oc_edisc_noise(n, &v->noise);
+  v->box = oc_enode_box(n);
+  oc_edisc_glob(n, &v->glob);
+}
+
 void oc_edisc_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                  int want, oc_enode_sample *s) {
-  const double *p = n->par; /* cx, cy, r, height */
+  const double *p = OC_EDISC(n)->par; /* cx, cy, r, height */
   double u = x - p[0], v = y - p[1], r = p[2];
   double q = (u * u + v * v) / (r * r);
   int grad = want & OC_EV_GRAD;
@@ -175,16 +240,18 @@ void oc_edisc_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
   }
   if (want & OC_EV_ALPHA) return;
   double g[2] = {0, 0};
+  oc_enoise noise;
+  oc_edisc_noise(n, &noise);
   octlod lod, *lp = NULL;
-  if (ft && ft->v > 0 && n->noise.kind != OC_ENOISE_NONE) {
+  if (ft && ft->v > 0 && noise.kind != OC_ENOISE_NONE) {
     double c = -1 / (ft->v * 0.69314718055994530942);
-    lod = (octlod){log2(n->noise.wavelength / ft->v), log2(n->noise.lacunarity),
+    lod = (octlod){log2(noise.wavelength / ft->v), log2(noise.lacunarity),
                    c * ft->gx, c * ft->gy};
     lp = &lod;
   }
-  s->f = p[3] + (n->noise.kind == OC_ENOISE_NONE
+  s->f = p[3] + (noise.kind == OC_ENOISE_NONE
                      ? 0
-                     : noise_sum(&n->noise, u, v, grad ? g : NULL, lp));
+                     : noise_sum(&noise, u, v, grad ? g : NULL, lp));
   s->fx = g[0];
   s->fy = g[1];
 }
@@ -240,8 +307,10 @@ static int noise_range_in(const oc_enoise *nz, double u, double v, double rho,
   return 1;
 }
 
-void oc_edisc_bound_in(const oc_enode *n, const oc_erect *b,
+void oc_edisc_bound_in(const oc_enode *node, const oc_erect *b,
                        const oc_efootb *fb, oc_ebound *o) {
+  dview v, *n = &v; /* (the disc unpacked) */
+  unpack(node, n);
   *o = n->glob;
   int filtered = 0; /* some octave may be weighted below 1 in the box */
   /* (every octave kept in the box, the finest included: the glob's) */
@@ -359,19 +428,37 @@ oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err) {
               p->height, p->radius, nz.amplitude, nz.wavelength);
     return NULL;
   }
-  oc_enode *n = oc_enode_alloc(OC_E_DISC, NULL, 0, err);
+  /* gain and lacunarity: none stored when they are the defaults, floats
+  ** when they are floats exactly; evaluation reads the same doubles */
+  int flags = nz.gain == 0.5 && nz.lacunarity == 2 ? OC_EF_GLDEF
+              : (double)(float)nz.gain == nz.gain &&
+                      (double)(float)nz.lacunarity == nz.lacunarity
+                  ? OC_EF_GLF
+                  : 0;
+  oc_enode *n =
+      oc_enode_alloc(OC_E_DISC, oc_edisc_size(nz.kind, flags), NULL, 0, err);
   if (!n) return NULL;
-  n->par[0] = p->cx;
-  n->par[1] = p->cy;
-  n->par[2] = p->radius;
-  n->par[3] = p->height;
-  n->noise = nz;
-  n->box = box;
-  n->glob = (oc_ebound){p->height + lo,
-                        p->height + hi,
-                        0,
-                        1,
-                        lip,
-                        OC_FALLOFF_LIPSCHITZ / p->radius};
-  return n;
+  oc_edisc *d = (oc_edisc *)n;
+  d->par[0] = p->cx;
+  d->par[1] = p->cy;
+  d->par[2] = p->radius;
+  d->par[3] = p->height;
+  n->nzkind = (uint8_t)nz.kind;
+  if (nz.kind != OC_ENOISE_NONE) {
+    n->octaves = (uint8_t)nz.octaves;
+    d->amplitude = nz.amplitude;
+    d->wavelength = nz.wavelength;
+    d->seed = nz.seed;
+    d->nhi = hi;
+    d->nlip = lip;
+    n->flags = (uint8_t)flags;
+    if (flags & OC_EF_GLF) {
+      d->gl.f[0] = (float)nz.gain;
+      d->gl.f[1] = (float)nz.lacunarity;
+    } else if (!flags) {
+      d->gl.d[0] = nz.gain;
+      d->gl.d[1] = nz.lacunarity;
+    }
+  }
+  return n; /* (its box and bound: oc_enode_box, oc_edisc_glob) */
 }

@@ -80,7 +80,7 @@ static size_t interval(const ecurve *d, double s, double *t, size_t *j) {
 void oc_ecurve_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                   int want, oc_enode_sample *s) {
   (void)ft;
-  const ecurve *d = n->data;
+  const ecurve *d = OC_EPRIM(n)->data;
   int grad = want & OC_EV_GRAD, lazy = want & OC_EV_LAZY;
   oc_curve_point pt;
   s->ax = s->ay = s->fx = s->fy = 0;
@@ -143,10 +143,10 @@ void oc_ecurve_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
 void oc_ecurve_bound_in(const oc_enode *n, const oc_erect *b,
                         const oc_efootb *fb, oc_ebound *o) {
   (void)fb;
-  const ecurve *d = n->data;
+  const ecurve *d = OC_EPRIM(n)->data;
   oc_curve_point pt;
-  *o = n->glob;
-  if (!oc_erect_meets(&n->box, b)) {
+  *o = OC_EPRIM(n)->glob;
+  if (!oc_erect_meets(&OC_EPRIM(n)->box, b)) {
     o->alo = o->ahi = o->la = 0;
     return;
   }
@@ -287,7 +287,8 @@ oc_enode *oc_enode_curve(const oc_enode_curve_params *p, oc_error *err) {
               "profiles too close along the curve)");
     goto fail;
   }
-  oc_enode *n = oc_enode_alloc(OC_E_CURVE, NULL, 0, err);
+  oc_eprim *n =
+      (oc_eprim *)oc_enode_alloc(OC_E_CURVE, sizeof(oc_eprim), NULL, 0, err);
   if (!n) goto fail;
   n->data = d;
   n->box = (oc_erect){bx.lo.x, bx.lo.y, bx.hi.x, bx.hi.y};
@@ -297,9 +298,7 @@ oc_enode *oc_enode_curve(const oc_enode_curve_params *p, oc_error *err) {
                         1,
                         lf,
                         OC_FALLOFF_LIPSCHITZ / (p->radius - p->core)};
-  n->par[0] = p->radius;
-  n->par[1] = p->core;
-  return n;
+  return &n->h;
 fail:
   oc_ecurve_free(d);
   return NULL;
@@ -359,4 +358,13 @@ oc_enode *oc_enode_road(const oc_enode_road_params *p, oc_error *err) {
   oc_enode_curve_params c = {p->points,  p->npoints, p->spline, w / 2 + sh + em,
                              w / 2 + sh, &pr,        1};
   return oc_enode_curve(&c, err);
+}
+
+size_t oc_ecurve_bytes(const void *data) {
+  const ecurve *d = data;
+  size_t b = sizeof *d + oc_curve_bytes(d->c) +
+             d->np * (sizeof *d->at + sizeof *d->prof);
+  for (size_t i = 0; i < d->np; i++)
+    b += oc_profile_bytes(d->prof[i]);
+  return b;
 }

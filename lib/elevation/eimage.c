@@ -47,6 +47,7 @@
 #include "core/error.h"
 #include "core/falloff.h"
 #include "elevation/enode.h"
+#include "terrain/terrain.h"
 
 typedef struct grid {
   oc_elevation src; /* src.ud NULL: none (weight 1) */
@@ -75,7 +76,7 @@ typedef struct eimage {
 } eimage;
 
 static const eimage *image_of(const oc_enode *n) {
-  return n->data;
+  return OC_EPRIM(n)->data;
 }
 
 static double cross(const double a[2], const double b[2]) {
@@ -255,7 +256,7 @@ void oc_eimage_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
     return;
   }
   (void)ft; /* no detail to filter */
-  const eimage *d = n->data;
+  const eimage *d = OC_EPRIM(n)->data;
   int grad = want & OC_EV_GRAD;
   double dk[4];
   int inside = 1;
@@ -513,7 +514,7 @@ void oc_eimage_bound_in(const oc_enode *n, const oc_erect *b,
     return;
   }
   (void)fb;
-  const eimage *d = n->data;
+  const eimage *d = OC_EPRIM(n)->data;
   /* f: over the quad within r of b */
   double r = 0;
   for (int c = 0; c < 4; c++)
@@ -771,7 +772,8 @@ oc_enode *oc_enode_image(const oc_enode_image_params *p, oc_error *err) {
                         : sqrt(area) / 10;
   if (take_grid(p->heightfield, &d->h, err)) goto fail;
   if (p->weight && take_grid(p->weight, &d->w, err)) goto fail;
-  oc_enode *n = oc_enode_alloc(OC_E_IMAGE, NULL, 0, err);
+  oc_eprim *n =
+      (oc_eprim *)oc_enode_alloc(OC_E_IMAGE, sizeof(oc_eprim), NULL, 0, err);
   if (!n) goto fail;
   n->data = d;
   n->box = (oc_erect){INFINITY, INFINITY, -INFINITY, -INFINITY};
@@ -785,7 +787,7 @@ oc_enode *oc_enode_image(const oc_enode_image_params *p, oc_error *err) {
     n->box.x1 = fmax(n->box.x1, d->P[k][0]);
     n->box.y1 = fmax(n->box.y1, d->P[k][1]);
   }
-  oc_eimage_bound_in(n, &n->box, NULL, &n->glob);
+  oc_eimage_bound_in(&n->h, &n->box, NULL, &n->glob);
   n->glob.alo = 0;
   if (!isfinite(n->glob.flo) || !isfinite(n->glob.fhi) ||
       !isfinite(n->glob.lf) || !isfinite(n->glob.la) || !isfinite(d->F) ||
@@ -794,11 +796,30 @@ oc_enode *oc_enode_image(const oc_enode_image_params *p, oc_error *err) {
               "image: its elevations or slopes overflow (height %g, offset "
               "%g, falloff %g)",
               vs, p->offset, d->F);
-    oc_enode_release(n);
+    oc_enode_release(&n->h);
     return NULL;
   }
-  return n;
+  return &n->h;
 fail:
   oc_eimage_free(d);
   return NULL;
+}
+
+int oc_eimage_bytes(const void *data, oc_pmap *seen, size_t *bytes) {
+  const eimage *d = data;
+  const grid *gs[2] = {&d->h, &d->w};
+  *bytes = sizeof *d;
+  if (d->cv) /* along a curve: its skeleton, flattening and chords' tree */
+    *bytes += oc_curve_bytes(d->cv) + d->nfl * sizeof *d->fl +
+              2 * d->m * sizeof *d->tree;
+  for (int k = 0; k < 2; k++) {
+    if (!gs[k]->src.ud) continue;
+    const oc_heightfield *hf;
+    size_t hb;
+    *bytes += oc_hfsrc_bytes(&gs[k]->src, &hf, &hb);
+    if (!hf || oc_pmap_slot(seen, hf, 0)) continue; /* counted */
+    if (!oc_pmap_slot(seen, hf, 1)) return OC_ENOMEM;
+    *bytes += hb;
+  }
+  return OC_OK;
 }

@@ -15,50 +15,141 @@
 #include "elevation/enode.h"
 
 static const char *const kind_names[OC_E_COUNT] = {
-    "disc", "curve", "blend", "replace", "add", "transform", "warp",
-    "lake", "image", "lod"};
-
-/* 1 + the parameters each kind stores (disc.c, ecurve.c, eops.c); 0, a
-** kind not listed: OC_ENODE_NPAR. */
-static const unsigned char par_counts[OC_E_COUNT] = {
-    [OC_E_DISC] = 1 + 4,    [OC_E_CURVE] = 1 + 2, [OC_E_BLEND] = 1 + 0,
-    [OC_E_REPLACE] = 1 + 1, [OC_E_ADD] = 1 + 7,   [OC_E_XFORM] = 1 + 11,
-    [OC_E_WARP] = 1 + 2,    [OC_E_LOD] = 1 + 3};
-
-static size_t par_count(oc_ekind kind) {
-  unsigned c = (unsigned)kind < OC_E_COUNT ? par_counts[kind] : 0;
-  return c ? c - 1 : OC_ENODE_NPAR;
-}
+    "disc",      "curve", "blend", "replace", "add",
+    "transform", "warp",  "lake",  "image",   "lod"};
 
 size_t oc_enode_size(const oc_enode *n) {
-  return offsetof(oc_enode, par) + par_count(n->kind) * sizeof(double) +
-         (n->kids != n->inl ? n->nkids * sizeof *n->kids : 0);
+  switch (n->kind) {
+  case OC_E_DISC:
+    return oc_edisc_size(n->nzkind, n->flags);
+  case OC_E_CURVE:
+  case OC_E_LAKE:
+  case OC_E_IMAGE:
+    return sizeof(oc_eprim);
+  case OC_E_BLEND:
+    return offsetof(oc_eblend, kids) + OC_EBLEND(n)->nkids * sizeof(oc_enode *);
+  case OC_E_REPLACE:
+    return offsetof(oc_ebin, par) + OC_EREPLACE_NPAR * sizeof(double);
+  case OC_E_ADD:
+    return offsetof(oc_ebin, par) +
+           (n->flags & OC_EF_SLOPE ? OC_EADD_SLOPE_NPAR : OC_EADD_NPAR) *
+               sizeof(double);
+  case OC_E_LOD:
+    return offsetof(oc_ebin, par) + OC_ELOD_NPAR * sizeof(double);
+  case OC_E_XFORM:
+    return offsetof(oc_eun, par) + OC_EXFORM_NPAR * sizeof(double);
+  case OC_E_WARP:
+    return offsetof(oc_eun, par) + OC_EWARP_NPAR * sizeof(double);
+  default:
+    return sizeof(oc_enode);
+  }
 }
 
-oc_enode *oc_enode_alloc(oc_ekind kind, oc_enode *const *kids, size_t nkids,
-                         oc_error *err) {
-  oc_enode *n =
-      calloc(1, offsetof(oc_enode, par) + par_count(kind) * sizeof(double));
+oc_enode *oc_enode_alloc(oc_ekind kind, size_t size, oc_enode *const *kids,
+                         size_t nkids, oc_error *err) {
+  oc_enode *n = size >= sizeof(oc_enode) ? calloc(1, size) : NULL;
   if (!n) {
     oc_seterr(err, OC_ENOMEM, "out of memory");
     return NULL;
   }
   n->refs = 1;
-  n->kind = kind;
-  if (nkids <= 2) {
-    n->kids = n->inl;
-  } else if (nkids > SIZE_MAX / sizeof *n->kids ||
-             !(n->kids = malloc(nkids * sizeof *n->kids))) {
-    free(n);
-    oc_seterr(err, OC_ENOMEM, "out of memory (%zu children)", nkids);
-    return NULL;
-  }
-  n->nkids = nkids;
+  n->kind = (uint8_t)kind;
+  if (kind == OC_E_BLEND) ((oc_eblend *)n)->nkids = (uint32_t)nkids;
+  oc_enode **k = (oc_enode **)oc_enode_kids(n);
   for (size_t i = 0; i < nkids; i++) {
-    n->kids[i] = kids[i];
+    k[i] = kids[i];
     oc_enode_retain(kids[i]);
   }
   return n;
+}
+
+/* ---- floats rounded outward ------------------------------------------- */
+
+float oc_efloat_down(double v) {
+  float f = (float)v;
+  return (double)f > v ? nextafterf(f, -INFINITY) : f;
+}
+
+float oc_efloat_up(double v) {
+  float f = (float)v;
+  return (double)f < v ? nextafterf(f, INFINITY) : f;
+}
+
+void oc_erect_round(const oc_erect *r, oc_erectf *o) {
+  o->x0 = oc_efloat_down(r->x0);
+  o->y0 = oc_efloat_down(r->y0);
+  o->x1 = oc_efloat_up(r->x1);
+  o->y1 = oc_efloat_up(r->y1);
+}
+
+void oc_ebound_round(const oc_ebound *b, oc_eboundf *o) {
+  o->flo = oc_efloat_down(b->flo);
+  o->fhi = oc_efloat_up(b->fhi);
+  o->alo = oc_efloat_down(b->alo);
+  o->ahi = oc_efloat_up(b->ahi);
+  o->lf = oc_efloat_up(b->lf);
+  o->la = oc_efloat_up(b->la);
+}
+
+void oc_ebound_widen(const oc_eboundf *f, oc_ebound *o) {
+  *o = (oc_ebound){f->flo, f->fhi, f->alo, f->ahi, f->lf, f->la};
+}
+
+/* ---- whole-plane bounds ----------------------------------------------- */
+
+void oc_enode_glob(const oc_enode *n, oc_ebound *o) {
+  switch (n->kind) {
+  case OC_E_DISC:
+    oc_edisc_glob(n, o);
+    return;
+  case OC_E_CURVE:
+  case OC_E_LAKE:
+  case OC_E_IMAGE:
+    *o = OC_EPRIM(n)->glob;
+    return;
+  case OC_E_BLEND:
+    oc_ebound_widen(&OC_EBLEND(n)->glob, o);
+    return;
+  case OC_E_XFORM:
+  case OC_E_WARP: {
+    oc_ebound c;
+    oc_erect cb = oc_enode_box(OC_EUN(n)->kid), box;
+    oc_enode_glob(OC_EUN(n)->kid, &c);
+    oc_eop_derive(n, &c, &cb, o, &box);
+    return;
+  }
+  default:
+    oc_ebound_widen(&OC_EBIN(n)->glob, o);
+  }
+}
+
+/* The children's exact bounds, then the node's from them. Recursive (as
+** evaluation is) with a small frame: more children than STACK take the
+** heap, and without memory the stored (wider) bounds answer. */
+void oc_enode_exact(const oc_enode *n, oc_ebound *glob, oc_erect *box) {
+  enum { STACK = 4 };
+  size_t nk = oc_enode_nkids(n);
+  oc_ebound kbs[STACK], *kb = kbs;
+  oc_erect kboxs[STACK], *kbox = kboxs;
+  void *heap = NULL;
+  if (nk > STACK) { /* both arrays in one block (doubles throughout) */
+    heap = malloc(nk * (sizeof *kb + sizeof *kbox));
+    kb = heap;
+    kbox = heap ? (oc_erect *)(void *)(kb + nk) : NULL;
+  }
+  if (nk == 0 || !kb) {
+    oc_enode_glob(n, glob);
+    *box = oc_enode_box(n);
+    return;
+  }
+  oc_enode *const *k = oc_enode_kids(n);
+  for (size_t i = 0; i < nk; i++)
+    oc_enode_exact(k[i], &kb[i], &kbox[i]);
+  if (n->kind == OC_E_LOD)
+    oc_elod_derive(n, kb, kbox, glob, box);
+  else
+    oc_eop_derive(n, kb, kbox, glob, box);
+  free(heap);
 }
 
 void oc_enode_retain(oc_enode *e) {
@@ -71,8 +162,10 @@ void oc_enode_release(oc_enode *e) {
   oc_enode **stack = NULL;
   size_t top = 0, cap = 0;
   for (oc_enode *cur = e;;) {
-    for (size_t i = 0; i < cur->nkids; i++) {
-      oc_enode *k = cur->kids[i];
+    size_t nk = oc_enode_nkids(cur);
+    oc_enode *const *kids = oc_enode_kids(cur);
+    for (size_t i = 0; i < nk; i++) {
+      oc_enode *k = kids[i];
       if (--k->refs > 0) continue;
       if (!OC_GROW(stack, top, cap, 1)) { /* no memory: recurse for it */
         k->refs = 1;
@@ -81,10 +174,9 @@ void oc_enode_release(oc_enode *e) {
       }
       stack[top++] = k;
     }
-    if (cur->kids != cur->inl) free(cur->kids);
-    if (cur->kind == OC_E_CURVE) oc_ecurve_free(cur->data);
-    if (cur->kind == OC_E_LAKE) oc_elake_free(cur->data);
-    if (cur->kind == OC_E_IMAGE) oc_eimage_free(cur->data);
+    if (cur->kind == OC_E_CURVE) oc_ecurve_free(OC_EPRIM(cur)->data);
+    if (cur->kind == OC_E_LAKE) oc_elake_free(OC_EPRIM(cur)->data);
+    if (cur->kind == OC_E_IMAGE) oc_eimage_free(OC_EPRIM(cur)->data);
     free(cur);
     if (!top) break;
     cur = stack[--top];
@@ -147,18 +239,24 @@ double oc_enode_weight(const oc_enode *e, double x, double y) {
 
 void oc_enode_get_bounds(const oc_enode *e, double box[4], double *flo,
                          double *fhi) {
+  oc_ebound g;
+  oc_erect b;
+  oc_enode_exact(e, &g, &b);
   if (box) {
-    box[0] = e->box.x0;
-    box[1] = e->box.y0;
-    box[2] = e->box.x1;
-    box[3] = e->box.y1;
+    box[0] = b.x0;
+    box[1] = b.y0;
+    box[2] = b.x1;
+    box[3] = b.y1;
   }
-  if (flo) *flo = e->glob.flo;
-  if (fhi) *fhi = e->glob.fhi;
+  if (flo) *flo = g.flo;
+  if (fhi) *fhi = g.fhi;
 }
 
 double oc_enode_lipschitz(const oc_enode *e) {
-  return e->glob.lf;
+  oc_ebound g;
+  oc_erect b;
+  oc_enode_exact(e, &g, &b);
+  return g.lf;
 }
 
 void oc_enode_bound_in(const oc_enode *e, double x0, double y0, double x1,
@@ -186,8 +284,15 @@ int oc_enode_get_stats(const oc_enode *e, oc_enode_stats *st, oc_error *err) {
     st->primitives += x->kind == OC_E_DISC || x->kind == OC_E_CURVE ||
                       x->kind == OC_E_LAKE || x->kind == OC_E_IMAGE;
     st->bytes += oc_enode_size(x);
-    for (size_t i = 0; i < x->nkids; i++) {
-      const oc_enode *k = x->kids[i];
+    size_t db = 0;
+    if (x->kind == OC_E_CURVE) db = oc_ecurve_bytes(OC_EPRIM(x)->data);
+    if (x->kind == OC_E_LAKE) db = oc_elake_bytes(OC_EPRIM(x)->data);
+    if (x->kind == OC_E_IMAGE && oc_eimage_bytes(OC_EPRIM(x)->data, &seen, &db))
+      goto nomem;
+    st->bytes += db;
+    size_t nk = oc_enode_nkids(x);
+    for (size_t i = 0; i < nk; i++) {
+      const oc_enode *k = oc_enode_kid(x, i);
       if (oc_pmap_slot(&seen, k, 0)) continue;
       if (!oc_pmap_slot(&seen, k, 1) || !OC_GROW(stack, n, cap, 1)) goto nomem;
       stack[n++] = k;
@@ -232,7 +337,10 @@ static void terrain_cells(const oc_enode *e, const oc_eview *v, oc_erect r,
 int oc_enode_terrain_box_in(const oc_enode *e, const oc_eview *v,
                             double box[4]) {
   oc_erect acc = {INFINITY, INFINITY, -INFINITY, -INFINITY};
-  terrain_cells(e, v, e->box, 7, &acc);
+  oc_ebound g;
+  oc_erect whole; /* (as built in doubles) */
+  oc_enode_exact(e, &g, &whole);
+  terrain_cells(e, v, whole, 7, &acc);
   if (!(acc.x0 < acc.x1 && acc.y0 < acc.y1)) return 0;
   box[0] = acc.x0, box[1] = acc.y0, box[2] = acc.x1, box[3] = acc.y1;
   return 1;

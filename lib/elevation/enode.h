@@ -19,7 +19,9 @@
 #define OC_ENODE_H
 
 #include <stddef.h>
+#include <stdint.h>
 
+#include "core/pmap.h"
 #include "outcrop.h"
 
 typedef enum oc_ekind {
@@ -44,7 +46,8 @@ typedef struct oc_erect {
   double x0, y0, x1, y1;
 } oc_erect;
 
-/* Noise sums of discs and warps. */
+/* Noise sums of discs and warps, as evaluation reads them (unpacked from
+** a node by oc_edisc_noise). */
 typedef struct oc_enoise {
   int kind; /* oc_enoise_kind */
   int octaves;
@@ -52,25 +55,242 @@ typedef struct oc_enoise {
   uint64_t seed;
 } oc_enoise;
 
+/*
+** Storage. Every node starts with this 8-byte header and is allocated at
+** the size of its kind's fields (oc_edisc, oc_eprim, oc_eblend, oc_ebin,
+** oc_eun below; oc_enode_size). What evaluation reads is kept exactly
+** (doubles); what only bounds read is kept as floats rounded outward
+** (oc_erectf, oc_eboundf: never tighter than the double they round), or
+** derived when that is cheap:
+**  - a disc's box and whole-plane bound come from its parameters (and
+**    its noise's range and slope, kept), so they are the doubles they
+**    always were; a transform's and a warp's bound from their child's;
+**  - curves, lakes and images keep theirs as doubles (their data dwarfs
+**    them);
+**  - operators keep both as floats. The exact doubles (what construction
+**    in doubles would give) are recomputed through the DAG by
+**    oc_enode_exact for what scripts see: e:bounds(), e:lipschitz(), the
+**    terrain's box and the level of detail's reference height.
+*/
 struct oc_enode {
-  int refs; /* built from one thread (Lua), like 3D nodes */
-  oc_ekind kind;
-  size_t nkids;
-  oc_enode **kids; /* retained */
-  oc_enode *inl[2];
+  uint32_t refs;   /* built from one thread (Lua), like 3D nodes */
+  uint8_t kind;    /* oc_ekind */
+  uint8_t flags;   /* OC_EF_* */
+  uint8_t nzkind;  /* disc: its noise's oc_enoise_kind */
+  uint8_t octaves; /* disc and warp */
+};
+
+/* Flags. */
+#define OC_EF_GLF 1   /* disc: gain and lacunarity are floats exactly */
+#define OC_EF_GLDEF 2 /* disc: they are 1/2 and 2 (not stored) */
+#define OC_EF_SLOPE 4 /* add: with a slope weight (OC_EADD_SLOPE_NPAR) */
+
+/* The parameters (doubles) operators store (eops.c, lod.c). */
+#define OC_EREPLACE_NPAR 1
+#define OC_EADD_NPAR 4
+#define OC_EADD_SLOPE_NPAR 7 /* with a slope weight: its angle, fade, step */
+#define OC_ELOD_NPAR 3
+#define OC_EXFORM_NPAR 8
+#define OC_EWARP_NPAR 5
+
+/* A box and bounds rounded outward to floats. */
+typedef struct oc_erectf {
+  float x0, y0, x1, y1;
+} oc_erectf;
+typedef struct oc_eboundf {
+  float flo, fhi, alo, ahi, lf, la;
+} oc_eboundf;
+
+/* disc: 40 bytes; with a noise 80, 88 when gain and lacunarity are not
+** the defaults but floats, 96 else. */
+typedef struct oc_edisc {
+  oc_enode h;
+  double par[4]; /* cx, cy, radius, height */
+  /* with a noise (h.nzkind != OC_ENOISE_NONE): */
+  double amplitude, wavelength;
+  uint64_t seed;
+  /* the noise sum's bound over the plane (disc.c, noise_bounds): its
+  ** range [-nhi, nhi] (plain) or [0, nhi], its Lipschitz bound nlip */
+  double nhi, nlip;
+  union {
+    float f[2]; /* OC_EF_GLF */
+    double d[2];
+  } gl; /* gain, lacunarity (none with OC_EF_GLDEF) */
+} oc_edisc;
+
+/* curve, lake, image: 96 bytes, and their data (skeleton, profiles,
+** grids). */
+typedef struct oc_eprim {
+  oc_enode h;
   oc_erect box;   /* Omega_0 lies inside */
   oc_ebound glob; /* over the whole plane */
-  oc_enoise noise;
-  void *data; /* curve: skeleton and profiles (ecurve.c), owned */
-  /* Parameters, as many as the kind uses (enode.c, par_count): a blend
-  ** stores none, a transform 11; kinds not in that table get
-  ** OC_ENODE_NPAR. Last, so that each node is allocated at its size. */
-  double par[];
-};
-#define OC_ENODE_NPAR 12
+  void *data;     /* owned (ecurve.c, lake.c, eimage.c) */
+} oc_eprim;
 
-/* The bytes of n, its children's array included. */
+/* blend: 56 bytes and 8 a child. */
+typedef struct oc_eblend {
+  oc_enode h;
+  oc_erectf box;
+  oc_eboundf glob;
+  uint32_t nkids;
+  oc_enode *kids[]; /* retained */
+} oc_eblend;
+
+/* replace (72 bytes), add (96; 120 with a slope weight), lod (88). */
+typedef struct oc_ebin {
+  oc_enode h;
+  oc_erectf box;
+  oc_eboundf glob;
+  oc_enode *kids[2]; /* retained */
+  double par[];      /* eops.c, lod.c */
+} oc_ebin;
+
+/* transform (96 bytes) and warp (72): the bound is the child's, mapped. */
+typedef struct oc_eun {
+  oc_enode h;
+  oc_erectf box;
+  oc_enode *kid; /* retained */
+  double par[];  /* eops.c */
+} oc_eun;
+
+#define OC_EDISC(n) ((const oc_edisc *)(n))
+#define OC_EPRIM(n) ((const oc_eprim *)(n))
+#define OC_EBLEND(n) ((const oc_eblend *)(n))
+#define OC_EBIN(n) ((const oc_ebin *)(n))
+#define OC_EUN(n) ((const oc_eun *)(n))
+
+/* The bytes of n (its children's pointers included, its data not). */
 size_t oc_enode_size(const oc_enode *n);
+
+/* Allocation (refs = 1) of size bytes (at least the kind's header) with
+** nkids children retained from kids. */
+oc_enode *oc_enode_alloc(oc_ekind kind, size_t size, oc_enode *const *kids,
+                         size_t nkids, oc_error *err);
+
+/* The children. */
+static inline size_t oc_enode_nkids(const oc_enode *n) {
+  switch (n->kind) {
+  case OC_E_BLEND:
+    return OC_EBLEND(n)->nkids;
+  case OC_E_REPLACE:
+  case OC_E_ADD:
+  case OC_E_LOD:
+    return 2;
+  case OC_E_XFORM:
+  case OC_E_WARP:
+    return 1;
+  default:
+    return 0;
+  }
+}
+static inline oc_enode *const *oc_enode_kids(const oc_enode *n) {
+  switch (n->kind) {
+  case OC_E_BLEND:
+    return OC_EBLEND(n)->kids;
+  case OC_E_REPLACE:
+  case OC_E_ADD:
+  case OC_E_LOD:
+    return OC_EBIN(n)->kids;
+  case OC_E_XFORM:
+  case OC_E_WARP:
+    return &OC_EUN(n)->kid;
+  default:
+    return NULL;
+  }
+}
+static inline const oc_enode *oc_enode_kid(const oc_enode *n, size_t i) {
+  return oc_enode_kids(n)[i];
+}
+
+/* The box of n (Omega_0 lies inside): a disc's exactly as built, a
+** curve's, lake's or image's as stored, an operator's rounded outward. */
+/* Curves, lakes and images keep a double box; operators a float one, at
+** the same place in each of their layouts. */
+#define OC_EPRIM_KIND(k)                                                       \
+  ((1u << (k)) & ((1u << OC_E_CURVE) | (1u << OC_E_LAKE) | (1u << OC_E_IMAGE)))
+_Static_assert(offsetof(oc_eblend, box) == offsetof(oc_ebin, box) &&
+                   offsetof(oc_eblend, box) == offsetof(oc_eun, box),
+               "operators keep their box at one offset");
+static inline const oc_erectf *oc_enode_boxf(const oc_enode *n) {
+  return &OC_EBLEND(n)->box;
+}
+
+static inline oc_erect oc_enode_box(const oc_enode *n) {
+  if (n->kind == OC_E_DISC) { /* (the commonest child: tested first) */
+    const double *p = OC_EDISC(n)->par;
+    return (oc_erect){p[0] - p[2], p[1] - p[2], p[0] + p[2], p[1] + p[2]};
+  }
+  if (OC_EPRIM_KIND(n->kind)) return OC_EPRIM(n)->box;
+  const oc_erectf *f = oc_enode_boxf(n);
+  return (oc_erect){f->x0, f->y0, f->x1, f->y1};
+}
+
+/* Whether (x, y) is in n's box (NaN is not); whether n's box meets r.
+** (A disc's tests compare as they always did, its edges computed as they
+** come; one side at a time.) */
+static inline int oc_edisc_holds(const oc_enode *n, double x, double y) {
+  const double *p = OC_EDISC(n)->par;
+  return x >= p[0] - p[2] && x <= p[0] + p[2] && y >= p[1] - p[2] &&
+         y <= p[1] + p[2];
+}
+static inline int oc_enode_holds(const oc_enode *n, double x, double y) {
+  if (n->kind == OC_E_DISC) return oc_edisc_holds(n, x, y);
+  if (OC_EPRIM_KIND(n->kind)) {
+    const oc_erect *b = &OC_EPRIM(n)->box;
+    return x >= b->x0 && x <= b->x1 && y >= b->y0 && y <= b->y1;
+  }
+  const oc_erectf *f = oc_enode_boxf(n);
+  return x >= f->x0 && x <= f->x1 && y >= f->y0 && y <= f->y1;
+}
+static inline int oc_edisc_meets(const oc_enode *n, const oc_erect *r) {
+  const double *p = OC_EDISC(n)->par;
+  return p[0] - p[2] <= r->x1 && p[0] + p[2] >= r->x0 && p[1] - p[2] <= r->y1 &&
+         p[1] + p[2] >= r->y0;
+}
+static inline int oc_enode_meets(const oc_enode *n, const oc_erect *r) {
+  if (n->kind == OC_E_DISC) return oc_edisc_meets(n, r);
+  if (OC_EPRIM_KIND(n->kind)) {
+    const oc_erect *b = &OC_EPRIM(n)->box;
+    return b->x0 <= r->x1 && b->x1 >= r->x0 && b->y0 <= r->y1 && b->y1 >= r->y0;
+  }
+  const oc_erectf *f = oc_enode_boxf(n);
+  return f->x0 <= r->x1 && f->x1 >= r->x0 && f->y0 <= r->y1 && f->y1 >= r->y0;
+}
+
+/* The bound of n over the whole plane: exact for primitives, else from
+** the stored floats (conservative). */
+void oc_enode_glob(const oc_enode *n, oc_ebound *o);
+
+/* The bound and box that construction in doubles gives (recomputed
+** through the DAG; the stored ones contain them). */
+void oc_enode_exact(const oc_enode *n, oc_ebound *glob, oc_erect *box);
+
+/* Rounding outward to floats, and back. */
+float oc_efloat_down(double v);
+float oc_efloat_up(double v);
+void oc_erect_round(const oc_erect *r, oc_erectf *o);
+void oc_ebound_round(const oc_ebound *b, oc_eboundf *o);
+void oc_ebound_widen(const oc_eboundf *f, oc_ebound *o);
+
+/* An operator's (blend, replace, add, transform, warp; eops.c) or a lod's
+** (lod.c) whole-plane bound and box from its children's kb and kbox. */
+void oc_eop_derive(const oc_enode *n, const oc_ebound *kb, const oc_erect *kbox,
+                   oc_ebound *glob, oc_erect *box);
+void oc_elod_derive(const oc_enode *n, const oc_ebound *kb,
+                    const oc_erect *kbox, oc_ebound *glob, oc_erect *box);
+
+/* The noise of a disc, unpacked; its bytes (with those flags); and its
+** whole-plane bound (disc.c). */
+void oc_edisc_noise(const oc_enode *n, oc_enoise *nz);
+size_t oc_edisc_size(int nzkind, int flags);
+void oc_edisc_glob(const oc_enode *n, oc_ebound *o);
+
+/* The bytes of a curve's, lake's or image's data: their skeletons,
+** profiles and grids; a grid shared by several images counts once (seen
+** holds the grids counted; OC_ENOMEM when it cannot grow). */
+size_t oc_ecurve_bytes(const void *data);
+size_t oc_elake_bytes(const void *data);
+int oc_eimage_bytes(const void *data, oc_pmap *seen, size_t *bytes);
 
 /* Level of detail (lod.c): the pixel footprint where a node is evaluated,
 ** in the node's local units (a transform divides it by its scale), with
@@ -96,10 +316,6 @@ typedef struct oc_efootb {
 
 void oc_enode_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                  int want, oc_enode_sample *s);
-
-/* Allocation (refs = 1) with nkids children retained from kids. */
-oc_enode *oc_enode_alloc(oc_ekind kind, oc_enode *const *kids, size_t nkids,
-                         oc_error *err);
 
 /* Kinds' parts (disc.c, eops.c): evaluation and bounds in a box. */
 void oc_edisc_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,

@@ -17,7 +17,10 @@
 **  transform |vscale| lambda_A / scale.
 */
 #include <math.h>
+#include <stddef.h>
+#include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "core/error.h"
 #include "core/noise.h"
@@ -36,25 +39,55 @@ enum {
   P_BELOW = 1,
   P_BZ = 2,
   P_FADE = 3,
-  /* transform: inverse 2x2 (row-major) and translation, then 1 / scale,
-  ** vscale, voffset; p' = Minv (p - t) */
+  /* transform: the first row (cos, sin) / scale of the inverse rotation
+  ** and scaling Minv = R^T / scale (its second row is (-sin, cos) /
+  ** scale), translation, vscale, voffset, scale and angle; p' = Minv (p
+  ** - t) */
   P_MI = 0,
-  P_TX = 4,
-  P_TY = 5,
-  P_ISCALE = 6,
-  P_VS = 7,
-  P_VO = 8,
-  P_SCALE = 9,
-  P_ANGLE = 10,
-  /* warp: largest displacement per axis, and delta's Lipschitz bound */
+  P_TX = 2,
+  P_TY = 3,
+  P_VS = 4,
+  P_VO = 5,
+  P_SCALE = 6,
+  P_ANGLE = 7,
+  /* warp: largest displacement per axis, delta's Lipschitz bound, the
+  ** noise's amplitude, wavelength and seed (its bits) */
   P_WMAX = 0,
-  P_WLIP = 1
+  P_WLIP = 1,
+  P_WAMP = 2,
+  P_WWL = 3,
+  P_WSEED = 4
 };
+
+/* A transform's Minv, row-major. */
+static void minv(const oc_enode *n, double m[4]) {
+  const double *q = OC_EUN(n)->par + P_MI;
+  m[0] = q[0];
+  m[1] = q[1];
+  m[2] = -q[1];
+  m[3] = q[0];
+}
 
 static oc_erect rect_union(oc_erect a, oc_erect b) {
   oc_erect r = {fmin(a.x0, b.x0), fmin(a.y0, b.y0), fmax(a.x1, b.x1),
                 fmax(a.y1, b.y1)};
   return r;
+}
+
+/* Stores the bound and box of a blend or a binary operator, derived from
+** its children's kb and kbox, rounded outward. */
+static void store_derived(oc_enode *n, const oc_ebound *kb,
+                          const oc_erect *kbox) {
+  oc_ebound g;
+  oc_erect box;
+  oc_eop_derive(n, kb, kbox, &g, &box);
+  if (n->kind == OC_E_BLEND) {
+    oc_ebound_round(&g, &((oc_eblend *)n)->glob);
+    oc_erect_round(&box, &((oc_eblend *)n)->box);
+  } else {
+    oc_ebound_round(&g, &((oc_ebin *)n)->glob);
+    oc_erect_round(&box, &((oc_ebin *)n)->box);
+  }
 }
 
 static double clamp01(double v, int *inside) {
@@ -68,9 +101,10 @@ static void blend_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                      int want, oc_enode_sample *s) {
   int grad = want & OC_EV_GRAD, only = want & OC_EV_ALPHA;
   double N = 0, S = 0, nx = 0, ny = 0, sx = 0, sy = 0;
-  for (size_t i = 0; i < n->nkids; i++) {
-    const oc_enode *k = n->kids[i];
-    if (!(x >= k->box.x0 && x <= k->box.x1 && y >= k->box.y0 && y <= k->box.y1))
+  const oc_eblend *bl = OC_EBLEND(n);
+  for (size_t i = 0; i < bl->nkids; i++) {
+    const oc_enode *k = bl->kids[i];
+    if (!oc_enode_holds(k, x, y))
       continue; /* alpha = 0 there: no contribution */
     oc_enode_sample c;
     oc_enode_ev(k, x, y, ft, grad | OC_EV_LAZY | only, &c);
@@ -114,7 +148,8 @@ static void blend_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
 ** combination: its slope is at most max lambda_i + Lambda D / inf S, D
 ** the width of the children's range; where sum alpha < T, f = sum
 ** alpha_i f_i / T: at most max lambda_i + sum lambda_alpha_i sup|f_i| / T. */
-static void blend_combine(const oc_ebound *kb, size_t n, oc_ebound *o) {
+static void blend_combine(const oc_ebound *kb, size_t n, int plane,
+                          oc_ebound *o) {
   if (n == 0) {
     *o = (oc_ebound){0, 0, 0, 0, 0, 0};
     return;
@@ -124,7 +159,7 @@ static void blend_combine(const oc_ebound *kb, size_t n, oc_ebound *o) {
   for (size_t i = 0; i < n; i++) {
     flo = fmin(flo, kb[i].flo);
     fhi = fmax(fhi, kb[i].fhi);
-    slo += kb[i].alo;
+    slo += plane ? 0 : kb[i].alo; /* (the plane: some point is outside) */
     shi += kb[i].ahi;
     lmax = fmax(lmax, kb[i].lf);
     lasum += kb[i].la;
@@ -154,20 +189,23 @@ static void blend_combine(const oc_ebound *kb, size_t n, oc_ebound *o) {
 
 static void blend_bound_in(const oc_enode *n, const oc_erect *b,
                            const oc_efootb *fb, oc_ebound *o) {
+  const oc_eblend *bl = OC_EBLEND(n);
   oc_ebound stack[KB_STACK], *kb = stack;
-  if (n->nkids > KB_STACK && !(kb = malloc(n->nkids * sizeof *kb))) {
-    *o = n->glob; /* (conservative: the whole plane's) */
+  if (bl->nkids > KB_STACK && !(kb = malloc(bl->nkids * sizeof *kb))) {
+    oc_enode_glob(n, o); /* (conservative: the whole plane's) */
     return;
   }
   size_t m = 0;
-  for (size_t i = 0; i < n->nkids; i++)
-    if (oc_erect_meets(&n->kids[i]->box, b)) {
-      oc_enode_bnd(n->kids[i], b, fb, &kb[m]);
+  for (size_t i = 0; i < bl->nkids; i++) {
+    const oc_enode *k = bl->kids[i];
+    if (oc_enode_meets(k, b)) {
+      oc_enode_bnd(k, b, fb, &kb[m]);
       /* alpha = 0 on the whole box: neither the child's f nor its
       ** weight's slope counts there */
       m += kb[m].ahi > 0;
     }
-  blend_combine(kb, m, o);
+  }
+  blend_combine(kb, m, 0, o);
   if (kb != stack) free(kb);
 }
 
@@ -181,26 +219,28 @@ oc_enode *oc_enode_blend(oc_enode *const *kids, size_t n, oc_error *err) {
       oc_seterr(err, OC_EINVAL, "blend: child %zu is NULL", i + 1);
       return NULL;
     }
+  if (n > UINT32_MAX || n > (SIZE_MAX - sizeof(oc_eblend)) / sizeof *kids) {
+    oc_seterr(err, OC_EINVAL, "blend: too many children (%zu)", n);
+    return NULL;
+  }
   oc_ebound *kb = malloc(n * sizeof *kb);
-  if (!kb) {
+  oc_erect *kbox = malloc(n * sizeof *kbox);
+  oc_enode *e = NULL;
+  if (!kb || !kbox) {
     oc_seterr(err, OC_ENOMEM, "out of memory (%zu children)", n);
-    return NULL;
+    goto done;
   }
-  oc_enode *e = oc_enode_alloc(OC_E_BLEND, kids, n, err);
-  if (!e) {
-    free(kb);
-    return NULL;
-  }
-  e->box = kids[0]->box;
+  e = oc_enode_alloc(OC_E_BLEND, offsetof(oc_eblend, kids) + n * sizeof *kids,
+                     kids, n, err);
+  if (!e) goto done;
   for (size_t i = 0; i < n; i++) {
-    kb[i] = kids[i]->glob;
-    e->box = rect_union(e->box, kids[i]->box);
+    oc_enode_glob(kids[i], &kb[i]);
+    kbox[i] = oc_enode_box(kids[i]);
   }
-  /* over the whole plane, some points are outside every support */
-  for (size_t i = 0; i < n; i++)
-    kb[i].alo = 0;
-  blend_combine(kb, n, &e->glob);
+  store_derived(e, kb, kbox);
+done:
   free(kb);
+  free(kbox);
   return e;
 }
 
@@ -209,24 +249,22 @@ oc_enode *oc_enode_blend(oc_enode *const *kids, size_t n, oc_error *err) {
 static void replace_ev(const oc_enode *n, double x, double y,
                        const oc_efoot *ft, int want, oc_enode_sample *s) {
   int grad = want & OC_EV_GRAD, in;
-  const oc_enode *A = n->kids[0], *B = n->kids[1];
+  const oc_enode *A = OC_EBIN(n)->kids[0], *B = OC_EBIN(n)->kids[1];
   oc_enode_sample a, b;
-  int lerp = n->par[P_LERP] != 0;
+  int lerp = OC_EBIN(n)->par[P_LERP] != 0;
   if (want & OC_EV_ALPHA) { /* alpha_A, or lerped with B's */
     oc_enode_ev(A, x, y, ft, OC_EV_ALPHA, &a);
     s->a = a.a;
     if (lerp) {
       b.a = 0;
-      if (x >= B->box.x0 && x <= B->box.x1 && y >= B->box.y0 && y <= B->box.y1)
-        oc_enode_ev(B, x, y, ft, OC_EV_ALPHA, &b);
+      if (oc_enode_holds(B, x, y)) oc_enode_ev(B, x, y, ft, OC_EV_ALPHA, &b);
       double w = clamp01(b.a, &in);
       s->a = (1 - w) * a.a + w * w;
     }
     return;
   }
   b.a = b.f = b.fx = b.fy = b.ax = b.ay = 0;
-  if (x >= B->box.x0 && x <= B->box.x1 && y >= B->box.y0 && y <= B->box.y1)
-    oc_enode_ev(B, x, y, ft, grad | OC_EV_LAZY, &b);
+  if (oc_enode_holds(B, x, y)) oc_enode_ev(B, x, y, ft, grad | OC_EV_LAZY, &b);
   double w = clamp01(b.a, &in);
   /* A's f is not needed where B replaces it wholly, nor, for a lazy
   ** caller, where A's weight (the node's, unless lerped) is 0 */
@@ -261,7 +299,7 @@ static void replace_ev(const oc_enode *n, double x, double y,
 /* Bounds from A's and B's over one region. */
 static void replace_combine(const oc_enode *n, const oc_ebound *A,
                             const oc_ebound *B, int bmeets, oc_ebound *o) {
-  int lerp = n->par[P_LERP] != 0;
+  int lerp = OC_EBIN(n)->par[P_LERP] != 0;
   double wlo = bmeets ? fmin(fmax(B->alo, 0), 1) : 0;
   double whi = bmeets ? fmin(fmax(B->ahi, 0), 1) : 0;
   double law = bmeets ? B->la : 0;
@@ -281,7 +319,7 @@ static void replace_combine(const oc_enode *n, const oc_ebound *A,
   }
 }
 
-static oc_enode *binary(oc_ekind kind, oc_enode *a, oc_enode *b,
+static oc_enode *binary(oc_ekind kind, oc_enode *a, oc_enode *b, size_t npar,
                         oc_error *err) {
   if (!a || !b) {
     oc_seterr(err, OC_EINVAL, "%s needs two elevation nodes",
@@ -289,18 +327,24 @@ static oc_enode *binary(oc_ekind kind, oc_enode *a, oc_enode *b,
     return NULL;
   }
   oc_enode *k[2] = {a, b};
-  return oc_enode_alloc(kind, k, 2, err);
+  return oc_enode_alloc(kind, offsetof(oc_ebin, par) + npar * sizeof(double), k,
+                        2, err);
+}
+
+/* Stores a binary operator's bound and box from its children's. */
+static void store_binary(oc_enode *n, const oc_enode *a, const oc_enode *b) {
+  oc_ebound kb[2];
+  oc_erect kbox[2] = {oc_enode_box(a), oc_enode_box(b)};
+  oc_enode_glob(a, &kb[0]);
+  oc_enode_glob(b, &kb[1]);
+  store_derived(n, kb, kbox);
 }
 
 oc_enode *oc_enode_replace(oc_enode *a, oc_enode *b, int lerp, oc_error *err) {
-  oc_enode *n = binary(OC_E_REPLACE, a, b, err);
+  oc_enode *n = binary(OC_E_REPLACE, a, b, OC_EREPLACE_NPAR, err);
   if (!n) return NULL;
-  n->par[P_LERP] = lerp != 0;
-  /* alpha may be > 0 where B alone is, with the summed or lerped weight */
-  n->box = lerp ? rect_union(a->box, b->box) : a->box;
-  oc_ebound B = b->glob;
-  B.alo = 0;
-  replace_combine(n, &a->glob, &B, 1, &n->glob);
+  ((oc_ebin *)n)->par[P_LERP] = lerp != 0;
+  store_binary(n, a, b);
   return n;
 }
 
@@ -342,7 +386,8 @@ enum { P_SLOPE = 4, P_SFADE = 5, P_SSTEP = 6 };
 ** *wy (want: OC_EV_GRAD or 0). */
 static double slope_w(const oc_enode *n, const oc_enode *A, double x, double y,
                       const oc_efoot *ft, int want, double *wx, double *wy) {
-  double h = n->par[P_SSTEP];
+  const double *par = OC_EBIN(n)->par;
+  double h = par[P_SSTEP];
   oc_enode_sample e, w, no, so;
   /* every f is needed, also where alpha_A = 0: no OC_EV_LAZY; the
   ** footprint is p's, so each term is a function of p whose gradient the
@@ -353,13 +398,13 @@ static double slope_w(const oc_enode *n, const oc_enode *A, double x, double y,
   oc_enode_ev(A, x, y - h, ft, want, &so);
   double dx = (e.f - w.f) / (2 * h), dy = (no.f - so.f) / (2 * h);
   double s2 = dx * dx + dy * dy, s = sqrt(s2);
-  double t = (atan(s) - n->par[P_SLOPE]) / n->par[P_SFADE];
+  double t = (atan(s) - par[P_SLOPE]) / par[P_SFADE];
   *wx = *wy = 0;
   if (!(t > 0)) return t == t ? 1 : NAN;
   if (t >= 1) return 0;
   if (want & OC_EV_GRAD) {
     /* dW/ds / s, then grad s = (dx grad dx + dy grad dy) / s */
-    double k = -6 * t * (1 - t) / n->par[P_SFADE] / (1 + s2) / s;
+    double k = -6 * t * (1 - t) / par[P_SFADE] / (1 + s2) / s;
     double i2h = 1 / (2 * h);
     double xx = (e.fx - w.fx) * i2h, xy = (e.fy - w.fy) * i2h;
     double yx = (no.fx - so.fx) * i2h, yy = (no.fy - so.fy) * i2h;
@@ -372,16 +417,15 @@ static double slope_w(const oc_enode *n, const oc_enode *A, double x, double y,
 static void add_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                    int want, oc_enode_sample *s) {
   int grad = want & OC_EV_GRAD, in;
-  const oc_enode *A = n->kids[0], *B = n->kids[1];
+  const oc_enode *A = OC_EBIN(n)->kids[0], *B = OC_EBIN(n)->kids[1];
   oc_enode_sample a, b;
-  int sumw = n->par[P_SUMW] != 0;
+  int sumw = OC_EBIN(n)->par[P_SUMW] != 0;
   if (want & OC_EV_ALPHA) { /* alpha_A, or plus w_B^2 */
     oc_enode_ev(A, x, y, ft, OC_EV_ALPHA, &a);
     s->a = a.a;
     if (sumw) {
       b.a = 0;
-      if (x >= B->box.x0 && x <= B->box.x1 && y >= B->box.y0 && y <= B->box.y1)
-        oc_enode_ev(B, x, y, ft, OC_EV_ALPHA, &b);
+      if (oc_enode_holds(B, x, y)) oc_enode_ev(B, x, y, ft, OC_EV_ALPHA, &b);
       double c = clamp01(b.a, &in);
       s->a += c * c;
     }
@@ -394,20 +438,19 @@ static void add_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
     return;
   }
   b.a = b.f = b.fx = b.fy = b.ax = b.ay = 0;
-  if (x >= B->box.x0 && x <= B->box.x1 && y >= B->box.y0 && y <= B->box.y1)
-    oc_enode_ev(B, x, y, ft, grad | OC_EV_LAZY, &b);
+  if (oc_enode_holds(B, x, y)) oc_enode_ev(B, x, y, ft, grad | OC_EV_LAZY, &b);
   double c = clamp01(b.a, &in), cx = grad && in ? b.ax : 0,
          cy = grad && in ? b.ay : 0;
   double w = c, wx = cx, wy = cy;
-  if (n->par[P_BELOW] != 0) {
-    double dW, W = below_w(n->par, a.f, &dW);
+  if (OC_EBIN(n)->par[P_BELOW] != 0) {
+    double dW, W = below_w(OC_EBIN(n)->par, a.f, &dW);
     w = c * W;
     wx = cx * W + c * dW * a.fx;
     wy = cy * W + c * dW * a.fy;
   }
   /* where w = 0 its gradient is 0 too (c and the altitude weight reach
   ** 0 with slope 0): the slope weight is not needed there */
-  if (n->par[P_SSTEP] != 0 && w != 0) {
+  if ((n->flags & OC_EF_SLOPE) && w != 0) {
     double Sx, Sy, S = slope_w(n, A, x, y, ft, grad, &Sx, &Sy);
     wx = wx * S + w * Sx;
     wy = wy * S + w * Sy;
@@ -433,24 +476,26 @@ static void add_combine(const oc_enode *n, const oc_ebound *A,
   *o = *A;
   /* the altitude weight is 0 on the region where f_A >= below_z, 1
   ** where f_A <= below_z - fade (with a hair for the rounding of t) */
-  int below = n->par[P_BELOW] != 0;
-  double bz = n->par[P_BZ], fade = n->par[P_FADE], fchi = chi;
+  const double *par = OC_EBIN(n)->par;
+  int below = par[P_BELOW] != 0;
+  double bz = par[P_BZ], fade = par[P_FADE], fchi = chi;
   if (below && A->flo >= bz) fchi = 0;
   if (below && A->fhi < bz - fade * (1 + 1e-9) - 1e-9 * fabs(bz)) below = 0;
   /* the slope weight is 1 on the region where |D| <= sqrt(2) lah stays
   ** below tan theta0 (with a hair for the rounding of D and atan) */
-  double h = n->par[P_SSTEP], th0 = n->par[P_SLOPE];
-  int slope = h != 0 && !(sqrt(2.0) * lah * (1 + 1e-9) < tan(th0) * (1 - 1e-9));
+  int slope = (n->flags & OC_EF_SLOPE) != 0;
+  double h = slope ? par[P_SSTEP] : 0, th0 = slope ? par[P_SLOPE] : 0;
+  slope = slope && !(sqrt(2.0) * lah * (1 + 1e-9) < tan(th0) * (1 - 1e-9));
   if (fchi > 0) {
     double wlo = clo, whi = fchi, lw = lc;
     if (below) {
       wlo = 0; /* the altitude weight may be 0 */
-      lw = lc + 1.5 / n->par[P_FADE] * A->lf;
+      lw = lc + 1.5 / par[P_FADE] * A->lf;
     }
     if (slope) {
       /* |D| <= sqrt(2) lah keeps t below tmax, where the smoothstep's
       ** slope 6 t (1 - t) is at most its value at tmax if tmax < 1/2 */
-      double c0 = cos(th0), phi = n->par[P_SFADE];
+      double c0 = cos(th0), phi = par[P_SFADE];
       double tmax = (atan(sqrt(2.0) * lah) - th0) / phi * (1 + 1e-9) + 1e-9;
       tmax = fmax(tmax, 0);
       double ss = tmax < 0.5 ? 6 * tmax * (1 - tmax) : 1.5;
@@ -465,7 +510,7 @@ static void add_combine(const oc_enode *n, const oc_ebound *A,
     o->fhi = A->fhi + phi;
     o->lf = A->lf + lw * fmax(fabs(B->flo), fabs(B->fhi)) + whi * B->lf;
   }
-  if (n->par[P_SUMW] != 0) {
+  if (par[P_SUMW] != 0) {
     o->alo = A->alo + clo * clo;
     o->ahi = A->ahi + chi * chi;
     o->la = A->la + 2 * chi * lc;
@@ -480,9 +525,10 @@ static void binary_bound_in(const oc_enode *n, const oc_erect *b,
                             const oc_efootb *fb, combine_fn combine,
                             oc_ebound *o) {
   oc_ebound A, B;
-  oc_enode_bnd(n->kids[0], b, fb, &A);
-  int meets = oc_erect_meets(&n->kids[1]->box, b);
-  if (meets) oc_enode_bnd(n->kids[1], b, fb, &B);
+  const oc_ebin *bn = OC_EBIN(n);
+  oc_enode_bnd(bn->kids[0], b, fb, &A);
+  int meets = oc_enode_meets(bn->kids[1], b);
+  if (meets) oc_enode_bnd(bn->kids[1], b, fb, &B);
   combine(n, &A, &B, meets, o);
 }
 
@@ -491,15 +537,17 @@ static void binary_bound_in(const oc_enode *n, const oc_erect *b,
 static void add_bound_in(const oc_enode *n, const oc_erect *b,
                          const oc_efootb *fb, oc_ebound *o) {
   oc_ebound A, B, G;
-  oc_enode_bnd(n->kids[0], b, fb, &A);
-  int meets = oc_erect_meets(&n->kids[1]->box, b);
-  if (meets) oc_enode_bnd(n->kids[1], b, fb, &B);
-  double lah = 0, h = n->par[P_SSTEP];
+  const oc_ebin *bn = OC_EBIN(n);
+  oc_enode_bnd(bn->kids[0], b, fb, &A);
+  int meets = oc_enode_meets(bn->kids[1], b);
+  if (meets) oc_enode_bnd(bn->kids[1], b, fb, &B);
+  double lah = 0;
   /* A's slope over the stencil's reach, where the slope weight counts */
-  if (h != 0 && meets && B.ahi > 0 &&
-      !(n->par[P_BELOW] != 0 && A.flo >= n->par[P_BZ])) {
+  if ((n->flags & OC_EF_SLOPE) && meets && B.ahi > 0 &&
+      !(bn->par[P_BELOW] != 0 && A.flo >= bn->par[P_BZ])) {
+    double h = bn->par[P_SSTEP];
     oc_erect g = {b->x0 - h, b->y0 - h, b->x1 + h, b->y1 + h};
-    oc_enode_bnd(n->kids[0], &g, fb, &G);
+    oc_enode_bnd(bn->kids[0], &g, fb, &G);
     lah = G.lf;
   }
   add_combine(n, &A, &B, meets, lah, o);
@@ -542,20 +590,21 @@ oc_enode *oc_enode_add(oc_enode *a, oc_enode *b, const oc_enode_add_params *p,
       return NULL;
     }
   }
-  oc_enode *n = binary(OC_E_ADD, a, b, err);
+  oc_enode *n =
+      binary(OC_E_ADD, a, b, p->slope ? OC_EADD_SLOPE_NPAR : OC_EADD_NPAR, err);
   if (!n) return NULL;
-  n->par[P_SUMW] = p->sum_weight != 0;
-  n->par[P_BELOW] = p->below != 0;
-  n->par[P_BZ] = p->below_z;
-  n->par[P_FADE] = p->fade;
-  n->par[P_SLOPE] = p->slope ? p->slope_deg * DEG : 0;
-  n->par[P_SFADE] = p->slope ? p->slope_fade * DEG : 0;
-  n->par[P_SSTEP] = p->slope ? step : 0;
-  /* alpha may be > 0 where B alone is, with the summed or lerped weight */
-  n->box = p->sum_weight ? rect_union(a->box, b->box) : a->box;
-  oc_ebound B = b->glob;
-  B.alo = 0;
-  add_combine(n, &a->glob, &B, 1, a->glob.lf, &n->glob);
+  double *par = ((oc_ebin *)n)->par;
+  par[P_SUMW] = p->sum_weight != 0;
+  par[P_BELOW] = p->below != 0;
+  par[P_BZ] = p->below_z;
+  par[P_FADE] = p->fade;
+  if (p->slope) {
+    n->flags |= OC_EF_SLOPE;
+    par[P_SLOPE] = p->slope_deg * DEG;
+    par[P_SFADE] = p->slope_fade * DEG;
+    par[P_SSTEP] = step;
+  }
+  store_binary(n, a, b);
   return n;
 }
 
@@ -563,28 +612,30 @@ oc_enode *oc_enode_add(oc_enode *a, oc_enode *b, const oc_enode_add_params *p,
 
 static void xform_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                      int want, oc_enode_sample *s) {
-  const double *m = n->par + P_MI;
-  double u = x - n->par[P_TX], v = y - n->par[P_TY];
+  const double *par = OC_EUN(n)->par;
+  double m[4];
+  minv(n, m);
+  double u = x - par[P_TX], v = y - par[P_TY];
   oc_enode_sample c;
   /* the footprint in the child's units: foot(M p' + t) / s, whose
   ** gradient in p' is R^T grad foot = s Minv grad foot */
   oc_efoot cf, *cft = NULL;
   if (ft) {
-    double sc = n->par[P_SCALE];
-    cf.v = ft->v * n->par[P_ISCALE];
+    double sc = par[P_SCALE];
+    cf.v = ft->v * (1 / sc);
     cf.gx = sc * (m[0] * ft->gx + m[1] * ft->gy);
     cf.gy = sc * (m[2] * ft->gx + m[3] * ft->gy);
     cft = &cf;
   }
-  oc_enode_ev(n->kids[0], m[0] * u + m[1] * v, m[2] * u + m[3] * v, cft, want,
-              &c);
-  double vs = n->par[P_VS];
+  oc_enode_ev(OC_EUN(n)->kid, m[0] * u + m[1] * v, m[2] * u + m[3] * v, cft,
+              want, &c);
+  double vs = par[P_VS];
   s->a = c.a;
   if (want & OC_EV_ALPHA) return;
   if (want & OC_EV_LAZY && c.a == 0)
     s->f = 0;
   else
-    s->f = vs * c.f + n->par[P_VO];
+    s->f = vs * c.f + par[P_VO];
   /* grad = Minv^T grad_child */
   s->fx = vs * (m[0] * c.fx + m[2] * c.fy);
   s->fy = vs * (m[1] * c.fx + m[3] * c.fy);
@@ -597,20 +648,22 @@ static void xform_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
 static oc_erect map_rect(const oc_enode *n, const oc_erect *r, int inverse) {
   double xs[2] = {r->x0, r->x1}, ys[2] = {r->y0, r->y1};
   oc_erect o = {INFINITY, INFINITY, -INFINITY, -INFINITY};
-  const double *mi = n->par + P_MI;
-  double s = n->par[P_SCALE];
+  const double *par = OC_EUN(n)->par;
+  double mi[4];
+  minv(n, mi);
+  double s = par[P_SCALE];
   /* M = s^2 Minv^T for a similarity: Minv = R^T / s, M = s R */
   double m[4] = {mi[0] * s * s, mi[2] * s * s, mi[1] * s * s, mi[3] * s * s};
   for (int a = 0; a < 2; a++)
     for (int b = 0; b < 2; b++) {
       double u, v;
       if (inverse) {
-        double px = xs[a] - n->par[P_TX], py = ys[b] - n->par[P_TY];
+        double px = xs[a] - par[P_TX], py = ys[b] - par[P_TY];
         u = mi[0] * px + mi[1] * py;
         v = mi[2] * px + mi[3] * py;
       } else {
-        u = m[0] * xs[a] + m[1] * ys[b] + n->par[P_TX];
-        v = m[2] * xs[a] + m[3] * ys[b] + n->par[P_TY];
+        u = m[0] * xs[a] + m[1] * ys[b] + par[P_TX];
+        v = m[2] * xs[a] + m[3] * ys[b] + par[P_TY];
       }
       o.x0 = fmin(o.x0, u);
       o.x1 = fmax(o.x1, u);
@@ -625,7 +678,8 @@ static oc_erect map_rect(const oc_enode *n, const oc_erect *r, int inverse) {
 
 static void xform_map_bound(const oc_enode *n, const oc_ebound *c,
                             oc_ebound *o) {
-  double vs = n->par[P_VS], vo = n->par[P_VO], is = n->par[P_ISCALE];
+  const double *par = OC_EUN(n)->par;
+  double vs = par[P_VS], vo = par[P_VO], is = 1 / par[P_SCALE];
   double a = vs * c->flo + vo, b = vs * c->fhi + vo;
   *o = *c;
   o->flo = fmin(a, b);
@@ -641,11 +695,11 @@ static void xform_bound_in(const oc_enode *n, const oc_erect *b,
   /* a similarity keeps the footprint's Lipschitz bound, in any units */
   oc_efootb cf, *cfb = NULL;
   if (fb) {
-    double is = n->par[P_ISCALE];
+    double is = 1 / OC_EUN(n)->par[P_SCALE];
     cf = (oc_efootb){fb->lo * is, fb->hi * is, fb->k};
     cfb = &cf;
   }
-  oc_enode_bnd(n->kids[0], &r, cfb, &c);
+  oc_enode_bnd(OC_EUN(n)->kid, &r, cfb, &c);
   xform_map_bound(n, &c, o);
 }
 
@@ -681,39 +735,40 @@ oc_enode *oc_enode_transform(oc_enode *e, const oc_enode_xform *x,
   double ang = x->angle, tx = x->tx, ty = x->ty, vo = x->voffset;
   oc_enode *child = e;
   if (e->kind == OC_E_XFORM) {
-    double s2 = e->par[P_SCALE];
+    const double *ep = OC_EUN(e)->par;
+    double s2 = ep[P_SCALE];
     double c1 = cos(ang * DEG), s1 = sin(ang * DEG);
-    double t2x = e->par[P_TX], t2y = e->par[P_TY];
+    double t2x = ep[P_TX], t2y = ep[P_TY];
     tx += s * (c1 * t2x - s1 * t2y);
     ty += s * (s1 * t2x + c1 * t2y);
-    vo += vs * e->par[P_VO];
-    vs *= e->par[P_VS];
+    vo += vs * ep[P_VO];
+    vs *= ep[P_VS];
     s *= s2;
-    ang += e->par[P_ANGLE];
-    child = e->kids[0];
+    ang += ep[P_ANGLE];
+    child = OC_EUN(e)->kid;
   }
   if (!(isfinite(s) && s > 0 && isfinite(1 / s) && isfinite(tx) &&
         isfinite(ty) && isfinite(vs) && vs != 0 && isfinite(vo))) {
     oc_seterr(err, OC_EINVAL, "transform: the composed transform overflows");
     return NULL;
   }
-  oc_enode *n = oc_enode_alloc(OC_E_XFORM, &child, 1, err);
+  oc_enode *n = oc_enode_alloc(
+      OC_E_XFORM, offsetof(oc_eun, par) + OC_EXFORM_NPAR * sizeof(double),
+      &child, 1, err);
   if (!n) return NULL;
   double th = ang * DEG, c = cos(th), sn = sin(th);
-  /* Minv = R^T / s */
-  n->par[P_MI + 0] = c / s;
-  n->par[P_MI + 1] = sn / s;
-  n->par[P_MI + 2] = -sn / s;
-  n->par[P_MI + 3] = c / s;
-  n->par[P_TX] = tx;
-  n->par[P_TY] = ty;
-  n->par[P_ISCALE] = 1 / s;
-  n->par[P_VS] = vs;
-  n->par[P_VO] = vo;
-  n->par[P_SCALE] = s;
-  n->par[P_ANGLE] = ang;
-  n->box = map_rect(n, &child->box, 0);
-  xform_map_bound(n, &child->glob, &n->glob);
+  double *par = ((oc_eun *)n)->par;
+  /* Minv = R^T / s: its first row (its second is minv's) */
+  par[P_MI + 0] = c / s;
+  par[P_MI + 1] = sn / s;
+  par[P_TX] = tx;
+  par[P_TY] = ty;
+  par[P_VS] = vs;
+  par[P_VO] = vo;
+  par[P_SCALE] = s;
+  par[P_ANGLE] = ang;
+  oc_erect cbox = oc_enode_box(child), box = map_rect(n, &cbox, 0);
+  oc_erect_round(&box, &((oc_eun *)n)->box);
   return n;
 }
 
@@ -723,15 +778,17 @@ oc_enode *oc_enode_transform(oc_enode *e, const oc_enode_xform *x,
 ** Jacobian rows. */
 static void warp_delta(const oc_enode *n, double x, double y, double d[2],
                        double jac[4]) {
-  const oc_enoise *nz = &n->noise;
-  double a = nz->amplitude, s = 1 / nz->wavelength;
+  const double *par = OC_EUN(n)->par;
+  double a = par[P_WAMP], s = 1 / par[P_WWL];
+  uint64_t nzseed;
+  memcpy(&nzseed, &par[P_WSEED], sizeof nzseed);
   d[0] = d[1] = 0;
   if (jac) jac[0] = jac[1] = jac[2] = jac[3] = 0;
-  for (int k = 0; k < nz->octaves; k++) {
+  for (int k = 0; k < n->octaves; k++) {
     for (int c = 0; c < 2; c++) {
       double g[2];
-      uint64_t seed = oc_mix64(nz->seed + 0x9e3779b97f4a7c15ull *
-                                              (uint64_t)(2 * k + c + 1));
+      uint64_t seed =
+          oc_mix64(nzseed + 0x9e3779b97f4a7c15ull * (uint64_t)(2 * k + c + 1));
       d[c] += a * oc_eta(seed, x * s, y * s, jac ? g : NULL);
       if (jac) {
         jac[2 * c] += a * s * g[0];
@@ -762,7 +819,7 @@ static void warp_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
     }
     cft = &cf;
   }
-  oc_enode_ev(n->kids[0], x + d[0], y + d[1], cft, want, &c);
+  oc_enode_ev(OC_EUN(n)->kid, x + d[0], y + d[1], cft, want, &c);
   *s = c;
   if (!grad) return;
   /* grad = (I + J)^T grad_child */
@@ -774,7 +831,7 @@ static void warp_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
 
 static void warp_bound_in(const oc_enode *n, const oc_erect *b,
                           const oc_efootb *fb, oc_ebound *o) {
-  double m = n->par[P_WMAX], l = n->par[P_WLIP];
+  double m = OC_EUN(n)->par[P_WMAX], l = OC_EUN(n)->par[P_WLIP];
   oc_erect r = {b->x0 - m, b->y0 - m, b->x1 + m, b->y1 + m};
   /* the inverse of p -> p + delta(p) is 1 / (1 - l) Lipschitz */
   oc_efootb cf, *cfb = NULL;
@@ -782,7 +839,7 @@ static void warp_bound_in(const oc_enode *n, const oc_erect *b,
     cf = (oc_efootb){fb->lo, fb->hi, fb->k / (1 - l)};
     cfb = &cf;
   }
-  oc_enode_bnd(n->kids[0], &r, cfb, o);
+  oc_enode_bnd(OC_EUN(n)->kid, &r, cfb, o);
   o->lf *= 1 + l;
   o->la *= 1 + l;
 }
@@ -822,19 +879,66 @@ oc_enode *oc_enode_warp(oc_enode *e, const oc_enode_warp_params *p,
               lip, p->amplitude / lip);
     return NULL;
   }
-  oc_enode *n = oc_enode_alloc(OC_E_WARP, &e, 1, err);
+  oc_enode *n = oc_enode_alloc(
+      OC_E_WARP, offsetof(oc_eun, par) + OC_EWARP_NPAR * sizeof(double), &e, 1,
+      err);
   if (!n) return NULL;
-  n->noise = (oc_enoise){OC_ENOISE_PLAIN, p->octaves, p->amplitude,
-                         p->wavelength,   0.5,        2,
-                         p->seed};
-  n->par[P_WMAX] = maxd;
-  n->par[P_WLIP] = lip;
-  n->box = (oc_erect){e->box.x0 - maxd, e->box.y0 - maxd, e->box.x1 + maxd,
-                      e->box.y1 + maxd};
-  n->glob = e->glob;
-  n->glob.lf *= 1 + lip;
-  n->glob.la *= 1 + lip;
+  double *par = ((oc_eun *)n)->par;
+  n->octaves = (uint8_t)p->octaves;
+  par[P_WMAX] = maxd;
+  par[P_WLIP] = lip;
+  par[P_WAMP] = p->amplitude;
+  par[P_WWL] = p->wavelength;
+  memcpy(&par[P_WSEED], &p->seed, sizeof p->seed);
+  oc_ebound g;
+  oc_erect cbox = oc_enode_box(e), box;
+  oc_enode_glob(e, &g);
+  oc_eop_derive(n, &g, &cbox, &g, &box);
+  oc_erect_round(&box, &((oc_eun *)n)->box);
   return n;
+}
+
+/* ---- bounds over the plane ------------------------------------------- */
+
+void oc_eop_derive(const oc_enode *n, const oc_ebound *kb, const oc_erect *kbox,
+                   oc_ebound *glob, oc_erect *box) {
+  switch (n->kind) {
+  case OC_E_BLEND: {
+    size_t nk = OC_EBLEND(n)->nkids;
+    *box = kbox[0];
+    for (size_t i = 0; i < nk; i++)
+      *box = rect_union(*box, kbox[i]);
+    /* over the whole plane, some points are outside every support */
+    blend_combine(kb, nk, 1, glob);
+    return;
+  }
+  case OC_E_REPLACE:
+  case OC_E_ADD: {
+    /* alpha may be > 0 where B alone is, with the summed or lerped
+    ** weight */
+    int both = OC_EBIN(n)->par[n->kind == OC_E_REPLACE ? P_LERP : P_SUMW] != 0;
+    *box = both ? rect_union(kbox[0], kbox[1]) : kbox[0];
+    oc_ebound B = kb[1];
+    B.alo = 0;
+    if (n->kind == OC_E_REPLACE)
+      replace_combine(n, &kb[0], &B, 1, glob);
+    else /* (A's slope over the plane for the slope weight's) */
+      add_combine(n, &kb[0], &B, 1, kb[0].lf, glob);
+    return;
+  }
+  case OC_E_XFORM:
+    *box = map_rect(n, &kbox[0], 0);
+    xform_map_bound(n, &kb[0], glob);
+    return;
+  default: { /* warp */
+    double maxd = OC_EUN(n)->par[P_WMAX], lip = OC_EUN(n)->par[P_WLIP];
+    *box = (oc_erect){kbox[0].x0 - maxd, kbox[0].y0 - maxd, kbox[0].x1 + maxd,
+                      kbox[0].y1 + maxd};
+    *glob = kb[0];
+    glob->lf *= 1 + lip;
+    glob->la *= 1 + lip;
+  }
+  }
 }
 
 /* ---- dispatch --------------------------------------------------------- */

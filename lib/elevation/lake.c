@@ -97,7 +97,7 @@ static double gap(const elake *d, size_t i) {
 void oc_elake_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                  int want, oc_enode_sample *s) {
   (void)ft; /* no detail to filter */
-  const elake *d = n->data;
+  const elake *d = OC_EPRIM(n)->data;
   int grad = want & OC_EV_GRAD;
   double u = x - d->cx, v = y - d->cy, rho = hypot(u, v), th = atan2(v, u);
   double dr, r = oc_profile_eval(d->shore, wrap(th, d->th0), &dr);
@@ -180,13 +180,14 @@ static void bound_rho(const elake *d, double rl, double rh, oc_ebound *o) {
   o->ahi = fmin(1, wyvill_or_one(dl, d->R) * (1 + 1e-12));
   o->alo = fmax(0, wyvill_or_one(dh, d->R) * (1 - 1e-12) - 1e-300);
   double ra = fmax(rl, d->rmin), kr = d->drmax / ra;
-  o->la = oc_falloff_slope_in(dl / d->R, dh / d->R) / d->R * sqrt(1 + kr * kr) * (1 + 1e-9);
+  o->la = oc_falloff_slope_in(dl / d->R, dh / d->R) / d->R * sqrt(1 + kr * kr) *
+          (1 + 1e-9);
 }
 
 void oc_elake_bound_in(const oc_enode *n, const oc_erect *b,
                        const oc_efootb *fb, oc_ebound *o) {
   (void)fb;
-  const elake *d = n->data;
+  const elake *d = OC_EPRIM(n)->data;
   double dx = fmax(fmax(b->x0 - d->cx, d->cx - b->x1), 0);
   double dy = fmax(fmax(b->y0 - d->cy, d->cy - b->y1), 0);
   double fx = fmax(fabs(b->x0 - d->cx), fabs(b->x1 - d->cx));
@@ -424,7 +425,8 @@ oc_enode *oc_enode_lake(const oc_enode_lake_params *p, oc_error *err) {
     }
   }
   d->rho0 = d->rmin + dlo;
-  oc_enode *n = oc_enode_alloc(OC_E_LAKE, NULL, 0, err);
+  oc_eprim *n =
+      (oc_eprim *)oc_enode_alloc(OC_E_LAKE, sizeof(oc_eprim), NULL, 0, err);
   if (!n) {
     oc_elake_free(d);
     return NULL;
@@ -443,8 +445,17 @@ oc_enode *oc_enode_lake(const oc_enode_lake_params *p, oc_error *err) {
               "lake: its elevations or slopes overflow (radii %g..%g, "
               "falloff %g)",
               d->rmin, d->rmax, d->R);
-    oc_enode_release(n);
+    oc_enode_release(&n->h);
     return NULL;
   }
-  return n;
+  return &n->h;
+}
+
+size_t oc_elake_bytes(const void *data) {
+  const elake *d = data;
+  size_t b = sizeof *d + oc_profile_bytes(d->shore) +
+             d->np * (sizeof *d->ang + sizeof *d->prof);
+  for (size_t i = 0; i < d->np; i++)
+    b += oc_profile_bytes(d->prof[i]);
+  return b;
 }

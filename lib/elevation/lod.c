@@ -17,6 +17,7 @@
 *k0).
 */
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 
 #include "core/error.h"
@@ -109,8 +110,8 @@ static double kappa_at(double w, const oc_efoot *ft, double g[2]) {
 
 void oc_elod_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                 int want, oc_enode_sample *s) {
-  const oc_enode *A = n->kids[0], *B = n->kids[1];
-  const double *p = n->par;
+  const oc_enode *A = OC_EBIN(n)->kids[0], *B = OC_EBIN(n)->kids[1];
+  const double *p = OC_EBIN(n)->par;
   int grad = want & OC_EV_GRAD;
   if (!ft || !(ft->v > 0)) { /* full detail: kappa = 1, t = 1 */
     oc_enode_ev(B, x, y, ft, want, s);
@@ -158,22 +159,23 @@ static void lod_combine(const oc_ebound *A, const oc_ebound *B, double lt,
 
 void oc_elod_bound_in(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
                       oc_ebound *o) {
-  const double *p = n->par;
+  const double *p = OC_EBIN(n)->par;
+  oc_enode *const *k = OC_EBIN(n)->kids;
   double klo, khi, lk;
   oc_elod_kappa_bound(p[P_W], fb, &klo, &khi, &lk);
   double c = 1 / (p[P_K1] - p[P_K0]);
   double tlo = (klo - p[P_K0]) * c, thi = (khi - p[P_K0]) * c;
   if (tlo >= 1) {
-    oc_enode_bnd(n->kids[1], b, fb, o);
+    oc_enode_bnd(k[1], b, fb, o);
     return;
   }
   if (thi <= 0) {
-    oc_enode_bnd(n->kids[0], b, fb, o);
+    oc_enode_bnd(k[0], b, fb, o);
     return;
   }
   oc_ebound A, B;
-  oc_enode_bnd(n->kids[0], b, fb, &A);
-  oc_enode_bnd(n->kids[1], b, fb, &B);
+  oc_enode_bnd(k[0], b, fb, &A);
+  oc_enode_bnd(k[1], b, fb, &B);
   lod_combine(&A, &B, lk * c, o);
 }
 
@@ -197,22 +199,38 @@ oc_enode *oc_enode_lod(oc_enode *a, oc_enode *b, const oc_enode_lod_params *p,
     return NULL;
   }
   oc_enode *k[2] = {a, b};
-  oc_enode *n = oc_enode_alloc(OC_E_LOD, k, 2, err);
+  oc_enode *n = oc_enode_alloc(
+      OC_E_LOD, offsetof(oc_ebin, par) + OC_ELOD_NPAR * sizeof(double), k, 2,
+      err);
   if (!n) return NULL;
-  n->par[P_W] = p->wavelength;
-  n->par[P_K0] = k0;
-  n->par[P_K1] = k1;
+  oc_ebin *bn = (oc_ebin *)n;
+  bn->par[P_W] = p->wavelength;
+  bn->par[P_K0] = k0;
+  bn->par[P_K1] = k1;
+  oc_ebound kb[2], g;
+  oc_erect kbox[2] = {oc_enode_box(a), oc_enode_box(b)}, box;
+  oc_enode_glob(a, &kb[0]);
+  oc_enode_glob(b, &kb[1]);
+  oc_elod_derive(n, kb, kbox, &g, &box);
+  oc_ebound_round(&g, &bn->glob);
+  oc_erect_round(&box, &bn->box);
+  return n;
+}
+
+void oc_elod_derive(const oc_enode *n, const oc_ebound *kb,
+                    const oc_erect *kbox, oc_ebound *glob, oc_erect *box) {
+  (void)n;
+  const oc_erect *a = &kbox[0], *b = &kbox[1];
   /* under a view alpha may come from a: its box too */
-  n->box = (oc_erect){fmin(a->box.x0, b->box.x0), fmin(a->box.y0, b->box.y0),
-                      fmax(a->box.x1, b->box.x1), fmax(a->box.y1, b->box.y1)};
+  *box = (oc_erect){fmin(a->x0, b->x0), fmin(a->y0, b->y0), fmax(a->x1, b->x1),
+                    fmax(a->y1, b->y1)};
   /* without a view the node is b (its slopes), with the ranges of both so
   ** that those of any view lie inside */
-  n->glob = b->glob;
-  n->glob.flo = fmin(a->glob.flo, b->glob.flo);
-  n->glob.fhi = fmax(a->glob.fhi, b->glob.fhi);
-  n->glob.alo = fmin(a->glob.alo, b->glob.alo);
-  n->glob.ahi = fmax(a->glob.ahi, b->glob.ahi);
-  return n;
+  *glob = kb[1];
+  glob->flo = fmin(kb[0].flo, kb[1].flo);
+  glob->fhi = fmax(kb[0].fhi, kb[1].fhi);
+  glob->alo = fmin(kb[0].alo, kb[1].alo);
+  glob->ahi = fmax(kb[0].ahi, kb[1].ahi);
 }
 
 /* ---- queries and the elevation source under a view --------------------- */
@@ -226,7 +244,10 @@ static int make_view(const oc_enode *e, const oc_enode_view *v, oc_eview *o,
                      "'k' must be a finite number >= 0 (got %g)", v->k);
   o->ex = v->eye[0];
   o->ey = v->eye[1];
-  o->dz = fabs(v->eye[2] - (e->glob.flo + e->glob.fhi) / 2);
+  oc_ebound g;
+  oc_erect box;
+  oc_enode_exact(e, &g, &box); /* (as built in doubles) */
+  o->dz = fabs(v->eye[2] - (g.flo + g.fhi) / 2);
   o->k = v->k;
   if (!isfinite(o->dz))
     return oc_seterr(err, OC_EINVAL, "'eye' is too far from the terrain");

@@ -20,6 +20,7 @@
 
 #include "core/error.h"
 #include "outcrop.h"
+#include "terrain/terrain.h"
 
 #define MAX_LEVELS 20
 
@@ -270,4 +271,18 @@ int oc_heightfield_elevation(oc_heightfield *hf, oc_elevation *src,
   src->x1 = s->x0 + (s->nx - 1) * s->cell;
   src->y1 = s->y0 + (s->ny - 1) * s->cell;
   return OC_OK;
+}
+
+size_t oc_hfsrc_bytes(const oc_elevation *src, const oc_heightfield **hf,
+                      size_t *hf_bytes) {
+  *hf = NULL;
+  *hf_bytes = 0;
+  if (src->height != hf_height) return 0;
+  const hfsrc *s = src->ud;
+  size_t b = sizeof *s;
+  for (int l = 0; l < s->nlev; l++)
+    b += (size_t)s->lev[l].w * (size_t)s->lev[l].h * 3 * sizeof(float);
+  *hf = s->hf;
+  *hf_bytes = (size_t)s->nx * (size_t)s->ny * sizeof *s->z;
+  return b;
 }

@@ -79,4 +79,11 @@ double oc_terrain_mask_dist(const oc_tdata *t, double x, double y,
 void oc_terrain_mask_range(const oc_tdata *t, double x0, double y0, double x1,
                            double y1, double *lo, double *hi);
 
+/* The bytes of a heightfield's elevation source (oc_heightfield_elevation,
+** elevation_hf.c): its own (the pyramid) returned, and in *hf and
+** *hf_bytes the heightfield it reads and that grid's bytes, which every
+** holder of the heightfield shares. 0 and NULL for another source. */
+size_t oc_hfsrc_bytes(const oc_elevation *src, const oc_heightfield **hf,
+                      size_t *hf_bytes);
+
 #endif

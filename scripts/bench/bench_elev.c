@@ -22,7 +22,10 @@
 ** queries, one per step, are not counted, as the paper counts calls of
 ** f). `bench_elev [-q | -qq] [hf] [fig1 ...]`: those scenes only, every
 ** image 4 or 8 times smaller in each axis with -q and -qq (for work on
-** the code: the figures then are not the HD ones).
+** the code: the figures then are not the HD ones). `bench_elev --bytes
+** [fig1 ...]`: the trees' memory alone (`elev.bytes.<scene>`, the nodes
+** and the data of curves and images, each shared node or grid once, and
+** `elev.bytes_per_node.<scene>`), no rendering.
 */
 #include <math.h>
 #include <omp.h>
@@ -35,6 +38,8 @@
 
 /* bench_elev -q: every size divided by 4 (while working on the code) */
 static int shrink = 1;
+/* bench_elev --bytes: the trees' memory, no rendering */
+static int bytes_only = 0;
 
 static void die(const char *what, const oc_error *err) {
   fprintf(stderr, "bench_elev: %s: %s\n", what, err->msg);
@@ -444,6 +449,12 @@ static void counted_bound(void *ud, double x0, double y0, double x1, double y1,
   counted_inner->bound(ud, x0, y0, x1, y1, lo, hi, slope);
 }
 
+static void print_bytes(const char *name, const oc_enode_stats *st) {
+  printf("elev.bytes.%s: %zu B\n", name, st->bytes);
+  printf("elev.bytes_per_node.%s: %.1f B\n", name,
+         (double)st->bytes / (double)st->nodes);
+}
+
 static void run_scene(const char *name, void (*build)(scene *), int prims,
                       int ops, int accel) {
   scene s;
@@ -464,6 +475,14 @@ static void run_scene(const char *name, void (*build)(scene *), int prims,
   oc_esurface es = {&src, tree_weight, s.root, OC_ENODE_T};
   oc_enode_stats es_st;
   if (oc_enode_get_stats(s.root, &es_st, &err)) die(name, &err);
+  if (bytes_only) {
+    printf("# %s: %zu nodes\n", name, es_st.nodes);
+    print_bytes(name, &es_st);
+    src.release(src.ud);
+    for (int i = 0; i < s.nmade; i++)
+      oc_enode_release(s.made[i]);
+    return;
+  }
   oc_render_params rp;
   params(&s, &rp, 1920 / shrink, 1080 / shrink);
   /* Table 1 times primary rays with their normals: the geometry phase;
@@ -502,9 +521,7 @@ static void run_scene(const char *name, void (*build)(scene *), int prims,
   printf("elev.render_hd_seconds_2t.%s: %.2f s\n", name, secs);
   printf("elev.render_hd_shaded_seconds_2t.%s: %.2f s\n", name,
          secs + shade_secs);
-  printf("elev.bytes.%s: %zu B\n", name, es_st.bytes);
-  printf("elev.bytes_per_node.%s: %.1f B\n", name,
-         (double)es_st.bytes / (double)es_st.nodes);
+  print_bytes(name, &es_st);
   if (accel) {
     double calls[2], hits[2];
     params(&s, &rp, 480 / shrink, 270 / shrink);
@@ -538,7 +555,8 @@ int main(int argc, char **argv) {
   /* bench_elev [scene...]: only those (hf for the heightfield) */
   if (argc > 1 && !strcmp(argv[1], "-q")) shrink = 4, argc--, argv++;
   if (argc > 1 && !strcmp(argv[1], "-qq")) shrink = 8, argc--, argv++;
-  int hf = argc < 2;
+  if (argc > 1 && !strcmp(argv[1], "--bytes")) bytes_only = 1, argc--, argv++;
+  int hf = argc < 2 && !bytes_only;
   for (int a = 1; a < argc; a++)
     hf |= !strcmp(argv[a], "hf");
   if (hf) heightfield_bench();

@@ -438,14 +438,17 @@ START_TEST(dag_stats_and_source) {
   ck_assert_int_eq(oc_enode_get_stats(e, &st, &err), OC_OK);
   ck_assert_uint_eq(st.nodes, 4); /* hill shared */
   ck_assert_uint_eq(st.primitives, 2);
-  /* nodes are allocated at their kind's size: a disc stores 4
-  ** parameters, a transform 11, a blend none but its 3 children */
-  ck_assert(st.bytes > 0 && st.bytes <= 4 * 400);
-  size_t head = oc_enode_size(e) - 3 * sizeof(oc_enode *);
-  ck_assert_uint_eq(oc_enode_size(base), head + 4 * sizeof(double));
-  ck_assert_uint_eq(oc_enode_size(moved), head + 11 * sizeof(double));
-  ck_assert_uint_eq(st.bytes, head * 4 + 3 * sizeof(oc_enode *) +
-                                  (4 + 4 + 11) * sizeof(double));
+  /* nodes are allocated at their kind's size (enode.h): a noisy disc
+  ** 8 + 4 parameters + amplitude, wavelength, seed and the noise's
+  ** range and slope over the plane (8 each), gain and lacunarity the
+  ** defaults (not stored); a transform 8 + a float box + its child + 8
+  ** parameters; a blend 8 + float box and bound + a count + its 3
+  ** children; each counted once */
+  ck_assert_uint_eq(oc_enode_size(base), 8 + 4 * 8 + 5 * 8);
+  ck_assert_uint_eq(oc_enode_size(hill), 80);
+  ck_assert_uint_eq(oc_enode_size(moved), 8 + 16 + 8 + 8 * 8);
+  ck_assert_uint_eq(oc_enode_size(e), 8 + 16 + 24 + 8 + 3 * 8);
+  ck_assert_uint_eq(st.bytes, 80 + 80 + 96 + 80);
   /* the source answers the tree's own values and bounds */
   oc_elevation src;
   ck_assert_int_eq(oc_enode_elevation(e, NULL, &src, &err), OC_OK);
