@@ -145,6 +145,11 @@ double oc_djacobi(const oc_dop *op, const oc_dlevel *lv, const float *x,
 ** or sets (!add) the unconstrained samples of fine values f (level lf). */
 void oc_dprolong(const oc_dop *op, const oc_dlevel *lc, const float *c,
                  const oc_dlevel *lf, float *f, int add);
+/* Loops over a grid of fewer samples run on one thread: a parallel
+** region costs more than the work there (and much more on a busy
+** machine, where idle threads spin). */
+#define OC_DPAR(lv) ((size_t)(lv)->nx * (size_t)(lv)->ny > 65536)
+
 /* Whether sample k of lv is constrained for op. */
 static inline int oc_dfixed(const oc_dop *op, const oc_dlevel *lv, size_t k) {
   return op->kind == DK_LAPLACE ? (lv->flags[k] & op->mask) != 0

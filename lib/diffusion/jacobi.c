@@ -78,7 +78,7 @@ static double sweep_row(const oc_dop *op, const oc_dlevel *lv, const float *x,
 double oc_djacobi(const oc_dop *op, const oc_dlevel *lv, const float *x,
                   float *y, const float *rhs, double w) {
   double big = 0;
-#pragma omp parallel for schedule(static) reduction(max : big)
+#pragma omp parallel for schedule(static) reduction(max : big) if (OC_DPAR(lv))
   for (int j = 0; j < lv->ny; j++) {
     double b = sweep_row(op, lv, x, y, rhs, w, j);
     if (b > big) big = b;
@@ -98,7 +98,7 @@ static inline void split(int i, int nc, int *a, int *b, double *w) {
 
 void oc_dprolong(const oc_dop *op, const oc_dlevel *lc, const float *c,
                  const oc_dlevel *lf, float *f, int add) {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (OC_DPAR(lf))
   for (int j = 0; j < lf->ny; j++) {
     int ja, jb;
     double wy;

@@ -113,7 +113,7 @@ void oc_dpyramid_restrict(oc_dpyramid *py) {
   for (int k = 1; k < py->nlevels; k++) {
     const oc_dlevel *f = &py->lv[k - 1];
     oc_dlevel *c = &py->lv[k];
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (OC_DPAR(f))
     for (int J = 0; J < c->ny; J++)
       for (int I = 0; I < c->nx; I++)
         restrict_one(f, c, I, J);

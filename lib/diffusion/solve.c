@@ -56,7 +56,7 @@ static int is_guide(const oc_dop *op, const oc_dlevel *lv, size_t k) {
 /* b (level k + 1) from the residual r of level k. */
 static void restrict_residual(const oc_dop *op, const oc_dlevel *f,
                               const float *r, const oc_dlevel *c, float *b) {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (OC_DPAR(f))
   for (int J = 0; J < c->ny; J++)
     for (int I = 0; I < c->nx; I++) {
       size_t kc = (size_t)J * (size_t)c->nx + (size_t)I;
@@ -83,7 +83,7 @@ static void residual(const oc_dop *op, const oc_dlevel *lv, const float *x,
                      const float *rhs, float *r) {
   oc_djacobi(op, lv, x, r, rhs, 1);
   size_t ns = (size_t)lv->nx * (size_t)lv->ny;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (OC_DPAR(lv))
   for (size_t q = 0; q < ns; q++)
     r[q] = oc_dfixed(op, lv, q) ? 0 : r[q] - x[q];
 }
@@ -95,7 +95,7 @@ static double step(const vctx *v, const oc_dlevel *lv, const float *r,
   oc_djacobi(&v->hom, lv, c, ac, NULL, 1);
   int ny = lv->ny;
   size_t nx = (size_t)lv->nx;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (OC_DPAR(lv))
   for (int j = 0; j < ny; j++) {
     double ra = 0, aa = 0;
     for (size_t i = 0; i < nx; i++) {
@@ -141,7 +141,7 @@ static double vcycle(const vctx *v, int k, float *x, const float *rhs) {
   double t = step(v, lv, v->r[k], v->c[k], v->ac[k]);
   size_t ns = (size_t)lv->nx * (size_t)lv->ny;
   const float *c = v->c[k];
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (OC_DPAR(lv))
   for (size_t q = 0; q < ns; q++)
     x[q] = (float)(x[q] + t * c[q]);
   return sweeps(op, lv, x, py->scratch, rhs, POST, OMEGA);
