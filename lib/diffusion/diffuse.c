@@ -17,6 +17,7 @@
 #include "terrain/analysis.h"
 
 #define MAX_CURVES 65534
+#define COHERENT 0.5
 
 static int check(const oc_diffusion_params *p, oc_error *err) {
   char b[OC_NUMSTR];
@@ -68,21 +69,25 @@ static int check(const oc_diffusion_params *p, oc_error *err) {
   return OC_OK;
 }
 
-/* n back to unit length on every level after its diffusion. */
-static void renormalise(oc_dpyramid *py) {
-  for (int k = 0; k < py->nlevels; k++) {
-    oc_dlevel *lv = &py->lv[k];
-    float *gx = lv->map[MAP_GX], *gy = lv->map[MAP_GY];
-    size_t ns = (size_t)lv->nx * (size_t)lv->ny;
-#pragma omp parallel for schedule(static)
-    for (size_t q = 0; q < ns; q++) {
-      double g = sqrt((double)gx[q] * gx[q] + (double)gy[q] * gy[q]);
-      if (g > 1e-6) {
-        gx[q] = (float)(gx[q] / g);
-        gy[q] = (float)(gy[q] / g);
-      } else {
-        gx[q] = gy[q] = 0;
-      }
+/* n back to unit length after its diffusion. Where the diffused n is
+** shorter than COHERENT (directions that met from opposite sides and
+** cancel: the sources and sinks of the filled field) it is dropped, so
+** that the elevation follows Laplace there: the upwind equations of two
+** samples each upwind of the other contradict each other and would stall
+** the solver. Only on the finest grid: the coarse grids keep every
+** direction, which their corrections need (measured: dropping there too
+** stalls the V-cycles). */
+static void renormalise(oc_dlevel *lv, double coherent) {
+  float *gx = lv->map[MAP_GX], *gy = lv->map[MAP_GY];
+  size_t ns = (size_t)lv->nx * (size_t)lv->ny;
+#pragma omp parallel for schedule(static) if (OC_DPAR(lv))
+  for (size_t q = 0; q < ns; q++) {
+    double g = sqrt((double)gx[q] * gx[q] + (double)gy[q] * gy[q]);
+    if (g > (lv->flags[q] & DF_SLOPE ? 1e-6 : coherent)) {
+      gx[q] = (float)(gx[q] / g);
+      gy[q] = (float)(gy[q] / g);
+    } else {
+      gx[q] = gy[q] = 0;
     }
   }
 }
@@ -169,7 +174,8 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
       rc = solve(&py, p, DK_LAPLACE, maps[q], DF_SLOPE, 0.05 + 0.1 * q, 0.1,
                  out, err);
     if (rc) goto done;
-    renormalise(&py);
+    for (int k = 0; k < py.nlevels; k++)
+      renormalise(&py.lv[k], k ? 1e-6 : COHERENT);
   }
   rc = solve(&py, p, DK_GUIDED, MAP_H, DF_H, 0.35, 0.3, out, err);
   if (!rc && st.strict_noise)
