@@ -167,8 +167,12 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
     rc = oc_seterr(err, OC_ECANCEL, "diffusion cancelled");
     goto done;
   }
+  rc = oc_dpyramid_grow(&py, err);
+  if (rc) goto done;
   oc_dpyramid_restrict(&py);
-  if (st.slope || st.conflict) {
+  /* the elevation reads the guide on slope samples (constrained: their
+  ** values stay) and on conflicts: without conflicts nothing to fill */
+  if (st.conflict) {
     static const int maps[3] = {MAP_GX, MAP_GY, MAP_GD};
     for (int q = 0; q < 3 && !rc; q++)
       rc = solve(&py, p, DK_LAPLACE, maps[q], DF_SLOPE, 0.05 + 0.1 * q, 0.1,
@@ -183,6 +187,7 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
   if (!rc && st.strict_noise)
     rc = solve(&py, p, DK_LAPLACE, MAP_R, DF_NOISE, 0.725, 0.075, out, err);
   if (rc) goto done;
+  oc_dpyramid_shrink(&py); /* the finest grid's maps are all that is left */
   const oc_dlevel *lv = &py.lv[0];
   size_t ns = (size_t)lv->nx * (size_t)lv->ny;
   row_ctx rx = {

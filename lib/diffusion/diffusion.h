@@ -60,9 +60,9 @@ struct oc_fcurve {
   size_t nk;
 };
 
-/* Attributes at normalised arc length u into v[FA_COUNT] (0 where absent;
-** the slope angles as tan theta). */
-void oc_fcurve_attrs(const oc_fcurve *c, double u, double *v);
+/* The attributes of `want` (bits 1 << FA_*) at normalised arc length u
+** into v[FA_COUNT] (0 where absent; the slope angles as tan theta). */
+void oc_fcurve_attrs(const oc_fcurve *c, double u, unsigned want, double *v);
 
 /* ---- levels and constraint maps ---- */
 
@@ -95,9 +95,14 @@ typedef struct oc_dpyramid {
 } oc_dpyramid;
 
 /* Levels down to a coarsest grid of at most 8 samples a side; allocates
-** the maps of every level (level 0's filled by the caller). */
+** the maps of level 0 (filled by the caller) and, with oc_dpyramid_grow,
+** those of the coarser levels and the scratch grid; oc_dpyramid_shrink
+** frees those again (so that the peak holds one of the rasteriser's
+** counters, the pyramid and the output grids at a time). */
 int oc_dpyramid_init(oc_dpyramid *py, int nx, int ny, double cell,
                      oc_error *err);
+int oc_dpyramid_grow(oc_dpyramid *py, oc_error *err);
+void oc_dpyramid_shrink(oc_dpyramid *py);
 void oc_dpyramid_free(oc_dpyramid *py);
 /* Coarse flags and constrained values from level k - 1 to k, for every
 ** k: a coarse sample is constrained if any child is, with the mean of

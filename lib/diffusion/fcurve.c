@@ -222,9 +222,10 @@ unsigned oc_fcurve_has(const oc_fcurve *c) {
   return c->has;
 }
 
-void oc_fcurve_attrs(const oc_fcurve *c, double u, double *v) {
+void oc_fcurve_attrs(const oc_fcurve *c, double u, unsigned want, double *v) {
   for (int a = 0; a < FA_COUNT; a++) {
     const oc_fattr *t = &c->attr[a];
+    if (!(want & (1u << a))) continue;
     if (!t->n)
       v[a] = 0;
     else if (a == FA_HEIGHT)
@@ -232,8 +233,8 @@ void oc_fcurve_attrs(const oc_fcurve *c, double u, double *v) {
     else
       v[a] = oc_linear_eval(t->u, t->v, t->n, u);
   }
-  v[FA_LEFT] = tan(v[FA_LEFT] * DEG);
-  v[FA_RIGHT] = tan(v[FA_RIGHT] * DEG);
+  if (want & (1u << FA_LEFT)) v[FA_LEFT] = tan(v[FA_LEFT] * DEG);
+  if (want & (1u << FA_RIGHT)) v[FA_RIGHT] = tan(v[FA_RIGHT] * DEG);
 }
 
 int oc_fcurve_sample_at(const oc_fcurve *c, double u, oc_fcurve_sample *out) {
@@ -242,7 +243,7 @@ int oc_fcurve_sample_at(const oc_fcurve *c, double u, oc_fcurve_sample *out) {
   oc_curve_point pt;
   oc_curve_at(c->c, u * c->length, &pt);
   double v[FA_COUNT];
-  oc_fcurve_attrs(c, u, v);
+  oc_fcurve_attrs(c, u, ~0u, v);
   out->x = pt.q.x, out->y = pt.q.y, out->tx = pt.tx, out->ty = pt.ty;
   out->has = c->has;
   out->height = v[FA_HEIGHT];

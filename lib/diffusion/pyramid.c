@@ -17,16 +17,44 @@
 #define COARSEST 8
 #define MAX_LEVELS 32
 
+static void free_level(oc_dlevel *lv) {
+  free(lv->map[0]);
+  free(lv->flags);
+  for (int q = 0; q < MAP_COUNT; q++)
+    lv->map[q] = NULL;
+  lv->flags = NULL;
+}
+
 void oc_dpyramid_free(oc_dpyramid *py) {
   if (!py->lv) return;
-  for (int k = 0; k < py->nlevels; k++) {
-    free(py->lv[k].map[0]);
-    free(py->lv[k].flags);
-  }
+  for (int k = 0; k < py->nlevels; k++)
+    free_level(&py->lv[k]);
   free(py->lv);
   free(py->scratch);
   py->lv = NULL;
   py->scratch = NULL;
+}
+
+void oc_dpyramid_shrink(oc_dpyramid *py) {
+  for (int k = 1; k < py->nlevels; k++)
+    free_level(&py->lv[k]);
+  free(py->scratch);
+  py->scratch = NULL;
+}
+
+static int alloc_level(oc_dlevel *lv) {
+  size_t ns = (size_t)lv->nx * (size_t)lv->ny;
+  float *m = malloc(MAP_COUNT * ns * sizeof *m);
+  lv->flags = calloc(ns, 1);
+  if (!m || !lv->flags) {
+    free(m);
+    free(lv->flags);
+    lv->flags = NULL;
+    return OC_ENOMEM;
+  }
+  for (int q = 0; q < MAP_COUNT; q++)
+    lv->map[q] = m + (size_t)q * ns;
+  return OC_OK;
 }
 
 int oc_dpyramid_init(oc_dpyramid *py, int nx, int ny, double cell,
@@ -44,22 +72,21 @@ int oc_dpyramid_init(oc_dpyramid *py, int nx, int ny, double cell,
     lv->nx = k ? (py->lv[k - 1].nx + 1) / 2 : nx;
     lv->ny = k ? (py->lv[k - 1].ny + 1) / 2 : ny;
     lv->cell = k ? 2 * py->lv[k - 1].cell : cell;
-    size_t ns = (size_t)lv->nx * (size_t)lv->ny;
-    float *m = malloc(MAP_COUNT * ns * sizeof *m);
-    lv->flags = calloc(ns, 1);
-    if (!m || !lv->flags) {
-      free(m);
-      oc_dpyramid_free(py);
-      return oc_seterr(err, OC_ENOMEM, "out of memory (%d x %d grid)", nx, ny);
-    }
-    for (int q = 0; q < MAP_COUNT; q++)
-      lv->map[q] = m + (size_t)q * ns;
   }
-  py->scratch = malloc((size_t)nx * (size_t)ny * sizeof *py->scratch);
-  if (!py->scratch) {
+  if (alloc_level(&py->lv[0])) {
     oc_dpyramid_free(py);
     return oc_seterr(err, OC_ENOMEM, "out of memory (%d x %d grid)", nx, ny);
   }
+  return OC_OK;
+}
+
+int oc_dpyramid_grow(oc_dpyramid *py, oc_error *err) {
+  for (int k = 1; k < py->nlevels; k++)
+    if (alloc_level(&py->lv[k]))
+      return oc_seterr(err, OC_ENOMEM, "out of memory (level %d)", k);
+  size_t ns = (size_t)py->lv[0].nx * (size_t)py->lv[0].ny;
+  py->scratch = malloc(ns * sizeof *py->scratch);
+  if (!py->scratch) return oc_seterr(err, OC_ENOMEM, "out of memory");
   return OC_OK;
 }
 

@@ -63,11 +63,13 @@ static void deposit(const rctx *rc, size_t k, uint32_t ci, double s,
                     double dist, int left, double nox, double noy, int slopes) {
   const rcurve *cv = &rc->cv[ci];
   const oc_fcurve *fc = cv->fc;
-  double a[FA_COUNT];
-  oc_fcurve_attrs(fc, fc->length > 0 ? s / fc->length : 0, a);
+  double a[FA_COUNT], u = fc->length > 0 ? s / fc->length : 0;
+  oc_fcurve_attrs(fc, u, 1u << FA_RADIUS, a);
   double r = a[FA_RADIUS];
   double ws = fmax(r, 0.5 * rc->lv->cell * (fabs(nox) + fabs(noy)));
-  if (dist <= ws) {
+  if (dist <= ws && (fc->has & (OC_FC_HEIGHT | OC_FC_NOISE))) {
+    oc_fcurve_attrs(fc, u,
+                    (1u << FA_HEIGHT) | (1u << FA_AMP) | (1u << FA_ROUGH), a);
     if (fc->has & OC_FC_HEIGHT) {
       rc->h[k] += (float)a[FA_HEIGHT];
       if (rc->hc[k] < 0xffffu) rc->hc[k]++;
@@ -79,6 +81,7 @@ static void deposit(const rctx *rc, size_t k, uint32_t ci, double s,
     }
   }
   if (!slopes || !(fc->has & OC_FC_SLOPE) || !(dist > r)) return;
+  oc_fcurve_attrs(fc, u, left ? (1u << FA_EXTA) : (1u << FA_EXTB), a);
   double ext = left ? a[FA_EXTA] : a[FA_EXTB];
   if (!(ext > 0 && dist <= r + ext)) return;
   uint16_t me = (uint16_t)(ci + 1);
@@ -88,6 +91,7 @@ static void deposit(const rctx *rc, size_t k, uint32_t ci, double s,
     return;
   }
   rc->owner[k] = me;
+  oc_fcurve_attrs(fc, u, left ? (1u << FA_LEFT) : (1u << FA_RIGHT), a);
   double tn = left ? a[FA_LEFT] : a[FA_RIGHT];
   double val = tn * (1 - (dist - r) / ext);
   double sg = (fc->has & OC_FC_HEIGHT) ? 1 : -1;
