@@ -14,7 +14,9 @@
 **
 ** Methods of a curve: c:length(), c:sample(u) -> {x =, y =, tx =, ty =,
 ** height =, radius =, left =, right =, extent = {a, b}, amplitude =,
-** roughness =} (the attributes the curve carries).
+** roughness =} (the attributes the curve carries), c:save() -> the
+** compact encoding (a binary string), read back by
+** outcrop.feature_curve_load(s).
 **
 ** Curves are immutable and reference counted: a diffusion reads them from
 ** its table, which keeps them alive for the call.
@@ -42,6 +44,13 @@ static oc_fcurve *checkcurve(lua_State *L, int idx, const char *fname,
     oclua_error(L, fname, "%s must be a feature curve (got %s)", what,
                 oclua_got(L, idx));
   return u->c;
+}
+
+static oclua_fcurve *newcurve(lua_State *L) {
+  oclua_fcurve *u = lua_newuserdatauv(L, sizeof *u, 0);
+  u->c = NULL;
+  luaL_setmetatable(L, OCLUA_FCURVE);
+  return u;
 }
 
 /* slope = {left =, right =, extent = {a, b}} of the table at the top. */
@@ -138,9 +147,7 @@ static int l_feature_curve(lua_State *L) {
   p.bezier = oclua_field_optbool(&f, "bezier", 0);
   p.constraints = read_constraints(&f, &p.nconstraints);
   oc_error err = {OC_OK, ""};
-  oclua_fcurve *u = lua_newuserdatauv(L, sizeof *u, 0);
-  u->c = NULL;
-  luaL_setmetatable(L, OCLUA_FCURVE);
+  oclua_fcurve *u = newcurve(L);
   u->c = oc_fcurve_new(&p, &err);
   if (!u->c) return oclua_liberror(L, fname, &err);
   return 1;
@@ -191,6 +198,35 @@ static int c_sample(lua_State *L) {
     setnum(L, "amplitude", s.amplitude);
     setnum(L, "roughness", s.roughness);
   }
+  return 1;
+}
+
+static int c_save(lua_State *L) {
+  const char *fname = "feature_curve:save";
+  oclua_checkargs(L, 1, fname, "()");
+  oc_fcurve *c = checkcurve(L, 1, fname, "self");
+  size_t n = oc_fcurve_encode(c, NULL, 0);
+  if (!n) oclua_error(L, fname, "a coordinate or value is too large to encode");
+  luaL_Buffer b;
+  unsigned char *p = (unsigned char *)luaL_buffinitsize(L, &b, n);
+  oc_fcurve_encode(c, p, n);
+  luaL_pushresultsize(&b, n);
+  return 1;
+}
+
+static int l_feature_curve_load(lua_State *L) {
+  const char *fname = "outcrop.feature_curve_load";
+  oclua_checkargs(L, 1, fname, "(string)");
+  if (lua_type(L, 1) != LUA_TSTRING)
+    oclua_error(L, fname,
+                "argument #1 must be a string from curve:save() (got %s)",
+                oclua_got(L, 1));
+  size_t n;
+  const char *s = lua_tolstring(L, 1, &n);
+  oclua_fcurve *u = newcurve(L);
+  oc_error err = {OC_OK, ""};
+  u->c = oc_fcurve_decode((const unsigned char *)s, n, &err);
+  if (!u->c) return oclua_liberror(L, fname, &err);
   return 1;
 }
 
@@ -333,12 +369,16 @@ static int l_diffusion(lua_State *L) {
 void oclua_open_diffusion(lua_State *L) {
   static const luaL_Reg meta[] = {
       {"__gc", c_gc}, {"__tostring", c_tostring}, {NULL, NULL}};
-  static const luaL_Reg methods[] = {
-      {"length", c_length}, {"sample", c_sample}, {NULL, NULL}};
+  static const luaL_Reg methods[] = {{"length", c_length},
+                                     {"sample", c_sample},
+                                     {"save", c_save},
+                                     {NULL, NULL}};
   oclua_newmeta(L, OCLUA_FCURVE, meta, methods);
   lua_pop(L, 1);
   lua_pushcfunction(L, l_feature_curve);
   lua_setfield(L, -2, "feature_curve");
+  lua_pushcfunction(L, l_feature_curve_load);
+  lua_setfield(L, -2, "feature_curve_load");
   lua_pushcfunction(L, l_diffusion);
   lua_setfield(L, -2, "diffusion");
 }

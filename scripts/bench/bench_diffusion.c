@@ -14,6 +14,9 @@
 **   diffusion.peak_mb_1024             peak resident memory of a child
 **                                      process diffusing the canyon at
 **                                      1024^2 (40 MB: the paper's 10 grids)
+**   diffusion.curves_kb                the largest scene in the compact
+**                                      encoding (oc_fcurve_encode; Table 1:
+**                                      1.30-4.48 kB)
 ** Prints `name: value unit` lines; '#' lines are context.
 */
 #define _GNU_SOURCE
@@ -161,6 +164,20 @@ int main(void) {
   ** for them forever (libgomp's pool does not survive fork) */
   if (bench_wanted("peak"))
     printf("diffusion.peak_mb_1024: %.1f MB\n", child_peak_mb(peak_child));
+  if (bench_wanted("curves")) {
+    double worst = 0;
+    for (int sc = 0; sc < 6; sc++) {
+      oc_fcurve *c[MAXC];
+      size_t n = scene(sc, c), bytes = 0;
+      for (size_t i = 0; i < n; i++) {
+        bytes += oc_fcurve_encode(c[i], NULL, 0);
+        oc_fcurve_release(c[i]);
+      }
+      printf("# %s: %zu curves in %zu bytes\n", names[sc], n, bytes);
+      if (bytes / 1024.0 > worst) worst = bytes / 1024.0;
+    }
+    printf("diffusion.curves_kb: %.2f kB\n", worst);
+  }
   if (bench_wanted("schedule")) {
     for (int z = 0; z < 3; z++) {
       double worst = 0, wcpu = 0;

@@ -477,6 +477,47 @@ START_TEST(bad_input_names_the_field) {
 }
 END_TEST
 
+/* ---- compact encoding ---------------------------------------------------- */
+
+START_TEST(encoding_round_trips) {
+  oc_fcurve *c[3];
+  scene(c);
+  for (int i = 0; i < 3; i++) {
+    size_t n = oc_fcurve_encode(c[i], NULL, 0);
+    ck_assert(n > 8 && n < 80);
+    unsigned char buf[128], buf2[128];
+    ck_assert_uint_eq(oc_fcurve_encode(c[i], buf, sizeof buf), n);
+    oc_error err;
+    oc_fcurve *d = oc_fcurve_decode(buf, n, &err);
+    ck_assert_msg(d != NULL, "%s", err.msg);
+    /* the quantised curve encodes to the same bytes */
+    ck_assert_uint_eq(oc_fcurve_encode(d, buf2, sizeof buf2), n);
+    ck_assert(memcmp(buf, buf2, n) == 0);
+    ck_assert(oc_fcurve_has(d) == oc_fcurve_has(c[i]));
+    for (int q = 0; q <= 20; q++) {
+      oc_fcurve_sample a, b;
+      oc_fcurve_sample_at(c[i], q / 20.0, &a);
+      oc_fcurve_sample_at(d, q / 20.0, &b);
+      ck_assert(fabs(a.x - b.x) < 0.1 && fabs(a.y - b.y) < 0.1);
+      ck_assert(fabs(a.height - b.height) < 0.1);
+      ck_assert(fabs(a.left - b.left) < 0.02 &&
+                fabs(a.extent_a - b.extent_a) < 0.05);
+      ck_assert(fabs(a.amplitude - b.amplitude) < 0.02 &&
+                fabs(a.roughness - b.roughness) < 0.001);
+    }
+    /* truncated, trailing and foreign bytes are refused */
+    ck_assert(oc_fcurve_decode(buf, n - 1, &err) == NULL);
+    buf[n] = 0;
+    ck_assert(oc_fcurve_decode(buf, n + 1, &err) == NULL);
+    ck_assert(oc_fcurve_decode((const unsigned char *)"hello", 5, &err) ==
+              NULL);
+    oc_fcurve_release(d);
+  }
+  for (int i = 0; i < 3; i++)
+    oc_fcurve_release(c[i]);
+}
+END_TEST
+
 /* ---- cancellation -------------------------------------------------------- */
 
 static int stop_at_half(void *ud, double f) {
@@ -516,6 +557,7 @@ int main(void) {
   tcase_add_test(tc, detail_octave_sum);
   tcase_add_test(tc, bad_input_names_the_field);
   tcase_add_test(tc, progress_cancels);
+  tcase_add_test(tc, encoding_round_trips);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }

@@ -41,6 +41,20 @@ describe("outcrop.feature_curve", function()
     assert.is_true(tostring(c):find("outcrop.feature_curve", 1, true) ~= nil)
   end)
 
+  it("saves to a few bytes and loads back", function()
+    local c = ridge(30)
+    local s = c:save()
+    assert.is_true(#s < 64)
+    local d = oc.feature_curve_load(s)
+    assert.are.equal(s, d:save())
+    R.close(d:sample(0.5).height, 40, 1e-12)
+    R.close(d:sample(0.5).left, 30, 1 / 64)
+    check(function() oc.feature_curve_load("nope") end,
+          "outcrop.feature_curve_load", "not a feature curve encoding")
+    check(function() oc.feature_curve_load(s:sub(1, -2)) end,
+          "outcrop.feature_curve_load", "truncated")
+  end)
+
   it("names the field of every bad input", function()
     local fc = "outcrop.feature_curve"
     local pts = {{0, 0}, {10, 0}}
