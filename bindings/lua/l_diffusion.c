@@ -249,7 +249,26 @@ static int c_tostring(lua_State *L) {
 /* ---- outcrop.diffusion ----------------------------------------------------
  */
 
-/* curves = {c1, c2, ...} into a Lua-owned array of pointers, pushed. */
+/* The curves of a diffusion, each retained: Lua code that may run before
+** the call ends (a metamethod of the options, a finalizer at an
+** allocation) could drop the script's last reference to one; the list's
+** __gc releases them, also when a raise ends the call. */
+#define OCLUA_CURVELIST "outcrop.diffusion.curves"
+
+typedef struct curvelist {
+  size_t n; /* curves retained so far */
+  oc_fcurve *c[];
+} curvelist;
+
+static int list_gc(lua_State *L) {
+  curvelist *l = luaL_checkudata(L, 1, OCLUA_CURVELIST);
+  for (size_t i = 0; i < l->n; i++)
+    oc_fcurve_release(l->c[i]);
+  l->n = 0;
+  return 0;
+}
+
+/* curves = {c1, c2, ...} into a retained list, pushed. */
 static oc_fcurve **read_curves(oclua_fields *f, size_t *n) {
   lua_State *L = f->L;
   if (oclua_field_push(f, "curves") != LUA_TTABLE)
@@ -259,16 +278,21 @@ static oc_fcurve **read_curves(oclua_fields *f, size_t *n) {
   if (m < 1 || m > 65534)
     oclua_error(L, f->fname, "'curves' must hold 1 to 65534 curves (got %I)",
                 m);
-  oc_fcurve **c = lua_newuserdatauv(L, (size_t)m * sizeof *c, 0);
+  curvelist *l =
+      lua_newuserdatauv(L, sizeof *l + (size_t)m * sizeof l->c[0], 0);
+  l->n = 0;
+  luaL_setmetatable(L, OCLUA_CURVELIST);
   for (lua_Integer i = 1; i <= m; i++) {
     lua_rawgeti(L, t, i);
     char what[40];
     snprintf(what, sizeof what, "'curves[%lld]'", (long long)i);
-    c[i - 1] = checkcurve(L, -1, f->fname, what);
+    oc_fcurve *c = checkcurve(L, -1, f->fname, what);
+    oc_fcurve_retain(c);
+    l->c[l->n++] = c;
     lua_pop(L, 1);
   }
   *n = (size_t)m;
-  return c;
+  return l->c;
 }
 
 static void read_dnoise(oclua_fields *f, oc_diffusion_params *p) {
@@ -373,7 +397,10 @@ void oclua_open_diffusion(lua_State *L) {
                                      {"sample", c_sample},
                                      {"save", c_save},
                                      {NULL, NULL}};
+  static const luaL_Reg listmeta[] = {{"__gc", list_gc}, {NULL, NULL}};
   oclua_newmeta(L, OCLUA_FCURVE, meta, methods);
+  lua_pop(L, 1);
+  oclua_newmeta(L, OCLUA_CURVELIST, listmeta, NULL);
   lua_pop(L, 1);
   lua_pushcfunction(L, l_feature_curve);
   lua_setfield(L, -2, "feature_curve");

@@ -130,6 +130,22 @@ describe("outcrop.diffusion", function()
     assert.are.equal(0, paper.cycles)
   end)
 
+  it("keeps its curves while Lua code runs in the call", function()
+    local curves = {ridge(30)}
+    local opts = setmetatable({size = {64, 64}, curves = curves}, {
+      __index = function(_, k)
+        if k == "seed" then
+          curves[1] = nil -- the script's last reference
+          collectgarbage()
+          collectgarbage()
+        end
+      end})
+    local hf, maps = oc.diffusion(opts)
+    assert.is_nil(curves[1])
+    R.close(maps.smooth:get(33, 33), 40, 1e-5)
+    assert.is_true(hf:max() > 30)
+  end)
+
   it("names the field of every bad input", function()
     local fn = "outcrop.diffusion"
     local r = ridge(10)
