@@ -3,8 +3,13 @@
 ** 5.2, after Orzan et al. 2008): a coarse-to-fine cascade with
 ** 5 (l - i) Jacobi sweeps at level i of l (0 the coarsest), each level
 ** starting from the bilinear prolongation of the one below; then, when a
-** tolerance is given, V-cycles on the correction equation until the
-** largest Jacobi update of the finest grid is below it.
+** tolerance is given, BiCGSTAB iterations preconditioned by V-cycles on
+** the correction equation until the largest Jacobi update of the finest
+** grid is below it. (V-cycles alone stall on the large grids: the
+** elevation's operator is not symmetric — upwind gradient terms — and
+** coarse levels see thin constraints thickened; the Krylov iteration
+** removes the few modes they leave. Its dot products are row sums added
+** in row order, so the result does not depend on the thread count.)
 **
 ** V-cycle at level k: 2 damped sweeps (weight 0.8), the residual r = M x + c -
 *x restricted
@@ -26,6 +31,7 @@
 #define POST 3
 #define COARSE_SWEEPS 100
 #define OMEGA 0.8 /* damped Jacobi smoothing */
+#define STALL 0.7 /* V-cycles removing less: BiCGSTAB takes over */
 
 typedef struct vctx {
   oc_dpyramid *py;
@@ -35,6 +41,8 @@ typedef struct vctx {
   ** prolonged correction and its image by the operator */
   float **e, **b, **r, **c, **ac;
   double *rows; /* per-row partial sums of the finest grid's height */
+  int linear;   /* as BiCGSTAB's preconditioner: the whole correction
+                ** (a fixed linear map: the Krylov iteration needs one) */
 } vctx;
 
 /* n sweeps of x (with rhs) using the scratch; returns the last update. */
@@ -127,7 +135,7 @@ static void prolong_correction(const vctx *v, int k, float *c) {
 ** long free (Neumann) regions. */
 static double vcycle(const vctx *v, int k, float *x, const float *rhs) {
   oc_dpyramid *py = v->py;
-  const oc_dop *op = k ? &v->hom : v->op;
+  const oc_dop *op = k || rhs ? &v->hom : v->op;
   const oc_dlevel *lv = &py->lv[k];
   if (k == py->nlevels - 1)
     return sweeps(op, lv, x, py->scratch, rhs, COARSE_SWEEPS, OMEGA);
@@ -138,7 +146,7 @@ static double vcycle(const vctx *v, int k, float *x, const float *rhs) {
   memset(v->e[k + 1], 0, (size_t)lc->nx * (size_t)lc->ny * sizeof(float));
   vcycle(v, k + 1, v->e[k + 1], v->b[k + 1]);
   prolong_correction(v, k, v->c[k]);
-  double t = step(v, lv, v->r[k], v->c[k], v->ac[k]);
+  double t = v->linear ? 1 : step(v, lv, v->r[k], v->c[k], v->ac[k]);
   size_t ns = (size_t)lv->nx * (size_t)lv->ny;
   const float *c = v->c[k];
 #pragma omp parallel for schedule(static) if (OC_DPAR(lv))
@@ -167,13 +175,119 @@ static void fixed_range(const oc_dpyramid *py, const oc_dop *op, double *lo,
   *lo = a, *hi = b;
 }
 
+/* Ordered dot product of two finest-level vectors (row sums in order). */
+static double dot(const vctx *v, const float *a, const float *b) {
+  const oc_dlevel *lv = &v->py->lv[0];
+  size_t nx = (size_t)lv->nx;
+#pragma omp parallel for schedule(static) if (OC_DPAR(lv))
+  for (int j = 0; j < lv->ny; j++) {
+    double d = 0;
+    for (size_t i = 0; i < nx; i++)
+      d += (double)a[(size_t)j * nx + i] * b[(size_t)j * nx + i];
+    v->rows[j] = d;
+  }
+  double d = 0;
+  for (int j = 0; j < lv->ny; j++)
+    d += v->rows[j];
+  return d;
+}
+
+/* y = A x = x - M x (homogeneous; 0 where constrained), finest level. */
+static void apply(const vctx *v, const float *x, float *y) {
+  const oc_dlevel *lv = &v->py->lv[0];
+  oc_djacobi(&v->hom, lv, x, y, NULL, 1);
+  size_t ns = (size_t)lv->nx * (size_t)lv->ny;
+#pragma omp parallel for schedule(static) if (OC_DPAR(lv))
+  for (size_t q = 0; q < ns; q++)
+    y[q] = oc_dfixed(&v->hom, lv, q) ? 0 : x[q] - y[q];
+}
+
+/* z = one V-cycle on A z = q from 0. */
+static void precond(const vctx *v, const float *q, float *z) {
+  const oc_dlevel *lv = &v->py->lv[0];
+  memset(z, 0, (size_t)lv->nx * (size_t)lv->ny * sizeof *z);
+  vcycle(v, 0, z, q);
+}
+
+static double maxabs(const oc_dlevel *lv, const float *r) {
+  double m = 0;
+  size_t ns = (size_t)lv->nx * (size_t)lv->ny;
+#pragma omp parallel for schedule(static) reduction(max : m) if (OC_DPAR(lv))
+  for (size_t q = 0; q < ns; q++)
+    if (fabs(r[q]) > m) m = fabs(r[q]);
+  return m;
+}
+
+/* BiCGSTAB (van der Vorst 1992) on A x = b, right-preconditioned by one
+** V-cycle; the true residual is recomputed after every iteration (one
+** sweep), so rounding cannot make it drift; restarts on breakdown. */
+static int krylov(const vctx *v, const oc_dsolve *s, double tol, double *res,
+                  int *cycles, oc_error *err) {
+  const oc_dlevel *lv = &v->py->lv[0];
+  size_t ns = (size_t)lv->nx * (size_t)lv->ny;
+  float *x = lv->map[v->op->map];
+  float *w = malloc(8 * ns * sizeof *w);
+  if (!w) return oc_seterr(err, OC_ENOMEM, "out of memory");
+  float *r = w, *r0 = w + ns, *p = w + 2 * ns, *vv = w + 3 * ns,
+        *ph = w + 4 * ns, *sv = w + 5 * ns, *sh = w + 6 * ns, *t = w + 7 * ns;
+  residual(v->op, lv, x, NULL, r);
+  memcpy(r0, r, ns * sizeof *r);
+  memset(p, 0, ns * sizeof *p);
+  memset(vv, 0, ns * sizeof *vv);
+  double rho = 1, alpha = 1, omega = 1;
+  int c = *cycles, rc = OC_OK;
+  while (*res > tol && c < OC_DIFFUSION_MAX_CYCLES) {
+    double rn = dot(v, r0, r);
+    if (rn == 0 || omega == 0) { /* breakdown: restart */
+      memcpy(r0, r, ns * sizeof *r);
+      memset(p, 0, ns * sizeof *p);
+      memset(vv, 0, ns * sizeof *vv);
+      rho = alpha = omega = 1;
+      rn = dot(v, r0, r);
+      if (rn == 0) break;
+    }
+    double beta = (rn / rho) * (alpha / omega);
+#pragma omp parallel for schedule(static) if (OC_DPAR(lv))
+    for (size_t q = 0; q < ns; q++)
+      p[q] = (float)(r[q] + beta * (p[q] - omega * vv[q]));
+    precond(v, p, ph);
+    apply(v, ph, vv);
+    double d = dot(v, r0, vv);
+    if (d == 0) break;
+    alpha = rn / d;
+#pragma omp parallel for schedule(static) if (OC_DPAR(lv))
+    for (size_t q = 0; q < ns; q++)
+      sv[q] = (float)(r[q] - alpha * vv[q]);
+    precond(v, sv, sh);
+    apply(v, sh, t);
+    double tt = dot(v, t, t);
+    omega = tt > 0 ? dot(v, t, sv) / tt : 0;
+#pragma omp parallel for schedule(static) if (OC_DPAR(lv))
+    for (size_t q = 0; q < ns; q++)
+      x[q] = (float)(x[q] + alpha * ph[q] + omega * sh[q]);
+    residual(v->op, lv, x, NULL, r); /* the true residual, no drift */
+    rho = rn;
+    *res = maxabs(lv, r);
+    c++;
+    if (s->residual) s->residual[c] = *res;
+    if (report(s, 0.5 + 0.5 * c / OC_DIFFUSION_MAX_CYCLES)) {
+      rc = oc_seterr(err, OC_ECANCEL, "diffusion cancelled");
+      break;
+    }
+  }
+  *cycles = c;
+  free(w);
+  return rc;
+}
+
 static int vcycles(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
                    double first, oc_error *err) {
   int L = py->nlevels, rc = OC_OK;
-  vctx v = {py, op, *op, NULL, NULL, NULL, NULL, NULL, NULL};
+  vctx v = {py, op, *op, NULL, NULL, NULL, NULL, NULL, NULL, 0};
   v.hom.hom = 1;
   float **all = calloc(5 * (size_t)L, sizeof *all);
   v.rows = malloc(2 * (size_t)py->lv[0].ny * sizeof *v.rows);
+
   if (!all || !v.rows) rc = oc_seterr(err, OC_ENOMEM, "out of memory");
   if (all)
     v.e = all, v.b = all + L, v.r = all + 2 * L, v.c = all + 3 * L,
@@ -191,13 +305,20 @@ static int vcycles(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
   double tol = s->tolerance * fmax(scale, 1e-6);
   double res = first;
   int c = 0;
+  /* V-cycles while each removes most of the largest update, then the
+  ** Krylov iteration for the modes they leave */
   while (!rc && res > tol && c < OC_DIFFUSION_MAX_CYCLES) {
+    double prev = res;
     res = vcycle(&v, 0, py->lv[0].map[op->map], NULL);
     c++;
     if (s->residual) s->residual[c] = res;
     if (report(s, 0.5 + 0.5 * c / OC_DIFFUSION_MAX_CYCLES))
       rc = oc_seterr(err, OC_ECANCEL, "diffusion cancelled");
+    if (res > STALL * prev) break;
   }
+  v.linear = 1;
+  if (!rc && res > tol && c < OC_DIFFUSION_MAX_CYCLES)
+    rc = krylov(&v, s, tol, &res, &c, err);
   if (s->cycles) *s->cycles = c;
   for (size_t q = 0; all && q < 5 * (size_t)L; q++)
     free(all[q]);

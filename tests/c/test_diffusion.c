@@ -326,15 +326,16 @@ START_TEST(converged_mode_converges) {
   oc_diffusion_result r;
   run(&p, &r);
   ck_assert(r.cycles >= 1 && r.cycles < OC_DIFFUSION_MAX_CYCLES);
-  printf("converged in %d V-cycles: largest update %.3g m after the "
+  printf("converged in %d iterations: largest update %.3g m after the "
          "cascade, %.3g m at the end\n",
          r.cycles, r.residual[0], r.residual[r.cycles]);
   /* scale: the strict elevations, 5 .. 90 */
   ck_assert(r.residual[r.cycles] <= 1e-5 * 90);
   ck_assert(r.residual[r.cycles - 1] > 1e-5 * 90);
-  /* every cycle lowers the largest update (1 % of slack for rounding) */
+  /* V-cycles, then BiCGSTAB (not monotone), never back to the cascade's */
   for (int k = 1; k <= r.cycles; k++)
-    ck_assert_msg(r.residual[k] < 1.01 * r.residual[k - 1], "cycle %d", k);
+    ck_assert_msg(r.residual[k] < r.residual[0], "iteration %d", k);
+  ck_assert(r.residual[r.cycles] < 1e-3 * r.residual[0]);
   oc_diffusion_result_clear(&r);
   for (int i = 0; i < 3; i++)
     oc_fcurve_release(c[i]);
