@@ -1918,9 +1918,10 @@ typedef struct oc_diffusion_params {
   uint64_t seed;
   oc_diffusion_scheme scheme;
   /* 0: the paper's cascade, 5 (l - i) Jacobi sweeps at level i of l (0
-  ** the coarsest); > 0: then V-cycles until the largest Jacobi update of
-  ** each diffused map is at most tolerance times its constraints' range
-  ** (at most OC_DIFFUSION_MAX_CYCLES) */
+  ** the coarsest); > 0: then V-cycles, and once they stall BiCGSTAB
+  ** preconditioned by V-cycles, until the largest Jacobi update of each
+  ** diffused map is at most tolerance times its constraints' scale (at
+  ** most OC_DIFFUSION_MAX_CYCLES steps) */
   double tolerance;
   double wavelength; /* lambda_0 metres (> 0; 0: the grid's extent / 8) */
   int octaves;       /* n + 1 in 1..16 (0: 4) */
@@ -1936,10 +1937,11 @@ typedef struct oc_diffusion_result {
   ** theta (> 0 where the ground falls along the guide direction) */
   oc_heightfield *smooth, *detail, *amplitude, *roughness, *gradient;
   int levels; /* grids of the multigrid pyramid */
-  int cycles; /* V-cycles of the elevation solve */
-  double residual[OC_DIFFUSION_MAX_CYCLES +
-                  1];             /* after the cascade and
-                                   ** each V-cycle (elevation, metres) */
+  /* steps of the elevation's solve (V-cycles, then BiCGSTAB iterations),
+  ** and its largest Jacobi update (metres) after the cascade and after
+  ** each step */
+  int cycles;
+  double residual[OC_DIFFUSION_MAX_CYCLES + 1];
   size_t strict, slope, conflict; /* constrained samples of the finest grid */
 } oc_diffusion_result;
 

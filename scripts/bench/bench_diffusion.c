@@ -203,7 +203,7 @@ int main(void) {
     double cpu;
     int cycles;
     double t = run(c, n, 2048, 1e-4, &cpu, &cycles);
-    printf("# canyon at 2048^2 to 1e-4: %d V-cycles, %.2f s of CPU\n", cycles,
+    printf("# canyon at 2048^2 to 1e-4: %d steps, %.2f s of CPU\n", cycles,
            cpu);
     printf("diffusion.converged_seconds_2048: %.3f s\n", t);
     for (size_t i = 0; i < n; i++)
