@@ -1888,7 +1888,7 @@ typedef struct oc_fcurve_sample {
 int oc_fcurve_sample_at(const oc_fcurve *c, double u, oc_fcurve_sample *out);
 
 /* The compact encoding of a curve (lib/diffusion/fcodec.c): varints of
-** coordinates in 1/16 m (each point from the previous), u in 1/16384,
+** coordinates in 1/16 m (each point from the previous), u in 1/4096,
 ** heights, radii and extents in 1/16 m, angles in 1/64 degree, amplitude
 ** in 1/64 m, roughness in 1/1024, each attribute from its previous
 ** value. oc_fcurve_encode writes at most cap bytes to buf (NULL to

@@ -3,12 +3,12 @@
 ** in the few kilobytes of Hnaidi et al. 2010, Table 1 (1.3–4.5 kB for 26
 ** to 74 curves). Bytes:
 **
-**   'F' 1 flags(bit 0: bezier) n  x0 y0 dx dy ...  m  (du has values)...
+**   'F' (2 n + bezier) x0 y0 dx dy ...  m  (du has values)...
 **
-** every number a LEB128 varint, signed ones zigzag-coded: coordinates in
-** 1/16 m, each point as the difference from the previous one; per
-** constraint point the difference of u (in 1/16384) from the previous
-** point's, the category bits, and each value the point gives as the
+** ('F' marks version 1) every number a LEB128 varint, signed ones
+** zigzag-coded: coordinates in 1/16 m, each point as the difference from
+** the previous one; per constraint point the difference of u (in 1/4096)
+** from the previous point's, the category bits, and each value the point gives as the
 ** difference from the last value given for it (heights, radii and
 ** extents in 1/16 m, angles in 1/64 degree, amplitudes in 1/64 m,
 ** roughness in 1/1024), so constant attributes cost a byte. Decoding
@@ -22,7 +22,7 @@
 #include "diffusion/diffusion.h"
 
 #define QXY 16.0
-#define QU 16384.0
+#define QU 4096.0
 #define LIMIT 0x1p52
 
 typedef struct wbuf {
@@ -74,9 +74,7 @@ static unsigned category(int a) {
 size_t oc_fcurve_encode(const oc_fcurve *c, unsigned char *buf, size_t cap) {
   wbuf w = {buf, buf ? cap : 0, 0, 0};
   put(&w, 'F');
-  put(&w, 1);
-  put(&w, (uint64_t)c->bezier);
-  put(&w, c->npoints);
+  put(&w, 2 * (uint64_t)c->npoints + (uint64_t)c->bezier);
   int64_t px = 0, py = 0;
   for (size_t i = 0; i < c->npoints; i++) {
     int64_t x = quant(&w, c->xy[2 * i], QXY),
@@ -135,13 +133,14 @@ static void set_value(oc_fconstraint *k, int a, double v) {
 
 oc_fcurve *oc_fcurve_decode(const unsigned char *buf, size_t n, oc_error *err) {
   rbuf r = {buf, buf ? n : 0, 0, 0};
-  if (get(&r) != 'F' || get(&r) != 1) {
+  if (get(&r) != 'F') {
     oc_seterr(err, OC_EINVAL, "not a feature curve encoding (version 1)");
     return NULL;
   }
   oc_fcurve_params p = {0};
-  p.bezier = get(&r) != 0;
   uint64_t np = get(&r);
+  p.bezier = (int)(np & 1);
+  np >>= 1;
   if (r.bad || np < 2 || np > (1u << 20) || np * 2 > n * 8) {
     oc_seterr(err, OC_EINVAL, "feature curve encoding: bad point count");
     return NULL;
