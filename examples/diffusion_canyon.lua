@@ -115,7 +115,7 @@ for _, n in ipairs(counts) do
   local some = table.move(curves, 1, n, 1, {})
   local hf, maps = oc.diffusion{size = {513, 513}, cell = 4, curves = some,
     converged = true, seed = 2, noise = {wavelength = 120}}
-  print(("diffusion_canyon: %d curves, %d V-cycles, %.0f..%.0f m")
+  print(("diffusion_canyon: %d curves, %d steps, %.0f..%.0f m")
         :format(n, maps.cycles, hf:min(), hf:max()))
   local img = oc.render(hf, {size = {w, h},
     camera = {eye = {1024, -1000, 1300}, target = {1024, 1000, 100}, fov = 40}})

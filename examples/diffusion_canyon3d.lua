@@ -44,7 +44,7 @@ local curves = {
 }
 local ground, maps = oc.diffusion{size = {201, 201}, cell = 1.5, curves = curves,
   converged = true, seed = 8, noise = {wavelength = 40}}
-print(("diffusion_canyon3d: %d V-cycles, %.1f..%.1f m"):format(maps.cycles,
+print(("diffusion_canyon3d: %d steps, %.1f..%.1f m"):format(maps.cycles,
       ground:min(), ground:max()))
 local terrain = oc.terrain(ground)
 

@@ -42,7 +42,7 @@ local curves = {
 
 local hf, maps = oc.diffusion{size = {513, 257}, cell = 4, curves = curves,
   converged = true}
-print(("diffusion_hill_crack: %d V-cycles, %.0f..%.0f m"):format(maps.cycles,
+print(("diffusion_hill_crack: %d steps, %.0f..%.0f m"):format(maps.cycles,
       hf:min(), hf:max()))
 local img = oc.render(hf, {size = {w, h},
   camera = {eye = {1024, -1300, 1400}, target = {1024, 520, 40}, fov = 40}})

@@ -74,7 +74,7 @@ end
 
 local hf, maps = oc.diffusion{size = {513, 513}, cell = 4, curves = curves,
   converged = true, seed = 12, noise = {wavelength = 300}}
-print(("diffusion_island: %d curves, %d V-cycles, %.0f..%.0f m")
+print(("diffusion_island: %d curves, %d steps, %.0f..%.0f m")
       :format(#curves, maps.cycles, hf:min(), hf:max()))
 local img = oc.render(hf, {size = {w, h},
   camera = {eye = {1024, -900, 1500}, target = {1024, 1100, 60}, fov = 40}})

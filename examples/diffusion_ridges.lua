@@ -39,7 +39,7 @@ curves[#curves + 1] = oc.feature_curve{
 
 local hf, maps = oc.diffusion{size = {513, 257}, cell = 4, curves = curves,
   converged = true}
-print(("diffusion_ridges: %d V-cycles, %d strict, %d slope and %d conflicting "
+print(("diffusion_ridges: %d steps, %d strict, %d slope and %d conflicting "
       .. "samples, %.0f..%.0f m"):format(maps.cycles, maps.strict, maps.slope,
       maps.conflict, hf:min(), hf:max()))
 local img = oc.render(hf, {size = {w, h},

@@ -42,7 +42,7 @@ local curves = {
 
 local hf, maps = oc.diffusion{size = {513, 321}, cell = 4, curves = curves,
   converged = true}
-print(("diffusion_river_cliff: %d V-cycles, %.0f..%.0f m"):format(maps.cycles,
+print(("diffusion_river_cliff: %d steps, %.0f..%.0f m"):format(maps.cycles,
       hf:min(), hf:max()))
 local img = oc.render(hf, {size = {w, h},
   camera = {eye = {1024, -1500, 1500}, target = {1024, 640, 40}, fov = 40}})

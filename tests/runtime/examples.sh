@@ -135,12 +135,12 @@ for ex in diffusion_ridges diffusion_island; do
   fi
   case $ex in
   diffusion_ridges)
-    # N V-cycles, A strict, B slope and C conflicting samples: C > 0
+    # N steps, A strict, B slope and C conflicting samples: C > 0
     awk '/conflicting/ { ok = ($9 + 0 > 0) } END { exit !ok }' FS='[ ]+' \
       "$T/out1" || because "the ridges' flanks did not meet"
     ;;
   diffusion_island)
-    # 9 curves, N V-cycles, LO..HI m: the rim's 440..460 m (plus noise)
+    # 9 curves, N steps, LO..HI m: the rim's 440..460 m (plus noise)
     awk '/curves/ { split($6, r, "[.][.]"); ok = (r[2] + 0 >= 440) }
       END { exit !ok }' FS='[ ]+' "$T/out1" || because "the island is too low"
     ;;
