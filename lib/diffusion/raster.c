@@ -187,8 +187,8 @@ static int curve_items(const oc_fcurve *fc, uint32_t ci, double cell,
     return err->code;
   }
   int closed = oc_curve_closed(fc->c);
-  if (*n + 2 * nv > *cap) {
-    size_t nc = 2 * (*cap + 2 * nv);
+  if (*n + 2 * nv + 1 > *cap) {
+    size_t nc = 2 * (*cap + 2 * nv + 1);
     ritem *t = realloc(*it, nc * sizeof *t);
     if (!t) {
       free(v);
@@ -197,7 +197,7 @@ static int curve_items(const oc_fcurve *fc, uint32_t ci, double cell,
     *it = t;
     *cap = nc;
   }
-  double ptx = 0, pty = 0;
+  double ptx = 0, pty = 0, ftx = 0, fty = 0;
   int have_prev = 0;
   for (size_t k = 0; k + 1 < nv; k++) {
     double dx = v[k + 1].x - v[k].x, dy = v[k + 1].y - v[k].y;
@@ -224,7 +224,18 @@ static int curve_items(const oc_fcurve *fc, uint32_t ci, double cell,
       }
     }
     (*it)[(*n)++] = s;
+    if (!have_prev) ftx = s.tx, fty = s.ty;
     ptx = s.tx, pty = s.ty, have_prev = 1;
+  }
+  /* a closed curve's last join, where it started */
+  double cr = ptx * fty - pty * ftx;
+  if (closed && have_prev && fabs(cr) > 1e-12) {
+    ritem w = {0};
+    w.curve = ci, w.wedge = 1, w.vx = v[0].x, w.vy = v[0].y;
+    w.tx = ptx, w.ty = pty, w.t2x = ftx, w.t2y = fty, w.s0 = v[0].s;
+    w.convex_left = cr < 0;
+    w.ylo = v[0].y - reach, w.yhi = v[0].y + reach;
+    (*it)[(*n)++] = w;
   }
   free(v);
   return OC_OK;

@@ -262,6 +262,31 @@ START_TEST(flat_slope_makes_a_plateau) {
 }
 END_TEST
 
+START_TEST(closed_curve_corners_alike) {
+  /* a square loop, counter-clockwise from (20, 20): the slope outside
+  ** rounds every corner the same, the one where the loop closes too */
+  oc_fconstraint k[2] = {height_pt(0, 30, 0), height_pt(1, 30, 0)};
+  add_slope(&k[0], 20, 30, 8, 10);
+  add_slope(&k[1], 20, 30, 8, 10);
+  double xy[10] = {20, 20, 60, 20, 60, 60, 20, 60, 20, 20};
+  oc_fcurve_params cp = {xy, 5, 0, k, 2};
+  oc_error err;
+  oc_fcurve *c = oc_fcurve_new(&cp, &err);
+  ck_assert_msg(c != NULL, "%s", err.msg);
+  oc_diffusion_params p = params(81, &c, 1);
+  oc_diffusion_result r;
+  run(&p, &r);
+  double g0 = at(r.gradient, 16, 16), t = tan(30 * PI / 180);
+  /* 4 sqrt 2 m from the corner: tan 30 (1 - 5.66 / 10) */
+  ck_assert_double_eq_tol(g0, t * (1 - sqrt(32) / 10), 1e-5);
+  ck_assert_double_eq_tol(at(r.gradient, 64, 16), g0, 1e-6);
+  ck_assert_double_eq_tol(at(r.gradient, 64, 64), g0, 1e-6);
+  ck_assert_double_eq_tol(at(r.gradient, 16, 64), g0, 1e-6);
+  oc_diffusion_result_clear(&r);
+  oc_fcurve_release(c);
+}
+END_TEST
+
 START_TEST(conflicting_gradients_filled) {
   /* two ridges crossing at right angles: their flanks meet in the four
   ** quadrants around the crossing, left empty and filled by diffusion */
@@ -556,6 +581,7 @@ int main(void) {
   tcase_add_test(tc, crossing_curves_averaged);
   tcase_add_test(tc, slopes_on_straight_ridges);
   tcase_add_test(tc, flat_slope_makes_a_plateau);
+  tcase_add_test(tc, closed_curve_corners_alike);
   tcase_add_test(tc, conflicting_gradients_filled);
   tcase_add_test(tc, converged_mode_converges);
   tcase_add_test(tc, deterministic_across_threads);
