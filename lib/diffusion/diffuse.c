@@ -153,7 +153,8 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
   rc = oc_dpyramid_init(&py, g->nx, g->ny, g->cell, err);
   if (rc) return rc;
   oc_draster_stats st;
-  rc = oc_draster(&py, g->x0, g->y0, p->curves, p->ncurves, &st, err);
+  rc = oc_draster(&py, g->x0, g->y0, p->curves, p->ncurves, p->progress, 0.05,
+                  &st, err);
   if (rc) goto done;
   out->strict = st.strict, out->slope = st.slope, out->conflict = st.conflict;
   out->levels = py.nlevels;

@@ -117,9 +117,10 @@ typedef struct oc_draster_stats {
 
 /* Paints the curves into level 0 of py (grid origin x0, y0): strict
 ** elevation and noise averaged, slopes with their guide direction,
-** conflicts flagged. */
+** conflicts flagged. Reports [0, span] of pr, which may cancel. */
 int oc_draster(oc_dpyramid *py, double x0, double y0, oc_fcurve *const *curves,
-               size_t ncurves, oc_draster_stats *st, oc_error *err);
+               size_t ncurves, oc_progress pr, double span,
+               oc_draster_stats *st, oc_error *err);
 
 /* ---- solving (jacobi.c, solve.c) ---- */
 

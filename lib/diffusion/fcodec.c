@@ -8,7 +8,8 @@
 ** ('F' marks version 1) every number a LEB128 varint, signed ones
 ** zigzag-coded: coordinates in 1/16 m, each point as the difference from
 ** the previous one; per constraint point the difference of u (in 1/4096)
-** from the previous point's, the category bits, and each value the point gives as the
+** from the previous point's, the category bits, and each value the point gives
+*as the
 ** difference from the last value given for it (heights, radii and
 ** extents in 1/16 m, angles in 1/64 degree, amplitudes in 1/64 m,
 ** roughness in 1/1024), so constant attributes cost a byte. Decoding

@@ -21,6 +21,7 @@
 ** contributions in that order whatever the thread count.
 */
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -266,7 +267,8 @@ static void normalise(const rctx *rc, size_t k, uint8_t *flags) {
 }
 
 int oc_draster(oc_dpyramid *py, double x0, double y0, oc_fcurve *const *curves,
-               size_t ncurves, oc_draster_stats *st, oc_error *err) {
+               size_t ncurves, oc_progress pr, double span,
+               oc_draster_stats *st, oc_error *err) {
   oc_dlevel *lv = &py->lv[0];
   size_t ns = (size_t)lv->nx * (size_t)lv->ny;
   rcurve *cv = malloc((ncurves ? ncurves : 1) * sizeof *cv);
@@ -307,9 +309,13 @@ int oc_draster(oc_dpyramid *py, double x0, double y0, oc_fcurve *const *curves,
             cnt + ns,
             cnt + 2 * ns,
             cnt + 3 * ns};
-  int nb = (lv->ny + BLOCK - 1) / BLOCK;
+  int nb = (lv->ny + BLOCK - 1) / BLOCK, stop = 0, done = 0;
 #pragma omp parallel for schedule(dynamic, 1)
   for (int b = 0; b < nb; b++) {
+    int halt;
+#pragma omp atomic read
+    halt = stop;
+    if (halt) continue;
     int j0 = b * BLOCK, j1 = j0 + BLOCK < lv->ny ? j0 + BLOCK : lv->ny;
     double ylo = y0 + j0 * lv->cell, yhi = y0 + (j1 - 1) * lv->cell;
     for (size_t t = 0; t < nit; t++) {
@@ -317,6 +323,18 @@ int oc_draster(oc_dpyramid *py, double x0, double y0, oc_fcurve *const *curves,
       for (int j = j0; j < j1; j++)
         paint_row(&x, &it[t], j);
     }
+    int d;
+#pragma omp atomic capture
+    d = ++done;
+    /* only the calling thread talks to the callback */
+    if (pr.fn && omp_get_thread_num() == 0 && pr.fn(pr.ud, span * d / nb)) {
+#pragma omp atomic write
+      stop = 1;
+    }
+  }
+  if (stop) {
+    rc = oc_seterr(err, OC_ECANCEL, "diffusion cancelled");
+    goto done;
   }
   size_t ss = 0, sl = 0, sc = 0, sn = 0;
 #pragma omp parallel for schedule(static) reduction(+ : ss, sl, sc, sn)

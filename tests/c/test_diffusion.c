@@ -556,6 +556,12 @@ static int stop_at_half(void *ud, double f) {
   return f > 0.5;
 }
 
+static int stop_at_once(void *ud, double f) {
+  (void)f;
+  ++*(int *)ud;
+  return 1;
+}
+
 START_TEST(progress_cancels) {
   oc_fcurve *c[3];
   scene(c);
@@ -566,6 +572,11 @@ START_TEST(progress_cancels) {
   oc_error err;
   ck_assert_int_eq(oc_diffusion(&p, &r, &err), OC_ECANCEL);
   ck_assert(calls > 2 && r.height == NULL);
+  /* stopped at once: in the rasterisation, the first phase */
+  p.progress = (oc_progress){stop_at_once, &calls};
+  calls = 0;
+  ck_assert_int_eq(oc_diffusion(&p, &r, &err), OC_ECANCEL);
+  ck_assert(calls == 1 && r.height == NULL);
   for (int i = 0; i < 3; i++)
     oc_fcurve_release(c[i]);
 }
