@@ -180,12 +180,14 @@ static int curve_items(const oc_fcurve *fc, uint32_t ci, double cell,
                        oc_error *err) {
   double tol = fmax(0.25 * cell, 1e-6 * fc->length);
   size_t nv = 0;
-  if (oc_curve_flatten(fc->c, tol, NULL, 0, &nv, err)) return err->code;
+  int rc = oc_curve_flatten(fc->c, tol, NULL, 0, &nv, err);
+  if (rc) return rc;
   oc_curve_vertex *v = malloc(nv * sizeof *v);
   if (!v) return oc_seterr(err, OC_ENOMEM, "out of memory (curve %u)", ci + 1);
-  if (oc_curve_flatten(fc->c, tol, v, nv, &nv, err)) {
+  rc = oc_curve_flatten(fc->c, tol, v, nv, &nv, err);
+  if (rc) {
     free(v);
-    return err->code;
+    return rc;
   }
   int closed = oc_curve_closed(fc->c);
   if (*n + 2 * nv + 1 > *cap) {
