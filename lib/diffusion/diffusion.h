@@ -171,7 +171,8 @@ typedef struct oc_dsolve {
 } oc_dsolve;
 
 /* Solves op's map on every level: the paper's coarse-to-fine cascade,
-** then V-cycles to the tolerance. OC_OK, OC_ENOMEM or OC_ECANCEL. */
+** then (tolerance > 0) V-cycles and BiCGSTAB to the tolerance. OC_OK,
+** OC_ENOMEM or OC_ECANCEL. */
 int oc_dsolve_map(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
                   oc_error *err);
 

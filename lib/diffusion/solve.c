@@ -3,22 +3,24 @@
 ** 5.2, after Orzan et al. 2008): a coarse-to-fine cascade with
 ** 5 (l - i) Jacobi sweeps at level i of l (0 the coarsest), each level
 ** starting from the bilinear prolongation of the one below; then, when a
-** tolerance is given, BiCGSTAB iterations preconditioned by V-cycles on
-** the correction equation until the largest Jacobi update of the finest
-** grid is below it. (V-cycles alone stall on the large grids: the
-** elevation's operator is not symmetric — upwind gradient terms — and
-** coarse levels see thin constraints thickened; the Krylov iteration
-** removes the few modes they leave. Its dot products are row sums added
-** in row order, so the result does not depend on the thread count.)
+** tolerance is given, V-cycles while each removes at least 30 % of the
+** largest Jacobi update of the finest grid, then BiCGSTAB preconditioned
+** by V-cycles, until that update is below the tolerance. (V-cycles alone
+** stall on large grids: the elevation's operator is not symmetric, with
+** its upwind gradient terms, and coarse levels see thin constraints
+** thickened; the Krylov iteration removes the few modes they leave. Its
+** dot products are row sums added in row order, so the result does not
+** depend on the thread count.)
 **
-** V-cycle at level k: 2 damped sweeps (weight 0.8), the residual r = M x + c -
-*x restricted
-** to level k + 1 (mean over the free children, times 4 where the coarse
-** sample is Laplace, 2 where it follows a gradient: the Laplacian scales
-** with the square of the cell, the first-order gradient term with the
-** cell), the coarse correction solved recursively from 0 (100 sweeps on
-** the coarsest grid), prolonged and added with the step that minimises
-** the residual (ordered sums), 2 sweeps.
+** V-cycle at level k: 3 damped sweeps (weight 0.8); the residual
+** r = M x + c - x restricted to level k + 1 (the mean over the free
+** children, times 4 where the coarse sample is Laplace and 2 where it
+** follows a gradient: the Laplacian scales with the square of the cell,
+** the first-order gradient term with the cell); the coarse correction
+** solved recursively from 0 (100 sweeps on the coarsest grid), prolonged
+** and added with the step that minimises the residual (the whole of it
+** as BiCGSTAB's preconditioner, which must be a fixed linear map); 3
+** damped sweeps.
 */
 #include <math.h>
 #include <stdlib.h>
