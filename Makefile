@@ -260,7 +260,16 @@ PICTURES := demo_arch_render.png:demo:arch_render.png \
   example_elev_lake.png:elev_lake:elev_lake.png \
   example_elev_craters.png:elev_craters:elev_craters.png \
   example_elev_multiscale.png:elev_multiscale:elev_multiscale.png \
-  example_elev_lod.png:elev_lod:elev_lod.png
+  example_elev_lod.png:elev_lod:elev_lod.png \
+  example_diffusion_ridges.png:diffusion_ridges:diffusion_ridges.png \
+  example_diffusion_river_cliff.png:diffusion_river_cliff:diffusion_river_cliff.png \
+  example_diffusion_hill_crack.png:diffusion_hill_crack:diffusion_hill_crack.png \
+  example_diffusion_noise.png:diffusion_noise:diffusion_noise.png \
+  example_diffusion_island.png:diffusion_island:diffusion_island.png \
+  example_diffusion_canyon_15.png:diffusion_canyon:diffusion_canyon_15.png \
+  example_diffusion_canyon_30.png:diffusion_canyon:diffusion_canyon_30.png \
+  example_diffusion_canyon_74.png:diffusion_canyon:diffusion_canyon_74.png \
+  example_diffusion_canyon3d.png:diffusion_canyon3d:diffusion_canyon3d.png
 PICTURE_SCENES := $(sort $(foreach p,$(PICTURES),$(word 2,$(subst :, ,$(p)))))
 
 pictures: all

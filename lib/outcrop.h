@@ -1349,7 +1349,7 @@ typedef struct oc_enode_image_params {
   int segment;            /* 1: seg and width instead of quad */
   double quad[8];
   double seg[4], width;
-  double height;  /* vertical scale (!= 0; 0 means 1) */
+  double height; /* vertical scale (!= 0; 0 means 1) */
   double offset;
   double falloff; /* > 0; 0: a tenth of the square root of the area */
   /* Along a curve (curve not NULL, with width): the skeleton through
@@ -1850,6 +1850,136 @@ typedef struct oc_gen_river_params {
 void oc_gen_river_defaults(oc_gen_river_params *p);
 oc_node *oc_generate_river(const oc_gen_river_params *p, oc_gen_sea_stats *st,
                            oc_error *err);
+
+/* ---- feature curves and diffusion (Hnaidi et al. 2010; lib/diffusion) -- */
+
+/* A feature curve: a planar curve (a polyline, or cubic Bézier pieces
+** pts[0..3], pts[3..6], ...) carrying constraint points at normalised arc
+** length u in [0, 1]. Each point gives any of the categories below; along
+** the curve each attribute is interpolated between the points that give
+** it (the elevation h by a natural cubic spline in u, linearly with two
+** points; every other attribute linearly) and held constant beyond the
+** first and last of them. An attribute given by no point is absent (a
+** radius defaults to 0). Reference counted, immutable. */
+typedef struct oc_fcurve oc_fcurve;
+
+enum {
+  OC_FC_HEIGHT = 1, /* height: the strict elevation h */
+  OC_FC_RADIUS = 2, /* radius: the half-width r of the strict plateau */
+  OC_FC_SLOPE = 4,  /* left, right (degrees), extent_a, extent_b */
+  OC_FC_NOISE = 8   /* amplitude, roughness */
+};
+
+typedef struct oc_fconstraint {
+  double u;      /* in [0, 1], strictly increasing along the array */
+  unsigned has;  /* OC_FC_* categories given */
+  double height; /* finite */
+  double radius; /* >= 0 metres, each side of the curve */
+  /* slope angles in degrees, |angle| <= 89, left and right of the
+  ** direction of travel: > 0 where the ground falls away from the curve
+  ** (ridge flanks, cliffs), < 0 where it rises (riverbanks, cracks); the
+  ** slope band runs from r to r + extent_a (left) or r + extent_b (right),
+  ** extents >= 0 metres */
+  double left, right, extent_a, extent_b;
+  double amplitude; /* >= 0 metres */
+  double roughness; /* in [0, 1] */
+} oc_fconstraint;
+
+typedef struct oc_fcurve_params {
+  const double *xy; /* npoints pairs (x, y) */
+  size_t npoints;   /* >= 2; with bezier, 3 k + 1 */
+  int bezier;       /* 1: cubic Bézier pieces; 0: a polyline */
+  const oc_fconstraint *constraints;
+  size_t nconstraints; /* >= 2 */
+} oc_fcurve_params;
+
+/* A new feature curve (one reference: oc_fcurve_release), or NULL with
+** err naming the field ('points', 'constraints[2].u', ...). */
+oc_fcurve *oc_fcurve_new(const oc_fcurve_params *p, oc_error *err);
+void oc_fcurve_retain(oc_fcurve *c);
+void oc_fcurve_release(oc_fcurve *c);
+double oc_fcurve_length(const oc_fcurve *c); /* xy arc length */
+unsigned oc_fcurve_has(const oc_fcurve *c);  /* OC_FC_* of any point */
+
+/* The curve at normalised arc length u (clamped to [0, 1]): the point,
+** the unit tangent and every attribute interpolated (absent ones 0; `has`
+** says which are present). */
+typedef struct oc_fcurve_sample {
+  double x, y, tx, ty;
+  unsigned has;
+  double height, radius, left, right, extent_a, extent_b, amplitude, roughness;
+} oc_fcurve_sample;
+int oc_fcurve_sample_at(const oc_fcurve *c, double u, oc_fcurve_sample *out);
+
+/* The compact encoding of a curve (lib/diffusion/fcodec.c): varints of
+** coordinates in 1/16 m (each point from the previous), u in 1/4096,
+** heights, radii and extents in 1/16 m, angles in 1/64 degree, amplitude
+** in 1/64 m, roughness in 1/1024, each attribute from its previous
+** value. oc_fcurve_encode writes at most cap bytes to buf (NULL to
+** measure) and returns the length of the whole encoding, 0 when a value
+** is too large to quantise (beyond 2^48 m); oc_fcurve_decode builds the
+** quantised curve (one reference) or NULL with err. */
+size_t oc_fcurve_encode(const oc_fcurve *c, unsigned char *buf, size_t cap);
+oc_fcurve *oc_fcurve_decode(const unsigned char *buf, size_t n, oc_error *err);
+
+typedef enum oc_diffusion_scheme {
+  /* F_G = (|nx| F(i - sx, j) + |ny| F(i, j - sy) - G) / (|nx| + |ny|):
+  ** exact on planes in every direction */
+  OC_DIFFUSION_UPWIND = 0,
+  /* the paper's printed F_G = nx^2 F(i - sx, j) + ny^2 F(i, j - sy) - G:
+  ** slopes up to sqrt 2 too steep at 45 degrees */
+  OC_DIFFUSION_PAPER
+} oc_diffusion_scheme;
+
+#define OC_DIFFUSION_MAX_CYCLES 64
+/* Grids of at most this many samples (6 floats each while solving). */
+#define OC_DIFFUSION_MAX_SAMPLES (1ull << 26)
+
+typedef struct oc_diffusion_params {
+  oc_heightfield_grid grid;
+  oc_fcurve *const *curves;
+  size_t ncurves;
+  uint64_t seed;
+  oc_diffusion_scheme scheme;
+  /* 0: the paper's cascade, 5 (l - i) Jacobi sweeps at level i of l (0
+  ** the coarsest); > 0: then V-cycles, and once they stall BiCGSTAB
+  ** preconditioned by V-cycles, until the largest Jacobi update of each
+  ** diffused map is at most tolerance times its constraints' scale (at
+  ** most OC_DIFFUSION_MAX_CYCLES steps) */
+  double tolerance;
+  double wavelength; /* lambda_0 metres (> 0; 0: the grid's extent / 8) */
+  int octaves;       /* n + 1 in 1..16 (0: 4) */
+  double ratio;      /* r > 1 (0: 2) */
+  int maps;          /* 1: fill the inspection grids of the result */
+  oc_progress progress;
+} oc_diffusion_params;
+
+typedef struct oc_diffusion_result {
+  oc_heightfield *height; /* smooth + detail */
+  /* with maps only (else NULL): the smooth elevation, the noise detail,
+  ** the diffused amplitude and roughness, and the diffused slope tan
+  ** theta (> 0 where the ground falls along the guide direction) */
+  oc_heightfield *smooth, *detail, *amplitude, *roughness, *gradient;
+  int levels; /* grids of the multigrid pyramid */
+  /* steps of the elevation's solve (V-cycles, then BiCGSTAB iterations),
+  ** and its largest Jacobi update (metres) after the cascade and after
+  ** each step */
+  int cycles;
+  double residual[OC_DIFFUSION_MAX_CYCLES + 1];
+  size_t strict, slope, conflict; /* constrained samples of the finest grid */
+} oc_diffusion_result;
+
+/* The terrain of the curves on p->grid: constraint maps rasterised,
+** gradient (n, norm), elevation guided by them, amplitude and roughness
+** diffused by multigrid, plus the noise detail
+** N = A sum_{k<octaves} r^(-k (1 - R)) S(r^k p / lambda_0), S the simplex
+** noise of lib/core scaled to [-1, 1]. Parallel, byte-identical for any
+** thread count, cancellable (OC_ECANCEL). Fills *out (the caller
+** releases its grids with oc_diffusion_result_clear); OC_OK or an error
+** naming the field ('curves', 'size', ...). */
+int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
+                 oc_error *err);
+void oc_diffusion_result_clear(oc_diffusion_result *r);
 
 /* ---- hashes (provenance) --------------------------------------------- */
 

@@ -440,41 +440,6 @@ static int l_transform(lua_State *L) {
 
 /* ---- lake and image --------------------------------------------------- */
 
-/* An array of {x, y} at stack index idx, n in [lo, hi] entries, into a
-** Lua-owned array of 2 n doubles pushed on the stack (raw reads). */
-static double *read_xy(lua_State *L, int idx, const char *fname,
-                       const char *label, lua_Integer lo, lua_Integer hi,
-                       size_t *n) {
-  if (!lua_istable(L, idx))
-    oclua_error(L, fname, "'%s' must be an array of {x, y} (got %s)", label,
-                oclua_got(L, idx));
-  lua_Integer m = (lua_Integer)lua_rawlen(L, idx);
-  if (m < lo || m > hi) {
-    if (lo == hi)
-      oclua_error(L, fname, "'%s' must hold %I points {x, y} (got %I)", label,
-                  lo, m);
-    oclua_error(L, fname, "'%s' must hold %I to %I points {x, y} (got %I)",
-                label, lo, hi, m);
-  }
-  double *a = lua_newuserdatauv(L, 2 * (size_t)m * sizeof *a, 0);
-  for (lua_Integer i = 1; i <= m; i++) {
-    lua_rawgeti(L, idx, i);
-    int ok = lua_istable(L, -1) && lua_rawlen(L, -1) == 2;
-    for (int k = 1; ok && k <= 2; k++) {
-      lua_rawgeti(L, -1, k);
-      ok = lua_type(L, -1) == LUA_TNUMBER && isfinite(lua_tonumber(L, -1));
-      if (ok) a[2 * (i - 1) + (k - 1)] = lua_tonumber(L, -1);
-      lua_pop(L, 1);
-    }
-    if (!ok)
-      oclua_error(L, fname, "'%s[%I]' must be {x, y} with finite numbers",
-                  label, i);
-    lua_pop(L, 1);
-  }
-  *n = (size_t)m;
-  return a;
-}
-
 static int l_lake(lua_State *L) {
   static const char *const known[] = {
       "center", "radius", "contour", "level",    "falloff",
@@ -524,7 +489,8 @@ static int l_lake(lua_State *L) {
   } else if (tr != LUA_TNIL) {
     oclua_field_error(&f, "radius", ir, "must be a number or {r1, r2, ...}");
   } else {
-    p.contour = read_xy(L, ic, fname, "contour", 3, MAX_POINTS, &p.ncontour);
+    p.contour =
+        oclua_read_xy(L, ic, fname, "contour", 3, MAX_POINTS, &p.ncontour);
   }
   p.level = oclua_field_optnumber(&f, "level", OCLUA_FINITE, 0);
   p.falloff = oclua_field_optnumber(&f, "falloff", OCLUA_POSITIVE, 0);
@@ -586,7 +552,7 @@ static int l_image(lua_State *L) {
                 "'width', or 'curve' = {{x, y}, ...} with 'width'");
   size_t n;
   if (tq != LUA_TNIL) {
-    const double *q = read_xy(L, iq, fname, "quad", 4, 4, &n);
+    const double *q = oclua_read_xy(L, iq, fname, "quad", 4, 4, &n);
     for (int k = 0; k < 8; k++)
       p.quad[k] = q[k];
     if (oclua_field_push(&f, "width") != LUA_TNIL)
@@ -595,12 +561,12 @@ static int l_image(lua_State *L) {
     lua_pop(L, 1);
   } else {
     if (ts != LUA_TNIL) {
-      const double *q = read_xy(L, is, fname, "segment", 2, 2, &n);
+      const double *q = oclua_read_xy(L, is, fname, "segment", 2, 2, &n);
       for (int k = 0; k < 4; k++)
         p.seg[k] = q[k];
       p.segment = 1;
     } else {
-      const double *q = read_xy(L, ic, fname, "curve", 2, MAX_POINTS, &n);
+      const double *q = oclua_read_xy(L, ic, fname, "curve", 2, MAX_POINTS, &n);
       oc_vec3 *c = lua_newuserdatauv(L, n * sizeof *c, 0);
       for (size_t k = 0; k < n; k++)
         c[k] = (oc_vec3){q[2 * k], q[2 * k + 1], 0};

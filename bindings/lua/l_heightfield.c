@@ -103,8 +103,7 @@ static void field_size(const oclua_fields *f, int *nx, int *ny) {
   *ny = (int)s[1];
 }
 
-/* cell, origin and size of a grid to be made. */
-static oc_heightfield_grid field_grid(const oclua_fields *f) {
+oc_heightfield_grid oclua_field_grid(const oclua_fields *f) {
   oc_heightfield_grid g;
   double o[2] = {0, 0};
   field_size(f, &g.nx, &g.ny);
@@ -224,7 +223,7 @@ static int l_fbm(lua_State *L) {
                   "{size =, cell =, origin =, amplitude =, wavelength =, "
                   "octaves =, seed =, offset =}");
   oclua_fields_open(&f, L, 1, fname, NULL, known, 0);
-  oc_heightfield_grid g = field_grid(&f);
+  oc_heightfield_grid g = oclua_field_grid(&f);
   oclua_field_noise(&f, &nz, NAN, DEFAULT_OCTAVES, 1);
   oc_progress pr = oclua_progress_start(L, &pl, fname);
   oclua_heightfield *u = oclua_newheightfield(L);
@@ -324,7 +323,7 @@ static int l_from(lua_State *L) {
                 "node or an elevation tree (got %s)",
                 oclua_got(L, 1));
   oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
-  oc_heightfield_grid g = field_grid(&f);
+  oc_heightfield_grid g = oclua_field_grid(&f);
   int hasz = oclua_field_numbers(&f, "zrange", 2, zr, "must be {z0, z1}");
   double t = oclua_field_optnumber(&f, "threshold", OCLUA_POSITIVE, 0);
   if (isfn) {

@@ -30,6 +30,10 @@ oc_heightfield *oclua_pinheightfield(lua_State *L, int idx, const char *fname);
 ** on cancel, else fname and err's message). */
 int oclua_sethf(lua_State *L, oclua_heightfield *u, oc_heightfield *hf,
                 const oc_error *err, const char *fname);
+/* The grid to be made from the fields size = {nx, ny} (required), cell
+** (> 0, default 1) and origin = {x0, y0} (default {0, 0}). */
+oc_heightfield_grid oclua_field_grid(const oclua_fields *f);
+
 /* Whether idx is a heightfield userdata, open or closed. */
 int oclua_isheightfield(lua_State *L, int idx);
 

@@ -552,3 +552,38 @@ const double *oclua_read_palette(lua_State *L, int idx, const char *fname,
   *nstops = (int)n;
   return stops;
 }
+
+/* An array of {x, y} at stack index idx, n in [lo, hi] entries, into a
+** Lua-owned array of 2 n doubles pushed on the stack (raw reads). */
+double *oclua_read_xy(lua_State *L, int idx, const char *fname,
+                      const char *label, lua_Integer lo, lua_Integer hi,
+                      size_t *n) {
+  if (!lua_istable(L, idx))
+    oclua_error(L, fname, "'%s' must be an array of {x, y} (got %s)", label,
+                oclua_got(L, idx));
+  lua_Integer m = (lua_Integer)lua_rawlen(L, idx);
+  if (m < lo || m > hi) {
+    if (lo == hi)
+      oclua_error(L, fname, "'%s' must hold %I points {x, y} (got %I)", label,
+                  lo, m);
+    oclua_error(L, fname, "'%s' must hold %I to %I points {x, y} (got %I)",
+                label, lo, hi, m);
+  }
+  double *a = lua_newuserdatauv(L, 2 * (size_t)m * sizeof *a, 0);
+  for (lua_Integer i = 1; i <= m; i++) {
+    lua_rawgeti(L, idx, i);
+    int ok = lua_istable(L, -1) && lua_rawlen(L, -1) == 2;
+    for (int k = 1; ok && k <= 2; k++) {
+      lua_rawgeti(L, -1, k);
+      ok = lua_type(L, -1) == LUA_TNUMBER && isfinite(lua_tonumber(L, -1));
+      if (ok) a[2 * (i - 1) + (k - 1)] = lua_tonumber(L, -1);
+      lua_pop(L, 1);
+    }
+    if (!ok)
+      oclua_error(L, fname, "'%s[%I]' must be {x, y} with finite numbers",
+                  label, i);
+    lua_pop(L, 1);
+  }
+  *n = (size_t)m;
+  return a;
+}

@@ -93,6 +93,13 @@ int oclua_field_optvec(const oclua_fields *f, const char *name, oc_vec3 *v);
 oc_vec3 oclua_tovec(lua_State *L, int idx, const char *fname, const char *label,
                     lua_Integer elem);
 
+/* An array of {x, y} at stack index idx, n in [lo, hi] entries, into a
+** Lua-owned array of 2 n doubles pushed on the stack (raw reads); `label`
+** names the field in messages. */
+double *oclua_read_xy(lua_State *L, int idx, const char *fname,
+                      const char *label, lua_Integer lo, lua_Integer hi,
+                      size_t *n);
+
 /* The scene seed: registry OCLUA_SEED when it is an integer >= 0, else 1.
 ** Notes in OCLUA_STATE that the seed was used, so that a later
 ** outcrop.configure cannot change it. */

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "l_config.h"
+#include "l_diffusion.h"
 #include "l_elevation.h"
 #include "l_field.h"
 #include "l_geology.h"
@@ -55,10 +56,11 @@ int luaopen_outcrop(lua_State *L) {
   oclua_open_mesh(L);
   oclua_open_heightfield(L); /* outcrop.heightfield */
   oclua_open_render(L);
-  oclua_open_terrain(L); /* outcrop.terrain */
-  oclua_open_gen(L);     /* outcrop.poisson2d/3d */
-  oclua_open_geology(L); /* outcrop.geology, outcrop.erosion */
+  oclua_open_terrain(L);   /* outcrop.terrain */
+  oclua_open_gen(L);       /* outcrop.poisson2d/3d */
+  oclua_open_geology(L);   /* outcrop.geology, outcrop.erosion */
   oclua_open_elevation(L); /* outcrop.elevation */
+  oclua_open_diffusion(L); /* outcrop.feature_curve, outcrop.diffusion */
   lua_pushliteral(L, OC_VERSION);
   lua_setfield(L, -2, "version");
   lua_pushnumber(L, OC_DEFAULT_THRESHOLD);

@@ -18,6 +18,8 @@
 # LoD render takes fewer tree calls per pixel than the full-detail one.
 # EXAMPLES_THREADS="2" (the sanitizer pass) runs them once, on two
 # threads: the release pass has compared the thread counts.
+#
+# diffusion-*: two feature-curve examples the same way (below).
 
 set -u
 
@@ -105,6 +107,42 @@ for ex in elev_river elev_dunes elev_instances elev_road elev_coast elev_lake \
     awk '/cuts the rim/ { d = $18 - ($24 - $27); ok = (d < 0.11 && d > -0.11) }
       END { exit !ok }' FS='[ ]+' "$T/out1" ||
       because "the younger crater's floor is not its own"
+    ;;
+  esac
+  tally "$T/out1" "$T/err"
+done
+
+# diffusion-*: the feature-curve examples (Hnaidi et al. 2010) with a
+# 96-pixel render, on one thread and on two: the same PNG bytes; the
+# ridges meet (their flanks conflict) and the island reaches its rim.
+for ex in diffusion_ridges diffusion_island; do
+  name=diffusion-${ex#diffusion_}
+  why=
+  mkdir -p "$T/$name/1" "$T/$name/2"
+  threads=${EXAMPLES_THREADS:-1 2}
+  for n in $threads; do
+    "$OUTCROP" run "$ROOT/examples/$ex.lua" --set size=96 --threads $n \
+      --out "$T/$name/$n" >"$T/out$n" 2>"$T/err" ||
+      because "$(grep -m1 -E 'outcrop:|assert' "$T/err" || echo "exit status $?")"
+  done
+  [ "$threads" = "1 2" ] || cp "$T/$name/$threads/$ex.png" "$T/$name/1/$ex.png" 2>/dev/null
+  [ "$threads" = "1 2" ] || cp "$T/out$threads" "$T/out1"
+  if [ -f "$T/$name/1/$ex.png" ] && [ -f "$T/$name/2/$ex.png" ]; then
+    cmp -s "$T/$name/1/$ex.png" "$T/$name/2/$ex.png" ||
+      because "$ex.png differs between --threads 1 and 2"
+  else
+    because "no $ex.png written"
+  fi
+  case $ex in
+  diffusion_ridges)
+    # N steps, A strict, B slope and C conflicting samples: C > 0
+    awk '/conflicting/ { ok = ($9 + 0 > 0) } END { exit !ok }' FS='[ ]+' \
+      "$T/out1" || because "the ridges' flanks did not meet"
+    ;;
+  diffusion_island)
+    # 9 curves, N steps, LO..HI m: the rim's 440..460 m (plus noise)
+    awk '/curves/ { split($6, r, "[.][.]"); ok = (r[2] + 0 >= 440) }
+      END { exit !ok }' FS='[ ]+' "$T/out1" || because "the island is too low"
     ;;
   esac
   tally "$T/out1" "$T/err"

@@ -1,0 +1,191 @@
+/*
+** diffusion.h — what the files of lib/diffusion share (Hnaidi et al.
+** 2010): the feature curve's insides, the natural cubic spline, the
+** multigrid levels with their constraint maps, and the steps of
+** oc_diffusion (rasterisation, restriction, Jacobi sweeps, cascade and
+** V-cycles, noise detail).
+*/
+#ifndef OC_DIFFUSION_H
+#define OC_DIFFUSION_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/curve.h"
+#include "outcrop.h"
+
+/* ---- natural cubic spline (nspline.c) ---- */
+
+/* Through n >= 1 knots (u[i], v[i]), u strictly increasing: second
+** derivatives m[i] with m[0] = m[n-1] = 0 (a line for n = 2, a constant
+** for n = 1). */
+void oc_nspline_fit(const double *u, const double *v, size_t n, double *m,
+                    double *work);
+/* The spline at t, constant beyond the end knots. */
+double oc_nspline_eval(const double *u, const double *v, const double *m,
+                       size_t n, double t);
+/* The piecewise linear interpolant, constant beyond the end knots. */
+double oc_linear_eval(const double *u, const double *v, size_t n, double t);
+
+/* ---- feature curves (fcurve.c) ---- */
+
+/* One interpolated attribute: its knots among the constraint points. */
+typedef struct oc_fattr {
+  size_t n;
+  double *u, *v, *m; /* m: spline second derivatives (height only) */
+} oc_fattr;
+
+enum {
+  FA_HEIGHT,
+  FA_RADIUS,
+  FA_LEFT,
+  FA_RIGHT,
+  FA_EXTA,
+  FA_EXTB,
+  FA_AMP,
+  FA_ROUGH,
+  FA_COUNT
+};
+
+struct oc_fcurve {
+  int refs;
+  oc_pcurve *c;
+  double length;
+  unsigned has;
+  oc_fattr attr[FA_COUNT];
+  double *xy; /* the control points as given (for the encoding) */
+  size_t npoints;
+  int bezier;
+  oc_fconstraint *k; /* the constraint points as given */
+  size_t nk;
+};
+
+/* The attributes of `want` (bits 1 << FA_*) at normalised arc length u
+** into v[FA_COUNT] (0 where absent; the slope angles as tan theta). */
+void oc_fcurve_attrs(const oc_fcurve *c, double u, unsigned want, double *v);
+
+/* ---- levels and constraint maps ---- */
+
+/* Flags of a sample. */
+enum {
+  DF_H = 1,        /* strict elevation */
+  DF_SLOPE = 2,    /* gradient constrained (n, norm) */
+  DF_CONFLICT = 4, /* gradients of different curves met: left empty */
+  DF_NOISE = 8     /* strict amplitude and roughness */
+};
+#define DF_GUIDE (DF_SLOPE | DF_CONFLICT) /* h follows the gradient there */
+
+/* Maps of one level (0 the finest): h (elevation), gx, gy (the guide
+** direction n), gd (drop per metre along n), A, R; samples (i, j) at
+** (x0 + (i + o) cell, y0 + (j + o) cell) with o = (2^level - 1) / 2 in
+** the finest grid's cells. */
+enum { MAP_H, MAP_GX, MAP_GY, MAP_GD, MAP_A, MAP_R, MAP_COUNT };
+
+typedef struct oc_dlevel {
+  int nx, ny;
+  double cell;
+  float *map[MAP_COUNT];
+  uint8_t *flags;
+} oc_dlevel;
+
+typedef struct oc_dpyramid {
+  int nlevels;
+  oc_dlevel *lv;
+  float *scratch; /* nx ny of level 0 */
+} oc_dpyramid;
+
+/* Levels down to a coarsest grid of at most 8 samples a side; allocates
+** the maps of level 0 (filled by the caller) and, with oc_dpyramid_grow,
+** those of the coarser levels and the scratch grid; oc_dpyramid_shrink
+** frees those again (so that the peak holds one of the rasteriser's
+** counters, the pyramid and the output grids at a time). */
+int oc_dpyramid_init(oc_dpyramid *py, int nx, int ny, double cell,
+                     oc_error *err);
+int oc_dpyramid_grow(oc_dpyramid *py, oc_error *err);
+void oc_dpyramid_shrink(oc_dpyramid *py);
+void oc_dpyramid_free(oc_dpyramid *py);
+/* Coarse flags and constrained values from level k - 1 to k, for every
+** k: a coarse sample is constrained if any child is, with the mean of
+** the constrained children. */
+void oc_dpyramid_restrict(oc_dpyramid *py);
+
+/* ---- rasterisation (raster.c) ---- */
+
+typedef struct oc_draster_stats {
+  size_t strict, slope, conflict, strict_noise;
+} oc_draster_stats;
+
+/* Paints the curves into level 0 of py (grid origin x0, y0): strict
+** elevation and noise averaged, slopes with their guide direction,
+** conflicts flagged. Reports [0, span] of pr, which may cancel. */
+int oc_draster(oc_dpyramid *py, double x0, double y0, oc_fcurve *const *curves,
+               size_t ncurves, oc_progress pr, double span,
+               oc_draster_stats *st, oc_error *err);
+
+/* ---- solving (jacobi.c, solve.c) ---- */
+
+typedef enum oc_dkind {
+  DK_LAPLACE, /* Laplace, identity where (flags & mask) */
+  DK_GUIDED   /* the elevation: identity on DF_H, gradient + Laplace on
+              ** DF_GUIDE, Laplace elsewhere */
+} oc_dkind;
+
+typedef struct oc_dop {
+  oc_dkind kind;
+  int map;      /* MAP_* being solved */
+  uint8_t mask; /* DK_LAPLACE: the flags holding constraints */
+  int paper;    /* DK_GUIDED: the paper's printed gradient term */
+  int hom;      /* the correction equation: 0 where constrained, no G */
+} oc_dop;
+
+/* One Jacobi sweep of level lv from x into y: y = M x + c, or with
+** op->hom (the correction equation of a V-cycle) y = M x + rhs (rhs NULL:
+** 0), 0 where constrained and without the G term; damped by w (1: plain Jacobi,
+*the
+** cascade's; below 1 for the V-cycles' smoothing: plain Jacobi leaves the
+** checkerboard mode undamped). Returns the largest |y - x| over the
+** samples not constrained. Rows in parallel. */
+double oc_djacobi(const oc_dop *op, const oc_dlevel *lv, const float *x,
+                  float *y, const float *rhs, double w);
+/* Adds the bilinear prolongation of coarse values c (level lc) to (add)
+** or sets (!add) the unconstrained samples of fine values f (level lf). */
+void oc_dprolong(const oc_dop *op, const oc_dlevel *lc, const float *c,
+                 const oc_dlevel *lf, float *f, int add);
+/* Loops over a grid of fewer samples run on one thread: a parallel
+** region costs more than the work there (and much more on a busy
+** machine, where idle threads spin). */
+#define OC_DPAR(lv) ((size_t)(lv)->nx * (size_t)(lv)->ny > 65536)
+
+/* Whether sample k of lv is constrained for op. */
+static inline int oc_dfixed(const oc_dop *op, const oc_dlevel *lv, size_t k) {
+  return op->kind == DK_LAPLACE ? (lv->flags[k] & op->mask) != 0
+                                : (lv->flags[k] & DF_H) != 0;
+}
+
+typedef struct oc_dsolve {
+  oc_progress progress;
+  double lo, span;  /* this solve's part of the progress range */
+  double tolerance; /* 0: cascade only */
+  double *residual; /* NULL or OC_DIFFUSION_MAX_CYCLES + 1 values */
+  int *cycles;
+} oc_dsolve;
+
+/* Solves op's map on every level: the paper's coarse-to-fine cascade,
+** then (tolerance > 0) V-cycles and BiCGSTAB to the tolerance. OC_OK,
+** OC_ENOMEM or OC_ECANCEL. */
+int oc_dsolve_map(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
+                  oc_error *err);
+
+/* ---- noise detail (detail.c) ---- */
+
+typedef struct oc_ddetail {
+  double x0, y0, cell, wavelength, ratio;
+  int octaves;
+  uint64_t seed;
+} oc_ddetail;
+
+/* N at (x, y) for amplitude A and roughness R. */
+double oc_ddetail_at(const oc_ddetail *d, double x, double y, double A,
+                     double R);
+
+#endif

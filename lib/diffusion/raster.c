@@ -1,0 +1,356 @@
+/*
+** raster.c — the constraint maps of the finest grid (Hnaidi et al. 2010,
+** section 4.1). Each curve is flattened (core/curve.h) within a quarter
+** cell; each segment paints the quadrangles on both sides of it, reaching
+** r (strict elevation, amplitude and roughness, uniform across) and then
+** a on the left or b on the right (the slope: tan theta at the inner
+** edge, 0 at the far end); the convex side of a join is closed by the
+** round wedge between the two quadrangles. Strict bands are at least
+** the half-extent of a cell across the curve (conservative), so cells the
+** curve crosses always get h, even when r is below a cell.
+**
+** Overlaps: strict values are averaged; a cell reached by the slopes of
+** two different curves is a conflict, left empty (its gradient is filled
+** by the Laplace diffusion, figure 9). The guide direction n is the
+** outward normal and the stored value the drop per metre along it; on a
+** curve without strict elevation both are inverted (n inward), as the
+** paper does so that the gradient propagates from the surroundings.
+**
+** Rows are split in blocks painted in parallel; every block visits the
+** items (segments, wedges) in the same order, so each cell sums its
+** contributions in that order whatever the thread count.
+*/
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "diffusion/diffusion.h"
+
+#define BLOCK 8
+#define CONFLICT_OWNER 0xffffu
+
+typedef struct ritem {
+  uint32_t curve;
+  int wedge;
+  double vx, vy, tx, ty, len; /* segment: start, unit direction, length */
+  double t2x, t2y;            /* wedge: next direction (tx, ty the previous) */
+  double s0, s1;              /* arc length at the ends (wedge: s0) */
+  double e0, e1;              /* conservative extension of the ends */
+  int convex_left;            /* wedge: the convex side is the left */
+  double ylo, yhi;
+} ritem;
+
+typedef struct rcurve {
+  const oc_fcurve *fc;
+  double reach; /* the farthest a painted cell lies from the curve */
+} rcurve;
+
+typedef struct rctx {
+  const oc_dlevel *lv;
+  double x0, y0;
+  const rcurve *cv;
+  const ritem *it;
+  size_t nit;
+  float *h, *gx, *gy, *gd, *A, *R;
+  uint16_t *hc, *nc, *gc, *owner;
+} rctx;
+
+/* The contributions of curve ci to cell k at arc length s, distance dist
+** on the left (or right) side, outward normal (nox, noy); no slope when
+** !slopes (conservative cells beyond an end). */
+static void deposit(const rctx *rc, size_t k, uint32_t ci, double s,
+                    double dist, int left, double nox, double noy, int slopes) {
+  const rcurve *cv = &rc->cv[ci];
+  const oc_fcurve *fc = cv->fc;
+  double a[FA_COUNT], u = fc->length > 0 ? s / fc->length : 0;
+  oc_fcurve_attrs(fc, u, 1u << FA_RADIUS, a);
+  double r = a[FA_RADIUS];
+  double ws = fmax(r, 0.5 * rc->lv->cell * (fabs(nox) + fabs(noy)));
+  if (dist <= ws && (fc->has & (OC_FC_HEIGHT | OC_FC_NOISE))) {
+    oc_fcurve_attrs(fc, u,
+                    (1u << FA_HEIGHT) | (1u << FA_AMP) | (1u << FA_ROUGH), a);
+    if (fc->has & OC_FC_HEIGHT) {
+      rc->h[k] += (float)a[FA_HEIGHT];
+      if (rc->hc[k] < 0xffffu) rc->hc[k]++;
+    }
+    if (fc->has & OC_FC_NOISE) {
+      rc->A[k] += (float)a[FA_AMP];
+      rc->R[k] += (float)a[FA_ROUGH];
+      if (rc->nc[k] < 0xffffu) rc->nc[k]++;
+    }
+  }
+  if (!slopes || !(fc->has & OC_FC_SLOPE) || !(dist > r)) return;
+  oc_fcurve_attrs(fc, u, left ? (1u << FA_EXTA) : (1u << FA_EXTB), a);
+  double ext = left ? a[FA_EXTA] : a[FA_EXTB];
+  if (!(ext > 0 && dist <= r + ext)) return;
+  uint16_t me = (uint16_t)(ci + 1);
+  if (rc->owner[k] == CONFLICT_OWNER) return;
+  if (rc->owner[k] && rc->owner[k] != me) {
+    rc->owner[k] = CONFLICT_OWNER;
+    return;
+  }
+  rc->owner[k] = me;
+  oc_fcurve_attrs(fc, u, left ? (1u << FA_LEFT) : (1u << FA_RIGHT), a);
+  double tn = left ? a[FA_LEFT] : a[FA_RIGHT];
+  double val = tn * (1 - (dist - r) / ext);
+  double sg = (fc->has & OC_FC_HEIGHT) ? 1 : -1;
+  rc->gx[k] += (float)(sg * nox);
+  rc->gy[k] += (float)(sg * noy);
+  rc->gd[k] += (float)(sg * val);
+  if (rc->gc[k] < 0xffffu) rc->gc[k]++;
+}
+
+/* x in [lo, hi] where lo <= a x + b <= hi' (updates *xlo, *xhi); 0 when
+** empty. */
+static int clip(double a, double b, double lo, double hi, double *xlo,
+                double *xhi) {
+  if (fabs(a) < 1e-12) return b >= lo && b <= hi;
+  double u = (lo - b) / a, v = (hi - b) / a;
+  if (u > v) {
+    double t = u;
+    u = v;
+    v = t;
+  }
+  if (u > *xlo) *xlo = u;
+  if (v < *xhi) *xhi = v;
+  return *xlo <= *xhi;
+}
+
+static void paint_row(const rctx *rc, const ritem *it, int j) {
+  const oc_dlevel *lv = rc->lv;
+  double cell = lv->cell, y = rc->y0 + j * cell;
+  double w = rc->cv[it->curve].reach;
+  double xlo = -INFINITY, xhi = INFINITY;
+  if (it->wedge) {
+    double dy = y - it->vy;
+    if (fabs(dy) > w) return;
+    double hw = sqrt(w * w - dy * dy);
+    xlo = it->vx - hw, xhi = it->vx + hw;
+  } else {
+    /* along = (x - vx) tx + (y - vy) ty, across = -(x - vx) ty + (y - vy) tx */
+    double dy = y - it->vy;
+    if (!clip(it->tx, -it->vx * it->tx + dy * it->ty, -it->e0, it->len + it->e1,
+              &xlo, &xhi) ||
+        !clip(-it->ty, it->vx * it->ty + dy * it->tx, -w, w, &xlo, &xhi))
+      return;
+  }
+  double fi0 = ceil((xlo - rc->x0) / cell - 1e-9),
+         fi1 = floor((xhi - rc->x0) / cell + 1e-9);
+  if (fi0 < 0) fi0 = 0;
+  if (fi1 > lv->nx - 1) fi1 = lv->nx - 1;
+  size_t row = (size_t)j * (size_t)lv->nx;
+  for (int i = (int)fi0; i <= (int)fi1; i++) {
+    double dx = rc->x0 + i * cell - it->vx, dy = y - it->vy;
+    if (it->wedge) {
+      if (!(dx * it->tx + dy * it->ty > 0 && dx * it->t2x + dy * it->t2y < 0))
+        continue;
+      double d = sqrt(dx * dx + dy * dy);
+      if (d > w || d == 0) continue;
+      deposit(rc, row + (size_t)i, it->curve, it->s0, d, it->convex_left,
+              dx / d, dy / d, 1);
+      continue;
+    }
+    double along = dx * it->tx + dy * it->ty;
+    double across = -dx * it->ty + dy * it->tx;
+    if (along < -it->e0 || along > it->len + it->e1 || fabs(across) > w)
+      continue;
+    double f = along <= 0 ? 0 : along >= it->len ? 1 : along / it->len;
+    double s = it->s0 + f * (it->s1 - it->s0);
+    int left = across >= 0;
+    double nox = left ? -it->ty : it->ty, noy = left ? it->tx : -it->tx;
+    /* beyond an end of the curve (conservative cells): strict values only */
+    deposit(rc, row + (size_t)i, it->curve, s, fabs(across), left, nox, noy,
+            along >= 0 && along <= it->len);
+  }
+}
+
+static double attr_max(const oc_fattr *t) {
+  double m = 0;
+  for (size_t i = 0; i < t->n; i++)
+    m = fmax(m, t->v[i]);
+  return m;
+}
+
+/* Appends the items of one curve (segments, then the wedge after each
+** join) to *it. */
+static int curve_items(const oc_fcurve *fc, uint32_t ci, double cell,
+                       double reach, ritem **it, size_t *n, size_t *cap,
+                       oc_error *err) {
+  double tol = fmax(0.25 * cell, 1e-6 * fc->length);
+  size_t nv = 0;
+  int rc = oc_curve_flatten(fc->c, tol, NULL, 0, &nv, err);
+  if (rc) return rc;
+  oc_curve_vertex *v = malloc(nv * sizeof *v);
+  if (!v) return oc_seterr(err, OC_ENOMEM, "out of memory (curve %u)", ci + 1);
+  rc = oc_curve_flatten(fc->c, tol, v, nv, &nv, err);
+  if (rc) {
+    free(v);
+    return rc;
+  }
+  int closed = oc_curve_closed(fc->c);
+  if (*n + 2 * nv + 1 > *cap) {
+    size_t nc = 2 * (*cap + 2 * nv + 1);
+    ritem *t = realloc(*it, nc * sizeof *t);
+    if (!t) {
+      free(v);
+      return oc_seterr(err, OC_ENOMEM, "out of memory (curve %u)", ci + 1);
+    }
+    *it = t;
+    *cap = nc;
+  }
+  double ptx = 0, pty = 0, ftx = 0, fty = 0;
+  int have_prev = 0;
+  for (size_t k = 0; k + 1 < nv; k++) {
+    double dx = v[k + 1].x - v[k].x, dy = v[k + 1].y - v[k].y;
+    double len = sqrt(dx * dx + dy * dy);
+    if (!(len > 0)) continue;
+    ritem s = {0};
+    s.curve = ci;
+    s.vx = v[k].x, s.vy = v[k].y, s.tx = dx / len, s.ty = dy / len;
+    s.len = len, s.s0 = v[k].s, s.s1 = v[k + 1].s;
+    double half = 0.5 * cell * (fabs(s.tx) + fabs(s.ty));
+    s.e0 = (k == 0 && !closed) ? half : 0;
+    s.e1 = (k + 2 == nv && !closed) ? half : 0;
+    double e = fmax(s.e0, s.e1) + reach;
+    s.ylo = fmin(v[k].y, v[k + 1].y) - e, s.yhi = fmax(v[k].y, v[k + 1].y) + e;
+    if (have_prev) {
+      double cr = ptx * s.ty - pty * s.tx;
+      if (fabs(cr) > 1e-12) {
+        ritem w = {0};
+        w.curve = ci, w.wedge = 1, w.vx = v[k].x, w.vy = v[k].y;
+        w.tx = ptx, w.ty = pty, w.t2x = s.tx, w.t2y = s.ty, w.s0 = v[k].s;
+        w.convex_left = cr < 0;
+        w.ylo = v[k].y - reach, w.yhi = v[k].y + reach;
+        (*it)[(*n)++] = w;
+      }
+    }
+    (*it)[(*n)++] = s;
+    if (!have_prev) ftx = s.tx, fty = s.ty;
+    ptx = s.tx, pty = s.ty, have_prev = 1;
+  }
+  /* a closed curve's last join, where it started */
+  double cr = ptx * fty - pty * ftx;
+  if (closed && have_prev && fabs(cr) > 1e-12) {
+    ritem w = {0};
+    w.curve = ci, w.wedge = 1, w.vx = v[0].x, w.vy = v[0].y;
+    w.tx = ptx, w.ty = pty, w.t2x = ftx, w.t2y = fty, w.s0 = v[0].s;
+    w.convex_left = cr < 0;
+    w.ylo = v[0].y - reach, w.yhi = v[0].y + reach;
+    (*it)[(*n)++] = w;
+  }
+  free(v);
+  return OC_OK;
+}
+
+static void normalise(const rctx *rc, size_t k, uint8_t *flags) {
+  uint8_t f = 0;
+  if (rc->hc[k]) {
+    rc->h[k] /= rc->hc[k];
+    f |= DF_H;
+  }
+  if (rc->nc[k]) {
+    rc->A[k] /= rc->nc[k];
+    rc->R[k] /= rc->nc[k];
+    f |= DF_NOISE;
+  }
+  double gx = rc->gx[k], gy = rc->gy[k], g = sqrt(gx * gx + gy * gy);
+  if (rc->owner[k] == CONFLICT_OWNER || (rc->gc[k] && !(g > 1e-6))) {
+    f |= DF_CONFLICT;
+    rc->gx[k] = rc->gy[k] = rc->gd[k] = 0;
+  } else if (rc->gc[k]) {
+    rc->gx[k] = (float)(gx / g);
+    rc->gy[k] = (float)(gy / g);
+    rc->gd[k] /= rc->gc[k];
+    f |= DF_SLOPE;
+  }
+  flags[k] = f;
+}
+
+int oc_draster(oc_dpyramid *py, double x0, double y0, oc_fcurve *const *curves,
+               size_t ncurves, oc_progress pr, double span,
+               oc_draster_stats *st, oc_error *err) {
+  oc_dlevel *lv = &py->lv[0];
+  size_t ns = (size_t)lv->nx * (size_t)lv->ny;
+  rcurve *cv = malloc((ncurves ? ncurves : 1) * sizeof *cv);
+  uint16_t *cnt = calloc(4 * ns, sizeof *cnt);
+  ritem *it = NULL;
+  size_t nit = 0, cap = 0;
+  int rc = OC_OK;
+  if (!cv || !cnt) {
+    rc = oc_seterr(err, OC_ENOMEM, "out of memory (%zu samples)", ns);
+    goto done;
+  }
+  for (size_t c = 0; c < ncurves; c++) {
+    const oc_fcurve *fc = curves[c];
+    cv[c].fc = fc;
+    cv[c].reach =
+        attr_max(&fc->attr[FA_RADIUS]) +
+        fmax(attr_max(&fc->attr[FA_EXTA]), attr_max(&fc->attr[FA_EXTB])) +
+        lv->cell;
+    rc = curve_items(fc, (uint32_t)c, lv->cell, cv[c].reach, &it, &nit, &cap,
+                     err);
+    if (rc) goto done;
+  }
+  for (int m = 0; m < MAP_COUNT; m++)
+    memset(lv->map[m], 0, ns * sizeof(float));
+  rctx x = {lv,
+            x0,
+            y0,
+            cv,
+            it,
+            nit,
+            lv->map[MAP_H],
+            lv->map[MAP_GX],
+            lv->map[MAP_GY],
+            lv->map[MAP_GD],
+            lv->map[MAP_A],
+            lv->map[MAP_R],
+            cnt,
+            cnt + ns,
+            cnt + 2 * ns,
+            cnt + 3 * ns};
+  int nb = (lv->ny + BLOCK - 1) / BLOCK, stop = 0, done = 0;
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int b = 0; b < nb; b++) {
+    int halt;
+#pragma omp atomic read
+    halt = stop;
+    if (halt) continue;
+    int j0 = b * BLOCK, j1 = j0 + BLOCK < lv->ny ? j0 + BLOCK : lv->ny;
+    double ylo = y0 + j0 * lv->cell, yhi = y0 + (j1 - 1) * lv->cell;
+    for (size_t t = 0; t < nit; t++) {
+      if (it[t].yhi < ylo || it[t].ylo > yhi) continue;
+      for (int j = j0; j < j1; j++)
+        paint_row(&x, &it[t], j);
+    }
+    int d;
+#pragma omp atomic capture
+    d = ++done;
+    /* only the calling thread talks to the callback */
+    if (pr.fn && omp_get_thread_num() == 0 && pr.fn(pr.ud, span * d / nb)) {
+#pragma omp atomic write
+      stop = 1;
+    }
+  }
+  if (stop) {
+    rc = oc_seterr(err, OC_ECANCEL, "diffusion cancelled");
+    goto done;
+  }
+  size_t ss = 0, sl = 0, sc = 0, sn = 0;
+#pragma omp parallel for schedule(static) reduction(+ : ss, sl, sc, sn)
+  for (size_t k = 0; k < ns; k++) {
+    normalise(&x, k, lv->flags);
+    ss += (lv->flags[k] & DF_H) != 0;
+    sl += (lv->flags[k] & DF_SLOPE) != 0;
+    sc += (lv->flags[k] & DF_CONFLICT) != 0;
+    sn += (lv->flags[k] & DF_NOISE) != 0;
+  }
+  st->strict = ss, st->slope = sl, st->conflict = sc, st->strict_noise = sn;
+done:
+  free(it);
+  free(cnt);
+  free(cv);
+  return rc;
+}
