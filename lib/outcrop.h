@@ -636,6 +636,11 @@ typedef struct oc_poisson_params {
   double (*density)(void *ud, double x, double y);
   void *density_ud;
   oc_progress progress;
+  /* 1: sample the torus made of the box by identifying opposite faces
+  ** (distances are periodic; the box must be a square in 2D, a cube in 3D,
+  ** with its side larger than 2 radius). Samples lie in [lo, hi) on each
+  ** axis; the set is maximal on the torus, so copies of it tile space. */
+  int periodic;
 } oc_poisson_params;
 
 /* Maximal Poisson disk (2D) or sphere (3D) sampling of the closed box: no
