@@ -12,6 +12,7 @@
 */
 #include <string.h>
 
+#include "l_blocks.h"
 #include "l_config.h"
 #include "l_elevation.h"
 #include "l_field.h"
@@ -55,10 +56,11 @@ int luaopen_outcrop(lua_State *L) {
   oclua_open_mesh(L);
   oclua_open_heightfield(L); /* outcrop.heightfield */
   oclua_open_render(L);
-  oclua_open_terrain(L); /* outcrop.terrain */
-  oclua_open_gen(L);     /* outcrop.poisson2d/3d */
-  oclua_open_geology(L); /* outcrop.geology, outcrop.erosion */
+  oclua_open_terrain(L);   /* outcrop.terrain */
+  oclua_open_gen(L);       /* outcrop.poisson2d/3d */
+  oclua_open_geology(L);   /* outcrop.geology, outcrop.erosion */
   oclua_open_elevation(L); /* outcrop.elevation */
+  oclua_open_blocks(L);    /* outcrop.blocks */
   lua_pushliteral(L, OC_VERSION);
   lua_setfield(L, -2, "version");
   lua_pushnumber(L, OC_DEFAULT_THRESHOLD);
