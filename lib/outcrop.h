@@ -736,6 +736,35 @@ oc_node *oc_btile_node(const oc_btile *t, oc_error *err);
 const double *oc_btile_planes(const oc_btile *t, size_t i, size_t *nplane);
 const double *oc_btile_vertices(const oc_btile *t, size_t i, size_t *nvert);
 
+/* Replication (Paris et al. 2020, section 5): a tile's blocks placed over
+** a terrain where they are present. */
+typedef struct oc_replicate_tile {
+  const oc_btile *tile; /* borrowed: the node copies what it needs */
+  double lo, hi;        /* resistance range where the tile applies (with a
+                        ** geology; ignored without) */
+} oc_replicate_tile;
+
+typedef struct oc_replicate_params {
+  const oc_replicate_tile *tiles; /* 1 .. 7 */
+  size_t ntiles;
+  oc_node *geology; /* resistance node, or NULL */
+  double slope;     /* present only where |g . z| < slope (default 1) */
+  double va, vb;    /* distance estimate (f - T) / |grad f| (> 0 inside)
+                    ** in [va, vb] (default -1 .. 1) */
+  int anchors;      /* centroid + hull vertices voting (default 9) */
+  double threshold; /* T of the criteria; 0: OC_DEFAULT_THRESHOLD */
+} oc_replicate_params;
+
+void oc_replicate_defaults(oc_replicate_params *rp);
+/* f~ = max(f, t), t the present blocks (decided here, by a majority of
+** each block's anchors). The terrain's bounds must be finite. A new node
+** retaining terrain, or NULL with err (OC_EINVAL naming the parameter). */
+oc_node *oc_blocks_replicate(oc_node *terrain, const oc_replicate_params *rp,
+                             oc_error *err);
+/* 1 and the count of instances (Table 2's #R) when n is a replication
+** node, else 0. */
+int oc_blocks_instances(const oc_node *n, size_t *count);
+
 /* ---- heightfields ----------------------------------------------------- */
 
 /* A grid of float elevations: sample (i, j), 0 <= i < nx, 0 <= j < ny,

@@ -29,12 +29,13 @@
 #include "core/error.h"
 #include "field/kind.h"
 
-typedef struct bdata {
+struct oc_bfield {
   size_t n;
   double R, W;
   oc_aabb box; /* of the hull */
   double pl[]; /* 4 per plane */
-} bdata;
+};
+typedef oc_bfield bdata;
 
 enum { P_T, P_W, P_K, P_DS, P_N };
 
@@ -67,7 +68,7 @@ static double sigma(const double *par, double v, double *ds) {
 
 /* ---- the distance -------------------------------------------------------- */
 
-static double dist(const bdata *b, oc_vec3 p, oc_vec3 *g) {
+double oc_bfield_dist(const oc_bfield *b, oc_vec3 p, oc_vec3 *g) {
   const double *h = b->pl;
   double R = b->R;
   double d = h[0] * p.x + h[1] * p.y + h[2] * p.z + h[3];
@@ -104,19 +105,12 @@ static int block_compile(oc_kcompile *c, oc_error *err) {
   c->info.lo = 0;
   c->info.hi = 2 * c->T;
   c->info.lip = c->par[P_DS];
-  double W = b->W;
-  c->info.box = (oc_aabb){{b->box.lo.x - W, b->box.lo.y - W, b->box.lo.z - W},
-                          {b->box.hi.x + W, b->box.hi.y + W, b->box.hi.z + W}};
+  c->info.box = oc_bfield_support(b);
   return OC_OK;
 }
 
 static double block_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
-  const bdata *b = k->data;
-  oc_vec3 gd;
-  double ds, d = dist(b, p, g ? &gd : NULL);
-  double f = sigma(k->par, -d, &ds);
-  if (g) *g = (oc_vec3){-ds * gd.x, -ds * gd.y, -ds * gd.z};
-  return f;
+  return oc_bfield_eval(k->data, k->par, p, g);
 }
 
 /* 0 all over the box when some plane is W or more away over all of it. */
@@ -148,17 +142,46 @@ static const oc_kind_def block_kind = {
     .release = block_release,
 };
 
-oc_node *oc_bblock_node(const oc_bblock *src, double R, double W,
-                        oc_error *err) {
+oc_bfield *oc_bfield_new(const oc_bblock *src, double R, double W) {
   bdata *b = malloc(sizeof *b + 4 * src->nplane * sizeof(double));
-  if (!b) {
-    oc_seterr(err, OC_ENOMEM, "out of memory for a block");
-    return NULL;
-  }
+  if (!b) return NULL;
   b->n = src->nplane;
   b->R = fmin(R, 0.5 * src->thickness);
   b->W = W;
   b->box = src->box;
   memcpy(b->pl, src->plane, 4 * src->nplane * sizeof(double));
+  return b;
+}
+
+oc_aabb oc_bfield_support(const oc_bfield *b) {
+  double W = b->W;
+  return (oc_aabb){{b->box.lo.x - W, b->box.lo.y - W, b->box.lo.z - W},
+                   {b->box.hi.x + W, b->box.hi.y + W, b->box.hi.z + W}};
+}
+
+double oc_bfield_width(const oc_bfield *b) {
+  return b->W;
+}
+
+double oc_bfield_eval(const oc_bfield *b, const double *sp, oc_vec3 p,
+                      oc_vec3 *g) {
+  oc_vec3 gd;
+  double ds, d = oc_bfield_dist(b, p, g ? &gd : NULL);
+  double f = sigma(sp, -d, &ds);
+  if (g) *g = (oc_vec3){-ds * gd.x, -ds * gd.y, -ds * gd.z};
+  return f;
+}
+
+void oc_bfield_sigma(double T, double W, double sp[OC_BSIGMA_N]) {
+  sigma_par(T, W, sp);
+}
+
+oc_node *oc_bblock_node(const oc_bblock *src, double R, double W,
+                        oc_error *err) {
+  bdata *b = oc_bfield_new(src, R, W);
+  if (!b) {
+    oc_seterr(err, OC_ENOMEM, "out of memory for a block");
+    return NULL;
+  }
   return oc_kind_node(&block_kind, NULL, 0, NULL, 0, b, err);
 }

@@ -96,6 +96,21 @@ void oc_bblock_free(oc_bblock *b);
 /* Cuts overlapping blocks apart with a plane each (separate.c). */
 int oc_bblocks_separate(oc_btile *t, oc_error *err);
 
+/* A block's field (block.c): its planes, rounding min(R, thickness / 2)
+** and width W, malloc'ed (free with free). */
+typedef struct oc_bfield oc_bfield;
+oc_bfield *oc_bfield_new(const oc_bblock *b, double R, double W);
+/* The hull's box grown by W (f = 0 outside), and W. */
+oc_aabb oc_bfield_support(const oc_bfield *b);
+double oc_bfield_width(const oc_bfield *b);
+/* The rounded distance d (<= 0 inside) and its gradient. */
+double oc_bfield_dist(const oc_bfield *b, oc_vec3 p, oc_vec3 *g);
+/* sigma's constants for threshold T and width W, then f = sigma(-d). */
+#define OC_BSIGMA_N 4
+void oc_bfield_sigma(double T, double W, double sp[OC_BSIGMA_N]);
+double oc_bfield_eval(const oc_bfield *b, const double *sp, oc_vec3 p,
+                      oc_vec3 *g);
+
 /* The block node of hull planes (block.c): rounding R, width W. */
 oc_node *oc_bblock_node(const oc_bblock *b, double R, double W, oc_error *err);
 

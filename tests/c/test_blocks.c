@@ -322,6 +322,126 @@ START_TEST(user_disc) {
 }
 END_TEST
 
+/* ---- replication -----------------------------------------------------------
+ */
+
+/* A 40 x 40 x 20 m box terrain: a flat top, vertical walls. */
+static oc_node *box_terrain(void) {
+  oc_error e = {0};
+  return OCT_OK(oc_box(oct_v(0, 0, 0), oct_v(40, 40, 20), 1, 1, &e));
+}
+
+static oc_btile *small_tile(uint64_t seed) {
+  oc_btile_params pp;
+  oc_btile_defaults(OC_BLOCKS_EQUIDIMENSIONAL, &pp);
+  pp.size = 8;
+  pp.radius = 0.5;
+  pp.disc_lo = 2;
+  pp.disc_hi = 3;
+  pp.spacing = 1;
+  pp.seed = seed;
+  return tile_ok(&pp);
+}
+
+/* Largest f~ - f over a grid of the square [u0, u1] x [v0, v1] of the
+** plane `axis` = w. */
+static double gain(const oc_program *rep, const oc_program *ter, int axis,
+                   double w, double u0, double u1, double v0, double v1) {
+  double m = 0;
+  for (int i = 0; i <= 60; i++)
+    for (int j = 0; j <= 60; j++) {
+      double u = u0 + (u1 - u0) * i / 60, v = v0 + (v1 - v0) * j / 60;
+      oc_vec3 p = axis == 2 ? oct_v(u, v, w) : oct_v(w, u, v);
+      m = fmax(m, oc_program_eval(rep, p) - oc_program_eval(ter, p));
+    }
+  return m;
+}
+
+START_TEST(replicate_presence) {
+  oc_btile *t = small_tile(4);
+  oc_replicate_tile rt = {t, 0, 0};
+  oc_replicate_params rp;
+  oc_replicate_defaults(&rp);
+  rp.tiles = &rt;
+  rp.ntiles = 1;
+  rp.slope = 0.5;
+  oc_error e = {0};
+  oc_node *ter = box_terrain();
+  oc_node *rep = OCT_OK(oc_blocks_replicate(ter, &rp, &e));
+  size_t ni = 0;
+  ck_assert(oc_blocks_instances(rep, &ni));
+  size_t none = 7;
+  ck_assert(!oc_blocks_instances(ter, &none));
+  ck_assert_uint_eq(none, 7);
+  printf("replicate: %zu instances on the walls of a 40 x 40 x 20 box\n", ni);
+  ck_assert_uint_gt(ni, 20);
+  oc_program *pt = oct_compile(ter, 0.5, 0);
+  oc_program *pr = oct_compile(rep, 0.5, 0);
+  /* flat top: no block above it, away from the edges (the walls' blocks
+  ** reach up to a block's size past the rim) */
+  ck_assert_double_eq(gain(pr, pt, 2, 20.4, 10, 30, 10, 30), 0);
+  ck_assert_double_eq(gain(pr, pt, 2, 21.5, 10, 30, 10, 30), 0);
+  /* the wall x = 0: blocks stand out of it */
+  ck_assert_double_gt(gain(pr, pt, 0, -1.0, 5, 35, 2, 18), 0.1);
+  /* never less than the terrain; gradient and Lipschitz bound */
+  oct_rng r = oct_rng_new(3);
+  for (int k = 0; k < 300; k++) {
+    oc_vec3 p = oct_in_box(&r, oct_v(-3, -3, -3), oct_v(43, 43, 23));
+    ck_assert_double_ge(oc_program_eval(pr, p), oc_program_eval(pt, p));
+    oct_check_grad(pr, p, 1e-6, 1e-5);
+  }
+  ck_assert_double_le(
+      oct_check_lipschitz(pr, oct_v(-3, -3, -3), oct_v(43, 43, 23), 2000, &r),
+      1);
+  /* the same instances for the same tile */
+  oc_node *again = OCT_OK(oc_blocks_replicate(ter, &rp, &e));
+  size_t n2 = 0;
+  oc_blocks_instances(again, &n2);
+  ck_assert_uint_eq(n2, ni);
+  oc_node_release(again);
+  oc_program_free(pt);
+  oc_program_free(pr);
+  oc_btile_free(t);
+}
+END_TEST
+
+START_TEST(replicate_by_geology) {
+  oc_btile *t = small_tile(5);
+  oc_error e = {0};
+  /* resistance 1 below z = 10, 0 above */
+  oc_node *geo =
+      OCT_OK(oc_box(oct_v(-100, -100, -100), oct_v(100, 100, 10), 0.01, 1, &e));
+  oc_replicate_tile rt = {t, 0.5, 2};
+  oc_replicate_params rp;
+  oc_replicate_defaults(&rp);
+  rp.tiles = &rt;
+  rp.ntiles = 1;
+  rp.slope = 0.5;
+  rp.geology = geo;
+  oc_node *ter = box_terrain();
+  oc_node *rep = OCT_OK(oc_blocks_replicate(ter, &rp, &e));
+  /* errors name the field */
+  oc_replicate_tile bad = {NULL, 0, 1};
+  oc_replicate_params rb = rp;
+  rb.tiles = &bad;
+  ck_assert_ptr_null(oc_blocks_replicate(ter, &rb, &e));
+  ck_assert_msg(strstr(e.msg, "'tiles[1]'") != NULL, "%s", e.msg);
+  rb = rp;
+  rb.va = 2, rb.vb = 1;
+  ck_assert_ptr_null(oc_blocks_replicate(ter, &rb, &e));
+  ck_assert_msg(strstr(e.msg, "'distance'") != NULL, "%s", e.msg);
+  oc_program *pt = oct_compile(ter, 0.5, 0);
+  oc_program *pr = oct_compile(rep, 0.5, 0);
+  /* blocks in the hard bed below 10 m, none high in the soft one */
+  ck_assert_double_gt(gain(pr, pt, 0, -1.0, 5, 35, 1, 8), 0.1);
+  ck_assert_double_eq(gain(pr, pt, 0, -1.0, 5, 35, 16, 19), 0);
+  oc_program_free(pt);
+  oc_program_free(pr);
+  oc_node_release(geo);
+  oc_btile_free(t);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("blocks");
   TCase *tc = tcase_create("blocks");
@@ -333,6 +453,8 @@ int main(void) {
   tcase_add_test(tc, meshed_blocks_closed_and_convex);
   tcase_add_test(tc, errors);
   tcase_add_test(tc, user_disc);
+  tcase_add_test(tc, replicate_presence);
+  tcase_add_test(tc, replicate_by_geology);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }
