@@ -10,7 +10,14 @@
 ** "tabular"), size 20, radius 0.75, neighbour 2, fractures Table 1's
 ** (15, 24, 44, 30), spacing 2 (1 polyhedral), disc_radius {4, 6},
 ** rounding 0.25, width 0.75, seed = the scene seed, discs none.
+**
+** outcrop.blocks.replicate(terrain, {tiles = {{tile =, resistance = {lo,
+**   hi}}, ...}, geology =, slope = 1, distance = {-1, 1}, anchors = 9})
+** builds the replication node (presence decided now, with the current
+** outcrop.threshold); resistance defaults to everything. node:stats()
+** then has `instances`.
 */
+#include <math.h>
 #include <string.h>
 
 #include "l_blocks.h"
@@ -197,7 +204,75 @@ static const luaL_Reg tile_meta[] = {{"__gc", tile_gc},
                                      {"__tostring", tile_tostring},
                                      {NULL, NULL}};
 
-static const luaL_Reg blocks_funcs[] = {{"tile", l_tile}, {NULL, NULL}};
+/* outcrop.blocks.replicate(terrain, {tiles = {{tile =, resistance = {lo,
+** hi}}, ...}, geology =, slope =, distance = {va, vb}, anchors =}) */
+static int l_replicate(lua_State *L) {
+  static const char *const known[] = {"tiles",    "geology", "slope",
+                                      "distance", "anchors", NULL};
+  static const char *const none[] = {NULL};
+  static const char *const tknown[] = {"tile", "resistance", NULL};
+  const char *fname = "outcrop.blocks.replicate";
+  oc_error err = {OC_OK, ""};
+  oclua_fields f, a;
+  oc_replicate_params rp;
+  oclua_checkargs(L, 2, fname, "(terrain, {tiles = ...})");
+  oc_node *ter = oclua_checknode(L, 1, fname, "argument #1");
+  oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
+  oc_replicate_defaults(&rp);
+  rp.slope = oclua_field_optnumber(&f, "slope", OCLUA_POSITIVE, rp.slope);
+  double d[2];
+  if (oclua_field_numbers(&f, "distance", 2, d, "must be {va, vb}")) {
+    rp.va = d[0];
+    rp.vb = d[1];
+  }
+  rp.anchors = (int)oclua_field_optint(&f, "anchors", 1, 64, rp.anchors);
+  if (oclua_field_push(&f, "geology") != LUA_TNIL)
+    rp.geology = oclua_checknode(L, -1, fname, "'geology'");
+  /* the geology stays on the stack (reachable) */
+  if (oclua_field_push(&f, "tiles") == LUA_TNIL)
+    oclua_field_missing(&f, "tiles", "an array of {tile =, resistance =}");
+  oclua_fields_open(&a, L, -1, fname, "tiles.", none, 1);
+  if (a.narray < 1 || a.narray > 7)
+    oclua_error(L, fname, "'tiles' must hold 1 .. 7 tiles (got %d)",
+                (int)a.narray);
+  oc_replicate_tile *rt =
+      lua_newuserdatauv(L, (size_t)a.narray * sizeof *rt, 0);
+  for (lua_Integer i = 1; i <= a.narray; i++) {
+    oclua_fields e;
+    lua_geti(L, a.t, i);
+    const char *pre = lua_pushfstring(L, "tiles[%d].", (int)i);
+    oclua_fields_open(&e, L, -2, fname, pre, tknown, 0);
+    if (oclua_field_push(&e, "tile") == LUA_TNIL)
+      oclua_field_missing(&e, "tile", "a tile of outcrop.blocks.tile");
+    if (!luaL_testudata(L, -1, OCLUA_BTILE))
+      oclua_field_error(&e, "tile", -1, "must be a block tile");
+    lua_pop(L, 1);
+    double r[2] = {-HUGE_VAL, HUGE_VAL};
+    oclua_field_numbers(&e, "resistance", 2, r, "must be {lo, hi}");
+    rt[i - 1].lo = r[0];
+    rt[i - 1].hi = r[1];
+    lua_pop(L, 2); /* the tiles stay reachable from the options */
+  }
+  rp.tiles = rt;
+  rp.ntiles = (size_t)a.narray;
+  rp.threshold = oclua_threshold(L, fname);
+  oclua_node *u = oclua_newnode(L);
+  /* the tiles last, by raw reads: no Lua code runs from here on */
+  for (lua_Integer i = 1; i <= a.narray; i++) {
+    lua_rawgeti(L, a.t, i);
+    lua_pushliteral(L, "tile");
+    lua_rawget(L, -2);
+    oclua_btile *b = luaL_testudata(L, -1, OCLUA_BTILE);
+    if (!b) oclua_error(L, fname, "'tiles[%d].tile' changed", (int)i);
+    oclua_handle_check(L, &b->h, fname);
+    rt[i - 1].tile = b->t;
+    lua_pop(L, 2);
+  }
+  return oclua_setnode(L, u, oc_blocks_replicate(ter, &rp, &err), &err, fname);
+}
+
+static const luaL_Reg blocks_funcs[] = {
+    {"tile", l_tile}, {"replicate", l_replicate}, {NULL, NULL}};
 
 void oclua_open_blocks(lua_State *L) {
   oclua_newmeta(L, OCLUA_BTILE, tile_meta, tile_methods);

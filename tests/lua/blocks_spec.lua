@@ -111,3 +111,37 @@ describe("outcrop.blocks.tile errors", function()
     check(function() B.tile{size = 8, radius = 0.5, fractures = 5000} end, "outcrop.blocks.tile", "could place only")
   end)
 end)
+
+describe("outcrop.blocks.replicate", function()
+  -- a 40 x 40 x 20 m box: vertical walls, a flat top
+  local ter = oc.box{min = {0, 0, 0}, max = {40, 40, 20}, falloff = 1}
+  local t = small{seed = 4}
+
+  it("puts blocks on steep walls only and counts the instances", function()
+    local r = B.replicate(ter, {tiles = {{tile = t}}, slope = 0.5})
+    assert.are.equal("replicate", r:kind())
+    local n = r:stats().instances
+    assert.is_true(n > 20, n)
+    assert.is_nil(ter:stats().instances)
+    local top, wall = 0, 0
+    for i = 0, 40 do
+      for j = 0, 40 do
+        local u, v = 10 + i / 2, 10 + j / 2
+        top = math.max(top, r:eval{u, v, 20.4} - ter:eval{u, v, 20.4})
+        local y, z = 5 + i * 0.75, 2 + j * 0.4
+        wall = math.max(wall, r:eval{-1, y, z} - ter:eval{-1, y, z})
+      end
+    end
+    assert.are.equal(0, top)
+    assert.is_true(wall > 0.1, wall)
+    -- the same tile gives the same instances
+    assert.are.equal(n, B.replicate(ter, {tiles = {{tile = t}}, slope = 0.5}):stats().instances)
+  end)
+
+  it("names the field in errors", function()
+    check(function() B.replicate(ter, {}) end, "outcrop.blocks.replicate", "'tiles'")
+    check(function() B.replicate(ter, {tiles = {{tile = 3}}}) end, "outcrop.blocks.replicate", "'tiles[1].tile' must be a block tile")
+    check(function() B.replicate(ter, {tiles = {{tile = t}}, distance = {2, 1}}) end, "outcrop.blocks.replicate", "'distance' must be {va, vb} with va <= vb")
+    check(function() B.replicate(ter, {tiles = {{tile = t}}, slope = 0}) end, "outcrop.blocks.replicate", "'slope'")
+  end)
+end)
