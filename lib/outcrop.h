@@ -692,8 +692,9 @@ typedef struct oc_btile_params {
   double neighbour; /* k: edges join points closer than k r, default 2 */
   size_t fractures; /* #D discs thrown (Table 1's defaults), >= 1 */
   double spacing;   /* minimum distance of disc centres (2; 1 polyhedral) */
-  double disc_lo, disc_hi; /* disc radii (equidimensional, rhombohedral,
-                           ** polyhedral), default 4 .. 6 */
+  double disc_lo, disc_hi; /* disc radii (equidimensional 7 .. 11,
+                           ** rhombohedral 4 .. 6, polyhedral 2.5 .. 3.5;
+                           ** tabular: s and s / 10) */
   double rounding;         /* R of the smooth intersection, default 0.25 */
   double width;            /* W: blocks' fields fall to 0 W outside, 0.75
                            ** (>= 1.5 T keeps the Lipschitz bound 1) */
@@ -718,6 +719,7 @@ void oc_btile_free(oc_btile *t);
 typedef struct oc_btile_stats {
   size_t points, fractures, blocks, edges, cut, thick;
   size_t separated;        /* pairs of overlapping hulls cut apart */
+  size_t merged;           /* clusters of < 8 points merged into another */
   double points_per_block; /* mean points of a block */
   double seconds;          /* wall time of oc_btile_new */
 } oc_btile_stats;

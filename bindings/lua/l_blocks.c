@@ -8,7 +8,8 @@
 **   discs = {{center =, normal =, radius =}, ...}}
 ** Defaults: type "equidimensional" (or "rhombohedral", "polyhedral",
 ** "tabular"), size 20, radius 0.75, neighbour 2, fractures Table 1's
-** (15, 24, 44, 30), spacing 2 (1 polyhedral), disc_radius {4, 6},
+** (15, 24, 44, 30), spacing 2 (1 polyhedral), disc_radius {7, 11}
+** equidimensional, {4, 6} rhombohedral, {2.5, 3.5} polyhedral,
 ** rounding 0.25, width 0.75, seed = the scene seed, discs none.
 **
 ** outcrop.blocks.replicate(terrain, {tiles = {{tile =, resistance = {lo,

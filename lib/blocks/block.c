@@ -17,9 +17,11 @@
 ** Field: f = sigma(-d), sigma the cubic of the terrain primitive (Paris
 ** et al. 2019, section 5.1): sigma(0) = T, sigma(v) = 2T for v >= W, 0 for
 ** v <= -W, slope 1 at 0 (W <= 3T). So f = T on the rounded hull, f > T
-** inside, and f = 0 at distance W outside: as d >= max_k h_k, f = 0 outside
-** the hull's box grown by W (the support). Lipschitz bound: sigma's
-** largest slope.
+** inside, and f = 0 where d >= W. d is then raised to the largest signed
+** distance to the faces of the hull's box (a plain max, which changes
+** nothing inside the rounded hull): f = 0 outside the box grown by W (the
+** support), also near sharp corners, where the planes' distances fall
+** short of the true distance. Lipschitz bound: sigma's largest slope.
 */
 #include <math.h>
 #include <stdlib.h>
@@ -90,6 +92,21 @@ double oc_bfield_dist(const oc_bfield *b, oc_vec3 p, oc_vec3 *g) {
     gd = (oc_vec3){wd * gd.x + we * h[0], wd * gd.y + we * h[1],
                    wd * gd.z + we * h[2]};
   }
+  /* the box's faces, by a plain max: inside the rounded hull none of them
+  ** is above d (a ray along an axis leaves the hull through a face before
+  ** it leaves the box), so the block is unchanged; outside, they make
+  ** d >= W beyond the box grown by W (the support), which the hull's
+  ** planes alone do not near sharp corners */
+  const oc_aabb *x = &b->box;
+  double e[6] = {p.x - x->hi.x, x->lo.x - p.x, p.y - x->hi.y,
+                 x->lo.y - p.y, p.z - x->hi.z, x->lo.z - p.z};
+  for (int a = 0; a < 6; a++)
+    if (e[a] > d) {
+      d = e[a];
+      double s = a & 1 ? -1 : 1;
+      gd =
+          (oc_vec3){a / 2 == 0 ? s : 0, a / 2 == 1 ? s : 0, a / 2 == 2 ? s : 0};
+    }
   if (g) *g = gd;
   return d;
 }

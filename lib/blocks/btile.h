@@ -66,8 +66,9 @@ struct oc_btile {
   double *unwrap;  /* each point's unwrapped position (3 per point) */
   size_t nb;       /* blocks (clusters with a hull) */
   oc_bblock *block;
-  size_t thick; /* degenerate clusters made thick polygons or points */
-  size_t ncut;  /* pairs of blocks cut apart (separate.c) */
+  size_t thick;  /* degenerate clusters made thick polygons or points */
+  size_t ncut;   /* pairs of blocks cut apart (separate.c) */
+  size_t merged; /* small clusters merged into a neighbour (merge.c) */
   double seconds;
 };
 
@@ -88,6 +89,10 @@ void oc_bgraph_free(oc_bgraph *g);
 /* Greedy clusters with the mutual-visibility check, unwrapped (cluster.c):
 ** fills t->ncl, t->label, t->unwrap. */
 int oc_bclusters_make(oc_btile *t, oc_error *err);
+
+/* Merges the smallest clusters into neighbours and moves each centroid
+** into the tile (merge.c); renumbers t->label, updates t->ncl. */
+int oc_bclusters_merge(oc_btile *t, oc_error *err);
 
 /* Convex hulls of the clusters (hull.c): fills t->block, t->nb. */
 int oc_bhulls_make(oc_btile *t, oc_error *err);

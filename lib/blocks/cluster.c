@@ -11,8 +11,8 @@
 ** periodic images; larger clusters, such as an uncut bed of a tabular
 ** tile, are split). A point refused by a cluster waits for the next one.
 ** Each joining point gets the image of itself nearest the member it came
-** from; the finished cluster is shifted so that its centroid lies in the
-** tile.
+** from (merge.c then merges the smallest clusters and moves each
+** centroid into the tile).
 */
 #include <math.h>
 #include <stdlib.h>
@@ -100,17 +100,6 @@ static void flood(grow *w, uint32_t i, uint32_t c, uint32_t *tried) {
       else
         tried[v] = c;
     }
-  }
-  /* centroid into the tile */
-  double m[3] = {0, 0, 0};
-  for (size_t k = 0; k < w->nm; k++)
-    for (int a = 0; a < 3; a++)
-      m[a] += t->unwrap[3 * (size_t)w->mem[k] + a];
-  for (int a = 0; a < 3; a++) {
-    double sh = -s * floor(m[a] / (double)w->nm / s);
-    if (sh != 0)
-      for (size_t k = 0; k < w->nm; k++)
-        t->unwrap[3 * (size_t)w->mem[k] + a] += sh;
   }
 }
 

@@ -6,7 +6,8 @@
 **
 ** Types (the paper's, with its constants):
 **  - equidimensional: normal along a random axis (x, y or z), radius
-**    uniform in [disc_lo, disc_hi] (about 5 m);
+**    uniform in [disc_lo, disc_hi] (7 .. 11 m by default: the paper's
+**    "about 5 m" gives blocks twice as large as its Table 1's);
 **  - rhombohedral: the same over three mutually oblique axes: x, x turned
 **    60 degrees about z, and z tilted 30 degrees towards (1, 1, 0);
 **  - polyhedral: uniform random normals, centres 1 m apart, more discs;

@@ -41,8 +41,13 @@ void oc_btile_defaults(oc_block_type type, oc_btile_params *pp) {
   pp->neighbour = 2;
   pp->fractures = (unsigned)type < OC_BLOCKS_NTYPES ? table_discs[type] : 0;
   pp->spacing = type == OC_BLOCKS_POLYHEDRAL ? 1 : 2;
-  pp->disc_lo = 4;
-  pp->disc_hi = 6;
+  /* disc radii, tuned to Table 1's #B and #Pi at the defaults (the
+  ** paper's "about 5 m" gives equidimensional blocks twice too large) */
+  static const double radii[OC_BLOCKS_NTYPES][2] = {
+      {7, 11}, {4, 6}, {2.5, 3.5}, {4, 6}};
+  int ty = (unsigned)type < OC_BLOCKS_NTYPES ? (int)type : 0;
+  pp->disc_lo = radii[ty][0];
+  pp->disc_hi = radii[ty][1];
   pp->rounding = 0.25;
   pp->width = 0.75;
   pp->seed = 1;
@@ -170,6 +175,7 @@ oc_btile *oc_btile_new(const oc_btile_params *pp, oc_error *err) {
   t->pp.discs = NULL; /* copied into t->disc: the caller's may go */
   if (!rc) rc = oc_bgraph_make(t, err);
   if (!rc) rc = oc_bclusters_make(t, err);
+  if (!rc) rc = oc_bclusters_merge(t, err);
   if (!rc) rc = oc_bhulls_make(t, err);
   if (!rc) rc = oc_bblocks_separate(t, err);
   if (rc) {
@@ -190,6 +196,7 @@ void oc_btile_stats_get(const oc_btile *t, oc_btile_stats *st) {
     st->cut += t->g.cut[e];
   st->thick = t->thick;
   st->separated = t->ncut;
+  st->merged = t->merged;
   size_t in = 0;
   for (size_t i = 0; i < t->nb; i++)
     in += t->block[i].npts;
