@@ -3,9 +3,10 @@
 ** seconds to build a 20 m tile of each type at the defaults (best of 3, on
 ** all threads), the tile's statistics against Table 1's, and the seconds
 ** to polygonize one equidimensional tile at 10 cm cells (200^3) on all
-** threads.
+** threads, and the mean cost of a field query on a wall amplified by
+** blocks.replicate (one thread).
 ** Prints `name: value unit` lines; '#' lines are context.
-** Parts (OUTCROP_BENCH_ONLY): tiles, mesh.
+** Parts (OUTCROP_BENCH_ONLY): tiles, mesh, query.
 */
 #include <math.h>
 #include <omp.h>
@@ -100,9 +101,62 @@ static int mesh(void) {
   return 0;
 }
 
+/* A 100 x 100 x 30 m box (falloff 8) with equidimensional blocks on its
+** walls: the mean time of oc_program_eval at points of the slab x in
+** [-4, 1] along the wall x = 0, one thread. */
+static int query(void) {
+  oc_btile_params pp;
+  oc_error err;
+  oc_btile_defaults(OC_BLOCKS_EQUIDIMENSIONAL, &pp);
+  pp.seed = 2026;
+  oc_btile *t = oc_btile_new(&pp, &err);
+  oc_node *box =
+      oc_box((oc_vec3){0, 0, 0}, (oc_vec3){100, 100, 30}, 8, 1, &err);
+  oc_replicate_tile rt = {t, 0, 0};
+  oc_replicate_params rp;
+  oc_replicate_defaults(&rp);
+  rp.tiles = &rt;
+  rp.ntiles = 1;
+  rp.slope = 0.5;
+  rp.va = -2;
+  rp.vb = 2;
+  oc_node *rep = t && box ? oc_blocks_replicate(box, &rp, &err) : NULL;
+  oc_program *pr = rep ? oc_compile(rep, NULL, &err) : NULL;
+  size_t ni = 0;
+  if (rep) oc_blocks_instances(rep, &ni);
+  oc_node_release(rep);
+  oc_node_release(box);
+  oc_btile_free(t);
+  if (!pr) {
+    fprintf(stderr, "bench_blocks: %s\n", err.msg);
+    return 1;
+  }
+  enum { N = 1000000 };
+  static oc_vec3 pts[N];
+  uint64_t z = 2026;
+  for (int i = 0; i < N; i++) {
+    double u[3];
+    for (int a = 0; a < 3; a++) {
+      z = z * 6364136223846793005ull + 1442695040888963407ull;
+      u[a] = (double)(z >> 11) * 0x1.0p-53;
+    }
+    pts[i] = (oc_vec3){-4 + 5 * u[0], 100 * u[1], 30 * u[2]};
+  }
+  double sum = 0, t0 = cpu();
+  for (int i = 0; i < N; i++)
+    sum += oc_program_eval(pr, pts[i]);
+  double c = cpu() - t0;
+  printf("# query: %zu instances on the walls, mean f %.4f over %d points\n",
+         ni, sum / N, N);
+  printf("blocks.query_ns: %.0f ns\n", 1e9 * c / N);
+  oc_program_free(pr);
+  return 0;
+}
+
 int main(void) {
   int rc = 0;
   if (bench_wanted("tiles")) rc |= tiles();
   if (bench_wanted("mesh")) rc |= mesh();
+  if (bench_wanted("query")) rc |= query();
   return rc;
 }
