@@ -19,7 +19,7 @@
 
 SHELL := /bin/bash
 PKGS := gcc g++ make pkg-config lua5.4 liblua5.4-dev libopenimageio-dev \
-        openimageio-tools libopenexr-dev openexr lua-busted check
+        openimageio-tools libopenexr-dev openexr lua-busted check libqhull-dev
 # clang with libFuzzer and its OpenMP, for the fuzz build (fuzz-smoke runs
 # in make test, so make deps installs them too)
 FUZZ_PKGS := clang-14 libclang-rt-14-dev libomp-14-dev
@@ -62,7 +62,7 @@ COMMON := $(OPT) -fPIC -fopenmp -ffp-contract=off -Wall -Wextra
 INC = -Ilib
 CFLAGS = -std=c17 -D_POSIX_C_SOURCE=200809L $(COMMON) $(INC)
 CXXFLAGS = -std=c++17 $(COMMON) $(INC)
-LDLIBS := -lm -fopenmp -ldl -lpthread
+LDLIBS := -lqhull_r -lm -fopenmp -ldl -lpthread
 
 LIB_SRC := $(shell find lib -name '*.c' | sort)
 # The OpenImageIO bridge (the only C++) is a shared object of its own,

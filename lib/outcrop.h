@@ -636,6 +636,11 @@ typedef struct oc_poisson_params {
   double (*density)(void *ud, double x, double y);
   void *density_ud;
   oc_progress progress;
+  /* 1: sample the torus made of the box by identifying opposite faces
+  ** (distances are periodic; the box must be a square in 2D, a cube in 3D,
+  ** with its side larger than 2 radius). Samples lie in [lo, hi) on each
+  ** axis; the set is maximal on the torus, so copies of it tile space. */
+  int periodic;
 } oc_poisson_params;
 
 /* Maximal Poisson disk (2D) or sphere (3D) sampling of the closed box: no
@@ -656,6 +661,111 @@ void oc_samples_free(oc_samples *s);
 size_t oc_samples_count(const oc_samples *s);
 int oc_samples_dim(const oc_samples *s);
 const double *oc_samples_data(const oc_samples *s);
+
+/* ---- rock blocks (blocks/, Paris et al. 2020) ------------------------- */
+
+/* A fracture tile: a periodic cube of side s cut into convex blocks
+** (section 4.1). Made by oc_btile_new, freed with oc_btile_free; nodes made
+** from it hold their own copies of what they need. */
+typedef struct oc_btile oc_btile;
+
+/* The block types of Table 1: how fracture discs are distributed. */
+typedef enum oc_block_type {
+  OC_BLOCKS_EQUIDIMENSIONAL, /* three axis-aligned sets */
+  OC_BLOCKS_RHOMBOHEDRAL,    /* three mutually oblique sets */
+  OC_BLOCKS_POLYHEDRAL,      /* random normals, more discs */
+  OC_BLOCKS_TABULAR,         /* bedding discs of radius s, rare small cross
+                             ** discs of radius s / 10 */
+  OC_BLOCKS_NTYPES
+} oc_block_type;
+
+/* A user-placed fracture disc. */
+typedef struct oc_block_disc {
+  oc_vec3 center, normal; /* normal: any non-zero length */
+  double radius;
+} oc_block_disc;
+
+typedef struct oc_btile_params {
+  oc_block_type type;
+  double size;      /* s: side of the tile (m), default 20 */
+  double radius;    /* r: Poisson radius of the points, default 0.75 */
+  double neighbour; /* k: edges join points closer than k r, default 2 */
+  size_t fractures; /* #D discs thrown (Table 1's defaults), >= 1 */
+  double spacing;   /* minimum distance of disc centres (2; 1 polyhedral) */
+  double disc_lo, disc_hi; /* disc radii (equidimensional 7 .. 11,
+                           ** rhombohedral 4 .. 6, polyhedral 2.5 .. 3.5;
+                           ** tabular: s and s / 10) */
+  double rounding;         /* R of the smooth intersection, default 0.25 */
+  double width;            /* W: blocks' fields fall to 0 W outside, 0.75
+                           ** (>= 1.5 T keeps the Lipschitz bound 1) */
+  uint64_t seed;
+  const oc_block_disc *discs; /* user discs, added to the thrown ones */
+  size_t ndiscs;
+} oc_btile_params;
+
+/* The defaults of type `type` (Table 1) into *pp. */
+void oc_btile_defaults(oc_block_type type, oc_btile_params *pp);
+/* The name of a type ("equidimensional", ...), or NULL; and its number by
+** name (-1 when unknown). */
+const char *oc_block_type_name(oc_block_type type);
+int oc_block_type_find(const char *name);
+
+/* Builds a tile. NULL with err: OC_EINVAL naming the parameter ('radius'
+** too large for 'size', 'fractures' 0, a zero 'normal'...), OC_ENOMEM
+** (sizes checked before allocating). Deterministic by seed. */
+oc_btile *oc_btile_new(const oc_btile_params *pp, oc_error *err);
+void oc_btile_free(oc_btile *t);
+
+typedef struct oc_btile_stats {
+  size_t points, fractures, blocks, edges, cut, thick;
+  size_t separated;        /* pairs of overlapping hulls cut apart */
+  size_t merged;           /* clusters of < 8 points merged into another */
+  double points_per_block; /* mean points of a block */
+  double seconds;          /* wall time of oc_btile_new */
+} oc_btile_stats;
+void oc_btile_stats_get(const oc_btile *t, oc_btile_stats *st);
+
+/* Block i (0 <= i < blocks) as a node: the smooth intersection of its hull's
+** half-spaces (distance d <= 0 inside), made a field f = sigma(-d) with the
+** terrain's cubic sigma of width W, so f = T on the rounded hull and f = 0
+** beyond W outside it. OC_EINVAL for i out of range. */
+oc_node *oc_btile_block(const oc_btile *t, size_t i, oc_error *err);
+/* The union of all the tile's blocks (each at the place of its centroid's
+** cell: blocks straddling the tile's faces stick out of it). */
+oc_node *oc_btile_node(const oc_btile *t, oc_error *err);
+/* Block i's hull: its planes (n.x, n.y, n.z, offset: n . p + offset <= 0
+** inside) and vertices; counts in *nplane, *nvert. NULL for i out of range. */
+const double *oc_btile_planes(const oc_btile *t, size_t i, size_t *nplane);
+const double *oc_btile_vertices(const oc_btile *t, size_t i, size_t *nvert);
+
+/* Replication (Paris et al. 2020, section 5): a tile's blocks placed over
+** a terrain where they are present. */
+typedef struct oc_replicate_tile {
+  const oc_btile *tile; /* borrowed: the node copies what it needs */
+  double lo, hi;        /* resistance range where the tile applies (with a
+                        ** geology; ignored without) */
+} oc_replicate_tile;
+
+typedef struct oc_replicate_params {
+  const oc_replicate_tile *tiles; /* 1 .. 7 */
+  size_t ntiles;
+  oc_node *geology; /* resistance node, or NULL */
+  double slope;     /* present only where |g . z| < slope (default 1) */
+  double va, vb;    /* distance estimate (f - T) / |grad f| (> 0 inside)
+                    ** in [va, vb] (default -1 .. 1) */
+  int anchors;      /* centroid + hull vertices voting (default 9) */
+  double threshold; /* T of the criteria; 0: OC_DEFAULT_THRESHOLD */
+} oc_replicate_params;
+
+void oc_replicate_defaults(oc_replicate_params *rp);
+/* f~ = max(f, t), t the present blocks (decided here, by a majority of
+** each block's anchors). The terrain's bounds must be finite. A new node
+** retaining terrain, or NULL with err (OC_EINVAL naming the parameter). */
+oc_node *oc_blocks_replicate(oc_node *terrain, const oc_replicate_params *rp,
+                             oc_error *err);
+/* 1 and the count of instances (Table 2's #R) when n is a replication
+** node, else 0. */
+int oc_blocks_instances(const oc_node *n, size_t *count);
 
 /* ---- heightfields ----------------------------------------------------- */
 

@@ -188,6 +188,11 @@ static int node_stats(lua_State *L) {
   checkself(L, "node:stats");
   oc_program_get_stats(oclua_program(L, 1, "node:stats"), &st);
   oclua_pushstats(L, st.nodes, st.primitives, st.bytes);
+  size_t inst;
+  if (oc_blocks_instances(oclua_testnode(L, 1)->node, &inst)) {
+    lua_pushinteger(L, (lua_Integer)inst);
+    lua_setfield(L, -2, "instances"); /* Table 2's #R */
+  }
   return 1;
 }
 

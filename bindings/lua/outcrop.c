@@ -12,6 +12,7 @@
 */
 #include <string.h>
 
+#include "l_blocks.h"
 #include "l_config.h"
 #include "l_diffusion.h"
 #include "l_elevation.h"
@@ -61,6 +62,7 @@ int luaopen_outcrop(lua_State *L) {
   oclua_open_geology(L);   /* outcrop.geology, outcrop.erosion */
   oclua_open_elevation(L); /* outcrop.elevation */
   oclua_open_diffusion(L); /* outcrop.feature_curve, outcrop.diffusion */
+  oclua_open_blocks(L);    /* outcrop.blocks */
   lua_pushliteral(L, OC_VERSION);
   lua_setfield(L, -2, "version");
   lua_pushnumber(L, OC_DEFAULT_THRESHOLD);

@@ -54,6 +54,35 @@ static double count_bound(int d, const double *len, double r) {
   return d == 2 ? v / (PI / 4) : v / (PI / 6);
 }
 
+/* Periodic mode: a square or cube of side len split into n cells of side
+** h = len / n <= r / sqrt(d) exactly, n a multiple of two tiles (or at
+** most one tile), so parity classes stay apart across the wrap. */
+static int periodic_cells(oc_pgrid *g, int d, const double *len,
+                          oc_error *err) {
+  for (int a = 1; a < d; a++)
+    if (len[a] != len[0])
+      return oc_seterr(err, OC_EINVAL,
+                       "'box' must be a %s when periodic (sides %g %g %g)",
+                       d == 2 ? "square" : "cube", len[0], len[1], len[2]);
+  if (!(len[0] > 2 * g->r))
+    return oc_seterr(err, OC_EINVAL,
+                     "'radius' %g must be less than half the side %g of a "
+                     "periodic box",
+                     g->r, len[0]);
+  double n = ceil(len[0] / g->h);
+  for (;; n++) {
+    if (n > g->tile) n = ceil(n / (2 * g->tile)) * (2 * g->tile);
+    double h = len[0] / n;
+    if (h * h * d <= g->r2) {
+      g->h = h;
+      break;
+    }
+  }
+  g->periodic = 1;
+  g->len = len[0];
+  return 0;
+}
+
 static int setup(const oc_poisson_params *pp, int d, oc_pgrid *g,
                  oc_error *err) {
   const char *fname = d == 2 ? "poisson2d" : "poisson3d";
@@ -115,13 +144,15 @@ static int setup(const oc_poisson_params *pp, int d, oc_pgrid *g,
   g->seed = pp->seed;
   g->cover_max = d == 2 ? COVER_MAX_2D : COVER_MAX_3D;
   g->cover_depth = COVER_DEPTH;
+  if (pp->periodic && periodic_cells(g, d, len, err)) return OC_EINVAL;
   size_t n[3], bytes;
   for (int a = 0; a < 3; a++) {
     g->lo[a] = lo[a];
     g->hi[a] = hi[a];
     /* n <= 2 bound^(1/d) + 2 fits, but checked all the same */
-    if (!oc_double_to_int(a < d ? fmax(1, ceil(len[a] / g->h)) : 1, 1,
-                          INT_MAX - g->tile, &g->n[a]))
+    double na = g->periodic ? round(len[a] / g->h) : ceil(len[a] / g->h);
+    if (!oc_double_to_int(a < d ? fmax(1, na) : 1, 1, INT_MAX - g->tile,
+                          &g->n[a]))
       return oc_seterr(err, OC_ENOMEM, "'radius' %g is too small for the box",
                        r);
     g->nt[a] = (g->n[a] + g->tile - 1) / g->tile;

@@ -11,6 +11,12 @@
 ** can be worked on at the same time without touching each other's samples
 ** or the samples they read. Running the 2^d parity classes one after the
 ** other makes the result independent of the thread count.
+**
+** Periodic mode: the box is a torus of side len = n h exactly; cells
+** beyond a face wrap to the other side, with their samples shifted by
+** +-len (the samples near a cell are then its neighbours' periodic
+** images). The tiles per axis are even (or one), so tiles of a parity
+** class stay a tile apart across the wrap too.
 */
 #ifndef OC_SAMPLE_POISSON_H
 #define OC_SAMPLE_POISSON_H
@@ -42,6 +48,8 @@ typedef struct oc_pgrid {
   int tile;            /* cells per tile side */
   int nt[3];           /* tiles per axis */
   uint64_t seed;
+  int periodic;    /* the box is a torus (oc_poisson_params.periodic) */
+  double len;      /* its side when periodic */
   int cover_max;   /* samples the exact coverage test takes on */
   int cover_depth; /* splits it may make when there are more */
   /* reach[dz][dy][dx] (offset + 2) is 1 when a point of that neighbour

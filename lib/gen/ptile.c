@@ -61,10 +61,47 @@ static void cell_coords(const oc_pgrid *g, size_t c, int ijk[3]) {
       }                                                                        \
   } while (0)
 
+/* Periodic mode: calls body with `s` pointing at the periodic image (a
+** shifted copy in sp_) of each sample of the cells within reach of cell
+** (i, j, k), wrapping across the faces of the torus. */
+#define FOR_NEAR_PERIODIC(g, i, j, k, s, body)                                 \
+  do {                                                                         \
+    int zr_ = (g)->d == 3 ? 2 : 0;                                             \
+    for (int dz_ = -zr_; dz_ <= zr_; dz_++) {                                  \
+      int kk_ = (k) + dz_, wz_ = kk_ < 0 ? -1 : kk_ >= (g)->n[2];              \
+      kk_ -= wz_ * (g)->n[2];                                                  \
+      for (int dy_ = -2; dy_ <= 2; dy_++) {                                    \
+        int jj_ = (j) + dy_, wy_ = jj_ < 0 ? -1 : jj_ >= (g)->n[1];            \
+        jj_ -= wy_ * (g)->n[1];                                                \
+        for (int dx_ = -2; dx_ <= 2; dx_++) {                                  \
+          int ii_ = (i) + dx_, wx_ = ii_ < 0 ? -1 : ii_ >= (g)->n[0];          \
+          if (!(g)->reach[dz_ + 2][dy_ + 2][dx_ + 2]) continue;                \
+          ii_ -= wx_ * (g)->n[0];                                              \
+          const double *q_ =                                                   \
+              (g)->pos + (size_t)(g)->d * oc_pcell((g), ii_, jj_, kk_);        \
+          if (isnan(q_[0])) continue;                                          \
+          double sp_[3] = {q_[0] + wx_ * (g)->len, q_[1] + wy_ * (g)->len,     \
+                           (g)->d == 3 ? q_[2] + wz_ * (g)->len : 0};          \
+          const double *s = sp_;                                               \
+          body;                                                                \
+        }                                                                      \
+      }                                                                        \
+    }                                                                          \
+  } while (0)
+
 /* Is p, in cell (i, j, k), farther than r from every sample? */
 static int is_free(const oc_pgrid *g, const double *p, int i, int j, int k) {
   int d = g->d;
   double r2 = g->r2;
+  if (g->periodic) {
+    FOR_NEAR_PERIODIC(g, i, j, k, s, {
+      double d2 = 0;
+      for (int a = 0; a < d; a++)
+        d2 += (s[a] - p[a]) * (s[a] - p[a]);
+      if (d2 <= r2) return 0;
+    });
+    return 1;
+  }
   FOR_NEAR(g, i, j, k, s, {
     double d2 = 0;
     for (int a = 0; a < d; a++)
@@ -76,6 +113,14 @@ static int is_free(const oc_pgrid *g, const double *p, int i, int j, int k) {
 
 int oc_pgather(const oc_pgrid *g, int i, int j, int k, double *nb) {
   int n = 0, d = g->d;
+  if (g->periodic) {
+    FOR_NEAR_PERIODIC(g, i, j, k, s, {
+      for (int a = 0; a < d; a++)
+        nb[d * n + a] = s[a];
+      n++;
+    });
+    return n;
+  }
   FOR_NEAR(g, i, j, k, s, {
     for (int a = 0; a < d; a++)
       nb[d * n + a] = s[a];
@@ -104,6 +149,7 @@ static void dart(oc_pgrid *g, size_t c, const double *lo, double side, int clip,
     }
     p[a] = a0 + len * oc_rng_uniform(rng);
     if (p[a] < g->lo[a] || p[a] > g->hi[a]) return;
+    if (g->periodic && p[a] >= g->hi[a]) return; /* [lo, hi) on a torus */
   }
   if (!isnan(slot[0])) return;
   cell_coords(g, c, ijk);

@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/rng.h"
 #include "ocheck.h"
 #include "outcrop.h"
 
@@ -653,6 +654,76 @@ START_TEST(progress_and_cancel) {
 }
 END_TEST
 
+/* ---- periodic mode ------------------------------------------------------ */
+
+/* Periodic distance in a torus of side len (brute force: small sets). */
+static double pdist2(int d, const double *a, const double *b, double len) {
+  double s2 = 0;
+  for (int k = 0; k < d; k++) {
+    double t = fabs(a[k] - b[k]);
+    t = fmin(t, len - t);
+    s2 += t * t;
+  }
+  return s2;
+}
+
+START_TEST(periodic_torus) {
+  for (int d = 2; d <= 3; d++) {
+    double len = d == 2 ? 9 : 7.5, r = 0.9;
+    oc_poisson_params pp = params(-1, 2, 3, -1 + len, 2 + len, 3 + len, r, 5);
+    pp.periodic = 1;
+    oc_samples *s = sample_ok(d, &pp);
+    size_t n = oc_samples_count(s);
+    const double *x = oc_samples_data(s);
+    double lo[3] = {-1, 2, 3}, m2 = INFINITY;
+    for (size_t i = 0; i < n; i++) {
+      for (int k = 0; k < d; k++) {
+        ck_assert_double_ge(x[d * i + k], lo[k]);
+        ck_assert_double_lt(x[d * i + k], lo[k] + len);
+      }
+      for (size_t j = 0; j < i; j++)
+        m2 = fmin(m2, pdist2(d, x + d * i, x + d * j, len));
+    }
+    ck_assert_double_ge(sqrt(m2), r);
+    /* maximal on the torus: random probes, faces included, are within r
+    ** of a sample across the wrap */
+    oc_rng u = oc_rng_stream(9, (uint64_t)d);
+    for (int t = 0; t < 20000; t++) {
+      double p[3], b2 = INFINITY;
+      for (int k = 0; k < d; k++)
+        p[k] = lo[k] + len * oc_rng_uniform(&u);
+      if (t < 200) p[t % d] = lo[t % d]; /* on a face */
+      for (size_t i = 0; i < n; i++)
+        b2 = fmin(b2, pdist2(d, p, x + d * i, len));
+      ck_assert_msg(sqrt(b2) <= r * (1 + 1e-9), "%dd probe %d: hole %g", d, t,
+                    sqrt(b2));
+    }
+    /* the same bytes for any thread count */
+    int saved = omp_get_max_threads();
+    omp_set_num_threads(1);
+    oc_samples *one = sample_ok(d, &pp);
+    omp_set_num_threads(saved);
+    ck_assert(same(one, s));
+    /* as dense as a maximal set: no face effect */
+    double per = (double)n / pow(len / r, d);
+    printf("poisson %dd periodic: %zu samples, %.3f per r^%d\n", d, n, per, d);
+    ck_assert_double_ge(per, 0.9 * (d == 2 ? RSA_2D : RSA_3D));
+    oc_samples_free(one);
+    oc_samples_free(s);
+  }
+}
+END_TEST
+
+START_TEST(periodic_errors) {
+  oc_poisson_params pp = params(0, 0, 0, 10, 10, 9, 1, 1);
+  pp.periodic = 1;
+  expect_error(3, &pp, OC_EINVAL, "must be a cube");
+  pp = params(0, 0, 0, 3, 3, 3, 1.6, 1);
+  pp.periodic = 1;
+  expect_error(3, &pp, OC_EINVAL, "less than half the side");
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("poisson");
   TCase *tc = tcase_create("poisson");
@@ -666,6 +737,8 @@ int main(void) {
   tcase_add_test(tc, thinning_by_density);
   tcase_add_test(tc, errors);
   tcase_add_test(tc, progress_and_cancel);
+  tcase_add_test(tc, periodic_torus);
+  tcase_add_test(tc, periodic_errors);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }

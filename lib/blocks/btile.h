@@ -1,0 +1,122 @@
+/*
+** btile.h — internals of the block family (Paris et al. 2020, section 4),
+** shared by its files: a fracture tile (tile.c) is made from periodic
+** Poisson points, a neighbour graph (graph.c), fracture discs (discs.c),
+** clusters (cluster.c) and their convex hulls (hull.c); each hull becomes
+** a block node (block.c).
+**
+** Coordinates: the tile is the cube [0, s)^3 of a 3-torus. Points are
+** stored in it; a cluster's points are unwrapped to contiguous
+** coordinates (each one a periodic image of a stored point) and the
+** cluster is then shifted so that its centroid lies in the tile.
+*/
+#ifndef OC_BTILE_H
+#define OC_BTILE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "outcrop.h"
+
+/* A fracture disc: centre c, unit normal n, radius r. */
+typedef struct oc_bdisc {
+  oc_vec3 c, n;
+  double r;
+} oc_bdisc;
+
+/* A periodic image of a disc (its centre shifted by a multiple of s) with
+** the box around it. */
+typedef struct oc_bimage {
+  oc_vec3 c, n;
+  double r2;
+  oc_aabb box;
+} oc_bimage;
+
+/* The neighbour graph: edge e joins points a[e] < b[e]; the image of b
+** nearest to a is at p[a] + v[e]. adj lists, for each point i,
+** the edges at it: adj[start[i] .. start[i + 1]). */
+typedef struct oc_bgraph {
+  size_t ne;
+  uint32_t *a, *b;
+  float *v; /* 3 per edge */
+  unsigned char *cut;
+  size_t *start;
+  uint32_t *adj;
+} oc_bgraph;
+
+/* One block: its hull planes n . p + off <= 0 (4 doubles each), the hull
+** vertices (3 doubles each), the cluster's points, centroid and box. */
+typedef struct oc_bblock {
+  size_t nplane, nvert, npts;
+  double *plane, *vert;
+  oc_vec3 centroid;
+  oc_aabb box; /* of the hull */
+  double thickness;
+} oc_bblock;
+
+struct oc_btile {
+  oc_btile_params pp;
+  size_t np;
+  double *pts; /* 3 per point, in [0, s)^3 */
+  size_t nd;
+  oc_bdisc *disc;
+  oc_bgraph g;
+  size_t ncl;      /* clusters */
+  uint32_t *label; /* cluster of each point */
+  double *unwrap;  /* each point's unwrapped position (3 per point) */
+  size_t nb;       /* blocks (clusters with a hull) */
+  oc_bblock *block;
+  size_t thick;  /* degenerate clusters made thick polygons or points */
+  size_t ncut;   /* pairs of blocks cut apart (separate.c) */
+  size_t merged; /* small clusters merged into a neighbour (merge.c) */
+  double seconds;
+};
+
+/* Fills t->disc with the type's discs then the user's (discs.c). */
+int oc_bdiscs_make(oc_btile *t, oc_error *err);
+/* The images of the discs whose boxes meet the box `in`; a new array
+** in *out (caller frees), its count in *n. */
+int oc_bdiscs_images(const oc_btile *t, oc_aabb in, oc_bimage **out, size_t *n,
+                     oc_error *err);
+/* 1 when segment [p, q] crosses the image's disc. */
+int oc_bimage_cuts(const oc_bimage *d, const double *p, const double *q);
+
+/* Builds t->g (edges shorter than neighbour * radius, periodic) and marks
+** the edges the discs cut (graph.c). */
+int oc_bgraph_make(oc_btile *t, oc_error *err);
+void oc_bgraph_free(oc_bgraph *g);
+
+/* Greedy clusters with the mutual-visibility check, unwrapped (cluster.c):
+** fills t->ncl, t->label, t->unwrap. */
+int oc_bclusters_make(oc_btile *t, oc_error *err);
+
+/* Merges the smallest clusters into neighbours and moves each centroid
+** into the tile (merge.c); renumbers t->label, updates t->ncl. */
+int oc_bclusters_merge(oc_btile *t, oc_error *err);
+
+/* Convex hulls of the clusters (hull.c): fills t->block, t->nb. */
+int oc_bhulls_make(oc_btile *t, oc_error *err);
+void oc_bblock_free(oc_bblock *b);
+
+/* Cuts overlapping blocks apart with a plane each (separate.c). */
+int oc_bblocks_separate(oc_btile *t, oc_error *err);
+
+/* A block's field (block.c): its planes, rounding min(R, thickness / 2)
+** and width W, malloc'ed (free with free). */
+typedef struct oc_bfield oc_bfield;
+oc_bfield *oc_bfield_new(const oc_bblock *b, double R, double W);
+/* The hull's box grown by W (f = 0 outside), and W. */
+oc_aabb oc_bfield_support(const oc_bfield *b);
+double oc_bfield_width(const oc_bfield *b);
+/* The rounded distance d (<= 0 inside) and its gradient. */
+double oc_bfield_dist(const oc_bfield *b, oc_vec3 p, oc_vec3 *g);
+/* sigma's constants for threshold T and width W, then f = sigma(-d). */
+#define OC_BSIGMA_N 4
+void oc_bfield_sigma(double T, double W, double sp[OC_BSIGMA_N]);
+double oc_bfield_eval(const oc_bfield *b, const double *sp, oc_vec3 p,
+                      oc_vec3 *g);
+
+/* The block node of hull planes (block.c): rounding R, width W. */
+oc_node *oc_bblock_node(const oc_bblock *b, double R, double W, oc_error *err);
+
+#endif

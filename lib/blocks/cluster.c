@@ -1,0 +1,148 @@
+/*
+** cluster.c — clusters of a tile's points (Paris et al. 2020, section
+** 4.1): greedy flood fill over the uncut edges of the neighbour graph with
+** the mutual-visibility check, unwrapped to contiguous coordinates.
+**
+** Clusters start at the points in a random order (keyed by the seed); a
+** cluster grows breadth-first: a neighbour joins when the edge to it is not
+** cut, no disc image crosses the segment from it to any member (so a
+** cluster never wraps around a disc's rim), and the cluster stays less
+** than s - 2 k r across on every axis (a block must not meet its own
+** periodic images; larger clusters, such as an uncut bed of a tabular
+** tile, are split). A point refused by a cluster waits for the next one.
+** Each joining point gets the image of itself nearest the member it came
+** from (merge.c then merges the smallest clusters and moves each
+** centroid into the tile).
+*/
+#include <math.h>
+#include <stdlib.h>
+
+#include "blocks/btile.h"
+#include "core/error.h"
+#include "core/rng.h"
+
+#define KEY_ORDER 0x6f72646572ull
+#define NONE UINT32_MAX
+
+typedef struct grow {
+  oc_btile *t;
+  const oc_bimage *im;
+  size_t nim;
+  const oc_bimage **near; /* the images meeting the cluster's box */
+  uint32_t *mem;          /* members, in order of joining */
+  size_t nm;
+  double lo[3], hi[3];
+} grow;
+
+/* May the point at q (unwrapped) join the cluster? */
+static int may_join(grow *w, const double *q) {
+  double lo[3], hi[3],
+      most = w->t->pp.size - 2 * w->t->pp.neighbour * w->t->pp.radius;
+  for (int a = 0; a < 3; a++) {
+    lo[a] = fmin(w->lo[a], q[a]);
+    hi[a] = fmax(w->hi[a], q[a]);
+    if (hi[a] - lo[a] > most) return 0;
+  }
+  size_t nn = 0;
+  for (size_t d = 0; d < w->nim; d++) {
+    const oc_aabb *b = &w->im[d].box;
+    if (b->lo.x > hi[0] || b->hi.x < lo[0] || b->lo.y > hi[1] ||
+        b->hi.y < lo[1] || b->lo.z > hi[2] || b->hi.z < lo[2])
+      continue;
+    w->near[nn++] = &w->im[d];
+  }
+  if (!nn) return 1;
+  for (size_t m = 0; m < w->nm; m++) {
+    const double *p = w->t->unwrap + 3 * (size_t)w->mem[m];
+    for (size_t d = 0; d < nn; d++)
+      if (oc_bimage_cuts(w->near[d], p, q)) return 0;
+  }
+  return 1;
+}
+
+static void join(grow *w, uint32_t i, uint32_t c, const double *q) {
+  double *u = w->t->unwrap + 3 * (size_t)i;
+  for (int a = 0; a < 3; a++) {
+    u[a] = q[a];
+    w->lo[a] = fmin(w->lo[a], q[a]);
+    w->hi[a] = fmax(w->hi[a], q[a]);
+  }
+  w->t->label[i] = c;
+  w->mem[w->nm++] = i;
+}
+
+/* Grows cluster c from point i. */
+static void flood(grow *w, uint32_t i, uint32_t c, uint32_t *tried) {
+  oc_btile *t = w->t;
+  const oc_bgraph *g = &t->g;
+  double s = t->pp.size;
+  w->nm = 0;
+  for (int a = 0; a < 3; a++)
+    w->lo[a] = w->hi[a] = t->pts[3 * (size_t)i + a];
+  join(w, i, c, t->pts + 3 * (size_t)i);
+  for (size_t head = 0; head < w->nm; head++) {
+    uint32_t u = w->mem[head];
+    const double *pu = t->unwrap + 3 * (size_t)u;
+    for (size_t k = g->start[u]; k < g->start[u + 1]; k++) {
+      uint32_t e = g->adj[k];
+      if (g->cut[e]) continue;
+      uint32_t v = g->a[e] == u ? g->b[e] : g->a[e];
+      if (t->label[v] != NONE || tried[v] == c) continue;
+      double sg = g->a[e] == u ? 1 : -1, q[3];
+      const double *pv = t->pts + 3 * (size_t)v;
+      for (int a = 0; a < 3; a++) {
+        /* the exact image of v nearest u */
+        double x = pu[a] + sg * g->v[3 * e + a];
+        q[a] = pv[a] + s * round((x - pv[a]) / s);
+      }
+      if (may_join(w, q))
+        join(w, v, c, q);
+      else
+        tried[v] = c;
+    }
+  }
+}
+
+int oc_bclusters_make(oc_btile *t, oc_error *err) {
+  size_t n = t->np;
+  double s = t->pp.size;
+  grow w = {.t = t};
+  uint32_t *order = malloc((n ? n : 1) * sizeof *order);
+  uint32_t *tried = malloc((n ? n : 1) * sizeof *tried);
+  t->label = malloc((n ? n : 1) * sizeof *t->label);
+  t->unwrap = malloc((n ? n : 1) * 3 * sizeof *t->unwrap);
+  w.mem = malloc((n ? n : 1) * sizeof *w.mem);
+  oc_bimage *im = NULL;
+  int rc = OC_ENOMEM;
+  if (!order || !tried || !t->label || !t->unwrap || !w.mem) goto done;
+  oc_aabb in = {{-s, -s, -s}, {2 * s, 2 * s, 2 * s}};
+  if (oc_bdiscs_images(t, in, &im, &w.nim, err)) goto done;
+  w.im = im;
+  w.near = malloc((w.nim ? w.nim : 1) * sizeof *w.near);
+  if (!w.near) goto done;
+  for (size_t i = 0; i < n; i++) {
+    order[i] = (uint32_t)i;
+    t->label[i] = NONE;
+    tried[i] = NONE;
+  }
+  oc_rng u = oc_rng_stream(t->pp.seed, KEY_ORDER);
+  for (size_t i = n; i > 1; i--) {
+    size_t j = (size_t)(((unsigned __int128)oc_rng_next(&u) * i) >> 64);
+    uint32_t x = order[i - 1];
+    order[i - 1] = order[j];
+    order[j] = x;
+  }
+  t->ncl = 0;
+  for (size_t k = 0; k < n; k++)
+    if (t->label[order[k]] == NONE)
+      flood(&w, order[k], (uint32_t)t->ncl++, tried);
+  rc = 0;
+done:
+  if (rc == OC_ENOMEM) oc_seterr(err, OC_ENOMEM, "out of memory for clusters");
+  free(order);
+  free(tried);
+  free(w.mem);
+  free(w.near);
+  free(im);
+  return rc;
+}
