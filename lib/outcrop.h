@@ -1926,8 +1926,7 @@ double oc_stacks_volume(const oc_stacks *s, int m);
 /* A heightfield of the grid's shape: the top of the highest layer of
 ** material m in each stack (zbase where there is none). The caller
 ** releases it. */
-oc_heightfield *oc_stacks_heightfield(const oc_stacks *s, int m,
-                                      oc_error *err);
+oc_heightfield *oc_stacks_heightfield(const oc_stacks *s, int m, oc_error *err);
 
 /* From a heightfield: one stack per sample, bedrock from zbase (default:
 ** 1 below the lowest sample when zbase is NaN) to the sample, and `sand`

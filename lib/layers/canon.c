@@ -87,8 +87,7 @@ size_t oc_layers_segments(const oc_stacks *s, size_t k, oc_lseg *out) {
   return n + 1;
 }
 
-size_t oc_layers_from_segments(const oc_lseg *seg, size_t nseg,
-                               oc_layer *out) {
+size_t oc_layers_from_segments(const oc_lseg *seg, size_t nseg, oc_layer *out) {
   size_t k = 0;
   for (size_t i = 0; i < nseg; i++) {
     const oc_lseg *c = &seg[i];
@@ -111,7 +110,8 @@ size_t oc_layers_from_segments(const oc_lseg *seg, size_t nseg,
   return k;
 }
 
-/* ---- every stack ---------------------------------------------------------- */
+/* ---- every stack ----------------------------------------------------------
+ */
 
 int oc_layers_decode_all(const oc_stacks *s, oc_lseg **seg, size_t **soff,
                          oc_error *err) {
@@ -150,8 +150,8 @@ int oc_layers_encode_all(oc_stacks *s, const oc_lseg *seg, const size_t *soff,
     return buf ? OC_ENOMEM : oc_seterr(err, OC_ENOMEM, "out of memory");
   }
   for (size_t k = 0; k < ns; k++) {
-    size_t n = oc_layers_from_segments(seg + soff[k], soff[k + 1] - soff[k],
-                                       buf);
+    size_t n =
+        oc_layers_from_segments(seg + soff[k], soff[k + 1] - soff[k], buf);
     size_t m = oc_layers_canon(buf, n, buf + 5 * most);
     if (oc_builder_push(&b, buf + 5 * most, m, err)) {
       oc_builder_free(&b);

@@ -25,11 +25,10 @@ int oc_stacks_deposit(oc_stacks *s, const oc_deposit_params *p, double *added,
                      p->amount);
   int q = oc_seg_index(p->material);
   if (q < 0)
-    return oc_seterr(err, OC_EINVAL,
-                     "'material' must be sand, rocks or water (got %s)",
-                     oc_material_name(p->material)
-                         ? oc_material_name(p->material)
-                         : "an unknown material");
+    return oc_seterr(
+        err, OC_EINVAL, "'material' must be sand, rocks or water (got %s)",
+        oc_material_name(p->material) ? oc_material_name(p->material)
+                                      : "an unknown material");
   oc_stabilize_params sp;
   if (p->stab)
     sp = *p->stab;

@@ -61,8 +61,8 @@ static double below(const double *v, uint32_t n, double z, int *in) {
 
 /* Stacks [*i0, *i1] overlapping [lo, hi] along one axis (empty: i0 > i1),
 ** and 1 when [lo, hi] reaches past the grid. */
-static int axis_range(double lo, double hi, double X0, double s, int n,
-                      int *i0, int *i1) {
+static int axis_range(double lo, double hi, double X0, double s, int n, int *i0,
+                      int *i1) {
   double a = floor((lo - X0) / s), b = floor((hi - X0) / s);
   *i0 = a < 0 ? 0 : a > n ? n : (int)a;
   *i1 = b < -1 ? -1 : b > n - 1 ? n - 1 : (int)b;
@@ -219,9 +219,9 @@ static int lf_compile(oc_kcompile *c, oc_error *err) {
   c->info.lo = 0;
   c->info.hi = 2 * c->T;
   c->info.lip = sqrt(3.0) * c->T / sg * (1 + 1e-9);
-  c->info.box = (oc_aabb){
-      {d->X0 - sg, d->Y0 - sg, d->zlo - sg},
-      {d->X0 + d->nx * d->cell + sg, d->Y0 + d->ny * d->cell + sg, d->zhi + sg}};
+  c->info.box = (oc_aabb){{d->X0 - sg, d->Y0 - sg, d->zlo - sg},
+                          {d->X0 + d->nx * d->cell + sg,
+                           d->Y0 + d->ny * d->cell + sg, d->zhi + sg}};
   return OC_OK;
 }
 

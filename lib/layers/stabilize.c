@@ -78,8 +78,8 @@ static double excess(const work *w, int i, int j, size_t g, int d, long *t) {
   long r = seg_at(w, (size_t)nj * w->nx + ni, h);
   if (r < 0) return 0;
   const oc_lseg *o = &w->seg[r];
-  double ex = h - (o->floor + o->a[OC_SEG_SAND] + o->a[OC_SEG_ROCKS]) -
-              w->thr[d >= 4];
+  double ex =
+      h - (o->floor + o->a[OC_SEG_SAND] + o->a[OC_SEG_ROCKS]) - w->thr[d >= 4];
   *t = r;
   return ex > 0 ? ex : 0;
 }
@@ -205,7 +205,7 @@ int oc_layers_stabilize_segs(oc_stacks *s, oc_lseg *seg, const size_t *soff,
   size_t ns = (size_t)s->nx * s->ny, nseg = soff[ns];
   oc_stabilize_result r = {0, 1, 0};
   work w = {s->nx, s->ny, 0, seg, soff, {0, 0}, p->rate, NULL, NULL, NULL};
-  w.kf = malloc(3 * nseg * sizeof *w.kf);
+  w.kf = calloc(3 * nseg, sizeof *w.kf);
   if (!w.kf) return oc_seterr(err, OC_ENOMEM, "out of memory");
   w.loss = w.kf + nseg;
   w.nxt = w.loss + nseg;
@@ -223,7 +223,7 @@ int oc_layers_stabilize_segs(oc_stacks *s, oc_lseg *seg, const size_t *soff,
     w.q = oc_seg_index(m);
     w.thr[0] = s->cell * ta;
     w.thr[1] = s->cell * sqrt(2.0) * ta;
-    memset(w.kf, 0, nseg * sizeof *w.kf);
+    memset(w.kf, 0, 2 * nseg * sizeof *w.kf);
     box b = start;
     long it = 0;
     int done = 0;
@@ -247,6 +247,12 @@ int oc_layers_stabilize_segs(oc_stacks *s, oc_lseg *seg, const size_t *soff,
           for (size_t g = soff[k]; g < soff[k + 1]; g++)
             seg[g].a[w.q] = w.nxt[g];
         }
+      /* factors and losses are 0 outside the givers (which pass 1 of the
+      ** next box covers), so pass 2 reads none stale */
+      for (int j = giv.j0; j <= giv.j1; j++)
+        for (size_t g = soff[(size_t)j * s->nx + giv.i0];
+             g < soff[(size_t)j * s->nx + giv.i1 + 1]; g++)
+          w.kf[g] = w.loss[g] = 0;
       r.moved += sum * s->cell * s->cell;
       b = grow(c, 1, s->nx, s->ny);
       it++;

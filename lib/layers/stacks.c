@@ -12,8 +12,8 @@
 #include "field/kind.h"
 #include "layers/layers.h"
 
-static const char *const NAMES[OC_MAT_COUNT] = {"air", "water", "sand",
-                                                "rocks", "bedrock"};
+static const char *const NAMES[OC_MAT_COUNT] = {"air", "water", "sand", "rocks",
+                                                "bedrock"};
 
 const char *oc_material_name(int m) {
   return m >= 0 && m < OC_MAT_COUNT ? NAMES[m] : NULL;
@@ -172,8 +172,8 @@ int oc_stacks_set(oc_stacks *s, int i, int j, const uint8_t *mat,
   for (size_t l = 0; l < n; l++) {
     if (mat[l] >= OC_MAT_COUNT)
       return oc_seterr(err, OC_EINVAL,
-                       "'material' of layer %zu is not a material (%d)",
-                       l + 1, mat[l]);
+                       "'material' of layer %zu is not a material (%d)", l + 1,
+                       mat[l]);
     if (!isfinite(thick[l]) || thick[l] < 0)
       return oc_seterr(err, OC_EINVAL,
                        "'thickness' of layer %zu must be finite and >= 0 "
