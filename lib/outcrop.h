@@ -1912,6 +1912,9 @@ double oc_stacks_base(const oc_stacks *s);
 ** naming 'i', 'j', 'material' or 'thickness'. */
 int oc_stacks_set(oc_stacks *s, int i, int j, const uint8_t *mat,
                   const double *thick, size_t n, oc_error *err);
+/* Every stack set to the same n layers (checked as oc_stacks_set). */
+int oc_stacks_fill(oc_stacks *s, const uint8_t *mat, const double *thick,
+                   size_t n, oc_error *err);
 /* The layer count of stack (i, j); the first `max` layers go to mat and
 ** thick (either may be NULL). */
 size_t oc_stacks_get(const oc_stacks *s, int i, int j, uint8_t *mat,

@@ -19,6 +19,7 @@
 #include "l_handle.h"
 #include "l_heightfield.h"
 #include "l_image.h"
+#include "l_layers.h"
 #include "l_mesh.h"
 #include "l_render.h"
 #include "l_terrain.h"
@@ -55,10 +56,11 @@ int luaopen_outcrop(lua_State *L) {
   oclua_open_mesh(L);
   oclua_open_heightfield(L); /* outcrop.heightfield */
   oclua_open_render(L);
-  oclua_open_terrain(L); /* outcrop.terrain */
-  oclua_open_gen(L);     /* outcrop.poisson2d/3d */
-  oclua_open_geology(L); /* outcrop.geology, outcrop.erosion */
+  oclua_open_terrain(L);   /* outcrop.terrain */
+  oclua_open_gen(L);       /* outcrop.poisson2d/3d */
+  oclua_open_geology(L);   /* outcrop.geology, outcrop.erosion */
   oclua_open_elevation(L); /* outcrop.elevation */
+  oclua_open_layers(L);    /* outcrop.layers */
   lua_pushliteral(L, OC_VERSION);
   lua_setfield(L, -2, "version");
   lua_pushnumber(L, OC_DEFAULT_THRESHOLD);

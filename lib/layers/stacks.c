@@ -164,9 +164,8 @@ static int check_ij(const oc_stacks *s, int i, int j, oc_error *err) {
   return OC_OK;
 }
 
-int oc_stacks_set(oc_stacks *s, int i, int j, const uint8_t *mat,
-                  const double *thick, size_t n, oc_error *err) {
-  if (check_ij(s, i, j, err)) return OC_EINVAL;
+static int check_layers(const uint8_t *mat, const double *thick, size_t n,
+                        oc_error *err) {
   if (n > OC_STACKS_MAX_LAYERS)
     return oc_seterr(err, OC_EINVAL, "too many layers (%zu)", n);
   for (size_t l = 0; l < n; l++) {
@@ -180,6 +179,36 @@ int oc_stacks_set(oc_stacks *s, int i, int j, const uint8_t *mat,
                        "(got %g)",
                        l + 1, thick[l]);
   }
+  return OC_OK;
+}
+
+int oc_stacks_fill(oc_stacks *s, const uint8_t *mat, const double *thick,
+                   size_t n, oc_error *err) {
+  if (check_layers(mat, thick, n, err)) return OC_EINVAL;
+  oc_layer *in = malloc((2 * n + 1) * sizeof *in);
+  if (!in) return oc_seterr(err, OC_ENOMEM, "out of memory");
+  for (size_t l = 0; l < n; l++)
+    in[l] = (oc_layer){thick[l], mat[l]};
+  size_t m = oc_layers_canon(in, n, in + n), ns = (size_t)s->nx * s->ny;
+  oc_stacks_builder b = {0};
+  int rc = (double)m * ns > (double)OC_STACKS_MAX_LAYERS
+               ? oc_seterr(err, OC_ENOMEM, "more than %llu layers",
+                           (unsigned long long)OC_STACKS_MAX_LAYERS)
+               : oc_builder_init(&b, ns, m * ns, err);
+  for (size_t k = 0; k < ns && rc == OC_OK; k++)
+    rc = oc_builder_push(&b, in + n, m, err);
+  if (rc == OC_OK)
+    oc_builder_commit(&b, s);
+  else if (b.off)
+    oc_builder_free(&b);
+  free(in);
+  return rc;
+}
+
+int oc_stacks_set(oc_stacks *s, int i, int j, const uint8_t *mat,
+                  const double *thick, size_t n, oc_error *err) {
+  if (check_ij(s, i, j, err)) return OC_EINVAL;
+  if (check_layers(mat, thick, n, err)) return OC_EINVAL;
   oc_layer *in = malloc((2 * n + 1) * sizeof *in);
   if (!in) return oc_seterr(err, OC_ENOMEM, "out of memory");
   oc_layer *out = in + n;
