@@ -134,19 +134,14 @@ describe("outcrop.layers", function()
 
   it("is the same to the byte on one and two threads", function()
     local function child(threads)
-      local p = assert(io.popen("OMP_NUM_THREADS=" .. threads ..
-        " lua5.4 -e 'package.cpath=[[" .. package.cpath .. "]] " ..
-        "local oc = require \"outcrop\" " ..
+      return R.child_output(threads, "local oc = require \"outcrop\" " ..
         "local s = oc.layers.new{size = {60, 50}, layers = {{\"bedrock\", 3}}} " ..
         "s:deposit{center = {20, 20}, radius = 12, amount = 9} " ..
         "s:deposit{center = {30, 25}, radius = 8, amount = 5, material = \"rocks\"} " ..
         "local t = {} for j = 1, 50 do for i = 1, 60 do " ..
         "for _, l in ipairs(s:get(i, j)) do " ..
         "t[#t + 1] = l[1] .. string.pack(\"d\", l[2]) end end end " ..
-        "io.write(table.concat(t))'"))
-      local out = p:read("a")
-      p:close()
-      return out
+        "io.write(table.concat(t))")
     end
     local one, two = child(1), child(2)
     assert.is_true(#one > 3000 * 8)
