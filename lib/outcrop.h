@@ -2009,6 +2009,28 @@ typedef struct oc_deposit_params {
 int oc_stacks_deposit(oc_stacks *s, const oc_deposit_params *p, double *added,
                       oc_stabilize_result *res, oc_error *err);
 
+/* Erosion (section 4): bedrock of the stacks whose centres lie in
+** [x0, x1] x [y0, y1] turned into loose material, `ratio` of it sand and
+** the rest rocks (volume conserved), then stabilised from that region when
+** `stabilize`. OC_STACKS_ERODE_SURFACE: the top `depth` metres of each stack's
+** highest bedrock; OC_STACKS_ERODE_COLLAPSE: every bedrock roof (a bedrock layer
+** over air) at most `depth` thick, whose debris falls to the floor below.
+** *eroded gets the bedrock volume turned (m^3). */
+typedef enum oc_stacks_erode_mode {
+  OC_STACKS_ERODE_SURFACE,
+  OC_STACKS_ERODE_COLLAPSE
+} oc_stacks_erode_mode;
+typedef struct oc_stacks_erode_params {
+  double x0, y0, x1, y1;
+  double ratio; /* [0, 1]: the sand fraction */
+  double depth; /* > 0 */
+  oc_stacks_erode_mode mode;
+  int stabilize;
+  const oc_stabilize_params *stab; /* NULL: defaults */
+} oc_stacks_erode_params;
+int oc_stacks_erode(oc_stacks *s, const oc_stacks_erode_params *p, double *eroded,
+                    oc_stabilize_result *res, oc_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -22,6 +22,10 @@
 **   s:deposit{center = {x, y}, radius =, amount =, material = "sand",
 **        stabilize = true | false | {stabilize's fields}}
 **        -> volume added (m^3), {iterations =, converged =, moved =}
+**   s:erode{region = {x0, y0, x1, y1}, ratio = 0.5 (sand; the rest rocks),
+**        mode = "surface" | "collapse", depth = 1 cell (surface: how deep;
+**        collapse: the thickest roof that falls; default 5 cells),
+**        stabilize = true | false | {...}} -> bedrock volume turned, {...}
 **
 ** Stacks are mutable: a node made by s:field is a snapshot. `local s
 ** <close>` frees the grid early.
@@ -470,6 +474,51 @@ static int m_deposit(lua_State *L) {
   return 2;
 }
 
+static int m_erode(lua_State *L) {
+  static const char *const known[] = {"region", "ratio",     "depth",
+                                      "mode",   "stabilize", NULL};
+  static const char *const sknown[] = {"angle", "rate", "tolerance",
+                                       "iterations", NULL};
+  static const char *const modes[] = {"surface", "collapse", NULL};
+  const char *fname = "layers:erode";
+  oclua_checkargs(L, 2, fname,
+                  "({region=, ratio=, depth=, mode=, stabilize=})");
+  oc_stacks *s = pinlayers(L, 1, fname);
+  oclua_fields f;
+  oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
+  double r[4];
+  if (!oclua_field_numbers(&f, "region", 4, r, "must be {x0, y0, x1, y1}"))
+    oclua_field_missing(&f, "region", "must be {x0, y0, x1, y1}");
+  oc_stabilize_params sp;
+  oc_stabilize_defaults(s, &sp);
+  oc_stacks_erode_params p = {
+      r[0], r[1], r[2], r[3], 0.5, 0, OC_STACKS_ERODE_SURFACE, 1, &sp};
+  p.ratio = oclua_field_optnumber(&f, "ratio", OCLUA_FINITE, 0.5);
+  p.mode = (oc_stacks_erode_mode)oclua_field_optoption(&f, "mode", modes, 0);
+  p.depth = oclua_field_optnumber(&f, "depth", OCLUA_POSITIVE,
+                                  (p.mode == OC_STACKS_ERODE_SURFACE ? 1 : 5) *
+                                      oc_stacks_cell(s));
+  int t = oclua_field_push(&f, "stabilize");
+  if (t == LUA_TBOOLEAN) {
+    p.stabilize = lua_toboolean(L, -1);
+  } else if (t == LUA_TTABLE) {
+    oclua_fields g;
+    oclua_fields_open(&g, L, lua_gettop(L), fname, "stabilize.", sknown, 0);
+    read_stab(&g, &sp);
+  } else if (t != LUA_TNIL) {
+    oclua_field_error(&f, "stabilize", -1,
+                      "must be a boolean or a table of stabilisation fields");
+  }
+  oc_error err = {OC_OK, ""};
+  oc_stabilize_result res;
+  double eroded;
+  if (oc_stacks_erode(s, &p, &eroded, &res, &err))
+    oclua_liberror(L, fname, &err);
+  lua_pushnumber(L, eroded);
+  push_result(L, &res);
+  return 2;
+}
+
 /* ---- metamethods ------------------------------------------------------- */
 
 static int m_gc(lua_State *L) {
@@ -505,6 +554,7 @@ static const luaL_Reg methods[] = {{"get", m_get},
                                    {"field", m_field},
                                    {"stabilize", m_stabilize},
                                    {"deposit", m_deposit},
+                                   {"erode", m_erode},
                                    {NULL, NULL}};
 
 static const luaL_Reg meta[] = {{"__gc", m_gc},

@@ -451,6 +451,54 @@ START_TEST(parameter_errors) {
 }
 END_TEST
 
+START_TEST(erode_modes) {
+  oc_error err;
+  oc_stacks *s = grid(10, 10, 1, 0);
+  uint8_t m[] = {OC_MAT_BEDROCK, OC_MAT_AIR, OC_MAT_BEDROCK, OC_MAT_SAND};
+  double t[] = {5, 3, 1, 0.5};
+  ck_assert(oc_stacks_fill(s, m, t, 4, &err) == OC_OK);
+  double tot0 = oc_stacks_volume(s, OC_MAT_BEDROCK) +
+                oc_stacks_volume(s, OC_MAT_SAND) +
+                oc_stacks_volume(s, OC_MAT_ROCKS);
+  /* the roofs of the 3 x 2 stacks in the region collapse onto the floor */
+  oc_stacks_erode_params ep = {
+      2, 3, 4, 4.5, 0.25, 2, OC_STACKS_ERODE_COLLAPSE, 0, NULL};
+  double v;
+  ck_assert(oc_stacks_erode(s, &ep, &v, NULL, &err) == OC_OK);
+  ck_assert_double_eq(v, 6);
+  uint8_t gm[8];
+  double gt[8];
+  ck_assert_uint_eq(oc_stacks_get(s, 3, 4, gm, gt, 8), 3);
+  ck_assert_int_eq(gm[0], OC_MAT_BEDROCK);
+  ck_assert_double_eq(gt[0], 5);
+  ck_assert_int_eq(gm[1], OC_MAT_SAND);
+  ck_assert_double_eq(gt[1], 0.75);
+  ck_assert_int_eq(gm[2], OC_MAT_ROCKS);
+  ck_assert_double_eq(gt[2], 0.75);
+  ck_assert_uint_eq(oc_stacks_get(s, 3, 5, NULL, NULL, 0), 4); /* outside */
+  ck_assert_double_eq(oc_stacks_volume(s, OC_MAT_ROCKS), 6 * 0.75);
+  /* a roof thicker than depth stays */
+  ep.x0 = 6, ep.x1 = 8, ep.depth = 0.5;
+  ck_assert(oc_stacks_erode(s, &ep, &v, NULL, &err) == OC_OK);
+  ck_assert_double_eq(v, 0);
+  /* the surface, stabilised: volume conserved */
+  ep = (oc_stacks_erode_params){0, 0,   9, 9, 0.5, 0.4, OC_STACKS_ERODE_SURFACE,
+                                1, NULL};
+  oc_stabilize_result res;
+  ck_assert(oc_stacks_erode(s, &ep, &v, &res, &err) == OC_OK);
+  ck_assert_double_eq_tol(v, 100 * 0.4, 1e-9);
+  double tot1 = oc_stacks_volume(s, OC_MAT_BEDROCK) +
+                oc_stacks_volume(s, OC_MAT_SAND) +
+                oc_stacks_volume(s, OC_MAT_ROCKS);
+  ck_assert_double_eq_tol(tot1, tot0, 1e-6 * tot0); /* floats */
+  ck_assert(res.converged && res.moved > 0);
+  ep.ratio = 2;
+  ck_assert_int_eq(oc_stacks_erode(s, &ep, &v, NULL, &err), OC_EINVAL);
+  ck_assert(strstr(err.msg, "'ratio'"));
+  oc_stacks_free(s);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("layers");
   TCase *tc = tcase_create("layers");
@@ -462,6 +510,7 @@ int main(void) {
   tcase_add_test(tc, from_program_reproduces_surface);
   tcase_add_test(tc, stabilize_conserves_and_rests);
   tcase_add_test(tc, deposit_and_threads);
+  tcase_add_test(tc, erode_modes);
   tcase_add_test(tc, parameter_errors);
   suite_add_tcase(s, tc);
   return oct_run(s);

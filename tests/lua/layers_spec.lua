@@ -132,6 +132,25 @@ describe("outcrop.layers", function()
     assert.is_true(math.abs(s:volume("rocks") - ar) < 1e-6 * ar)
   end)
 
+  it("erodes bedrock into sand and rocks, conserving volume", function()
+    local s = L.new{size = {8, 8}, layers = {{"bedrock", 4}, {"air", 2}, {"bedrock", 1}}}
+    local v, r = s:erode{region = {2, 2, 3, 4}, mode = "collapse", ratio = 0.25,
+                         stabilize = false}
+    assert.are.equal(6, v)
+    assert.are.same({{"bedrock", 4}, {"sand", 0.25}, {"rocks", 0.75}}, s:get(3, 4))
+    assert.are.equal(3, #s:get(3, 5))
+    local total = function()
+      return s:volume("bedrock") + s:volume("sand") + s:volume("rocks")
+    end
+    local t0 = total()
+    v, r = s:erode{region = {0, 0, 7, 7}, depth = 0.5}
+    assert.are.equal(64 * 0.5 - 6 * 0.5 + 6 * 0.5, v)
+    assert.is_true(math.abs(total() - t0) < 1e-6 * t0 and r.converged)
+    check(function() s:erode{region = {0, 0, 1, 1}, ratio = 2} end, "layers:erode", "'ratio'")
+    check(function() s:erode{region = {0, 0, 1, 1}, mode = "melt"} end, "layers:erode", "'mode'")
+    check(function() s:erode{} end, "layers:erode", "'region'")
+  end)
+
   it("is the same to the byte on one and two threads", function()
     local function child(threads)
       return R.child_output(threads, "local oc = require \"outcrop\" " ..
