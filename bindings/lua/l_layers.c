@@ -394,6 +394,26 @@ static void read_stab(oclua_fields *f, oc_stabilize_params *p) {
       (long)oclua_field_optint(f, "iterations", 1, 1000000000, p->iterations);
 }
 
+/* The field `stabilize` of a tool: true (the default) or false, or a
+** table of stabilize's fields read into p. Returns whether to stabilise.
+** (The value stays on the stack.) */
+static int read_stab_option(oclua_fields *f, oc_stabilize_params *p) {
+  static const char *const sknown[] = {"angle", "rate", "tolerance",
+                                       "iterations", NULL};
+  lua_State *L = f->L;
+  int t = oclua_field_push(f, "stabilize");
+  if (t == LUA_TBOOLEAN) return lua_toboolean(L, -1);
+  if (t == LUA_TTABLE) {
+    oclua_fields g;
+    oclua_fields_open(&g, L, lua_gettop(L), f->fname, "stabilize.", sknown, 0);
+    read_stab(&g, p);
+  } else if (t != LUA_TNIL) {
+    oclua_field_error(f, "stabilize", -1,
+                      "must be a boolean or a table of stabilisation fields");
+  }
+  return 1;
+}
+
 static void push_result(lua_State *L, const oc_stabilize_result *r) {
   lua_createtable(L, 0, 3);
   lua_pushinteger(L, r->iterations);
@@ -428,8 +448,6 @@ static int m_stabilize(lua_State *L) {
 static int m_deposit(lua_State *L) {
   static const char *const known[] = {"center",   "radius",    "amount",
                                       "material", "stabilize", NULL};
-  static const char *const sknown[] = {"angle", "rate", "tolerance",
-                                       "iterations", NULL};
   const char *fname = "layers:deposit";
   oclua_checkargs(L, 2, fname,
                   "({center=, radius=, amount=, material=, stabilize=})");
@@ -453,17 +471,7 @@ static int m_deposit(lua_State *L) {
         p.material != OC_MAT_WATER)
       oclua_error(L, fname, "'material' must be sand, rocks or water");
   }
-  int t = oclua_field_push(&f, "stabilize");
-  if (t == LUA_TBOOLEAN) {
-    p.stabilize = lua_toboolean(L, -1);
-  } else if (t == LUA_TTABLE) {
-    oclua_fields g;
-    oclua_fields_open(&g, L, lua_gettop(L), fname, "stabilize.", sknown, 0);
-    read_stab(&g, &sp);
-  } else if (t != LUA_TNIL) {
-    oclua_field_error(&f, "stabilize", -1,
-                      "must be a boolean or a table of stabilisation fields");
-  }
+  p.stabilize = read_stab_option(&f, &sp);
   oc_error err = {OC_OK, ""};
   oc_stabilize_result r;
   double added;
@@ -477,8 +485,6 @@ static int m_deposit(lua_State *L) {
 static int m_erode(lua_State *L) {
   static const char *const known[] = {"region", "ratio",     "depth",
                                       "mode",   "stabilize", NULL};
-  static const char *const sknown[] = {"angle", "rate", "tolerance",
-                                       "iterations", NULL};
   static const char *const modes[] = {"surface", "collapse", NULL};
   const char *fname = "layers:erode";
   oclua_checkargs(L, 2, fname,
@@ -498,17 +504,7 @@ static int m_erode(lua_State *L) {
   p.depth = oclua_field_optnumber(&f, "depth", OCLUA_POSITIVE,
                                   (p.mode == OC_STACKS_ERODE_SURFACE ? 1 : 5) *
                                       oc_stacks_cell(s));
-  int t = oclua_field_push(&f, "stabilize");
-  if (t == LUA_TBOOLEAN) {
-    p.stabilize = lua_toboolean(L, -1);
-  } else if (t == LUA_TTABLE) {
-    oclua_fields g;
-    oclua_fields_open(&g, L, lua_gettop(L), fname, "stabilize.", sknown, 0);
-    read_stab(&g, &sp);
-  } else if (t != LUA_TNIL) {
-    oclua_field_error(&f, "stabilize", -1,
-                      "must be a boolean or a table of stabilisation fields");
-  }
+  p.stabilize = read_stab_option(&f, &sp);
   oc_error err = {OC_OK, ""};
   oc_stabilize_result res;
   double eroded;

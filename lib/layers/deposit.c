@@ -30,11 +30,7 @@ int oc_stacks_deposit(oc_stacks *s, const oc_deposit_params *p, double *added,
         oc_material_name(p->material) ? oc_material_name(p->material)
                                       : "an unknown material");
   oc_stabilize_params sp;
-  if (p->stab)
-    sp = *p->stab;
-  else
-    oc_stabilize_defaults(s, &sp);
-  if (p->stabilize && oc_layers_check_stabilize(&sp, err)) return OC_EINVAL;
+  if (oc_layers_tool_stab(s, p->stab, p->stabilize, &sp, err)) return OC_EINVAL;
   /* the stacks whose centres may lie within R */
   double c = s->cell;
   double fi0 = ceil((p->cx - p->radius - s->x0) / c);

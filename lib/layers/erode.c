@@ -39,11 +39,7 @@ int oc_stacks_erode(oc_stacks *s, const oc_stacks_erode_params *p,
   if (p->mode != OC_STACKS_ERODE_SURFACE && p->mode != OC_STACKS_ERODE_COLLAPSE)
     return oc_seterr(err, OC_EINVAL, "'mode' must be surface or collapse");
   oc_stabilize_params sp;
-  if (p->stab)
-    sp = *p->stab;
-  else
-    oc_stabilize_defaults(s, &sp);
-  if (p->stabilize && oc_layers_check_stabilize(&sp, err)) return OC_EINVAL;
+  if (oc_layers_tool_stab(s, p->stab, p->stabilize, &sp, err)) return OC_EINVAL;
   double c = s->cell;
   double i0 = fmax(ceil((p->x0 - s->x0) / c), 0);
   double i1 = fmin(floor((p->x1 - s->x0) / c), s->nx - 1);

@@ -85,6 +85,10 @@ int oc_layers_stabilize_segs(oc_stacks *s, oc_lseg *seg, const size_t *soff,
                              oc_stabilize_result *res, oc_error *err);
 /* Checks the stabilisation parameters (messages name the Lua fields). */
 int oc_layers_check_stabilize(const oc_stabilize_params *p, oc_error *err);
+/* A tool's stabilisation parameters: `given`, or the defaults when NULL;
+** checked when the tool stabilises. */
+int oc_layers_tool_stab(const oc_stacks *s, const oc_stabilize_params *given,
+                        int stabilize, oc_stabilize_params *p, oc_error *err);
 /* All stacks to segments: *seg (soff[k] .. soff[k + 1] - 1 for stack k)
 ** and *soff, both malloc'ed. */
 int oc_layers_decode_all(const oc_stacks *s, oc_lseg **seg, size_t **soff,

@@ -298,6 +298,15 @@ int oc_layers_check_stabilize(const oc_stabilize_params *p, oc_error *err) {
   return OC_OK;
 }
 
+int oc_layers_tool_stab(const oc_stacks *s, const oc_stabilize_params *given,
+                        int stabilize, oc_stabilize_params *p, oc_error *err) {
+  if (given)
+    *p = *given;
+  else
+    oc_stabilize_defaults(s, p);
+  return stabilize ? oc_layers_check_stabilize(p, err) : OC_OK;
+}
+
 int oc_stacks_stabilize(oc_stacks *s, const oc_stabilize_params *p,
                         oc_stabilize_result *res, oc_error *err) {
   oc_stabilize_params d;
