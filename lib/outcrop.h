@@ -2013,7 +2013,8 @@ int oc_stacks_deposit(oc_stacks *s, const oc_deposit_params *p, double *added,
 ** [x0, x1] x [y0, y1] turned into loose material, `ratio` of it sand and
 ** the rest rocks (volume conserved), then stabilised from that region when
 ** `stabilize`. OC_STACKS_ERODE_SURFACE: the top `depth` metres of each stack's
-** highest bedrock; OC_STACKS_ERODE_COLLAPSE: every bedrock roof (a bedrock layer
+** highest bedrock; OC_STACKS_ERODE_COLLAPSE: every bedrock roof (a bedrock
+*layer
 ** over air) at most `depth` thick, whose debris falls to the floor below.
 ** *eroded gets the bedrock volume turned (m^3). */
 typedef enum oc_stacks_erode_mode {
@@ -2028,8 +2029,29 @@ typedef struct oc_stacks_erode_params {
   int stabilize;
   const oc_stabilize_params *stab; /* NULL: defaults */
 } oc_stacks_erode_params;
-int oc_stacks_erode(oc_stacks *s, const oc_stacks_erode_params *p, double *eroded,
-                    oc_stabilize_result *res, oc_error *err);
+int oc_stacks_erode(oc_stacks *s, const oc_stacks_erode_params *p,
+                    double *eroded, oc_stabilize_result *res, oc_error *err);
+
+/* Sculpting (section 4): the bedrock's convolution surface f (sigma one
+** cell) plus or minus strength 2T K(|p - c'| / R), K(x) = (1 - x^2)^2,
+** with c' offset by delta from c along the surface normal at c (inward
+** when adding, outward when carving); the stacks within R of c' are
+** rebuilt inside [c'.z - R, c'.z + R] from the crossings of f' = T along
+** their axes (bedrock where f' > T, elsewhere air where there was bedrock
+** and the material there before), then stabilised from that region.
+** *changed gets the bedrock volume added (negative: removed), m^3. */
+typedef struct oc_sculpt_params {
+  oc_vec3 center;
+  double radius;    /* > 0 */
+  double strength;  /* > 0 */
+  double delta;     /* NaN: radius / 2 */
+  int carve;        /* 0: add */
+  double threshold; /* T; 0: OC_DEFAULT_THRESHOLD */
+  int stabilize;
+  const oc_stabilize_params *stab; /* NULL: defaults */
+} oc_sculpt_params;
+int oc_stacks_sculpt(oc_stacks *s, const oc_sculpt_params *p, double *changed,
+                     oc_stabilize_result *res, oc_error *err);
 
 #ifdef __cplusplus
 }

@@ -26,6 +26,9 @@
 **        mode = "surface" | "collapse", depth = 1 cell (surface: how deep;
 **        collapse: the thickest roof that falls; default 5 cells),
 **        stabilize = true | false | {...}} -> bedrock volume turned, {...}
+**   s:sculpt{center = {x, y, z}, radius =, strength = 1, mode = "add" |
+**        "carve", delta = radius / 2, stabilize = true | false | {...}}
+**        -> bedrock volume added (negative: removed), {...}
 **
 ** Stacks are mutable: a node made by s:field is a snapshot. `local s
 ** <close>` frees the grid early.
@@ -515,6 +518,38 @@ static int m_erode(lua_State *L) {
   return 2;
 }
 
+static int m_sculpt(lua_State *L) {
+  static const char *const known[] = {"center", "radius",    "strength", "mode",
+                                      "delta",  "stabilize", NULL};
+  static const char *const modes[] = {"add", "carve", NULL};
+  const char *fname = "layers:sculpt";
+  oclua_checkargs(L, 2, fname,
+                  "({center=, radius=, strength=, mode=, delta=, stabilize=})");
+  oc_stacks *s = pinlayers(L, 1, fname);
+  oclua_fields f;
+  oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
+  oc_stabilize_params sp;
+  oc_stabilize_defaults(s, &sp);
+  oc_sculpt_params p = {oclua_field_vec(&f, "center"), 0, 1, NAN, 0, 0, 1, &sp};
+  p.radius = oclua_field_number(&f, "radius", OCLUA_POSITIVE);
+  p.strength = oclua_field_optnumber(&f, "strength", OCLUA_POSITIVE, 1);
+  p.carve = oclua_field_optoption(&f, "mode", modes, 0);
+  p.delta = oclua_field_optnumber(&f, "delta", OCLUA_FINITE, p.radius / 2);
+  if (p.delta < 0)
+    oclua_error(L, fname, "'delta' must be >= 0 (got %f)",
+                (LUAI_UACNUMBER)p.delta);
+  p.stabilize = read_stab_option(&f, &sp);
+  p.threshold = oclua_threshold(L, fname);
+  oc_error err = {OC_OK, ""};
+  oc_stabilize_result res;
+  double changed;
+  if (oc_stacks_sculpt(s, &p, &changed, &res, &err))
+    oclua_liberror(L, fname, &err);
+  lua_pushnumber(L, changed);
+  push_result(L, &res);
+  return 2;
+}
+
 /* ---- metamethods ------------------------------------------------------- */
 
 static int m_gc(lua_State *L) {
@@ -551,6 +586,7 @@ static const luaL_Reg methods[] = {{"get", m_get},
                                    {"stabilize", m_stabilize},
                                    {"deposit", m_deposit},
                                    {"erode", m_erode},
+                                   {"sculpt", m_sculpt},
                                    {NULL, NULL}};
 
 static const luaL_Reg meta[] = {{"__gc", m_gc},

@@ -499,6 +499,50 @@ START_TEST(erode_modes) {
 }
 END_TEST
 
+/* Sculpting a flat slab: adding raises the top around the centre and
+** adds bedrock there only; carving the same place removes it. */
+START_TEST(sculpt_add_carve) {
+  oc_error err;
+  oc_stacks *s = grid(24, 24, 0.5, 0);
+  uint8_t m = OC_MAT_BEDROCK;
+  double t = 10;
+  ck_assert(oc_stacks_fill(s, &m, &t, 1, &err) == OC_OK);
+  double v0 = oc_stacks_volume(s, OC_MAT_BEDROCK);
+  oc_sculpt_params sp = {{6, 6, 10}, 3, 2, NAN, 0, 0, 0, NULL};
+  double dv;
+  ck_assert_msg(oc_stacks_sculpt(s, &sp, &dv, NULL, &err) == OC_OK, "%s",
+                err.msg);
+  ck_assert(dv > 1);
+  ck_assert_double_eq_tol(oc_stacks_volume(s, OC_MAT_BEDROCK), v0 + dv, 1e-9);
+  /* the top at the centre: where T(1 - (z - 10)) + 4T K = T, K over the
+  ** distance to c' = (6, 6, 8.5) (f of the slab, sigma = 0.5: linear
+  ** over 9.5 .. 10.5, then 0) */
+  oc_heightfield *hf = oc_stacks_heightfield(s, OC_MAT_BEDROCK, &err);
+  double top = oc_heightfield_samples(hf)[12 * 24 + 12];
+  double a = 10, b = 13;
+  for (int it = 0; it < 60; it++) {
+    double z = 0.5 * (a + b), q = (z - 8.5) * (z - 8.5) / 9;
+    double K = q < 1 ? (1 - q) * (1 - q) : 0;
+    double f = 2 * T * fmin(fmax((10.5 - z) / 1, 0), 1) + 4 * T * K;
+    if (f > T)
+      a = z;
+    else
+      b = z;
+  }
+  ck_assert_double_eq_tol(top, a, 1e-4);
+  ck_assert_float_eq(oc_heightfield_samples(hf)[0], 10); /* far: as before */
+  oc_heightfield_release(hf);
+  sp.carve = 1;
+  sp.center.z = top;
+  ck_assert(oc_stacks_sculpt(s, &sp, &dv, NULL, &err) == OC_OK);
+  ck_assert(dv < -1);
+  sp.radius = 0;
+  ck_assert_int_eq(oc_stacks_sculpt(s, &sp, &dv, NULL, &err), OC_EINVAL);
+  ck_assert(strstr(err.msg, "'radius'"));
+  oc_stacks_free(s);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("layers");
   TCase *tc = tcase_create("layers");
@@ -511,6 +555,7 @@ int main(void) {
   tcase_add_test(tc, stabilize_conserves_and_rests);
   tcase_add_test(tc, deposit_and_threads);
   tcase_add_test(tc, erode_modes);
+  tcase_add_test(tc, sculpt_add_carve);
   tcase_add_test(tc, parameter_errors);
   suite_add_tcase(s, tc);
   return oct_run(s);

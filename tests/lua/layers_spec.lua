@@ -151,6 +151,24 @@ describe("outcrop.layers", function()
     check(function() s:erode{} end, "layers:erode", "'region'")
   end)
 
+  it("sculpts bedrock: add raises it, carve removes it", function()
+    local s = L.new{size = {20, 20}, cell = 0.5, layers = {{"bedrock", 10}, {"sand", 0.2}}}
+    local v0 = s:volume("bedrock")
+    local dv = s:sculpt{center = {5, 5, 10}, radius = 2.5, strength = 2}
+    assert.is_true(dv > 1)
+    assert.is_true(math.abs(s:volume("bedrock") - v0 - dv) < 1e-9)
+    assert.is_true(s:heightfield("bedrock"):get(11, 11) > 10.5)
+    assert.are.equal(10, s:heightfield("bedrock"):get(1, 1))
+    -- the sand it lifted stays on top, and no sand is lost
+    assert.is_true(math.abs(s:volume("sand") - 400 * 0.2 * 0.25) < 1e-4)
+    local dc = s:sculpt{center = {5, 5, 9}, radius = 2.5, mode = "carve", stabilize = false}
+    assert.is_true(dc < -1)
+    check(function() s:sculpt{center = {0, 0, 0}, radius = -1} end, "layers:sculpt", "'radius'")
+    check(function() s:sculpt{center = {0, 0, 0}, radius = 1, mode = "smear"} end,
+      "layers:sculpt", "'mode'")
+    check(function() s:sculpt{radius = 1} end, "layers:sculpt", "'center'")
+  end)
+
   it("is the same to the byte on one and two threads", function()
     local function child(threads)
       return R.child_output(threads, "local oc = require \"outcrop\" " ..
