@@ -40,30 +40,37 @@ int oc_stacks_deposit(oc_stacks *s, const oc_deposit_params *p, double *added,
   fi0 = fmax(fi0, 0), fj0 = fmax(fj0, 0);
   fi1 = fmin(fi1, s->nx - 1), fj1 = fmin(fj1, s->ny - 1);
   if (fi0 > fi1 || fj0 > fj1 || p->amount == 0) return OC_OK;
+  /* the stacks of the footprint, edited as a grid of their own */
+  int i0 = (int)fi0, j0 = (int)fj0, i1 = (int)fi1, j1 = (int)fj1;
+  oc_stacks *w = oc_stacks_window(s, i0, j0, i1, j1, err);
+  if (!w) return OC_ENOMEM;
   oc_lseg *seg;
   size_t *soff;
-  int rc = oc_layers_decode_all(s, &seg, &soff, err);
-  if (rc) return rc;
+  int rc = oc_layers_decode_all(w, &seg, &soff, err);
   double vol = 0;
-  for (int j = (int)fj0; j <= (int)fj1; j++)
-    for (int i = (int)fi0; i <= (int)fi1; i++) {
-      double dx = s->x0 + i * c - p->cx, dy = s->y0 + j * c - p->cy;
-      double t = p->amount * oc_falloff(sqrt(dx * dx + dy * dy) / p->radius);
-      if (!(t > 0)) continue;
-      size_t k = (size_t)j * s->nx + i;
-      seg[soff[k + 1] - 1].a[q] += t; /* the top segment: open to the sky */
-      vol += t;
-    }
-  if (p->stabilize) {
-    sp.region[0] = (int)fi0;
-    sp.region[1] = (int)fj0;
-    sp.region[2] = (int)fi1;
-    sp.region[3] = (int)fj1;
-    rc = oc_layers_stabilize_segs(s, seg, soff, &sp, res, err);
+  if (!rc) {
+    for (int j = j0; j <= j1; j++)
+      for (int i = i0; i <= i1; i++) {
+        double dx = s->x0 + i * c - p->cx, dy = s->y0 + j * c - p->cy;
+        double t = p->amount * oc_falloff(sqrt(dx * dx + dy * dy) / p->radius);
+        if (!(t > 0)) continue;
+        size_t k = (size_t)(j - j0) * w->nx + (i - i0);
+        seg[soff[k + 1] - 1].a[q] += t; /* the top segment: the sky's */
+        vol += t;
+      }
+    rc = oc_layers_encode_all(w, seg, soff, err);
+    free(seg);
+    free(soff);
   }
-  if (!rc) rc = oc_layers_encode_all(s, seg, soff, err);
-  free(seg);
-  free(soff);
+  if (!rc) rc = oc_stacks_splice(s, w, i0, j0, err);
+  oc_stacks_free(w);
+  if (!rc && p->stabilize) {
+    sp.region[0] = i0;
+    sp.region[1] = j0;
+    sp.region[2] = i1;
+    sp.region[3] = j1;
+    rc = oc_layers_stabilize_local(s, &sp, res, err);
+  }
   if (!rc && added) *added = vol * c * c;
   return rc;
 }

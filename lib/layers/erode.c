@@ -46,55 +46,53 @@ int oc_stacks_erode(oc_stacks *s, const oc_stacks_erode_params *p,
   double j0 = fmax(ceil((p->y0 - s->y0) / c), 0);
   double j1 = fmin(floor((p->y1 - s->y0) / c), s->ny - 1);
   if (i0 > i1 || j0 > j1) return OC_OK;
-  size_t ns = (size_t)s->nx * s->ny, most = 0;
+  oc_stacks *w = oc_stacks_window(s, (int)i0, (int)j0, (int)i1, (int)j1, err);
+  if (!w) return OC_ENOMEM;
+  size_t ns = (size_t)w->nx * w->ny, most = 0;
   for (size_t k = 0; k < ns; k++)
-    if (s->off[k + 1] - s->off[k] > most) most = s->off[k + 1] - s->off[k];
+    if (w->off[k + 1] - w->off[k] > most) most = w->off[k + 1] - w->off[k];
   /* each bedrock layer may gain 2 debris layers */
   oc_layer *l = malloc((3 * most + 3) * 2 * sizeof *l);
   oc_stacks_builder b;
-  if (!l || oc_builder_init(&b, ns, s->off[ns] + ns / 4, err)) {
-    free(l);
-    return l ? OC_ENOMEM : oc_seterr(err, OC_ENOMEM, "out of memory");
-  }
-  oc_layer *out = l + 3 * most + 3;
+  int rc = l ? oc_builder_init(&b, ns, w->off[ns] + ns, err)
+             : oc_seterr(err, OC_ENOMEM, "out of memory");
   double vol = 0;
-  int rc = OC_OK;
   for (size_t k = 0; k < ns && rc == OC_OK; k++) {
+    oc_layer *out = l + 3 * most + 3;
     size_t n = 0;
-    for (uint32_t q = s->off[k]; q < s->off[k + 1]; q++)
-      l[n++] = (oc_layer){s->thick[q], s->mat[q]};
-    int i = (int)(k % s->nx), j = (int)(k / s->nx);
-    if (i >= i0 && i <= i1 && j >= j0 && j <= j1) {
-      if (p->mode == OC_STACKS_ERODE_SURFACE) {
-        for (size_t q = n; q-- > 0;)
-          if (l[q].m == OC_MAT_BEDROCK) {
-            double d = fmin(p->depth, l[q].t);
-            debris(l, &n, q, d, p->ratio);
-            vol += d;
-            break;
-          }
-      } else {
-        for (size_t q = n; q-- > 1;)
-          if (l[q].m == OC_MAT_BEDROCK && l[q - 1].m == OC_MAT_AIR &&
-              l[q].t <= p->depth) {
-            vol += l[q].t;
-            debris(l, &n, q, l[q].t, p->ratio);
-          }
-      }
+    for (uint32_t q = w->off[k]; q < w->off[k + 1]; q++)
+      l[n++] = (oc_layer){w->thick[q], w->mat[q]};
+    if (p->mode == OC_STACKS_ERODE_SURFACE) {
+      for (size_t q = n; q-- > 0;)
+        if (l[q].m == OC_MAT_BEDROCK) {
+          double d = fmin(p->depth, l[q].t);
+          debris(l, &n, q, d, p->ratio);
+          vol += d;
+          break;
+        }
+    } else {
+      for (size_t q = n; q-- > 1;)
+        if (l[q].m == OC_MAT_BEDROCK && l[q - 1].m == OC_MAT_AIR &&
+            l[q].t <= p->depth) {
+          vol += l[q].t;
+          debris(l, &n, q, l[q].t, p->ratio);
+        }
     }
     rc = oc_builder_push(&b, out, oc_layers_canon(l, n, out), err);
   }
-  free(l);
-  if (rc) {
+  if (rc == OC_OK)
+    oc_builder_commit(&b, w);
+  else if (l)
     oc_builder_free(&b);
-    return rc;
-  }
-  oc_builder_commit(&b, s);
+  free(l);
+  if (rc == OC_OK) rc = oc_stacks_splice(s, w, (int)i0, (int)j0, err);
+  oc_stacks_free(w);
+  if (rc) return rc;
   if (eroded) *eroded = vol * c * c;
   if (!p->stabilize || vol == 0) return OC_OK;
   sp.region[0] = (int)i0;
   sp.region[1] = (int)j0;
   sp.region[2] = (int)i1;
   sp.region[3] = (int)j1;
-  return oc_stacks_stabilize(s, &sp, res, err);
+  return oc_layers_stabilize_local(s, &sp, res, err);
 }

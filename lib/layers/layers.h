@@ -89,6 +89,16 @@ int oc_layers_check_stabilize(const oc_stabilize_params *p, oc_error *err);
 ** checked when the tool stabilises. */
 int oc_layers_tool_stab(const oc_stacks *s, const oc_stabilize_params *given,
                         int stabilize, oc_stabilize_params *p, oc_error *err);
+/* Stacks [i0, i1] x [j0, j1] of s as a grid of their own (origin moved;
+** the caller frees it), and such a grid put back at (i0, j0) (window.c). */
+oc_stacks *oc_stacks_window(const oc_stacks *s, int i0, int j0, int i1, int j1,
+                            oc_error *err);
+int oc_stacks_splice(oc_stacks *s, const oc_stacks *w, int i0, int j0,
+                     oc_error *err);
+/* Stabilisation from p->region (which must be set) in a window around
+** it, grown until nothing reaches its border. */
+int oc_layers_stabilize_local(oc_stacks *s, const oc_stabilize_params *p,
+                              oc_stabilize_result *res, oc_error *err);
 /* All stacks to segments: *seg (soff[k] .. soff[k + 1] - 1 for stack k)
 ** and *soff, both malloc'ed. */
 int oc_layers_decode_all(const oc_stacks *s, oc_lseg **seg, size_t **soff,

@@ -160,13 +160,29 @@ int oc_stacks_sculpt(oc_stacks *s, const oc_sculpt_params *p, double *changed,
   if (!oc_check_positive(T, "threshold", err)) return OC_EINVAL;
   oc_stabilize_params sp;
   if (oc_layers_tool_stab(s, p->stab, p->stabilize, &sp, err)) return OC_EINVAL;
-  double before = oc_stacks_volume(s, OC_MAT_BEDROCK);
-  oc_node *n = oc_stacks_field(s, 1u << OC_MAT_BEDROCK, NAN, err);
-  if (!n) return err ? err->code : OC_ENOMEM;
-  oc_compile_options co = {T, 0};
-  oc_program *P = oc_compile(n, &co, err);
-  oc_node_release(n);
-  if (!P) return err ? err->code : OC_ENOMEM;
+  /* the stacks around, edited as a grid of their own: the footprint
+  ** (found below) grown by the kernel's reach and a margin */
+  double c = s->cell, R = p->radius;
+  double ext = R + delta + 3 * c;
+  int wi0 = (int)fmax(ceil((p->center.x - ext - s->x0) / c), 0);
+  int wi1 = (int)fmin(floor((p->center.x + ext - s->x0) / c), s->nx - 1);
+  int wj0 = (int)fmax(ceil((p->center.y - ext - s->y0) / c), 0);
+  int wj1 = (int)fmin(floor((p->center.y + ext - s->y0) / c), s->ny - 1);
+  if (wi0 > wi1 || wj0 > wj1) return OC_OK;
+  oc_stacks *w = oc_stacks_window(s, wi0, wj0, wi1, wj1, err);
+  if (!w) return OC_ENOMEM;
+  double before = oc_stacks_volume(w, OC_MAT_BEDROCK);
+  oc_node *n = oc_stacks_field(w, 1u << OC_MAT_BEDROCK, NAN, err);
+  oc_program *P = NULL;
+  if (n) {
+    oc_compile_options co = {T, 0};
+    P = oc_compile(n, &co, err);
+    oc_node_release(n);
+  }
+  if (!P) {
+    oc_stacks_free(w);
+    return err ? err->code : OC_ENOMEM;
+  }
   /* the normal at the picked point: outward is down the gradient */
   oc_vec3 g;
   oc_program_gradient(P, p->center, &g);
@@ -180,28 +196,27 @@ int oc_stacks_sculpt(oc_stacks *s, const oc_sculpt_params *p, double *changed,
             p->radius,
             (p->carve ? -1 : 1) * p->strength * 2 * T,
             T};
-  double c = s->cell, R = p->radius;
   double i0 = fmax(ceil((x.c.x - R - s->x0) / c), 0);
   double i1 = fmin(floor((x.c.x + R - s->x0) / c), s->nx - 1);
   double j0 = fmax(ceil((x.c.y - R - s->y0) / c), 0);
   double j1 = fmin(floor((x.c.y + R - s->y0) / c), s->ny - 1);
-  size_t ns = (size_t)s->nx * s->ny, most = 0;
+  size_t ns = (size_t)w->nx * w->ny, most = 0;
   for (size_t k = 0; k < ns; k++)
-    if (s->off[k + 1] - s->off[k] > most) most = s->off[k + 1] - s->off[k];
+    if (w->off[k + 1] - w->off[k] > most) most = w->off[k + 1] - w->off[k];
   oc_layer *in = malloc((most + 1) * sizeof *in);
   oc_layer *out = NULL;
   lbuf b = {NULL, 0, 0};
   oc_stacks_builder bd;
-  int rc = in ? oc_builder_init(&bd, ns, s->off[ns] + 64, err)
+  int rc = in ? oc_builder_init(&bd, ns, w->off[ns] + 64, err)
               : oc_seterr(err, OC_ENOMEM, "out of memory");
   for (size_t k = 0; k < ns && rc == OC_OK; k++) {
     size_t n0 = 0;
-    for (uint32_t q = s->off[k]; q < s->off[k + 1]; q++)
-      in[n0++] = (oc_layer){s->thick[q], s->mat[q]};
-    int i = (int)(k % s->nx), j = (int)(k / s->nx);
-    double px = s->x0 + i * c, py = s->y0 + j * c;
+    for (uint32_t q = w->off[k]; q < w->off[k + 1]; q++)
+      in[n0++] = (oc_layer){w->thick[q], w->mat[q]};
+    double px = w->x0 + (double)(k % w->nx) * c;
+    double py = w->y0 + (double)(k / w->nx) * c;
     double dx = px - x.c.x, dy = py - x.c.y;
-    if (i < i0 || i > i1 || j < j0 || j > j1 || dx * dx + dy * dy >= R * R) {
+    if (dx * dx + dy * dy >= R * R) {
       rc = oc_builder_push(&bd, in, n0, err);
       continue;
     }
@@ -219,19 +234,22 @@ int oc_stacks_sculpt(oc_stacks *s, const oc_sculpt_params *p, double *changed,
     rc = oc_builder_push(&bd, out, oc_layers_canon(b.l, b.n, out), err);
   }
   if (rc == OC_OK)
-    oc_builder_commit(&bd, s);
+    oc_builder_commit(&bd, w);
   else if (in)
     oc_builder_free(&bd);
   free(in);
   free(out);
   free(b.l);
   oc_program_free(P);
+  double after = oc_stacks_volume(w, OC_MAT_BEDROCK);
+  if (rc == OC_OK) rc = oc_stacks_splice(s, w, wi0, wj0, err);
+  oc_stacks_free(w);
   if (rc) return rc;
-  if (changed) *changed = oc_stacks_volume(s, OC_MAT_BEDROCK) - before;
+  if (changed) *changed = after - before;
   if (!p->stabilize || i0 > i1 || j0 > j1) return OC_OK;
   sp.region[0] = (int)i0;
   sp.region[1] = (int)j0;
   sp.region[2] = (int)i1;
   sp.region[3] = (int)j1;
-  return oc_stacks_stabilize(s, &sp, res, err);
+  return oc_layers_stabilize_local(s, &sp, res, err);
 }

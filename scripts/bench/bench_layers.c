@@ -7,6 +7,9 @@
 **                              canyon and cliff scenes as context lines
 **   layers.stabilize_seconds_2t  1000 x 750 stacks of 1 m, a 10^5 m^3
 **                              sand deposit (R = 50 m) stabilised
+**   layers.edit_ms             a sculpt stroke of radius 10 cells on the
+**                              same grid under 1 m of sand (re-layering
+**                              and local stabilisation), best of 3
 **
 ** The scenes are synthetic stand-ins built stack by stack (the paper's
 ** scenes are not available): a ground of bedrock under a sand cover,
@@ -23,6 +26,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "benchout.h"
 #include "layers/layers.h"
 
 /* Layers of stack (i, j) of scene `kind` into l (canonical after). */
@@ -133,16 +137,46 @@ static double stabilize_seconds(double *cpu, long *iters, double *moved) {
   return sec;
 }
 
+static double edit_ms(void) {
+  oc_error err;
+  oc_stacks *s = oc_stacks_new(1000, 750, 1, 0, 0, 0, &err);
+  uint8_t m[2] = {OC_MAT_BEDROCK, OC_MAT_SAND};
+  double t[2] = {50, 1}, best = INFINITY, cpu = INFINITY;
+  oc_stacks_fill(s, m, t, 2, &err);
+  for (int r = 0; r < 3; r++) {
+    oc_sculpt_params sp = {{500 + 30 * r, 375, 50}, 10, 1, NAN, 0, 0, 1, NULL};
+    double dv;
+    clock_t c0 = clock();
+    double t0 = omp_get_wtime();
+    if (oc_stacks_sculpt(s, &sp, &dv, NULL, &err)) {
+      fprintf(stderr, "bench_layers: %s\n", err.msg);
+      break;
+    }
+    best = fmin(best, omp_get_wtime() - t0);
+    cpu = fmin(cpu, (double)(clock() - c0) / CLOCKS_PER_SEC);
+  }
+  printf("# sculpt stroke: %.1f ms of CPU (both threads), best of 3\n",
+         cpu * 1e3);
+  oc_stacks_free(s);
+  return best * 1e3;
+}
+
+/* Parts (OUTCROP_BENCH_ONLY): mb, edit, stabilize. */
 int main(void) {
-  double cave = memory(0, 1000, 750, "cave");
-  memory(1, 1000, 500, "canyon");
-  memory(2, 2000, 500, "cliff");
-  printf("layers.mb: %.2f MB\n", cave);
-  double cpu, moved;
-  long it;
-  double sec = stabilize_seconds(&cpu, &it, &moved);
-  printf("# %d threads; %ld iterations, %.0f m^3 moved, %.2f s CPU\n",
-         omp_get_max_threads(), it, moved, cpu);
-  printf("layers.stabilize_seconds_2t: %.3f s\n", sec);
+  if (bench_wanted("mb")) {
+    double cave = memory(0, 1000, 750, "cave");
+    memory(1, 1000, 500, "canyon");
+    memory(2, 2000, 500, "cliff");
+    printf("layers.mb: %.2f MB\n", cave);
+  }
+  if (bench_wanted("edit")) printf("layers.edit_ms: %.1f ms\n", edit_ms());
+  if (bench_wanted("stabilize")) {
+    double cpu, moved;
+    long it;
+    double sec = stabilize_seconds(&cpu, &it, &moved);
+    printf("# %d threads; %ld iterations, %.0f m^3 moved, %.2f s CPU\n",
+           omp_get_max_threads(), it, moved, cpu);
+    printf("layers.stabilize_seconds_2t: %.3f s\n", sec);
+  }
   return 0;
 }

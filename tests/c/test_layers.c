@@ -543,6 +543,35 @@ START_TEST(sculpt_add_carve) {
 }
 END_TEST
 
+/* A deposit stabilised in a window around it (grown while material
+** reaches its border) gives the stacks the whole grid's stabilisation
+** gives. */
+START_TEST(local_equals_whole) {
+  oc_error err;
+  oc_stacks *s[2];
+  for (int k = 0; k < 2; k++) {
+    s[k] = grid(90, 80, 1, 0);
+    uint8_t m = OC_MAT_BEDROCK;
+    double t = 3;
+    ck_assert(oc_stacks_fill(s[k], &m, &t, 1, &err) == OC_OK);
+    oc_deposit_params dp = {40, 35, 3, 200, OC_MAT_SAND, k == 0, NULL};
+    double added;
+    oc_stabilize_result res;
+    ck_assert(oc_stacks_deposit(s[k], &dp, &added, &res, &err) == OC_OK);
+    if (k == 1) {
+      ck_assert(oc_stacks_stabilize(s[k], NULL, &res, &err) == OC_OK);
+      ck_assert(res.converged);
+    }
+  }
+  /* the pile spread past the first window (8 stacks around 7 x 7) */
+  uint8_t mm[4];
+  ck_assert_uint_eq(oc_stacks_get(s[0], 40 - 13, 35, mm, NULL, 4), 2);
+  same_stacks(s[0], s[1]);
+  oc_stacks_free(s[0]);
+  oc_stacks_free(s[1]);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("layers");
   TCase *tc = tcase_create("layers");
@@ -554,6 +583,7 @@ int main(void) {
   tcase_add_test(tc, from_program_reproduces_surface);
   tcase_add_test(tc, stabilize_conserves_and_rests);
   tcase_add_test(tc, deposit_and_threads);
+  tcase_add_test(tc, local_equals_whole);
   tcase_add_test(tc, erode_modes);
   tcase_add_test(tc, sculpt_add_carve);
   tcase_add_test(tc, parameter_errors);
