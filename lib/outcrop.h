@@ -1989,7 +1989,7 @@ typedef struct oc_stabilize_result {
   int converged;   /* 1: no transfer exceeds the tolerance */
   double moved;    /* m^3 moved in all */
 } oc_stabilize_result;
-/* sand 32, rocks 42 degrees; rate 0.25; tolerance 1e-4 cell; 100000
+/* sand 32, rocks 42 degrees; rate 0.25; tolerance 1e-3 cell; 100000
 ** iterations; the whole grid. */
 void oc_stabilize_defaults(const oc_stacks *s, oc_stabilize_params *p);
 int oc_stacks_stabilize(oc_stacks *s, const oc_stabilize_params *p,

@@ -17,7 +17,7 @@
 **   s:stats() -> {stacks =, layers =, bytes =}
 **   s:field{materials = {"bedrock", "sand", "rocks"}, sigma = cell} -> node
 **   s:stabilize{angle = {sand = 32, rocks = 42}, rate = 0.25,
-**        tolerance = cell / 10000, iterations = 100000}
+**        tolerance = cell / 1000, iterations = 100000}
 **        -> {iterations =, converged =, moved =}
 **   s:deposit{center = {x, y}, radius =, amount =, material = "sand",
 **        stabilize = true | false | {stabilize's fields}}

@@ -283,7 +283,7 @@ void oc_stabilize_defaults(const oc_stacks *s, oc_stabilize_params *p) {
   p->angle[OC_MAT_SAND] = 32;
   p->angle[OC_MAT_ROCKS] = 42;
   p->rate = 0.25;
-  p->tolerance = 1e-4 * (s ? s->cell : 1);
+  p->tolerance = 1e-3 * (s ? s->cell : 1);
   p->iterations = 100000;
   p->region[0] = 0;
   p->region[2] = -1;

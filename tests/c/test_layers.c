@@ -572,6 +572,30 @@ START_TEST(local_equals_whole) {
 }
 END_TEST
 
+/* Passes over large boxes run on both threads: the same stacks as on
+** one. */
+START_TEST(large_grid_threads) {
+  oc_error err;
+  oc_stacks *s[2];
+  for (int t = 0; t < 2; t++) {
+    omp_set_num_threads(t + 1);
+    s[t] = sand_pile(300, 6);
+    for (int k = 0; k < 4; k++) { /* piles far apart: a box of 90 000 */
+      oc_deposit_params dp = {
+          20 + 260 * (k & 1), 20 + 260 * (k >> 1), 6, 5, OC_MAT_SAND, 0, NULL};
+      ck_assert(oc_stacks_deposit(s[t], &dp, NULL, NULL, &err) == OC_OK);
+    }
+    oc_stabilize_result res;
+    ck_assert(oc_stacks_stabilize(s[t], NULL, &res, &err) == OC_OK);
+    ck_assert(res.converged && res.moved > 0);
+  }
+  omp_set_num_threads(2);
+  same_stacks(s[0], s[1]);
+  oc_stacks_free(s[0]);
+  oc_stacks_free(s[1]);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("layers");
   TCase *tc = tcase_create("layers");
@@ -584,6 +608,7 @@ int main(void) {
   tcase_add_test(tc, stabilize_conserves_and_rests);
   tcase_add_test(tc, deposit_and_threads);
   tcase_add_test(tc, local_equals_whole);
+  tcase_add_test(tc, large_grid_threads);
   tcase_add_test(tc, erode_modes);
   tcase_add_test(tc, sculpt_add_carve);
   tcase_add_test(tc, parameter_errors);
