@@ -2123,6 +2123,200 @@ void oc_sha256_text(const void *data, size_t n, char hex[OC_SHA256_HEX]);
 ** a message naming the path. (lib/io/infile.c) */
 int oc_infile_sha256(const char *path, char *hex, oc_error *err);
 
+/* ---- material layers (Peytavie et al. 2009) (layers/) ------------------ */
+
+/* A 2D grid of material stacks: stack (i, j), 0 <= i < nx, 0 <= j < ny,
+** is the square of side `cell` centred on (x0 + i cell, y0 + j cell) (as
+** the samples of a heightfield), and holds layers bottom-up from the
+** common base elevation `zbase`; above its last layer is air. Layers are
+** kept canonical: no empty layer, adjacent layers of one material merged,
+** and between two bedrock layers (and below the first, above the last)
+** sand, rocks, water, air upwards (the paper sorts sand, rocks, air;
+** water just below air is outcrop's choice). Thicknesses are stored as
+** floats: about 5 bytes per layer and 4 per stack.
+** Mutable, with one owner: oc_stacks_new and the converters return a grid
+** the caller frees with oc_stacks_free; edits are not thread-safe, the
+** work inside them runs on both cores with results independent of the
+** thread count. */
+typedef struct oc_stacks oc_stacks;
+
+typedef enum oc_material {
+  OC_MAT_AIR = 0,
+  OC_MAT_WATER,
+  OC_MAT_SAND,
+  OC_MAT_ROCKS,
+  OC_MAT_BEDROCK,
+  OC_MAT_COUNT
+} oc_material;
+
+/* "air", "water", "sand", "rocks", "bedrock"; NULL out of range. */
+const char *oc_material_name(int m);
+/* The material named `name`, or -1. */
+int oc_material_parse(const char *name);
+
+/* Stacks per grid at most (as heightfields), and layers in all. */
+#define OC_STACKS_MAX (1ull << 28)
+#define OC_STACKS_MAX_LAYERS (1ull << 31)
+
+/* nx, ny in 1 .. 65535 and nx ny <= OC_STACKS_MAX; cell > 0; finite
+** origin and base. Every stack starts empty (all air). */
+oc_stacks *oc_stacks_new(int nx, int ny, double cell, double x0, double y0,
+                         double zbase, oc_error *err);
+void oc_stacks_free(oc_stacks *s);
+
+int oc_stacks_nx(const oc_stacks *s);
+int oc_stacks_ny(const oc_stacks *s);
+double oc_stacks_cell(const oc_stacks *s);
+void oc_stacks_origin(const oc_stacks *s, double *x0, double *y0);
+double oc_stacks_base(const oc_stacks *s);
+
+/* Replaces the layers of stack (i, j) by n layers (materials and
+** thicknesses, bottom-up; each thickness finite and >= 0), made
+** canonical. Rewrites the grid's tail: O(layers). OC_OK or OC_EINVAL
+** naming 'i', 'j', 'material' or 'thickness'. */
+int oc_stacks_set(oc_stacks *s, int i, int j, const uint8_t *mat,
+                  const double *thick, size_t n, oc_error *err);
+/* Every stack set to the same n layers (checked as oc_stacks_set). */
+int oc_stacks_fill(oc_stacks *s, const uint8_t *mat, const double *thick,
+                   size_t n, oc_error *err);
+/* The layer count of stack (i, j); the first `max` layers go to mat and
+** thick (either may be NULL). */
+size_t oc_stacks_get(const oc_stacks *s, int i, int j, uint8_t *mat,
+                     double *thick, size_t max);
+
+typedef struct oc_stacks_stats {
+  size_t stacks, layers, bytes; /* bytes: the grid's own arrays */
+} oc_stacks_stats;
+void oc_stacks_get_stats(const oc_stacks *s, oc_stacks_stats *st);
+/* Volume of material m in m^3 (thicknesses times cell^2). */
+double oc_stacks_volume(const oc_stacks *s, int m);
+/* A heightfield of the grid's shape: the top of the highest layer of
+** material m in each stack (zbase where there is none). The caller
+** releases it. */
+oc_heightfield *oc_stacks_heightfield(const oc_stacks *s, int m, oc_error *err);
+
+/* From a heightfield: one stack per sample, bedrock from zbase (default:
+** 1 below the lowest sample when zbase is NaN) to the sample, and `sand`
+** metres of sand on it (>= 0). */
+typedef struct oc_stacks_hf_params {
+  double zbase; /* NaN: the lowest sample - 1 */
+  double sand;  /* >= 0 */
+} oc_stacks_hf_params;
+oc_stacks *oc_stacks_from_heightfield(const oc_heightfield *hf,
+                                      const oc_stacks_hf_params *p,
+                                      oc_error *err);
+
+/* From a compiled field: stacks of side `cell` whose centres cover
+** box's x and y ([lo, hi] inclusive, floor((hi - lo) / cell) + 1 of
+** them), each layering the column [box.lo.z, box.hi.z] at every f = T
+** crossing (material inside, air outside; found by sampling every
+** `step` (default cell / 4 when 0) where the column spans say f may
+** vary, then bisection to 1e-6 cell). zbase = box.lo.z. */
+typedef struct oc_stacks_node_params {
+  oc_aabb box;
+  double cell, step;
+  int material; /* OC_MAT_*, not air */
+} oc_stacks_node_params;
+oc_stacks *oc_stacks_from_program(const oc_program *prog,
+                                  const oc_stacks_node_params *p,
+                                  oc_error *err);
+
+/* The convolution surface of the materials in `mask` (bits 1 << OC_MAT_*):
+** f(p) = 2T V_M(p) / V_Omega, V_M the volume of those materials inside
+** the cube Omega of half-side sigma around p (V_Omega = 8 sigma^3): T
+** where the cube is half full. A snapshot: later edits of the grid do not
+** change the node. sigma > 0 (NaN: one cell). */
+oc_node *oc_stacks_field(const oc_stacks *s, unsigned mask, double sigma,
+                         oc_error *err);
+
+/* Stabilisation by the angle of repose (section 3.4). For sand, then
+** rocks, until no transfer exceeds `tolerance`: every stack with material
+** m at height h (the top of m in its segment between bedrock layers)
+** moves to each of its 8 neighbours i an amount proportional to
+** dh~_i = dh_i - t_i where dh_i = h - h_i > t_i, h_i the top of the solid
+** in the neighbour's segment holding elevation h, t_i = cell tan(alpha)
+** (sides) or cell sqrt(2) tan(alpha) (diagonals); the total moved is
+** rate * max dh~_i capped by the material present, and each transfer by
+** an eighth of the air of the receiving segment. Double-buffered: the
+** result does not depend on the thread count. Volume is conserved to
+** rounding. */
+typedef struct oc_stabilize_params {
+  double angle[OC_MAT_COUNT]; /* degrees in (0, 90): sand and rocks read */
+  double rate;                /* (0, 0.5] */
+  double tolerance;           /* > 0, metres */
+  long iterations;            /* per material, >= 1 */
+  int region[4];              /* i0, j0, i1, j1 of the stacks first
+                              ** examined (inclusive); i1 < i0: all */
+} oc_stabilize_params;
+typedef struct oc_stabilize_result {
+  long iterations; /* passes over both materials */
+  int converged;   /* 1: no transfer exceeds the tolerance */
+  double moved;    /* m^3 moved in all */
+} oc_stabilize_result;
+/* sand 32, rocks 42 degrees; rate 0.25; tolerance 1e-3 cell; 100000
+** iterations; the whole grid. */
+void oc_stabilize_defaults(const oc_stacks *s, oc_stabilize_params *p);
+int oc_stacks_stabilize(oc_stacks *s, const oc_stabilize_params *p,
+                        oc_stabilize_result *res, oc_error *err);
+
+/* Deposit (section 4): amount A g(|p - c| / R) metres of sand, rocks or
+** water on top of every stack whose centre p lies within R of c (g the
+** engine's falloff (1 - x^2)^3), then stabilisation from that region when
+** `stabilize` (p->stab; NULL: defaults). *added gets the volume added
+** (m^3). */
+typedef struct oc_deposit_params {
+  double cx, cy, radius, amount;
+  int material; /* sand, rocks or water */
+  int stabilize;
+  const oc_stabilize_params *stab;
+} oc_deposit_params;
+int oc_stacks_deposit(oc_stacks *s, const oc_deposit_params *p, double *added,
+                      oc_stabilize_result *res, oc_error *err);
+
+/* Erosion (section 4): bedrock of the stacks whose centres lie in
+** [x0, x1] x [y0, y1] turned into loose material, `ratio` of it sand and
+** the rest rocks (volume conserved), then stabilised from that region when
+** `stabilize`. OC_STACKS_ERODE_SURFACE: the top `depth` metres of each stack's
+** highest bedrock; OC_STACKS_ERODE_COLLAPSE: every bedrock roof (a bedrock
+*layer
+** over air) at most `depth` thick, whose debris falls to the floor below.
+** *eroded gets the bedrock volume turned (m^3). */
+typedef enum oc_stacks_erode_mode {
+  OC_STACKS_ERODE_SURFACE,
+  OC_STACKS_ERODE_COLLAPSE
+} oc_stacks_erode_mode;
+typedef struct oc_stacks_erode_params {
+  double x0, y0, x1, y1;
+  double ratio; /* [0, 1]: the sand fraction */
+  double depth; /* > 0 */
+  oc_stacks_erode_mode mode;
+  int stabilize;
+  const oc_stabilize_params *stab; /* NULL: defaults */
+} oc_stacks_erode_params;
+int oc_stacks_erode(oc_stacks *s, const oc_stacks_erode_params *p,
+                    double *eroded, oc_stabilize_result *res, oc_error *err);
+
+/* Sculpting (section 4): the bedrock's convolution surface f (sigma one
+** cell) plus or minus strength 2T K(|p - c'| / R), K(x) = (1 - x^2)^2,
+** with c' offset by delta from c along the surface normal at c (inward
+** when adding, outward when carving); the stacks within R of c' are
+** rebuilt inside [c'.z - R, c'.z + R] from the crossings of f' = T along
+** their axes (bedrock where f' > T, elsewhere air where there was bedrock
+** and the material there before), then stabilised from that region.
+** *changed gets the bedrock volume added (negative: removed), m^3. */
+typedef struct oc_sculpt_params {
+  oc_vec3 center;
+  double radius;    /* > 0 */
+  double strength;  /* > 0 */
+  double delta;     /* NaN: radius / 2 */
+  int carve;        /* 0: add */
+  double threshold; /* T; 0: OC_DEFAULT_THRESHOLD */
+  int stabilize;
+  const oc_stabilize_params *stab; /* NULL: defaults */
+} oc_sculpt_params;
+int oc_stacks_sculpt(oc_stacks *s, const oc_sculpt_params *p, double *changed,
+                     oc_stabilize_result *res, oc_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -181,8 +181,7 @@ describe("outcrop.heightfield.from of an elevation tree", function()
 
   it("is the same to the byte on one and two threads", function()
     local function child(threads)
-      local p = assert(io.popen("OMP_NUM_THREADS=" .. threads ..
-        " lua5.4 -e 'package.cpath=[[" .. package.cpath .. "]] " ..
+      return R.child_output(threads,
         "local oc = require \"outcrop\" local E = oc.elevation " ..
         "local e = E.blend{E.disc{center = {0, 0}, radius = 900, height = 50, " ..
         "noise = {kind = \"turbulence\", amplitude = 80, wavelength = 150}}, " ..
@@ -191,10 +190,7 @@ describe("outcrop.heightfield.from of an elevation tree", function()
         "origin = {-400, -270}}) local t = {} " ..
         "for j = 1, 200 do for i = 1, 300 do " ..
         "t[#t + 1] = string.pack(\"f\", hf:get(i, j)) end end " ..
-        "io.write(table.concat(t))'"))
-      local out = p:read("a")
-      p:close()
-      return out
+        "io.write(table.concat(t))")
     end
     local one, two = child(1), child(2)
     assert.are.equal(300 * 200 * 4, #one)

@@ -197,4 +197,16 @@ function M.reset_config()
   end
 end
 
+-- What the Lua chunk `body` writes to stdout when run by a child lua5.4
+-- on `threads` OpenMP threads, with this process's package.cpath (for
+-- "the same bytes on one and two threads" checks). `body` must not hold
+-- single quotes.
+function M.child_output(threads, body)
+  local p = assert(io.popen("OMP_NUM_THREADS=" .. threads ..
+    " lua5.4 -e 'package.cpath=[[" .. package.cpath .. "]] " .. body .. "'"))
+  local out = p:read("a")
+  p:close()
+  return out
+end
+
 return M

@@ -1,0 +1,110 @@
+/*
+** layers.h — the material-stack grid of Peytavie et al. 2009, section 3.2
+** (internal to lib/layers): its packed storage, the canonical form of a
+** stack, and the segment view (the gaps between bedrock layers) that the
+** stabilisation and the tools edit.
+**
+** Storage: compressed rows. Stack k = j nx + i holds layers
+** off[k] .. off[k + 1] - 1 of two parallel arrays, a float thickness and
+** a material byte (5 bytes a layer, 4 a stack), bottom-up from zbase.
+** Edits decode stacks to doubles, work there, and re-encode (rounding
+** each thickness to a float once).
+*/
+#ifndef OC_LAYERS_H
+#define OC_LAYERS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "outcrop.h"
+
+struct oc_stacks {
+  int nx, ny;
+  double cell, x0, y0, zbase;
+  uint32_t *off; /* nx ny + 1 */
+  float *thick;  /* off[nx ny] layers */
+  uint8_t *mat;
+  size_t cap; /* capacity of thick and mat */
+};
+
+/* One layer while being edited. */
+typedef struct oc_layer {
+  double t;
+  int m;
+} oc_layer;
+
+/* The canonical form of n layers (see outcrop.h) into out (room for n;
+** may not alias in): drops empty layers, merges, sorts each gap between
+** bedrock layers (sand, rocks, water, air) and drops trailing air.
+** Returns the count. */
+size_t oc_layers_canon(const oc_layer *in, size_t n, oc_layer *out);
+
+/* A segment: the gap above a bedrock layer (or above zbase for the
+** first), and the bedrock below it. floor: its bottom elevation; cap:
+** its height up to the next bedrock (INFINITY for the last); a: its
+** sand, rocks and water (air fills the rest). */
+enum { OC_SEG_SAND, OC_SEG_ROCKS, OC_SEG_WATER, OC_SEG_N };
+typedef struct oc_lseg {
+  double floor, cap, bed;
+  double a[OC_SEG_N];
+} oc_lseg;
+
+/* The segment index a granular material or water uses; -1 otherwise. */
+int oc_seg_index(int m);
+/* Stack k as segments (one more than its bedrock layers) into out, which
+** has room for off[k + 1] - off[k] + 1. Returns the count. */
+size_t oc_layers_segments(const oc_stacks *s, size_t k, oc_lseg *out);
+/* Segments back to canonical layers into out (room for 5 nseg); returns
+** the count. */
+size_t oc_layers_from_segments(const oc_lseg *seg, size_t nseg, oc_layer *out);
+
+/* A grid being rebuilt stack by stack, in order (k = 0, 1, ...). */
+typedef struct oc_stacks_builder {
+  uint32_t *off;
+  float *thick;
+  uint8_t *mat;
+  size_t n, cap, nstacks, k;
+} oc_stacks_builder;
+int oc_builder_init(oc_stacks_builder *b, size_t nstacks, size_t cap,
+                    oc_error *err);
+/* Appends the next stack (layers already canonical). */
+int oc_builder_push(oc_stacks_builder *b, const oc_layer *l, size_t n,
+                    oc_error *err);
+/* Moves the arrays into s (freeing its old ones); b is empty after. */
+void oc_builder_commit(oc_stacks_builder *b, oc_stacks *s);
+void oc_builder_free(oc_stacks_builder *b);
+
+/* A grid with no layers yet, its arrays unset (for converters). */
+oc_stacks *oc_stacks_alloc(int nx, int ny, double cell, double x0, double y0,
+                           double zbase, oc_error *err);
+
+/* Stabilisation over the stacks, with the segments already decoded
+** (stabilize.c; deposit.c calls it after adding material). */
+int oc_layers_stabilize_segs(oc_stacks *s, oc_lseg *seg, const size_t *soff,
+                             const oc_stabilize_params *p,
+                             oc_stabilize_result *res, oc_error *err);
+/* Checks the stabilisation parameters (messages name the Lua fields). */
+int oc_layers_check_stabilize(const oc_stabilize_params *p, oc_error *err);
+/* A tool's stabilisation parameters: `given`, or the defaults when NULL;
+** checked when the tool stabilises. */
+int oc_layers_tool_stab(const oc_stacks *s, const oc_stabilize_params *given,
+                        int stabilize, oc_stabilize_params *p, oc_error *err);
+/* Stacks [i0, i1] x [j0, j1] of s as a grid of their own (origin moved;
+** the caller frees it), and such a grid put back at (i0, j0) (window.c). */
+oc_stacks *oc_stacks_window(const oc_stacks *s, int i0, int j0, int i1, int j1,
+                            oc_error *err);
+int oc_stacks_splice(oc_stacks *s, const oc_stacks *w, int i0, int j0,
+                     oc_error *err);
+/* Stabilisation from p->region (which must be set) in a window around
+** it, grown until nothing reaches its border. */
+int oc_layers_stabilize_local(oc_stacks *s, const oc_stabilize_params *p,
+                              oc_stabilize_result *res, oc_error *err);
+/* All stacks to segments: *seg (soff[k] .. soff[k + 1] - 1 for stack k)
+** and *soff, both malloc'ed. */
+int oc_layers_decode_all(const oc_stacks *s, oc_lseg **seg, size_t **soff,
+                         oc_error *err);
+/* Segments back into s's storage. */
+int oc_layers_encode_all(oc_stacks *s, const oc_lseg *seg, const size_t *soff,
+                         oc_error *err);
+
+#endif

@@ -1,0 +1,301 @@
+/*
+** lfield.c — the convolution surface of a set of materials (Peytavie et
+** al. 2009, section 3.3) as a node kind on the node-family seam
+** (field/kind.h).
+**
+** The kernel is the cube Omega of half-side sigma (the paper's infinity
+** norm), so the convolution is the volume V_M of the materials inside the
+** cube, and in the engine's convention f = 2T V_M / V_Omega, V_Omega =
+** 8 sigma^3: T where the cube is half full, 2T deep inside, 0 farther
+** than sigma from any of them (the paper's 2 V_M / V_Omega - 1 shifted
+** and scaled). Each stack keeps the z-intervals of the materials and the
+** thickness below each, so V_M is a sum over the (at most (2 sigma /
+** cell + 2)^2) stacks the cube overlaps of overlap area times
+** F(z + sigma) - F(z - sigma), F found by binary search.
+**
+** Gradient: dV/dx is the signed area of the cube's faces x = +-sigma in
+** material, here the x-overlap's derivative (+1, 0 or -1 per stack)
+** times the rest; dV/dz the material area on the top face minus the
+** bottom's. Exact off the layer and stack boundaries (the field is C0).
+** Lipschitz: a face has area 4 sigma^2, so |grad V| <= sqrt 3 4 sigma^2
+** and |grad f| <= sqrt 3 T / sigma. Column spans: f varies along a column
+** only within sigma of a layer boundary, and across the footprint also
+** where the stacks around disagree (a vertical wall).
+*/
+#include <math.h>
+#include <stdlib.h>
+
+#include "core/error.h"
+#include "field/kind.h"
+#include "layers/layers.h"
+
+typedef struct lfield {
+  int nx, ny;
+  double cell, X0, Y0; /* the corner of stack (0, 0) */
+  double sigma, zlo, zhi;
+  uint32_t *off; /* stack k: intervals off[k] .. off[k + 1] - 1 */
+  double *iv;    /* a, b, thickness below a: 3 per interval */
+} lfield;
+
+enum { P_K, P_SIGMA, P_N }; /* K = 2T / V_Omega */
+
+/* The material below z in intervals v[0 .. n - 1], and whether z is in
+** one (*in). */
+static double below(const double *v, uint32_t n, double z, int *in) {
+  uint32_t lo = 0, hi = n;
+  while (lo < hi) {
+    uint32_t m = (lo + hi) / 2;
+    if (v[3 * m] <= z)
+      lo = m + 1;
+    else
+      hi = m;
+  }
+  if (lo == 0) {
+    *in = 0;
+    return 0;
+  }
+  const double *c = v + 3 * (lo - 1);
+  *in = z < c[1];
+  return c[2] + (*in ? z : c[1]) - c[0];
+}
+
+/* Stacks [*i0, *i1] overlapping [lo, hi] along one axis (empty: i0 > i1),
+** and 1 when [lo, hi] reaches past the grid. */
+static int axis_range(double lo, double hi, double X0, double s, int n, int *i0,
+                      int *i1) {
+  double a = floor((lo - X0) / s), b = floor((hi - X0) / s);
+  *i0 = a < 0 ? 0 : a > n ? n : (int)a;
+  *i1 = b < -1 ? -1 : b > n - 1 ? n - 1 : (int)b;
+  return lo < X0 || hi > X0 + n * s;
+}
+
+static double lf_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
+  const lfield *d = k->data;
+  double sg = d->sigma, s = d->cell;
+  if (g) *g = (oc_vec3){0, 0, 0};
+  if (!(p.x == p.x && p.y == p.y && p.z == p.z)) return NAN;
+  if (p.z + sg <= d->zlo || p.z - sg >= d->zhi) return 0;
+  int i0, i1, j0, j1;
+  axis_range(p.x - sg, p.x + sg, d->X0, s, d->nx, &i0, &i1);
+  axis_range(p.y - sg, p.y + sg, d->Y0, s, d->ny, &j0, &j1);
+  double V = 0, gx = 0, gy = 0, gz = 0;
+  for (int j = j0; j <= j1; j++) {
+    double c0 = d->Y0 + j * s, c1 = c0 + s;
+    double wy = fmin(p.y + sg, c1) - fmax(p.y - sg, c0);
+    if (!(wy > 0)) continue;
+    double dwy = (p.y + sg < c1) - (p.y - sg > c0);
+    for (int i = i0; i <= i1; i++) {
+      double e0 = d->X0 + i * s, e1 = e0 + s;
+      double wx = fmin(p.x + sg, e1) - fmax(p.x - sg, e0);
+      if (!(wx > 0)) continue;
+      size_t q = (size_t)j * d->nx + i;
+      uint32_t n = d->off[q + 1] - d->off[q];
+      if (n == 0) continue;
+      const double *v = d->iv + 3 * (size_t)d->off[q];
+      int inhi, inlo;
+      double D = below(v, n, p.z + sg, &inhi) - below(v, n, p.z - sg, &inlo);
+      V += wx * wy * D;
+      if (g) {
+        double dwx = (p.x + sg < e1) - (p.x - sg > e0);
+        gx += dwx * wy * D;
+        gy += wx * dwy * D;
+        gz += wx * wy * (inhi - inlo);
+      }
+    }
+  }
+  double K = k->par[P_K];
+  if (g) *g = (oc_vec3){K * gx, K * gy, K * gz};
+  return K * V;
+}
+
+/* ---- local queries ----------------------------------------------------- */
+
+#define EXACT_STACKS 4096
+#define MAX_ZSPANS 256
+
+/* 1 when no interval of the stacks under footprint [x0, x1] x [y0, y1]
+** (grown by sigma) meets [z0 - sigma, z1 + sigma]; 0 when some may, or
+** the footprint holds too many stacks to tell. */
+static int lf_zero_box(const lfield *d, double x0, double y0, double x1,
+                       double y1, double z0, double z1) {
+  double sg = d->sigma;
+  int i0, i1, j0, j1;
+  axis_range(x0 - sg, x1 + sg, d->X0, d->cell, d->nx, &i0, &i1);
+  axis_range(y0 - sg, y1 + sg, d->Y0, d->cell, d->ny, &j0, &j1);
+  if (i0 > i1 || j0 > j1) return 1;
+  if ((double)(i1 - i0 + 1) * (j1 - j0 + 1) > EXACT_STACKS) return 0;
+  for (int j = j0; j <= j1; j++)
+    for (int i = i0; i <= i1; i++) {
+      size_t q = (size_t)j * d->nx + i;
+      for (uint32_t l = d->off[q]; l < d->off[q + 1]; l++)
+        if (d->iv[3 * l] < z1 + sg && d->iv[3 * l + 1] > z0 - sg) return 0;
+    }
+  return 1;
+}
+
+static int lf_zero_in(const oc_kctx *k, const oc_aabb *b) {
+  return lf_zero_box(k->data, b->lo.x, b->lo.y, b->hi.x, b->hi.y, b->lo.z,
+                     b->hi.z);
+}
+
+static double lf_lip_in(const oc_kctx *k, const oc_aabb *b) {
+  return lf_zero_in(k, b) ? 0 : k->lip;
+}
+
+static int cmp_span(const void *a, const void *b) {
+  double x = ((const oc_zspan *)a)->lo, y = ((const oc_zspan *)b)->lo;
+  return (x > y) - (x < y);
+}
+
+/* Whether stack q is in the materials at z. */
+static int inside_at(const lfield *d, size_t q, double z) {
+  int in;
+  below(d->iv + 3 * (size_t)d->off[q], d->off[q + 1] - d->off[q], z, &in);
+  return in;
+}
+
+static int lf_column(const oc_kctx *k, const oc_foot *f, oc_colq *q) {
+  const lfield *d = k->data;
+  double sg = d->sigma, pad = 1e-9 * (fabs(d->zlo) + fabs(d->zhi) + sg);
+  int i0, i1, j0, j1;
+  int out = axis_range(f->x0 - sg, f->x1 + sg, d->X0, d->cell, d->nx, &i0, &i1);
+  out |= axis_range(f->y0 - sg, f->y1 + sg, d->Y0, d->cell, d->ny, &j0, &j1);
+  if (i0 > i1 || j0 > j1) return 0;
+  oc_zspan sp[MAX_ZSPANS];
+  int n = 0, exact = (double)(i1 - i0 + 1) * (j1 - j0 + 1) <= EXACT_STACKS;
+  double zmin = INFINITY, zmax = -INFINITY;
+  for (int j = j0; j <= j1; j++)
+    for (int i = i0; i <= i1; i++) {
+      size_t s = (size_t)j * d->nx + i;
+      for (uint32_t l = d->off[s]; l < d->off[s + 1]; l++) {
+        double a = d->iv[3 * l], b = d->iv[3 * l + 1];
+        zmin = fmin(zmin, a);
+        zmax = fmax(zmax, b);
+        if (exact && n + 2 <= MAX_ZSPANS) {
+          sp[n++] = (oc_zspan){a - sg - pad, a + sg + pad};
+          sp[n++] = (oc_zspan){b - sg - pad, b + sg + pad};
+        } else {
+          exact = 0;
+        }
+      }
+    }
+  if (!(zmin <= zmax)) return 0; /* no material around: f = 0 */
+  if (!exact) {
+    oc_col_add(q, zmin - sg - pad, zmax + sg + pad);
+    return 0;
+  }
+  qsort(sp, (size_t)n, sizeof *sp, cmp_span);
+  int m = 0;
+  for (int r = 1; r < n; r++)
+    if (sp[r].lo <= sp[m].hi)
+      sp[m].hi = fmax(sp[m].hi, sp[r].hi);
+    else
+      sp[++m] = sp[r];
+  n = m + 1;
+  for (int r = 0; r < n; r++) {
+    oc_col_add(q, sp[r].lo, sp[r].hi);
+    if (r + 1 == n) break;
+    /* the gap above: constant along z; across the footprint too when
+    ** every stack around (and the outside, empty) agrees */
+    double z = 0.5 * (sp[r].hi + sp[r + 1].lo);
+    int first = out ? 0 : inside_at(d, (size_t)j0 * d->nx + i0, z), agree = 1;
+    for (int j = j0; j <= j1 && agree; j++)
+      for (int i = i0; i <= i1 && agree; i++)
+        agree = inside_at(d, (size_t)j * d->nx + i, z) == first;
+    if (!agree) oc_col_add(q, sp[r].hi, sp[r + 1].lo);
+  }
+  return 0;
+}
+
+/* ---- the kind ------------------------------------------------------------ */
+
+static int lf_compile(oc_kcompile *c, oc_error *err) {
+  const lfield *d = c->data;
+  double sg = d->sigma;
+  (void)err;
+  c->par[P_K] = 2 * c->T / (8 * sg * sg * sg);
+  c->par[P_SIGMA] = sg;
+  c->npar = P_N;
+  c->info.lo = 0;
+  c->info.hi = 2 * c->T;
+  c->info.lip = sqrt(3.0) * c->T / sg * (1 + 1e-9);
+  c->info.box = (oc_aabb){{d->X0 - sg, d->Y0 - sg, d->zlo - sg},
+                          {d->X0 + d->nx * d->cell + sg,
+                           d->Y0 + d->ny * d->cell + sg, d->zhi + sg}};
+  return OC_OK;
+}
+
+static void lf_release(void *data) {
+  lfield *d = data;
+  if (!d) return;
+  free(d->off);
+  free(d->iv);
+  free(d);
+}
+
+static const oc_kind_def layers_kind = {
+    .name = "layers",
+    .flags = OC_KF_PRIM,
+    .compile = lf_compile,
+    .eval = lf_eval,
+    .lipschitz_in = lf_lip_in,
+    .zero_in = lf_zero_in,
+    .column = lf_column,
+    .release = lf_release,
+};
+
+oc_node *oc_stacks_field(const oc_stacks *s, unsigned mask, double sigma,
+                         oc_error *err) {
+  if (mask == 0 || mask >= (1u << OC_MAT_COUNT) || (mask & 1u << OC_MAT_AIR)) {
+    oc_seterr(err, OC_EINVAL,
+              "'materials' must name at least one of water, sand, rocks, "
+              "bedrock (not air)");
+    return NULL;
+  }
+  if (isnan(sigma)) sigma = s->cell;
+  if (!oc_check_positive(sigma, "sigma", err)) return NULL;
+  size_t ns = (size_t)s->nx * s->ny, nl = s->off[ns];
+  lfield *d = calloc(1, sizeof *d);
+  if (d) {
+    d->off = malloc((ns + 1) * sizeof *d->off);
+    d->iv = malloc((nl ? nl : 1) * 3 * sizeof *d->iv);
+  }
+  if (!d || !d->off || !d->iv) {
+    lf_release(d);
+    oc_seterr(err, OC_ENOMEM, "out of memory");
+    return NULL;
+  }
+  d->nx = s->nx;
+  d->ny = s->ny;
+  d->cell = s->cell;
+  d->X0 = s->x0 - 0.5 * s->cell;
+  d->Y0 = s->y0 - 0.5 * s->cell;
+  d->sigma = sigma;
+  d->zlo = INFINITY;
+  d->zhi = -INFINITY;
+  uint32_t n = 0;
+  for (size_t k = 0; k < ns; k++) {
+    d->off[k] = n;
+    double z = s->zbase, below_z = 0;
+    for (uint32_t l = s->off[k]; l < s->off[k + 1]; l++) {
+      double t = s->thick[l], z1 = z + t;
+      if (mask & 1u << s->mat[l]) {
+        if (n > d->off[k] && d->iv[3 * (n - 1) + 1] == z) {
+          d->iv[3 * (n - 1) + 1] = z1; /* continues the interval */
+        } else {
+          d->iv[3 * n] = z;
+          d->iv[3 * n + 1] = z1;
+          d->iv[3 * n + 2] = below_z;
+          n++;
+        }
+        below_z += t;
+        d->zlo = fmin(d->zlo, d->iv[3 * (d->off[k])]);
+        d->zhi = fmax(d->zhi, z1);
+      }
+      z = z1;
+    }
+  }
+  d->off[ns] = n;
+  if (n == 0) d->zlo = d->zhi = s->zbase;
+  return oc_kind_node(&layers_kind, NULL, 0, NULL, 0, d, err);
+}

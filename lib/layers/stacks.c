@@ -1,0 +1,300 @@
+/*
+** stacks.c — the material-stack grid (Peytavie et al. 2009, section 3.2):
+** creation, the builder that packs stacks in order, reading and replacing
+** one stack, statistics, volumes and the top of a material as a
+** heightfield.
+*/
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "field/kind.h"
+#include "layers/layers.h"
+
+static const char *const NAMES[OC_MAT_COUNT] = {"air", "water", "sand", "rocks",
+                                                "bedrock"};
+
+const char *oc_material_name(int m) {
+  return m >= 0 && m < OC_MAT_COUNT ? NAMES[m] : NULL;
+}
+
+int oc_material_parse(const char *name) {
+  for (int m = 0; name && m < OC_MAT_COUNT; m++)
+    if (strcmp(name, NAMES[m]) == 0) return m;
+  return -1;
+}
+
+oc_stacks *oc_stacks_alloc(int nx, int ny, double cell, double x0, double y0,
+                           double zbase, oc_error *err) {
+  if (nx < 1 || ny < 1 || nx > 65535 || ny > 65535 ||
+      (unsigned long long)nx * (unsigned long long)ny > OC_STACKS_MAX) {
+    oc_seterr(err, OC_EINVAL,
+              "'size' must be 1 .. 65535 stacks a side and at most %llu in "
+              "all (got %d x %d)",
+              (unsigned long long)OC_STACKS_MAX, nx, ny);
+    return NULL;
+  }
+  if (!oc_check_positive(cell, "cell", err)) return NULL;
+  if (!isfinite(x0) || !isfinite(y0)) {
+    oc_seterr(err, OC_EINVAL, "'origin' must be finite");
+    return NULL;
+  }
+  if (!isfinite(zbase)) {
+    oc_seterr(err, OC_EINVAL, "'base' must be finite (got %g)", zbase);
+    return NULL;
+  }
+  oc_stacks *s = calloc(1, sizeof *s);
+  if (!s) {
+    oc_seterr(err, OC_ENOMEM, "out of memory");
+    return NULL;
+  }
+  *s = (oc_stacks){nx, ny, cell, x0, y0, zbase, NULL, NULL, NULL, 0};
+  return s;
+}
+
+oc_stacks *oc_stacks_new(int nx, int ny, double cell, double x0, double y0,
+                         double zbase, oc_error *err) {
+  oc_stacks *s = oc_stacks_alloc(nx, ny, cell, x0, y0, zbase, err);
+  if (!s) return NULL;
+  s->off = calloc((size_t)nx * ny + 1, sizeof *s->off);
+  if (!s->off) {
+    free(s);
+    oc_seterr(err, OC_ENOMEM, "out of memory");
+    return NULL;
+  }
+  return s;
+}
+
+void oc_stacks_free(oc_stacks *s) {
+  if (!s) return;
+  free(s->off);
+  free(s->thick);
+  free(s->mat);
+  free(s);
+}
+
+int oc_stacks_nx(const oc_stacks *s) {
+  return s->nx;
+}
+int oc_stacks_ny(const oc_stacks *s) {
+  return s->ny;
+}
+double oc_stacks_cell(const oc_stacks *s) {
+  return s->cell;
+}
+void oc_stacks_origin(const oc_stacks *s, double *x0, double *y0) {
+  *x0 = s->x0;
+  *y0 = s->y0;
+}
+double oc_stacks_base(const oc_stacks *s) {
+  return s->zbase;
+}
+
+/* ---- the builder ------------------------------------------------------- */
+
+int oc_builder_init(oc_stacks_builder *b, size_t nstacks, size_t cap,
+                    oc_error *err) {
+  memset(b, 0, sizeof *b);
+  b->nstacks = nstacks;
+  b->cap = cap < 16 ? 16 : cap;
+  b->off = malloc((nstacks + 1) * sizeof *b->off);
+  b->thick = malloc(b->cap * sizeof *b->thick);
+  b->mat = malloc(b->cap);
+  if (!b->off || !b->thick || !b->mat) {
+    oc_builder_free(b);
+    return oc_seterr(err, OC_ENOMEM, "out of memory");
+  }
+  b->off[0] = 0;
+  return OC_OK;
+}
+
+int oc_builder_push(oc_stacks_builder *b, const oc_layer *l, size_t n,
+                    oc_error *err) {
+  if (b->n + n > OC_STACKS_MAX_LAYERS)
+    return oc_seterr(err, OC_ENOMEM, "more than %llu layers",
+                     (unsigned long long)OC_STACKS_MAX_LAYERS);
+  if (b->n + n > b->cap) {
+    size_t cap = b->cap;
+    while (cap < b->n + n)
+      cap += cap / 2;
+    float *t = realloc(b->thick, cap * sizeof *t);
+    if (t) b->thick = t;
+    uint8_t *m = t ? realloc(b->mat, cap) : NULL;
+    if (m) b->mat = m;
+    if (!t || !m) return oc_seterr(err, OC_ENOMEM, "out of memory");
+    b->cap = cap;
+  }
+  for (size_t i = 0; i < n; i++) {
+    b->thick[b->n + i] = (float)l[i].t;
+    b->mat[b->n + i] = (uint8_t)l[i].m;
+  }
+  b->n += n;
+  b->off[++b->k] = (uint32_t)b->n;
+  return OC_OK;
+}
+
+void oc_builder_commit(oc_stacks_builder *b, oc_stacks *s) {
+  free(s->off);
+  free(s->thick);
+  free(s->mat);
+  s->off = b->off;
+  s->thick = b->thick;
+  s->mat = b->mat;
+  s->cap = b->cap;
+  memset(b, 0, sizeof *b);
+}
+
+void oc_builder_free(oc_stacks_builder *b) {
+  free(b->off);
+  free(b->thick);
+  free(b->mat);
+  memset(b, 0, sizeof *b);
+}
+
+/* ---- one stack ---------------------------------------------------------- */
+
+static int check_ij(const oc_stacks *s, int i, int j, oc_error *err) {
+  if (i < 0 || i >= s->nx)
+    return oc_seterr(err, OC_EINVAL, "'i' must be in 0 .. %d (got %d)",
+                     s->nx - 1, i);
+  if (j < 0 || j >= s->ny)
+    return oc_seterr(err, OC_EINVAL, "'j' must be in 0 .. %d (got %d)",
+                     s->ny - 1, j);
+  return OC_OK;
+}
+
+static int check_layers(const uint8_t *mat, const double *thick, size_t n,
+                        oc_error *err) {
+  if (n > OC_STACKS_MAX_LAYERS)
+    return oc_seterr(err, OC_EINVAL, "too many layers (%zu)", n);
+  for (size_t l = 0; l < n; l++) {
+    if (mat[l] >= OC_MAT_COUNT)
+      return oc_seterr(err, OC_EINVAL,
+                       "'material' of layer %zu is not a material (%d)", l + 1,
+                       mat[l]);
+    if (!isfinite(thick[l]) || thick[l] < 0)
+      return oc_seterr(err, OC_EINVAL,
+                       "'thickness' of layer %zu must be finite and >= 0 "
+                       "(got %g)",
+                       l + 1, thick[l]);
+  }
+  return OC_OK;
+}
+
+int oc_stacks_fill(oc_stacks *s, const uint8_t *mat, const double *thick,
+                   size_t n, oc_error *err) {
+  if (check_layers(mat, thick, n, err)) return OC_EINVAL;
+  oc_layer *in = malloc((2 * n + 1) * sizeof *in);
+  if (!in) return oc_seterr(err, OC_ENOMEM, "out of memory");
+  for (size_t l = 0; l < n; l++)
+    in[l] = (oc_layer){thick[l], mat[l]};
+  size_t m = oc_layers_canon(in, n, in + n), ns = (size_t)s->nx * s->ny;
+  oc_stacks_builder b = {0};
+  int rc = (double)m * ns > (double)OC_STACKS_MAX_LAYERS
+               ? oc_seterr(err, OC_ENOMEM, "more than %llu layers",
+                           (unsigned long long)OC_STACKS_MAX_LAYERS)
+               : oc_builder_init(&b, ns, m * ns, err);
+  for (size_t k = 0; k < ns && rc == OC_OK; k++)
+    rc = oc_builder_push(&b, in + n, m, err);
+  if (rc == OC_OK)
+    oc_builder_commit(&b, s);
+  else if (b.off)
+    oc_builder_free(&b);
+  free(in);
+  return rc;
+}
+
+int oc_stacks_set(oc_stacks *s, int i, int j, const uint8_t *mat,
+                  const double *thick, size_t n, oc_error *err) {
+  if (check_ij(s, i, j, err)) return OC_EINVAL;
+  if (check_layers(mat, thick, n, err)) return OC_EINVAL;
+  oc_layer *in = malloc((2 * n + 1) * sizeof *in);
+  if (!in) return oc_seterr(err, OC_ENOMEM, "out of memory");
+  oc_layer *out = in + n;
+  for (size_t l = 0; l < n; l++)
+    in[l] = (oc_layer){thick[l], mat[l]};
+  size_t m = oc_layers_canon(in, n, out);
+  size_t k = (size_t)j * s->nx + i, ns = (size_t)s->nx * s->ny;
+  size_t old = s->off[k + 1] - s->off[k], total = s->off[ns] - old + m;
+  if (total > OC_STACKS_MAX_LAYERS) {
+    free(in);
+    return oc_seterr(err, OC_ENOMEM, "more than %llu layers",
+                     (unsigned long long)OC_STACKS_MAX_LAYERS);
+  }
+  if (total > s->cap) {
+    size_t cap = total + total / 2 + 16;
+    float *t = realloc(s->thick, cap * sizeof *t);
+    if (t) s->thick = t;
+    uint8_t *mm = t ? realloc(s->mat, cap) : NULL;
+    if (mm) s->mat = mm;
+    if (!t || !mm) {
+      free(in);
+      return oc_seterr(err, OC_ENOMEM, "out of memory");
+    }
+    s->cap = cap;
+  }
+  size_t tail = s->off[ns] - s->off[k + 1];
+  memmove(s->thick + s->off[k] + m, s->thick + s->off[k + 1],
+          tail * sizeof *s->thick);
+  memmove(s->mat + s->off[k] + m, s->mat + s->off[k + 1], tail);
+  for (size_t l = 0; l < m; l++) {
+    s->thick[s->off[k] + l] = (float)out[l].t;
+    s->mat[s->off[k] + l] = (uint8_t)out[l].m;
+  }
+  for (size_t q = k + 1; q <= ns; q++)
+    s->off[q] = (uint32_t)(s->off[q] - old + m);
+  free(in);
+  return OC_OK;
+}
+
+size_t oc_stacks_get(const oc_stacks *s, int i, int j, uint8_t *mat,
+                     double *thick, size_t max) {
+  if (i < 0 || i >= s->nx || j < 0 || j >= s->ny) return 0;
+  size_t k = (size_t)j * s->nx + i, n = s->off[k + 1] - s->off[k];
+  for (size_t l = 0; l < n && l < max; l++) {
+    if (mat) mat[l] = s->mat[s->off[k] + l];
+    if (thick) thick[l] = s->thick[s->off[k] + l];
+  }
+  return n;
+}
+
+/* ---- summaries ---------------------------------------------------------- */
+
+void oc_stacks_get_stats(const oc_stacks *s, oc_stacks_stats *st) {
+  size_t ns = (size_t)s->nx * s->ny;
+  st->stacks = ns;
+  st->layers = s->off[ns];
+  st->bytes = sizeof *s + (ns + 1) * sizeof *s->off +
+              s->off[ns] * (sizeof *s->thick + sizeof *s->mat);
+}
+
+double oc_stacks_volume(const oc_stacks *s, int m) {
+  size_t n = s->off[(size_t)s->nx * s->ny];
+  double v = 0;
+  for (size_t l = 0; l < n; l++)
+    if (s->mat[l] == m) v += s->thick[l];
+  return v * s->cell * s->cell;
+}
+
+oc_heightfield *oc_stacks_heightfield(const oc_stacks *s, int m,
+                                      oc_error *err) {
+  if (!oc_material_name(m)) {
+    oc_seterr(err, OC_EINVAL, "'material' is not a material (%d)", m);
+    return NULL;
+  }
+  oc_heightfield *hf =
+      oc_heightfield_new(s->nx, s->ny, s->cell, s->x0, s->y0, NULL, err);
+  if (!hf) return NULL;
+  float *z = oc_heightfield_samples_mut(hf);
+  size_t ns = (size_t)s->nx * s->ny;
+  for (size_t k = 0; k < ns; k++) {
+    double h = s->zbase, top = s->zbase;
+    for (uint32_t l = s->off[k]; l < s->off[k + 1]; l++) {
+      h += s->thick[l];
+      if (s->mat[l] == m) top = h;
+    }
+    z[k] = (float)top;
+  }
+  return hf;
+}
