@@ -10,7 +10,7 @@
 #   make compare-revisions OLD=rev [NEW=rev]  build an earlier commit and
 #                the working tree (or NEW) side by side, compare every
 #                output byte for byte and the benchmark figures
-#                (scripts/compare_revisions.sh)
+#                (scripts/compare_revisions.sh; ROUNDS=n, OUTPUTS=0 for timing only)
 #   make fuzz    the scene fuzzer, long run (FUZZ_TIME seconds; fuzz-smoke:
 #                about 2 minutes, part of make test)
 #

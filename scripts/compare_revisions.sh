@@ -37,6 +37,8 @@
 # OMP_NUM_THREADS=2 throughout (the benchmarks set their own threads).
 # Builds and outputs go to a temporary folder (KEEP=1 keeps it); the
 # working tree is built in its own build/release as `make` does.
+# OUTPUTS=0 skips the outputs (a timing run alone, when the outputs were
+# compared before on the same revisions).
 set -uo pipefail
 
 if [ $# -lt 1 ] || [ $# -gt 2 ]; then
@@ -121,8 +123,9 @@ run_scene() { # side name script [options]
     failed=1
   fi
 }
-log "outputs: examples, golden scenes"
-for e in "$NEWT"/examples/*.lua; do
+OUTPUTS=${OUTPUTS:-1}
+[ "$OUTPUTS" = 1 ] && log "outputs: examples, golden scenes"
+[ "$OUTPUTS" = 1 ] && for e in "$NEWT"/examples/*.lua; do
   name=$(basename "$e" .lua)
   opts=()
   [ "$name" = sea_cliffs ] && opts=(--set render=false)
@@ -134,7 +137,7 @@ for e in "$NEWT"/examples/*.lua; do
   fi
   for side in $sides; do run_scene "$side" "examples/$name" "examples/$name.lua" "${opts[@]}"; done
 done
-for side in old new; do run_scene "$side" golden scripts/compare/golden.lua; done
+[ "$OUTPUTS" = 1 ] && for side in old new; do run_scene "$side" golden scripts/compare/golden.lua; done
 
 # ---- benchmarks, interleaved --------------------------------------------
 only() { # bench -> its parts
@@ -151,7 +154,7 @@ for r in $(seq "$ROUNDS"); do
   for b in $BENCHES; do
     for side in old new; do
       keep=
-      if [ "$r" = 1 ] && ! { [ "$side" = old ] && [ -e "$T/old-own-bench" ]; }; then
+      if [ "$OUTPUTS" = 1 ] && [ "$r" = 1 ] && ! { [ "$side" = old ] && [ -e "$T/old-own-bench" ]; }; then
         keep="$T/out/$side/bench/$b" && mkdir -p "$keep"
       fi
       if ! OUTCROP_BENCH_OUT=$keep OUTCROP_BENCH_ONLY=$(only "$b") \
@@ -164,6 +167,7 @@ for r in $(seq "$ROUNDS"); do
 done
 
 # ---- the comparison --------------------------------------------------------
+mkdir -p "$T/out/old" "$T/out/new"
 echo "== outputs (sha256, old against new)"
 (cd "$T/out/old" && find . -type f | sort) >"$T/files.old"
 (cd "$T/out/new" && find . -type f | sort) >"$T/files.new"
