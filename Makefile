@@ -253,7 +253,8 @@ PICTURES := demo_arch_render.png:demo:arch_render.png \
   example_elev_lake.png:elev_lake:elev_lake.png \
   example_elev_craters.png:elev_craters:elev_craters.png \
   example_elev_multiscale.png:elev_multiscale:elev_multiscale.png \
-  example_elev_lod.png:elev_lod:elev_lod.png
+  example_elev_lod.png:elev_lod:elev_lod.png \
+  example_blocks_types.png:blocks_types:blocks_types.png
 PICTURE_SCENES := $(sort $(foreach p,$(PICTURES),$(word 2,$(subst :, ,$(p)))))
 
 pictures: all
