@@ -49,13 +49,30 @@ static int may_join(grow *w, const double *q) {
     if (b->lo.x > hi[0] || b->hi.x < lo[0] || b->lo.y > hi[1] ||
         b->hi.y < lo[1] || b->lo.z > hi[2] || b->hi.z < lo[2])
       continue;
-    w->near[nn++] = &w->im[d];
+    /* the disc's plane must cross the box too */
+    const oc_bimage *D = &w->im[d];
+    double ctr = (0.5 * (lo[0] + hi[0]) - D->c.x) * D->n.x +
+                 (0.5 * (lo[1] + hi[1]) - D->c.y) * D->n.y +
+                 (0.5 * (lo[2] + hi[2]) - D->c.z) * D->n.z;
+    double ext =
+        0.5 * (fabs(D->n.x) * (hi[0] - lo[0]) + fabs(D->n.y) * (hi[1] - lo[1]) +
+               fabs(D->n.z) * (hi[2] - lo[2]));
+    if (fabs(ctr) > ext) continue;
+    w->near[nn++] = D;
   }
-  if (!nn) return 1;
-  for (size_t m = 0; m < w->nm; m++) {
-    const double *p = w->t->unwrap + 3 * (size_t)w->mem[m];
-    for (size_t d = 0; d < nn; d++)
-      if (oc_bimage_cuts(w->near[d], p, q)) return 0;
+  /* per disc image: q's side once, then only the members on the other
+  ** side (or on the plane) get the full test (oc_bimage_cuts' arithmetic) */
+  for (size_t d = 0; d < nn; d++) {
+    const oc_bimage *D = w->near[d];
+    double b = (q[0] - D->c.x) * D->n.x + (q[1] - D->c.y) * D->n.y +
+               (q[2] - D->c.z) * D->n.z;
+    for (size_t m = 0; m < w->nm; m++) {
+      const double *p = w->t->unwrap + 3 * (size_t)w->mem[m];
+      double a = (p[0] - D->c.x) * D->n.x + (p[1] - D->c.y) * D->n.y +
+                 (p[2] - D->c.z) * D->n.z;
+      if ((a > 0 && b > 0) || (a < 0 && b < 0)) continue;
+      if (oc_bimage_cuts(D, p, q)) return 0;
+    }
   }
   return 1;
 }
