@@ -41,6 +41,15 @@
 ** the simplex where some assignment reaches 0.0130071 and 0.0906200: the
 ** bounds are within 0.01 % and 0.2 % of the true suprema.
 **
+** The same prover (a third mode, with centred forms from the third
+** derivatives of one corner's term) bounds the Hessian of raw on the
+** coordinate planes: every principal 2 x 2 block of it has operator norm
+** at most RAW_HESS_MAX, within a few per cent of a witness. (Each simplex
+** is the reference one moved by a translation and an axis permutation, so
+** the Hessian on a coordinate plane is such a block of the reference
+** simplex's.) Elevation discs bound their noise in small boxes with it
+** (elevation/disc.c).
+**
 ** Scale. n = 1/2 + raw / (2 RAW_MAX) lies in [0, 1] since |raw| <= RAW_MAX
 ** (and reaches to within 3.3e-5 of either end): no clamp is needed and
 ** none is applied (a clamp would break the gradient).
@@ -66,12 +75,14 @@
 /* Proved bounds of the raw sum and its gradient (see above). */
 #define RAW_MAX 0.013008
 #define RAW_GRAD_MAX 0.0908
+#define RAW_HESS_MAX 0.64
 #define SCALE (0.5 / RAW_MAX)
 
 /* The lattice period used to reduce huge coordinates (a multiple of 3). */
 #define REDUCE_PERIOD (3.0 * 0x1p48)
 
 const double oc_noise3_lipschitz = 0.5 * RAW_GRAD_MAX / RAW_MAX;
+const double oc_noise3_hessian = 0.5 * RAW_HESS_MAX / RAW_MAX;
 
 /* Pairs g, -g next to each other: the mean is 1/2 by symmetry. */
 static const double grad12[12][3] = {
@@ -98,9 +109,11 @@ static inline unsigned corner_grad(uint64_t key, uint64_t i, uint64_t j,
   return (unsigned)(((h >> 32) * 12) >> 32);
 }
 
-/* Adds one corner's term; d is p minus the corner. */
+/* Adds one corner's term; d is p minus the corner; the gradient's too
+** when wg (a constant once inlined: the value alone skips its sums, with
+** the same value bit for bit). */
 static inline void corner_add(unsigned gi, double dx, double dy, double dz,
-                              double *v, double *g) {
+                              double *v, double *g, int wg) {
   double a = 0.5 - (dx * dx + dy * dy + dz * dz);
   /* max(a, 0), exactly, without the branch gcc emits for a ?: (a corner is
   ** out of reach too often for that branch to be predicted). */
@@ -109,6 +122,7 @@ static inline void corner_add(unsigned gi, double dx, double dy, double dz,
   double t = gr[0] * dx + gr[1] * dy + gr[2] * dz;
   double a2 = a * a, a3 = a2 * a;
   *v += a3 * a * t;
+  if (!wg) return;
   double k = 8 * t;
   g[0] += a3 * (a * gr[0] - k * dx);
   g[1] += a3 * (a * gr[1] - k * dy);
@@ -141,7 +155,8 @@ static oc_vec3 reduce(oc_vec3 p) {
   return r;
 }
 
-double oc_noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad) {
+/* n(p), with the gradient when wg (then grad is not NULL). */
+static inline double noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad, int wg) {
   if (is_huge(p)) {
     if (!(isfinite(p.x) && isfinite(p.y) && isfinite(p.z))) {
       if (grad) grad->x = grad->y = grad->z = NAN;
@@ -170,20 +185,24 @@ double oc_noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad) {
 
   uint64_t key = oc_mix64(seed ^ 0x8a5cd789635d2dffull);
   double v = 0, g[3] = {0, 0, 0};
-  corner_add(corner_grad(key, i, j, k), x0, y0, z0, &v, g);
+  corner_add(corner_grad(key, i, j, k), x0, y0, z0, &v, g, wg);
   corner_add(corner_grad(key, i + i1, j + j1, k + k1), x0 - i1 + G3,
-             y0 - j1 + G3, z0 - k1 + G3, &v, g);
+             y0 - j1 + G3, z0 - k1 + G3, &v, g, wg);
   corner_add(corner_grad(key, i + i2, j + j2, k + k2), x0 - i2 + 2 * G3,
-             y0 - j2 + 2 * G3, z0 - k2 + 2 * G3, &v, g);
+             y0 - j2 + 2 * G3, z0 - k2 + 2 * G3, &v, g, wg);
   corner_add(corner_grad(key, i + 1, j + 1, k + 1), x0 - 1 + 3 * G3,
-             y0 - 1 + 3 * G3, z0 - 1 + 3 * G3, &v, g);
+             y0 - 1 + 3 * G3, z0 - 1 + 3 * G3, &v, g, wg);
 
-  if (grad) {
+  if (wg) {
     grad->x = SCALE * g[0];
     grad->y = SCALE * g[1];
     grad->z = SCALE * g[2];
   }
   return 0.5 + SCALE * v;
+}
+
+double oc_noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad) {
+  return grad ? noise3(seed, p, grad, 1) : noise3(seed, p, NULL, 0);
 }
 
 double oc_turb3(uint64_t seed, int octaves, oc_vec3 p, oc_vec3 *grad) {

@@ -16,6 +16,11 @@
 
 /* A provable bound on |grad n| (not an estimate). */
 extern const double oc_noise3_lipschitz;
+/* A provable bound on the Hessian of n on any coordinate plane (the
+** operator norm of each principal 2 x 2 block of its Hessian): on such a
+** plane the gradient's part in it changes by at most this much per unit
+** of distance (elevation discs sample the plane z = 0). */
+extern const double oc_noise3_hessian;
 
 /* n(p) in [0, 1]; stores the gradient in *grad when grad != NULL. */
 double oc_noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad);

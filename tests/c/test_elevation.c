@@ -7,6 +7,7 @@
 ** field named.
 */
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "elevation/enode.h"
@@ -168,6 +169,65 @@ START_TEST(disc_noises) {
     ck_assert(b.la < 0.9 * 1.7173002067198386 / 100);
     oc_enode_release(d);
   }
+}
+END_TEST
+
+START_TEST(disc_local_bounds) {
+  /* In boxes small against the wavelength a disc bounds its noise from
+  ** each octave's value and gradient at the box's centre and the proved
+  ** Hessian bound of the noise: the ranges and slopes must hold at every
+  ** sampled point (corners included) of boxes from 1/1000 to a third of
+  ** the wavelength, for every kind and several seeds, and be well below
+  ** the whole plane's in the smallest ones. */
+  oc_enoise_kind kinds[3] = {OC_ENOISE_PLAIN, OC_ENOISE_TURBULENCE,
+                             OC_ENOISE_RIDGED};
+  oct_rng r = oct_rng_new(77);
+  double worst = 0; /* largest sampled |grad f| / lf */
+  for (int k = 0; k < 3; k++) {
+    double small = 0, glob = 0; /* mean lf in boxes of wl / 300 */
+    int nsmall = 0;
+    for (int sd = 0; sd < 6; sd++) {
+      oc_error err;
+      oc_enode_disc_params p = {
+          3, -2, 400, 20, {kinds[k], 12, 50, 5, 0, 0, 1000 + sd}};
+      oc_enode *d = EOK(oc_enode_disc(&p, &err));
+      glob = oc_enode_lipschitz(d);
+      for (int i = 0; i < 150; i++) {
+        double w = 50 * pow(10, oct_unif(&r, -3, -0.5));
+        double x0 = oct_unif(&r, -150, 150), y0 = oct_unif(&r, -150, 150);
+        double x1 = x0 + w, y1 = y0 + w * oct_unif(&r, 0.3, 1);
+        oc_enode_bound b;
+        oc_enode_bound_in(d, x0, y0, x1, y1, &b);
+        for (int j = 0; j < 40; j++) {
+          double px = j < 4 ? (j & 1 ? x1 : x0) : oct_unif(&r, x0, x1);
+          double py = j < 4 ? (j & 2 ? y1 : y0) : oct_unif(&r, y0, y1);
+          oc_enode_sample sp;
+          oc_enode_eval(d, px, py, &sp);
+          double m = 1e-9 * (1 + fabs(b.flo) + fabs(b.fhi));
+          ck_assert_msg(sp.f >= b.flo - m && sp.f <= b.fhi + m,
+                        "kind %d: f %.17g outside [%.17g, %.17g]", k, sp.f,
+                        b.flo, b.fhi);
+          double gn = hypot(sp.fx, sp.fy);
+          ck_assert_msg(gn <= b.lf * (1 + 1e-9), "kind %d: |grad f| %g > %g", k,
+                        gn, b.lf);
+          worst = fmax(worst, gn / b.lf);
+        }
+        if (w < 50.0 / 300) small += b.lf, nsmall++;
+      }
+      oc_enode_release(d);
+    }
+    small /= nsmall;
+    printf("disc %s noise: mean slope bound in boxes of 1/300 wavelength "
+           "%.3f, whole plane %.3f\n",
+           kinds[k] == OC_ENOISE_PLAIN        ? "plain"
+           : kinds[k] == OC_ENOISE_TURBULENCE ? "turbulent"
+                                              : "ridged",
+           small, glob);
+    ck_assert(nsmall > 50 && small < 0.6 * glob);
+  }
+  printf("disc local bounds: sampled |grad f| up to %.3f of the bound\n",
+         worst);
+  ck_assert(worst > 0.5);
 }
 END_TEST
 
@@ -595,6 +655,7 @@ int main(void) {
   tcase_set_timeout(tc, 60);
   tcase_add_test(tc, disc_formula);
   tcase_add_test(tc, disc_noises);
+  tcase_add_test(tc, disc_local_bounds);
   tcase_add_test(tc, blend_formula);
   tcase_add_test(tc, replace_and_add_formulas);
   tcase_add_test(tc, add_slope_weight);

@@ -24,6 +24,12 @@
 /* The constants the proof establishes; noise.c must scale by them. */
 #define CERT_RAW_MAX 0.013008
 #define CERT_RAW_GRAD_MAX 0.0908
+/* ... and the bound of the Hessian on coordinate planes it states. */
+#define CERT_RAW_HESS_MAX 0.64
+/* A point of the reference simplex (skewed) where some assignment reaches
+** 0.62360, and the share of the bound that is. */
+#define WIT_HESS 0.97984, 0.97070, 0.66960
+#define WIT_HESS_SHARE 0.97
 
 static oc_vec3 rand_point(oc_rng *r, double half) {
   return oc_v3(oc_rng_range(r, -half, half), oc_rng_range(r, -half, half),
@@ -485,19 +491,47 @@ static double one_grad(double s) {
   double a = 0.5 - s;
   return sqrt(2.0) * a * a * a * dmax(a, fabs(0.5 - 9 * s));
 }
+/* The Hessian H = -8 a^3 (g d^T + d g^T + t I) + 48 a^2 t d d^T of one
+** corner's term (t = g.d): its operator norm is at most 8 a^3 (2 sqrt2 r +
+** sqrt2 r) + 48 a^2 sqrt2 r^3 = sqrt2 a^2 r (12 + 24 s). Unimodal in s (its
+** log's derivative -2/a + 1/(2s) + 1/(1/2 + s) decreases), peak by
+** bisection. */
+static double one_hess(double s) {
+  if (s >= 0.5) return 0;
+  double a = 0.5 - s;
+  return sqrt(2.0) * a * a * sqrt(dmax(s, 0)) * (12 + 24 * s);
+}
+static double hess_peak(void) {
+  double lo = 0.01, hi = 0.4;
+  for (int k = 0; k < 200; k++) {
+    double m = 0.5 * (lo + hi);
+    if (-2 / (0.5 - m) + 0.5 / m + 1 / (0.5 + m) > 0)
+      lo = m;
+    else
+      hi = m;
+  }
+  return lo;
+}
 static double one_max(int mode, double slo, double shi) {
-  double (*f)(double) = mode ? one_grad : one_value;
-  double peak = mode ? 1.0 / 6 : 1.0 / 18;
+  double (*f)(double) = mode == 2 ? one_hess : mode ? one_grad : one_value;
+  double peak = mode == 2 ? hess_peak() : mode ? 1.0 / 6 : 1.0 / 18;
   double m = dmax(f(slo), f(shi));
   if (slo < peak && shi > peak) m = dmax(m, f(peak));
   return m;
 }
 
 /* Enclosures of every corner term over a box, for each of the 12
-** gradients: mode 0 the value (one component), mode 1 the gradient. */
+** gradients: mode 0 the value (one component), mode 1 the gradient, mode 2
+** the Hessian (its entries 00, 11, 22, 01, 02, 12). */
 typedef struct {
-  iv c[3];
+  iv c[6];
 } ivec;
+
+static const int HR[6] = {0, 1, 2, 0, 0, 1}, HC[6] = {0, 1, 2, 1, 2, 2};
+
+static iv iv_dd(const iv *D, int r, int c) {
+  return r == c ? iv_sq(D[r]) : iv_mul(D[r], D[c]);
+}
 
 typedef struct {
   int n;           /* corners within reach of the box */
@@ -546,12 +580,45 @@ static void enclose(int mode, const double lo[3], const double hi[3],
         h[c] = iv_add(iv_scale(a4, g[c]), iv_mul(k8, D[c]));
       /* Centred forms (mean value theorem on the hull of D), met with the
       ** direct enclosures: f(D) in f(dc) + f'(D) (D - dc). */
+      for (int c = 3; c < 6; c++)
+        e->w[n][q].c[c] = iv_c(0);
       if (mode == 0) {
         iv acc = iv_c(ac * ac * ac * ac * tc);
         for (int c = 0; c < 3; c++)
           acc = iv_add(acc, iv_mul(h[c], R[c]));
         e->w[n][q].c[0] = iv_meet(acc, iv_mul(a4, t));
         e->w[n][q].c[1] = e->w[n][q].c[2] = iv_c(0);
+      } else if (mode == 2) {
+        /* H = A M + B d d^T with A = -8 a^3, M = g d^T + d g^T + t I,
+        ** B = 48 a^2 t; its derivative along d_k (a' = -2 d_k, t' = g_k):
+        ** 48 a^2 d_k M + A M'_k + (48 a^2 g_k - 192 a t d_k) d d^T
+        ** + B (e_k d^T + d e_k^T); the centred form as above. */
+        iv A = iv_scale(a3, -8), B = iv_scale(iv_mul(a2, t), 48);
+        iv a48 = iv_scale(a2, 48), at192 = iv_scale(iv_mul(a, t), 192);
+        double Ac = -8 * ac * ac * ac, Bc = 48 * ac * ac * tc;
+        for (int m = 0; m < 6; m++) {
+          int r = HR[m], c = HC[m];
+          iv M = iv_add(iv_scale(D[c], g[r]), iv_scale(D[r], g[c]));
+          if (r == c) M = iv_add(M, t);
+          iv DD = iv_dd(D, r, c);
+          iv direct = iv_add(iv_mul(A, M), iv_mul(B, DD));
+          double Mc = g[r] * dc[c] + dc[r] * g[c] + (r == c ? tc : 0);
+          iv acc = iv_c(Ac * Mc + Bc * dc[r] * dc[c]);
+          for (int k = 0; k < 3; k++) {
+            double dM =
+                (c == k ? g[r] : 0) + (r == k ? g[c] : 0) + (r == c ? g[k] : 0);
+            iv Tk = iv_add(iv_mul(iv_mul(a48, D[k]), M), iv_scale(A, dM));
+            iv coef =
+                iv_add(iv_scale(a48, g[k]), iv_scale(iv_mul(at192, D[k]), -1));
+            Tk = iv_add(Tk, iv_mul(coef, DD));
+            iv ed = iv_c(0);
+            if (r == k) ed = iv_add(ed, D[c]);
+            if (c == k) ed = iv_add(ed, D[r]);
+            Tk = iv_add(Tk, iv_mul(B, ed));
+            acc = iv_add(acc, iv_mul(Tk, R[k]));
+          }
+          e->w[n][q].c[m] = iv_meet(acc, direct);
+        }
       } else {
         /* Jacobian of h: -8 a^3 (g d^T + d g^T + t I) + 48 a^2 t d d^T. */
         iv m8a3 = iv_scale(a3, -8), k48 = iv_scale(iv_mul(a2, t), 48);
@@ -570,7 +637,27 @@ static void enclose(int mode, const double lo[3], const double hi[3],
   }
 }
 
-static double ivec_norm_ub(const ivec *v) {
+static double iv_abs(iv a) {
+  return dmax(fabs(a.lo), fabs(a.hi));
+}
+
+/* The norm the proofs bound: Euclidean for modes 0 and 1; for the Hessian
+** (mode 2), the largest operator norm of its three principal 2 x 2 blocks,
+** |a + c| / 2 + sqrt(((a - c) / 2)^2 + b^2) for the block (a b; b c).
+** Each simplex is the reference one moved by a lattice translation and an
+** axis permutation, so the Hessian of n on any coordinate plane is such a
+** block of the reference simplex's. */
+static double block_norm_ub(iv a, iv b, iv c) {
+  double sm = iv_abs(iv_add(a, c)), dm = iv_abs(iv_add(a, iv_scale(c, -1)));
+  double bm = iv_abs(b);
+  return 0.5 * sm + sqrt(0.25 * dm * dm + bm * bm);
+}
+
+static double ivec_norm_ub(int mode, const ivec *v) {
+  if (mode == 2)
+    return dmax(dmax(block_norm_ub(v->c[0], v->c[3], v->c[1]),
+                     block_norm_ub(v->c[0], v->c[4], v->c[2])),
+                block_norm_ub(v->c[1], v->c[5], v->c[2]));
   double m = 0;
   for (int c = 0; c < 3; c++) {
     double q = dmax(fabs(v->c[c].lo), fabs(v->c[c].hi));
@@ -582,21 +669,23 @@ static double ivec_norm_ub(const ivec *v) {
 /* 1 when some gradient assignment may exceed T on the box. The first
 ** corner takes one of each pair g, -g only: negating every gradient
 ** negates the sum. */
-static int may_exceed(const enclosure *e, int i, ivec acc, double rest,
-                      double T) {
-  if (i == e->n) return ivec_norm_ub(&acc) > T - MARGIN;
+static int may_exceed(int mode, const enclosure *e, int i, ivec acc,
+                      double rest, double T) {
+  if (i == e->n) return ivec_norm_ub(mode, &acc) > T - MARGIN;
+  int nc = mode == 2 ? 6 : 3;
   for (int q = 0; q < 12; q += i == 0 ? 2 : 1) {
     ivec s = acc;
-    for (int c = 0; c < 3; c++)
+    for (int c = 0; c < nc; c++)
       s.c[c] = iv_add(s.c[c], e->w[i][q].c[c]);
     double r = rest - e->bound[i];
-    if (ivec_norm_ub(&s) + r <= T - MARGIN) continue;
-    if (may_exceed(e, i + 1, s, r, T)) return 1;
+    if (ivec_norm_ub(mode, &s) + r <= T - MARGIN) continue;
+    if (may_exceed(mode, e, i + 1, s, r, T)) return 1;
   }
   return 0;
 }
 
-/* Proves sup |raw| <= T (mode 0) or sup |grad raw| <= T (mode 1) over the
+/* Proves sup |raw| <= T (mode 0), sup |grad raw| <= T (mode 1) or the
+** Hessian's bound of ivec_norm_ub <= T (mode 2) over the
 ** reference simplex and every gradient assignment, by bisection down to
 ** boxes of width min_w. Returns 1 when proved, 0 when a box of width below
 ** min_w could not be discharged. */
@@ -618,8 +707,11 @@ static int certify(int mode, double T, double min_w, long *boxes) {
     double total = 0;
     for (int i = 0; i < e.n; i++)
       total += e.bound[i];
-    ivec zero = {{{0, 0}, {0, 0}, {0, 0}}};
-    if (total <= T - MARGIN || !may_exceed(&e, 0, zero, total, T)) continue;
+    ivec zero;
+    for (int c = 0; c < 6; c++)
+      zero.c[c] = iv_c(0);
+    if (total <= T - MARGIN || !may_exceed(mode, &e, 0, zero, total, T))
+      continue;
     int k = 0;
     for (int c = 1; c < 3; c++)
       if (b.hi[c] - b.lo[c] > b.hi[k] - b.lo[k]) k = c;
@@ -635,25 +727,41 @@ static int certify(int mode, double T, double min_w, long *boxes) {
 
 /* The exact terms at one point, for the soundness check. */
 static void point_terms(int mode, const double p[3], int i, int q,
-                        double out[3]) {
+                        double out[6]) {
   double d[3], s = 0;
   for (int c = 0; c < 3; c++)
     d[c] = p[c] - SV[i][c], s += d[c] * d[c];
   double a = fmax(0.5 - s, 0), t = 0;
   for (int c = 0; c < 3; c++)
     t += GR[q][c] * d[c];
+  for (int c = 0; c < 6; c++)
+    out[c] = 0;
   if (mode == 0) {
-    out[0] = a * a * a * a * t, out[1] = out[2] = 0;
-  } else {
+    out[0] = a * a * a * a * t;
+  } else if (mode == 1) {
     for (int c = 0; c < 3; c++)
       out[c] = a * a * a * (a * GR[q][c] - 8 * t * d[c]);
+  } else {
+    for (int m = 0; m < 6; m++) {
+      int r = HR[m], c = HC[m];
+      double M = GR[q][r] * d[c] + d[r] * GR[q][c] + (r == c ? t : 0);
+      out[m] = -8 * a * a * a * M + 48 * a * a * t * d[r] * d[c];
+    }
   }
+}
+
+/* The norm of a point value (ivec_norm_ub of an exact vector). */
+static double point_norm(int mode, const double v[6]) {
+  ivec x;
+  for (int c = 0; c < 6; c++)
+    x.c[c] = iv_c(v[c]);
+  return ivec_norm_ub(mode, &x);
 }
 
 /* The largest |sum| over every gradient assignment at one point p of the
 ** reference simplex (unskewed): a lower bound of the supremum. */
 static double witness(int mode, const double p[3]) {
-  double term[4][12][3];
+  double term[4][12][6];
   int n = 0;
   for (int i = 0; i < 4; i++) {
     double s = 0;
@@ -669,11 +777,11 @@ static double witness(int mode, const double p[3]) {
     total *= 12;
   double best = 0;
   for (int k = 0; k < total; k++) {
-    double v[3] = {0, 0, 0};
+    double v[6] = {0, 0, 0, 0, 0, 0};
     for (int i = 0, kk = k; i < n; i++, kk /= 12)
-      for (int c = 0; c < 3; c++)
+      for (int c = 0; c < 6; c++)
         v[c] += term[i][kk % 12][c];
-    best = dmax(best, sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+    best = dmax(best, point_norm(mode, v));
   }
   return best;
 }
@@ -688,7 +796,7 @@ START_TEST(enclosures_are_sound) {
     double lo[3], hi[3], w = pow(10, oc_rng_range(&r, -4, -0.5));
     for (int c = 0; c < 3; c++)
       lo[c] = oc_rng_range(&r, -0.1, 1), hi[c] = lo[c] + w;
-    for (int mode = 0; mode < 2; mode++) {
+    for (int mode = 0; mode < 3; mode++) {
       enclosure e;
       enclose(mode, lo, hi, &e);
       for (int k = 0; k < 20; k++) {
@@ -702,19 +810,19 @@ START_TEST(enclosures_are_sound) {
         for (int i = 0; i < 4; i++) {
           int in = slot < e.n && e.corner[slot] == i;
           for (int q = 0; q < 12; q++) {
-            double v[3];
+            double v[6];
             point_terms(mode, p, i, q, v);
-            double nv = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+            double nv = point_norm(mode, v);
             checked++;
             /* a corner left out must be out of reach */
             if (!in) {
               bad += nv != 0;
               continue;
             }
-            bad += nv > e.bound[slot] + 1e-15;
-            for (int c = 0; c < 3; c++)
-              bad += v[c] < e.w[slot][q].c[c].lo - 1e-15 ||
-                     v[c] > e.w[slot][q].c[c].hi + 1e-15;
+            bad += nv > e.bound[slot] + 1e-14;
+            for (int c = 0; c < 6; c++)
+              bad += v[c] < e.w[slot][q].c[c].lo - 1e-14 ||
+                     v[c] > e.w[slot][q].c[c].hi + 1e-14;
           }
           slot += in;
         }
@@ -770,6 +878,63 @@ START_TEST(bounds_are_proved) {
   /* ... and neither wastes range: both within 1e-9 of the proved values. */
   ck_assert_double_eq_tol(scale * CERT_RAW_MAX, 0.5, 1e-9);
   ck_assert_double_eq_tol(oc_noise3_lipschitz, scale * CERT_RAW_GRAD_MAX, 1e-9);
+}
+END_TEST
+
+START_TEST(hessian_bound_is_proved) {
+  /* The Hessian of n on any coordinate plane (the plane z = 0 of the
+  ** elevation discs' noise): the largest operator norm of a principal 2 x 2
+  ** block of the raw sum's Hessian, over the reference simplex and every
+  ** assignment. */
+  init_simplex();
+  long boxes;
+  clock_t t0 = clock();
+  int ok = certify(2, CERT_RAW_HESS_MAX, 1e-7, &boxes);
+  printf("noise: proof of the plane Hessian bound %.4f: %s (%ld boxes, %.1f "
+         "s)\n",
+         CERT_RAW_HESS_MAX, ok ? "done" : "FAILED", boxes,
+         (double)(clock() - t0) / CLOCKS_PER_SEC);
+  ck_assert(ok);
+  const double wit[3] = {WIT_HESS};
+  double t = (wit[0] + wit[1] + wit[2]) / 6;
+  double p[3] = {wit[0] - t, wit[1] - t, wit[2] - t};
+  double reach = witness(2, p);
+  printf("noise: a witness reaches %.5f (%.2f %% of the bound)\n", reach,
+         100 * reach / CERT_RAW_HESS_MAX);
+  ck_assert(reach > WIT_HESS_SHARE * CERT_RAW_HESS_MAX &&
+            reach <= CERT_RAW_HESS_MAX);
+  ck_assert(!certify(2, 0.95 * reach, 1e-3, &boxes));
+  double scale = implementation_scale();
+  ck_assert_double_eq_tol(oc_noise3_hessian, scale * CERT_RAW_HESS_MAX, 1e-9);
+}
+END_TEST
+
+START_TEST(noise_hessian_on_planes) {
+  /* The gradient's part in a coordinate plane changes by at most
+  ** oc_noise3_hessian times the distance along that plane. */
+  oc_rng r = oc_rng_stream(16, 16);
+  double worst = 0;
+  for (int i = 0; i < 100000; i++) {
+    int ax = i % 3; /* the axis normal to the plane */
+    oc_vec3 p = rand_point(&r, 30), d = rand_dir(&r), gp, gq;
+    double len = pow(10, oc_rng_range(&r, -4, -0.5));
+    double *dd = ax == 0 ? &d.x : ax == 1 ? &d.y : &d.z;
+    *dd = 0;
+    oc_vec3 q = oc_add(p, oc_mul(d, len));
+    double dist = oc_len(oc_sub(q, p));
+    if (!(dist > 0)) continue;
+    oc_noise3(3, p, &gp);
+    oc_noise3(3, q, &gq);
+    oc_vec3 dg = oc_sub(gq, gp);
+    double *dgn = ax == 0 ? &dg.x : ax == 1 ? &dg.y : &dg.z;
+    *dgn = 0;
+    double ratio = oc_len(dg) / dist;
+    if (ratio > worst) worst = ratio;
+  }
+  printf("noise: plane Hessian sampled up to %.3f, bound %.3f\n", worst,
+         oc_noise3_hessian);
+  ck_assert(worst <= oc_noise3_hessian);
+  ck_assert(worst > 0.6 * oc_noise3_hessian);
 }
 END_TEST
 
@@ -966,12 +1131,14 @@ int main(void) {
   tcase_add_test(tc, noise_huge_coordinates);
   tcase_add_test(tc, turbulence_bounds_and_definition);
   tcase_add_test(tc, turbulence_gradient_and_lipschitz);
+  tcase_add_test(tc, noise_hessian_on_planes);
   tcase_add_test(tc, noise_speed);
   suite_add_tcase(s, tc);
   TCase *proof = tcase_create("proof");
   tcase_set_timeout(proof, 600);
   tcase_add_test(proof, enclosures_are_sound);
   tcase_add_test(proof, bounds_are_proved);
+  tcase_add_test(proof, hessian_bound_is_proved);
   suite_add_tcase(s, proof);
   SRunner *sr = srunner_create(s);
   srunner_run_all(sr, CK_NORMAL);
