@@ -12,7 +12,7 @@
 #                output byte for byte and the benchmark figures
 #                (scripts/compare_revisions.sh; ROUNDS=n, OUTPUTS=0 for timing only)
 #   make fuzz    the scene fuzzer, long run (FUZZ_TIME seconds; fuzz-smoke:
-#                about 2 minutes, part of make test)
+#                FUZZ_SMOKE_TIME = 60 s after its build, part of make test)
 #
 # Objects go to build/release (or build/asan for the sanitizer pass, made
 # by a recursive make with SAN=1).
@@ -169,8 +169,15 @@ tests-bin: $(CTEST_BIN)
 
 # ---- tests -------------------------------------------------------------
 
+# Two test programs at a time (most run on one thread); each one's output
+# is printed whole when it ends. Check's timeouts are tripled, as two
+# programs share the cores (the sanitizer pass runs unforked: no timeouts).
+CTEST_JOBS ?= 2
 check-c: $(CTEST_BIN)
-	@set -e; for t in $(CTEST_BIN); do echo "== $$t"; CK_VERBOSITY=minimal $$t; done
+	@printf '%s\n' $(CTEST_BIN) | xargs -P$(CTEST_JOBS) -I{} sh -c \
+	  '{ echo "== {}"; CK_TIMEOUT_MULTIPLIER=3 CK_VERBOSITY=minimal {}; } \
+	   >{}.log 2>&1; s=$$?; cat {}.log; exit $$s' \
+	  || { echo "check-c: a C test failed (above)"; exit 1; }
 
 # OpenImageIO's dependency tree (its log4cplus) starts a thread when it
 # is loaded; a test forked by Check after its parent had loaded it would
@@ -204,11 +211,13 @@ check-runtime: $(BIN)
 	@OUTCROP=$(abspath $(BIN)) bash tests/runtime/run.sh
 	@OUTCROP=$(abspath $(BIN)) bash tests/runtime/outpaths.sh
 	@OUTCROP=$(abspath $(BIN)) bash tests/runtime/examples.sh
-	@OUTCROP=$(abspath $(BIN)) bash tests/runtime/readme_snippets.sh
+	@[ "$(SNIPPETS)" = 0 ] || OUTCROP=$(abspath $(BIN)) bash tests/runtime/readme_snippets.sh
 
 # The sanitizer pass: C tests, Lua specs (stock lua5.4 with libasan
 # preloaded; leak checking off there because lua5.4 itself is not
-# instrumented) and the interpreter tests with leak checking on.
+# instrumented) and the interpreter tests with leak checking on (the
+# README snippets, which call what the specs call, only in the release
+# pass: the 20-minute budget).
 check-asan:
 	@$(MAKE) --no-print-directory SAN=1 all tests-bin
 	@CK_FORK=no $(MAKE) --no-print-directory SAN=1 check-c
@@ -216,7 +225,7 @@ check-asan:
 	  SPEC_PRELOAD="ASAN_OPTIONS=detect_leaks=0 LD_PRELOAD=$$(gcc -print-file-name=libasan.so):$$(gcc -print-file-name=libubsan.so)"
 	@$(MAKE) --no-print-directory SAN=1 check-lua-gc \
 	  SPEC_PRELOAD="ASAN_OPTIONS=detect_leaks=0 LD_PRELOAD=$$(gcc -print-file-name=libasan.so):$$(gcc -print-file-name=libubsan.so)"
-	@EXAMPLES_THREADS=2 $(MAKE) --no-print-directory SAN=1 check-runtime
+	@EXAMPLES_THREADS=2 $(MAKE) --no-print-directory SAN=1 SNIPPETS=0 check-runtime
 	@$(MAKE) --no-print-directory SAN=1 check-corpus
 	@$(MAKE) --no-print-directory SAN=1 check-alloc
 
@@ -353,6 +362,8 @@ fuzz-bin:
 # (or tests/corpus/pending). $(1): seconds, $(2): environment, $(3):
 # corpus folder, $(4): more options.
 FUZZ_TIME ?= 3600
+# the smoke run of make test, seconds
+FUZZ_SMOKE_TIME ?= 60
 FUZZ_OPTS = -max_len=512 -timeout=10 -rss_limit_mb=2048 -print_final_stats=1
 FUZZ_LONG_OPTS = -fork=1 -ignore_crashes=1 -ignore_timeouts=1
 FUZZ_SMOKE_SKIP ?=
@@ -373,7 +384,7 @@ fuzz: fuzz-deps fuzz-bin
 # first finding.
 fuzz-smoke: fuzz-bin
 	@rm -rf build/fuzz/smoke
-	$(call fuzz-run,100,OCFUZZ_SKIP=$(FUZZ_SMOKE_SKIP),build/fuzz/smoke,)
+	$(call fuzz-run,$(FUZZ_SMOKE_TIME),OCFUZZ_SKIP=$(FUZZ_SMOKE_SKIP),build/fuzz/smoke,)
 
 # The findings left to other branches (tests/corpus/pending), through the
 # fuzz build: each one still failing prints its report and is listed.
