@@ -28,6 +28,7 @@
 #include <string.h>
 
 #include "blocks/btile.h"
+#include "core/sigma.h"
 #include "core/error.h"
 #include "field/kind.h"
 
@@ -39,34 +40,10 @@ struct oc_bfield {
 };
 typedef oc_bfield bdata;
 
-enum { P_T, P_W, P_K, P_DS, P_N };
-
-/* ---- sigma (as the terrain's) ------------------------------------------ */
-
-static void sigma_par(double T, double W, double *par) {
-  double k = fmin(W / T, 3.0), m = k;
-  if (k != 2) {
-    double u = (2 * k - 3) / (3 * (k - 2));
-    if (u > 0 && u < 1)
-      m = fmax(m, k + u * (2 * (3 - 2 * k) + 3 * (k - 2) * u));
-  }
-  par[P_T] = T;
-  par[P_W] = W;
-  par[P_K] = k;
-  par[P_DS] = T / W * m * (1 + 1e-12);
-}
-
-static double sigma(const double *par, double v, double *ds) {
-  double T = par[P_T], W = par[P_W], k = par[P_K], u = v / W;
-  if (u >= 1 || u <= -1) {
-    *ds = 0;
-    return u >= 1 ? 2 * T : 0;
-  }
-  double a = fabs(u);
-  double s = a * (k + a * ((3 - 2 * k) + a * (k - 2)));
-  *ds = T / W * (k + a * (2 * (3 - 2 * k) + 3 * (k - 2) * a));
-  return u >= 0 ? T + T * s : T - T * s;
-}
+enum {
+  P_DS = OC_SIG_DS,
+  P_N = OC_SIG_N
+}; /* the compiled op holds sigma's parameters */
 
 /* ---- the distance -------------------------------------------------------- */
 
@@ -117,7 +94,7 @@ double oc_bfield_dist(const oc_bfield *b, oc_vec3 p, oc_vec3 *g) {
 static int block_compile(oc_kcompile *c, oc_error *err) {
   const bdata *b = c->data;
   (void)err;
-  sigma_par(c->T, b->W, c->par);
+  oc_sigma_params(c->T, b->W, c->par);
   c->npar = P_N;
   c->info.lo = 0;
   c->info.hi = 2 * c->T;
@@ -184,13 +161,13 @@ double oc_bfield_eval(const oc_bfield *b, const double *sp, oc_vec3 p,
                       oc_vec3 *g) {
   oc_vec3 gd;
   double ds, d = oc_bfield_dist(b, p, g ? &gd : NULL);
-  double f = sigma(sp, -d, &ds);
+  double f = oc_sigma(sp, -d, &ds);
   if (g) *g = (oc_vec3){-ds * gd.x, -ds * gd.y, -ds * gd.z};
   return f;
 }
 
 void oc_bfield_sigma(double T, double W, double sp[OC_BSIGMA_N]) {
-  sigma_par(T, W, sp);
+  oc_sigma_params(T, W, sp);
 }
 
 oc_node *oc_bblock_node(const oc_bblock *src, double R, double W,

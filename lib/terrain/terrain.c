@@ -30,6 +30,7 @@
 
 #include "core/error.h"
 #include "core/falloff.h"
+#include "core/sigma.h"
 #include "field/kind.h"
 #include "terrain/terrain.h"
 
@@ -44,36 +45,11 @@
 /* ---- sigma ------------------------------------------------------------ */
 
 void oc_terrain_sigma(double T, double W, double par[OC_TPAR_N]) {
-  double k = fmin(W / T, 3.0);
-  /* s'(u) = k + 2 (3 - 2k) u + 3 (k - 2) u^2 on [0, 1]: its largest value
-  ** is at u = 0 or at the vertex */
-  double m = k;
-  if (k != 2) {
-    double u = (2 * k - 3) / (3 * (k - 2));
-    if (u > 0 && u < 1)
-      m = fmax(m, k + u * (2 * (3 - 2 * k) + 3 * (k - 2) * u));
-  }
-  par[OC_TPAR_T] = T;
-  par[OC_TPAR_W] = W;
-  par[OC_TPAR_K] = k;
-  par[OC_TPAR_DS] = T / W * m * (1 + 1e-12);
+  oc_sigma_params(T, W, par);
 }
 
-static double sigma(const double *par, double v, double *ds) {
-  double T = par[OC_TPAR_T], W = par[OC_TPAR_W], k = par[OC_TPAR_K];
-  double u = v / W;
-  if (u >= 1) {
-    *ds = 0;
-    return 2 * T;
-  }
-  if (u <= -1) {
-    *ds = 0;
-    return 0;
-  }
-  double a = fabs(u);
-  double s = a * (k + a * ((3 - 2 * k) + a * (k - 2)));
-  *ds = T / W * (k + a * (2 * (3 - 2 * k) + 3 * (k - 2) * a));
-  return u >= 0 ? T + T * s : T - T * s;
+static inline double sigma(const double *par, double v, double *ds) {
+  return oc_sigma(par, v, ds);
 }
 
 /* ---- the prism ---------------------------------------------------------- */
