@@ -62,12 +62,11 @@ grep -q '^topology: 1 component' "$T/out" || because "no single component report
 tally "$T/out" "$T/err"
 grep "^topology" "$T/out" | sed "s/^/     /"
 
-for ex in elev_river elev_dunes elev_instances elev_road elev_coast elev_lake \
-  elev_craters elev_multiscale elev_lod; do
-  name=elev-${ex#elev_}
-  why=
+# Runs example $1 at 96 pixels into $T/$2/N on one thread and on two
+# (EXAMPLES_THREADS), stdout in $T/out1 (and out2): the same PNG bytes.
+run_96() {
+  local ex=$1 name=$2 n threads=${EXAMPLES_THREADS:-1 2}
   mkdir -p "$T/$name/1" "$T/$name/2"
-  threads=${EXAMPLES_THREADS:-1 2}
   for n in $threads; do
     "$OUTCROP" run "$ROOT/examples/$ex.lua" --set size=96 --threads $n \
       --out "$T/$name/$n" >"$T/out$n" 2>"$T/err" ||
@@ -81,6 +80,13 @@ for ex in elev_river elev_dunes elev_instances elev_road elev_coast elev_lake \
   else
     because "no $ex.png written"
   fi
+}
+
+for ex in elev_river elev_dunes elev_instances elev_road elev_coast elev_lake \
+  elev_craters elev_multiscale elev_lod; do
+  name=elev-${ex#elev_}
+  why=
+  run_96 "$ex" "$name"
   case $ex in
   elev_dunes)
     # desert floor A m -> B m with dunes; peak C m -> D m: B > A, D = C
@@ -118,21 +124,7 @@ done
 for ex in diffusion_ridges diffusion_island; do
   name=diffusion-${ex#diffusion_}
   why=
-  mkdir -p "$T/$name/1" "$T/$name/2"
-  threads=${EXAMPLES_THREADS:-1 2}
-  for n in $threads; do
-    "$OUTCROP" run "$ROOT/examples/$ex.lua" --set size=96 --threads $n \
-      --out "$T/$name/$n" >"$T/out$n" 2>"$T/err" ||
-      because "$(grep -m1 -E 'outcrop:|assert' "$T/err" || echo "exit status $?")"
-  done
-  [ "$threads" = "1 2" ] || cp "$T/$name/$threads/$ex.png" "$T/$name/1/$ex.png" 2>/dev/null
-  [ "$threads" = "1 2" ] || cp "$T/out$threads" "$T/out1"
-  if [ -f "$T/$name/1/$ex.png" ] && [ -f "$T/$name/2/$ex.png" ]; then
-    cmp -s "$T/$name/1/$ex.png" "$T/$name/2/$ex.png" ||
-      because "$ex.png differs between --threads 1 and 2"
-  else
-    because "no $ex.png written"
-  fi
+  run_96 "$ex" "$name"
   case $ex in
   diffusion_ridges)
     # N steps, A strict, B slope and C conflicting samples: C > 0
