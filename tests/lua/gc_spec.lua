@@ -90,7 +90,7 @@ describe("garbage collection", function()
   end)
 end)
 
-describe("deep chains", function()
+describe("deep chains #slowgc", function()
   local p = oc.point{center = {0, 0, 0}, radius = 1}
 
   it("n = n + p, 100000 times, evaluates (blends flatten)", function()

@@ -106,7 +106,7 @@ describe("outcrop.polygonize", function()
     end
   end)
 
-  it("returns triangles as 1-based vertex indices, counter-clockwise from outside", function()
+  it("returns triangles as 1-based vertex indices, counter-clockwise from outside #slowgc", function()
     local m = oc.polygonize(ball, {cell = 0.2})
     local nv, nt = m:counts()
     for t = 1, nt do
@@ -657,7 +657,7 @@ describe("components", function()
     assert.are.same({}, oc.polygonize(oc.point{center = {0, 0, 0}, radius = 1}, {box = {5, 5, 5, 6, 6, 6}}):components())
   end)
 
-  it("min_component drops the small ones, with the same bytes for 1 and 2 threads", function()
+  it("min_component drops the small ones, with the same bytes for 1 and 2 threads #slowgc", function()
     local all = oc.polygonize(two, {box = box, cell = 0.05})
     local c = all:components()
     local big, small = math.max(c[1], c[2]), math.min(c[1], c[2])
@@ -763,7 +763,7 @@ io.stderr:write("done ", m:counts(), "\n")
     return out
   end
 
-  it("is a line on stderr when it is a terminal, cleared at the end", function()
+  it("is a line on stderr when it is a terminal, cleared at the end #slowgc", function()
     if not (build and has_script) then pending("needs OUTCROP_TEST_BUILD and script(1)") return end
     local out = run(function(cmd) return "script -qec \"" .. cmd .. "\" /dev/null" end)
     assert.truthy(out:find("\routcrop.polygonize: +%d+ %%"), out)
@@ -771,7 +771,7 @@ io.stderr:write("done ", m:counts(), "\n")
     assert.truthy(out:find("\r +\rdone %d+"), out) -- cleared before the next output
   end)
 
-  it("is silent when stderr is not a terminal", function()
+  it("is silent when stderr is not a terminal #slowgc", function()
     if not build then pending("needs OUTCROP_TEST_BUILD") return end
     local out = run(function(cmd) return cmd .. " 2>&1" end)
     assert.truthy(out:match("^done %d+\n$"), out)

@@ -113,7 +113,7 @@ describe("outcrop.render of a heightfield", function()
     R.check_error(function() oc.render(doomed, {size = {4, 4}}) end, F, "outcrop.render", "closed")
   end)
 
-  it("is the same across calls", function()
+  it("is the same across calls #slowgc", function()
     local a = oc.render(hf, {size = {24, 16}})
     local b = oc.render(hf, {size = {24, 16}})
     for j = 1, 16 do

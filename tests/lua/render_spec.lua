@@ -162,7 +162,7 @@ describe("outcrop.render", function()
       assert.are.equal(12, img:channels())
     end)
 
-    it("gives depth, position and normal of the sphere", function()
+    it("gives depth, position and normal of the sphere #slowgc", function()
       -- footprint of a pixel at the sphere: the hit tolerance of the tracer
       local tol = 2 * D * math.tan(math.rad(7.5)) / n
       local c = {img:get(16, 16)} -- on the axis
@@ -214,7 +214,7 @@ describe("outcrop.render", function()
     local rgba = oc.render(sphere, {size = {20, 14}, camera = cam, aov = false})
     local with = oc.render(sphere, {size = {20, 14}, camera = cam, aov = true})
 
-    it("do not change the colours", function()
+    it("do not change the colours #slowgc", function()
       assert.are.equal(12, plain:channels())
       assert.are.equal(4, rgba:channels())
       for j = 1, 14 do
@@ -265,7 +265,7 @@ describe("outcrop.render", function()
       R.check_error(function() oc.render(sphere, {tone = 1}) end, F, "outcrop.render", "'tone'")
     end)
 
-    it("multiplies the colours by 2^exposure, alpha and AOVs kept", function()
+    it("multiplies the colours by 2^exposure, alpha and AOVs kept #slowgc", function()
       local base = oc.render(sphere, {size = size, camera = cam})
       local up = oc.render(sphere, {size = size, camera = cam, exposure = 1.5})
       local zero = oc.render(sphere, {size = size, camera = cam, exposure = 0, tone = "clamp"})
@@ -345,7 +345,7 @@ describe("outcrop.render", function()
       assert.are.equal(8, (img:size()))
     end)
 
-    it("maps a node through a palette", function()
+    it("maps a node through a palette #slowgc", function()
       local img = oc.render(scene, {size = {24, 18}, camera = cam, background = {0, 0, 0, 0},
         color = scene, palette = {{0, {0, 1, 0}}, {1, {0, 1, 0}}}})
       local same = oc.render(scene, {size = {24, 18}, camera = cam, background = {0, 0, 0, 0},
@@ -447,7 +447,7 @@ describe("outcrop.render", function()
     assert.is_true(differ <= 2, differ .. " pixels hit by one tracer only")
   end)
 
-  it("traces an open terrain's side wall the same with both tracers", function()
+  it("traces an open terrain's side wall the same with both tracers #slowgc", function()
     -- rays climb through the corner where the wall x = 0 meets the top
     -- z = 10: under it they cross less solid than one sphere step
     local flat = oc.heightfield.from(function() return 10 end, {size = {41, 41}})
