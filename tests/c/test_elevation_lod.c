@@ -16,6 +16,18 @@
 #include "ocheck.h"
 #include "render/etrace.h"
 
+/* Sizes: the sanitizer pass (about 7x slower) samples less, the release
+** pass the full sets. */
+#ifdef __SANITIZE_ADDRESS__
+#define MARCH_NX 10 /* rays against a 0.5 m march */
+#define MARCH_NY 6
+#define LINE_STEP 1.0 /* metres between samples along the lines */
+#else
+#define MARCH_NX 20
+#define MARCH_NY 12
+#define LINE_STEP 0.25
+#endif
+
 static oc_enode *eok_(oc_enode *e, const oc_error *err, const char *what,
                       int line) {
   ck_assert_msg(e != NULL, "line %d: %s failed: %s", line, what, err->msg);
@@ -300,7 +312,7 @@ START_TEST(continuous_across_thresholds) {
   for (int q = 0; q < 4; q++) {
     const oc_enode *t = trees[q];
     const oc_enode_view v = views[q >= 2];
-    double step = 0.25, jumps = 0;
+    double step = LINE_STEP, jumps = 0;
     for (int line = 0; line < 3; line++) {
       double y = -3500 + 1200 * line;
       oc_enode_sample s0, s1;
@@ -477,9 +489,10 @@ START_TEST(lod_trace_against_march) {
   oc_etracer_init(&tr, &es, OC_TRACE_SEGMENT, eps_k, eps_min);
   int hits = 0, differ = 0, n = 0;
   double ev = 0;
-  for (int j = 0; j < 12; j++)
-    for (int i = 0; i < 20; i++) {
-      double x = (i + 0.5) / 20 * 2 - 1, y = ((j + 0.5) / 12 * 2 - 1) * 0.3;
+  for (int j = 0; j < MARCH_NY; j++)
+    for (int i = 0; i < MARCH_NX; i++) {
+      double x = (i + 0.5) / MARCH_NX * 2 - 1,
+             y = ((j + 0.5) / MARCH_NY * 2 - 1) * 0.3;
       oc_vec3 d = oct_add(w, oct_add(oct_mul(rt, 0.6 * x), oct_mul(up, y)));
       d = oct_mul(d, 1 / oct_len(d));
       double t, tref = march(&es, eye, d, 20000, 0.5);
