@@ -182,6 +182,8 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
     for (int k = 0; k < py.nlevels; k++)
       renormalise(&py.lv[k], k ? 1e-6 : COHERENT);
   }
+  for (int k = 0; k < py.nlevels; k++)
+    oc_dguide_prepare(&py.lv[k], p->scheme == OC_DIFFUSION_PAPER);
   rc = solve(&py, p, DK_GUIDED, MAP_H, DF_H, 0.35, 0.3, out, err);
   if (!rc && st.strict_noise)
     rc = solve(&py, p, DK_LAPLACE, MAP_A, DF_NOISE, 0.65, 0.075, out, err);

@@ -138,15 +138,34 @@ typedef struct oc_dop {
   int hom;      /* the correction equation: 0 where constrained, no G */
 } oc_dop;
 
+/* Flag bits oc_dguide_prepare sets on the gradient samples of the
+** elevation that have a direction (|nx| + |ny| > 0): the guide applies,
+** and its upwind neighbour is i + 1 (DF_SX) or j + 1 (DF_SY) instead of
+** i - 1, j - 1. */
+enum { DF_GACT = 16, DF_SX = 32, DF_SY = 64 };
+
+/* Folds the guide of level lv (n in MAP_GX, MAP_GY, the drop per metre
+** in MAP_GD) into the relaxation's coefficients: MAP_GX becomes the
+** weight t of the upwind x neighbour, MAP_GY the constant c (see
+** jacobi.c), and the flags get DF_GACT, DF_SX, DF_SY. After the gradient
+** diffusion, before the elevation's. */
+void oc_dguide_prepare(oc_dlevel *lv, int paper);
+
 /* One Jacobi sweep of level lv from x into y: y = M x + c, or with
 ** op->hom (the correction equation of a V-cycle) y = M x + rhs (rhs NULL:
-** 0), 0 where constrained and without the G term; damped by w (1: plain Jacobi,
-*the
-** cascade's; below 1 for the V-cycles' smoothing: plain Jacobi leaves the
-** checkerboard mode undamped). Returns the largest |y - x| over the
-** samples not constrained. Rows in parallel. */
+** 0), 0 where constrained and without the constant term. Returns the
+** largest |y - x| over the samples not constrained. Rows in parallel. */
 double oc_djacobi(const oc_dop *op, const oc_dlevel *lv, const float *x,
-                  float *y, const float *rhs, double w);
+                  float *y, const float *rhs);
+/* One red-black Gauss-Seidel sweep of x in place (the samples with i + j
+** even, then the others): the same result for any thread count. Returns
+** the largest update. */
+double oc_dgauss_seidel(const oc_dop *op, const oc_dlevel *lv, float *x,
+                        const float *rhs);
+/* The residual of x: r = M x + c (or rhs) - x, 0 where constrained;
+** returns its largest magnitude. */
+double oc_dresidual(const oc_dop *op, const oc_dlevel *lv, const float *x,
+                    const float *rhs, float *r);
 /* Adds the bilinear prolongation of coarse values c (level lc) to (add)
 ** or sets (!add) the unconstrained samples of fine values f (level lf). */
 void oc_dprolong(const oc_dop *op, const oc_dlevel *lc, const float *c,
@@ -160,6 +179,10 @@ void oc_dprolong(const oc_dop *op, const oc_dlevel *lc, const float *c,
 static inline int oc_dfixed(const oc_dop *op, const oc_dlevel *lv, size_t k) {
   return op->kind == DK_LAPLACE ? (lv->flags[k] & op->mask) != 0
                                 : (lv->flags[k] & DF_H) != 0;
+}
+/* Whether sample k follows the gradient (after oc_dguide_prepare). */
+static inline int oc_dguided(const oc_dop *op, const oc_dlevel *lv, size_t k) {
+  return op->kind == DK_GUIDED && (lv->flags[k] & DF_GACT);
 }
 
 typedef struct oc_dsolve {

@@ -47,20 +47,24 @@ typedef struct vctx {
                 ** (a fixed linear map: the Krylov iteration needs one) */
 } vctx;
 
-/* n sweeps of x (with rhs) using the scratch; returns the last update. */
+/* n Jacobi sweeps of x using the scratch; returns the last update. */
 static double sweeps(const oc_dop *op, const oc_dlevel *lv, float *x,
-                     float *scr, const float *rhs, int n, double w) {
+                     float *scr, int n) {
   double big = 0;
   for (int it = 0; it < n; it++)
-    big = (it & 1) ? oc_djacobi(op, lv, scr, x, rhs, w)
-                   : oc_djacobi(op, lv, x, scr, rhs, w);
+    big = (it & 1) ? oc_djacobi(op, lv, scr, x, NULL)
+                   : oc_djacobi(op, lv, x, scr, NULL);
   if (n & 1) memcpy(x, scr, (size_t)lv->nx * (size_t)lv->ny * sizeof *x);
   return big;
 }
 
-static int is_guide(const oc_dop *op, const oc_dlevel *lv, size_t k) {
-  return op->kind == DK_GUIDED && (lv->flags[k] & DF_GUIDE) &&
-         fabs(lv->map[MAP_GX][k]) + fabs(lv->map[MAP_GY][k]) > 1e-6;
+/* n red-black Gauss-Seidel sweeps of x; returns the last update. */
+static double smooth(const oc_dop *op, const oc_dlevel *lv, float *x,
+                     const float *rhs, int n) {
+  double big = 0;
+  for (int it = 0; it < n; it++)
+    big = oc_dgauss_seidel(op, lv, x, rhs);
+  return big;
 }
 
 /* b (level k + 1) from the residual r of level k. */
@@ -83,7 +87,7 @@ static void restrict_residual(const oc_dop *op, const oc_dlevel *f,
       if (oc_dfixed(op, c, kc) || !n)
         b[kc] = 0;
       else
-        b[kc] = (float)((is_guide(op, c, kc) ? 2.0 : 4.0) * sum / n);
+        b[kc] = (float)((oc_dguided(op, c, kc) ? 2.0 : 4.0) * sum / n);
     }
 }
 
@@ -91,18 +95,14 @@ static void restrict_residual(const oc_dop *op, const oc_dlevel *f,
 ** constrained. */
 static void residual(const oc_dop *op, const oc_dlevel *lv, const float *x,
                      const float *rhs, float *r) {
-  oc_djacobi(op, lv, x, r, rhs, 1);
-  size_t ns = (size_t)lv->nx * (size_t)lv->ny;
-#pragma omp parallel for schedule(static) if (OC_DPAR(lv))
-  for (size_t q = 0; q < ns; q++)
-    r[q] = oc_dfixed(op, lv, q) ? 0 : r[q] - x[q];
+  oc_dresidual(op, lv, x, rhs, r);
 }
 
 /* The step t minimising |r - t A c| (A c = c - M c, homogeneous), by
 ** sums over rows added in row order (the same for any thread count). */
 static double step(const vctx *v, const oc_dlevel *lv, const float *r,
                    const float *c, float *ac) {
-  oc_djacobi(&v->hom, lv, c, ac, NULL, 1);
+  oc_djacobi(&v->hom, lv, c, ac, NULL);
   int ny = lv->ny;
   size_t nx = (size_t)lv->nx;
 #pragma omp parallel for schedule(static) if (OC_DPAR(lv))
@@ -139,9 +139,8 @@ static double vcycle(const vctx *v, int k, float *x, const float *rhs) {
   oc_dpyramid *py = v->py;
   const oc_dop *op = k || rhs ? &v->hom : v->op;
   const oc_dlevel *lv = &py->lv[k];
-  if (k == py->nlevels - 1)
-    return sweeps(op, lv, x, py->scratch, rhs, COARSE_SWEEPS, OMEGA);
-  sweeps(op, lv, x, py->scratch, rhs, PRE, OMEGA);
+  if (k == py->nlevels - 1) return smooth(op, lv, x, rhs, COARSE_SWEEPS);
+  smooth(op, lv, x, rhs, PRE);
   residual(op, lv, x, rhs, v->r[k]);
   const oc_dlevel *lc = &py->lv[k + 1];
   restrict_residual(op, lv, v->r[k], lc, v->b[k + 1]);
@@ -154,7 +153,7 @@ static double vcycle(const vctx *v, int k, float *x, const float *rhs) {
 #pragma omp parallel for schedule(static) if (OC_DPAR(lv))
   for (size_t q = 0; q < ns; q++)
     x[q] = (float)(x[q] + t * c[q]);
-  return sweeps(op, lv, x, py->scratch, rhs, POST, OMEGA);
+  return smooth(op, lv, x, rhs, POST);
 }
 
 static int report(const oc_dsolve *s, double f) {
@@ -197,7 +196,7 @@ static double dot(const vctx *v, const float *a, const float *b) {
 /* y = A x = x - M x (homogeneous; 0 where constrained), finest level. */
 static void apply(const vctx *v, const float *x, float *y) {
   const oc_dlevel *lv = &v->py->lv[0];
-  oc_djacobi(&v->hom, lv, x, y, NULL, 1);
+  oc_djacobi(&v->hom, lv, x, y, NULL);
   size_t ns = (size_t)lv->nx * (size_t)lv->ny;
 #pragma omp parallel for schedule(static) if (OC_DPAR(lv))
   for (size_t q = 0; q < ns; q++)
@@ -349,7 +348,7 @@ int oc_dsolve_map(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
     if (k < L - 1)
       oc_dprolong(op, &py->lv[k + 1], py->lv[k + 1].map[op->map], lv,
                   lv->map[op->map], 0);
-    last = sweeps(op, lv, lv->map[op->map], py->scratch, NULL, 5 * (k + 1), 1);
+    last = sweeps(op, lv, lv->map[op->map], py->scratch, 5 * (k + 1));
     done += 5.0 * (k + 1) * lv->nx * lv->ny;
     if (report(s, (s->tolerance > 0 ? 0.5 : 1.0) * done / total))
       return oc_seterr(err, OC_ECANCEL, "diffusion cancelled");
