@@ -207,8 +207,16 @@ typedef struct oc_ddetail {
   uint64_t seed;
 } oc_ddetail;
 
-/* N at (x, y) for amplitude A and roughness R. */
+/* N at (x, y) for amplitude A and roughness R, every octave sampled
+** exactly. */
 double oc_ddetail_at(const oc_ddetail *d, double x, double y, double A,
                      double R);
+/* The final heights z = h + N over the samples of lv (its maps H, A, R),
+** each octave interpolated from a lattice (detail.c); N also into detail
+** unless NULL. Rows in parallel, the same for any thread count; reports
+** [lo, lo + span] of pr, which may cancel. OC_OK, OC_ENOMEM, OC_ECANCEL. */
+int oc_ddetail_grid(const oc_ddetail *d, const oc_dlevel *lv, float *z,
+                    float *detail, oc_progress pr, double lo, double span,
+                    oc_error *err);
 
 #endif
