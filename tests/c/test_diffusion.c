@@ -442,6 +442,45 @@ START_TEST(detail_octave_sum) {
 }
 END_TEST
 
+/* The grid's detail (lattice octaves interpolated, fine octaves sampled
+** directly, octaves under 2 cells dropped) against the exact sum. */
+START_TEST(detail_grid_matches_octaves) {
+  enum { N = 48 };
+  static float maps[MAP_COUNT][N * N], z[N * N], det[N * N];
+  static uint8_t flags[N * N];
+  oc_dlevel lv = {N, N, 1, {NULL}, flags};
+  for (int q = 0; q < MAP_COUNT; q++)
+    lv.map[q] = maps[q];
+  for (int k = 0; k < N * N; k++)
+    maps[MAP_H][k] = 10, maps[MAP_A][k] = 3, maps[MAP_R][k] = 0.5f;
+  /* wavelengths 50, 25, 12.5, 6.25 m: lattices of 6.25, 3.125, 1.5625 m,
+  ** the last finer than the 1 m cell (direct) */
+  oc_ddetail d = {-7.5, 3.25, 1, 50, 2, 4, 11};
+  oc_error err;
+  ck_assert_int_eq(
+      oc_ddetail_grid(&d, &lv, z, det, (oc_progress){0}, 0, 1, &err), OC_OK);
+  double big = 0, sum = 0;
+  for (int j = 0; j < N; j++)
+    for (int i = 0; i < N; i++) {
+      double n = oc_ddetail_at(&d, d.x0 + i, d.y0 + j, 3, 0.5);
+      big = fmax(big, fabs(det[j * N + i] - n));
+      sum += n * n;
+      ck_assert(z[j * N + i] == (float)(10 + det[j * N + i]));
+    }
+  /* Catmull-Rom at 8 nodes a wavelength: within 0.026 of S per octave,
+  ** weights 1 + 0.71 + 0.5 (the last exact), A = 3 */
+  ck_assert_msg(big < 3 * 0.026 * 1.71, "lattice detail off by %g", big);
+  ck_assert(sqrt(sum / (N * N)) > 0.3);
+  /* an octave under 2 cells is dropped: wavelength 3 m keeps 3 m only */
+  oc_ddetail e = {0, 0, 1, 3, 2, 2, 11}, e1 = e;
+  e1.octaves = 1;
+  ck_assert_int_eq(
+      oc_ddetail_grid(&e, &lv, z, det, (oc_progress){0}, 0, 1, &err), OC_OK);
+  for (int k = 0; k < N * N; k += 97)
+    ck_assert(fabs(det[k] - oc_ddetail_at(&e1, k % N, k / N, 3, 0.5)) < 1e-5);
+}
+END_TEST
+
 /* ---- bad input ----------------------------------------------------------- */
 
 static void expect(int ok, const oc_error *err, const char *name) {
@@ -597,6 +636,7 @@ int main(void) {
   tcase_add_test(tc, converged_mode_converges);
   tcase_add_test(tc, deterministic_across_threads);
   tcase_add_test(tc, detail_octave_sum);
+  tcase_add_test(tc, detail_grid_matches_octaves);
   tcase_add_test(tc, bad_input_names_the_field);
   tcase_add_test(tc, progress_cancels);
   tcase_add_test(tc, encoding_round_trips);
