@@ -25,15 +25,16 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <stdio.h>
 
 #include "core/error.h"
 #include "diffusion/diffusion.h"
 
-#define PRE 3
-#define POST 3
+static int PRE = 3;
+static int POST = 3;
 #define COARSE_SWEEPS 100
 #define OMEGA 0.8 /* damped Jacobi smoothing */
-#define STALL 0.7 /* V-cycles removing less: BiCGSTAB takes over */
+static double STALL = 0.7;
 
 typedef struct vctx {
   oc_dpyramid *py;
@@ -306,6 +307,8 @@ static int vcycles(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
   double tol = s->tolerance * fmax(scale, 1e-6);
   double res = first;
   int c = 0;
+  if (getenv("PRE")) PRE = atoi(getenv("PRE")), POST = atoi(getenv("POST"));
+  if (getenv("STALL")) STALL = atof(getenv("STALL"));
   /* V-cycles while each removes most of the largest update, then the
   ** Krylov iteration for the modes they leave */
   while (!rc && res > tol && c < OC_DIFFUSION_MAX_CYCLES) {
@@ -313,6 +316,17 @@ static int vcycles(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
     res = vcycle(&v, 0, py->lv[0].map[op->map], NULL);
     c++;
     if (s->residual) s->residual[c] = res;
+    if (getenv("DBG")) {
+      const oc_dlevel *l0 = &py->lv[0];
+      float *r = v.r[0];
+      double m = oc_dresidual(op, l0, l0->map[op->map], NULL, r);
+      size_t ns = (size_t)l0->nx * l0->ny, big = 0, nb = 0;
+      for (size_t q = 0; q < ns; q++) {
+        if (fabsf(r[q]) > tol) nb++;
+        if (fabsf(r[q]) > fabsf(r[big])) big = q;
+      }
+      fprintf(stderr, "cycle %d: res %.3g (true %.3g) at %zu,%zu flags %x; %zu over tol %.3g\n", c, res, m, big % l0->nx, big / l0->nx, l0->flags[big], nb, tol);
+    }
     if (report(s, 0.5 + 0.5 * c / OC_DIFFUSION_MAX_CYCLES))
       rc = oc_seterr(err, OC_ECANCEL, "diffusion cancelled");
     if (res > STALL * prev) break;

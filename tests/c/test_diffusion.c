@@ -584,6 +584,22 @@ START_TEST(encoding_round_trips) {
   }
   for (int i = 0; i < 3; i++)
     oc_fcurve_release(c[i]);
+  /* version 1 still loads: (0, 0) to (10, 0), heights 5 and radii 1 at
+  ** u = 0 and 1, LEB128 varints of 1/16 m */
+  static const unsigned char v1[] = {'F', 4,    0, 0,  0xc0, 0x02, 0, 2, 0,
+                                     3,   0xa0, 1, 32, 0x80, 0x40, 3, 0, 0};
+  oc_error err;
+  oc_fcurve *o = oc_fcurve_decode(v1, sizeof v1, &err);
+  ck_assert_msg(o != NULL, "%s", err.msg);
+  oc_fcurve_sample a;
+  oc_fcurve_sample_at(o, 0.5, &a);
+  ck_assert(a.x == 5 && a.y == 0 && a.height == 5 && a.radius == 1);
+  ck_assert(oc_fcurve_length(o) == 10);
+  /* and re-encodes as version 2 (marker bits 111): 101 bits */
+  unsigned char b2[16];
+  ck_assert_uint_eq(oc_fcurve_encode(o, b2, sizeof b2), 13);
+  ck_assert((b2[0] & 0xe0) == 0xe0);
+  oc_fcurve_release(o);
 }
 END_TEST
 
