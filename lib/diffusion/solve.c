@@ -1,40 +1,42 @@
 /*
 ** solve.c — the multigrid solve of one map (Hnaidi et al. 2010, section
-** 5.2, after Orzan et al. 2008): a coarse-to-fine cascade with
-** 5 (l - i) Jacobi sweeps at level i of l (0 the coarsest), each level
-** starting from the bilinear prolongation of the one below; then, when a
-** tolerance is given, V-cycles while each removes at least 30 % of the
-** largest Jacobi update of the finest grid, then BiCGSTAB preconditioned
-** by V-cycles, until that update is below the tolerance. (V-cycles alone
-** stall on large grids: the elevation's operator is not symmetric, with
-** its upwind gradient terms, and coarse levels see thin constraints
-** thickened; the Krylov iteration removes the few modes they leave. Its
-** dot products are row sums added in row order, so the result does not
-** depend on the thread count.)
+** 5.2, after Orzan et al. 2008). The paper's schedule: a coarse-to-fine
+** cascade with 5 (l - i) Jacobi sweeps at level i of l (0 the coarsest),
+** each level starting from the bilinear prolongation of the one below.
 **
-** V-cycle at level k: 3 damped sweeps (weight 0.8); the residual
-** r = M x + c - x restricted to level k + 1 (the mean over the free
-** children, times 4 where the coarse sample is Laplace and 2 where it
-** follows a gradient: the Laplacian scales with the square of the cell,
-** the first-order gradient term with the cell); the coarse correction
-** solved recursively from 0 (100 sweeps on the coarsest grid), prolonged
-** and added with the step that minimises the residual (the whole of it
-** as BiCGSTAB's preconditioner, which must be a fixed linear map); 3
-** damped sweeps.
+** The converged mode (a tolerance given) replaces the cascade by full
+** multigrid: each level, coarsest first, starts from the prolonged
+** solution of the one below and gets one V-cycle; then V-cycles on the
+** finest grid while each removes at least 30 % of its largest update,
+** then BiCGSTAB preconditioned by V-cycles, until that update is below
+** the tolerance. (The elevation's operator is not symmetric, with its
+** upwind gradient terms, and its slowest modes sit where filled
+** gradients meet (conflicts) and coarse levels see thin constraints
+** thickened; the Krylov iteration removes the few modes V-cycles leave.
+** Its dot products are row sums added in row order, so the result does
+** not depend on the thread count.)
+**
+** V-cycle at level k: 2 red-black Gauss-Seidel sweeps (the same for any
+** thread count); the residual r = M x + c - x restricted to level k + 1
+** (the mean over the free children, times 4 where the coarse sample is
+** Laplace and 2 where it follows a gradient: the Laplacian scales with
+** the square of the cell, the first-order gradient term with the cell);
+** the coarse correction solved recursively from 0 (100 sweeps on the
+** coarsest grid), prolonged and added with the step that minimises the
+** residual (the whole of it as BiCGSTAB's preconditioner, which must be
+** a fixed linear map); 2 sweeps.
 */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <stdio.h>
 
 #include "core/error.h"
 #include "diffusion/diffusion.h"
 
-static int PRE = 3;
-static int POST = 3;
+#define PRE 2
+#define POST 2
 #define COARSE_SWEEPS 100
-#define OMEGA 0.8 /* damped Jacobi smoothing */
-static double STALL = 0.7;
+#define STALL 0.7 /* V-cycles removing less: BiCGSTAB takes over */
 
 typedef struct vctx {
   oc_dpyramid *py;
@@ -138,7 +140,7 @@ static void prolong_correction(const vctx *v, int k, float *c) {
 ** long free (Neumann) regions. */
 static double vcycle(const vctx *v, int k, float *x, const float *rhs) {
   oc_dpyramid *py = v->py;
-  const oc_dop *op = k || rhs ? &v->hom : v->op;
+  const oc_dop *op = rhs ? &v->hom : v->op;
   const oc_dlevel *lv = &py->lv[k];
   if (k == py->nlevels - 1) return smooth(op, lv, x, rhs, COARSE_SWEEPS);
   smooth(op, lv, x, rhs, PRE);
@@ -283,7 +285,7 @@ static int krylov(const vctx *v, const oc_dsolve *s, double tol, double *res,
 }
 
 static int vcycles(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
-                   double first, oc_error *err) {
+                   oc_error *err) {
   int L = py->nlevels, rc = OC_OK;
   vctx v = {py, op, *op, NULL, NULL, NULL, NULL, NULL, NULL, 0};
   v.hom.hom = 1;
@@ -305,10 +307,18 @@ static int vcycles(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
   fixed_range(py, op, &lo, &hi);
   double scale = fmax(hi - lo, fmax(fabs(lo), fabs(hi)));
   double tol = s->tolerance * fmax(scale, 1e-6);
-  double res = first;
+  /* full multigrid: each level from the prolonged solution of the one
+  ** below, one V-cycle there */
+  double res = 0;
+  for (int k = L - 1; !rc && k >= 0; k--) {
+    float *x = py->lv[k].map[op->map];
+    if (k < L - 1)
+      oc_dprolong(op, &py->lv[k + 1], py->lv[k + 1].map[op->map], &py->lv[k], x,
+                  0);
+    res = vcycle(&v, k, x, NULL);
+  }
+  if (s->residual) s->residual[0] = res;
   int c = 0;
-  if (getenv("PRE")) PRE = atoi(getenv("PRE")), POST = atoi(getenv("POST"));
-  if (getenv("STALL")) STALL = atof(getenv("STALL"));
   /* V-cycles while each removes most of the largest update, then the
   ** Krylov iteration for the modes they leave */
   while (!rc && res > tol && c < OC_DIFFUSION_MAX_CYCLES) {
@@ -316,17 +326,6 @@ static int vcycles(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
     res = vcycle(&v, 0, py->lv[0].map[op->map], NULL);
     c++;
     if (s->residual) s->residual[c] = res;
-    if (getenv("DBG")) {
-      const oc_dlevel *l0 = &py->lv[0];
-      float *r = v.r[0];
-      double m = oc_dresidual(op, l0, l0->map[op->map], NULL, r);
-      size_t ns = (size_t)l0->nx * l0->ny, big = 0, nb = 0;
-      for (size_t q = 0; q < ns; q++) {
-        if (fabsf(r[q]) > tol) nb++;
-        if (fabsf(r[q]) > fabsf(r[big])) big = q;
-      }
-      fprintf(stderr, "cycle %d: res %.3g (true %.3g) at %zu,%zu flags %x; %zu over tol %.3g\n", c, res, m, big % l0->nx, big / l0->nx, l0->flags[big], nb, tol);
-    }
     if (report(s, 0.5 + 0.5 * c / OC_DIFFUSION_MAX_CYCLES))
       rc = oc_seterr(err, OC_ECANCEL, "diffusion cancelled");
     if (res > STALL * prev) break;
@@ -354,6 +353,7 @@ int oc_dsolve_map(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
     if (oc_dfixed(op, top, k)) sum += xt[k], nf++;
   for (size_t k = 0; k < nt; k++)
     if (!oc_dfixed(op, top, k)) xt[k] = nf ? (float)(sum / nf) : 0;
+  if (s->tolerance > 0) return vcycles(py, op, s, err);
   double total = 0, done = 0, last = 0;
   for (int k = 0; k < L; k++)
     total += 5.0 * (k + 1) * py->lv[k].nx * py->lv[k].ny;
@@ -364,11 +364,10 @@ int oc_dsolve_map(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
                   lv->map[op->map], 0);
     last = sweeps(op, lv, lv->map[op->map], py->scratch, 5 * (k + 1));
     done += 5.0 * (k + 1) * lv->nx * lv->ny;
-    if (report(s, (s->tolerance > 0 ? 0.5 : 1.0) * done / total))
+    if (report(s, done / total))
       return oc_seterr(err, OC_ECANCEL, "diffusion cancelled");
   }
   if (s->residual) s->residual[0] = last;
   if (s->cycles) *s->cycles = 0;
-  if (!(s->tolerance > 0)) return OC_OK;
-  return vcycles(py, op, s, last, err);
+  return OC_OK;
 }

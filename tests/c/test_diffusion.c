@@ -352,7 +352,7 @@ START_TEST(converged_mode_converges) {
   run(&p, &r);
   ck_assert(r.cycles >= 1 && r.cycles < OC_DIFFUSION_MAX_CYCLES);
   printf("converged in %d iterations: largest update %.3g m after the "
-         "cascade, %.3g m at the end\n",
+         "full multigrid pass, %.3g m at the end\n",
          r.cycles, r.residual[0], r.residual[r.cycles]);
   /* scale: the strict elevations, 5 .. 90 */
   ck_assert(r.residual[r.cycles] <= 1e-5 * 90);
