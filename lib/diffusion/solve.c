@@ -70,28 +70,35 @@ static double smooth(const oc_dop *op, const oc_dlevel *lv, float *x,
   return big;
 }
 
-/* b (level k + 1) from the residual r of level k. */
+/* b (level k + 1) from the residual r of level k (0 where constrained,
+** so the sum over all children is that over the free ones). */
 static void restrict_residual(const oc_dop *op, const oc_dlevel *f,
                               const float *r, const oc_dlevel *c, float *b) {
+  uint8_t fix = op->kind == DK_LAPLACE ? op->mask : DF_H;
+  uint8_t gact = op->kind == DK_GUIDED ? DF_GACT : 0;
+  static const float inv[5] = {0, 1, 0.5f, 1.0f / 3, 0.25f};
+  size_t nxf = (size_t)f->nx, nxc = (size_t)c->nx;
 #pragma omp parallel for schedule(static) if (OC_DPAR(f))
-  for (int J = 0; J < c->ny; J++)
-    for (int I = 0; I < c->nx; I++) {
-      size_t kc = (size_t)J * (size_t)c->nx + (size_t)I;
-      double sum = 0;
-      int n = 0;
-      for (int q = 0; q < 4; q++) {
-        int i = 2 * I + (q & 1), j = 2 * J + (q >> 1);
-        if (i >= f->nx || j >= f->ny) continue;
-        size_t k = (size_t)j * (size_t)f->nx + (size_t)i;
-        if (oc_dfixed(op, f, k)) continue;
-        sum += r[k];
-        n++;
+  for (int J = 0; J < c->ny; J++) {
+    size_t j0 = 2 * (size_t)J;
+    int two = (int)j0 + 1 < f->ny;
+    const float *r0 = r + j0 * nxf, *r1 = two ? r0 + nxf : r0;
+    const uint8_t *f0 = f->flags + j0 * nxf, *f1 = two ? f0 + nxf : f0;
+    const uint8_t *fc = c->flags + (size_t)J * nxc;
+    float *br = b + (size_t)J * nxc;
+    for (size_t I = 0; I < nxc; I++) {
+      size_t i0 = 2 * I, i1 = i0 + 1 < nxf ? i0 + 1 : i0;
+      int cols = i1 != i0;
+      float sum = r0[i0] + (cols ? r0[i1] : 0);
+      int n = !(f0[i0] & fix) + (cols && !(f0[i1] & fix));
+      if (two) {
+        sum += r1[i0] + (cols ? r1[i1] : 0);
+        n += !(f1[i0] & fix) + (cols && !(f1[i1] & fix));
       }
-      if (oc_dfixed(op, c, kc) || !n)
-        b[kc] = 0;
-      else
-        b[kc] = (float)((oc_dguided(op, c, kc) ? 2.0 : 4.0) * sum / n);
+      float scale = (fc[I] & gact) ? 2.0f : 4.0f;
+      br[I] = (fc[I] & fix) ? 0 : scale * sum * inv[n];
     }
+  }
 }
 
 /* The residual of x at level lv into r: one sweep's update, 0 where
