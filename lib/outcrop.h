@@ -2021,13 +2021,15 @@ typedef struct oc_fcurve_sample {
 } oc_fcurve_sample;
 int oc_fcurve_sample_at(const oc_fcurve *c, double u, oc_fcurve_sample *out);
 
-/* The compact encoding of a curve (lib/diffusion/fcodec.c): varints of
-** coordinates in 1/16 m (each point from the previous), u in 1/4096,
-** heights, radii and extents in 1/16 m, angles in 1/64 degree, amplitude
-** in 1/64 m, roughness in 1/1024, each attribute from its previous
-** value. oc_fcurve_encode writes at most cap bytes to buf (NULL to
+/* The compact encoding of a curve (lib/diffusion/fcodec.c), version 2: a
+** bit stream of Exp-Golomb codes, coordinates in 1/8 m (second
+** differences), u in 1/4096 (omitted when evenly spaced), heights, radii
+** and extents in 1/8 m, angles in 1/64 degree, amplitude in 1/64 m,
+** roughness in 1/1024, each attribute from its previous value, a
+** symmetric slope's right side omitted; version 1 (LEB128 varints)
+** still decodes. oc_fcurve_encode writes at most cap bytes to buf (NULL to
 ** measure) and returns the length of the whole encoding, 0 when a value
-** is too large to quantise (beyond 2^48 m); oc_fcurve_decode builds the
+** is too large to quantise (beyond 2^49 m); oc_fcurve_decode builds the
 ** quantised curve (one reference) or NULL with err. */
 size_t oc_fcurve_encode(const oc_fcurve *c, unsigned char *buf, size_t cap);
 oc_fcurve *oc_fcurve_decode(const unsigned char *buf, size_t n, oc_error *err);
