@@ -157,6 +157,12 @@ void oc_dguide_prepare(oc_dlevel *lv, int paper);
 ** largest |y - x| over the samples not constrained. Rows in parallel. */
 double oc_djacobi(const oc_dop *op, const oc_dlevel *lv, const float *x,
                   float *y, const float *rhs);
+/* n Jacobi sweeps of x (no rhs), the result in x, using scr (the size of
+** lv's grid): on grids run in parallel, fused in blocks of rows so that
+** the grid is read and written once (the same values as n separate
+** sweeps). Returns the last sweep's largest update. */
+double oc_djacobi_n(const oc_dop *op, const oc_dlevel *lv, float *x, float *scr,
+                    int n);
 /* One red-black Gauss-Seidel sweep of x in place (the samples with i + j
 ** even, then the others): the same result for any thread count. Returns
 ** the largest update. */

@@ -34,6 +34,9 @@
 ** thread count; the largest update is a max, exact in any order.
 */
 #include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "diffusion/diffusion.h"
 
@@ -74,15 +77,34 @@ void oc_dguide_prepare(oc_dlevel *lv, int paper) {
 
 #define INLINE static inline __attribute__((always_inline))
 
-/* The update of one sample from its neighbours w, e, s, n and itself xv. */
-INLINE float update(int guided, float w, float e, float s, float n, float xv,
-                    uint8_t f, float t, float c, float chom) {
-  (void)xv;
+/* a where c != 0, else b, by bit masks: a conditional expression lets
+** the compiler move the work of one side into a branch, and a loop with
+** branches is not vectorised. */
+INLINE float sel(unsigned c, float a, float b) {
+  uint32_t ua, ub, m = 0u - (uint32_t)(c != 0), r;
+  memcpy(&ua, &a, sizeof ua);
+  memcpy(&ub, &b, sizeof ub);
+  r = (ua & m) | (ub & ~m);
+  float f;
+  memcpy(&f, &r, sizeof f);
+  return f;
+}
+
+/* The bits of a float >= 0 (or NaN), ordered as the values. */
+INLINE uint32_t fbits(float d) {
+  uint32_t u;
+  memcpy(&u, &d, sizeof u);
+  return u;
+}
+
+/* The update of one sample from its neighbours w, e, s, n. */
+INLINE float update(int guided, float w, float e, float s, float n, uint8_t f,
+                    float t, float c, float chom) {
   float L = 0.25f * ((w + e) + (s + n));
   if (!guided) return L;
-  float fx = (f & DF_SX) ? e : w, fy = (f & DF_SY) ? n : s;
+  float fx = sel(f & DF_SX, e, w), fy = sel(f & DF_SY, n, s);
   float g = 0.5f * L + t * fx + (0.5f - t) * fy + chom * c;
-  return (f & DF_GACT) ? g : L;
+  return sel(f & DF_GACT, g, L);
 }
 
 enum { R_JACOBI, R_RED, R_BLACK, R_RESIDUAL };
@@ -90,17 +112,16 @@ enum { R_JACOBI, R_RED, R_BLACK, R_RESIDUAL };
 /* One row j: mode R_JACOBI writes every sample of y, R_RED / R_BLACK the
 ** samples of that colour (y == x), R_RESIDUAL the update v - x (0 where
 ** fixed). Returns the largest |v - x| over the free samples written. */
-INLINE float row(int guided, int mode, int has_rhs, const oc_dlevel *lv,
-                 uint8_t fix, float keep, float chom, const float *x, float *y,
-                 const float *rhs, int j) {
+/* Row j from its rows below (xs), itself (xr) and above (xn) into yr. */
+INLINE float row3(int guided, int mode, int has_rhs, const oc_dlevel *lv,
+                  uint8_t fix, float keep, float chom, const float *xs,
+                  const float *xr, const float *xn, float *yr, const float *rhs,
+                  int j) {
   size_t nx = (size_t)lv->nx, r0 = (size_t)j * nx;
-  const float *xr = x + r0, *xs = j > 0 ? xr - nx : xr,
-              *xn = j + 1 < lv->ny ? xr + nx : xr;
   const uint8_t *fl = lv->flags + r0;
   const float *t = guided ? lv->map[MAP_GX] + r0 : NULL;
   const float *c = guided ? lv->map[MAP_GY] + r0 : NULL;
   const float *b = has_rhs ? rhs + r0 : NULL;
-  float *yr = y + r0;
   float big = 0;
   /* colour of sample i: (i + j) & 1; the one updated: */
   int want = mode == R_BLACK;
@@ -111,7 +132,7 @@ INLINE float row(int guided, int mode, int has_rhs, const oc_dlevel *lv,
     if (q && last == 0) break;
     size_t iw = i ? i - 1 : 0, ie = i < last ? i + 1 : last;
     float xv = xr[i];
-    float v = update(guided, xr[iw], xr[ie], xs[i], xn[i], xv, fl[i],
+    float v = update(guided, xr[iw], xr[ie], xs[i], xn[i], fl[i],
                      guided ? t[i] : 0, guided ? c[i] : 0, chom);
     if (has_rhs) v += b[i];
     int fixed = (fl[i] & fix) != 0;
@@ -131,7 +152,7 @@ INLINE float row(int guided, int mode, int has_rhs, const oc_dlevel *lv,
     ** (thread) reads is written in this half-sweep */
     for (size_t i = 2 - (((size_t)j + (size_t)want) & 1); i < last; i += 2) {
       float xv = xr[i];
-      float v = update(guided, xr[i - 1], xr[i + 1], xs[i], xn[i], xv, fl[i],
+      float v = update(guided, xr[i - 1], xr[i + 1], xs[i], xn[i], fl[i],
                        guided ? t[i] : 0, guided ? c[i] : 0, chom);
       if (has_rhs) v += b[i];
       int fixed = (fl[i] & fix) != 0;
@@ -141,20 +162,31 @@ INLINE float row(int guided, int mode, int has_rhs, const oc_dlevel *lv,
     }
     return big;
   }
-#pragma omp simd reduction(max : big)
+  uint32_t bigb = fbits(big);
+#pragma omp simd reduction(max : bigb)
   for (size_t i = 1; i < last; i++) {
     float xv = xr[i];
-    float v = update(guided, xr[i - 1], xr[i + 1], xs[i], xn[i], xv, fl[i],
+    float v = update(guided, xr[i - 1], xr[i + 1], xs[i], xn[i], fl[i],
                      guided ? t[i] : 0, guided ? c[i] : 0, chom);
     if (has_rhs) v += b[i];
-    int fixed = (fl[i] & fix) != 0;
-    float d = fixed ? 0 : fabsf(v - xv);
-    float o =
-        mode == R_RESIDUAL ? (fixed ? 0 : v - xv) : (fixed ? keep * xv : v);
-    yr[i] = o;
-    big = d > big ? d : big;
+    unsigned fixed = fl[i] & fix;
+    uint32_t d = fbits(sel(fixed, 0, fabsf(v - xv)));
+    yr[i] =
+        mode == R_RESIDUAL ? sel(fixed, 0, v - xv) : sel(fixed, keep * xv, v);
+    bigb = d > bigb ? d : bigb;
   }
+  memcpy(&big, &bigb, sizeof big);
   return big;
+}
+
+INLINE float row(int guided, int mode, int has_rhs, const oc_dlevel *lv,
+                 uint8_t fix, float keep, float chom, const float *x, float *y,
+                 const float *rhs, int j) {
+  size_t nx = (size_t)lv->nx, r0 = (size_t)j * nx;
+  const float *xr = x + r0, *xs = j > 0 ? xr - nx : xr,
+              *xn = j + 1 < lv->ny ? xr + nx : xr;
+  return row3(guided, mode, has_rhs, lv, fix, keep, chom, xs, xr, xn, y + r0,
+              rhs, j);
 }
 
 /* The rows of one relaxation. Each combination of kind, mode and rhs has
@@ -219,6 +251,81 @@ double oc_djacobi(const oc_dop *op, const oc_dlevel *lv, const float *x,
   return relax(R_JACOBI, op, lv, x, y, rhs);
 }
 
+/* n Jacobi sweeps of rows [j0, j1) fused: stage s (sweep s) of row j is
+** computed as soon as stage s - 1 has rows j - 1 .. j + 1, each
+** intermediate stage keeping 3 rows in ring (3 nx floats a stage); the
+** stages reach n - s rows beyond the block (recomputed by the
+** neighbouring block: the same values), the last writes y. Every value
+** comes from the same inputs by the same arithmetic as in n separate
+** sweeps. */
+INLINE float fused_block(int guided, const oc_dlevel *lv, uint8_t fix,
+                         const float *x, float *y, int n, float *ring, int j0,
+                         int j1) {
+  int ny = lv->ny;
+  size_t nx = (size_t)lv->nx;
+  float big = 0;
+  for (int t = j0 - (n - 1); t < j1 + n - 1; t++)
+    for (int s = 1; s <= n; s++) {
+      int j = t - (s - 1), reach = n - s;
+      int lo = j0 - reach < 0 ? 0 : j0 - reach;
+      int hi = j1 + reach > ny ? ny : j1 + reach;
+      if (j < lo || j >= hi) continue;
+      int js = j > 0 ? j - 1 : 0, jn = j + 1 < ny ? j + 1 : ny - 1;
+      const float *xs, *xr, *xn;
+      if (s == 1) {
+        xs = x + (size_t)js * nx, xr = x + (size_t)j * nx,
+        xn = x + (size_t)jn * nx;
+      } else {
+        float *rg = ring + (size_t)(s - 2) * 3 * nx;
+        xs = rg + (size_t)(js % 3) * nx, xr = rg + (size_t)(j % 3) * nx,
+        xn = rg + (size_t)(jn % 3) * nx;
+      }
+      float *out = s == n ? y + (size_t)j * nx
+                          : ring + ((size_t)(s - 1) * 3 + (size_t)(j % 3)) * nx;
+      float b =
+          row3(guided, R_JACOBI, 0, lv, fix, 1, 1, xs, xr, xn, out, NULL, j);
+      if (s == n) big = b > big ? b : big;
+    }
+  return big;
+}
+
+#define FUSED_BLOCK 64
+#define FUSED_MAX 16
+
+double oc_djacobi_n(const oc_dop *op, const oc_dlevel *lv, float *x, float *scr,
+                    int n) {
+  size_t nx = (size_t)lv->nx, ns = nx * (size_t)lv->ny;
+  int threads = omp_get_max_threads();
+  float *ring = NULL;
+  if (n > 1 && n <= FUSED_MAX && OC_DPAR(lv) && !op->hom)
+    ring = malloc((size_t)threads * (size_t)(n - 1) * 3 * nx * sizeof *ring);
+  if (!ring) { /* separate sweeps */
+    double big = 0;
+    for (int it = 0; it < n; it++)
+      big = (it & 1) ? oc_djacobi(op, lv, scr, x, NULL)
+                     : oc_djacobi(op, lv, x, scr, NULL);
+    if (n & 1) memcpy(x, scr, ns * sizeof *x);
+    return big;
+  }
+  uint8_t fix = op->kind == DK_LAPLACE ? op->mask : DF_H;
+  int guided = op->kind == DK_GUIDED;
+  int nb = (lv->ny + FUSED_BLOCK - 1) / FUSED_BLOCK;
+  float big = 0;
+#pragma omp parallel for schedule(static) reduction(max : big)
+  for (int b = 0; b < nb; b++) {
+    int tid = omp_get_thread_num();
+    float *rg = ring + (size_t)tid * (size_t)(n - 1) * 3 * nx;
+    int j0 = b * FUSED_BLOCK,
+        j1 = j0 + FUSED_BLOCK < lv->ny ? j0 + FUSED_BLOCK : lv->ny;
+    float m = guided ? fused_block(1, lv, fix, x, scr, n, rg, j0, j1)
+                     : fused_block(0, lv, fix, x, scr, n, rg, j0, j1);
+    big = m > big ? m : big;
+  }
+  free(ring);
+  memcpy(x, scr, ns * sizeof *x);
+  return big;
+}
+
 double oc_dgauss_seidel(const oc_dop *op, const oc_dlevel *lv, float *x,
                         const float *rhs) {
   double a = relax(R_RED, op, lv, x, x, rhs);
@@ -241,6 +348,13 @@ static inline void split(int i, int nc, int *a, int *b, float *wb) {
   *b = a0 + 1 >= nc ? nc - 1 : a0 + 1;
 }
 
+/* Fine sample i of a row from the y-blended coarse values at a, b. */
+INLINE void put_fine(float *fr, const uint8_t *fl, uint8_t fix, int add, int i,
+                     float v) {
+  float o = add ? fr[i] + v : v;
+  fr[i] = (fl[i] & fix) ? fr[i] : o;
+}
+
 void oc_dprolong(const oc_dop *op, const oc_dlevel *lc, const float *c,
                  const oc_dlevel *lf, float *f, int add) {
   uint8_t fix = op->kind == DK_LAPLACE ? op->mask : DF_H;
@@ -254,15 +368,21 @@ void oc_dprolong(const oc_dop *op, const oc_dlevel *lc, const float *c,
                 *cb = c + (size_t)jb * (size_t)ncx;
     float *fr = f + (size_t)j * (size_t)nfx;
     const uint8_t *fl = lf->flags + (size_t)j * (size_t)nfx;
-    for (int i = 0; i < nfx; i++) {
+    float uy = 1 - wy;
+    /* fine 2I + 1 and 2I + 2 lie between coarse I and I + 1 (weights
+    ** 1/4 and 3/4 of I + 1); fine 0 and the last ones are clamped */
+    int I = 0;
+    for (; I + 1 < ncx && 2 * I + 2 < nfx; I++) {
+      float va = uy * ca[I] + wy * cb[I], vb = uy * ca[I + 1] + wy * cb[I + 1];
+      put_fine(fr, fl, fix, add, 2 * I + 1, 0.75f * va + 0.25f * vb);
+      put_fine(fr, fl, fix, add, 2 * I + 2, 0.25f * va + 0.75f * vb);
+    }
+    for (int i = 0; i < nfx; i = i ? i + 1 : 2 * I + 1) {
       int ia, ib;
       float wx;
       split(i, ncx, &ia, &ib, &wx);
-      float v0 = (1 - wx) * ca[ia] + wx * ca[ib];
-      float v1 = (1 - wx) * cb[ia] + wx * cb[ib];
-      float v = (1 - wy) * v0 + wy * v1;
-      float o = add ? fr[i] + v : v;
-      fr[i] = (fl[i] & fix) ? fr[i] : o;
+      float va = uy * ca[ia] + wy * cb[ia], vb = uy * ca[ib] + wy * cb[ib];
+      put_fine(fr, fl, fix, add, i, (1 - wx) * va + wx * vb);
     }
   }
 }

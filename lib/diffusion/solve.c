@@ -50,17 +50,6 @@ typedef struct vctx {
                 ** (a fixed linear map: the Krylov iteration needs one) */
 } vctx;
 
-/* n Jacobi sweeps of x using the scratch; returns the last update. */
-static double sweeps(const oc_dop *op, const oc_dlevel *lv, float *x,
-                     float *scr, int n) {
-  double big = 0;
-  for (int it = 0; it < n; it++)
-    big = (it & 1) ? oc_djacobi(op, lv, scr, x, NULL)
-                   : oc_djacobi(op, lv, x, scr, NULL);
-  if (n & 1) memcpy(x, scr, (size_t)lv->nx * (size_t)lv->ny * sizeof *x);
-  return big;
-}
-
 /* n red-black Gauss-Seidel sweeps of x; returns the last update. */
 static double smooth(const oc_dop *op, const oc_dlevel *lv, float *x,
                      const float *rhs, int n) {
@@ -369,7 +358,7 @@ int oc_dsolve_map(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
     if (k < L - 1)
       oc_dprolong(op, &py->lv[k + 1], py->lv[k + 1].map[op->map], lv,
                   lv->map[op->map], 0);
-    last = sweeps(op, lv, lv->map[op->map], py->scratch, 5 * (k + 1));
+    last = oc_djacobi_n(op, lv, lv->map[op->map], py->scratch, 5 * (k + 1));
     done += 5.0 * (k + 1) * lv->nx * lv->ny;
     if (report(s, done / total))
       return oc_seterr(err, OC_ECANCEL, "diffusion cancelled");

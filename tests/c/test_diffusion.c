@@ -415,6 +415,48 @@ START_TEST(deterministic_across_threads) {
 }
 END_TEST
 
+/* The fused sweeps of the cascade give the bytes of separate sweeps. */
+START_TEST(fused_sweeps_match) {
+  enum { NX = 300, NY = 230 }; /* over 65 536 samples: the fused path */
+  size_t ns = (size_t)NX * NY;
+  float *m = malloc(MAP_COUNT * ns * sizeof *m), *x = malloc(ns * sizeof *x),
+        *y = malloc(ns * sizeof *y), *scr = malloc(ns * sizeof *scr);
+  uint8_t *flags = malloc(ns);
+  ck_assert(m && x && y && scr && flags);
+  oc_dlevel lv = {NX, NY, 2, {NULL}, flags};
+  for (int q = 0; q < MAP_COUNT; q++)
+    lv.map[q] = m + (size_t)q * ns;
+  oct_rng rg = oct_rng_new(5);
+  for (size_t k = 0; k < ns; k++) {
+    double u = oct_unif(&rg, 0, 1);
+    flags[k] = u < 0.1   ? DF_H
+               : u < 0.5 ? (uint8_t)(DF_SLOPE | DF_GACT |
+                                     (oct_unif(&rg, 0, 1) < 0.5 ? DF_SX : 0) |
+                                     (oct_unif(&rg, 0, 1) < 0.5 ? DF_SY : 0))
+                         : 0;
+    lv.map[MAP_GX][k] = (float)oct_unif(&rg, 0, 0.5);
+    lv.map[MAP_GY][k] = (float)oct_unif(&rg, -1, 1);
+    x[k] = (float)oct_unif(&rg, -10, 10);
+  }
+  for (int kind = 0; kind < 2; kind++)
+    for (int n = 1; n <= 6; n += 5) {
+      oc_dop op = {kind ? DK_GUIDED : DK_LAPLACE, MAP_H, DF_H, 0, 0};
+      memcpy(y, x, ns * sizeof *x);
+      double b0 = 0;
+      for (int it = 0; it < n; it++) {
+        b0 = oc_djacobi(&op, &lv, y, scr, NULL);
+        memcpy(y, scr, ns * sizeof *y);
+      }
+      memcpy(lv.map[MAP_H], x, ns * sizeof *x);
+      double b1 = oc_djacobi_n(&op, &lv, lv.map[MAP_H], scr, n);
+      ck_assert_msg(memcmp(y, lv.map[MAP_H], ns * sizeof *y) == 0,
+                    "kind %d, %d sweeps", kind, n);
+      ck_assert(b0 == b1 && b0 > 0);
+    }
+  free(m), free(x), free(y), free(scr), free(flags);
+}
+END_TEST
+
 /* ---- noise detail -------------------------------------------------------- */
 
 START_TEST(detail_octave_sum) {
@@ -651,6 +693,7 @@ int main(void) {
   tcase_add_test(tc, conflicting_gradients_filled);
   tcase_add_test(tc, converged_mode_converges);
   tcase_add_test(tc, deterministic_across_threads);
+  tcase_add_test(tc, fused_sweeps_match);
   tcase_add_test(tc, detail_octave_sum);
   tcase_add_test(tc, detail_grid_matches_octaves);
   tcase_add_test(tc, bad_input_names_the_field);
