@@ -65,7 +65,13 @@ static void deposit(const rctx *rc, size_t k, uint32_t ci, double s,
   const rcurve *cv = &rc->cv[ci];
   const oc_fcurve *fc = cv->fc;
   double a[FA_COUNT], u = fc->length > 0 ? s / fc->length : 0;
-  oc_fcurve_attrs(fc, u, 1u << FA_RADIUS, a);
+  /* the radius and, on a slope, that side's extent and angle at once */
+  int sloped = slopes && (fc->has & OC_FC_SLOPE);
+  unsigned want = 1u << FA_RADIUS;
+  if (sloped)
+    want |= left ? (1u << FA_EXTA) | (1u << FA_LEFT)
+                 : (1u << FA_EXTB) | (1u << FA_RIGHT);
+  oc_fcurve_attrs(fc, u, want, a);
   double r = a[FA_RADIUS];
   double ws = fmax(r, 0.5 * rc->lv->cell * (fabs(nox) + fabs(noy)));
   if (dist <= ws && (fc->has & (OC_FC_HEIGHT | OC_FC_NOISE))) {
@@ -81,8 +87,7 @@ static void deposit(const rctx *rc, size_t k, uint32_t ci, double s,
       if (rc->nc[k] < 0xffffu) rc->nc[k]++;
     }
   }
-  if (!slopes || !(fc->has & OC_FC_SLOPE) || !(dist > r)) return;
-  oc_fcurve_attrs(fc, u, left ? (1u << FA_EXTA) : (1u << FA_EXTB), a);
+  if (!sloped || !(dist > r)) return;
   double ext = left ? a[FA_EXTA] : a[FA_EXTB];
   if (!(ext > 0 && dist <= r + ext)) return;
   uint16_t me = (uint16_t)(ci + 1);
@@ -92,7 +97,6 @@ static void deposit(const rctx *rc, size_t k, uint32_t ci, double s,
     return;
   }
   rc->owner[k] = me;
-  oc_fcurve_attrs(fc, u, left ? (1u << FA_LEFT) : (1u << FA_RIGHT), a);
   double tn = left ? a[FA_LEFT] : a[FA_RIGHT];
   double val = tn * (1 - (dist - r) / ext);
   double sg = (fc->has & OC_FC_HEIGHT) ? 1 : -1;
