@@ -150,16 +150,24 @@ INLINE float row3(int guided, int mode, int has_rhs, const oc_dlevel *lv,
   if (mode == R_RED || mode == R_BLACK) {
     /* only the samples of that colour are written: no sample another row
     ** (thread) reads is written in this half-sweep */
-    for (size_t i = 2 - (((size_t)j + (size_t)want) & 1); i < last; i += 2) {
+    size_t i0 = 2 - (((size_t)j + (size_t)want) & 1);
+    size_t nk = last > i0 ? (last - i0 + 1) / 2 : 0;
+    uint32_t bb = fbits(big);
+    /* (the iterations are independent: each writes its own sample and
+    ** reads only samples of the other colour besides it) */
+#pragma omp simd reduction(max : bb)
+    for (size_t q = 0; q < nk; q++) {
+      size_t i = i0 + 2 * q;
       float xv = xr[i];
       float v = update(guided, xr[i - 1], xr[i + 1], xs[i], xn[i], fl[i],
                        guided ? t[i] : 0, guided ? c[i] : 0, chom);
       if (has_rhs) v += b[i];
-      int fixed = (fl[i] & fix) != 0;
-      yr[i] = fixed ? keep * xv : v;
-      float d = fixed ? 0 : fabsf(v - xv);
-      big = d > big ? d : big;
+      unsigned fixed = fl[i] & fix;
+      yr[i] = sel(fixed, keep * xv, v);
+      uint32_t d = fbits(sel(fixed, 0, fabsf(v - xv)));
+      bb = d > bb ? d : bb;
     }
+    memcpy(&big, &bb, sizeof big);
     return big;
   }
   uint32_t bigb = fbits(big);
