@@ -194,14 +194,14 @@ static inline int oc_dguided(const oc_dop *op, const oc_dlevel *lv, size_t k) {
 typedef struct oc_dsolve {
   oc_progress progress;
   double lo, span;  /* this solve's part of the progress range */
-  double tolerance; /* 0: cascade only */
+  double tolerance; /* 0: the cascade; > 0: full multigrid and cycles */
   double *residual; /* NULL or OC_DIFFUSION_MAX_CYCLES + 1 values */
   int *cycles;
 } oc_dsolve;
 
 /* Solves op's map on every level: the paper's coarse-to-fine cascade,
-** then (tolerance > 0) V-cycles and BiCGSTAB to the tolerance. OC_OK,
-** OC_ENOMEM or OC_ECANCEL. */
+** or (tolerance > 0) full multigrid, V-cycles and BiCGSTAB to the
+** tolerance. OC_OK, OC_ENOMEM or OC_ECANCEL. */
 int oc_dsolve_map(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
                   oc_error *err);
 
