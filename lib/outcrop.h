@@ -2021,13 +2021,15 @@ typedef struct oc_fcurve_sample {
 } oc_fcurve_sample;
 int oc_fcurve_sample_at(const oc_fcurve *c, double u, oc_fcurve_sample *out);
 
-/* The compact encoding of a curve (lib/diffusion/fcodec.c): varints of
-** coordinates in 1/16 m (each point from the previous), u in 1/4096,
-** heights, radii and extents in 1/16 m, angles in 1/64 degree, amplitude
-** in 1/64 m, roughness in 1/1024, each attribute from its previous
-** value. oc_fcurve_encode writes at most cap bytes to buf (NULL to
+/* The compact encoding of a curve (lib/diffusion/fcodec.c), version 2: a
+** bit stream of Exp-Golomb codes, coordinates in 1/8 m (second
+** differences), u in 1/4096 (omitted when evenly spaced), heights, radii
+** and extents in 1/8 m, angles in 1/64 degree, amplitude in 1/64 m,
+** roughness in 1/1024, each attribute from its previous value, a
+** symmetric slope's right side omitted; version 1 (LEB128 varints)
+** still decodes. oc_fcurve_encode writes at most cap bytes to buf (NULL to
 ** measure) and returns the length of the whole encoding, 0 when a value
-** is too large to quantise (beyond 2^48 m); oc_fcurve_decode builds the
+** is too large to quantise (beyond 2^49 m); oc_fcurve_decode builds the
 ** quantised curve (one reference) or NULL with err. */
 size_t oc_fcurve_encode(const oc_fcurve *c, unsigned char *buf, size_t cap);
 oc_fcurve *oc_fcurve_decode(const unsigned char *buf, size_t n, oc_error *err);
@@ -2052,10 +2054,11 @@ typedef struct oc_diffusion_params {
   uint64_t seed;
   oc_diffusion_scheme scheme;
   /* 0: the paper's cascade, 5 (l - i) Jacobi sweeps at level i of l (0
-  ** the coarsest); > 0: then V-cycles, and once they stall BiCGSTAB
-  ** preconditioned by V-cycles, until the largest Jacobi update of each
-  ** diffused map is at most tolerance times its constraints' scale (at
-  ** most OC_DIFFUSION_MAX_CYCLES steps) */
+  ** the coarsest); > 0: full multigrid instead, then V-cycles (red-black
+  ** Gauss-Seidel smoothing), and once they stall BiCGSTAB preconditioned
+  ** by V-cycles, until the largest update of each diffused map is at
+  ** most tolerance times its constraints' scale (at most
+  ** OC_DIFFUSION_MAX_CYCLES steps) */
   double tolerance;
   double wavelength; /* lambda_0 metres (> 0; 0: the grid's extent / 8) */
   int octaves;       /* n + 1 in 1..16 (0: 4) */
@@ -2072,8 +2075,8 @@ typedef struct oc_diffusion_result {
   oc_heightfield *smooth, *detail, *amplitude, *roughness, *gradient;
   int levels; /* grids of the multigrid pyramid */
   /* steps of the elevation's solve (V-cycles, then BiCGSTAB iterations),
-  ** and its largest Jacobi update (metres) after the cascade and after
-  ** each step */
+  ** and its largest update (metres) after the cascade (converged: after
+  ** the full multigrid pass) and after each step */
   int cycles;
   double residual[OC_DIFFUSION_MAX_CYCLES + 1];
   size_t strict, slope, conflict; /* constrained samples of the finest grid */

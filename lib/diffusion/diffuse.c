@@ -92,38 +92,6 @@ static void renormalise(oc_dlevel *lv, double coherent) {
   }
 }
 
-typedef struct row_ctx {
-  const oc_dlevel *lv;
-  oc_ddetail d;
-  float *detail; /* or NULL */
-} row_ctx;
-
-static void detail_row(const void *ctx, oc_heightfield *out, int j) {
-  const row_ctx *c = ctx;
-  const oc_dlevel *lv = c->lv;
-  size_t nx = (size_t)lv->nx, row = (size_t)j * nx;
-  float *z = oc_heightfield_samples_mut(out) + row;
-  const float *h = lv->map[MAP_H] + row, *A = lv->map[MAP_A] + row,
-              *R = lv->map[MAP_R] + row;
-  double y = c->d.y0 + j * c->d.cell;
-  for (size_t i = 0; i < nx; i++) {
-    double n =
-        oc_ddetail_at(&c->d, c->d.x0 + (double)i * c->d.cell, y, A[i], R[i]);
-    if (c->detail) c->detail[row + i] = (float)n;
-    z[i] = (float)(h[i] + n);
-  }
-}
-
-typedef struct relay {
-  oc_progress outer;
-  double lo, span;
-} relay;
-
-static int relay_fn(void *ud, double f) {
-  const relay *r = ud;
-  return r->outer.fn(r->outer.ud, r->lo + r->span * f);
-}
-
 static oc_heightfield *grid_of(const oc_diffusion_params *p, const float *z,
                                oc_error *err) {
   const oc_heightfield_grid *g = &p->grid;
@@ -182,6 +150,8 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
     for (int k = 0; k < py.nlevels; k++)
       renormalise(&py.lv[k], k ? 1e-6 : COHERENT);
   }
+  for (int k = 0; k < py.nlevels; k++)
+    oc_dguide_prepare(&py.lv[k], p->scheme == OC_DIFFUSION_PAPER);
   rc = solve(&py, p, DK_GUIDED, MAP_H, DF_H, 0.35, 0.3, out, err);
   if (!rc && st.strict_noise)
     rc = solve(&py, p, DK_LAPLACE, MAP_A, DF_NOISE, 0.65, 0.075, out, err);
@@ -191,12 +161,15 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
   oc_dpyramid_shrink(&py); /* the finest grid's maps are all that is left */
   const oc_dlevel *lv = &py.lv[0];
   size_t ns = (size_t)lv->nx * (size_t)lv->ny;
-  row_ctx rx = {
-      lv,
-      {g->x0, g->y0, g->cell,
-       p->wavelength > 0 ? p->wavelength : fmax(g->nx, g->ny) * g->cell / 8,
-       p->ratio > 0 ? p->ratio : 2, p->octaves ? p->octaves : 4, p->seed},
-      NULL};
+  oc_ddetail dd = {g->x0,
+                   g->y0,
+                   g->cell,
+                   p->wavelength > 0 ? p->wavelength
+                                     : fmax(g->nx, g->ny) * g->cell / 8,
+                   p->ratio > 0 ? p->ratio : 2,
+                   p->octaves ? p->octaves : 4,
+                   p->seed};
+  float *detail = NULL;
   if (!st.strict_noise) memset(lv->map[MAP_A], 0, ns * sizeof(float));
   if (p->maps) {
     out->smooth = grid_of(p, lv->map[MAP_H], err);
@@ -208,17 +181,15 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
       rc = err ? err->code : OC_ENOMEM;
       goto done;
     }
-    rx.detail = oc_heightfield_samples_mut(out->detail);
+    detail = oc_heightfield_samples_mut(out->detail);
   }
   out->height = grid_of(p, NULL, err);
   if (!out->height) {
     rc = err ? err->code : OC_ENOMEM;
     goto done;
   }
-  relay r = {p->progress, 0.8, 0.2};
-  oc_progress pr = {p->progress.fn ? relay_fn : NULL, &r};
-  rc = oc_heightfield_each_row(out->height, detail_row, &rx, pr, "diffusion",
-                               err);
+  rc = oc_ddetail_grid(&dd, lv, oc_heightfield_samples_mut(out->height), detail,
+                       p->progress, 0.8, 0.2, err);
 done:
   oc_dpyramid_free(&py);
   if (rc) oc_diffusion_result_clear(out);

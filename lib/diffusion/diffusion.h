@@ -138,15 +138,40 @@ typedef struct oc_dop {
   int hom;      /* the correction equation: 0 where constrained, no G */
 } oc_dop;
 
+/* Flag bits oc_dguide_prepare sets on the gradient samples of the
+** elevation that have a direction (|nx| + |ny| > 0): the guide applies,
+** and its upwind neighbour is i + 1 (DF_SX) or j + 1 (DF_SY) instead of
+** i - 1, j - 1. */
+enum { DF_GACT = 16, DF_SX = 32, DF_SY = 64 };
+
+/* Folds the guide of level lv (n in MAP_GX, MAP_GY, the drop per metre
+** in MAP_GD) into the relaxation's coefficients: MAP_GX becomes the
+** weight t of the upwind x neighbour, MAP_GY the constant c (see
+** jacobi.c), and the flags get DF_GACT, DF_SX, DF_SY. After the gradient
+** diffusion, before the elevation's. */
+void oc_dguide_prepare(oc_dlevel *lv, int paper);
+
 /* One Jacobi sweep of level lv from x into y: y = M x + c, or with
 ** op->hom (the correction equation of a V-cycle) y = M x + rhs (rhs NULL:
-** 0), 0 where constrained and without the G term; damped by w (1: plain Jacobi,
-*the
-** cascade's; below 1 for the V-cycles' smoothing: plain Jacobi leaves the
-** checkerboard mode undamped). Returns the largest |y - x| over the
-** samples not constrained. Rows in parallel. */
+** 0), 0 where constrained and without the constant term. Returns the
+** largest |y - x| over the samples not constrained. Rows in parallel. */
 double oc_djacobi(const oc_dop *op, const oc_dlevel *lv, const float *x,
-                  float *y, const float *rhs, double w);
+                  float *y, const float *rhs);
+/* n Jacobi sweeps of x (no rhs), the result in x, using scr (the size of
+** lv's grid): on grids run in parallel, fused in blocks of rows so that
+** the grid is read and written once (the same values as n separate
+** sweeps). Returns the last sweep's largest update. */
+double oc_djacobi_n(const oc_dop *op, const oc_dlevel *lv, float *x, float *scr,
+                    int n);
+/* One red-black Gauss-Seidel sweep of x in place (the samples with i + j
+** even, then the others): the same result for any thread count. Returns
+** the largest update. */
+double oc_dgauss_seidel(const oc_dop *op, const oc_dlevel *lv, float *x,
+                        const float *rhs);
+/* The residual of x: r = M x + c (or rhs) - x, 0 where constrained;
+** returns its largest magnitude. */
+double oc_dresidual(const oc_dop *op, const oc_dlevel *lv, const float *x,
+                    const float *rhs, float *r);
 /* Adds the bilinear prolongation of coarse values c (level lc) to (add)
 ** or sets (!add) the unconstrained samples of fine values f (level lf). */
 void oc_dprolong(const oc_dop *op, const oc_dlevel *lc, const float *c,
@@ -161,18 +186,22 @@ static inline int oc_dfixed(const oc_dop *op, const oc_dlevel *lv, size_t k) {
   return op->kind == DK_LAPLACE ? (lv->flags[k] & op->mask) != 0
                                 : (lv->flags[k] & DF_H) != 0;
 }
+/* Whether sample k follows the gradient (after oc_dguide_prepare). */
+static inline int oc_dguided(const oc_dop *op, const oc_dlevel *lv, size_t k) {
+  return op->kind == DK_GUIDED && (lv->flags[k] & DF_GACT);
+}
 
 typedef struct oc_dsolve {
   oc_progress progress;
   double lo, span;  /* this solve's part of the progress range */
-  double tolerance; /* 0: cascade only */
+  double tolerance; /* 0: the cascade; > 0: full multigrid and cycles */
   double *residual; /* NULL or OC_DIFFUSION_MAX_CYCLES + 1 values */
   int *cycles;
 } oc_dsolve;
 
 /* Solves op's map on every level: the paper's coarse-to-fine cascade,
-** then (tolerance > 0) V-cycles and BiCGSTAB to the tolerance. OC_OK,
-** OC_ENOMEM or OC_ECANCEL. */
+** or (tolerance > 0) full multigrid, V-cycles and BiCGSTAB to the
+** tolerance. OC_OK, OC_ENOMEM or OC_ECANCEL. */
 int oc_dsolve_map(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
                   oc_error *err);
 
@@ -184,8 +213,16 @@ typedef struct oc_ddetail {
   uint64_t seed;
 } oc_ddetail;
 
-/* N at (x, y) for amplitude A and roughness R. */
+/* N at (x, y) for amplitude A and roughness R, every octave sampled
+** exactly. */
 double oc_ddetail_at(const oc_ddetail *d, double x, double y, double A,
                      double R);
+/* The final heights z = h + N over the samples of lv (its maps H, A, R),
+** each octave interpolated from a lattice (detail.c); N also into detail
+** unless NULL. Rows in parallel, the same for any thread count; reports
+** [lo, lo + span] of pr, which may cancel. OC_OK, OC_ENOMEM, OC_ECANCEL. */
+int oc_ddetail_grid(const oc_ddetail *d, const oc_dlevel *lv, float *z,
+                    float *detail, oc_progress pr, double lo, double span,
+                    oc_error *err);
 
 #endif

@@ -1,6 +1,6 @@
 /*
-** jacobi.c — one Jacobi relaxation of a level and the bilinear
-** prolongation between levels (Hnaidi et al. 2010, section 5.2):
+** jacobi.c — the relaxations of a level and the bilinear prolongation
+** between levels (Hnaidi et al. 2010, section 5.2):
 **
 **   F' = alpha F_L + beta F_G + (1 - alpha - beta) F_I,
 **
@@ -11,108 +11,386 @@
 **
 **   upwind (default) F_G = (|nx| F(i - sx, j) + |ny| F(i, j - sy) - G)
 **                          / (|nx| + |ny|)
-**   paper            F_G = nx^2 F(i - sx, j) + ny^2 F(i, j - sy) - G
+**   paper            F_G = (nx^2 F(i - sx, j) + ny^2 F(i, j - sy))
+**                          / (nx^2 + ny^2) - G
 **
 ** The upwind form holds every plane of slope g along n exactly; the
 ** printed one makes 45-degree slopes sqrt 2 too steep (the two
 ** neighbours each differ by g cell / sqrt 2, weighted 1/2 each).
 ** Neumann border: a missing neighbour is the sample itself.
 **
-** A sweep reads x and writes y, so rows run in parallel in any order and
-** the result does not depend on the thread count; the largest update is
-** a max, exact in any order.
+** oc_dguide_prepare folds n and g of a gradient sample into two numbers
+** and two flag bits, F' = F_L / 2 + t F(i - sx, j) + (1/2 - t)
+** F(i, j - sy) + c, so that a relaxation reads per sample one flag byte
+** and (gradient samples of the elevation) two floats, with no branch:
+** the kinds of sample are selected arithmetically and the rows vectorise.
+** Arithmetic in float (the maps are float; the elevation's solves end
+** far above float's rounding).
+**
+** Jacobi reads x and writes y; red-black Gauss-Seidel updates the samples
+** of one colour ((i + j) even: red) in place from those of the other.
+** Either way every value depends only on values of the previous step, so
+** rows run in parallel in any order and the result does not depend on the
+** thread count; the largest update is a max, exact in any order.
 */
 #include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "diffusion/diffusion.h"
 
-static inline float at(const float *x, const oc_dlevel *lv, int i, int j) {
-  i = i < 0 ? 0 : i >= lv->nx ? lv->nx - 1 : i;
-  j = j < 0 ? 0 : j >= lv->ny ? lv->ny - 1 : j;
-  return x[(size_t)j * (size_t)lv->nx + (size_t)i];
-}
+/* The relaxation rows select between sample kinds; gcc's default cost
+** model at -O2 ("very cheap") leaves such loops scalar. */
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC optimize("vect-cost-model=cheap")
+#endif
 
-static double sweep_row(const oc_dop *op, const oc_dlevel *lv, const float *x,
-                        float *y, const float *rhs, double w, int j) {
-  const float *gx = lv->map[MAP_GX], *gy = lv->map[MAP_GY],
-              *gd = lv->map[MAP_GD];
-  size_t nx = (size_t)lv->nx, row = (size_t)j * nx;
-  /* the rows around, the row itself at the border (Neumann) */
-  const float *xr = x + row, *xs = j > 0 ? xr - nx : xr,
-              *xn = j + 1 < lv->ny ? xr + nx : xr;
-  int guided = op->kind == DK_GUIDED;
-  double big = 0;
-  for (size_t i = 0; i < nx; i++) {
-    size_t k = row + i;
-    uint8_t fl = lv->flags[k];
-    if (oc_dfixed(op, lv, k)) {
-      y[k] = op->hom ? 0 : x[k];
-      continue;
-    }
-    size_t iw = i > 0 ? i - 1 : 0, ie = i + 1 < nx ? i + 1 : i;
-    double L = 0.25 * ((double)xr[iw] + xr[ie] + xs[i] + xn[i]);
-    double v = L;
-    if (guided && (fl & DF_GUIDE)) {
-      double nxv = gx[k], nyv = gy[k], ax = fabs(nxv), ay = fabs(nyv);
-      if (ax + ay > 1e-6) {
-        /* the upwind neighbours: i - sx and j - sy */
-        double fx = nxv >= 0 ? xr[iw] : xr[ie];
-        double fy = nyv >= 0 ? xs[i] : xn[i];
-        double G = op->hom ? 0 : gd[k] * lv->cell, F;
-        if (op->paper)
-          F = (nxv * nxv * fx + nyv * nyv * fy) / (nxv * nxv + nyv * nyv) - G;
-        else
-          F = (ax * fx + ay * fy - G) / (ax + ay);
-        v = 0.5 * L + 0.5 * F;
+void oc_dguide_prepare(oc_dlevel *lv, int paper) {
+  float *gx = lv->map[MAP_GX], *gy = lv->map[MAP_GY];
+  const float *gd = lv->map[MAP_GD];
+  size_t ns = (size_t)lv->nx * (size_t)lv->ny;
+  double cell = lv->cell;
+#pragma omp parallel for schedule(static) if (OC_DPAR(lv))
+  for (size_t k = 0; k < ns; k++) {
+    uint8_t f = (uint8_t)(lv->flags[k] & ~(DF_GACT | DF_SX | DF_SY));
+    double nx = gx[k], ny = gy[k], ax = fabs(nx), ay = fabs(ny);
+    float t = 0, c = 0;
+    if ((f & DF_GUIDE) && ax + ay > 1e-6) {
+      double G = gd[k] * cell;
+      f |= DF_GACT;
+      if (nx < 0) f |= DF_SX; /* upwind: i + 1 */
+      if (ny < 0) f |= DF_SY; /* upwind: j + 1 */
+      if (paper) {
+        t = (float)(0.5 * nx * nx / (nx * nx + ny * ny));
+        c = (float)(-0.5 * G);
+      } else {
+        t = (float)(0.5 * ax / (ax + ay));
+        c = (float)(-0.5 * G / (ax + ay));
       }
     }
-    if (rhs) v += rhs[k];
-    if (w != 1) v = x[k] + w * (v - x[k]);
-    y[k] = (float)v;
-    double d = fabs(v - x[k]);
-    if (d > big) big = d;
+    lv->flags[k] = f;
+    gx[k] = t;
+    gy[k] = c;
+  }
+}
+
+#define INLINE static inline __attribute__((always_inline))
+
+/* a where c != 0, else b, by bit masks: a conditional expression lets
+** the compiler move the work of one side into a branch, and a loop with
+** branches is not vectorised. */
+INLINE float sel(unsigned c, float a, float b) {
+  uint32_t ua, ub, m = 0u - (uint32_t)(c != 0), r;
+  memcpy(&ua, &a, sizeof ua);
+  memcpy(&ub, &b, sizeof ub);
+  r = (ua & m) | (ub & ~m);
+  float f;
+  memcpy(&f, &r, sizeof f);
+  return f;
+}
+
+/* The bits of a float >= 0 (or NaN), ordered as the values. */
+INLINE uint32_t fbits(float d) {
+  uint32_t u;
+  memcpy(&u, &d, sizeof u);
+  return u;
+}
+
+/* The update of one sample from its neighbours w, e, s, n. */
+INLINE float update(int guided, float w, float e, float s, float n, uint8_t f,
+                    float t, float c, float chom) {
+  float L = 0.25f * ((w + e) + (s + n));
+  if (!guided) return L;
+  float fx = sel(f & DF_SX, e, w), fy = sel(f & DF_SY, n, s);
+  float g = 0.5f * L + t * fx + (0.5f - t) * fy + chom * c;
+  return sel(f & DF_GACT, g, L);
+}
+
+enum { R_JACOBI, R_RED, R_BLACK, R_RESIDUAL };
+
+/* One row j: mode R_JACOBI writes every sample of y, R_RED / R_BLACK the
+** samples of that colour (y == x), R_RESIDUAL the update v - x (0 where
+** fixed). Returns the largest |v - x| over the free samples written. */
+/* Row j from its rows below (xs), itself (xr) and above (xn) into yr. */
+INLINE float row3(int guided, int mode, int has_rhs, const oc_dlevel *lv,
+                  uint8_t fix, float keep, float chom, const float *xs,
+                  const float *xr, const float *xn, float *yr, const float *rhs,
+                  int j) {
+  size_t nx = (size_t)lv->nx, r0 = (size_t)j * nx;
+  const uint8_t *fl = lv->flags + r0;
+  const float *t = guided ? lv->map[MAP_GX] + r0 : NULL;
+  const float *c = guided ? lv->map[MAP_GY] + r0 : NULL;
+  const float *b = has_rhs ? rhs + r0 : NULL;
+  float big = 0;
+  /* colour of sample i: (i + j) & 1; the one updated: */
+  int want = mode == R_BLACK;
+  size_t last = nx - 1;
+  /* the border columns (Neumann: the sample itself for the missing one) */
+  for (size_t q = 0; q < 2 && q <= last; q++) {
+    size_t i = q ? last : 0;
+    if (q && last == 0) break;
+    size_t iw = i ? i - 1 : 0, ie = i < last ? i + 1 : last;
+    float xv = xr[i];
+    float v = update(guided, xr[iw], xr[ie], xs[i], xn[i], fl[i],
+                     guided ? t[i] : 0, guided ? c[i] : 0, chom);
+    if (has_rhs) v += b[i];
+    int fixed = (fl[i] & fix) != 0;
+    float d = fixed ? 0 : fabsf(v - xv);
+    if (mode == R_RESIDUAL) {
+      yr[i] = fixed ? 0 : v - xv;
+    } else if (mode == R_JACOBI) {
+      yr[i] = fixed ? keep * xv : v;
+    } else {
+      if ((int)((i + (size_t)j) & 1) != want) continue;
+      yr[i] = fixed ? keep * xv : v;
+    }
+    big = d > big ? d : big;
+  }
+  if (mode == R_RED || mode == R_BLACK) {
+    /* only the samples of that colour are written: no sample another row
+    ** (thread) reads is written in this half-sweep */
+    size_t i0 = 2 - (((size_t)j + (size_t)want) & 1);
+    size_t nk = last > i0 ? (last - i0 + 1) / 2 : 0;
+    uint32_t bb = fbits(big);
+    /* (the iterations are independent: each writes its own sample and
+    ** reads only samples of the other colour besides it) */
+#pragma omp simd reduction(max : bb)
+    for (size_t q = 0; q < nk; q++) {
+      size_t i = i0 + 2 * q;
+      float xv = xr[i];
+      float v = update(guided, xr[i - 1], xr[i + 1], xs[i], xn[i], fl[i],
+                       guided ? t[i] : 0, guided ? c[i] : 0, chom);
+      if (has_rhs) v += b[i];
+      unsigned fixed = fl[i] & fix;
+      yr[i] = sel(fixed, keep * xv, v);
+      uint32_t d = fbits(sel(fixed, 0, fabsf(v - xv)));
+      bb = d > bb ? d : bb;
+    }
+    memcpy(&big, &bb, sizeof big);
+    return big;
+  }
+  uint32_t bigb = fbits(big);
+#pragma omp simd reduction(max : bigb)
+  for (size_t i = 1; i < last; i++) {
+    float xv = xr[i];
+    float v = update(guided, xr[i - 1], xr[i + 1], xs[i], xn[i], fl[i],
+                     guided ? t[i] : 0, guided ? c[i] : 0, chom);
+    if (has_rhs) v += b[i];
+    unsigned fixed = fl[i] & fix;
+    uint32_t d = fbits(sel(fixed, 0, fabsf(v - xv)));
+    yr[i] =
+        mode == R_RESIDUAL ? sel(fixed, 0, v - xv) : sel(fixed, keep * xv, v);
+    bigb = d > bigb ? d : bigb;
+  }
+  memcpy(&big, &bigb, sizeof big);
+  return big;
+}
+
+INLINE float row(int guided, int mode, int has_rhs, const oc_dlevel *lv,
+                 uint8_t fix, float keep, float chom, const float *x, float *y,
+                 const float *rhs, int j) {
+  size_t nx = (size_t)lv->nx, r0 = (size_t)j * nx;
+  const float *xr = x + r0, *xs = j > 0 ? xr - nx : xr,
+              *xn = j + 1 < lv->ny ? xr + nx : xr;
+  return row3(guided, mode, has_rhs, lv, fix, keep, chom, xs, xr, xn, y + r0,
+              rhs, j);
+}
+
+/* The rows of one relaxation. Each combination of kind, mode and rhs has
+** its own parallel loop with constant arguments: the loop body the
+** compiler outlines for the threads must see them as constants to drop
+** the unused branches and vectorise. */
+// clang-format off
+#define SWEEP(G, M, B)                                                         \
+  _Pragma("omp parallel for schedule(static) reduction(max:big) if(par)")      \
+  for (int j = 0; j < ny; j++) {                                               \
+    float b = row(G, M, B, lv, fix, keep, chom, x, y, rhs, j);                 \
+    big = b > big ? b : big;                                                   \
+  }                                                                            \
+  break
+// clang-format on
+
+static double relax(int mode, const oc_dop *op, const oc_dlevel *lv,
+                    const float *x, float *y, const float *rhs) {
+  uint8_t fix = op->kind == DK_LAPLACE ? op->mask : DF_H;
+  float keep = op->hom ? 0.0f : 1.0f, chom = op->hom ? 0.0f : 1.0f;
+  float big = 0;
+  int ny = lv->ny, par = OC_DPAR(lv);
+  switch ((op->kind == DK_GUIDED) * 8 + mode * 2 + (rhs != NULL)) {
+  case 0:
+    SWEEP(0, R_JACOBI, 0);
+  case 1:
+    SWEEP(0, R_JACOBI, 1);
+  case 2:
+    SWEEP(0, R_RED, 0);
+  case 3:
+    SWEEP(0, R_RED, 1);
+  case 4:
+    SWEEP(0, R_BLACK, 0);
+  case 5:
+    SWEEP(0, R_BLACK, 1);
+  case 6:
+    SWEEP(0, R_RESIDUAL, 0);
+  case 7:
+    SWEEP(0, R_RESIDUAL, 1);
+  case 8:
+    SWEEP(1, R_JACOBI, 0);
+  case 9:
+    SWEEP(1, R_JACOBI, 1);
+  case 10:
+    SWEEP(1, R_RED, 0);
+  case 11:
+    SWEEP(1, R_RED, 1);
+  case 12:
+    SWEEP(1, R_BLACK, 0);
+  case 13:
+    SWEEP(1, R_BLACK, 1);
+  case 14:
+    SWEEP(1, R_RESIDUAL, 0);
+  default:
+    SWEEP(1, R_RESIDUAL, 1);
   }
   return big;
 }
 
 double oc_djacobi(const oc_dop *op, const oc_dlevel *lv, const float *x,
-                  float *y, const float *rhs, double w) {
-  double big = 0;
-#pragma omp parallel for schedule(static) reduction(max : big) if (OC_DPAR(lv))
-  for (int j = 0; j < lv->ny; j++) {
-    double b = sweep_row(op, lv, x, y, rhs, w, j);
-    if (b > big) big = b;
-  }
+                  float *y, const float *rhs) {
+  return relax(R_JACOBI, op, lv, x, y, rhs);
+}
+
+/* n Jacobi sweeps of rows [j0, j1) fused: stage s (sweep s) of row j is
+** computed as soon as stage s - 1 has rows j - 1 .. j + 1, each
+** intermediate stage keeping 3 rows in ring (3 nx floats a stage); the
+** stages reach n - s rows beyond the block (recomputed by the
+** neighbouring block: the same values), the last writes y. Every value
+** comes from the same inputs by the same arithmetic as in n separate
+** sweeps. */
+INLINE float fused_block(int guided, const oc_dlevel *lv, uint8_t fix,
+                         const float *x, float *y, int n, float *ring, int j0,
+                         int j1) {
+  int ny = lv->ny;
+  size_t nx = (size_t)lv->nx;
+  float big = 0;
+  for (int t = j0 - (n - 1); t < j1 + n - 1; t++)
+    for (int s = 1; s <= n; s++) {
+      int j = t - (s - 1), reach = n - s;
+      int lo = j0 - reach < 0 ? 0 : j0 - reach;
+      int hi = j1 + reach > ny ? ny : j1 + reach;
+      if (j < lo || j >= hi) continue;
+      int js = j > 0 ? j - 1 : 0, jn = j + 1 < ny ? j + 1 : ny - 1;
+      const float *xs, *xr, *xn;
+      if (s == 1) {
+        xs = x + (size_t)js * nx, xr = x + (size_t)j * nx,
+        xn = x + (size_t)jn * nx;
+      } else {
+        float *rg = ring + (size_t)(s - 2) * 3 * nx;
+        xs = rg + (size_t)(js % 3) * nx, xr = rg + (size_t)(j % 3) * nx,
+        xn = rg + (size_t)(jn % 3) * nx;
+      }
+      float *out = s == n ? y + (size_t)j * nx
+                          : ring + ((size_t)(s - 1) * 3 + (size_t)(j % 3)) * nx;
+      float b =
+          row3(guided, R_JACOBI, 0, lv, fix, 1, 1, xs, xr, xn, out, NULL, j);
+      if (s == n) big = b > big ? b : big;
+    }
   return big;
 }
 
-/* Fine index i in coarse coordinates: (i - 1/2) / 2; the two coarse
-** samples around it and the weight of the second. */
-static inline void split(int i, int nc, int *a, int *b, double *w) {
-  double xc = 0.5 * i - 0.25;
-  int a0 = (int)floor(xc);
-  *w = xc - a0;
+#define FUSED_BLOCK 64
+#define FUSED_MAX 16
+
+double oc_djacobi_n(const oc_dop *op, const oc_dlevel *lv, float *x, float *scr,
+                    int n) {
+  size_t nx = (size_t)lv->nx, ns = nx * (size_t)lv->ny;
+  int threads = omp_get_max_threads();
+  float *ring = NULL;
+  if (n > 1 && n <= FUSED_MAX && OC_DPAR(lv) && !op->hom)
+    ring = malloc((size_t)threads * (size_t)(n - 1) * 3 * nx * sizeof *ring);
+  if (!ring) { /* separate sweeps */
+    double big = 0;
+    for (int it = 0; it < n; it++)
+      big = (it & 1) ? oc_djacobi(op, lv, scr, x, NULL)
+                     : oc_djacobi(op, lv, x, scr, NULL);
+    if (n & 1) memcpy(x, scr, ns * sizeof *x);
+    return big;
+  }
+  uint8_t fix = op->kind == DK_LAPLACE ? op->mask : DF_H;
+  int guided = op->kind == DK_GUIDED;
+  int nb = (lv->ny + FUSED_BLOCK - 1) / FUSED_BLOCK;
+  float big = 0;
+#pragma omp parallel for schedule(static) reduction(max : big)
+  for (int b = 0; b < nb; b++) {
+    int tid = omp_get_thread_num();
+    float *rg = ring + (size_t)tid * (size_t)(n - 1) * 3 * nx;
+    int j0 = b * FUSED_BLOCK,
+        j1 = j0 + FUSED_BLOCK < lv->ny ? j0 + FUSED_BLOCK : lv->ny;
+    float m = guided ? fused_block(1, lv, fix, x, scr, n, rg, j0, j1)
+                     : fused_block(0, lv, fix, x, scr, n, rg, j0, j1);
+    big = m > big ? m : big;
+  }
+  free(ring);
+  memcpy(x, scr, ns * sizeof *x);
+  return big;
+}
+
+double oc_dgauss_seidel(const oc_dop *op, const oc_dlevel *lv, float *x,
+                        const float *rhs) {
+  double a = relax(R_RED, op, lv, x, x, rhs);
+  double b = relax(R_BLACK, op, lv, x, x, rhs);
+  return a > b ? a : b;
+}
+
+double oc_dresidual(const oc_dop *op, const oc_dlevel *lv, const float *x,
+                    const float *rhs, float *r) {
+  return relax(R_RESIDUAL, op, lv, x, r, rhs);
+}
+
+/* Fine sample i lies at coarse coordinate (i - 1/2) / 2: between coarse
+** samples i/2 - 1 and i/2 with weights 1/4, 3/4 when i is even, between
+** (i-1)/2 and (i+1)/2 with 3/4, 1/4 when odd; clamped at the ends. */
+static inline void split(int i, int nc, int *a, int *b, float *wb) {
+  int a0 = (i & 1) ? (i - 1) / 2 : i / 2 - 1;
+  *wb = (i & 1) ? 0.25f : 0.75f;
   *a = a0 < 0 ? 0 : a0 >= nc ? nc - 1 : a0;
-  *b = a0 + 1 < 0 ? 0 : a0 + 1 >= nc ? nc - 1 : a0 + 1;
+  *b = a0 + 1 >= nc ? nc - 1 : a0 + 1;
+}
+
+/* Fine sample i of a row from the y-blended coarse values at a, b. */
+INLINE void put_fine(float *fr, const uint8_t *fl, uint8_t fix, int add, int i,
+                     float v) {
+  float o = add ? fr[i] + v : v;
+  fr[i] = (fl[i] & fix) ? fr[i] : o;
 }
 
 void oc_dprolong(const oc_dop *op, const oc_dlevel *lc, const float *c,
                  const oc_dlevel *lf, float *f, int add) {
+  uint8_t fix = op->kind == DK_LAPLACE ? op->mask : DF_H;
+  int ncx = lc->nx, nfx = lf->nx;
 #pragma omp parallel for schedule(static) if (OC_DPAR(lf))
   for (int j = 0; j < lf->ny; j++) {
     int ja, jb;
-    double wy;
+    float wy;
     split(j, lc->ny, &ja, &jb, &wy);
-    for (int i = 0; i < lf->nx; i++) {
-      size_t k = (size_t)j * (size_t)lf->nx + (size_t)i;
-      if (oc_dfixed(op, lf, k)) continue;
+    const float *ca = c + (size_t)ja * (size_t)ncx,
+                *cb = c + (size_t)jb * (size_t)ncx;
+    float *fr = f + (size_t)j * (size_t)nfx;
+    const uint8_t *fl = lf->flags + (size_t)j * (size_t)nfx;
+    float uy = 1 - wy;
+    /* fine 2I + 1 and 2I + 2 lie between coarse I and I + 1 (weights
+    ** 1/4 and 3/4 of I + 1); fine 0 and the last ones are clamped */
+    int I = 0;
+    for (; I + 1 < ncx && 2 * I + 2 < nfx; I++) {
+      float va = uy * ca[I] + wy * cb[I], vb = uy * ca[I + 1] + wy * cb[I + 1];
+      put_fine(fr, fl, fix, add, 2 * I + 1, 0.75f * va + 0.25f * vb);
+      put_fine(fr, fl, fix, add, 2 * I + 2, 0.25f * va + 0.75f * vb);
+    }
+    for (int i = 0; i < nfx; i = i ? i + 1 : 2 * I + 1) {
       int ia, ib;
-      double wx;
-      split(i, lc->nx, &ia, &ib, &wx);
-      double v0 = (1 - wx) * at(c, lc, ia, ja) + wx * at(c, lc, ib, ja);
-      double v1 = (1 - wx) * at(c, lc, ia, jb) + wx * at(c, lc, ib, jb);
-      double v = (1 - wy) * v0 + wy * v1;
-      f[k] = (float)(add ? f[k] + v : v);
+      float wx;
+      split(i, ncx, &ia, &ib, &wx);
+      float va = uy * ca[ia] + wy * cb[ia], vb = uy * ca[ib] + wy * cb[ib];
+      put_fine(fr, fl, fix, add, i, (1 - wx) * va + wx * vb);
     }
   }
 }

@@ -40,6 +40,11 @@ typedef struct ritem {
   double e0, e1;              /* conservative extension of the ends */
   int convex_left;            /* wedge: the convex side is the left */
   double ylo, yhi;
+  /* the linear attributes at the ends (slope angles in degrees), and
+  ** whether no knot of theirs lies inside (then they are linear along
+  ** the item and interpolated; else looked up per sample) */
+  double a0[FA_COUNT], a1[FA_COUNT];
+  int linear;
 } ritem;
 
 typedef struct rcurve {
@@ -57,21 +62,29 @@ typedef struct rctx {
   uint16_t *hc, *nc, *gc, *owner;
 } rctx;
 
-/* The contributions of curve ci to cell k at arc length s, distance dist
-** on the left (or right) side, outward normal (nox, noy); no slope when
-** !slopes (conservative cells beyond an end). */
-static void deposit(const rctx *rc, size_t k, uint32_t ci, double s,
-                    double dist, int left, double nox, double noy, int slopes) {
-  const rcurve *cv = &rc->cv[ci];
-  const oc_fcurve *fc = cv->fc;
+#define DEG (3.14159265358979323846 / 180)
+
+/* The contributions of item it's curve to cell k at the fraction f of
+** the item (arc length s), distance dist on the left (or right) side,
+** outward normal (nox, noy); no slope when !slopes (conservative cells
+** beyond an end). */
+static void deposit(const rctx *rc, size_t k, const ritem *it, double f,
+                    double s, double dist, int left, double nox, double noy,
+                    int slopes) {
+  uint32_t ci = it->curve;
+  const oc_fcurve *fc = rc->cv[ci].fc;
   double a[FA_COUNT], u = fc->length > 0 ? s / fc->length : 0;
-  oc_fcurve_attrs(fc, u, 1u << FA_RADIUS, a);
+  if (it->linear) {
+    for (int q = FA_RADIUS; q < FA_COUNT; q++)
+      a[q] = it->a0[q] + f * (it->a1[q] - it->a0[q]);
+  } else { /* (the angles as tan) */
+    oc_fcurve_attrs(fc, u, ((1u << FA_COUNT) - 1) & ~(1u << FA_HEIGHT), a);
+  }
   double r = a[FA_RADIUS];
   double ws = fmax(r, 0.5 * rc->lv->cell * (fabs(nox) + fabs(noy)));
   if (dist <= ws && (fc->has & (OC_FC_HEIGHT | OC_FC_NOISE))) {
-    oc_fcurve_attrs(fc, u,
-                    (1u << FA_HEIGHT) | (1u << FA_AMP) | (1u << FA_ROUGH), a);
     if (fc->has & OC_FC_HEIGHT) {
+      oc_fcurve_attrs(fc, u, 1u << FA_HEIGHT, a);
       rc->h[k] += (float)a[FA_HEIGHT];
       if (rc->hc[k] < 0xffffu) rc->hc[k]++;
     }
@@ -82,7 +95,6 @@ static void deposit(const rctx *rc, size_t k, uint32_t ci, double s,
     }
   }
   if (!slopes || !(fc->has & OC_FC_SLOPE) || !(dist > r)) return;
-  oc_fcurve_attrs(fc, u, left ? (1u << FA_EXTA) : (1u << FA_EXTB), a);
   double ext = left ? a[FA_EXTA] : a[FA_EXTB];
   if (!(ext > 0 && dist <= r + ext)) return;
   uint16_t me = (uint16_t)(ci + 1);
@@ -92,8 +104,8 @@ static void deposit(const rctx *rc, size_t k, uint32_t ci, double s,
     return;
   }
   rc->owner[k] = me;
-  oc_fcurve_attrs(fc, u, left ? (1u << FA_LEFT) : (1u << FA_RIGHT), a);
   double tn = left ? a[FA_LEFT] : a[FA_RIGHT];
+  if (it->linear) tn = tan(tn * DEG);
   double val = tn * (1 - (dist - r) / ext);
   double sg = (fc->has & OC_FC_HEIGHT) ? 1 : -1;
   rc->gx[k] += (float)(sg * nox);
@@ -148,8 +160,8 @@ static void paint_row(const rctx *rc, const ritem *it, int j) {
         continue;
       double d = sqrt(dx * dx + dy * dy);
       if (d > w || d == 0) continue;
-      deposit(rc, row + (size_t)i, it->curve, it->s0, d, it->convex_left,
-              dx / d, dy / d, 1);
+      deposit(rc, row + (size_t)i, it, 0, it->s0, d, it->convex_left, dx / d,
+              dy / d, 1);
       continue;
     }
     double along = dx * it->tx + dy * it->ty;
@@ -161,7 +173,7 @@ static void paint_row(const rctx *rc, const ritem *it, int j) {
     int left = across >= 0;
     double nox = left ? -it->ty : it->ty, noy = left ? it->tx : -it->tx;
     /* beyond an end of the curve (conservative cells): strict values only */
-    deposit(rc, row + (size_t)i, it->curve, s, fabs(across), left, nox, noy,
+    deposit(rc, row + (size_t)i, it, f, s, fabs(across), left, nox, noy,
             along >= 0 && along <= it->len);
   }
 }
@@ -171,6 +183,21 @@ static double attr_max(const oc_fattr *t) {
   for (size_t i = 0; i < t->n; i++)
     m = fmax(m, t->v[i]);
   return m;
+}
+
+/* The linear attributes of item it at its ends (arc lengths s0, s1), and
+** whether they are linear along it: no knot strictly between. */
+static void item_attrs(const oc_fcurve *fc, ritem *it, double s0, double s1) {
+  double u0 = fc->length > 0 ? s0 / fc->length : 0,
+         u1 = fc->length > 0 ? s1 / fc->length : 0;
+  it->linear = 1;
+  for (int q = FA_RADIUS; q < FA_COUNT; q++) {
+    const oc_fattr *t = &fc->attr[q];
+    it->a0[q] = t->n ? oc_linear_eval(t->u, t->v, t->n, u0) : 0;
+    it->a1[q] = t->n ? oc_linear_eval(t->u, t->v, t->n, u1) : 0;
+    for (size_t i = 0; i < t->n; i++)
+      if (t->u[i] > u0 && t->u[i] < u1) it->linear = 0;
+  }
 }
 
 /* Appends the items of one curve (segments, then the wedge after each
@@ -210,6 +237,7 @@ static int curve_items(const oc_fcurve *fc, uint32_t ci, double cell,
     s.curve = ci;
     s.vx = v[k].x, s.vy = v[k].y, s.tx = dx / len, s.ty = dy / len;
     s.len = len, s.s0 = v[k].s, s.s1 = v[k + 1].s;
+    item_attrs(fc, &s, s.s0, s.s1);
     double half = 0.5 * cell * (fabs(s.tx) + fabs(s.ty));
     s.e0 = (k == 0 && !closed) ? half : 0;
     s.e1 = (k + 2 == nv && !closed) ? half : 0;
@@ -221,6 +249,7 @@ static int curve_items(const oc_fcurve *fc, uint32_t ci, double cell,
         ritem w = {0};
         w.curve = ci, w.wedge = 1, w.vx = v[k].x, w.vy = v[k].y;
         w.tx = ptx, w.ty = pty, w.t2x = s.tx, w.t2y = s.ty, w.s0 = v[k].s;
+        item_attrs(fc, &w, w.s0, w.s0);
         w.convex_left = cr < 0;
         w.ylo = v[k].y - reach, w.yhi = v[k].y + reach;
         (*it)[(*n)++] = w;
@@ -236,6 +265,7 @@ static int curve_items(const oc_fcurve *fc, uint32_t ci, double cell,
     ritem w = {0};
     w.curve = ci, w.wedge = 1, w.vx = v[0].x, w.vy = v[0].y;
     w.tx = ptx, w.ty = pty, w.t2x = ftx, w.t2y = fty, w.s0 = v[0].s;
+    item_attrs(fc, &w, w.s0, w.s0);
     w.convex_left = cr < 0;
     w.ylo = v[0].y - reach, w.yhi = v[0].y + reach;
     (*it)[(*n)++] = w;

@@ -1,26 +1,30 @@
 /*
 ** solve.c — the multigrid solve of one map (Hnaidi et al. 2010, section
-** 5.2, after Orzan et al. 2008): a coarse-to-fine cascade with
-** 5 (l - i) Jacobi sweeps at level i of l (0 the coarsest), each level
-** starting from the bilinear prolongation of the one below; then, when a
-** tolerance is given, V-cycles while each removes at least 30 % of the
-** largest Jacobi update of the finest grid, then BiCGSTAB preconditioned
-** by V-cycles, until that update is below the tolerance. (V-cycles alone
-** stall on large grids: the elevation's operator is not symmetric, with
-** its upwind gradient terms, and coarse levels see thin constraints
-** thickened; the Krylov iteration removes the few modes they leave. Its
-** dot products are row sums added in row order, so the result does not
-** depend on the thread count.)
+** 5.2, after Orzan et al. 2008). The paper's schedule: a coarse-to-fine
+** cascade with 5 (l - i) Jacobi sweeps at level i of l (0 the coarsest),
+** each level starting from the bilinear prolongation of the one below.
 **
-** V-cycle at level k: 3 damped sweeps (weight 0.8); the residual
-** r = M x + c - x restricted to level k + 1 (the mean over the free
-** children, times 4 where the coarse sample is Laplace and 2 where it
-** follows a gradient: the Laplacian scales with the square of the cell,
-** the first-order gradient term with the cell); the coarse correction
-** solved recursively from 0 (100 sweeps on the coarsest grid), prolonged
-** and added with the step that minimises the residual (the whole of it
-** as BiCGSTAB's preconditioner, which must be a fixed linear map); 3
-** damped sweeps.
+** The converged mode (a tolerance given) replaces the cascade by full
+** multigrid: each level, coarsest first, starts from the prolonged
+** solution of the one below and gets one V-cycle; then V-cycles on the
+** finest grid while each removes at least 30 % of its largest update,
+** then BiCGSTAB preconditioned by V-cycles, until that update is below
+** the tolerance. (The elevation's operator is not symmetric, with its
+** upwind gradient terms, and its slowest modes sit where filled
+** gradients meet (conflicts) and coarse levels see thin constraints
+** thickened; the Krylov iteration removes the few modes V-cycles leave.
+** Its dot products are row sums added in row order, so the result does
+** not depend on the thread count.)
+**
+** V-cycle at level k: 2 red-black Gauss-Seidel sweeps (the same for any
+** thread count); the residual r = M x + c - x restricted to level k + 1
+** (the mean over the free children, times 4 where the coarse sample is
+** Laplace and 2 where it follows a gradient: the Laplacian scales with
+** the square of the cell, the first-order gradient term with the cell);
+** the coarse correction solved recursively from 0 (100 sweeps on the
+** coarsest grid), prolonged and added with the step that minimises the
+** residual (the whole of it as BiCGSTAB's preconditioner, which must be
+** a fixed linear map); 2 sweeps.
 */
 #include <math.h>
 #include <stdlib.h>
@@ -29,10 +33,9 @@
 #include "core/error.h"
 #include "diffusion/diffusion.h"
 
-#define PRE 3
-#define POST 3
+#define PRE 2
+#define POST 2
 #define COARSE_SWEEPS 100
-#define OMEGA 0.8 /* damped Jacobi smoothing */
 #define STALL 0.7 /* V-cycles removing less: BiCGSTAB takes over */
 
 typedef struct vctx {
@@ -47,62 +50,58 @@ typedef struct vctx {
                 ** (a fixed linear map: the Krylov iteration needs one) */
 } vctx;
 
-/* n sweeps of x (with rhs) using the scratch; returns the last update. */
-static double sweeps(const oc_dop *op, const oc_dlevel *lv, float *x,
-                     float *scr, const float *rhs, int n, double w) {
+/* n red-black Gauss-Seidel sweeps of x; returns the last update. */
+static double smooth(const oc_dop *op, const oc_dlevel *lv, float *x,
+                     const float *rhs, int n) {
   double big = 0;
   for (int it = 0; it < n; it++)
-    big = (it & 1) ? oc_djacobi(op, lv, scr, x, rhs, w)
-                   : oc_djacobi(op, lv, x, scr, rhs, w);
-  if (n & 1) memcpy(x, scr, (size_t)lv->nx * (size_t)lv->ny * sizeof *x);
+    big = oc_dgauss_seidel(op, lv, x, rhs);
   return big;
 }
 
-static int is_guide(const oc_dop *op, const oc_dlevel *lv, size_t k) {
-  return op->kind == DK_GUIDED && (lv->flags[k] & DF_GUIDE) &&
-         fabs(lv->map[MAP_GX][k]) + fabs(lv->map[MAP_GY][k]) > 1e-6;
-}
-
-/* b (level k + 1) from the residual r of level k. */
+/* b (level k + 1) from the residual r of level k (0 where constrained,
+** so the sum over all children is that over the free ones). */
 static void restrict_residual(const oc_dop *op, const oc_dlevel *f,
                               const float *r, const oc_dlevel *c, float *b) {
+  uint8_t fix = op->kind == DK_LAPLACE ? op->mask : DF_H;
+  uint8_t gact = op->kind == DK_GUIDED ? DF_GACT : 0;
+  static const float inv[5] = {0, 1, 0.5f, 1.0f / 3, 0.25f};
+  size_t nxf = (size_t)f->nx, nxc = (size_t)c->nx;
 #pragma omp parallel for schedule(static) if (OC_DPAR(f))
-  for (int J = 0; J < c->ny; J++)
-    for (int I = 0; I < c->nx; I++) {
-      size_t kc = (size_t)J * (size_t)c->nx + (size_t)I;
-      double sum = 0;
-      int n = 0;
-      for (int q = 0; q < 4; q++) {
-        int i = 2 * I + (q & 1), j = 2 * J + (q >> 1);
-        if (i >= f->nx || j >= f->ny) continue;
-        size_t k = (size_t)j * (size_t)f->nx + (size_t)i;
-        if (oc_dfixed(op, f, k)) continue;
-        sum += r[k];
-        n++;
+  for (int J = 0; J < c->ny; J++) {
+    size_t j0 = 2 * (size_t)J;
+    int two = (int)j0 + 1 < f->ny;
+    const float *r0 = r + j0 * nxf, *r1 = two ? r0 + nxf : r0;
+    const uint8_t *f0 = f->flags + j0 * nxf, *f1 = two ? f0 + nxf : f0;
+    const uint8_t *fc = c->flags + (size_t)J * nxc;
+    float *br = b + (size_t)J * nxc;
+    for (size_t I = 0; I < nxc; I++) {
+      size_t i0 = 2 * I, i1 = i0 + 1 < nxf ? i0 + 1 : i0;
+      int cols = i1 != i0;
+      float sum = r0[i0] + (cols ? r0[i1] : 0);
+      int n = !(f0[i0] & fix) + (cols && !(f0[i1] & fix));
+      if (two) {
+        sum += r1[i0] + (cols ? r1[i1] : 0);
+        n += !(f1[i0] & fix) + (cols && !(f1[i1] & fix));
       }
-      if (oc_dfixed(op, c, kc) || !n)
-        b[kc] = 0;
-      else
-        b[kc] = (float)((is_guide(op, c, kc) ? 2.0 : 4.0) * sum / n);
+      float scale = (fc[I] & gact) ? 2.0f : 4.0f;
+      br[I] = (fc[I] & fix) ? 0 : scale * sum * inv[n];
     }
+  }
 }
 
 /* The residual of x at level lv into r: one sweep's update, 0 where
 ** constrained. */
 static void residual(const oc_dop *op, const oc_dlevel *lv, const float *x,
                      const float *rhs, float *r) {
-  oc_djacobi(op, lv, x, r, rhs, 1);
-  size_t ns = (size_t)lv->nx * (size_t)lv->ny;
-#pragma omp parallel for schedule(static) if (OC_DPAR(lv))
-  for (size_t q = 0; q < ns; q++)
-    r[q] = oc_dfixed(op, lv, q) ? 0 : r[q] - x[q];
+  oc_dresidual(op, lv, x, rhs, r);
 }
 
 /* The step t minimising |r - t A c| (A c = c - M c, homogeneous), by
 ** sums over rows added in row order (the same for any thread count). */
 static double step(const vctx *v, const oc_dlevel *lv, const float *r,
                    const float *c, float *ac) {
-  oc_djacobi(&v->hom, lv, c, ac, NULL, 1);
+  oc_djacobi(&v->hom, lv, c, ac, NULL);
   int ny = lv->ny;
   size_t nx = (size_t)lv->nx;
 #pragma omp parallel for schedule(static) if (OC_DPAR(lv))
@@ -137,11 +136,10 @@ static void prolong_correction(const vctx *v, int k, float *c) {
 ** long free (Neumann) regions. */
 static double vcycle(const vctx *v, int k, float *x, const float *rhs) {
   oc_dpyramid *py = v->py;
-  const oc_dop *op = k || rhs ? &v->hom : v->op;
+  const oc_dop *op = rhs ? &v->hom : v->op;
   const oc_dlevel *lv = &py->lv[k];
-  if (k == py->nlevels - 1)
-    return sweeps(op, lv, x, py->scratch, rhs, COARSE_SWEEPS, OMEGA);
-  sweeps(op, lv, x, py->scratch, rhs, PRE, OMEGA);
+  if (k == py->nlevels - 1) return smooth(op, lv, x, rhs, COARSE_SWEEPS);
+  smooth(op, lv, x, rhs, PRE);
   residual(op, lv, x, rhs, v->r[k]);
   const oc_dlevel *lc = &py->lv[k + 1];
   restrict_residual(op, lv, v->r[k], lc, v->b[k + 1]);
@@ -154,7 +152,7 @@ static double vcycle(const vctx *v, int k, float *x, const float *rhs) {
 #pragma omp parallel for schedule(static) if (OC_DPAR(lv))
   for (size_t q = 0; q < ns; q++)
     x[q] = (float)(x[q] + t * c[q]);
-  return sweeps(op, lv, x, py->scratch, rhs, POST, OMEGA);
+  return smooth(op, lv, x, rhs, POST);
 }
 
 static int report(const oc_dsolve *s, double f) {
@@ -197,7 +195,7 @@ static double dot(const vctx *v, const float *a, const float *b) {
 /* y = A x = x - M x (homogeneous; 0 where constrained), finest level. */
 static void apply(const vctx *v, const float *x, float *y) {
   const oc_dlevel *lv = &v->py->lv[0];
-  oc_djacobi(&v->hom, lv, x, y, NULL, 1);
+  oc_djacobi(&v->hom, lv, x, y, NULL);
   size_t ns = (size_t)lv->nx * (size_t)lv->ny;
 #pragma omp parallel for schedule(static) if (OC_DPAR(lv))
   for (size_t q = 0; q < ns; q++)
@@ -283,7 +281,7 @@ static int krylov(const vctx *v, const oc_dsolve *s, double tol, double *res,
 }
 
 static int vcycles(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
-                   double first, oc_error *err) {
+                   oc_error *err) {
   int L = py->nlevels, rc = OC_OK;
   vctx v = {py, op, *op, NULL, NULL, NULL, NULL, NULL, NULL, 0};
   v.hom.hom = 1;
@@ -305,7 +303,17 @@ static int vcycles(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
   fixed_range(py, op, &lo, &hi);
   double scale = fmax(hi - lo, fmax(fabs(lo), fabs(hi)));
   double tol = s->tolerance * fmax(scale, 1e-6);
-  double res = first;
+  /* full multigrid: each level from the prolonged solution of the one
+  ** below, one V-cycle there */
+  double res = 0;
+  for (int k = L - 1; !rc && k >= 0; k--) {
+    float *x = py->lv[k].map[op->map];
+    if (k < L - 1)
+      oc_dprolong(op, &py->lv[k + 1], py->lv[k + 1].map[op->map], &py->lv[k], x,
+                  0);
+    res = vcycle(&v, k, x, NULL);
+  }
+  if (s->residual) s->residual[0] = res;
   int c = 0;
   /* V-cycles while each removes most of the largest update, then the
   ** Krylov iteration for the modes they leave */
@@ -341,6 +349,7 @@ int oc_dsolve_map(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
     if (oc_dfixed(op, top, k)) sum += xt[k], nf++;
   for (size_t k = 0; k < nt; k++)
     if (!oc_dfixed(op, top, k)) xt[k] = nf ? (float)(sum / nf) : 0;
+  if (s->tolerance > 0) return vcycles(py, op, s, err);
   double total = 0, done = 0, last = 0;
   for (int k = 0; k < L; k++)
     total += 5.0 * (k + 1) * py->lv[k].nx * py->lv[k].ny;
@@ -349,13 +358,12 @@ int oc_dsolve_map(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
     if (k < L - 1)
       oc_dprolong(op, &py->lv[k + 1], py->lv[k + 1].map[op->map], lv,
                   lv->map[op->map], 0);
-    last = sweeps(op, lv, lv->map[op->map], py->scratch, NULL, 5 * (k + 1), 1);
+    last = oc_djacobi_n(op, lv, lv->map[op->map], py->scratch, 5 * (k + 1));
     done += 5.0 * (k + 1) * lv->nx * lv->ny;
-    if (report(s, (s->tolerance > 0 ? 0.5 : 1.0) * done / total))
+    if (report(s, done / total))
       return oc_seterr(err, OC_ECANCEL, "diffusion cancelled");
   }
   if (s->residual) s->residual[0] = last;
   if (s->cycles) *s->cycles = 0;
-  if (!(s->tolerance > 0)) return OC_OK;
-  return vcycles(py, op, s, last, err);
+  return OC_OK;
 }

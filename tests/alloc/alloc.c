@@ -217,6 +217,18 @@ static const scene scenes[] = {
      "assert(h:save('h.tif', {bits = 16})); assert(h:save('p.png', "
      "{palette = true}))\n"
      "outcrop.heightfield.load(OUT .. '/h.tif')\n"},
+    {"diffusion", 0,
+     "local c = outcrop.feature_curve{points = {{2, 2}, {6, 10}, {12, 12}, "
+     "{14, 4}}, bezier = true, constraints = {{u = 0, height = 5, radius = "
+     "1, slope = {left = 20, right = 20, extent = {3, 3}}, noise = "
+     "{amplitude = 1, roughness = 0.5}}, {u = 1, height = 8}}}\n"
+     "local k = {u = 0, slope = {left = -30, right = -30, extent = {2, 2}}}\n"
+     "local d = outcrop.feature_curve{points = {{0, 8}, {16, 8}}, "
+     "constraints = {k, {u = 1, slope = k.slope}}}\n"
+     "local h, m = outcrop.diffusion{size = {16, 12}, curves = {c, d}, "
+     "seed = 1, converged = true, noise = {wavelength = 8}}\n"
+     "h:height(3, 3); m.detail:height(2, 2)\n"
+     "outcrop.feature_curve_load(c:save()):sample(0.5)\n"},
     {"poisson", 0,
      "local p = outcrop.poisson2d{box = {0, 0, 20, 20}, radius = 3, "
      "density = function(x, y) return 0.5 end}\n"

@@ -352,7 +352,7 @@ START_TEST(converged_mode_converges) {
   run(&p, &r);
   ck_assert(r.cycles >= 1 && r.cycles < OC_DIFFUSION_MAX_CYCLES);
   printf("converged in %d iterations: largest update %.3g m after the "
-         "cascade, %.3g m at the end\n",
+         "full multigrid pass, %.3g m at the end\n",
          r.cycles, r.residual[0], r.residual[r.cycles]);
   /* scale: the strict elevations, 5 .. 90 */
   ck_assert(r.residual[r.cycles] <= 1e-5 * 90);
@@ -415,6 +415,48 @@ START_TEST(deterministic_across_threads) {
 }
 END_TEST
 
+/* The fused sweeps of the cascade give the bytes of separate sweeps. */
+START_TEST(fused_sweeps_match) {
+  enum { NX = 300, NY = 230 }; /* over 65 536 samples: the fused path */
+  size_t ns = (size_t)NX * NY;
+  float *m = malloc(MAP_COUNT * ns * sizeof *m), *x = malloc(ns * sizeof *x),
+        *y = malloc(ns * sizeof *y), *scr = malloc(ns * sizeof *scr);
+  uint8_t *flags = malloc(ns);
+  ck_assert(m && x && y && scr && flags);
+  oc_dlevel lv = {NX, NY, 2, {NULL}, flags};
+  for (int q = 0; q < MAP_COUNT; q++)
+    lv.map[q] = m + (size_t)q * ns;
+  oct_rng rg = oct_rng_new(5);
+  for (size_t k = 0; k < ns; k++) {
+    double u = oct_unif(&rg, 0, 1);
+    flags[k] = u < 0.1   ? DF_H
+               : u < 0.5 ? (uint8_t)(DF_SLOPE | DF_GACT |
+                                     (oct_unif(&rg, 0, 1) < 0.5 ? DF_SX : 0) |
+                                     (oct_unif(&rg, 0, 1) < 0.5 ? DF_SY : 0))
+                         : 0;
+    lv.map[MAP_GX][k] = (float)oct_unif(&rg, 0, 0.5);
+    lv.map[MAP_GY][k] = (float)oct_unif(&rg, -1, 1);
+    x[k] = (float)oct_unif(&rg, -10, 10);
+  }
+  for (int kind = 0; kind < 2; kind++)
+    for (int n = 1; n <= 6; n += 5) {
+      oc_dop op = {kind ? DK_GUIDED : DK_LAPLACE, MAP_H, DF_H, 0, 0};
+      memcpy(y, x, ns * sizeof *x);
+      double b0 = 0;
+      for (int it = 0; it < n; it++) {
+        b0 = oc_djacobi(&op, &lv, y, scr, NULL);
+        memcpy(y, scr, ns * sizeof *y);
+      }
+      memcpy(lv.map[MAP_H], x, ns * sizeof *x);
+      double b1 = oc_djacobi_n(&op, &lv, lv.map[MAP_H], scr, n);
+      ck_assert_msg(memcmp(y, lv.map[MAP_H], ns * sizeof *y) == 0,
+                    "kind %d, %d sweeps", kind, n);
+      ck_assert(b0 == b1 && b0 > 0);
+    }
+  free(m), free(x), free(y), free(scr), free(flags);
+}
+END_TEST
+
 /* ---- noise detail -------------------------------------------------------- */
 
 START_TEST(detail_octave_sum) {
@@ -439,6 +481,45 @@ START_TEST(detail_octave_sum) {
   ck_assert(oc_ddetail_at(&d, 3.5, 7.25, 1, 0.5) !=
             oc_ddetail_at(&e, 3.5, 7.25, 1, 0.5));
   ck_assert(oc_ddetail_at(&d, 3.5, 7.25, 0, 0.5) == 0);
+}
+END_TEST
+
+/* The grid's detail (lattice octaves interpolated, fine octaves sampled
+** directly, octaves under 2 cells dropped) against the exact sum. */
+START_TEST(detail_grid_matches_octaves) {
+  enum { N = 48 };
+  static float maps[MAP_COUNT][N * N], z[N * N], det[N * N];
+  static uint8_t flags[N * N];
+  oc_dlevel lv = {N, N, 1, {NULL}, flags};
+  for (int q = 0; q < MAP_COUNT; q++)
+    lv.map[q] = maps[q];
+  for (int k = 0; k < N * N; k++)
+    maps[MAP_H][k] = 10, maps[MAP_A][k] = 3, maps[MAP_R][k] = 0.5f;
+  /* wavelengths 50, 25, 12.5, 6.25 m: lattices of 6.25, 3.125, 1.5625 m,
+  ** the last finer than the 1 m cell (direct) */
+  oc_ddetail d = {-7.5, 3.25, 1, 50, 2, 4, 11};
+  oc_error err;
+  ck_assert_int_eq(
+      oc_ddetail_grid(&d, &lv, z, det, (oc_progress){0}, 0, 1, &err), OC_OK);
+  double big = 0, sum = 0;
+  for (int j = 0; j < N; j++)
+    for (int i = 0; i < N; i++) {
+      double n = oc_ddetail_at(&d, d.x0 + i, d.y0 + j, 3, 0.5);
+      big = fmax(big, fabs(det[j * N + i] - n));
+      sum += n * n;
+      ck_assert(z[j * N + i] == (float)(10 + det[j * N + i]));
+    }
+  /* Catmull-Rom at 8 nodes a wavelength: within 0.026 of S per octave,
+  ** weights 1 + 0.71 + 0.5 (the last exact), A = 3 */
+  ck_assert_msg(big < 3 * 0.026 * 1.71, "lattice detail off by %g", big);
+  ck_assert(sqrt(sum / (N * N)) > 0.3);
+  /* an octave under 2 cells is dropped: wavelength 3 m keeps 3 m only */
+  oc_ddetail e = {0, 0, 1, 3, 2, 2, 11}, e1 = e;
+  e1.octaves = 1;
+  ck_assert_int_eq(
+      oc_ddetail_grid(&e, &lv, z, det, (oc_progress){0}, 0, 1, &err), OC_OK);
+  for (int k = 0; k < N * N; k += 97)
+    ck_assert(fabs(det[k] - oc_ddetail_at(&e1, k % N, k / N, 3, 0.5)) < 1e-5);
 }
 END_TEST
 
@@ -545,6 +626,22 @@ START_TEST(encoding_round_trips) {
   }
   for (int i = 0; i < 3; i++)
     oc_fcurve_release(c[i]);
+  /* version 1 still loads: (0, 0) to (10, 0), heights 5 and radii 1 at
+  ** u = 0 and 1, LEB128 varints of 1/16 m */
+  static const unsigned char v1[] = {'F', 4,    0, 0,  0xc0, 0x02, 0, 2, 0,
+                                     3,   0xa0, 1, 32, 0x80, 0x40, 3, 0, 0};
+  oc_error err;
+  oc_fcurve *o = oc_fcurve_decode(v1, sizeof v1, &err);
+  ck_assert_msg(o != NULL, "%s", err.msg);
+  oc_fcurve_sample a;
+  oc_fcurve_sample_at(o, 0.5, &a);
+  ck_assert(a.x == 5 && a.y == 0 && a.height == 5 && a.radius == 1);
+  ck_assert(oc_fcurve_length(o) == 10);
+  /* and re-encodes as version 2 (marker bits 111): 101 bits */
+  unsigned char b2[16];
+  ck_assert_uint_eq(oc_fcurve_encode(o, b2, sizeof b2), 13);
+  ck_assert((b2[0] & 0xe0) == 0xe0);
+  oc_fcurve_release(o);
 }
 END_TEST
 
@@ -596,7 +693,9 @@ int main(void) {
   tcase_add_test(tc, conflicting_gradients_filled);
   tcase_add_test(tc, converged_mode_converges);
   tcase_add_test(tc, deterministic_across_threads);
+  tcase_add_test(tc, fused_sweeps_match);
   tcase_add_test(tc, detail_octave_sum);
+  tcase_add_test(tc, detail_grid_matches_octaves);
   tcase_add_test(tc, bad_input_names_the_field);
   tcase_add_test(tc, progress_cancels);
   tcase_add_test(tc, encoding_round_trips);
