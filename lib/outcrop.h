@@ -2211,11 +2211,13 @@ oc_stacks *oc_stacks_from_heightfield(const oc_heightfield *hf,
 ** them), each layering the column [box.lo.z, box.hi.z] at every f = T
 ** crossing (material inside, air outside; found by sampling every
 ** `step` (default cell / 4 when 0) where the column spans say f may
-** vary, then bisection to 1e-6 cell). zbase = box.lo.z. */
+** vary, then bisection to 1e-6 cell). zbase = box.lo.z. Parallel by
+** rows; `progress` (may hold NULL) can cancel it: NULL with OC_ECANCEL. */
 typedef struct oc_stacks_node_params {
   oc_aabb box;
   double cell, step;
-  int material; /* OC_MAT_*, not air */
+  int material;         /* OC_MAT_*, not air */
+  oc_progress progress; /* may be {NULL, NULL} */
 } oc_stacks_node_params;
 oc_stacks *oc_stacks_from_program(const oc_program *prog,
                                   const oc_stacks_node_params *p,

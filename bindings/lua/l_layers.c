@@ -41,6 +41,7 @@
 #include "l_handle.h"
 #include "l_heightfield.h"
 #include "l_layers.h"
+#include "l_progress.h"
 
 typedef struct oclua_layers {
   oclua_handle h; /* first: pins and closing (l_handle.h) */
@@ -213,7 +214,11 @@ static int l_from_node(lua_State *L) {
   const oc_program *prog = oclua_program(L, 1, fname);
   oclua_layers *u = newlayers(L);
   oc_error err = {OC_OK, ""};
-  return setlayers(L, u, oc_stacks_from_program(prog, &p, &err), &err, fname);
+  oclua_progress pl; /* the line on stderr and Ctrl-C */
+  p.progress = oclua_progress_start(L, &pl, fname);
+  oc_stacks *s = oc_stacks_from_program(prog, &p, &err);
+  oclua_progress_end(&pl);
+  return setlayers(L, u, s, &err, fname);
 }
 
 /* ---- methods ------------------------------------------------------------- */
