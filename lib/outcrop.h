@@ -2319,6 +2319,37 @@ typedef struct oc_sculpt_params {
 int oc_stacks_sculpt(oc_stacks *s, const oc_sculpt_params *p, double *changed,
                      oc_stabilize_result *res, oc_error *err);
 
+/* Sweeping (section 4.2): a graph of `npoints` points joined by `nedges`
+** arcs (pairs of point indices from 0), each point carrying a profile: a
+** closed cross-section, the Catmull-Rom spline through its control
+** points (u, v) (u across the arc, to the right of travel; v along the
+** up vector; non-convex allowed). The profiles, interpolated along each
+** arc and turned about the up vector past its ends (so joints close and
+** ends are rounded), sweep a volume V; bedrock inside V becomes air (the
+** difference), other materials stay and settle, and the stacks around
+** are stabilised. Cracks (tunnel = 0): points are projected on the top of
+** the solid (their z ignored) and the up vector is the surface normal
+** there; tunnels: points are used as given, up is the vertical. Profile
+** k is the pairs profile_off[k] .. profile_off[k + 1] - 1 of profile_uv
+** (3 .. 1024 points). *changed gets the bedrock volume added (negative),
+** m^3. */
+#define OC_SWEEP_MAX_POINTS 100000
+typedef struct oc_sweep_params {
+  const oc_vec3 *points;
+  const int *point_profile; /* per point: 0 .. nprofiles - 1 */
+  size_t npoints;
+  const int *edges; /* 2 nedges point indices */
+  size_t nedges;
+  const double *profile_uv;
+  const size_t *profile_off; /* nprofiles + 1 */
+  size_t nprofiles;
+  int tunnel;
+  int stabilize;
+  const oc_stabilize_params *stab; /* NULL: defaults */
+} oc_sweep_params;
+int oc_stacks_sweep(oc_stacks *s, const oc_sweep_params *p, double *changed,
+                    oc_stabilize_result *res, oc_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -107,4 +107,22 @@ int oc_layers_decode_all(const oc_stacks *s, oc_lseg **seg, size_t **soff,
 int oc_layers_encode_all(oc_stacks *s, const oc_lseg *seg, const size_t *soff,
                          oc_error *err);
 
+/* The stacks of w rebuilt where an edit changes them (sculpt.c, used by
+** sweep.c): `window` says whether the stack centred on (px, py) may
+** change and over which [z0, z1]; `after` gives the material at
+** (px, py, z) after the edit, m0 the one before. Inside the window the
+** column is sampled every `step` and each change refined by bisection;
+** outside it the layers stay. Loose material that new bedrock took goes
+** back on top of it; stacks are made canonical. */
+typedef int (*oc_layers_after_fn)(const void *ctx, double px, double py,
+                                  double z, int m0);
+typedef struct oc_layers_edit {
+  int (*window)(void *ctx, double px, double py, double *z0, double *z1);
+  oc_layers_after_fn after;
+  void *ctx;
+  double step;
+} oc_layers_edit;
+int oc_layers_rebuild_grid(oc_stacks *w, const oc_layers_edit *e,
+                           oc_error *err);
+
 #endif

@@ -238,7 +238,7 @@ START_TEST(from_program_reproduces_surface) {
   oc_program *src = oct_compile(cave, T, 0);
   double cell = 0.5;
   oc_stacks_node_params np = {
-      {{-11, -11, -11}, {11, 11, 11}}, cell, 0, OC_MAT_BEDROCK};
+      {{-11, -11, -11}, {11, 11, 11}}, cell, 0, OC_MAT_BEDROCK, {NULL, NULL}};
   oc_stacks *s = oc_stacks_from_program(src, &np, &err);
   ck_assert_msg(s != NULL, "%s", err.msg);
   ck_assert_int_eq(oc_stacks_nx(s), 45);

@@ -100,12 +100,242 @@ START_TEST(from_program_progress) {
 }
 END_TEST
 
+/* ---- sweeping ------------------------------------------------------------ */
+
+/* A closed polyline with control points every `h` along its sides (the
+** Catmull-Rom spline through collinear, evenly spaced points is those
+** sides, so the profile is the polygon away from its corners). */
+static size_t polygon(const double *corner, int n, double h, double *uv) {
+  size_t m = 0;
+  for (int k = 0; k < n; k++) {
+    const double *a = corner + 2 * k, *b = corner + 2 * ((k + 1) % n);
+    int steps = (int)round(hypot(b[0] - a[0], b[1] - a[1]) / h);
+    for (int q = 0; q < steps; q++) {
+      uv[2 * m] = a[0] + (b[0] - a[0]) * q / steps;
+      uv[2 * m + 1] = a[1] + (b[1] - a[1]) * q / steps;
+      m++;
+    }
+  }
+  return m;
+}
+
+/* A bottle-shaped (non-convex) cross-section: a neck |u| < 1 from v = 1
+** down to -2 over a chamber |u| < 3 from -2 to -5. */
+static size_t bottle(double *uv) {
+  static const double c[] = {-1, 1,  1,  1,  1,  -2, 3,  -2,
+                             3,  -5, -3, -5, -3, -2, -1, -2};
+  return polygon(c, 8, 0.5, uv);
+}
+
+/* The layers of stack (i, j) as bottom-up (material, top) pairs. */
+static size_t column(const oc_stacks *s, int i, int j, uint8_t *m,
+                     double *top) {
+  size_t n = oc_stacks_get(s, i, j, m, top, 16);
+  double z = oc_stacks_base(s);
+  for (size_t l = 0; l < n; l++)
+    top[l] = z += top[l];
+  return n;
+}
+
+/* A crack along x on a flat slab: across it, the stacks hold the profile's
+** cross-section (open neck, a chamber under bedrock overhangs, untouched
+** beyond), to the bisection's precision away from the profile's corners;
+** the volume removed is the profile's area below the surface times the
+** length, plus the rounded ends. */
+START_TEST(sweep_crack_profile) {
+  oc_error err;
+  double cell = 0.5;
+  oc_stacks *s = slab(41, cell, 10);
+  double uv[2 * 128];
+  size_t n = bottle(uv), off[2] = {0, n};
+  oc_vec3 pts[2] = {{2, 10, 0}, {18, 10, 0}};
+  int prof[2] = {0, 0}, edges[2] = {0, 1};
+  oc_sweep_params p = {pts, prof, 2, edges, 1, uv, off, 1, 0, 0, NULL};
+  double dv;
+  ck_assert_msg(oc_stacks_sweep(s, &p, &dv, NULL, &err) == OC_OK, "%s",
+                err.msg);
+  uint8_t m[16];
+  double top[16];
+  /* x = 10 (i = 20); right of travel along +x is -y: u = 10 - y */
+  for (int j = 10; j <= 30; j++) {
+    double u = 10 - j * cell;
+    size_t k = column(s, 20, j, m, top);
+    if (fabs(u) <= 0.5) { /* the neck and chamber: bedrock up to 5 */
+      ck_assert_uint_eq(k, 1);
+      ck_assert_double_eq_tol(top[0], 5, 1e-5);
+    } else if (fabs(u) >= 1.75 && fabs(u) <= 2.25) { /* under the overhang */
+      ck_assert_uint_eq(k, 3);
+      ck_assert_int_eq(m[1], OC_MAT_AIR);
+      ck_assert_double_eq_tol(top[0], 5, 1e-5);
+      ck_assert_double_eq_tol(top[1], 8, 1e-5);
+      ck_assert_double_eq_tol(top[2], 10, 1e-6);
+    } else if (fabs(u) >= 3.5) {
+      ck_assert_uint_eq(k, 1);
+      ck_assert_double_eq_tol(top[0], 10, 1e-6);
+    }
+  }
+  /* 22 m^2 below the surface (less the rounded corners) over 16 m, and
+  ** the two ends: the half-profile turned through a half turn */
+  ck_assert_msg(dv < -0.95 * 22 * 16 && dv > -22 * (16 + 2 * 3), "%g", dv);
+  oc_stacks_free(s);
+}
+END_TEST
+
+/* On a slope the profile hangs along the surface normal: its bottom
+** (v = -5) lies 5 / cos(slope) below the surface, measured vertically. */
+START_TEST(sweep_crack_follows_surface) {
+  oc_error err;
+  double cell = 0.5;
+  oc_stacks *s = slab(41, cell, 10);
+  for (int j = 0; j < 41; j++)
+    for (int i = 0; i < 41; i++) {
+      uint8_t m = OC_MAT_BEDROCK;
+      double t = 10 + 0.2 * i * cell;
+      ck_assert(oc_stacks_set(s, i, j, &m, &t, 1, &err) == OC_OK);
+    }
+  double uv[2 * 128];
+  size_t n = bottle(uv), off[2] = {0, n};
+  oc_vec3 pts[2] = {{2, 10, 999}, {18, 10, -999}}; /* z ignored */
+  int prof[2] = {0, 0}, edges[2] = {0, 1};
+  oc_sweep_params p = {pts, prof, 2, edges, 1, uv, off, 1, 0, 0, NULL};
+  ck_assert_msg(oc_stacks_sweep(s, &p, NULL, NULL, &err) == OC_OK, "%s",
+                err.msg);
+  uint8_t m[16];
+  double top[16];
+  for (int i = 12; i <= 28; i += 4) {
+    ck_assert_uint_eq(column(s, i, 20, m, top), 1);
+    double want = 10 + 0.2 * i * cell - 5 * sqrt(1 + 0.04);
+    ck_assert_msg(fabs(top[0] - want) < 0.01, "i %d: %g vs %g", i, top[0],
+                  want);
+  }
+  oc_stacks_free(s);
+}
+END_TEST
+
+/* A branching graph: three arcs from a junction, the profile growing
+** from a square of half-side 1 at the far end of one arc to half-side 3
+** at the junction (so half-side 2 half-way); a tunnel: a round bore with
+** the ground above left alone. */
+START_TEST(sweep_branches_and_tunnel) {
+  oc_error err;
+  double cell = 0.5;
+  oc_stacks *s = slab(61, cell, 10);
+  double uv[2 * 256];
+  static const double sq1[] = {-1, 1, 1, 1, 1, -1, -1, -1};
+  static const double sq3[] = {-3, 3, 3, 3, 3, -3, -3, -3};
+  size_t n1 = polygon(sq1, 4, 0.25, uv);
+  size_t n3 = polygon(sq3, 4, 0.25, uv + 2 * n1);
+  size_t off[3] = {0, n1, n1 + n3};
+  oc_vec3 pts[4] = {{15, 15, 0}, {3, 15, 0}, {27, 15, 0}, {15, 27, 0}};
+  int prof[4] = {1, 0, 1, 1}, edges[6] = {0, 1, 0, 2, 0, 3};
+  oc_sweep_params p = {pts, prof, 4, edges, 3, uv, off, 2, 0, 0, NULL};
+  ck_assert_msg(oc_stacks_sweep(s, &p, NULL, NULL, &err) == OC_OK, "%s",
+                err.msg);
+  uint8_t m[16];
+  double top[16];
+  /* half-way along the first arc (x = 9): carved to v = -2 (half-way
+  ** between -1 and -3) over |u| < 2, away from the corners (the small
+  ** square's rounded corners pair with points 0.75 from the corner) */
+  for (int j = 20; j <= 40; j++) {
+    double u = 15 - j * cell;
+    column(s, 18, j, m, top);
+    if (fabs(u) <= 1.25)
+      ck_assert_msg(fabs(top[0] - 8) < 1e-5, "u %g: %.9g", u, top[0]);
+    else if (fabs(u) >= 2.5)
+      ck_assert_double_eq_tol(top[0], 10, 1e-6);
+  }
+  /* the junction and each branch are carved */
+  column(s, 30, 30, m, top);
+  ck_assert_double_eq_tol(top[0], 7, 1e-5);
+  column(s, 50, 30, m, top);
+  ck_assert_double_eq_tol(top[0], 7, 1e-5);
+  column(s, 30, 50, m, top);
+  ck_assert_double_eq_tol(top[0], 7, 1e-5);
+  /* a tunnel at z = 5 through the same slab, round (16 control points on
+  ** a circle of radius 2): an air layer of thickness 4 on its axis */
+  oc_stacks_free(s);
+  s = slab(41, cell, 10);
+  double circle[32];
+  for (int k = 0; k < 16; k++) {
+    circle[2 * k] = 2 * cos(k * 3.14159265358979 / 8);
+    circle[2 * k + 1] = 2 * sin(k * 3.14159265358979 / 8);
+  }
+  size_t offc[2] = {0, 16};
+  oc_vec3 tp[2] = {{0, 10, 5}, {20, 10, 5}};
+  int tprof[2] = {0, 0};
+  oc_sweep_params tpp = {tp, tprof, 2, edges, 1, circle, offc, 1, 1, 0, NULL};
+  ck_assert(oc_stacks_sweep(s, &tpp, NULL, NULL, &err) == OC_OK);
+  ck_assert_uint_eq(column(s, 20, 20, m, top), 3);
+  ck_assert_int_eq(m[1], OC_MAT_AIR);
+  ck_assert_double_eq_tol(top[1] - top[0], 4, 0.02);
+  ck_assert_double_eq_tol(top[2], 10, 1e-6);
+  oc_stacks_free(s);
+}
+END_TEST
+
+/* Sand over the crack falls in and is stabilised: sand volume conserved,
+** the same stacks for 1 and 2 threads; bad input names the field. */
+START_TEST(sweep_sand_threads_errors) {
+  oc_error err;
+  double uv[2 * 128];
+  size_t n = bottle(uv), off[2] = {0, n};
+  oc_vec3 pts[2] = {{3, 8, 0}, {13, 8, 0}};
+  int prof[2] = {0, 0}, edges[2] = {0, 1};
+  oc_stacks *s[2];
+  for (int t = 0; t < 2; t++) {
+    omp_set_num_threads(t + 1);
+    s[t] = slab(33, 0.5, 10);
+    uint8_t m[2] = {OC_MAT_BEDROCK, OC_MAT_SAND};
+    double th[2] = {10, 0.5};
+    ck_assert(oc_stacks_fill(s[t], m, th, 2, &err) == OC_OK);
+    double sand = oc_stacks_volume(s[t], OC_MAT_SAND);
+    oc_sweep_params p = {pts, prof, 2, edges, 1, uv, off, 1, 0, 1, NULL};
+    oc_stabilize_result res;
+    ck_assert_msg(oc_stacks_sweep(s[t], &p, NULL, &res, &err) == OC_OK, "%s",
+                  err.msg);
+    ck_assert(res.moved > 0);
+    ck_assert_double_eq_tol(oc_stacks_volume(s[t], OC_MAT_SAND), sand,
+                            1e-9 * sand);
+  }
+  omp_set_num_threads(2);
+  for (int j = 0; j < 33; j++)
+    for (int i = 0; i < 33; i++) {
+      uint8_t ma[16], mb[16];
+      double ta[16], tb[16];
+      size_t na = oc_stacks_get(s[0], i, j, ma, ta, 16);
+      ck_assert_uint_eq(na, oc_stacks_get(s[1], i, j, mb, tb, 16));
+      ck_assert(!memcmp(ma, mb, na) && !memcmp(ta, tb, na * sizeof *ta));
+    }
+  oc_sweep_params p = {pts, prof, 2, edges, 1, uv, off, 1, 0, 0, NULL};
+  size_t off2[2] = {0, 2};
+  p.profile_off = off2;
+  ck_assert_int_eq(oc_stacks_sweep(s[0], &p, NULL, NULL, &err), OC_EINVAL);
+  ck_assert(strstr(err.msg, "'profiles[1]'"));
+  p.profile_off = off;
+  int bad[2] = {1, 1};
+  p.edges = bad;
+  ck_assert_int_eq(oc_stacks_sweep(s[0], &p, NULL, NULL, &err), OC_EINVAL);
+  ck_assert(strstr(err.msg, "arc 1"));
+  p.edges = edges;
+  int badp[2] = {0, 1};
+  p.point_profile = badp;
+  ck_assert_int_eq(oc_stacks_sweep(s[0], &p, NULL, NULL, &err), OC_EINVAL);
+  ck_assert(strstr(err.msg, "'profile' of path point 2"));
+  oc_stacks_free(s[0]);
+  oc_stacks_free(s[1]);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("layers_tools");
   TCase *tc = tcase_create("layers_tools");
   tcase_set_timeout(tc, 60);
   tcase_add_test(tc, sculpt_round_trip);
   tcase_add_test(tc, from_program_progress);
+  tcase_add_test(tc, sweep_crack_profile);
+  tcase_add_test(tc, sweep_crack_follows_surface);
+  tcase_add_test(tc, sweep_branches_and_tunnel);
+  tcase_add_test(tc, sweep_sand_threads_errors);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }
