@@ -2132,8 +2132,9 @@ int oc_infile_sha256(const char *path, char *hex, oc_error *err);
 ** kept canonical: no empty layer, adjacent layers of one material merged,
 ** and between two bedrock layers (and below the first, above the last)
 ** sand, rocks, water, air upwards (the paper sorts sand, rocks, air;
-** water just below air is outcrop's choice). Thicknesses are stored as
-** floats: about 5 bytes per layer and 4 per stack.
+** water just below air is outcrop's choice). A layer is packed in 4
+** bytes (its thickness rounded to 21 bits of mantissa, a relative error
+** of at most 2^-22, and its material), plus 4 bytes a stack.
 ** Mutable, with one owner: oc_stacks_new and the converters return a grid
 ** the caller frees with oc_stacks_free; edits are not thread-safe, the
 ** work inside them runs on both cores with results independent of the

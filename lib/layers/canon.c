@@ -70,8 +70,8 @@ size_t oc_layers_segments(const oc_stacks *s, size_t k, oc_lseg *out) {
   oc_lseg *c = &out[0];
   *c = (oc_lseg){z, 0, 0, {0, 0, 0}};
   for (uint32_t l = s->off[k]; l < s->off[k + 1]; l++) {
-    double t = s->thick[l];
-    int m = s->mat[l];
+    double t = oc_lay_t(s->lay[l]);
+    int m = oc_lay_m(s->lay[l]);
     if (m == OC_MAT_BEDROCK) {
       c->cap = z - c->floor;
       z += t;
@@ -122,7 +122,7 @@ int oc_layers_decode_all(const oc_stacks *s, oc_lseg **seg, size_t **soff,
   for (size_t k = 0; k < ns; k++) {
     size_t nb = 0;
     for (uint32_t l = s->off[k]; l < s->off[k + 1]; l++)
-      nb += s->mat[l] == OC_MAT_BEDROCK;
+      nb += oc_lay_m(s->lay[l]) == OC_MAT_BEDROCK;
     o[k + 1] = o[k] + nb + 1;
   }
   oc_lseg *g = malloc(o[ns] * sizeof *g);

@@ -61,7 +61,7 @@ int oc_stacks_erode(oc_stacks *s, const oc_stacks_erode_params *p,
     oc_layer *out = l + 3 * most + 3;
     size_t n = 0;
     for (uint32_t q = w->off[k]; q < w->off[k + 1]; q++)
-      l[n++] = (oc_layer){w->thick[q], w->mat[q]};
+      l[n++] = (oc_layer){oc_lay_t(w->lay[q]), oc_lay_m(w->lay[q])};
     if (p->mode == OC_STACKS_ERODE_SURFACE) {
       for (size_t q = n; q-- > 0;)
         if (l[q].m == OC_MAT_BEDROCK) {

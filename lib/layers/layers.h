@@ -5,16 +5,16 @@
 ** stabilisation and the tools edit.
 **
 ** Storage: compressed rows. Stack k = j nx + i holds layers
-** off[k] .. off[k + 1] - 1 of two parallel arrays, a float thickness and
-** a material byte (5 bytes a layer, 4 a stack), bottom-up from zbase.
-** Edits decode stacks to doubles, work there, and re-encode (rounding
-** each thickness to a float once).
+** off[k] .. off[k + 1] - 1 of one array of packed layers (4 bytes a layer,
+** 4 a stack), bottom-up from zbase. Edits decode stacks to doubles, work
+** there, and re-encode (rounding each thickness once).
 */
 #ifndef OC_LAYERS_H
 #define OC_LAYERS_H
 
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "outcrop.h"
 
@@ -22,10 +22,31 @@ struct oc_stacks {
   int nx, ny;
   double cell, x0, y0, zbase;
   uint32_t *off; /* nx ny + 1 */
-  float *thick;  /* off[nx ny] layers */
-  uint8_t *mat;
-  size_t cap; /* capacity of thick and mat */
+  uint32_t *lay; /* off[nx ny] packed layers (oc_lay_pack) */
+  size_t cap;    /* capacity of lay */
 };
+
+/* A layer in 32 bits: the bits of its thickness as a float (>= 0, so the
+** sign bit is free) moved up one bit, their two lowest mantissa bits
+** dropped (rounded to nearest: 21 bits of mantissa, a relative error of
+** at most 2^-22), and the material in the lowest 3 bits. */
+static inline uint32_t oc_lay_pack(double t, int m) {
+  float f = (float)t;
+  uint32_t b, r;
+  memcpy(&b, &f, sizeof b);
+  r = (b + 2u) & ~3u;
+  if ((r & 0x7f800000u) == 0x7f800000u) r = b & ~3u; /* no carry to inf */
+  return r << 1 | (uint32_t)m;
+}
+static inline double oc_lay_t(uint32_t w) {
+  uint32_t b = (w >> 1) & ~3u;
+  float f;
+  memcpy(&f, &b, sizeof f);
+  return f;
+}
+static inline int oc_lay_m(uint32_t w) {
+  return (int)(w & 7u);
+}
 
 /* One layer while being edited. */
 typedef struct oc_layer {
@@ -61,8 +82,7 @@ size_t oc_layers_from_segments(const oc_lseg *seg, size_t nseg, oc_layer *out);
 /* A grid being rebuilt stack by stack, in order (k = 0, 1, ...). */
 typedef struct oc_stacks_builder {
   uint32_t *off;
-  float *thick;
-  uint8_t *mat;
+  uint32_t *lay;
   size_t n, cap, nstacks, k;
 } oc_stacks_builder;
 int oc_builder_init(oc_stacks_builder *b, size_t nstacks, size_t cap,

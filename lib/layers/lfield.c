@@ -278,8 +278,8 @@ oc_node *oc_stacks_field(const oc_stacks *s, unsigned mask, double sigma,
     d->off[k] = n;
     double z = s->zbase, below_z = 0;
     for (uint32_t l = s->off[k]; l < s->off[k + 1]; l++) {
-      double t = s->thick[l], z1 = z + t;
-      if (mask & 1u << s->mat[l]) {
+      double t = oc_lay_t(s->lay[l]), z1 = z + t;
+      if (mask & 1u << oc_lay_m(s->lay[l])) {
         if (n > d->off[k] && d->iv[3 * (n - 1) + 1] == z) {
           d->iv[3 * (n - 1) + 1] = z1; /* continues the interval */
         } else {

@@ -164,7 +164,7 @@ int oc_layers_rebuild_grid(oc_stacks *w, const oc_layers_edit *e,
   for (size_t k = 0; k < ns && rc == OC_OK; k++) {
     size_t n0 = 0;
     for (uint32_t q = w->off[k]; q < w->off[k + 1]; q++)
-      in[n0++] = (oc_layer){w->thick[q], w->mat[q]};
+      in[n0++] = (oc_layer){oc_lay_t(w->lay[q]), oc_lay_m(w->lay[q])};
     double px = w->x0 + (double)(k % w->nx) * w->cell;
     double py = w->y0 + (double)(k / w->nx) * w->cell, z0, z1;
     if (!e->window(e->ctx, px, py, &z0, &z1)) {

@@ -49,7 +49,7 @@ oc_stacks *oc_stacks_alloc(int nx, int ny, double cell, double x0, double y0,
     oc_seterr(err, OC_ENOMEM, "out of memory");
     return NULL;
   }
-  *s = (oc_stacks){nx, ny, cell, x0, y0, zbase, NULL, NULL, NULL, 0};
+  *s = (oc_stacks){nx, ny, cell, x0, y0, zbase, NULL, NULL, 0};
   return s;
 }
 
@@ -69,8 +69,7 @@ oc_stacks *oc_stacks_new(int nx, int ny, double cell, double x0, double y0,
 void oc_stacks_free(oc_stacks *s) {
   if (!s) return;
   free(s->off);
-  free(s->thick);
-  free(s->mat);
+  free(s->lay);
   free(s);
 }
 
@@ -99,9 +98,8 @@ int oc_builder_init(oc_stacks_builder *b, size_t nstacks, size_t cap,
   b->nstacks = nstacks;
   b->cap = cap < 16 ? 16 : cap;
   b->off = malloc((nstacks + 1) * sizeof *b->off);
-  b->thick = malloc(b->cap * sizeof *b->thick);
-  b->mat = malloc(b->cap);
-  if (!b->off || !b->thick || !b->mat) {
+  b->lay = malloc(b->cap * sizeof *b->lay);
+  if (!b->off || !b->lay) {
     oc_builder_free(b);
     return oc_seterr(err, OC_ENOMEM, "out of memory");
   }
@@ -118,17 +116,13 @@ int oc_builder_push(oc_stacks_builder *b, const oc_layer *l, size_t n,
     size_t cap = b->cap;
     while (cap < b->n + n)
       cap += cap / 2;
-    float *t = realloc(b->thick, cap * sizeof *t);
-    if (t) b->thick = t;
-    uint8_t *m = t ? realloc(b->mat, cap) : NULL;
-    if (m) b->mat = m;
-    if (!t || !m) return oc_seterr(err, OC_ENOMEM, "out of memory");
+    uint32_t *t = realloc(b->lay, cap * sizeof *t);
+    if (!t) return oc_seterr(err, OC_ENOMEM, "out of memory");
+    b->lay = t;
     b->cap = cap;
   }
-  for (size_t i = 0; i < n; i++) {
-    b->thick[b->n + i] = (float)l[i].t;
-    b->mat[b->n + i] = (uint8_t)l[i].m;
-  }
+  for (size_t i = 0; i < n; i++)
+    b->lay[b->n + i] = oc_lay_pack(l[i].t, l[i].m);
   b->n += n;
   b->off[++b->k] = (uint32_t)b->n;
   return OC_OK;
@@ -136,19 +130,16 @@ int oc_builder_push(oc_stacks_builder *b, const oc_layer *l, size_t n,
 
 void oc_builder_commit(oc_stacks_builder *b, oc_stacks *s) {
   free(s->off);
-  free(s->thick);
-  free(s->mat);
+  free(s->lay);
   s->off = b->off;
-  s->thick = b->thick;
-  s->mat = b->mat;
+  s->lay = b->lay;
   s->cap = b->cap;
   memset(b, 0, sizeof *b);
 }
 
 void oc_builder_free(oc_stacks_builder *b) {
   free(b->off);
-  free(b->thick);
-  free(b->mat);
+  free(b->lay);
   memset(b, 0, sizeof *b);
 }
 
@@ -224,24 +215,19 @@ int oc_stacks_set(oc_stacks *s, int i, int j, const uint8_t *mat,
   }
   if (total > s->cap) {
     size_t cap = total + total / 2 + 16;
-    float *t = realloc(s->thick, cap * sizeof *t);
-    if (t) s->thick = t;
-    uint8_t *mm = t ? realloc(s->mat, cap) : NULL;
-    if (mm) s->mat = mm;
-    if (!t || !mm) {
+    uint32_t *t = realloc(s->lay, cap * sizeof *t);
+    if (!t) {
       free(in);
       return oc_seterr(err, OC_ENOMEM, "out of memory");
     }
+    s->lay = t;
     s->cap = cap;
   }
   size_t tail = s->off[ns] - s->off[k + 1];
-  memmove(s->thick + s->off[k] + m, s->thick + s->off[k + 1],
-          tail * sizeof *s->thick);
-  memmove(s->mat + s->off[k] + m, s->mat + s->off[k + 1], tail);
-  for (size_t l = 0; l < m; l++) {
-    s->thick[s->off[k] + l] = (float)out[l].t;
-    s->mat[s->off[k] + l] = (uint8_t)out[l].m;
-  }
+  memmove(s->lay + s->off[k] + m, s->lay + s->off[k + 1],
+          tail * sizeof *s->lay);
+  for (size_t l = 0; l < m; l++)
+    s->lay[s->off[k] + l] = oc_lay_pack(out[l].t, out[l].m);
   for (size_t q = k + 1; q <= ns; q++)
     s->off[q] = (uint32_t)(s->off[q] - old + m);
   free(in);
@@ -253,8 +239,8 @@ size_t oc_stacks_get(const oc_stacks *s, int i, int j, uint8_t *mat,
   if (i < 0 || i >= s->nx || j < 0 || j >= s->ny) return 0;
   size_t k = (size_t)j * s->nx + i, n = s->off[k + 1] - s->off[k];
   for (size_t l = 0; l < n && l < max; l++) {
-    if (mat) mat[l] = s->mat[s->off[k] + l];
-    if (thick) thick[l] = s->thick[s->off[k] + l];
+    if (mat) mat[l] = (uint8_t)oc_lay_m(s->lay[s->off[k] + l]);
+    if (thick) thick[l] = oc_lay_t(s->lay[s->off[k] + l]);
   }
   return n;
 }
@@ -265,15 +251,15 @@ void oc_stacks_get_stats(const oc_stacks *s, oc_stacks_stats *st) {
   size_t ns = (size_t)s->nx * s->ny;
   st->stacks = ns;
   st->layers = s->off[ns];
-  st->bytes = sizeof *s + (ns + 1) * sizeof *s->off +
-              s->off[ns] * (sizeof *s->thick + sizeof *s->mat);
+  st->bytes =
+      sizeof *s + (ns + 1) * sizeof *s->off + s->off[ns] * sizeof *s->lay;
 }
 
 double oc_stacks_volume(const oc_stacks *s, int m) {
   size_t n = s->off[(size_t)s->nx * s->ny];
   double v = 0;
   for (size_t l = 0; l < n; l++)
-    if (s->mat[l] == m) v += s->thick[l];
+    if (oc_lay_m(s->lay[l]) == m) v += oc_lay_t(s->lay[l]);
   return v * s->cell * s->cell;
 }
 
@@ -291,8 +277,8 @@ oc_heightfield *oc_stacks_heightfield(const oc_stacks *s, int m,
   for (size_t k = 0; k < ns; k++) {
     double h = s->zbase, top = s->zbase;
     for (uint32_t l = s->off[k]; l < s->off[k + 1]; l++) {
-      h += s->thick[l];
-      if (s->mat[l] == m) top = h;
+      h += oc_lay_t(s->lay[l]);
+      if (oc_lay_m(s->lay[l]) == m) top = h;
     }
     z[k] = (float)top;
   }

@@ -173,8 +173,8 @@ static int sweep_after(const void *ctx, double px, double py, double z,
 static double solid_top(const oc_stacks *s, size_t k) {
   double z = s->zbase, top = s->zbase;
   for (uint32_t l = s->off[k]; l < s->off[k + 1]; l++) {
-    z += s->thick[l];
-    if (s->mat[l] >= OC_MAT_SAND) top = z;
+    z += oc_lay_t(s->lay[l]);
+    if (oc_lay_m(s->lay[l]) >= OC_MAT_SAND) top = z;
   }
   return top;
 }

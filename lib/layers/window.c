@@ -24,10 +24,9 @@ oc_stacks *oc_stacks_window(const oc_stacks *s, int i0, int j0, int i1, int j1,
   for (int j = j0; j <= j1; j++)
     n += s->off[(size_t)j * s->nx + i1 + 1] - s->off[(size_t)j * s->nx + i0];
   w->off = malloc(((size_t)nx * ny + 1) * sizeof *w->off);
-  w->thick = malloc((n ? n : 1) * sizeof *w->thick);
-  w->mat = malloc(n ? n : 1);
+  w->lay = malloc((n ? n : 1) * sizeof *w->lay);
   w->cap = n ? n : 1;
-  if (!w->off || !w->thick || !w->mat) {
+  if (!w->off || !w->lay) {
     oc_stacks_free(w);
     oc_seterr(err, OC_ENOMEM, "out of memory");
     return NULL;
@@ -37,8 +36,7 @@ oc_stacks *oc_stacks_window(const oc_stacks *s, int i0, int j0, int i1, int j1,
   for (int j = j0; j <= j1; j++) {
     size_t a = (size_t)j * s->nx + i0;
     uint32_t l0 = s->off[a], l1 = s->off[a + nx];
-    memcpy(w->thick + at, s->thick + l0, (l1 - l0) * sizeof *w->thick);
-    memcpy(w->mat + at, s->mat + l0, l1 - l0);
+    memcpy(w->lay + at, s->lay + l0, (l1 - l0) * sizeof *w->lay);
     for (int i = 0; i < nx; i++, k++)
       w->off[k + 1] = (uint32_t)(at + s->off[a + i + 1] - l0);
     at += l1 - l0;
@@ -57,12 +55,10 @@ int oc_stacks_splice(oc_stacks *s, const oc_stacks *w, int i0, int j0,
     return oc_seterr(err, OC_ENOMEM, "more than %llu layers",
                      (unsigned long long)OC_STACKS_MAX_LAYERS);
   uint32_t *off = malloc((ns + 1) * sizeof *off);
-  float *thick = malloc((total ? total : 1) * sizeof *thick);
-  uint8_t *mat = malloc(total ? total : 1);
-  if (!off || !thick || !mat) {
+  uint32_t *lay = malloc((total ? total : 1) * sizeof *lay);
+  if (!off || !lay) {
     free(off);
-    free(thick);
-    free(mat);
+    free(lay);
     return oc_seterr(err, OC_ENOMEM, "out of memory");
   }
   size_t at = 0;
@@ -71,8 +67,7 @@ int oc_stacks_splice(oc_stacks *s, const oc_stacks *w, int i0, int j0,
 #define RUN(g, a, b)                                                           \
   do {                                                                         \
     uint32_t l0 = (g)->off[a], l1 = (g)->off[b];                               \
-    memcpy(thick + at, (g)->thick + l0, (l1 - l0) * sizeof *thick);            \
-    memcpy(mat + at, (g)->mat + l0, l1 - l0);                                  \
+    memcpy(lay + at, (g)->lay + l0, (l1 - l0) * sizeof *lay);                  \
     for (size_t q = (a); q < (b); q++)                                         \
       off[++k] = (uint32_t)(at + (g)->off[q + 1] - l0);                        \
     at += l1 - l0;                                                             \
@@ -89,11 +84,9 @@ int oc_stacks_splice(oc_stacks *s, const oc_stacks *w, int i0, int j0,
   RUN(s, bot, ns);
 #undef RUN
   free(s->off);
-  free(s->thick);
-  free(s->mat);
+  free(s->lay);
   s->off = off;
-  s->thick = thick;
-  s->mat = mat;
+  s->lay = lay;
   s->cap = total ? total : 1;
   return OC_OK;
 }
@@ -106,9 +99,7 @@ static int border_changed(const oc_stacks *a, const oc_stacks *b) {
       size_t k = (size_t)j * a->nx + i;
       size_t n = a->off[k + 1] - a->off[k];
       if (n != b->off[k + 1] - b->off[k] ||
-          memcmp(a->thick + a->off[k], b->thick + b->off[k],
-                 n * sizeof *a->thick) ||
-          memcmp(a->mat + a->off[k], b->mat + b->off[k], n))
+          memcmp(a->lay + a->off[k], b->lay + b->off[k], n * sizeof *a->lay))
         return 1;
     }
   return 0;

@@ -295,7 +295,7 @@ START_TEST(sweep_sand_threads_errors) {
                   err.msg);
     ck_assert(res.moved > 0);
     ck_assert_double_eq_tol(oc_stacks_volume(s[t], OC_MAT_SAND), sand,
-                            1e-9 * sand);
+                            1e-6 * sand);
   }
   omp_set_num_threads(2);
   for (int j = 0; j < 33; j++)
