@@ -6,7 +6,7 @@
 -- follows the surface (its up vector is the surface normal); the branch
 -- narrows towards its end (a second, smaller profile at its last point).
 -- Sand poured on the rim spills into the ravine and is stabilised. The
--- picture is coloured by the sand's convolution.
+-- picture and the mesh's vertex colours are textured by material.
 --
 --   outcrop run examples/layers_ravine.lua [--set cell=0.5] [--out DIR]
 
@@ -49,14 +49,14 @@ print(string.format("layers_ravine: %d stacks, %d layers, %d bytes",
 local box = {-40, -30, 0, 40, 30, 26}
 -- sigma two cells: a smoother surface than one cell's on the slot's rim
 local solid = s:field{materials = {"bedrock", "sand"}, sigma = 2 * cell}
-local sand = s:field{materials = {"sand"}, sigma = 2 * cell}
 local mesh = oc.polygonize(solid, {box = box, cell = cell})
-mesh:write("layers_ravine.ply")
+-- textured by material (section 6): each material's colour and triplanar
+-- texture, blended by its share of the box of half-side 2 cells around
+local colors = s:colors{bedrock = {0.30, 0.22, 0.17}}
+mesh:write("layers_ravine.ply", {colors = colors})
 print(string.format("layers_ravine: %d triangles", mesh:stats().triangles))
 oc.render(solid, {camera = {eye = {78, -36, 42}, target = {10, 0, 8},
                             fov = 40},
                   size = {800, 450},
-                  color = sand,
-                  palette = {{0, {0.30, 0.25, 0.22}}, {0.3, {0.55, 0.44, 0.30}},
-                             {1, {0.88, 0.76, 0.50}}}}):write("layers_ravine.png")
+                  color = colors}):write("layers_ravine.png")
 print("layers_ravine: wrote layers_ravine.ply, layers_ravine.png")

@@ -300,6 +300,13 @@ int oc_mesh_set_colors(oc_mesh *mesh, const float *rgb, oc_error *err);
 ** sorted by value, linearly interpolated, clamped at the ends. */
 int oc_mesh_color_by_field(oc_mesh *mesh, const oc_program *field,
                            const double *stops, int n, oc_error *err);
+/* Colours blended by n weight programs, as a render's OC_COLOR_BLEND
+** (oc_render_params) with the vertex normals: texture amplitude in
+** [0, 1], texture_scale > 0 metres a period. Parallel, independent of
+** the thread count. */
+int oc_mesh_color_by_blend(oc_mesh *mesh, const oc_program *const *fields,
+                           const double *colors, int n, double texture,
+                           double texture_scale, oc_error *err);
 
 /* Connected components (triangles joined by shared edges and vertices):
 ** (*sizes)[i] is the vertex count of component i, components numbered in
@@ -470,7 +477,8 @@ typedef enum oc_render_tracer {
 
 typedef enum oc_render_color {
   OC_COLOR_RULES = 0, /* rock, grass, snow, sand by altitude and slope */
-  OC_COLOR_FIELD      /* a program (e.g. geology) through a palette */
+  OC_COLOR_FIELD,     /* a program (e.g. geology) through a palette */
+  OC_COLOR_BLEND      /* colours blended by weight programs (materials) */
 } oc_render_color;
 
 /* How linear colours become display values in 8/16-bit files (see
@@ -521,6 +529,16 @@ typedef struct oc_render_params {
   const double *stops;           /* OC_COLOR_FIELD: n stops (value, r, g, b),
                                  ** values ascending, components in [0, 1] */
   int nstops;                    /* 1 .. 256 */
+  /* OC_COLOR_BLEND (texturing by material, Peytavie et al. 2009 section
+  ** 6): nblend (1 .. 16) weight programs and colours (r, g, b in [0, 1]);
+  ** the albedo at p is sum w_i c_i k_i / sum w_i, w_i = max(f_i(p), 0)
+  ** (for material stacks, each material's convolution surface: its share
+  ** of the box around p), k_i the gain of material i's own triplanar
+  ** texture (weights |n_x|^8, |n_y|^8, |n_z|^8 for the planes orthogonal
+  ** to x, y, z; amplitude `texture`); c_0 where every weight is 0. */
+  const oc_program *const *blend_fields;
+  const double *blend_colors;
+  int nblend;
 
   double threshold;        /* iso-value; 0 means the program's T */
   double max_distance;     /* farthest hit, metres; 0: auto (the scene's

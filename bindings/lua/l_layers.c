@@ -33,6 +33,11 @@
 **        profiles = {{u, v}, ...} or {{{u, v}, ...}, ...},
 **        mode = "crack" | "tunnel", stabilize = true | false | {...}}
 **        -> bedrock volume added (negative), {...}
+**   s:colors{sigma = 1 cell, sand = {r, g, b}, ...} -> {blend = {{node,
+**        {r, g, b}}, ...}}: each material present (bedrock first) with
+**        its convolution surface of half-side sigma (its share of the box
+**        around a point) and its colour, for render's `color =` and a
+**        mesh's `colors =` (texturing by material)
 **
 ** Stacks are mutable: a node made by s:field is a snapshot. `local s
 ** <close>` frees the grid early.
@@ -720,6 +725,60 @@ static int m_sweep(lua_State *L) {
   return 2;
 }
 
+/* Linear albedos of the materials (air: none), as the renderer's rule
+** colours for sand and rock. */
+static const double MAT_RGB[OC_MAT_COUNT][3] = {{0, 0, 0},
+                                                {0.05, 0.12, 0.18},
+                                                {0.50, 0.42, 0.28},
+                                                {0.12, 0.11, 0.10},
+                                                {0.22, 0.18, 0.15}};
+
+static int m_colors(lua_State *L) {
+  static const char *const known[] = {"sigma", "water",   "sand",
+                                      "rocks", "bedrock", NULL};
+  const char *fname = "layers:colors";
+  oclua_checkargs(L, 2, fname, "([{sigma=, water=, sand=, rocks=, bedrock=}])");
+  lua_settop(L, 2);
+  oc_stacks *s = pinlayers(L, 1, fname);
+  double sigma = oc_stacks_cell(s), rgb[OC_MAT_COUNT][3];
+  memcpy(rgb, MAT_RGB, sizeof rgb);
+  if (!lua_isnil(L, 2)) {
+    oclua_fields f;
+    oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
+    sigma = oclua_field_optnumber(&f, "sigma", OCLUA_POSITIVE, sigma);
+    for (int m = OC_MAT_WATER; m < OC_MAT_COUNT; m++) {
+      const char *name = oc_material_name(m);
+      if (!oclua_field_numbers(&f, name, 3, rgb[m], "must be {r, g, b}"))
+        continue;
+      for (int c = 0; c < 3; c++)
+        if (!(rgb[m][c] >= 0 && rgb[m][c] <= 1))
+          oclua_error(L, fname, "'%s' must be {r, g, b} in [0, 1]", name);
+    }
+  }
+  /* {blend = {{field of m, {r, g, b}}, ...}} for the materials present */
+  lua_createtable(L, 0, 1);
+  lua_createtable(L, OC_MAT_COUNT, 0);
+  int n = 0;
+  for (int m = OC_MAT_COUNT - 1; m > OC_MAT_AIR; m--) {
+    if (!(oc_stacks_volume(s, m) > 0)) continue;
+    lua_createtable(L, 2, 0);
+    oclua_node *u = oclua_newnode(L);
+    oc_error err = {OC_OK, ""};
+    oclua_setnode(L, u, oc_stacks_field(s, 1u << m, sigma, &err), &err, fname);
+    lua_rawseti(L, -2, 1);
+    lua_createtable(L, 3, 0);
+    for (int c = 0; c < 3; c++) {
+      lua_pushnumber(L, rgb[m][c]);
+      lua_rawseti(L, -2, c + 1);
+    }
+    lua_rawseti(L, -2, 2);
+    lua_rawseti(L, -2, ++n);
+  }
+  if (n == 0) oclua_error(L, fname, "the stacks hold no material");
+  lua_setfield(L, -2, "blend");
+  return 1;
+}
+
 /* ---- metamethods ------------------------------------------------------- */
 
 static int m_gc(lua_State *L) {
@@ -758,6 +817,7 @@ static const luaL_Reg methods[] = {{"get", m_get},
                                    {"erode", m_erode},
                                    {"sculpt", m_sculpt},
                                    {"sweep", m_sweep},
+                                   {"colors", m_colors},
                                    {NULL, NULL}};
 
 static const luaL_Reg meta[] = {{"__gc", m_gc},

@@ -3,7 +3,8 @@
 ** section 4) beyond test_layers.c: sculpting add then carve returns the
 ** surface within a cell, from_program's progress and cancellation, and
 ** the sweep tool (a crack's cross-section equal to its profile, branches,
-** tunnels, volume bookkeeping, thread independence, bad input).
+** tunnels, volume bookkeeping, thread independence, bad input), and mesh
+** vertex colours textured by material (oc_mesh_color_by_blend).
 */
 #include <omp.h>
 #include <string.h>
@@ -326,6 +327,83 @@ START_TEST(sweep_sand_threads_errors) {
 }
 END_TEST
 
+/* ---- texturing by material ------------------------------------------------
+ */
+
+/* Bedrock 5 m thick, under 2 m of sand on the half x < 10: mesh vertex
+** colours blended by the two materials' convolution surfaces (sigma 1)
+** are the sand's colour on the sand, the bedrock's on the bare rock, a
+** mix of both on the step between; the triplanar texture (amplitude 0.3)
+** scales each colour by a gain within 1 +- 0.3. */
+START_TEST(texture_by_material) {
+  oc_error err;
+  oc_stacks *s = slab(20, 1, 5);
+  uint8_t m[2] = {OC_MAT_BEDROCK, OC_MAT_SAND};
+  double t[2] = {5, 2};
+  for (int j = 0; j < 20; j++)
+    for (int i = 0; i < 10; i++)
+      ck_assert(oc_stacks_set(s, i, j, m, t, 2, &err) == OC_OK);
+  oc_program *solid =
+      oct_compile(OCT_OK(oc_stacks_field(
+                      s, 1u << OC_MAT_BEDROCK | 1u << OC_MAT_SAND, NAN, &err)),
+                  T, 0);
+  const oc_program *w[2] = {
+      oct_compile(OCT_OK(oc_stacks_field(s, 1u << OC_MAT_SAND, 1, &err)), T, 0),
+      oct_compile(OCT_OK(oc_stacks_field(s, 1u << OC_MAT_BEDROCK, 1, &err)), T,
+                  0)};
+  const double col[6] = {0.5, 0.42, 0.28, 0.22, 0.18, 0.15};
+  oc_polygonize_params pp;
+  memset(&pp, 0, sizeof pp);
+  pp.box = (oc_aabb){{0, 0, 1}, {19, 19, 10}};
+  pp.cell = 0.5;
+  pp.open = 1;
+  oc_mesh *mesh = oc_polygonize(solid, &pp, &err);
+  ck_assert_msg(mesh != NULL, "%s", err.msg);
+  size_t nv = oc_mesh_vertex_count(mesh);
+  const float *P = oc_mesh_positions(mesh);
+  for (int pass = 0; pass < 2; pass++) {
+    double amp = pass ? 0.3 : 0;
+    ck_assert_msg(oc_mesh_color_by_blend(mesh, w, col, 2, amp, 4, &err) ==
+                      OC_OK,
+                  "%s", err.msg);
+    const float *C = oc_mesh_colors(mesh);
+    int sand = 0, rock = 0, mixed = 0;
+    for (size_t v = 0; v < nv; v++) {
+      double x = P[3 * v], y = P[3 * v + 1];
+      if (y < 2 || y > 17) continue; /* away from the grid's sides */
+      const double *want = x < 7 ? col : x > 12 ? col + 3 : NULL;
+      if (want) {
+        for (int c = 0; c < 3; c++) {
+          double lo = want[c] * (1 - amp) - 1e-6, hi = want[c] * (1 + amp);
+          ck_assert_msg(C[3 * v + c] >= lo && C[3 * v + c] <= hi + 1e-6,
+                        "vertex at x %g: %g not in [%g, %g]", x, C[3 * v + c],
+                        lo, hi);
+        }
+        if (amp == 0) ck_assert_float_eq_tol(C[3 * v], want[0], 1e-6);
+        sand += x < 7;
+        rock += x > 12;
+      } else if (amp == 0 && C[3 * v] < 0.49 && C[3 * v] > 0.23) {
+        mixed++;
+      }
+    }
+    ck_assert(sand > 50 && rock > 50 && (amp > 0 || mixed > 10));
+  }
+  /* bad input names the field */
+  const double bad[6] = {0.5, 0.42, 2, 0.22, 0.18, 0.15};
+  ck_assert_int_eq(oc_mesh_color_by_blend(mesh, w, bad, 2, 0, 4, &err),
+                   OC_EINVAL);
+  ck_assert(strstr(err.msg, "'blend[1]'"));
+  ck_assert_int_eq(oc_mesh_color_by_blend(mesh, w, col, 2, 0, 0, &err),
+                   OC_EINVAL);
+  ck_assert(strstr(err.msg, "'texture_scale'"));
+  oc_mesh_free(mesh);
+  oc_program_free(solid);
+  oc_program_free((oc_program *)w[0]);
+  oc_program_free((oc_program *)w[1]);
+  oc_stacks_free(s);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("layers_tools");
   TCase *tc = tcase_create("layers_tools");
@@ -336,6 +414,7 @@ int main(void) {
   tcase_add_test(tc, sweep_crack_follows_surface);
   tcase_add_test(tc, sweep_branches_and_tunnel);
   tcase_add_test(tc, sweep_sand_threads_errors);
+  tcase_add_test(tc, texture_by_material);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }

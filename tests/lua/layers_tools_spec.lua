@@ -1,12 +1,17 @@
 -- layers_tools_spec.lua — layers:sweep (Peytavie et al. 2009, section
 -- 4.2): a crack's cross-section is its profile, branches and profiles
--- per point, tunnels, and every error with its script line.
+-- per point, tunnels, and every error with its script line; texturing by
+-- material (section 6): a render with color = stacks:colors() against a
+-- golden image (tests/fixtures/render/layers_texture.lua, the linear
+-- R, G, B of 32 x 24 pixels; OUTCROP_REGEN_GOLDEN=1 rewrites it).
 local oc = require "outcrop"
 local R = require "helpers.ref"
 
 local F = "layers_tools_spec.lua"
 local function check(f, fname, ...) return R.check_error(f, F, fname, ...) end
 local L = oc.layers
+local GOLDEN = "../fixtures/render/layers_texture.lua"
+local regen = os.getenv("OUTCROP_REGEN_GOLDEN") == "1"
 
 -- a square of half-side h with control points every h / 4 along its sides
 -- (straight sides for the Catmull-Rom spline away from the corners)
@@ -78,5 +83,64 @@ describe("layers:sweep", function()
           "layers:sweep", "'mode'")
     check(function() s:sweep{path = two, profiles = sq, mode = "tunnel"} end,
           "layers:sweep", "'path[1]' must be {x, y, z}")
+  end)
+end)
+
+describe("texturing by material", function()
+  it("renders stacks:colors() as the golden image", function()
+    -- bedrock 4 m, sand 1.5 m on one half, a rock bank on a corner
+    local s = L.new{size = {16, 16}, layers = {{"bedrock", 4}}}
+    for j = 1, 16 do
+      for i = 1, 16 do
+        if i <= 8 then s:set(i, j, {{"bedrock", 4}, {"sand", 1.5}}) end
+        if i > 11 and j > 11 then s:set(i, j, {{"bedrock", 4}, {"rocks", 2}}) end
+      end
+    end
+    local c = s:colors()
+    assert.are.equal(3, #c.blend) -- bedrock, rocks, sand: those present
+    local img = oc.render(s:field(), {size = {32, 24}, aov = false,
+      camera = {eye = {30, -18, 22}, target = {8, 8, 3}, fov = 45},
+      color = c})
+    local now = {}
+    for j = 1, 24 do
+      for i = 1, 32 do
+        local r, g, b = img:get(i, j)
+        now[#now + 1] = string.format("%.4f,%.4f,%.4f", r, g, b)
+      end
+    end
+    if regen then
+      local f = assert(io.open(GOLDEN, "w"))
+      f:write("-- layers_tools_spec.lua's golden render (linear R, G, B)\n",
+              "return {", table.concat(now, ","), "}\n")
+      f:close()
+      print("\nwrote " .. GOLDEN)
+      return
+    end
+    local want = dofile(GOLDEN)
+    assert.are.equal(32 * 24 * 3, #want)
+    local sum, max, k = 0, 0, 0
+    for _, px in ipairs(now) do
+      for v in px:gmatch("[^,]+") do
+        k = k + 1
+        local d = math.abs(tonumber(v) - want[k])
+        sum, max = sum + d, math.max(max, d)
+      end
+    end
+    -- rendering is deterministic: beyond the 4 digits kept, a change
+    assert.is_true(sum / k <= 2e-3, "mean difference " .. sum / k)
+    assert.is_true(max <= 0.05, "largest difference " .. max)
+  end)
+  it("names the field and the line in errors", function()
+    local s = L.new{size = {4, 4}, layers = {{"bedrock", 2}}}
+    local f = s:field()
+    check(function() oc.render(f, {color = {blend = {{5, {1, 1, 1}}}}}) end,
+          "outcrop.render", "'color.blend[1]' must be {node, {r, g, b}}")
+    check(function() oc.render(f, {color = {blend = {}}}) end,
+          "outcrop.render", "'color.blend' must hold 1 to 16 pairs")
+    check(function() s:colors{sand = {2, 0, 0}} end, "layers:colors",
+          "'sand' must be {r, g, b} in [0, 1]")
+    check(function() s:colors{sigma = 0} end, "layers:colors", "'sigma'")
+    check(function() L.new{size = {2, 2}}:colors() end, "layers:colors",
+          "the stacks hold no material")
   end)
 end)
