@@ -2343,8 +2343,10 @@ int oc_stacks_sculpt(oc_stacks *s, const oc_sculpt_params *p, double *changed,
 ** closed cross-section, the Catmull-Rom spline through its control
 ** points (u, v) (u across the arc, to the right of travel; v along the
 ** up vector; non-convex allowed). The profiles, interpolated along each
-** arc and turned about the up vector past its ends (so joints close and
-** ends are rounded), sweep a volume V; bedrock inside V becomes air (the
+** arc, sweep a volume V, with its arcs' ends (grouped by the points'
+** coordinates) cut square where an end is alone, mitred where two meet,
+** and where three or more meet (branches) the profile turned about the
+** up vector past them, closing the joint; bedrock inside V becomes air (the
 ** difference), other materials stay and settle, and the stacks around
 ** are stabilised. Cracks (tunnel = 0): points are projected on the top of
 ** the solid (their z ignored) and the up vector is the surface normal

@@ -10,9 +10,11 @@
 ** control point, so two profiles interpolate point by point along an
 ** arc. The up vector is the surface normal at a node for cracks (the
 ** graph projected on the top of the solid) and the vertical for tunnels,
-** made orthogonal to the arc. Past an arc's ends the profile turns about
-** the up vector (u becomes the signed horizontal distance), which closes
-** the joints of a branching graph and rounds its ends.
+** made orthogonal to the arc. An arc's end alone is cut square; two ends
+** meeting are mitred (the plane halfway between the arcs, so a bend has
+** neither gap nor overlap); at a branching node (three or more ends) the
+** profile turns about the up vector past the ends (u becomes the signed
+** distance from the node's axis), closing the joint.
 **
 ** The difference is taken on the layers themselves: bedrock inside V
 ** becomes air, other materials stay (loose material falls to the floor
@@ -32,6 +34,8 @@
 
 typedef struct sarc {
   oc_vec3 a, b, t;       /* ends and unit tangent */
+  oc_vec3 ma, mb;        /* end planes' normals (along t), where not capped */
+  int cap[2];            /* 1: the profile turns about up past that end */
   oc_vec3 na, nb;        /* up vectors at the ends (unit, orthogonal to t) */
   double len, reach;     /* length; largest profile radius */
   const double *pa, *pb; /* resampled profiles at the ends (NP u, v pairs) */
@@ -129,6 +133,9 @@ static int in_arc(const sarc *c, oc_vec3 p) {
   s = s < 0 ? 0 : s > 1 ? 1 : s;
   oc_vec3 q = v3(c->a.x + s * (c->b.x - c->a.x), c->a.y + s * (c->b.y - c->a.y),
                  c->a.z + s * (c->b.z - c->a.z));
+  /* flat or mitred ends: nothing past their planes */
+  if (!c->cap[0] && dot(sub(p, c->a), c->ma) < 0) return 0;
+  if (!c->cap[1] && dot(sub(p, c->b), c->mb) > 0) return 0;
   d = sub(p, q);
   if (dot(d, d) > c->reach * c->reach) return 0;
   oc_vec3 n = ortho(v3(c->na.x + s * (c->nb.x - c->na.x),
@@ -137,8 +144,9 @@ static int in_arc(const sarc *c, oc_vec3 p) {
                     c->t);
   oc_vec3 r = cross(c->t, n);
   double u = dot(d, r), v = dot(d, n), along = dot(d, c->t);
-  /* past an end: the profile turned about the up vector */
-  u = copysign(sqrt(u * u + along * along), u);
+  /* past a capped end: the profile turned about the up vector */
+  if ((s == 0 && c->cap[0]) || (s == 1 && c->cap[1]))
+    u = copysign(sqrt(u * u + along * along), u);
   return in_profile(c->pa, c->pb, s, u, v);
 }
 
@@ -276,6 +284,68 @@ static void make_arcs(const oc_stacks *s, const oc_sweep_params *p,
   }
 }
 
+/* The arcs' ends grouped by position (the points' given coordinates,
+** before any projection): an end alone is flat (cut square to its arc),
+** two ends meeting are mitred (the plane halfway between the two arcs),
+** three or more are capped (the profile turned about the up vector, so
+** the branches' joint is closed). */
+typedef struct jend {
+  oc_vec3 p;
+  int arc, end;
+} jend;
+
+static int cmp_end(const void *x, const void *y) {
+  const jend *a = x, *b = y;
+  if (a->p.x != b->p.x) return a->p.x < b->p.x ? -1 : 1;
+  if (a->p.y != b->p.y) return a->p.y < b->p.y ? -1 : 1;
+  if (a->p.z != b->p.z) return a->p.z < b->p.z ? -1 : 1;
+  return a->arc != b->arc ? (a->arc < b->arc ? -1 : 1) : a->end - b->end;
+}
+
+/* Direction of arc c travelled away from its end `end`. */
+static oc_vec3 away(const sarc *c, int end) {
+  return end ? v3(-c->t.x, -c->t.y, -c->t.z) : c->t;
+}
+
+static int joints(const oc_sweep_params *p, sarc *arc) {
+  size_t ne = p->nedges;
+  jend *e = malloc(2 * ne * sizeof *e);
+  if (!e) return 1;
+  for (size_t k = 0; k < 2 * ne; k++) {
+    oc_vec3 q = p->points[p->edges[k]];
+    if (!p->tunnel) q.z = 0; /* cracks: z is not given */
+    e[k] = (jend){q, (int)(k / 2), (int)(k % 2)};
+  }
+  qsort(e, 2 * ne, sizeof *e, cmp_end);
+  for (size_t a = 0, b; a < 2 * ne; a = b) {
+    for (b = a + 1; b < 2 * ne && e[b].p.x == e[a].p.x &&
+                    e[b].p.y == e[a].p.y && e[b].p.z == e[a].p.z;
+         b++)
+      ;
+    for (size_t k = a; k < b; k++) {
+      sarc *c = &arc[e[k].arc];
+      int end = e[k].end;
+      oc_vec3 m = c->t; /* flat */
+      int cap = b - a > 2;
+      if (b - a == 2) { /* mitred: the plane between the two arcs */
+        const jend *o = &e[k == a ? a + 1 : a];
+        oc_vec3 h = sub(away(&arc[o->arc], o->end), away(c, end));
+        if (dot(h, h) < 1e-12)
+          cap = 1; /* a U-turn */
+        else
+          m = unit(end ? h : v3(-h.x, -h.y, -h.z));
+      }
+      c->cap[end] = cap;
+      if (end)
+        c->mb = m;
+      else
+        c->ma = m;
+    }
+  }
+  free(e);
+  return 0;
+}
+
 int oc_stacks_sweep(oc_stacks *s, const oc_sweep_params *p, double *changed,
                     oc_stabilize_result *res, oc_error *err) {
   if (changed) *changed = 0;
@@ -315,6 +385,13 @@ int oc_stacks_sweep(oc_stacks *s, const oc_sweep_params *p, double *changed,
   }
   free(scratch);
   make_arcs(s, p, prof, reach, pts, pts + np, arc);
+  if (joints(p, arc)) {
+    free(prof);
+    free(pts);
+    free(arc);
+    free(list);
+    return oc_seterr(err, OC_ENOMEM, "out of memory");
+  }
   /* the stacks the volume can reach, as a window grid of their own */
   double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
   for (size_t e = 0; e < ne; e++)

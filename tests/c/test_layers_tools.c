@@ -327,6 +327,39 @@ START_TEST(sweep_sand_threads_errors) {
 }
 END_TEST
 
+/* A right-angle bend: the two arcs are mitred, so the outer corner of the
+** bend is carved (no wedge left between square-cut ends) and nothing
+** beyond the profile's width is; the path's far ends are cut square. */
+START_TEST(sweep_bend_mitred) {
+  oc_error err;
+  double cell = 0.25;
+  oc_stacks *s = slab(81, cell, 10);
+  static const double sq[] = {-1, 1, 1, 1, 1, -1, -1, -1};
+  double uv[2 * 64];
+  size_t n = polygon(sq, 4, 0.25, uv), off[2] = {0, n};
+  oc_vec3 pts[3] = {{2, 10, 0}, {10, 10, 0}, {10, 18, 0}};
+  int prof[3] = {0, 0, 0}, edges[4] = {0, 1, 1, 2};
+  oc_sweep_params p = {pts, prof, 3, edges, 2, uv, off, 1, 0, 0, NULL};
+  ck_assert_msg(oc_stacks_sweep(s, &p, NULL, NULL, &err) == OC_OK, "%s",
+                err.msg);
+  uint8_t m[16];
+  double top[16];
+  /* (10.75, 9.5): the bend's outer corner (0.25 from the profile's
+  ** rounded corner, hence the looser tolerance) */
+  column(s, 43, 38, m, top);
+  ck_assert_double_eq_tol(top[0], 9, 1e-3);
+  column(s, 42, 41, m, top); /* (10.5, 10.25) */
+  ck_assert_double_eq_tol(top[0], 9, 1e-5);
+  column(s, 45, 35, m, top); /* (11.25, 8.75): beyond the width */
+  ck_assert_double_eq_tol(top[0], 10, 1e-6);
+  column(s, 6, 40, m, top); /* (1.5, 10): before the square-cut start */
+  ck_assert_double_eq_tol(top[0], 10, 1e-6);
+  column(s, 9, 40, m, top); /* (2.25, 10): just after it */
+  ck_assert_double_eq_tol(top[0], 9, 1e-5);
+  oc_stacks_free(s);
+}
+END_TEST
+
 /* ---- texturing by material ------------------------------------------------
  */
 
@@ -413,6 +446,7 @@ int main(void) {
   tcase_add_test(tc, sweep_crack_profile);
   tcase_add_test(tc, sweep_crack_follows_surface);
   tcase_add_test(tc, sweep_branches_and_tunnel);
+  tcase_add_test(tc, sweep_bend_mitred);
   tcase_add_test(tc, sweep_sand_threads_errors);
   tcase_add_test(tc, texture_by_material);
   suite_add_tcase(s, tc);
