@@ -1,8 +1,9 @@
 -- layers_arches.lua — arches carved into a cliff block with the material
 -- stack tools (Peytavie et al. 2009, figure 23): a block of bedrock, a
 -- rough cliff profile swept along its front (a ledge and an overhang),
--- two bays swept into the face leaving a fin between them, an arch
--- swept through the fin and another through the ledge, a few carving
+-- two bays swept into the face and a corridor behind leaving a fin
+-- between them, an arch swept through the fin and another through the
+-- ledge, a few carving
 -- strokes to break the walls, and the walls' surface eroded into sand and
 -- rocks that settle at the foot. Rendered and meshed textured by
 -- material (section 6).
@@ -26,28 +27,33 @@ local removed = -s:sweep{path = {{-8, 17, 0}, {14, 15, 0}, {30, 18, 0},
                                  {46, 15, 0}, {68, 17, 0}},
                          profiles = front, mode = "tunnel", stabilize = false}
 
--- two bays cut into the face (open to the sky, 10 m wide), a fin between
+-- two bays cut into the face (open to the sky, 10 m wide) and a corridor
+-- joining them behind: the rock between them stands free, a fin
 local bay = {{-5, 40}, {5, 40}, {5, 4.5}, {3, 4}, {-3, 4}, {-5, 4.5}}
 for _, x in ipairs{18, 42} do
-  removed = removed - s:sweep{path = {{x, 8, 0}, {x, 24, 0}}, profiles = bay,
+  removed = removed - s:sweep{path = {{x, 8, 0}, {x, 30, 0}}, profiles = bay,
                               mode = "tunnel", stabilize = false}
 end
+local corridor = {{-3, 40}, {3, 40}, {3, 4.5}, {2, 4}, {-2, 4}, {-3, 4.5}}
+removed = removed - s:sweep{path = {{18, 27, 0}, {42, 27, 0}},
+                            profiles = corridor, mode = "tunnel",
+                            stabilize = false}
 
--- the arches: an opening through the fin, another through the ledge
+-- the arches: one through the fin, a smaller one through the ledge
 local arch = {}
 for k = 0, 15 do
   local a = 2 * math.pi * k / 16
-  arch[#arch + 1] = {4.5 * math.cos(a), 6 * math.sin(a)}
+  arch[#arch + 1] = {3.5 * math.cos(a), 5.5 * math.sin(a)}
 end
-removed = removed - s:sweep{path = {{12, 20, 11}, {48, 20, 11}},
+removed = removed - s:sweep{path = {{30, 10, 11}, {30, 30, 11}},
                             profiles = arch, mode = "tunnel", stabilize = false}
 local small = {}
-for k, p in ipairs(arch) do small[k] = {0.5 * p[1], 0.45 * p[2]} end
-removed = removed - s:sweep{path = {{30, 4, 6.5}, {30, 14, 6.5}},
+for k, p in ipairs(arch) do small[k] = {0.6 * p[1], 0.45 * p[2]} end
+removed = removed - s:sweep{path = {{8, 4, 6.5}, {8, 14, 6.5}},
                             profiles = small, mode = "tunnel", stabilize = false}
 
 -- carving strokes on the walls
-for _, c in ipairs{{8, 17, 20}, {30, 20, 24}, {52, 16, 14}, {36, 15, 7}} do
+for _, c in ipairs{{8, 17, 20}, {52, 16, 14}, {50, 24, 24}, {4, 22, 25}} do
   local dv = s:sculpt{center = c, radius = 3, mode = "carve", stabilize = false}
   removed = removed - dv
 end
@@ -68,7 +74,7 @@ local box = {0, 0, 0.5, 60, 40, 30}
 local mesh = oc.polygonize(solid, {box = box, cell = cell})
 mesh:write("layers_arches.ply", {colors = colors})
 print(string.format("layers_arches: %d triangles", mesh:stats().triangles))
-oc.render(solid, {camera = {eye = {44, -34, 24}, target = {30, 16, 11},
+oc.render(solid, {camera = {eye = {50, -26, 26}, target = {28, 18, 10},
                             fov = 48},
                   size = {800, 450}, color = colors}):write("layers_arches.png")
 print("layers_arches: wrote layers_arches.ply, layers_arches.png")
