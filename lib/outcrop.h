@@ -2152,7 +2152,8 @@ int oc_infile_sha256(const char *path, char *hex, oc_error *err);
 ** sand, rocks, water, air upwards (the paper sorts sand, rocks, air;
 ** water just below air is outcrop's choice). A layer is packed in 4
 ** bytes (its thickness rounded to 21 bits of mantissa, a relative error
-** of at most 2^-22, and its material), plus 4 bytes a stack.
+** of at most 2^-22, and its material), plus 1.25 bytes a stack (4 once a
+** stack holds more than 255 layers).
 ** Mutable, with one owner: oc_stacks_new and the converters return a grid
 ** the caller frees with oc_stacks_free; edits are not thread-safe, the
 ** work inside them runs on both cores with results independent of the

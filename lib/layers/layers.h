@@ -5,9 +5,12 @@
 ** stabilisation and the tools edit.
 **
 ** Storage: compressed rows. Stack k = j nx + i holds layers
-** off[k] .. off[k + 1] - 1 of one array of packed layers (4 bytes a layer,
-** 4 a stack), bottom-up from zbase. Edits decode stacks to doubles, work
-** there, and re-encode (rounding each thickness once).
+** oc_soff(s, k) .. oc_soff(s, k + 1) - 1 of one array of packed layers
+** (4 bytes a layer), bottom-up from zbase. The offsets are compact when
+** every stack holds at most 255 layers: a byte of layer count per stack
+** and the offset of every block of OC_SBLOCK stacks (1.25 bytes a stack);
+** otherwise one offset per stack (4 bytes). Edits decode stacks to
+** doubles, work there, and re-encode (rounding each thickness once).
 */
 #ifndef OC_LAYERS_H
 #define OC_LAYERS_H
@@ -21,10 +24,30 @@
 struct oc_stacks {
   int nx, ny;
   double cell, x0, y0, zbase;
-  uint32_t *off; /* nx ny + 1 */
-  uint32_t *lay; /* off[nx ny] packed layers (oc_lay_pack) */
-  size_t cap;    /* capacity of lay */
+  uint32_t *off;  /* nx ny + 1 offsets, or NULL when compact: */
+  uint8_t *cnt;   /* nx ny layer counts */
+  uint32_t *base; /* nx ny / OC_SBLOCK + 1 block offsets */
+  uint32_t *lay;  /* oc_soff(s, nx ny) packed layers (oc_lay_pack) */
+  size_t cap;     /* capacity of lay */
 };
+
+#define OC_SBLOCK 16
+
+/* The offset of stack k's first layer (k = nx ny: the layer count). */
+static inline size_t oc_soff(const oc_stacks *s, size_t k) {
+  if (s->off) return s->off[k];
+  size_t o = s->base[k / OC_SBLOCK];
+  for (size_t q = k - k % OC_SBLOCK; q < k; q++)
+    o += s->cnt[q];
+  return o;
+}
+/* The layer count of stack k. */
+static inline size_t oc_scount(const oc_stacks *s, size_t k) {
+  return s->off ? s->off[k + 1] - s->off[k] : s->cnt[k];
+}
+/* Full offsets (nx ny + 1, malloc'ed) made s's, compact when they can be
+** (then freed); s's old offsets are freed. */
+void oc_stacks_take_offsets(oc_stacks *s, uint32_t *off);
 
 /* A layer in 32 bits: the bits of its thickness as a float (>= 0, so the
 ** sign bit is free) moved up one bit, their two lowest mantissa bits

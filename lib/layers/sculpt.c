@@ -154,16 +154,16 @@ int oc_layers_rebuild_grid(oc_stacks *w, const oc_layers_edit *e,
                            oc_error *err) {
   size_t ns = (size_t)w->nx * w->ny, most = 0;
   for (size_t k = 0; k < ns; k++)
-    if (w->off[k + 1] - w->off[k] > most) most = w->off[k + 1] - w->off[k];
+    if (oc_scount(w, k) > most) most = oc_scount(w, k);
   oc_layer *in = malloc((most + 1) * sizeof *in);
   oc_layer *out = NULL;
   lbuf b = {NULL, 0, 0};
   oc_stacks_builder bd;
-  int rc = in ? oc_builder_init(&bd, ns, w->off[ns] + 64, err)
+  int rc = in ? oc_builder_init(&bd, ns, oc_soff(w, ns) + 64, err)
               : oc_seterr(err, OC_ENOMEM, "out of memory");
   for (size_t k = 0; k < ns && rc == OC_OK; k++) {
     size_t n0 = 0;
-    for (uint32_t q = w->off[k]; q < w->off[k + 1]; q++)
+    for (size_t q = oc_soff(w, k), qend = q + oc_scount(w, k); q < qend; q++)
       in[n0++] = (oc_layer){oc_lay_t(w->lay[q]), oc_lay_m(w->lay[q])};
     double px = w->x0 + (double)(k % w->nx) * w->cell;
     double py = w->y0 + (double)(k / w->nx) * w->cell, z0, z1;

@@ -49,7 +49,7 @@ oc_stacks *oc_stacks_alloc(int nx, int ny, double cell, double x0, double y0,
     oc_seterr(err, OC_ENOMEM, "out of memory");
     return NULL;
   }
-  *s = (oc_stacks){nx, ny, cell, x0, y0, zbase, NULL, NULL, 0};
+  *s = (oc_stacks){nx, ny, cell, x0, y0, zbase, NULL, NULL, NULL, NULL, 0};
   return s;
 }
 
@@ -57,18 +57,21 @@ oc_stacks *oc_stacks_new(int nx, int ny, double cell, double x0, double y0,
                          double zbase, oc_error *err) {
   oc_stacks *s = oc_stacks_alloc(nx, ny, cell, x0, y0, zbase, err);
   if (!s) return NULL;
-  s->off = calloc((size_t)nx * ny + 1, sizeof *s->off);
-  if (!s->off) {
+  uint32_t *off = calloc((size_t)nx * ny + 1, sizeof *off);
+  if (!off) {
     free(s);
     oc_seterr(err, OC_ENOMEM, "out of memory");
     return NULL;
   }
+  oc_stacks_take_offsets(s, off);
   return s;
 }
 
 void oc_stacks_free(oc_stacks *s) {
   if (!s) return;
   free(s->off);
+  free(s->cnt);
+  free(s->base);
   free(s->lay);
   free(s);
 }
@@ -128,10 +131,36 @@ int oc_builder_push(oc_stacks_builder *b, const oc_layer *l, size_t n,
   return OC_OK;
 }
 
-void oc_builder_commit(oc_stacks_builder *b, oc_stacks *s) {
+void oc_stacks_take_offsets(oc_stacks *s, uint32_t *off) {
+  size_t ns = (size_t)s->nx * s->ny, nb = ns / OC_SBLOCK + 1;
+  int narrow = 1;
+  for (size_t k = 0; k < ns && narrow; k++)
+    narrow = off[k + 1] - off[k] <= 255;
+  uint8_t *cnt = narrow ? malloc(ns) : NULL;
+  uint32_t *base = cnt ? malloc(nb * sizeof *base) : NULL;
   free(s->off);
+  free(s->cnt);
+  free(s->base);
+  s->off = NULL;
+  s->cnt = NULL;
+  s->base = NULL;
+  if (!base) { /* a stack too tall for a byte (or no memory): as given */
+    free(cnt);
+    s->off = off;
+    return;
+  }
+  for (size_t k = 0; k < ns; k++)
+    cnt[k] = (uint8_t)(off[k + 1] - off[k]);
+  for (size_t q = 0; q < nb; q++)
+    base[q] = off[q * OC_SBLOCK];
+  free(off);
+  s->cnt = cnt;
+  s->base = base;
+}
+
+void oc_builder_commit(oc_stacks_builder *b, oc_stacks *s) {
   free(s->lay);
-  s->off = b->off;
+  oc_stacks_take_offsets(s, b->off);
   s->lay = b->lay;
   s->cap = b->cap;
   memset(b, 0, sizeof *b);
@@ -207,7 +236,7 @@ int oc_stacks_set(oc_stacks *s, int i, int j, const uint8_t *mat,
     in[l] = (oc_layer){thick[l], mat[l]};
   size_t m = oc_layers_canon(in, n, out);
   size_t k = (size_t)j * s->nx + i, ns = (size_t)s->nx * s->ny;
-  size_t old = s->off[k + 1] - s->off[k], total = s->off[ns] - old + m;
+  size_t old = oc_scount(s, k), total = oc_soff(s, ns) - old + m;
   if (total > OC_STACKS_MAX_LAYERS) {
     free(in);
     return oc_seterr(err, OC_ENOMEM, "more than %llu layers",
@@ -223,13 +252,34 @@ int oc_stacks_set(oc_stacks *s, int i, int j, const uint8_t *mat,
     s->lay = t;
     s->cap = cap;
   }
-  size_t tail = s->off[ns] - s->off[k + 1];
-  memmove(s->lay + s->off[k] + m, s->lay + s->off[k + 1],
-          tail * sizeof *s->lay);
+  /* a count that no longer fits a byte: the offsets in full from now */
+  if (!s->off && m > 255) {
+    uint32_t *off = malloc((ns + 1) * sizeof *off);
+    if (!off) {
+      free(in);
+      return oc_seterr(err, OC_ENOMEM, "out of memory");
+    }
+    off[0] = 0;
+    for (size_t q = 0; q < ns; q++)
+      off[q + 1] = (uint32_t)(off[q] + s->cnt[q]);
+    free(s->cnt);
+    free(s->base);
+    s->cnt = NULL;
+    s->base = NULL;
+    s->off = off;
+  }
+  size_t at = oc_soff(s, k), tail = oc_soff(s, ns) - at - old;
+  memmove(s->lay + at + m, s->lay + at + old, tail * sizeof *s->lay);
   for (size_t l = 0; l < m; l++)
-    s->lay[s->off[k] + l] = oc_lay_pack(out[l].t, out[l].m);
-  for (size_t q = k + 1; q <= ns; q++)
-    s->off[q] = (uint32_t)(s->off[q] - old + m);
+    s->lay[at + l] = oc_lay_pack(out[l].t, out[l].m);
+  if (s->off) {
+    for (size_t q = k + 1; q <= ns; q++)
+      s->off[q] = (uint32_t)(s->off[q] - old + m);
+  } else {
+    s->cnt[k] = (uint8_t)m;
+    for (size_t q = k / OC_SBLOCK + 1; q <= ns / OC_SBLOCK; q++)
+      s->base[q] = (uint32_t)(s->base[q] - old + m);
+  }
   free(in);
   return OC_OK;
 }
@@ -237,10 +287,10 @@ int oc_stacks_set(oc_stacks *s, int i, int j, const uint8_t *mat,
 size_t oc_stacks_get(const oc_stacks *s, int i, int j, uint8_t *mat,
                      double *thick, size_t max) {
   if (i < 0 || i >= s->nx || j < 0 || j >= s->ny) return 0;
-  size_t k = (size_t)j * s->nx + i, n = s->off[k + 1] - s->off[k];
+  size_t k = (size_t)j * s->nx + i, n = oc_scount(s, k), o = oc_soff(s, k);
   for (size_t l = 0; l < n && l < max; l++) {
-    if (mat) mat[l] = (uint8_t)oc_lay_m(s->lay[s->off[k] + l]);
-    if (thick) thick[l] = oc_lay_t(s->lay[s->off[k] + l]);
+    if (mat) mat[l] = (uint8_t)oc_lay_m(s->lay[o + l]);
+    if (thick) thick[l] = oc_lay_t(s->lay[o + l]);
   }
   return n;
 }
@@ -250,13 +300,15 @@ size_t oc_stacks_get(const oc_stacks *s, int i, int j, uint8_t *mat,
 void oc_stacks_get_stats(const oc_stacks *s, oc_stacks_stats *st) {
   size_t ns = (size_t)s->nx * s->ny;
   st->stacks = ns;
-  st->layers = s->off[ns];
-  st->bytes =
-      sizeof *s + (ns + 1) * sizeof *s->off + s->off[ns] * sizeof *s->lay;
+  st->layers = oc_soff(s, ns);
+  st->bytes = sizeof *s +
+              (s->off ? (ns + 1) * sizeof *s->off
+                      : ns + (ns / OC_SBLOCK + 1) * sizeof *s->base) +
+              st->layers * sizeof *s->lay;
 }
 
 double oc_stacks_volume(const oc_stacks *s, int m) {
-  size_t n = s->off[(size_t)s->nx * s->ny];
+  size_t n = oc_soff(s, (size_t)s->nx * s->ny);
   double v = 0;
   for (size_t l = 0; l < n; l++)
     if (oc_lay_m(s->lay[l]) == m) v += oc_lay_t(s->lay[l]);
@@ -276,7 +328,7 @@ oc_heightfield *oc_stacks_heightfield(const oc_stacks *s, int m,
   size_t ns = (size_t)s->nx * s->ny;
   for (size_t k = 0; k < ns; k++) {
     double h = s->zbase, top = s->zbase;
-    for (uint32_t l = s->off[k]; l < s->off[k + 1]; l++) {
+    for (size_t l = oc_soff(s, k), lend = l + oc_scount(s, k); l < lend; l++) {
       h += oc_lay_t(s->lay[l]);
       if (oc_lay_m(s->lay[l]) == m) top = h;
     }

@@ -180,7 +180,7 @@ static int sweep_after(const void *ctx, double px, double py, double z,
 /* The top of the solid (bedrock, sand, rocks) of stack k. */
 static double solid_top(const oc_stacks *s, size_t k) {
   double z = s->zbase, top = s->zbase;
-  for (uint32_t l = s->off[k]; l < s->off[k + 1]; l++) {
+  for (size_t l = oc_soff(s, k), lend = l + oc_scount(s, k); l < lend; l++) {
     z += oc_lay_t(s->lay[l]);
     if (oc_lay_m(s->lay[l]) >= OC_MAT_SAND) top = z;
   }

@@ -22,25 +22,28 @@ oc_stacks *oc_stacks_window(const oc_stacks *s, int i0, int j0, int i1, int j1,
   if (!w) return NULL;
   size_t n = 0;
   for (int j = j0; j <= j1; j++)
-    n += s->off[(size_t)j * s->nx + i1 + 1] - s->off[(size_t)j * s->nx + i0];
-  w->off = malloc(((size_t)nx * ny + 1) * sizeof *w->off);
+    n += oc_soff(s, (size_t)j * s->nx + i1 + 1) -
+         oc_soff(s, (size_t)j * s->nx + i0);
+  uint32_t *off = malloc(((size_t)nx * ny + 1) * sizeof *off);
   w->lay = malloc((n ? n : 1) * sizeof *w->lay);
   w->cap = n ? n : 1;
-  if (!w->off || !w->lay) {
+  if (!off || !w->lay) {
+    free(off);
     oc_stacks_free(w);
     oc_seterr(err, OC_ENOMEM, "out of memory");
     return NULL;
   }
   size_t at = 0, k = 0;
-  w->off[0] = 0;
+  off[0] = 0;
   for (int j = j0; j <= j1; j++) {
     size_t a = (size_t)j * s->nx + i0;
-    uint32_t l0 = s->off[a], l1 = s->off[a + nx];
+    size_t l0 = oc_soff(s, a), l1 = oc_soff(s, a + nx);
     memcpy(w->lay + at, s->lay + l0, (l1 - l0) * sizeof *w->lay);
     for (int i = 0; i < nx; i++, k++)
-      w->off[k + 1] = (uint32_t)(at + s->off[a + i + 1] - l0);
+      off[k + 1] = (uint32_t)(off[k] + oc_scount(s, a + i));
     at += l1 - l0;
   }
+  oc_stacks_take_offsets(w, off);
   return w;
 }
 
@@ -48,9 +51,9 @@ int oc_stacks_splice(oc_stacks *s, const oc_stacks *w, int i0, int j0,
                      oc_error *err) {
   size_t ns = (size_t)s->nx * s->ny, old = 0;
   for (int j = j0; j < j0 + w->ny; j++)
-    old +=
-        s->off[(size_t)j * s->nx + i0 + w->nx] - s->off[(size_t)j * s->nx + i0];
-  size_t total = s->off[ns] - old + w->off[(size_t)w->nx * w->ny];
+    old += oc_soff(s, (size_t)j * s->nx + i0 + w->nx) -
+           oc_soff(s, (size_t)j * s->nx + i0);
+  size_t total = oc_soff(s, ns) - old + oc_soff(w, (size_t)w->nx * w->ny);
   if (total > OC_STACKS_MAX_LAYERS)
     return oc_seterr(err, OC_ENOMEM, "more than %llu layers",
                      (unsigned long long)OC_STACKS_MAX_LAYERS);
@@ -66,10 +69,10 @@ int oc_stacks_splice(oc_stacks *s, const oc_stacks *w, int i0, int j0,
   /* copies stacks [a, b) of g (whose offsets are go) to the end */
 #define RUN(g, a, b)                                                           \
   do {                                                                         \
-    uint32_t l0 = (g)->off[a], l1 = (g)->off[b];                               \
+    size_t l0 = oc_soff(g, a), l1 = oc_soff(g, b);                             \
     memcpy(lay + at, (g)->lay + l0, (l1 - l0) * sizeof *lay);                  \
-    for (size_t q = (a); q < (b); q++)                                         \
-      off[++k] = (uint32_t)(at + (g)->off[q + 1] - l0);                        \
+    for (size_t q = (a); q < (b); q++, k++)                                    \
+      off[k + 1] = (uint32_t)(off[k] + oc_scount(g, q));                       \
     at += l1 - l0;                                                             \
   } while (0)
   size_t k = 0;
@@ -83,9 +86,8 @@ int oc_stacks_splice(oc_stacks *s, const oc_stacks *w, int i0, int j0,
   }
   RUN(s, bot, ns);
 #undef RUN
-  free(s->off);
   free(s->lay);
-  s->off = off;
+  oc_stacks_take_offsets(s, off);
   s->lay = lay;
   s->cap = total ? total : 1;
   return OC_OK;
@@ -97,9 +99,10 @@ static int border_changed(const oc_stacks *a, const oc_stacks *b) {
     for (int i = 0; i < a->nx; i++) {
       if (j > 0 && j < a->ny - 1 && i > 0 && i < a->nx - 1) i = a->nx - 1;
       size_t k = (size_t)j * a->nx + i;
-      size_t n = a->off[k + 1] - a->off[k];
-      if (n != b->off[k + 1] - b->off[k] ||
-          memcmp(a->lay + a->off[k], b->lay + b->off[k], n * sizeof *a->lay))
+      size_t n = oc_scount(a, k);
+      if (n != oc_scount(b, k) ||
+          memcmp(a->lay + oc_soff(a, k), b->lay + oc_soff(b, k),
+                 n * sizeof *a->lay))
         return 1;
     }
   return 0;

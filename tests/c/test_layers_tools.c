@@ -437,6 +437,46 @@ START_TEST(texture_by_material) {
 }
 END_TEST
 
+/* ---- storage ---------------------------------------------------------------
+ */
+
+/* Offsets are a byte of layer count per stack and one offset per block of
+** 16 stacks (1.25 bytes a stack) until a stack holds more than 255 layers:
+** then one offset per stack. Both give the same layers back, and a set in
+** the middle moves every later stack's offset. */
+START_TEST(compact_offsets) {
+  oc_error err;
+  oc_stacks *s = slab(40, 1, 5); /* 1600 stacks of one layer */
+  oc_stacks_stats st;
+  oc_stacks_get_stats(s, &st);
+  ck_assert_uint_eq(st.bytes,
+                    sizeof(oc_stacks) + 1600 + (1600 / 16 + 1) * 4 + 1600 * 4);
+  uint8_t m[600];
+  double t[600];
+  for (int l = 0; l < 600; l++) {
+    m[l] = l % 2 ? OC_MAT_AIR : OC_MAT_BEDROCK;
+    t[l] = 0.25 + 0.001 * l;
+  }
+  ck_assert(oc_stacks_set(s, 3, 7, m, t, 5, &err) == OC_OK); /* 5 layers */
+  ck_assert_uint_eq(oc_soff(s, 7 * 40 + 4), 7 * 40 + 3 + 5);
+  ck_assert_uint_eq(oc_soff(s, 1600), 1604);
+  ck_assert(s->off == NULL);
+  ck_assert(oc_stacks_set(s, 3, 7, m, t, 599, &err) == OC_OK); /* 599 */
+  ck_assert(s->off != NULL);
+  oc_stacks_get_stats(s, &st);
+  ck_assert_uint_eq(st.layers, 1599 + 599);
+  ck_assert_uint_eq(st.bytes, sizeof(oc_stacks) + 1601 * 4 + st.layers * 4);
+  uint8_t gm[600];
+  double gt[600];
+  ck_assert_uint_eq(oc_stacks_get(s, 3, 7, gm, gt, 600), 599);
+  ck_assert_int_eq(gm[598], OC_MAT_BEDROCK);
+  ck_assert_double_eq_tol(gt[598], 0.25 + 0.598, 1e-6);
+  ck_assert_uint_eq(oc_stacks_get(s, 4, 7, gm, gt, 600), 1);
+  ck_assert_double_eq(gt[0], 5);
+  oc_stacks_free(s);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("layers_tools");
   TCase *tc = tcase_create("layers_tools");
@@ -449,6 +489,7 @@ int main(void) {
   tcase_add_test(tc, sweep_bend_mitred);
   tcase_add_test(tc, sweep_sand_threads_errors);
   tcase_add_test(tc, texture_by_material);
+  tcase_add_test(tc, compact_offsets);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }
