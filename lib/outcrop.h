@@ -300,6 +300,13 @@ int oc_mesh_set_colors(oc_mesh *mesh, const float *rgb, oc_error *err);
 ** sorted by value, linearly interpolated, clamped at the ends. */
 int oc_mesh_color_by_field(oc_mesh *mesh, const oc_program *field,
                            const double *stops, int n, oc_error *err);
+/* Colours blended by n weight programs, as a render's OC_COLOR_BLEND
+** (oc_render_params) with the vertex normals: texture amplitude in
+** [0, 1], texture_scale > 0 metres a period. Parallel, independent of
+** the thread count. */
+int oc_mesh_color_by_blend(oc_mesh *mesh, const oc_program *const *fields,
+                           const double *colors, int n, double texture,
+                           double texture_scale, oc_error *err);
 
 /* Connected components (triangles joined by shared edges and vertices):
 ** (*sizes)[i] is the vertex count of component i, components numbered in
@@ -470,7 +477,8 @@ typedef enum oc_render_tracer {
 
 typedef enum oc_render_color {
   OC_COLOR_RULES = 0, /* rock, grass, snow, sand by altitude and slope */
-  OC_COLOR_FIELD      /* a program (e.g. geology) through a palette */
+  OC_COLOR_FIELD,     /* a program (e.g. geology) through a palette */
+  OC_COLOR_BLEND      /* colours blended by weight programs (materials) */
 } oc_render_color;
 
 /* How linear colours become display values in 8/16-bit files (see
@@ -521,6 +529,16 @@ typedef struct oc_render_params {
   const double *stops;           /* OC_COLOR_FIELD: n stops (value, r, g, b),
                                  ** values ascending, components in [0, 1] */
   int nstops;                    /* 1 .. 256 */
+  /* OC_COLOR_BLEND (texturing by material, Peytavie et al. 2009 section
+  ** 6): nblend (1 .. 16) weight programs and colours (r, g, b in [0, 1]);
+  ** the albedo at p is sum w_i c_i k_i / sum w_i, w_i = max(f_i(p), 0)
+  ** (for material stacks, each material's convolution surface: its share
+  ** of the box around p), k_i the gain of material i's own triplanar
+  ** texture (weights |n_x|^8, |n_y|^8, |n_z|^8 for the planes orthogonal
+  ** to x, y, z; amplitude `texture`); c_0 where every weight is 0. */
+  const oc_program *const *blend_fields;
+  const double *blend_colors;
+  int nblend;
 
   double threshold;        /* iso-value; 0 means the program's T */
   double max_distance;     /* farthest hit, metres; 0: auto (the scene's
@@ -2135,8 +2153,10 @@ int oc_infile_sha256(const char *path, char *hex, oc_error *err);
 ** kept canonical: no empty layer, adjacent layers of one material merged,
 ** and between two bedrock layers (and below the first, above the last)
 ** sand, rocks, water, air upwards (the paper sorts sand, rocks, air;
-** water just below air is outcrop's choice). Thicknesses are stored as
-** floats: about 5 bytes per layer and 4 per stack.
+** water just below air is outcrop's choice). A layer is packed in 4
+** bytes (its thickness rounded to 21 bits of mantissa, a relative error
+** of at most 2^-22, and its material), plus 1.25 bytes a stack (4 once a
+** stack holds more than 255 layers).
 ** Mutable, with one owner: oc_stacks_new and the converters return a grid
 ** the caller frees with oc_stacks_free; edits are not thread-safe, the
 ** work inside them runs on both cores with results independent of the
@@ -2214,11 +2234,13 @@ oc_stacks *oc_stacks_from_heightfield(const oc_heightfield *hf,
 ** them), each layering the column [box.lo.z, box.hi.z] at every f = T
 ** crossing (material inside, air outside; found by sampling every
 ** `step` (default cell / 4 when 0) where the column spans say f may
-** vary, then bisection to 1e-6 cell). zbase = box.lo.z. */
+** vary, then bisection to 1e-6 cell). zbase = box.lo.z. Parallel by
+** rows; `progress` (may hold NULL) can cancel it: NULL with OC_ECANCEL. */
 typedef struct oc_stacks_node_params {
   oc_aabb box;
   double cell, step;
-  int material; /* OC_MAT_*, not air */
+  int material;         /* OC_MAT_*, not air */
+  oc_progress progress; /* may be {NULL, NULL} */
 } oc_stacks_node_params;
 oc_stacks *oc_stacks_from_program(const oc_program *prog,
                                   const oc_stacks_node_params *p,
@@ -2319,6 +2341,39 @@ typedef struct oc_sculpt_params {
 } oc_sculpt_params;
 int oc_stacks_sculpt(oc_stacks *s, const oc_sculpt_params *p, double *changed,
                      oc_stabilize_result *res, oc_error *err);
+
+/* Sweeping (section 4.2): a graph of `npoints` points joined by `nedges`
+** arcs (pairs of point indices from 0), each point carrying a profile: a
+** closed cross-section, the Catmull-Rom spline through its control
+** points (u, v) (u across the arc, to the right of travel; v along the
+** up vector; non-convex allowed). The profiles, interpolated along each
+** arc, sweep a volume V, with its arcs' ends (grouped by the points'
+** coordinates) cut square where an end is alone, mitred where two meet,
+** and where three or more meet (branches) the profile turned about the
+** up vector past them, closing the joint; bedrock inside V becomes air (the
+** difference), other materials stay and settle, and the stacks around
+** are stabilised. Cracks (tunnel = 0): points are projected on the top of
+** the solid (their z ignored) and the up vector is the surface normal
+** there; tunnels: points are used as given, up is the vertical. Profile
+** k is the pairs profile_off[k] .. profile_off[k + 1] - 1 of profile_uv
+** (3 .. 1024 points). *changed gets the bedrock volume added (negative),
+** m^3. */
+#define OC_SWEEP_MAX_POINTS 100000
+typedef struct oc_sweep_params {
+  const oc_vec3 *points;
+  const int *point_profile; /* per point: 0 .. nprofiles - 1 */
+  size_t npoints;
+  const int *edges; /* 2 nedges point indices */
+  size_t nedges;
+  const double *profile_uv;
+  const size_t *profile_off; /* nprofiles + 1 */
+  size_t nprofiles;
+  int tunnel;
+  int stabilize;
+  const oc_stabilize_params *stab; /* NULL: defaults */
+} oc_sweep_params;
+int oc_stacks_sweep(oc_stacks *s, const oc_sweep_params *p, double *changed,
+                    oc_stabilize_result *res, oc_error *err);
 
 #ifdef __cplusplus
 }

@@ -29,10 +29,20 @@
 **   s:sculpt{center = {x, y, z}, radius =, strength = 1, mode = "add" |
 **        "carve", delta = radius / 2, stabilize = true | false | {...}}
 **        -> bedrock volume added (negative: removed), {...}
+**   s:sweep{path = {{x, y [, z] [, profile = k]}, ...} or {branch, ...},
+**        profiles = {{u, v}, ...} or {{{u, v}, ...}, ...},
+**        mode = "crack" | "tunnel", stabilize = true | false | {...}}
+**        -> bedrock volume added (negative), {...}
+**   s:colors{sigma = 1 cell, sand = {r, g, b}, ...} -> {blend = {{node,
+**        {r, g, b}}, ...}}: each material present (bedrock first) with
+**        its convolution surface of half-side sigma (its share of the box
+**        around a point) and its colour, for render's `color =` and a
+**        mesh's `colors =` (texturing by material)
 **
 ** Stacks are mutable: a node made by s:field is a snapshot. `local s
 ** <close>` frees the grid early.
 */
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -41,6 +51,7 @@
 #include "l_handle.h"
 #include "l_heightfield.h"
 #include "l_layers.h"
+#include "l_progress.h"
 
 typedef struct oclua_layers {
   oclua_handle h; /* first: pins and closing (l_handle.h) */
@@ -213,7 +224,11 @@ static int l_from_node(lua_State *L) {
   const oc_program *prog = oclua_program(L, 1, fname);
   oclua_layers *u = newlayers(L);
   oc_error err = {OC_OK, ""};
-  return setlayers(L, u, oc_stacks_from_program(prog, &p, &err), &err, fname);
+  oclua_progress pl; /* the line on stderr and Ctrl-C */
+  p.progress = oclua_progress_start(L, &pl, fname);
+  oc_stacks *s = oc_stacks_from_program(prog, &p, &err);
+  oclua_progress_end(&pl);
+  return setlayers(L, u, s, &err, fname);
 }
 
 /* ---- methods ------------------------------------------------------------- */
@@ -550,6 +565,220 @@ static int m_sculpt(lua_State *L) {
   return 2;
 }
 
+/* One path point {x, y [, z] [, profile = k]} at the top of the stack into
+** pt and its profile index (from 0); `label` names it in messages. */
+static void read_point(lua_State *L, const char *fname, const char *label,
+                       lua_Integer b, lua_Integer i, int tunnel, oc_vec3 *pt,
+                       int *prof) {
+  int n = lua_istable(L, -1) ? (int)lua_rawlen(L, -1) : 0;
+  double v[3] = {0, 0, 0};
+  int ok = n == 2 + tunnel || (!tunnel && n == 3);
+  for (int k = 1; ok && k <= n; k++) {
+    lua_rawgeti(L, -1, k);
+    ok = lua_type(L, -1) == LUA_TNUMBER && isfinite(lua_tonumber(L, -1));
+    v[k - 1] = lua_tonumber(L, -1);
+    lua_pop(L, 1);
+  }
+  if (!ok) {
+    const char *want = tunnel ? "{x, y, z}" : "{x, y}";
+    if (b)
+      oclua_error(L, fname, "'%s[%I][%I]' must be %s with finite numbers",
+                  label, b, i, want);
+    oclua_error(L, fname, "'%s[%I]' must be %s with finite numbers", label, i,
+                want);
+  }
+  *pt = (oc_vec3){v[0], v[1], v[2]};
+  lua_pushliteral(L, "profile");
+  lua_rawget(L, -2);
+  *prof = 0;
+  if (!lua_isnil(L, -1)) {
+    int isint;
+    lua_Integer k = lua_tointegerx(L, -1, &isint);
+    if (!isint || k < 1 || k > INT_MAX)
+      oclua_error(L, fname,
+                  "'profile' of a '%s' point must be an integer >= 1 "
+                  "(got %s)",
+                  label, oclua_got(L, -1));
+    *prof = (int)(k - 1);
+  }
+  lua_pop(L, 1);
+}
+
+static int m_sweep(lua_State *L) {
+  static const char *const known[] = {"path", "profiles", "mode", "stabilize",
+                                      NULL};
+  static const char *const modes[] = {"crack", "tunnel", NULL};
+  const char *fname = "layers:sweep";
+  oclua_checkargs(L, 2, fname, "({path=, profiles=, mode=, stabilize=})");
+  oc_stacks *s = pinlayers(L, 1, fname);
+  oclua_fields f;
+  oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
+  oc_stabilize_params sp;
+  oc_stabilize_defaults(s, &sp);
+  oc_sweep_params p;
+  memset(&p, 0, sizeof p);
+  p.tunnel = oclua_field_optoption(&f, "mode", modes, 0);
+  p.stab = &sp;
+  p.stabilize = read_stab_option(&f, &sp);
+  /* path: one polyline, or branches (polylines sharing points) */
+  if (oclua_field_push(&f, "path") != LUA_TTABLE)
+    oclua_field_error(&f, "path", -1,
+                      "must be an array of points or of arrays of points");
+  int path = lua_gettop(L);
+  lua_Integer nb = (lua_Integer)lua_rawlen(L, path);
+  lua_rawgeti(L, path, 1);
+  int branches = 0;
+  if (lua_istable(L, -1)) {
+    lua_rawgeti(L, -1, 1);
+    branches = lua_istable(L, -1);
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+  if (nb < 1 || nb > OC_SWEEP_MAX_POINTS)
+    oclua_error(L, fname, "'path' must hold 1 .. %d entries (got %I)",
+                OC_SWEEP_MAX_POINTS, nb);
+  size_t np = 0;
+  for (lua_Integer b = 1; branches && b <= nb; b++) {
+    lua_rawgeti(L, path, b);
+    lua_Integer n = lua_istable(L, -1) ? (lua_Integer)lua_rawlen(L, -1) : 0;
+    if (n < 2)
+      oclua_error(L, fname, "'path[%I]' must be an array of 2 or more points",
+                  b);
+    np += (size_t)n;
+    lua_pop(L, 1);
+    if (np > OC_SWEEP_MAX_POINTS)
+      oclua_error(L, fname, "'path' must hold at most %d points",
+                  OC_SWEEP_MAX_POINTS);
+  }
+  if (!branches) np = (size_t)nb;
+  if (np < 2) oclua_error(L, fname, "'path' must hold 2 or more points");
+  oc_vec3 *pts = lua_newuserdatauv(L, np * sizeof *pts, 0);
+  int *prof = lua_newuserdatauv(L, np * sizeof *prof, 0);
+  int *edges = lua_newuserdatauv(L, 2 * np * sizeof *edges, 0);
+  size_t k = 0, ne = 0;
+  for (lua_Integer b = 1; b <= (branches ? nb : 1); b++) {
+    if (branches) lua_rawgeti(L, path, b);
+    int line = branches ? lua_gettop(L) : path;
+    lua_Integer n = (lua_Integer)lua_rawlen(L, line);
+    for (lua_Integer i = 1; i <= n; i++, k++) {
+      lua_rawgeti(L, line, i);
+      read_point(L, fname, "path", branches ? b : 0, i, p.tunnel, &pts[k],
+                 &prof[k]);
+      lua_pop(L, 1);
+      if (i > 1) {
+        edges[2 * ne] = (int)k - 1;
+        edges[2 * ne + 1] = (int)k;
+        ne++;
+      }
+    }
+    if (branches) lua_pop(L, 1);
+  }
+  /* profiles: one closed curve of {u, v}, or an array of them */
+  if (oclua_field_push(&f, "profiles") != LUA_TTABLE)
+    oclua_field_error(&f, "profiles", -1,
+                      "must be a closed curve {{u, v}, ...} or an array of "
+                      "them");
+  int pidx = lua_gettop(L);
+  lua_rawgeti(L, pidx, 1);
+  int many = 0;
+  if (lua_istable(L, -1)) {
+    lua_rawgeti(L, -1, 1);
+    many = lua_istable(L, -1);
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+  lua_Integer nprof = many ? (lua_Integer)lua_rawlen(L, pidx) : 1;
+  if (nprof < 1 || nprof > 4096)
+    oclua_error(L, fname, "'profiles' must hold 1 .. 4096 curves (got %I)",
+                nprof);
+  size_t *off = lua_newuserdatauv(L, ((size_t)nprof + 1) * sizeof *off, 0);
+  off[0] = 0;
+  int first = lua_gettop(L) + 1;
+  for (lua_Integer q = 1; q <= nprof; q++) {
+    if (many) lua_rawgeti(L, pidx, q);
+    size_t n;
+    char label[32];
+    snprintf(label, sizeof label, "profiles[%d]", (int)q);
+    oclua_read_xy(L, many ? lua_gettop(L) : pidx, fname, label, 3, 1024, &n);
+    if (many) lua_remove(L, -2);
+    off[q] = off[q - 1] + n;
+  }
+  double *uv = lua_newuserdatauv(L, 2 * off[nprof] * sizeof *uv + 1, 0);
+  for (lua_Integer q = 1; q <= nprof; q++)
+    memcpy(uv + 2 * off[q - 1], lua_touserdata(L, first + (int)q - 1),
+           2 * (off[q] - off[q - 1]) * sizeof *uv);
+  p.points = pts;
+  p.point_profile = prof;
+  p.npoints = np;
+  p.edges = edges;
+  p.nedges = ne;
+  p.profile_uv = uv;
+  p.profile_off = off;
+  p.nprofiles = (size_t)nprof;
+  oc_error err = {OC_OK, ""};
+  oc_stabilize_result res;
+  double changed;
+  if (oc_stacks_sweep(s, &p, &changed, &res, &err))
+    oclua_liberror(L, fname, &err);
+  lua_pushnumber(L, changed);
+  push_result(L, &res);
+  return 2;
+}
+
+/* Linear albedos of the materials (air: none), as the renderer's rule
+** colours for sand and rock. */
+static const double MAT_RGB[OC_MAT_COUNT][3] = {{0, 0, 0},
+                                                {0.05, 0.12, 0.18},
+                                                {0.50, 0.42, 0.28},
+                                                {0.12, 0.11, 0.10},
+                                                {0.22, 0.18, 0.15}};
+
+static int m_colors(lua_State *L) {
+  static const char *const known[] = {"sigma", "water",   "sand",
+                                      "rocks", "bedrock", NULL};
+  const char *fname = "layers:colors";
+  oclua_checkargs(L, 2, fname, "([{sigma=, water=, sand=, rocks=, bedrock=}])");
+  lua_settop(L, 2);
+  oc_stacks *s = pinlayers(L, 1, fname);
+  double sigma = oc_stacks_cell(s), rgb[OC_MAT_COUNT][3];
+  memcpy(rgb, MAT_RGB, sizeof rgb);
+  if (!lua_isnil(L, 2)) {
+    oclua_fields f;
+    oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
+    sigma = oclua_field_optnumber(&f, "sigma", OCLUA_POSITIVE, sigma);
+    for (int m = OC_MAT_WATER; m < OC_MAT_COUNT; m++) {
+      const char *name = oc_material_name(m);
+      if (!oclua_field_numbers(&f, name, 3, rgb[m], "must be {r, g, b}"))
+        continue;
+      for (int c = 0; c < 3; c++)
+        if (!(rgb[m][c] >= 0 && rgb[m][c] <= 1))
+          oclua_error(L, fname, "'%s' must be {r, g, b} in [0, 1]", name);
+    }
+  }
+  /* {blend = {{field of m, {r, g, b}}, ...}} for the materials present */
+  lua_createtable(L, 0, 1);
+  lua_createtable(L, OC_MAT_COUNT, 0);
+  int n = 0;
+  for (int m = OC_MAT_COUNT - 1; m > OC_MAT_AIR; m--) {
+    if (!(oc_stacks_volume(s, m) > 0)) continue;
+    lua_createtable(L, 2, 0);
+    oclua_node *u = oclua_newnode(L);
+    oc_error err = {OC_OK, ""};
+    oclua_setnode(L, u, oc_stacks_field(s, 1u << m, sigma, &err), &err, fname);
+    lua_rawseti(L, -2, 1);
+    lua_createtable(L, 3, 0);
+    for (int c = 0; c < 3; c++) {
+      lua_pushnumber(L, rgb[m][c]);
+      lua_rawseti(L, -2, c + 1);
+    }
+    lua_rawseti(L, -2, 2);
+    lua_rawseti(L, -2, ++n);
+  }
+  if (n == 0) oclua_error(L, fname, "the stacks hold no material");
+  lua_setfield(L, -2, "blend");
+  return 1;
+}
+
 /* ---- metamethods ------------------------------------------------------- */
 
 static int m_gc(lua_State *L) {
@@ -587,6 +816,8 @@ static const luaL_Reg methods[] = {{"get", m_get},
                                    {"deposit", m_deposit},
                                    {"erode", m_erode},
                                    {"sculpt", m_sculpt},
+                                   {"sweep", m_sweep},
+                                   {"colors", m_colors},
                                    {NULL, NULL}};
 
 static const luaL_Reg meta[] = {{"__gc", m_gc},

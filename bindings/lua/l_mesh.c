@@ -19,8 +19,11 @@
 **   {field = node, palette = {{value, {r, g, b}}, ...}}
 ** (the node evaluated at each vertex with outcrop.threshold, mapped
 ** through the palette: values ascending, linear between stops, clamped
-** at the ends) or a function (x, y, z, nx, ny, nz) -> r, g, b called
-** once per vertex in index order. Components are linear, in [0, 1].
+** at the ends), {blend = {{node, {r, g, b}}, ...}, texture = 0.3,
+** texture_scale = 8} (colours blended by the nodes' values with a
+** triplanar texture each: texturing by material, e.g. stacks:colors())
+** or a function (x, y, z, nx, ny, nz) -> r, g, b called once per vertex
+** in index order. Components are linear, in [0, 1].
 **
 ** Every write carries the provenance images get (l_provenance.h).
 */
@@ -33,6 +36,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "l_blend.h"
 #include "l_field.h"
 #include "l_mesh.h"
 #include "l_progress.h"
@@ -67,7 +71,7 @@ static oclua_mesh *checkmesh(lua_State *L, const char *fname, int pin) {
 
 /* ---- colours --------------------------------------------------------- */
 
-enum { COLORS_NONE, COLORS_FUNCTION, COLORS_FIELD };
+enum { COLORS_NONE, COLORS_FUNCTION, COLORS_FIELD, COLORS_BLEND };
 
 /* What a `colors` field asked for. Everything it points to stays on the
 ** Lua stack (the function or node at `idx`, the stops in a userdata)
@@ -77,6 +81,9 @@ typedef struct colors {
   int idx;
   const double *stops; /* value, r, g, b per stop */
   int nstops;
+  const double *blend; /* COLORS_BLEND: r, g, b per node of the table at idx */
+  int nblend;
+  double texture, texture_scale;
 } colors;
 
 static const char *const rgb_names[3] = {"r", "g", "b"};
@@ -92,7 +99,8 @@ static void read_palette(const oclua_fields *cf, colors *c) {
 /* Reads the optional `colors` field of f, leaving what it needs on the
 ** stack. */
 static void read_colors(const oclua_fields *f, colors *c) {
-  static const char *const known[] = {"field", "palette", NULL};
+  static const char *const known[] = {"field",   "palette",       "blend",
+                                      "texture", "texture_scale", NULL};
   lua_State *L = f->L;
   oclua_fields cf;
   int t = oclua_field_push(f, "colors");
@@ -110,6 +118,24 @@ static void read_colors(const oclua_fields *f, colors *c) {
     oclua_field_error(f, "colors", -1,
                       "must be a function or a table {field =, palette =}");
   oclua_fields_open(&cf, L, -1, f->fname, "colors.", known, 0);
+  if (oclua_field_push(&cf, "blend") != LUA_TNIL) { /* by material */
+    c->kind = COLORS_BLEND;
+    c->idx = lua_gettop(L);
+    c->nblend =
+        oclua_read_blend(L, c->idx, f->fname, "colors.blend", &c->blend);
+    c->texture = oclua_field_optnumber(&cf, "texture", OCLUA_FINITE, 0.3);
+    if (!(c->texture >= 0 && c->texture <= 1))
+      oclua_error(L, f->fname, "'colors.texture' must be in [0, 1] (got %f)",
+                  (LUAI_UACNUMBER)c->texture);
+    c->texture_scale =
+        oclua_field_optnumber(&cf, "texture_scale", OCLUA_POSITIVE, 8);
+    return;
+  }
+  lua_pop(L, 1);
+  if (oclua_field_push(&cf, "texture") != LUA_TNIL ||
+      oclua_field_push(&cf, "texture_scale") != LUA_TNIL)
+    oclua_error(L, f->fname, "'colors.texture' goes with 'colors.blend'");
+  lua_pop(L, 2);
   if (oclua_field_push(&cf, "field") == LUA_TNIL)
     oclua_field_missing(&cf, "field", "an outcrop node");
   if (oclua_testnode(L, -1) == NULL)
@@ -169,6 +195,12 @@ static void apply_colors(lua_State *L, oclua_mesh *u, const colors *c,
     if (oc_mesh_color_by_field(u->mesh, prog, c->stops, c->nstops, &err) !=
         OC_OK)
       oclua_liberror(L, fname, &err);
+  } else if (c->kind == COLORS_BLEND) {
+    const oc_program *const *p = oclua_blend_programs(
+        L, c->idx, c->nblend, fname, oclua_threshold(L, fname));
+    if (oc_mesh_color_by_blend(u->mesh, p, c->blend, c->nblend, c->texture,
+                               c->texture_scale, &err) != OC_OK)
+      oclua_liberror(L, fname, &err);
   }
 }
 
@@ -179,7 +211,7 @@ static int mesh_write(lua_State *L) {
   const char *fname = "mesh:write";
   checkmesh(L, fname, 0);
   oc_error err = {OC_OK, ""};
-  colors c = {COLORS_NONE, 0, NULL, 0};
+  colors c = {COLORS_NONE, 0, NULL, 0, NULL, 0, 0, 0};
   if (lua_type(L, 2) != LUA_TSTRING)
     oclua_error(L, fname, "the path must be a string (got %s)",
                 oclua_got(L, 2));

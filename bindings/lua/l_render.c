@@ -25,7 +25,10 @@
 ** node mapped through `palette` (the lib's oc_palette_strata by default,
 ** strata colours for resistances in [0, 1]), {field = node, palette = ...} as
 *polygonize
-** takes it, or a function (x, y, z, nx, ny, nz) -> r, g, b called once
+** takes it, {blend = {{node, {r, g, b}}, ...}} (colours blended by the
+** nodes' values, each with its own triplanar texture: texturing by
+** material, e.g. stacks:colors()), or a function (x, y, z, nx, ny, nz) ->
+** r, g, b called once
 ** per pixel that hits the surface, row by row from the top left, between
 ** the lib's two passes (geometry, then shading). Colours are linear RGB.
 */
@@ -37,6 +40,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "l_blend.h"
 #include "l_elevation.h"
 #include "l_field.h"
 #include "l_heightfield.h"
@@ -244,7 +248,7 @@ static void read_rules(const oclua_fields *f, oc_render_params *rp) {
   close_sub(L);
 }
 
-enum { SRC_RULES, SRC_FIELD, SRC_FUNCTION };
+enum { SRC_RULES, SRC_FIELD, SRC_FUNCTION, SRC_BLEND };
 
 /* What `color` asked for; the node or function stays on the stack at idx
 ** (and the stops in a userdata) until the image is made. */
@@ -255,7 +259,7 @@ typedef struct source {
 
 static void read_color(const oclua_fields *f, oc_render_params *rp,
                        source *src) {
-  static const char *const known[] = {"field", "palette", NULL};
+  static const char *const known[] = {"field", "palette", "blend", NULL};
   lua_State *L = f->L;
   int t = oclua_field_push(f, "color");
   int has_palette = oclua_field_push(f, "palette") != LUA_TNIL;
@@ -293,6 +297,20 @@ static void read_color(const oclua_fields *f, oc_render_params *rp,
   if (t == LUA_TTABLE) { /* {field =, palette =}, as polygonize's colors */
     oclua_fields c;
     oclua_fields_open(&c, L, -1, f->fname, "color.", known, 0);
+    if (oclua_field_push(&c, "blend") != LUA_TNIL) { /* by material */
+      src->kind = SRC_BLEND;
+      src->idx = lua_gettop(L);
+      rp->color = OC_COLOR_BLEND;
+      rp->nblend = oclua_read_blend(L, src->idx, FNAME, "color.blend",
+                                    &rp->blend_colors);
+      if (oclua_field_push(&c, "field") != LUA_TNIL ||
+          oclua_field_push(&c, "palette") != LUA_TNIL)
+        oclua_error(L, f->fname,
+                    "'color.blend' cannot go with 'field' or 'palette'");
+      lua_pop(L, 2);
+      return;
+    }
+    lua_pop(L, 1);
     if (oclua_field_push(&c, "field") == LUA_TNIL)
       oclua_field_missing(&c, "field", "an outcrop node");
     if (oclua_testnode(L, -1) == NULL)
@@ -540,11 +558,14 @@ static int stats_of(const oc_image *geo, const oc_image *img,
 
 static int l_render(lua_State *L) {
   static const char *const known[] = {
-      "camera",    "size",         "sun",     "sky",           "shadows",
-      "ao",        "ao_distance",  "fog",     "color",         "palette",
-      "rules",     "background",   "texture", "texture_scale", "aov",
-      "threshold", "max_distance", "tracer",  "exposure",      "tone",
-      "lod",       NULL};
+      "camera",      "size",          "sun",
+      "sky",         "shadows",       "ao",
+      "ao_distance", "fog",           "color",
+      "palette",     "rules",         "background",
+      "texture",     "texture_scale", "aov",
+      "threshold",   "max_distance",  "tracer",
+      "exposure",    "tone",          "lod",
+      NULL};
   static const char *const tracers[] = {"segment", "sphere", NULL};
   static const char *const tones[] = {"clamp", "filmic", NULL};
   oclua_fields f;
@@ -614,8 +635,8 @@ static int l_render(lua_State *L) {
   const oc_esurface *es = NULL;
   if (elev) {
     es = surface_at(L, 1, t);
-    if (oc_render_frame_box(surface_bounds(es), &rp, ci.has_eye,
-                            ci.has_target, &err))
+    if (oc_render_frame_box(surface_bounds(es), &rp, ci.has_eye, ci.has_target,
+                            &err))
       oclua_liberror(L, FNAME, &err);
   } else {
     prog = oclua_program_at(L, 1, FNAME, t);
@@ -628,6 +649,8 @@ static int l_render(lua_State *L) {
   ** function runs between the lib's passes). */
   if (src.kind == SRC_FIELD)
     rp.color_field = oclua_program_at(L, src.idx, FNAME, t);
+  if (src.kind == SRC_BLEND)
+    rp.blend_fields = oclua_blend_programs(L, src.idx, rp.nblend, FNAME, t);
   if (prog ? oc_render_check(prog, &rp, &err)
            : oc_render_check_surface(es, &rp, &err) ||
                  oc_render_check_shade(&rp, &err))

@@ -69,9 +69,9 @@ size_t oc_layers_segments(const oc_stacks *s, size_t k, oc_lseg *out) {
   double z = s->zbase;
   oc_lseg *c = &out[0];
   *c = (oc_lseg){z, 0, 0, {0, 0, 0}};
-  for (uint32_t l = s->off[k]; l < s->off[k + 1]; l++) {
-    double t = s->thick[l];
-    int m = s->mat[l];
+  for (size_t l = oc_soff(s, k), lend = l + oc_scount(s, k); l < lend; l++) {
+    double t = oc_lay_t(s->lay[l]);
+    int m = oc_lay_m(s->lay[l]);
     if (m == OC_MAT_BEDROCK) {
       c->cap = z - c->floor;
       z += t;
@@ -121,8 +121,8 @@ int oc_layers_decode_all(const oc_stacks *s, oc_lseg **seg, size_t **soff,
   o[0] = 0;
   for (size_t k = 0; k < ns; k++) {
     size_t nb = 0;
-    for (uint32_t l = s->off[k]; l < s->off[k + 1]; l++)
-      nb += s->mat[l] == OC_MAT_BEDROCK;
+    for (size_t l = oc_soff(s, k), lend = l + oc_scount(s, k); l < lend; l++)
+      nb += oc_lay_m(s->lay[l]) == OC_MAT_BEDROCK;
     o[k + 1] = o[k] + nb + 1;
   }
   oc_lseg *g = malloc(o[ns] * sizeof *g);
@@ -145,7 +145,7 @@ int oc_layers_encode_all(oc_stacks *s, const oc_lseg *seg, const size_t *soff,
     if (soff[k + 1] - soff[k] > most) most = soff[k + 1] - soff[k];
   oc_layer *buf = malloc(10 * most * sizeof *buf);
   oc_stacks_builder b;
-  if (!buf || oc_builder_init(&b, ns, s->off[ns] + ns / 4, err)) {
+  if (!buf || oc_builder_init(&b, ns, oc_soff(s, ns) + ns / 4, err)) {
     free(buf);
     return buf ? OC_ENOMEM : oc_seterr(err, OC_ENOMEM, "out of memory");
   }

@@ -5,6 +5,7 @@
 ** tree become air layers). Peytavie et al. 2009, sections 3.2 and 7.
 */
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 
 #include "core/error.h"
@@ -181,18 +182,40 @@ oc_stacks *oc_stacks_from_program(const oc_program *P,
       oc_stacks_alloc(nx, ny, p->cell, b->lo.x, b->lo.y, b->lo.z, err);
   if (!s) return NULL;
   row *rows = calloc((size_t)ny, sizeof *rows);
-  int fail = !rows;
+  int fail = !rows, stop = 0, done = 0;
   for (int j = 0; j < ny && !fail; j++)
     fail = !(rows[j].count = malloc((size_t)nx * sizeof *rows[j].count));
+  oc_progress pr = p->progress;
 #pragma omp parallel for schedule(dynamic, 1) if (!fail)
   for (int j = 0; j < ny; j++) {
-    if (fail) continue;
+    int halt;
+#pragma omp atomic read
+    halt = stop;
+    if (fail || halt) continue;
     row *r = &rows[j];
     for (int i = 0; i < nx; i++) {
       size_t n0 = r->n;
       column(P, p, b->lo.x + i * p->cell, b->lo.y + j * p->cell, r);
       r->count[i] = (uint32_t)(r->n - n0);
     }
+    int d;
+#pragma omp atomic capture
+    d = ++done;
+    /* the callback from one thread only (oc_progress's contract) */
+    if (pr.fn && omp_get_thread_num() == 0 && pr.fn(pr.ud, 0.99 * d / ny)) {
+#pragma omp atomic write
+      stop = 1;
+    }
+  }
+  if (!fail && (stop || (pr.fn && pr.fn(pr.ud, 1.0)))) {
+    for (int j = 0; j < ny; j++) {
+      free(rows[j].l);
+      free(rows[j].count);
+    }
+    free(rows);
+    oc_stacks_free(s);
+    oc_seterr(err, OC_ECANCEL, "from_node cancelled");
+    return NULL;
   }
   size_t total = 0;
   for (int j = 0; rows && j < ny; j++) {

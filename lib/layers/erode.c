@@ -50,18 +50,18 @@ int oc_stacks_erode(oc_stacks *s, const oc_stacks_erode_params *p,
   if (!w) return OC_ENOMEM;
   size_t ns = (size_t)w->nx * w->ny, most = 0;
   for (size_t k = 0; k < ns; k++)
-    if (w->off[k + 1] - w->off[k] > most) most = w->off[k + 1] - w->off[k];
+    if (oc_scount(w, k) > most) most = oc_scount(w, k);
   /* each bedrock layer may gain 2 debris layers */
   oc_layer *l = malloc((3 * most + 3) * 2 * sizeof *l);
   oc_stacks_builder b;
-  int rc = l ? oc_builder_init(&b, ns, w->off[ns] + ns, err)
+  int rc = l ? oc_builder_init(&b, ns, oc_soff(w, ns) + ns, err)
              : oc_seterr(err, OC_ENOMEM, "out of memory");
   double vol = 0;
   for (size_t k = 0; k < ns && rc == OC_OK; k++) {
     oc_layer *out = l + 3 * most + 3;
     size_t n = 0;
-    for (uint32_t q = w->off[k]; q < w->off[k + 1]; q++)
-      l[n++] = (oc_layer){w->thick[q], w->mat[q]};
+    for (size_t q = oc_soff(w, k), qend = q + oc_scount(w, k); q < qend; q++)
+      l[n++] = (oc_layer){oc_lay_t(w->lay[q]), oc_lay_m(w->lay[q])};
     if (p->mode == OC_STACKS_ERODE_SURFACE) {
       for (size_t q = n; q-- > 0;)
         if (l[q].m == OC_MAT_BEDROCK) {

@@ -5,27 +5,71 @@
 ** stabilisation and the tools edit.
 **
 ** Storage: compressed rows. Stack k = j nx + i holds layers
-** off[k] .. off[k + 1] - 1 of two parallel arrays, a float thickness and
-** a material byte (5 bytes a layer, 4 a stack), bottom-up from zbase.
-** Edits decode stacks to doubles, work there, and re-encode (rounding
-** each thickness to a float once).
+** oc_soff(s, k) .. oc_soff(s, k + 1) - 1 of one array of packed layers
+** (4 bytes a layer), bottom-up from zbase. The offsets are compact when
+** every stack holds at most 255 layers: a byte of layer count per stack
+** and the offset of every block of OC_SBLOCK stacks (1.25 bytes a stack);
+** otherwise one offset per stack (4 bytes). Edits decode stacks to
+** doubles, work there, and re-encode (rounding each thickness once).
 */
 #ifndef OC_LAYERS_H
 #define OC_LAYERS_H
 
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "outcrop.h"
 
 struct oc_stacks {
   int nx, ny;
   double cell, x0, y0, zbase;
-  uint32_t *off; /* nx ny + 1 */
-  float *thick;  /* off[nx ny] layers */
-  uint8_t *mat;
-  size_t cap; /* capacity of thick and mat */
+  uint32_t *off;  /* nx ny + 1 offsets, or NULL when compact: */
+  uint8_t *cnt;   /* nx ny layer counts */
+  uint32_t *base; /* nx ny / OC_SBLOCK + 1 block offsets */
+  uint32_t *lay;  /* oc_soff(s, nx ny) packed layers (oc_lay_pack) */
+  size_t cap;     /* capacity of lay */
 };
+
+#define OC_SBLOCK 16
+
+/* The offset of stack k's first layer (k = nx ny: the layer count). */
+static inline size_t oc_soff(const oc_stacks *s, size_t k) {
+  if (s->off) return s->off[k];
+  size_t o = s->base[k / OC_SBLOCK];
+  for (size_t q = k - k % OC_SBLOCK; q < k; q++)
+    o += s->cnt[q];
+  return o;
+}
+/* The layer count of stack k. */
+static inline size_t oc_scount(const oc_stacks *s, size_t k) {
+  return s->off ? s->off[k + 1] - s->off[k] : s->cnt[k];
+}
+/* Full offsets (nx ny + 1, malloc'ed) made s's, compact when they can be
+** (then freed); s's old offsets are freed. */
+void oc_stacks_take_offsets(oc_stacks *s, uint32_t *off);
+
+/* A layer in 32 bits: the bits of its thickness as a float (>= 0, so the
+** sign bit is free) moved up one bit, their two lowest mantissa bits
+** dropped (rounded to nearest: 21 bits of mantissa, a relative error of
+** at most 2^-22), and the material in the lowest 3 bits. */
+static inline uint32_t oc_lay_pack(double t, int m) {
+  float f = (float)t;
+  uint32_t b, r;
+  memcpy(&b, &f, sizeof b);
+  r = (b + 2u) & ~3u;
+  if ((r & 0x7f800000u) == 0x7f800000u) r = b & ~3u; /* no carry to inf */
+  return r << 1 | (uint32_t)m;
+}
+static inline double oc_lay_t(uint32_t w) {
+  uint32_t b = (w >> 1) & ~3u;
+  float f;
+  memcpy(&f, &b, sizeof f);
+  return f;
+}
+static inline int oc_lay_m(uint32_t w) {
+  return (int)(w & 7u);
+}
 
 /* One layer while being edited. */
 typedef struct oc_layer {
@@ -61,8 +105,7 @@ size_t oc_layers_from_segments(const oc_lseg *seg, size_t nseg, oc_layer *out);
 /* A grid being rebuilt stack by stack, in order (k = 0, 1, ...). */
 typedef struct oc_stacks_builder {
   uint32_t *off;
-  float *thick;
-  uint8_t *mat;
+  uint32_t *lay;
   size_t n, cap, nstacks, k;
 } oc_stacks_builder;
 int oc_builder_init(oc_stacks_builder *b, size_t nstacks, size_t cap,
@@ -106,5 +149,23 @@ int oc_layers_decode_all(const oc_stacks *s, oc_lseg **seg, size_t **soff,
 /* Segments back into s's storage. */
 int oc_layers_encode_all(oc_stacks *s, const oc_lseg *seg, const size_t *soff,
                          oc_error *err);
+
+/* The stacks of w rebuilt where an edit changes them (sculpt.c, used by
+** sweep.c): `window` says whether the stack centred on (px, py) may
+** change and over which [z0, z1]; `after` gives the material at
+** (px, py, z) after the edit, m0 the one before. Inside the window the
+** column is sampled every `step` and each change refined by bisection;
+** outside it the layers stay. Loose material that new bedrock took goes
+** back on top of it; stacks are made canonical. */
+typedef int (*oc_layers_after_fn)(const void *ctx, double px, double py,
+                                  double z, int m0);
+typedef struct oc_layers_edit {
+  int (*window)(void *ctx, double px, double py, double *z0, double *z1);
+  oc_layers_after_fn after;
+  void *ctx;
+  double step;
+} oc_layers_edit;
+int oc_layers_rebuild_grid(oc_stacks *w, const oc_layers_edit *e,
+                           oc_error *err);
 
 #endif

@@ -254,7 +254,7 @@ oc_node *oc_stacks_field(const oc_stacks *s, unsigned mask, double sigma,
   }
   if (isnan(sigma)) sigma = s->cell;
   if (!oc_check_positive(sigma, "sigma", err)) return NULL;
-  size_t ns = (size_t)s->nx * s->ny, nl = s->off[ns];
+  size_t ns = (size_t)s->nx * s->ny, nl = oc_soff(s, ns);
   lfield *d = calloc(1, sizeof *d);
   if (d) {
     d->off = malloc((ns + 1) * sizeof *d->off);
@@ -277,9 +277,9 @@ oc_node *oc_stacks_field(const oc_stacks *s, unsigned mask, double sigma,
   for (size_t k = 0; k < ns; k++) {
     d->off[k] = n;
     double z = s->zbase, below_z = 0;
-    for (uint32_t l = s->off[k]; l < s->off[k + 1]; l++) {
-      double t = s->thick[l], z1 = z + t;
-      if (mask & 1u << s->mat[l]) {
+    for (size_t l = oc_soff(s, k), lend = l + oc_scount(s, k); l < lend; l++) {
+      double t = oc_lay_t(s->lay[l]), z1 = z + t;
+      if (mask & 1u << oc_lay_m(s->lay[l])) {
         if (n > d->off[k] && d->iv[3 * (n - 1) + 1] == z) {
           d->iv[3 * (n - 1) + 1] = z1; /* continues the interval */
         } else {

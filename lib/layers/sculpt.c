@@ -77,10 +77,15 @@ static int push(lbuf *b, double t, int m) {
   return 0;
 }
 
-/* Rebuilds one stack's layers in into b: unchanged outside [z0, z1]. */
-static int rebuild(const sctx *x, double px, double py, const oc_layer *in,
-                   size_t n, double zbase, double z0, double z1, double step,
-                   lbuf *b) {
+static int sculpt_after(const void *x, double px, double py, double z, int m0) {
+  return after(x, px, py, z, m0);
+}
+
+/* Rebuilds one stack's layers in into b: unchanged outside [z0, z1]
+** (see oc_layers_rebuild_grid). */
+static int rebuild(oc_layers_after_fn after, const void *x, double px,
+                   double py, const oc_layer *in, size_t n, double zbase,
+                   double z0, double z1, double step, lbuf *b) {
   b->n = 0;
   double z = zbase;
   int fail = 0;
@@ -145,6 +150,60 @@ static int rebuild(const sctx *x, double px, double py, const oc_layer *in,
   return fail;
 }
 
+int oc_layers_rebuild_grid(oc_stacks *w, const oc_layers_edit *e,
+                           oc_error *err) {
+  size_t ns = (size_t)w->nx * w->ny, most = 0;
+  for (size_t k = 0; k < ns; k++)
+    if (oc_scount(w, k) > most) most = oc_scount(w, k);
+  oc_layer *in = malloc((most + 1) * sizeof *in);
+  oc_layer *out = NULL;
+  lbuf b = {NULL, 0, 0};
+  oc_stacks_builder bd;
+  int rc = in ? oc_builder_init(&bd, ns, oc_soff(w, ns) + 64, err)
+              : oc_seterr(err, OC_ENOMEM, "out of memory");
+  for (size_t k = 0; k < ns && rc == OC_OK; k++) {
+    size_t n0 = 0;
+    for (size_t q = oc_soff(w, k), qend = q + oc_scount(w, k); q < qend; q++)
+      in[n0++] = (oc_layer){oc_lay_t(w->lay[q]), oc_lay_m(w->lay[q])};
+    double px = w->x0 + (double)(k % w->nx) * w->cell;
+    double py = w->y0 + (double)(k / w->nx) * w->cell, z0, z1;
+    if (!e->window(e->ctx, px, py, &z0, &z1)) {
+      rc = oc_builder_push(&bd, in, n0, err);
+      continue;
+    }
+    if (rebuild(e->after, e->ctx, px, py, in, n0, w->zbase, z0, z1, e->step,
+                &b)) {
+      rc = oc_seterr(err, OC_ENOMEM, "out of memory");
+      break;
+    }
+    oc_layer *o = realloc(out, (b.n + 1) * sizeof *o);
+    if (!o) {
+      rc = oc_seterr(err, OC_ENOMEM, "out of memory");
+      break;
+    }
+    out = o;
+    rc = oc_builder_push(&bd, out, oc_layers_canon(b.l, b.n, out), err);
+  }
+  if (rc == OC_OK)
+    oc_builder_commit(&bd, w);
+  else if (in)
+    oc_builder_free(&bd);
+  free(in);
+  free(out);
+  free(b.l);
+  return rc;
+}
+
+/* The stacks within R of the kernel's centre, over [c'.z - R, c'.z + R]. */
+static int sculpt_window(void *ctx, double px, double py, double *z0,
+                         double *z1) {
+  const sctx *x = ctx;
+  double dx = px - x->c.x, dy = py - x->c.y;
+  *z0 = x->c.z - x->R;
+  *z1 = x->c.z + x->R;
+  return dx * dx + dy * dy < x->R * x->R;
+}
+
 int oc_stacks_sculpt(oc_stacks *s, const oc_sculpt_params *p, double *changed,
                      oc_stabilize_result *res, oc_error *err) {
   if (changed) *changed = 0;
@@ -200,46 +259,8 @@ int oc_stacks_sculpt(oc_stacks *s, const oc_sculpt_params *p, double *changed,
   double i1 = fmin(floor((x.c.x + R - s->x0) / c), s->nx - 1);
   double j0 = fmax(ceil((x.c.y - R - s->y0) / c), 0);
   double j1 = fmin(floor((x.c.y + R - s->y0) / c), s->ny - 1);
-  size_t ns = (size_t)w->nx * w->ny, most = 0;
-  for (size_t k = 0; k < ns; k++)
-    if (w->off[k + 1] - w->off[k] > most) most = w->off[k + 1] - w->off[k];
-  oc_layer *in = malloc((most + 1) * sizeof *in);
-  oc_layer *out = NULL;
-  lbuf b = {NULL, 0, 0};
-  oc_stacks_builder bd;
-  int rc = in ? oc_builder_init(&bd, ns, w->off[ns] + 64, err)
-              : oc_seterr(err, OC_ENOMEM, "out of memory");
-  for (size_t k = 0; k < ns && rc == OC_OK; k++) {
-    size_t n0 = 0;
-    for (uint32_t q = w->off[k]; q < w->off[k + 1]; q++)
-      in[n0++] = (oc_layer){w->thick[q], w->mat[q]};
-    double px = w->x0 + (double)(k % w->nx) * c;
-    double py = w->y0 + (double)(k / w->nx) * c;
-    double dx = px - x.c.x, dy = py - x.c.y;
-    if (dx * dx + dy * dy >= R * R) {
-      rc = oc_builder_push(&bd, in, n0, err);
-      continue;
-    }
-    if (rebuild(&x, px, py, in, n0, s->zbase, x.c.z - R, x.c.z + R, c / 8,
-                &b)) {
-      rc = oc_seterr(err, OC_ENOMEM, "out of memory");
-      break;
-    }
-    oc_layer *o = realloc(out, (b.n + 1) * sizeof *o);
-    if (!o) {
-      rc = oc_seterr(err, OC_ENOMEM, "out of memory");
-      break;
-    }
-    out = o;
-    rc = oc_builder_push(&bd, out, oc_layers_canon(b.l, b.n, out), err);
-  }
-  if (rc == OC_OK)
-    oc_builder_commit(&bd, w);
-  else if (in)
-    oc_builder_free(&bd);
-  free(in);
-  free(out);
-  free(b.l);
+  oc_layers_edit ed = {sculpt_window, sculpt_after, &x, c / 8};
+  int rc = oc_layers_rebuild_grid(w, &ed, err);
   oc_program_free(P);
   double after = oc_stacks_volume(w, OC_MAT_BEDROCK);
   if (rc == OC_OK) rc = oc_stacks_splice(s, w, wi0, wj0, err);

@@ -49,7 +49,7 @@ oc_stacks *oc_stacks_alloc(int nx, int ny, double cell, double x0, double y0,
     oc_seterr(err, OC_ENOMEM, "out of memory");
     return NULL;
   }
-  *s = (oc_stacks){nx, ny, cell, x0, y0, zbase, NULL, NULL, NULL, 0};
+  *s = (oc_stacks){nx, ny, cell, x0, y0, zbase, NULL, NULL, NULL, NULL, 0};
   return s;
 }
 
@@ -57,20 +57,22 @@ oc_stacks *oc_stacks_new(int nx, int ny, double cell, double x0, double y0,
                          double zbase, oc_error *err) {
   oc_stacks *s = oc_stacks_alloc(nx, ny, cell, x0, y0, zbase, err);
   if (!s) return NULL;
-  s->off = calloc((size_t)nx * ny + 1, sizeof *s->off);
-  if (!s->off) {
+  uint32_t *off = calloc((size_t)nx * ny + 1, sizeof *off);
+  if (!off) {
     free(s);
     oc_seterr(err, OC_ENOMEM, "out of memory");
     return NULL;
   }
+  oc_stacks_take_offsets(s, off);
   return s;
 }
 
 void oc_stacks_free(oc_stacks *s) {
   if (!s) return;
   free(s->off);
-  free(s->thick);
-  free(s->mat);
+  free(s->cnt);
+  free(s->base);
+  free(s->lay);
   free(s);
 }
 
@@ -99,9 +101,8 @@ int oc_builder_init(oc_stacks_builder *b, size_t nstacks, size_t cap,
   b->nstacks = nstacks;
   b->cap = cap < 16 ? 16 : cap;
   b->off = malloc((nstacks + 1) * sizeof *b->off);
-  b->thick = malloc(b->cap * sizeof *b->thick);
-  b->mat = malloc(b->cap);
-  if (!b->off || !b->thick || !b->mat) {
+  b->lay = malloc(b->cap * sizeof *b->lay);
+  if (!b->off || !b->lay) {
     oc_builder_free(b);
     return oc_seterr(err, OC_ENOMEM, "out of memory");
   }
@@ -118,37 +119,56 @@ int oc_builder_push(oc_stacks_builder *b, const oc_layer *l, size_t n,
     size_t cap = b->cap;
     while (cap < b->n + n)
       cap += cap / 2;
-    float *t = realloc(b->thick, cap * sizeof *t);
-    if (t) b->thick = t;
-    uint8_t *m = t ? realloc(b->mat, cap) : NULL;
-    if (m) b->mat = m;
-    if (!t || !m) return oc_seterr(err, OC_ENOMEM, "out of memory");
+    uint32_t *t = realloc(b->lay, cap * sizeof *t);
+    if (!t) return oc_seterr(err, OC_ENOMEM, "out of memory");
+    b->lay = t;
     b->cap = cap;
   }
-  for (size_t i = 0; i < n; i++) {
-    b->thick[b->n + i] = (float)l[i].t;
-    b->mat[b->n + i] = (uint8_t)l[i].m;
-  }
+  for (size_t i = 0; i < n; i++)
+    b->lay[b->n + i] = oc_lay_pack(l[i].t, l[i].m);
   b->n += n;
   b->off[++b->k] = (uint32_t)b->n;
   return OC_OK;
 }
 
-void oc_builder_commit(oc_stacks_builder *b, oc_stacks *s) {
+void oc_stacks_take_offsets(oc_stacks *s, uint32_t *off) {
+  size_t ns = (size_t)s->nx * s->ny, nb = ns / OC_SBLOCK + 1;
+  int narrow = 1;
+  for (size_t k = 0; k < ns && narrow; k++)
+    narrow = off[k + 1] - off[k] <= 255;
+  uint8_t *cnt = narrow ? malloc(ns) : NULL;
+  uint32_t *base = cnt ? malloc(nb * sizeof *base) : NULL;
   free(s->off);
-  free(s->thick);
-  free(s->mat);
-  s->off = b->off;
-  s->thick = b->thick;
-  s->mat = b->mat;
+  free(s->cnt);
+  free(s->base);
+  s->off = NULL;
+  s->cnt = NULL;
+  s->base = NULL;
+  if (!base) { /* a stack too tall for a byte (or no memory): as given */
+    free(cnt);
+    s->off = off;
+    return;
+  }
+  for (size_t k = 0; k < ns; k++)
+    cnt[k] = (uint8_t)(off[k + 1] - off[k]);
+  for (size_t q = 0; q < nb; q++)
+    base[q] = off[q * OC_SBLOCK];
+  free(off);
+  s->cnt = cnt;
+  s->base = base;
+}
+
+void oc_builder_commit(oc_stacks_builder *b, oc_stacks *s) {
+  free(s->lay);
+  oc_stacks_take_offsets(s, b->off);
+  s->lay = b->lay;
   s->cap = b->cap;
   memset(b, 0, sizeof *b);
 }
 
 void oc_builder_free(oc_stacks_builder *b) {
   free(b->off);
-  free(b->thick);
-  free(b->mat);
+  free(b->lay);
   memset(b, 0, sizeof *b);
 }
 
@@ -216,7 +236,7 @@ int oc_stacks_set(oc_stacks *s, int i, int j, const uint8_t *mat,
     in[l] = (oc_layer){thick[l], mat[l]};
   size_t m = oc_layers_canon(in, n, out);
   size_t k = (size_t)j * s->nx + i, ns = (size_t)s->nx * s->ny;
-  size_t old = s->off[k + 1] - s->off[k], total = s->off[ns] - old + m;
+  size_t old = oc_scount(s, k), total = oc_soff(s, ns) - old + m;
   if (total > OC_STACKS_MAX_LAYERS) {
     free(in);
     return oc_seterr(err, OC_ENOMEM, "more than %llu layers",
@@ -224,26 +244,42 @@ int oc_stacks_set(oc_stacks *s, int i, int j, const uint8_t *mat,
   }
   if (total > s->cap) {
     size_t cap = total + total / 2 + 16;
-    float *t = realloc(s->thick, cap * sizeof *t);
-    if (t) s->thick = t;
-    uint8_t *mm = t ? realloc(s->mat, cap) : NULL;
-    if (mm) s->mat = mm;
-    if (!t || !mm) {
+    uint32_t *t = realloc(s->lay, cap * sizeof *t);
+    if (!t) {
       free(in);
       return oc_seterr(err, OC_ENOMEM, "out of memory");
     }
+    s->lay = t;
     s->cap = cap;
   }
-  size_t tail = s->off[ns] - s->off[k + 1];
-  memmove(s->thick + s->off[k] + m, s->thick + s->off[k + 1],
-          tail * sizeof *s->thick);
-  memmove(s->mat + s->off[k] + m, s->mat + s->off[k + 1], tail);
-  for (size_t l = 0; l < m; l++) {
-    s->thick[s->off[k] + l] = (float)out[l].t;
-    s->mat[s->off[k] + l] = (uint8_t)out[l].m;
+  /* a count that no longer fits a byte: the offsets in full from now */
+  if (!s->off && m > 255) {
+    uint32_t *off = malloc((ns + 1) * sizeof *off);
+    if (!off) {
+      free(in);
+      return oc_seterr(err, OC_ENOMEM, "out of memory");
+    }
+    off[0] = 0;
+    for (size_t q = 0; q < ns; q++)
+      off[q + 1] = (uint32_t)(off[q] + s->cnt[q]);
+    free(s->cnt);
+    free(s->base);
+    s->cnt = NULL;
+    s->base = NULL;
+    s->off = off;
   }
-  for (size_t q = k + 1; q <= ns; q++)
-    s->off[q] = (uint32_t)(s->off[q] - old + m);
+  size_t at = oc_soff(s, k), tail = oc_soff(s, ns) - at - old;
+  memmove(s->lay + at + m, s->lay + at + old, tail * sizeof *s->lay);
+  for (size_t l = 0; l < m; l++)
+    s->lay[at + l] = oc_lay_pack(out[l].t, out[l].m);
+  if (s->off) {
+    for (size_t q = k + 1; q <= ns; q++)
+      s->off[q] = (uint32_t)(s->off[q] - old + m);
+  } else {
+    s->cnt[k] = (uint8_t)m;
+    for (size_t q = k / OC_SBLOCK + 1; q <= ns / OC_SBLOCK; q++)
+      s->base[q] = (uint32_t)(s->base[q] - old + m);
+  }
   free(in);
   return OC_OK;
 }
@@ -251,10 +287,10 @@ int oc_stacks_set(oc_stacks *s, int i, int j, const uint8_t *mat,
 size_t oc_stacks_get(const oc_stacks *s, int i, int j, uint8_t *mat,
                      double *thick, size_t max) {
   if (i < 0 || i >= s->nx || j < 0 || j >= s->ny) return 0;
-  size_t k = (size_t)j * s->nx + i, n = s->off[k + 1] - s->off[k];
+  size_t k = (size_t)j * s->nx + i, n = oc_scount(s, k), o = oc_soff(s, k);
   for (size_t l = 0; l < n && l < max; l++) {
-    if (mat) mat[l] = s->mat[s->off[k] + l];
-    if (thick) thick[l] = s->thick[s->off[k] + l];
+    if (mat) mat[l] = (uint8_t)oc_lay_m(s->lay[o + l]);
+    if (thick) thick[l] = oc_lay_t(s->lay[o + l]);
   }
   return n;
 }
@@ -264,16 +300,18 @@ size_t oc_stacks_get(const oc_stacks *s, int i, int j, uint8_t *mat,
 void oc_stacks_get_stats(const oc_stacks *s, oc_stacks_stats *st) {
   size_t ns = (size_t)s->nx * s->ny;
   st->stacks = ns;
-  st->layers = s->off[ns];
-  st->bytes = sizeof *s + (ns + 1) * sizeof *s->off +
-              s->off[ns] * (sizeof *s->thick + sizeof *s->mat);
+  st->layers = oc_soff(s, ns);
+  st->bytes = sizeof *s +
+              (s->off ? (ns + 1) * sizeof *s->off
+                      : ns + (ns / OC_SBLOCK + 1) * sizeof *s->base) +
+              st->layers * sizeof *s->lay;
 }
 
 double oc_stacks_volume(const oc_stacks *s, int m) {
-  size_t n = s->off[(size_t)s->nx * s->ny];
+  size_t n = oc_soff(s, (size_t)s->nx * s->ny);
   double v = 0;
   for (size_t l = 0; l < n; l++)
-    if (s->mat[l] == m) v += s->thick[l];
+    if (oc_lay_m(s->lay[l]) == m) v += oc_lay_t(s->lay[l]);
   return v * s->cell * s->cell;
 }
 
@@ -290,9 +328,9 @@ oc_heightfield *oc_stacks_heightfield(const oc_stacks *s, int m,
   size_t ns = (size_t)s->nx * s->ny;
   for (size_t k = 0; k < ns; k++) {
     double h = s->zbase, top = s->zbase;
-    for (uint32_t l = s->off[k]; l < s->off[k + 1]; l++) {
-      h += s->thick[l];
-      if (s->mat[l] == m) top = h;
+    for (size_t l = oc_soff(s, k), lend = l + oc_scount(s, k); l < lend; l++) {
+      h += oc_lay_t(s->lay[l]);
+      if (oc_lay_m(s->lay[l]) == m) top = h;
     }
     z[k] = (float)top;
   }

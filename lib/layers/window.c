@@ -22,27 +22,28 @@ oc_stacks *oc_stacks_window(const oc_stacks *s, int i0, int j0, int i1, int j1,
   if (!w) return NULL;
   size_t n = 0;
   for (int j = j0; j <= j1; j++)
-    n += s->off[(size_t)j * s->nx + i1 + 1] - s->off[(size_t)j * s->nx + i0];
-  w->off = malloc(((size_t)nx * ny + 1) * sizeof *w->off);
-  w->thick = malloc((n ? n : 1) * sizeof *w->thick);
-  w->mat = malloc(n ? n : 1);
+    n += oc_soff(s, (size_t)j * s->nx + i1 + 1) -
+         oc_soff(s, (size_t)j * s->nx + i0);
+  uint32_t *off = malloc(((size_t)nx * ny + 1) * sizeof *off);
+  w->lay = malloc((n ? n : 1) * sizeof *w->lay);
   w->cap = n ? n : 1;
-  if (!w->off || !w->thick || !w->mat) {
+  if (!off || !w->lay) {
+    free(off);
     oc_stacks_free(w);
     oc_seterr(err, OC_ENOMEM, "out of memory");
     return NULL;
   }
   size_t at = 0, k = 0;
-  w->off[0] = 0;
+  off[0] = 0;
   for (int j = j0; j <= j1; j++) {
     size_t a = (size_t)j * s->nx + i0;
-    uint32_t l0 = s->off[a], l1 = s->off[a + nx];
-    memcpy(w->thick + at, s->thick + l0, (l1 - l0) * sizeof *w->thick);
-    memcpy(w->mat + at, s->mat + l0, l1 - l0);
+    size_t l0 = oc_soff(s, a), l1 = oc_soff(s, a + nx);
+    memcpy(w->lay + at, s->lay + l0, (l1 - l0) * sizeof *w->lay);
     for (int i = 0; i < nx; i++, k++)
-      w->off[k + 1] = (uint32_t)(at + s->off[a + i + 1] - l0);
+      off[k + 1] = (uint32_t)(off[k] + oc_scount(s, a + i));
     at += l1 - l0;
   }
+  oc_stacks_take_offsets(w, off);
   return w;
 }
 
@@ -50,19 +51,17 @@ int oc_stacks_splice(oc_stacks *s, const oc_stacks *w, int i0, int j0,
                      oc_error *err) {
   size_t ns = (size_t)s->nx * s->ny, old = 0;
   for (int j = j0; j < j0 + w->ny; j++)
-    old +=
-        s->off[(size_t)j * s->nx + i0 + w->nx] - s->off[(size_t)j * s->nx + i0];
-  size_t total = s->off[ns] - old + w->off[(size_t)w->nx * w->ny];
+    old += oc_soff(s, (size_t)j * s->nx + i0 + w->nx) -
+           oc_soff(s, (size_t)j * s->nx + i0);
+  size_t total = oc_soff(s, ns) - old + oc_soff(w, (size_t)w->nx * w->ny);
   if (total > OC_STACKS_MAX_LAYERS)
     return oc_seterr(err, OC_ENOMEM, "more than %llu layers",
                      (unsigned long long)OC_STACKS_MAX_LAYERS);
   uint32_t *off = malloc((ns + 1) * sizeof *off);
-  float *thick = malloc((total ? total : 1) * sizeof *thick);
-  uint8_t *mat = malloc(total ? total : 1);
-  if (!off || !thick || !mat) {
+  uint32_t *lay = malloc((total ? total : 1) * sizeof *lay);
+  if (!off || !lay) {
     free(off);
-    free(thick);
-    free(mat);
+    free(lay);
     return oc_seterr(err, OC_ENOMEM, "out of memory");
   }
   size_t at = 0;
@@ -70,11 +69,10 @@ int oc_stacks_splice(oc_stacks *s, const oc_stacks *w, int i0, int j0,
   /* copies stacks [a, b) of g (whose offsets are go) to the end */
 #define RUN(g, a, b)                                                           \
   do {                                                                         \
-    uint32_t l0 = (g)->off[a], l1 = (g)->off[b];                               \
-    memcpy(thick + at, (g)->thick + l0, (l1 - l0) * sizeof *thick);            \
-    memcpy(mat + at, (g)->mat + l0, l1 - l0);                                  \
-    for (size_t q = (a); q < (b); q++)                                         \
-      off[++k] = (uint32_t)(at + (g)->off[q + 1] - l0);                        \
+    size_t l0 = oc_soff(g, a), l1 = oc_soff(g, b);                             \
+    memcpy(lay + at, (g)->lay + l0, (l1 - l0) * sizeof *lay);                  \
+    for (size_t q = (a); q < (b); q++, k++)                                    \
+      off[k + 1] = (uint32_t)(off[k] + oc_scount(g, q));                       \
     at += l1 - l0;                                                             \
   } while (0)
   size_t k = 0;
@@ -88,12 +86,9 @@ int oc_stacks_splice(oc_stacks *s, const oc_stacks *w, int i0, int j0,
   }
   RUN(s, bot, ns);
 #undef RUN
-  free(s->off);
-  free(s->thick);
-  free(s->mat);
-  s->off = off;
-  s->thick = thick;
-  s->mat = mat;
+  free(s->lay);
+  oc_stacks_take_offsets(s, off);
+  s->lay = lay;
   s->cap = total ? total : 1;
   return OC_OK;
 }
@@ -104,11 +99,10 @@ static int border_changed(const oc_stacks *a, const oc_stacks *b) {
     for (int i = 0; i < a->nx; i++) {
       if (j > 0 && j < a->ny - 1 && i > 0 && i < a->nx - 1) i = a->nx - 1;
       size_t k = (size_t)j * a->nx + i;
-      size_t n = a->off[k + 1] - a->off[k];
-      if (n != b->off[k + 1] - b->off[k] ||
-          memcmp(a->thick + a->off[k], b->thick + b->off[k],
-                 n * sizeof *a->thick) ||
-          memcmp(a->mat + a->off[k], b->mat + b->off[k], n))
+      size_t n = oc_scount(a, k);
+      if (n != oc_scount(b, k) ||
+          memcmp(a->lay + oc_soff(a, k), b->lay + oc_soff(b, k),
+                 n * sizeof *a->lay))
         return 1;
     }
   return 0;

@@ -1,15 +1,15 @@
 /*
 ** color.c — surface albedo for the renderer: the rule palette (sand,
 ** grass, rock, snow by altitude and slope), a field (e.g. a geology
-** tree's resistance) through a palette of stops, and the triplanar
-** texture variation of Peytavie et al. 2009, section 6 that every source
-** receives.
+** tree's resistance) through a palette of stops, colours blended by
+** weights (materials, triplanar.c), and the triplanar texture variation
+** of Peytavie et al. 2009, section 6 that every other source receives.
 */
 #include <math.h>
 
 #include "core/palette.h"
-#include "core/noise.h"
 #include "render/shade.h"
+#include "render/triplanar.h"
 
 /* Linear-RGB albedos (measured-ish reflectances of dry materials). */
 static const double ROCK[3] = {0.22, 0.18, 0.15};
@@ -57,36 +57,20 @@ void oc_albedo(const oc_shader *sh, oc_vec3 p, oc_vec3 n, double rgb[3],
     double v = oc_program_eval(rp->color_field, p);
     *evals += 1;
     oc_palette_eval(rp->stops, rp->nstops, v, rgb);
+  } else if (rp->color == OC_COLOR_BLEND) {
+    oc_blend_albedo(rp->blend_fields, rp->blend_colors, rp->nblend, rp->texture,
+                    1 / sh->tex_scale, p, n, rgb, evals);
   } else {
     rules(sh, p, n, rgb);
   }
 }
 
-/* A 2D texture in [0, 1]: two octaves of simplex noise, stretched along
-** u so that steep faces show horizontal bands like strata. */
-static double tex2(double u, double v, uint64_t plane) {
-  oc_vec3 q = {u * 0.35, v * 2.0, 0.5};
-  return oc_turb3(0x7e57u + plane, 3, q, NULL) / oc_turb3_max(3);
-}
-
 void oc_texture(const oc_shader *sh, oc_vec3 p, oc_vec3 n, double rgb[3]) {
   double amp = sh->rp->texture;
-  if (!(amp > 0)) return;
-  double s = 1 / sh->tex_scale;
-  double ax = fabs(n.x), ay = fabs(n.y), az = fabs(n.z);
-  /* weights |n_i|^8, normalised (p = 8 as in the paper) */
-  double wx = ax * ax, wy = ay * ay, wz = az * az;
-  wx *= wx, wy *= wy, wz *= wz;
-  wx *= wx, wy *= wy, wz *= wz;
-  double sum = wx + wy + wz;
-  if (!(sum > 0)) return;
-  /* the projection along x sees (y, z), and so on */
-  double t = (wx * tex2(p.y * s, p.z * s, 0) + wy * tex2(p.x * s, p.z * s, 1) +
-              wz * tex2(p.x * s, p.y * s, 2)) /
-             sum;
-  double steep = 0.35 + 0.65 * (1 - az);
-  double k = 1 + amp * steep * 2 * (t - 0.5);
-  if (k < 0) k = 0;
+  if (!(amp > 0) || sh->rp->color == OC_COLOR_BLEND) return;
+  double t = oc_triplanar(p, n, 1 / sh->tex_scale, 0);
+  if (t != t) return;
+  double k = oc_triplanar_gain(t, amp, n.z);
   for (int c = 0; c < 3; c++)
     rgb[c] *= k;
 }

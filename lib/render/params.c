@@ -9,6 +9,7 @@
 #include "core/vec.h"
 #include "render/etrace.h"
 #include "render/render.h"
+#include "render/triplanar.h"
 
 void oc_render_defaults(oc_render_params *rp) {
   static const oc_render_params d = {
@@ -222,6 +223,8 @@ int oc_render_check_shade(const oc_render_params *rp, oc_error *err) {
       return oc_seterr(err, OC_EINVAL, "'color' field program is NULL");
     return check_stops(rp->stops, rp->nstops, err);
   }
+  if (rp->color == OC_COLOR_BLEND)
+    return oc_blend_check(rp->blend_fields, rp->blend_colors, rp->nblend, err);
   return oc_seterr(err, OC_EINVAL, "'color' source is unknown (%d)",
                    (int)rp->color);
 }
