@@ -2250,10 +2250,11 @@ oc_node *oc_stacks_field(const oc_stacks *s, unsigned mask, double sigma,
 ** in the neighbour's segment holding elevation h, t_i = cell tan(alpha)
 ** (sides) or cell sqrt(2) tan(alpha) (diagonals); the total moved is
 ** rate * max dh~_i capped by the material present, and each transfer by
-** an eighth of the air of the receiving segment. Coarse levels first
-** (neighbours 8, 4 and 2 stacks away down a slope, thresholds and
-** tolerance times the stride) bring a large pile near rest in few
-** passes; the last level (the 8 neighbours) decides it. Double-buffered: the
+** an eighth of the air of the receiving segment. For a large pile,
+** coarse levels first (neighbours k = 8, 4, 2 stacks away down a slope,
+** thresholds and tolerance times k; the first k from the extent of the
+** unstable stacks) bring it near rest in few passes; the last level (the
+** 8 neighbours) decides it. Double-buffered: the
 ** result does not depend on the thread count. Volume is conserved to
 ** rounding. */
 typedef struct oc_stabilize_params {
