@@ -45,8 +45,8 @@
 #define KEY_CONTACT 0x636f6e74616374ull
 #define ROCKS_MAX 20000 /* sites at most */
 #define CAND_MAX 400    /* candidate planes of a cell at most */
-#define RING_R 6        /* rings around a contact, at spread/3 .. 2 spread */
-#define RING_A 12       /* points on a ring */
+#define RING_R 4        /* rings around a contact, out to 2 spread */
+#define RING_A 8        /* points on a ring */
 
 /* ---- Voronoi cells --------------------------------------------------- */
 
@@ -327,7 +327,7 @@ static int rock_make(const rcell *cells, const double *sites, size_t i,
       const double *cq = ct + 3 * (k * nc + q);
       for (int ri = 0; ri <= RING_R; ri++)
         for (int ai = 0; ai < (ri ? RING_A : 1); ai++) {
-          double d = sp * ri / 3.0, th = 6.283185307179586 * ai / RING_A;
+          double d = 2 * sp * ri / RING_R, th = 6.283185307179586 * ai / RING_A;
           double x[3];
           for (int a = 0; a < 3; a++)
             x[a] = cq[a] + d * (cos(th) * u[a] + sin(th) * w[a]);
