@@ -39,7 +39,6 @@
 #include "blocks/btile.h"
 #include "core/error.h"
 #include "core/rng.h"
-#include "layers/layers.h"
 
 #define KEY_SITES 0x726f636b73ull
 #define KEY_CONTACT 0x636f6e74616374ull
@@ -504,29 +503,51 @@ double oc_rocks_reach(const oc_btile *t) {
 
 typedef struct presence {
   const oc_stacks *s;
-  double depth;
+  double depth, x0, y0, cell, base;
+  int nx, ny;
+  size_t cap; /* of the scratch layers below */
+  uint8_t *mat;
+  double *thick;
+  int nomem;
 } presence;
+
+/* Stack (i, j)'s layers into q's scratch (grown as needed; the public
+** reader, so the storage may change); the count, or 0 out of memory. */
+static size_t layers_of(presence *q, int i, int j) {
+  size_t n = oc_stacks_get(q->s, i, j, q->mat, q->thick, q->cap);
+  if (n > q->cap) {
+    uint8_t *m = realloc(q->mat, n);
+    double *t = m ? realloc(q->thick, n * sizeof *t) : NULL;
+    if (m) q->mat = m;
+    if (!t) {
+      q->nomem = 1;
+      return 0;
+    }
+    q->thick = t;
+    q->cap = n;
+    oc_stacks_get(q->s, i, j, q->mat, q->thick, q->cap);
+  }
+  return n;
+}
 
 /* 1 when p lies in a rocks layer at most depth below the top of the
 ** solid above it (rocks, then any loose material or bedrock on it). */
 static int present(void *ctx, oc_vec3 p) {
-  const presence *q = ctx;
-  const oc_stacks *s = q->s;
-  double fi = floor((p.x - s->x0) / s->cell + 0.5),
-         fj = floor((p.y - s->y0) / s->cell + 0.5);
-  if (!(fi >= 0 && fj >= 0 && fi < s->nx && fj < s->ny)) return 0;
-  size_t k = (size_t)fj * s->nx + (size_t)fi;
-  double z = s->zbase;
-  uint32_t l = s->off[k], end = s->off[k + 1];
-  for (; l < end; l++) {
-    double top = z + s->thick[l];
+  presence *q = ctx;
+  double fi = floor((p.x - q->x0) / q->cell + 0.5),
+         fj = floor((p.y - q->y0) / q->cell + 0.5);
+  if (!(fi >= 0 && fj >= 0 && fi < q->nx && fj < q->ny)) return 0;
+  size_t n = layers_of(q, (int)fi, (int)fj), l = 0;
+  double z = q->base;
+  for (; l < n; l++) {
+    double top = z + q->thick[l];
     if (p.z < top) break;
     z = top;
   }
-  if (l == end || p.z < z || s->mat[l] != OC_MAT_ROCKS) return 0;
+  if (l == n || p.z < z || q->mat[l] != OC_MAT_ROCKS) return 0;
   double top = z;
-  for (; l < end && s->mat[l] != OC_MAT_AIR && s->mat[l] != OC_MAT_WATER; l++)
-    top += s->thick[l];
+  for (; l < n && q->mat[l] != OC_MAT_AIR && q->mat[l] != OC_MAT_WATER; l++)
+    top += q->thick[l];
   return top - p.z <= q->depth;
 }
 
@@ -537,35 +558,48 @@ oc_node *oc_stacks_rocks(const oc_stacks *s, const oc_btile *tile,
     oc_seterr(err, OC_EINVAL, "layers:rocks needs stacks, a tile, params");
     return NULL;
   }
-  presence q = {s, p->depth};
+  presence q = {s,
+                p->depth,
+                0,
+                0,
+                oc_stacks_cell(s),
+                oc_stacks_base(s),
+                oc_stacks_nx(s),
+                oc_stacks_ny(s),
+                0,
+                NULL,
+                NULL,
+                0};
+  oc_stacks_origin(s, &q.x0, &q.y0);
   if (isnan(q.depth)) q.depth = 2 * oc_rocks_reach(tile);
   if (!(q.depth >= 0) || !isfinite(q.depth)) {
     oc_seterr(err, OC_EINVAL, "'depth' must be >= 0 (got %g)", q.depth);
     return NULL;
   }
   /* where rocks are: the grid's footprint, the rocks layers' heights */
-  oc_aabb where = {{s->x0 - 0.5 * s->cell, s->y0 - 0.5 * s->cell, INFINITY},
-                   {s->x0 + (s->nx - 0.5) * s->cell,
-                    s->y0 + (s->ny - 0.5) * s->cell, -INFINITY}};
-  size_t ns = (size_t)s->nx * s->ny;
-  for (size_t k = 0; k < ns; k++) {
-    double z = s->zbase;
-    for (uint32_t l = s->off[k]; l < s->off[k + 1]; l++) {
-      double top = z + s->thick[l];
-      if (s->mat[l] == OC_MAT_ROCKS) {
-        where.lo.z = fmin(where.lo.z, z);
-        where.hi.z = fmax(where.hi.z, top);
+  oc_aabb where = {
+      {q.x0 - 0.5 * q.cell, q.y0 - 0.5 * q.cell, INFINITY},
+      {q.x0 + (q.nx - 0.5) * q.cell, q.y0 + (q.ny - 0.5) * q.cell, -INFINITY}};
+  for (int j = 0; j < q.ny; j++)
+    for (int i = 0; i < q.nx; i++) {
+      size_t n = layers_of(&q, i, j);
+      double z = q.base;
+      for (size_t l = 0; l < n; l++) {
+        double top = z + q.thick[l];
+        if (q.mat[l] == OC_MAT_ROCKS) {
+          where.lo.z = fmin(where.lo.z, z);
+          where.hi.z = fmax(where.hi.z, top);
+        }
+        z = top;
       }
-      z = top;
     }
-  }
   if (where.lo.z > where.hi.z) /* no rocks: nothing placed */
-    where.lo.z = s->zbase + 1, where.hi.z = s->zbase;
-  oc_node *own = NULL;
+    where.lo.z = q.base + 1, where.hi.z = q.base;
+  oc_node *own = NULL, *out = NULL;
   if (!ground) {
     own =
         oc_stacks_field(s, 1u << OC_MAT_BEDROCK | 1u << OC_MAT_SAND, NAN, err);
-    if (!own) return NULL;
+    if (!own) goto done;
     ground = own;
   }
   oc_replicate_tile rt = {tile, -INFINITY, INFINITY};
@@ -578,7 +612,15 @@ oc_node *oc_stacks_rocks(const oc_stacks *s, const oc_btile *tile,
   rp.present = present;
   rp.ctx = &q;
   rp.where = &where;
-  oc_node *out = oc_blocks_replicate(ground, &rp, err);
+  out = oc_blocks_replicate(ground, &rp, err);
+  if (out && q.nomem) {
+    oc_node_release(out);
+    out = NULL;
+    oc_seterr(err, OC_ENOMEM, "out of memory for rocks");
+  }
+done:
   if (own) oc_node_release(own);
+  free(q.mat);
+  free(q.thick);
   return out;
 }
