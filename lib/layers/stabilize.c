@@ -248,7 +248,7 @@ static void pass2(work *w, box b) {
 
 /* The coarsest stride, and the extent of the givers (in strides) below
 ** which a stride is not used (see the top of the file). */
-#define STRIDE_TOP 8
+#define STRIDE_TOP OC_LAYERS_STRIDE_MAX
 #define STRIDE_SPAN 8
 
 static box box_union(box a, box b) {
