@@ -47,6 +47,12 @@ START_TEST(rocks_in_cells) {
     const oc_bblock *b = &t->block[i];
     const double *pi = t->pts + 3 * i;
     ck_assert(b->centroid.x == pi[0] && b->centroid.z == pi[2]);
+    /* convex: every vertex inside every plane of the hull */
+    for (size_t v = 0; v < b->nvert; v++)
+      for (size_t k = 0; k < b->nplane; k++) {
+        const double *h = b->plane + 4 * k, *x = b->vert + 3 * v;
+        ck_assert(h[0] * x[0] + h[1] * x[1] + h[2] * x[2] + h[3] < 1e-9);
+      }
     size_t touching = 0; /* neighbours some vertex lies on the face with */
     unsigned char *seen = calloc(t->np, 1);
     for (size_t v = 0; v < b->nvert; v++) {
