@@ -48,28 +48,32 @@ START_TEST(rocks_in_cells) {
     const double *pi = t->pts + 3 * i;
     ck_assert(b->centroid.x == pi[0] && b->centroid.z == pi[2]);
     /* convex: every vertex inside every plane of the hull */
+    double out = -INFINITY;
     for (size_t v = 0; v < b->nvert; v++)
       for (size_t k = 0; k < b->nplane; k++) {
         const double *h = b->plane + 4 * k, *x = b->vert + 3 * v;
-        ck_assert(h[0] * x[0] + h[1] * x[1] + h[2] * x[2] + h[3] < 1e-9);
+        out = fmax(out, h[0] * x[0] + h[1] * x[1] + h[2] * x[2] + h[3]);
       }
+    ck_assert_msg(out < 1e-9, "rock %zu: a vertex %g outside a plane", i, out);
     size_t touching = 0; /* neighbours some vertex lies on the face with */
     unsigned char *seen = calloc(t->np, 1);
+    double reach = 0, nearer = -INFINITY;
     for (size_t v = 0; v < b->nvert; v++) {
       const double *x = b->vert + 3 * v;
       double own = d2(x, pi, s);
-      ck_assert(sqrt(own) < r); /* within the cell's reach */
+      reach = fmax(reach, own);
       for (size_t j = 0; j < t->np; j++) {
         if (j == i) continue;
         double other = d2(x, t->pts + 3 * j, s);
-        /* in its own cell: no nearer site (so hulls cannot overlap) */
-        ck_assert_msg(own <= other + 1e-9,
-                      "rock %zu vertex %zu in cell %zu by %g", i, v, j,
-                      own - other);
+        nearer = fmax(nearer, own - other);
         if (other - own < 1e-6 && !seen[j]) seen[j] = 1, touching++;
       }
     }
     free(seen);
+    ck_assert(sqrt(reach) < r); /* within the cell's reach */
+    /* in its own cell: no nearer site (so hulls cannot overlap) */
+    ck_assert_msg(nearer <= 1e-9,
+                  "rock %zu: a vertex nearer another site by %g", i, nearer);
     ck_assert_msg(touching >= 4, "rock %zu touches %zu", i, touching);
     /* eroded: the hull's thickness below the cell's (sites >= r apart, so
     ** every cell holds a ball of radius r / 2 around its site) */
