@@ -293,6 +293,8 @@ PICTURES := demo_arch_render.png:demo:arch_render.png \
   example_layers_sand.png:layers_sand:layers_sand.png \
   example_layers_ravine.png:layers_ravine:layers_ravine.png \
   example_layers_arches.png:layers_arches:layers_arches.png \
+  example_layers_caves.png:layers_caves:layers_caves.png \
+  example_layers_canyon.png:layers_canyon:layers_canyon.png \
   example_blocks_types.png:blocks_types:blocks_types.png
 PICTURE_SCENES := $(sort $(foreach p,$(PICTURES),$(word 2,$(subst :, ,$(p)))))
 

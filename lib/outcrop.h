@@ -773,6 +773,13 @@ typedef struct oc_replicate_params {
                     ** in [va, vb] (default -1 .. 1) */
   int anchors;      /* centroid + hull vertices voting (default 9) */
   double threshold; /* T of the criteria; 0: OC_DEFAULT_THRESHOLD */
+  /* Optional (NULL: unused): present(ctx, anchor) decides each anchor's
+  ** vote instead of the criteria above (called from the calling thread),
+  ** and blocks are placed where their supports meet *where (instead of
+  ** the terrain's bounds). */
+  int (*present)(void *ctx, oc_vec3 anchor);
+  void *ctx;
+  const oc_aabb *where;
 } oc_replicate_params;
 
 void oc_replicate_defaults(oc_replicate_params *rp);
@@ -784,6 +791,12 @@ oc_node *oc_blocks_replicate(oc_node *terrain, const oc_replicate_params *rp,
 /* 1 and the count of instances (Table 2's #R) when n is a replication
 ** node, else 0. */
 int oc_blocks_instances(const oc_node *n, size_t *count);
+/* Instance i (0 <= i < count) of a replication node: its block (numbered
+** through the tiles in order) and its offset (the block's field is
+** evaluated at p - off). 1, or 0 when n is not a replication node or i is
+** out of range. */
+int oc_blocks_instance(const oc_node *n, size_t i, size_t *block,
+                       double off[3]);
 
 /* ---- heightfields ----------------------------------------------------- */
 
@@ -2262,7 +2275,11 @@ oc_node *oc_stacks_field(const oc_stacks *s, unsigned mask, double sigma,
 ** in the neighbour's segment holding elevation h, t_i = cell tan(alpha)
 ** (sides) or cell sqrt(2) tan(alpha) (diagonals); the total moved is
 ** rate * max dh~_i capped by the material present, and each transfer by
-** an eighth of the air of the receiving segment. Double-buffered: the
+** an eighth of the air of the receiving segment. For a large pile,
+** coarse levels first (neighbours k = 8, 4, 2 stacks away down a slope,
+** thresholds and tolerance times k; the first k from the extent of the
+** unstable stacks) bring it near rest in few passes; the last level (the
+** 8 neighbours) decides it. Double-buffered: the
 ** result does not depend on the thread count. Volume is conserved to
 ** rounding. */
 typedef struct oc_stabilize_params {
@@ -2374,6 +2391,46 @@ typedef struct oc_sweep_params {
 } oc_sweep_params;
 int oc_stacks_sweep(oc_stacks *s, const oc_sweep_params *p, double *changed,
                     oc_stabilize_result *res, oc_error *err);
+/* Rock piles (section 5): a rock tile is a block tile (oc_btile, freed
+** with oc_btile_free; oc_btile_block, _node, _planes work on it) whose
+** blocks are rocks: the Voronoi cells of periodic maximal Poisson sites
+** in the cube [0, size)^3, eroded by `erosion` r except around `contacts`
+** random points on each face shared with a neighbour (resistance
+** exp(-|p - c|^2 / (spread r)^2)), as convex blocks. Rocks are convex,
+** inside their cells (disjoint) and touch at the contacts; a block's
+** centroid is its Voronoi site. Deterministic by seed. */
+typedef struct oc_rocks_params {
+  double size;     /* side of the tile (m), >= 4 radius; default 8 */
+  double radius;   /* r: sites at least r apart, > 0; default 1.5 */
+  double erosion;  /* depth eroded, in r, [0, 0.45]; default 0.3 */
+  double spread;   /* width of the resistance, in r, > 0; default 1 */
+  int contacts;    /* per shared face, 1 .. 8; default 1 */
+  double rounding; /* of the blocks' smooth intersection, in r; 0.15 */
+  double width;    /* W of the blocks' fields (m), > 0; default 0.75 */
+  uint64_t seed;
+} oc_rocks_params;
+void oc_rocks_defaults(oc_rocks_params *p);
+/* A new tile, or NULL with err (OC_EINVAL naming the parameter,
+** OC_ENOMEM). At most 20000 rocks. */
+oc_btile *oc_rocks_tile(const oc_rocks_params *p, oc_error *err);
+/* The largest distance from a rock's site to its vertices. */
+double oc_rocks_reach(const oc_btile *t);
+
+/* The rocks of `tile` placed over the stacks (the blocks' replication):
+** a rock of each tile cell is an instance when its site lies in a rocks
+** layer at most `depth` below the top of the solid above it (deeper
+** rocks are hidden and culled). The node is max(ground, instances);
+** ground NULL: the stacks' bedrock and sand convolution surface (sigma one
+** cell). oc_blocks_instances and oc_blocks_instance list the instances.
+** Presence is decided now (later edits of the stacks do not move rocks).
+** A new node, or NULL with err. */
+typedef struct oc_stacks_rocks_params {
+  double depth;     /* NaN: twice oc_rocks_reach */
+  double threshold; /* T; 0: OC_DEFAULT_THRESHOLD */
+} oc_stacks_rocks_params;
+oc_node *oc_stacks_rocks(const oc_stacks *s, const oc_btile *tile,
+                         oc_node *ground, const oc_stacks_rocks_params *p,
+                         oc_error *err);
 
 #ifdef __cplusplus
 }

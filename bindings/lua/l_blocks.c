@@ -272,6 +272,25 @@ static int l_replicate(lua_State *L) {
   return oclua_setnode(L, u, oc_blocks_replicate(ter, &rp, &err), &err, fname);
 }
 
+oc_btile **oclua_newtile(lua_State *L) {
+  oclua_btile *u = lua_newuserdatauv(L, sizeof *u, 0);
+  oclua_handle_init(&u->h, "tile", btile_release);
+  u->t = NULL;
+  luaL_setmetatable(L, OCLUA_BTILE);
+  return &u->t;
+}
+
+oc_btile *oclua_checktile(lua_State *L, int idx, const char *fname,
+                          const char *what) {
+  oclua_btile *u = luaL_testudata(L, idx, OCLUA_BTILE);
+  if (!u)
+    oclua_error(L, fname, "%s must be a block tile (got %s)", what,
+                oclua_got(L, idx));
+  oclua_handle_check(L, &u->h, fname);
+  if (!u->t) oclua_error(L, fname, "the tile is not made");
+  return u->t;
+}
+
 static const luaL_Reg blocks_funcs[] = {
     {"tile", l_tile}, {"replicate", l_replicate}, {NULL, NULL}};
 

@@ -9,5 +9,11 @@
 
 /* Adds outcrop.blocks to the module table at the stack top. */
 void oclua_open_blocks(lua_State *L);
+/* A new, empty tile userdata pushed; set the returned slot to the tile
+** (its __gc frees it). */
+oc_btile **oclua_newtile(lua_State *L);
+/* The tile at idx (an error naming `what` otherwise). */
+oc_btile *oclua_checktile(lua_State *L, int idx, const char *fname,
+                          const char *what);
 
 #endif

@@ -38,6 +38,8 @@
 **        its convolution surface of half-side sigma (its share of the box
 **        around a point) and its colour, for render's `color =` and a
 **        mesh's `colors =` (texturing by material)
+**   outcrop.layers.rocks{...} and s:rocks(tile, {...}): rock piles
+**        (l_rocks.c)
 **
 ** Stacks are mutable: a node made by s:field is a snapshot. `local s
 ** <close>` frees the grid early.
@@ -830,9 +832,14 @@ static const luaL_Reg funcs[] = {{"new", l_new},
                                  {"from_node", l_from_node},
                                  {NULL, NULL}};
 
+oc_stacks *oclua_pinlayers(lua_State *L, int idx, const char *fname) {
+  return pinlayers(L, idx, fname);
+}
+
 void oclua_open_layers(lua_State *L) {
   oclua_newmeta(L, OCLUA_LAYERS, meta, methods);
   lua_pop(L, 1);
   luaL_newlib(L, funcs);
+  oclua_open_rocks(L); /* l_rocks.c */
   lua_setfield(L, -2, "layers");
 }

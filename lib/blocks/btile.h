@@ -97,6 +97,10 @@ int oc_bclusters_merge(oc_btile *t, oc_error *err);
 /* Convex hulls of the clusters (hull.c): fills t->block, t->nb. */
 int oc_bhulls_make(oc_btile *t, oc_error *err);
 void oc_bblock_free(oc_bblock *b);
+/* One block from the hull of n points (3 doubles each): planes, vertices,
+** box, thickness, centroid the points' mean. OC_EINVAL when qhull finds
+** them flat (or n < 4), OC_ENOMEM; b is then empty. */
+int oc_bblock_hull(double *xyz, size_t n, oc_bblock *b, oc_error *err);
 
 /* Cuts overlapping blocks apart with a plane each (separate.c). */
 int oc_bblocks_separate(oc_btile *t, oc_error *err);

@@ -148,3 +148,25 @@ done:
   free(fill);
   return rc;
 }
+
+int oc_bblock_hull(double *xyz, size_t n, oc_bblock *b, oc_error *err) {
+  memset(b, 0, sizeof *b);
+  FILE *quiet = fopen("/dev/null", "w");
+  if (!quiet) return oc_seterr(err, OC_ENOMEM, "out of memory for a hull");
+  int h = hull(xyz, n, b, quiet);
+  fclose(quiet);
+  if (h) {
+    oc_bblock_free(b);
+    return h == OC_ENOMEM
+               ? oc_seterr(err, OC_ENOMEM, "out of memory for a hull")
+               : oc_seterr(err, OC_EINVAL, "flat or too few points for a hull");
+  }
+  double g[3] = {0, 0, 0};
+  for (size_t i = 0; i < n; i++)
+    for (int a = 0; a < 3; a++)
+      g[a] += xyz[3 * i + a];
+  b->centroid = (oc_vec3){g[0] / n, g[1] / n, g[2] / n};
+  b->npts = n;
+  measure(b);
+  return OC_OK;
+}

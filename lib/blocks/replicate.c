@@ -259,9 +259,12 @@ static const oc_kind_def replicate_kind = {
 typedef struct crit {
   const oc_program *terrain, *geology;
   double T, va, vb, slope, lo, hi;
+  int (*present)(void *ctx, oc_vec3 anchor);
+  void *ctx;
 } crit;
 
 static int anchor_ok(const crit *c, oc_vec3 a) {
+  if (c->present) return c->present(c->ctx, a) != 0;
   oc_vec3 g;
   double f = oc_program_gradient(c->terrain, a, &g);
   double gl = sqrt(g.x * g.x + g.y * g.y + g.z * g.z);
@@ -391,6 +394,7 @@ oc_node *oc_blocks_replicate(oc_node *terrain, const oc_replicate_params *rp,
   oc_node *out = NULL;
   oc_aabb tb = oc_program_bounds(tp);
   if (!r || (rp->geology && !gp)) goto done;
+  if (rp->where) tb = *rp->where; /* instead of the terrain's bounds */
   if (!isfinite(tb.lo.x) || !isfinite(tb.lo.y) || !isfinite(tb.lo.z) ||
       !isfinite(tb.hi.x) || !isfinite(tb.hi.y) || !isfinite(tb.hi.z)) {
     oc_seterr(err, OC_EINVAL, "the terrain's bounds must be finite");
@@ -413,9 +417,10 @@ oc_node *oc_blocks_replicate(oc_node *terrain, const oc_replicate_params *rp,
       if (!r->bf[b]) goto nomem;
     }
   }
-  crit c = {tp,        gp,      oc_program_threshold(tp),
-            rp->va,    rp->vb,  rp->slope,
-            -INFINITY, INFINITY};
+  crit c = {tp,        gp,       oc_program_threshold(tp),
+            rp->va,    rp->vb,   rp->slope,
+            -INFINITY, INFINITY, rp->present,
+            rp->ctx};
   if (place(r, rp, &c, tb, err)) goto done;
   if (grid_make(r)) goto nomem;
   out = oc_kind_node(&replicate_kind, &terrain, 1, NULL, 0, r, err);
@@ -433,5 +438,15 @@ done:
 int oc_blocks_instances(const oc_node *n, size_t *count) {
   if (oc_node_def(n) != &replicate_kind) return 0;
   *count = ((const rdata *)oc_node_data(n))->ni;
+  return 1;
+}
+
+int oc_blocks_instance(const oc_node *n, size_t i, size_t *block,
+                       double off[3]) {
+  if (oc_node_def(n) != &replicate_kind) return 0;
+  const rdata *r = oc_node_data(n);
+  if (i >= r->ni) return 0;
+  *block = r->in[i].b;
+  memcpy(off, r->in[i].off, sizeof r->in[i].off);
   return 1;
 }

@@ -121,6 +121,10 @@ void oc_builder_free(oc_stacks_builder *b);
 oc_stacks *oc_stacks_alloc(int nx, int ny, double cell, double x0, double y0,
                            double zbase, oc_error *err);
 
+/* The coarsest stride of the stabilisation (stabilize.c): material moves
+** at most this many stacks in one transfer. */
+#define OC_LAYERS_STRIDE_MAX 8
+
 /* Stabilisation over the stacks, with the segments already decoded
 ** (stabilize.c; deposit.c calls it after adding material). */
 int oc_layers_stabilize_segs(oc_stacks *s, oc_lseg *seg, const size_t *soff,

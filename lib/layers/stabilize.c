@@ -25,6 +25,28 @@
 ** thread count, and every share is subtracted and added once: volume is
 ** conserved to rounding. Only stacks near the last changes are visited:
 ** the givers' box grown by 2 (the first pass: the region given).
+**
+** Multiresolution: the same passes run first with a stride k (8, 4 or 2),
+** then with its halves down to 1, between a stack and its 8 neighbours k
+** stacks away, with the
+** thresholds k t_i and tolerance k times the given one. A coarse pass moves
+** material k stacks at once, so a pile spreads over L stacks in about
+** L / k passes instead of the L^2 / rate of a diffusion; the next finer
+** level starts from every stack the coarser one changed, and the last
+** (k = 1) alone decides the rest state, so every slope ends below the angle
+** of repose as without the coarse levels. A stride only follows a slope
+** down: each stack between holds elevation h in a segment whose solid top
+** lies between the receiver's and h, so material never jumps over a wall,
+** a bump or a gap. The first stride is the largest power of 2 up to 8
+** with 8 k at most the extent of the box of the stacks that give at a
+** first pass with k = 1: a coarse level leaves each of its k^2 sub-lattices a
+*pile
+** of its own, which the finer levels cannot gather back, so a small pile
+** (a 75 m^3 one at cells of 0.5 m) spreads one or two strides wider than
+** with k = 1 alone; it is then left to k = 1. The box depends on the
+** material to move, not on the grid or the region given, so a window
+** gives the stacks the whole grid gives. A 10^5 m^3 deposit on 1000 x 750
+** stacks: 99 passes (first stride 8) instead of 5037.
 */
 #include <math.h>
 #include <stdlib.h>
@@ -38,6 +60,7 @@ static const int DY[8] = {0, 0, 1, -1, 1, -1, 1, -1};
 
 typedef struct work {
   int nx, ny, q; /* q: OC_SEG_SAND or OC_SEG_ROCKS */
+  int k;         /* stride: neighbours k stacks away */
   const oc_lseg *seg;
   const size_t *soff;
   double thr[2]; /* sides, diagonals */
@@ -47,6 +70,10 @@ typedef struct work {
 
 static double src_h(const oc_lseg *c, int q) {
   return c->floor + c->a[OC_SEG_SAND] + (q == OC_SEG_ROCKS ? c->a[q] : 0);
+}
+
+static double solid_top(const oc_lseg *c) {
+  return c->floor + c->a[OC_SEG_SAND] + c->a[OC_SEG_ROCKS];
 }
 
 static double air(const oc_lseg *c) {
@@ -72,16 +99,25 @@ static long seg_at(const work *w, size_t n, double h) {
 /* The excess dh~ of giver segment g of stack (i, j) toward direction d,
 ** its receiving segment in *t; 0 when nothing moves that way. */
 static double excess(const work *w, int i, int j, size_t g, int d, long *t) {
-  int ni = i + DX[d], nj = j + DY[d];
+  int k = w->k, ni = i + k * DX[d], nj = j + k * DY[d];
   if (ni < 0 || nj < 0 || ni >= w->nx || nj >= w->ny) return 0;
   double h = src_h(&w->seg[g], w->q);
   long r = seg_at(w, (size_t)nj * w->nx + ni, h);
   if (r < 0) return 0;
-  const oc_lseg *o = &w->seg[r];
-  double ex =
-      h - (o->floor + o->a[OC_SEG_SAND] + o->a[OC_SEG_ROCKS]) - w->thr[d >= 4];
+  double hr = solid_top(&w->seg[r]);
+  double ex = h - hr - w->thr[d >= 4];
+  if (!(ex > 0)) return 0;
+  /* a stride over k stacks only down a slope: each stack between holds
+  ** elevation h in a segment whose solid top lies in [hr, h] (no jump over
+  ** a wall, a bump or a gap) */
+  for (int m = 1; m < k; m++) {
+    long b = seg_at(w, (size_t)(j + m * DY[d]) * w->nx + (i + m * DX[d]), h);
+    if (b < 0) return 0;
+    double hb = solid_top(&w->seg[b]);
+    if (!(hb >= hr && hb <= h)) return 0;
+  }
   *t = r;
-  return ex > 0 ? ex : 0;
+  return ex;
 }
 
 static double share(const work *w, size_t g, double ex, long t) {
@@ -197,7 +233,7 @@ static void pass2(work *w, box b) {
       for (size_t g = w->soff[k]; g < w->soff[k + 1]; g++)
         w->nxt[g] = w->seg[g].a[w->q] - w->loss[g];
       for (int d = 0; d < 8; d++) {
-        int ni = i - DX[d], nj = j - DY[d]; /* gives toward d */
+        int ni = i - w->k * DX[d], nj = j - w->k * DY[d]; /* gives toward d */
         if (ni < 0 || nj < 0 || ni >= w->nx || nj >= w->ny) continue;
         size_t n = (size_t)nj * w->nx + ni;
         for (size_t g = w->soff[n]; g < w->soff[n + 1]; g++) {
@@ -210,13 +246,25 @@ static void pass2(work *w, box b) {
     }
 }
 
+/* The coarsest stride, and the extent of the givers (in strides) below
+** which a stride is not used (see the top of the file). */
+#define STRIDE_TOP OC_LAYERS_STRIDE_MAX
+#define STRIDE_SPAN 8
+
+static box box_union(box a, box b) {
+  if (a.i0 > a.i1) return b;
+  if (b.i0 > b.i1) return a;
+  return (box){a.i0 < b.i0 ? a.i0 : b.i0, a.j0 < b.j0 ? a.j0 : b.j0,
+               a.i1 > b.i1 ? a.i1 : b.i1, a.j1 > b.j1 ? a.j1 : b.j1};
+}
+
 int oc_layers_stabilize_segs(oc_stacks *s, oc_lseg *seg, const size_t *soff,
                              const oc_stabilize_params *p,
                              oc_stabilize_result *res, oc_error *err) {
   static const int MATS[2] = {OC_MAT_SAND, OC_MAT_ROCKS};
   size_t ns = (size_t)s->nx * s->ny, nseg = soff[ns];
   oc_stabilize_result r = {0, 1, 0};
-  work w = {s->nx, s->ny, 0, seg, soff, {0, 0}, p->rate, NULL, NULL, NULL};
+  work w = {s->nx, s->ny, 0, 1, seg, soff, {0, 0}, p->rate, NULL, NULL, NULL};
   w.kf = calloc(3 * nseg, sizeof *w.kf);
   if (!w.kf) return oc_seterr(err, OC_ENOMEM, "out of memory");
   w.loss = w.kf + nseg;
@@ -233,43 +281,66 @@ int oc_layers_stabilize_segs(oc_stacks *s, oc_lseg *seg, const size_t *soff,
     int m = MATS[mi];
     double ta = tan(p->angle[m] * (3.14159265358979323846 / 180));
     w.q = oc_seg_index(m);
-    w.thr[0] = s->cell * ta;
-    w.thr[1] = s->cell * sqrt(2.0) * ta;
-    memset(w.kf, 0, 2 * nseg * sizeof *w.kf);
-    box b = start;
     long it = 0;
-    int done = 0;
-    while (it < p->iterations && b.i0 <= b.i1 && b.j0 <= b.j1) {
+    int done = 0, top = 1;
+    { /* the coarsest stride, from the extent of the first givers */
       box giv;
       double big, sum;
-      pass1(&w, b, &giv, &big, &sum);
+      w.k = 1;
+      w.thr[0] = s->cell * ta;
+      w.thr[1] = s->cell * sqrt(2.0) * ta;
+      pass1(&w, start, &giv, &big, &sum);
       if (isinf(big)) {
         free(w.kf);
         return oc_seterr(err, OC_ENOMEM, "out of memory");
       }
-      if (!(big > p->tolerance)) {
-        done = 1;
-        break;
-      }
-      box c = grow(giv, 1, s->nx, s->ny);
-      pass2(&w, c);
-      for (int j = c.j0; j <= c.j1; j++)
-        for (int i = c.i0; i <= c.i1; i++) {
-          size_t k = (size_t)j * s->nx + i;
-          for (size_t g = soff[k]; g < soff[k + 1]; g++)
-            seg[g].a[w.q] = w.nxt[g];
-        }
-      /* factors and losses are 0 outside the givers (which pass 1 of the
-      ** next box covers), so pass 2 reads none stale */
-      for (int j = giv.j0; j <= giv.j1; j++)
-        for (size_t g = soff[(size_t)j * s->nx + giv.i0];
-             g < soff[(size_t)j * s->nx + giv.i1 + 1]; g++)
-          w.kf[g] = w.loss[g] = 0;
-      r.moved += sum * s->cell * s->cell;
-      b = grow(c, 1, s->nx, s->ny);
-      it++;
+      int ext = giv.i0 > giv.i1                     ? 0
+                : giv.i1 - giv.i0 > giv.j1 - giv.j0 ? giv.i1 - giv.i0 + 1
+                                                    : giv.j1 - giv.j0 + 1;
+      while (2 * top <= STRIDE_TOP && 2 * top * STRIDE_SPAN <= ext)
+        top *= 2;
     }
-    if (b.i0 > b.i1) done = 1;
+    for (w.k = top; w.k >= 1; w.k /= 2) {
+      w.thr[0] = w.k * s->cell * ta;
+      w.thr[1] = w.k * s->cell * sqrt(2.0) * ta;
+      double tol = w.k * p->tolerance;
+      memset(w.kf, 0, 2 * nseg * sizeof *w.kf);
+      box b = start;
+      done = 0;
+      while (it < p->iterations && b.i0 <= b.i1 && b.j0 <= b.j1) {
+        box giv;
+        double big, sum;
+        pass1(&w, b, &giv, &big, &sum);
+        if (isinf(big)) {
+          free(w.kf);
+          return oc_seterr(err, OC_ENOMEM, "out of memory");
+        }
+        if (!(big > tol)) {
+          done = 1;
+          break;
+        }
+        box c = grow(giv, w.k, s->nx, s->ny);
+        pass2(&w, c);
+        for (int j = c.j0; j <= c.j1; j++)
+          for (int i = c.i0; i <= c.i1; i++) {
+            size_t k = (size_t)j * s->nx + i;
+            for (size_t g = soff[k]; g < soff[k + 1]; g++)
+              seg[g].a[w.q] = w.nxt[g];
+          }
+        /* factors and losses are 0 outside the givers (which pass 1 of the
+        ** next box covers), so pass 2 reads none stale */
+        for (int j = giv.j0; j <= giv.j1; j++)
+          for (size_t g = soff[(size_t)j * s->nx + giv.i0];
+               g < soff[(size_t)j * s->nx + giv.i1 + 1]; g++)
+            w.kf[g] = w.loss[g] = 0;
+        r.moved += sum * s->cell * s->cell;
+        b = grow(c, w.k, s->nx, s->ny);
+        /* the next level starts from every stack this one changed */
+        if (w.k > 1) start = box_union(start, b);
+        it++;
+      }
+      if (b.i0 > b.i1) done = 1;
+    }
     r.iterations += it;
     r.converged &= done;
   }

@@ -93,11 +93,14 @@ int oc_stacks_splice(oc_stacks *s, const oc_stacks *w, int i0, int j0,
   return OC_OK;
 }
 
-/* Whether the stacks on the border of a and b (same shape) differ. */
+/* Whether the stacks of a and b (same shape) within the longest stride of
+** the border differ: material that reached them might have gone on
+** past the window. */
 static int border_changed(const oc_stacks *a, const oc_stacks *b) {
+  const int B = OC_LAYERS_STRIDE_MAX;
   for (int j = 0; j < a->ny; j++)
     for (int i = 0; i < a->nx; i++) {
-      if (j > 0 && j < a->ny - 1 && i > 0 && i < a->nx - 1) i = a->nx - 1;
+      if (j >= B && j < a->ny - B && i >= B && i < a->nx - B) i = a->nx - B;
       size_t k = (size_t)j * a->nx + i;
       size_t n = oc_scount(a, k);
       if (n != oc_scount(b, k) ||

@@ -596,6 +596,41 @@ START_TEST(large_grid_threads) {
 }
 END_TEST
 
+/* The coarse levels move material several stacks at once, but only down
+** a slope: a pile against a thin, tall bedrock wall stays on its side
+** (a stride of 8 from a 12 m pile would otherwise clear the wall). */
+START_TEST(strides_do_not_jump_walls) {
+  oc_error err;
+  oc_stacks *s = grid(120, 40, 1, 0);
+  uint8_t m = OC_MAT_BEDROCK;
+  double t = 5, wall = 45;
+  ck_assert(oc_stacks_fill(s, &m, &t, 1, &err) == OC_OK);
+  for (int j = 0; j < 40; j++)
+    set(s, 62, j, &m, &wall, 1);
+  oc_deposit_params dp = {46, 20, 15, 30, OC_MAT_SAND, 1, NULL};
+  double added;
+  oc_stabilize_result res;
+  ck_assert(oc_stacks_deposit(s, &dp, &added, &res, &err) == OC_OK);
+  ck_assert(res.converged && res.moved > 0);
+  ck_assert_double_eq_tol(oc_stacks_volume(s, OC_MAT_SAND), added,
+                          1e-6 * added);
+  double beyond = 0, near = 0;
+  for (int j = 0; j < 40; j++)
+    for (int i = 0; i < 120; i++) {
+      uint8_t mm[4];
+      double th[4];
+      size_t n = oc_stacks_get(s, i, j, mm, th, 4);
+      if (n > 1 && mm[n - 1] == OC_MAT_SAND) {
+        if (i > 62) beyond += th[n - 1];
+        if (i == 61) near += th[n - 1];
+      }
+    }
+  ck_assert(beyond == 0);
+  ck_assert(near > 1); /* the pile reached the wall */
+  oc_stacks_free(s);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("layers");
   TCase *tc = tcase_create("layers");
@@ -606,6 +641,7 @@ int main(void) {
   tcase_add_test(tc, field_flat_slab);
   tcase_add_test(tc, from_program_reproduces_surface);
   tcase_add_test(tc, stabilize_conserves_and_rests);
+  tcase_add_test(tc, strides_do_not_jump_walls);
   tcase_add_test(tc, deposit_and_threads);
   tcase_add_test(tc, local_equals_whole);
   tcase_add_test(tc, large_grid_threads);
