@@ -155,6 +155,57 @@ static oc_vec3 reduce(oc_vec3 p) {
   return r;
 }
 
+/* The simplex of a point: its cell (skewed lattice coordinates), the
+** second and third corners' steps from it, and the offset to the first
+** corner. */
+typedef struct simplex {
+  uint64_t i, j, k;
+  unsigned i1, j1, k1, i2, j2, k2;
+  double x0, y0, z0;
+} simplex;
+
+/* Locates (x, y, z), a point that is not huge. */
+static inline void simplex_locate(double x, double y, double z, simplex *S) {
+  /* The cell, and p's offset in it, all in skewed space: fractional parts
+  ** are exact there, so large coordinates lose nothing more than the
+  ** rounding of x + s itself. */
+  double s = (x + y + z) * F3;
+  double xs = x + s, ys = y + s, zs = z + s;
+  int64_t ci = floor_i64(xs), cj = floor_i64(ys), ck = floor_i64(zs);
+  double fx = xs - (double)ci, fy = ys - (double)cj, fz = zs - (double)ck;
+  S->i = (uint64_t)ci, S->j = (uint64_t)cj, S->k = (uint64_t)ck;
+  double t = (fx + fy + fz) * G3;
+  double x0 = fx - t, y0 = fy - t, z0 = fz - t;
+  S->x0 = x0, S->y0 = y0, S->z0 = z0;
+
+  /* The simplex: the axes in decreasing order of the offset, the second
+  ** and third corners stepping along the first one and the first two.
+  ** Computed without branches, which would be mispredicted half the time. */
+  unsigned xy = x0 >= y0, xz = x0 >= z0, yz = y0 >= z0;
+  S->i1 = xy & xz, S->j1 = (!xy) & yz, S->k1 = (!xz) & (!yz);
+  S->i2 = xy | xz, S->j2 = (!xy) | yz, S->k2 = (!xz) | (!yz);
+}
+
+/* The raw sum of the four corners' terms, gi their gradient indices; the
+** gradient's in g when wg. */
+static inline double simplex_sum(const simplex *S, const unsigned gi[4],
+                                 double g[3], int wg) {
+  double x0 = S->x0, y0 = S->y0, z0 = S->z0, v = 0;
+  unsigned i1 = S->i1, j1 = S->j1, k1 = S->k1;
+  unsigned i2 = S->i2, j2 = S->j2, k2 = S->k2;
+  corner_add(gi[0], x0, y0, z0, &v, g, wg);
+  corner_add(gi[1], x0 - i1 + G3, y0 - j1 + G3, z0 - k1 + G3, &v, g, wg);
+  corner_add(gi[2], x0 - i2 + 2 * G3, y0 - j2 + 2 * G3, z0 - k2 + 2 * G3, &v, g,
+             wg);
+  corner_add(gi[3], x0 - 1 + 3 * G3, y0 - 1 + 3 * G3, z0 - 1 + 3 * G3, &v, g,
+             wg);
+  return v;
+}
+
+static inline uint64_t noise_key(uint64_t seed) {
+  return oc_mix64(seed ^ 0x8a5cd789635d2dffull);
+}
+
 /* n(p), with the gradient when wg (then grad is not NULL). */
 static inline double noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad, int wg) {
   if (is_huge(p)) {
@@ -164,35 +215,16 @@ static inline double noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad, int wg) {
     }
     p = reduce(p);
   }
-  double x = p.x, y = p.y, z = p.z;
-  /* The cell, and p's offset in it, all in skewed space: fractional parts
-  ** are exact there, so large coordinates lose nothing more than the
-  ** rounding of x + s itself. */
-  double s = (x + y + z) * F3;
-  double xs = x + s, ys = y + s, zs = z + s;
-  int64_t ci = floor_i64(xs), cj = floor_i64(ys), ck = floor_i64(zs);
-  double fx = xs - (double)ci, fy = ys - (double)cj, fz = zs - (double)ck;
-  uint64_t i = (uint64_t)ci, j = (uint64_t)cj, k = (uint64_t)ck;
-  double t = (fx + fy + fz) * G3;
-  double x0 = fx - t, y0 = fy - t, z0 = fz - t;
-
-  /* The simplex: the axes in decreasing order of the offset, the second
-  ** and third corners stepping along the first one and the first two.
-  ** Computed without branches, which would be mispredicted half the time. */
-  unsigned xy = x0 >= y0, xz = x0 >= z0, yz = y0 >= z0;
-  unsigned i1 = xy & xz, j1 = (!xy) & yz, k1 = (!xz) & (!yz);
-  unsigned i2 = xy | xz, j2 = (!xy) | yz, k2 = (!xz) | (!yz);
-
-  uint64_t key = oc_mix64(seed ^ 0x8a5cd789635d2dffull);
-  double v = 0, g[3] = {0, 0, 0};
-  corner_add(corner_grad(key, i, j, k), x0, y0, z0, &v, g, wg);
-  corner_add(corner_grad(key, i + i1, j + j1, k + k1), x0 - i1 + G3,
-             y0 - j1 + G3, z0 - k1 + G3, &v, g, wg);
-  corner_add(corner_grad(key, i + i2, j + j2, k + k2), x0 - i2 + 2 * G3,
-             y0 - j2 + 2 * G3, z0 - k2 + 2 * G3, &v, g, wg);
-  corner_add(corner_grad(key, i + 1, j + 1, k + 1), x0 - 1 + 3 * G3,
-             y0 - 1 + 3 * G3, z0 - 1 + 3 * G3, &v, g, wg);
-
+  simplex S;
+  simplex_locate(p.x, p.y, p.z, &S);
+  uint64_t key = noise_key(seed), i = S.i, j = S.j, k = S.k;
+  unsigned gi[4] = {
+      corner_grad(key, i, j, k),
+      corner_grad(key, i + S.i1, j + S.j1, k + S.k1),
+      corner_grad(key, i + S.i2, j + S.j2, k + S.k2),
+      corner_grad(key, i + 1, j + 1, k + 1),
+  };
+  double g[3] = {0, 0, 0}, v = simplex_sum(&S, gi, g, wg);
   if (wg) {
     grad->x = SCALE * g[0];
     grad->y = SCALE * g[1];
@@ -203,6 +235,37 @@ static inline double noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad, int wg) {
 
 double oc_noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad) {
   return grad ? noise3(seed, p, grad, 1) : noise3(seed, p, NULL, 0);
+}
+
+void oc_noise3_z0_row(uint64_t seed, const double *x, const double *y, size_t n,
+                      double *out) {
+  uint64_t key = noise_key(seed), ci = 0, cj = 0, ck = 0;
+  unsigned valid = 0;  /* the cube corners of cell (ci, cj, ck) in cg */
+  unsigned char cg[8]; /* corner di + 2 dj + 4 dk: its gradient index */
+  for (size_t m = 0; m < n; m++) {
+    oc_vec3 p = {x[m], y[m], 0};
+    if (is_huge(p)) {
+      out[m] = noise3(seed, p, NULL, 0);
+      continue;
+    }
+    simplex S;
+    simplex_locate(p.x, p.y, p.z, &S);
+    if (S.i != ci || S.j != cj || S.k != ck)
+      ci = S.i, cj = S.j, ck = S.k, valid = 0;
+    unsigned c[4] = {0, S.i1 | S.j1 << 1 | S.k1 << 2,
+                     S.i2 | S.j2 << 1 | S.k2 << 2, 7},
+             gi[4];
+    for (int q = 0; q < 4; q++) {
+      unsigned b = c[q];
+      if (!(valid >> b & 1)) {
+        cg[b] = (unsigned char)corner_grad(key, ci + (b & 1), cj + (b >> 1 & 1),
+                                           ck + (b >> 2));
+        valid |= 1u << b;
+      }
+      gi[q] = cg[b];
+    }
+    out[m] = 0.5 + SCALE * simplex_sum(&S, gi, NULL, 0);
+  }
 }
 
 double oc_turb3(uint64_t seed, int octaves, oc_vec3 p, oc_vec3 *grad) {

@@ -317,6 +317,27 @@ typedef struct oc_efootb {
 void oc_enode_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                  int want, oc_enode_sample *s);
 
+/* Rows (sampling: full detail, no gradients). For m < cnt, f[m] and a[m]
+** are bit for bit the f and alpha of oc_enode_ev(n, x[m], y, NULL, want,
+** &s), want a mix of OC_EV_LAZY and OC_EV_ALPHA (f is not written under
+** OC_EV_ALPHA); x finite and non-decreasing, y finite, cnt <= OC_EROW.
+** A row shares per-row work (which children's boxes it crosses, the noise
+** octaves' keys, lattice corners' hashes) that points repeat. Discs,
+** blends and replaces have row code; other kinds take their points one
+** by one. */
+#define OC_EROW 64
+void oc_enode_ev_row(const oc_enode *n, const double *x, double y, int cnt,
+                     int want, double *f, double *a);
+void oc_edisc_ev_row(const oc_enode *n, const double *x, double y, int cnt,
+                     int want, double *f, double *a);
+/* blend and replace; 0 for the other operators (no row code) */
+int oc_eop_ev_row(const oc_enode *n, const double *x, double y, int cnt,
+                  int want, double *f, double *a);
+/* The range [*i0, *i1) of x[0..cnt) that k's box holds on the line y
+** (oc_enode_holds' comparisons; x non-decreasing). */
+void oc_enode_row_span(const oc_enode *k, const double *x, double y, int cnt,
+                       int *i0, int *i1);
+
 /* Kinds' parts (disc.c, eops.c): evaluation and bounds in a box. */
 void oc_edisc_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                  int want, oc_enode_sample *s);

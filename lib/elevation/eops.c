@@ -941,6 +941,87 @@ void oc_eop_derive(const oc_enode *n, const oc_ebound *kb, const oc_erect *kbox,
   }
 }
 
+/* ---- rows (oc_enode_ev_row) -------------------------------------------- */
+
+/* blend_ev without gradients, a row at a time: each child on the span of
+** the row its box holds, the sums taken child by child as there. */
+static void blend_ev_row(const oc_enode *n, const double *x, double y, int cnt,
+                         int want, double *f, double *a) {
+  int only = want & OC_EV_ALPHA;
+  double N[OC_EROW], S[OC_EROW], kf[OC_EROW], ka[OC_EROW];
+  const oc_eblend *bl = OC_EBLEND(n);
+  for (int m = 0; m < cnt; m++)
+    N[m] = S[m] = 0;
+  for (size_t i = 0; i < bl->nkids; i++) {
+    const oc_enode *k = bl->kids[i];
+    int i0, i1;
+    oc_enode_row_span(k, x, y, cnt, &i0, &i1);
+    if (i0 >= i1) continue;
+    oc_enode_ev_row(k, x + i0, y, i1 - i0, OC_EV_LAZY | only, kf + i0, ka + i0);
+    for (int m = i0; m < i1; m++) {
+      if (only) {
+        S[m] += ka[m];
+        continue;
+      }
+      if (ka[m] == 0) continue;
+      N[m] += ka[m] * kf[m];
+      S[m] += ka[m];
+    }
+  }
+  for (int m = 0; m < cnt; m++) {
+    a[m] = S[m];
+    if (!only) f[m] = S[m] >= T ? N[m] / S[m] : N[m] / T;
+  }
+}
+
+/* replace_ev without gradients, a row at a time. A is evaluated lazily
+** only where the point would be (its f is not read where w >= 1). */
+static void replace_ev_row(const oc_enode *n, const double *x, double y,
+                           int cnt, int want, double *f, double *a) {
+  const oc_enode *A = OC_EBIN(n)->kids[0], *B = OC_EBIN(n)->kids[1];
+  int lerp = OC_EBIN(n)->par[P_LERP] != 0, in, i0, i1;
+  double bf[OC_EROW], ba[OC_EROW], af[OC_EROW];
+  int only = want & OC_EV_ALPHA;
+  for (int m = 0; m < cnt; m++)
+    ba[m] = bf[m] = 0;
+  oc_enode_row_span(B, x, y, cnt, &i0, &i1);
+  if (only) {
+    oc_enode_ev_row(A, x, y, cnt, OC_EV_ALPHA, NULL, a);
+    if (!lerp) return;
+    if (i0 < i1)
+      oc_enode_ev_row(B, x + i0, y, i1 - i0, OC_EV_ALPHA, NULL, ba + i0);
+    for (int m = 0; m < cnt; m++) {
+      double w = clamp01(ba[m], &in);
+      a[m] = (1 - w) * a[m] + w * w;
+    }
+    return;
+  }
+  if (i0 < i1)
+    oc_enode_ev_row(B, x + i0, y, i1 - i0, OC_EV_LAZY, bf + i0, ba + i0);
+  int lazy = want & OC_EV_LAZY && !lerp;
+  oc_enode_ev_row(A, x, y, cnt, lazy ? OC_EV_LAZY : 0, af, a);
+  for (int m = 0; m < cnt; m++) {
+    double w = clamp01(ba[m], &in), fa = w >= 1 ? 0 : af[m];
+    if (lazy && a[m] == 0) {
+      f[m] = 0;
+      continue;
+    }
+    f[m] = (1 - w) * fa + w * bf[m];
+    if (lerp) a[m] = (1 - w) * a[m] + w * w;
+  }
+}
+
+int oc_eop_ev_row(const oc_enode *n, const double *x, double y, int cnt,
+                  int want, double *f, double *a) {
+  if (n->kind == OC_E_BLEND)
+    blend_ev_row(n, x, y, cnt, want, f, a);
+  else if (n->kind == OC_E_REPLACE)
+    replace_ev_row(n, x, y, cnt, want, f, a);
+  else
+    return 0;
+  return 1;
+}
+
 /* ---- dispatch --------------------------------------------------------- */
 
 void oc_eop_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,

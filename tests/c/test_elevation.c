@@ -649,6 +649,78 @@ START_TEST(bad_input) {
 }
 END_TEST
 
+/* Rows (oc_enode_ev_row, and the source's height_weight_row) give every
+** point's f and alpha bit for bit, for each kind of row code (discs of
+** each noise, a lone disc's lazy zeros, blends, replaces plain and
+** lerped) and the kinds that take points one by one, under each want;
+** rows crossing the children's boxes at their edges and beyond. */
+static int same(double a, double b) {
+  return !memcmp(&a, &b, sizeof a);
+}
+
+START_TEST(rows_match_points) {
+  oc_error err;
+  oc_enode *d[4] = {disc(0, 0, 600, 50, OC_ENOISE_PLAIN, 30, 200, 5),
+                    disc(150, 40, 180, 120, OC_ENOISE_RIDGED, 40, 60, 6),
+                    disc(-200, -60, 150, 80, OC_ENOISE_TURBULENCE, 20, 40, 4),
+                    disc(60, -30, 90, 30, OC_ENOISE_NONE, 0, 0, 0)};
+  oc_enode *land = EOK(oc_enode_blend(d, 4, &err));
+  oc_vec3 pts[3] = {{-500, -100, 40}, {0, 10, 45}, {500, 120, 50}};
+  oc_enode_river_params rp = {pts, 3, OC_ECURVE_CATMULL, OC_RIVER_RIVER, 0,
+                              0,   0};
+  oc_enode *river = EOK(oc_enode_river(&rp, &err));
+  oc_enode *rep = EOK(oc_enode_replace(land, river, 0, &err));
+  oc_enode *lrep = EOK(oc_enode_replace(land, d[1], 1, &err));
+  oc_enode_add_params ap = {0};
+  oc_enode *add = EOK(oc_enode_add(rep, d[2], &ap, &err));
+  oc_enode *top[3] = {add, lrep, d[3]};
+  oc_enode *mix = EOK(oc_enode_blend(top, 3, &err));
+  oc_enode *all[] = {d[0], d[1], d[2], d[3], land, rep, lrep, add, mix};
+  int wants[4] = {0, OC_EV_LAZY, OC_EV_ALPHA, OC_EV_LAZY | OC_EV_ALPHA};
+  size_t n = sizeof all / sizeof *all, checked = 0;
+  for (size_t t = 0; t < n; t++)
+    for (int row = 0; row < 9; row++) {
+      /* rows 1.3 m apart (points in one lattice cell share corners) or
+      ** 23 m, from outside the base disc across it */
+      double y = -650 + row * 160, dx = row % 2 ? 1.3 : 23;
+      double x[OC_EROW], f[OC_EROW], a[OC_EROW];
+      for (int m = 0; m < OC_EROW; m++)
+        x[m] = (row % 2 ? -40 : -700) + m * dx;
+      for (int w = 0; w < 4; w++) {
+        oc_enode_ev_row(all[t], x, y, OC_EROW, wants[w], f, a);
+        for (int m = 0; m < OC_EROW; m++) {
+          oc_enode_sample s;
+          oc_enode_ev(all[t], x[m], y, NULL, wants[w], &s);
+          ck_assert_msg(same(a[m], s.a), "%s alpha at (%g, %g): %.17g vs %.17g",
+                        oc_enode_kind(all[t]), x[m], y, a[m], s.a);
+          if (wants[w] & OC_EV_ALPHA) continue;
+          ck_assert_msg(same(f[m], s.f), "%s f at (%g, %g): %.17g vs %.17g",
+                        oc_enode_kind(all[t]), x[m], y, f[m], s.f);
+          checked += s.a > 0 && s.f != 0;
+        }
+      }
+    }
+  ck_assert_uint_gt(checked, 2000); /* most points inside: real values */
+  /* the source's rows: any length (chunks of OC_EROW), = height_weight */
+  oc_elevation src;
+  ck_assert_int_eq(oc_enode_elevation(mix, NULL, &src, &err), OC_OK);
+  ck_assert(src.height_weight_row != NULL);
+  enum { LEN = 150 };
+  double x[LEN], h[LEN], al[LEN];
+  for (int m = 0; m < LEN; m++)
+    x[m] = -300 + 4 * m;
+  src.height_weight_row(src.ud, x, 25, LEN, h, al);
+  for (int m = 0; m < LEN; m++) {
+    double am, hm = src.height_weight(src.ud, x[m], 25, NULL, &am, NULL);
+    ck_assert(same(hm, h[m]) && same(am, al[m]));
+  }
+  src.release(src.ud);
+  for (size_t t = 0; t < n; t++)
+    oc_enode_release(all[t]);
+  oc_enode_release(river);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("elevation");
   TCase *tc = tcase_create("elevation");
@@ -664,6 +736,7 @@ int main(void) {
   tcase_add_test(tc, dag_stats_and_source);
   tcase_add_test(tc, curve_river_road);
   tcase_add_test(tc, bad_input);
+  tcase_add_test(tc, rows_match_points);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }
