@@ -237,34 +237,137 @@ double oc_noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad) {
   return grad ? noise3(seed, p, grad, 1) : noise3(seed, p, NULL, 0);
 }
 
-void oc_noise3_z0_row(uint64_t seed, const double *x, const double *y, size_t n,
-                      double *out) {
-  uint64_t key = noise_key(seed), ci = 0, cj = 0, ck = 0;
-  unsigned valid = 0;  /* the cube corners of cell (ci, cj, ck) in cg */
+/* Rows go in blocks of ZB points, in three passes: locating the points in
+** the skewed lattice and summing the corners' terms are the same
+** arithmetic for every point (vector loops: `omp simd` asks for them, and
+** a vector lane rounds as the scalar code does, -ffp-contract=off keeping
+** products and sums apart); between them, the simplexes and the corners'
+** gradients, hashed once per lattice cell along the row. */
+#define ZB 64
+
+/* The corners' gradients of the current cell along a row. */
+typedef struct row_cache {
+  uint64_t key, ci, cj, ck;
+  unsigned valid;      /* the cube corners of cell (ci, cj, ck) in cg */
   unsigned char cg[8]; /* corner di + 2 dj + 4 dk: its gradient index */
-  for (size_t m = 0; m < n; m++) {
-    oc_vec3 p = {x[m], y[m], 0};
-    if (is_huge(p)) {
-      out[m] = noise3(seed, p, NULL, 0);
-      continue;
+} row_cache;
+
+/* floor(x) for |x| < 2^51 as a double, exactly (= (double)floor_i64(x)):
+** x + 1.5 2^52 rounds x to an integer, which the subtraction gives back
+** exactly, one less where it rounded up. Baseline x86-64 has no vector
+** floor nor int64 conversion; this is two adds and a compare. */
+#define FLOOR_C 0x1.8p52
+static inline double floor_d(double x) {
+  double r = (x + FLOOR_C) - FLOOR_C;
+  return r > x ? r - 1 : r;
+}
+
+/* Two points at a time (GCC's vector extensions, which clang shares): the
+** same operations as the scalar code, lane by lane. */
+typedef double v2d __attribute__((vector_size(16)));
+typedef long long v2l __attribute__((vector_size(16)));
+static inline v2d floor_v(v2d x) {
+  const v2d c = {FLOOR_C, FLOOR_C}, one = {1, 1};
+  v2d r = (x + c) - c;
+  v2l up = r > x; /* all ones where r rounded up */
+  return r - (v2d)((v2l)one & up);
+}
+
+/* The offset to the first corner and the cell of (x, y, 0) (not huge): a
+** point's simplex_locate, in parts. */
+static inline void locate_z0(double px, double py, double *x0, double *y0,
+                             double *z0, double *fi, double *fj, double *fk) {
+  double pz = 0, s = (px + py + pz) * F3;
+  double xs = px + s, ys = py + s, zs = pz + s;
+  *fi = floor_d(xs), *fj = floor_d(ys), *fk = floor_d(zs);
+  double fx = xs - *fi, fy = ys - *fj, fz = zs - *fk;
+  double t = (fx + fy + fz) * G3;
+  *x0 = fx - t, *y0 = fy - t, *z0 = fz - t;
+}
+
+/* v plus one corner's term, as corner_add adds it (value alone), its
+** gradient gr[.][m]. */
+static inline double corner_term(long long gi, double dx, double dy, double dz,
+                                 double v) {
+  double a = 0.5 - (dx * dx + dy * dy + dz * dz);
+  a = 0.5 * (a + fabs(a));
+  double t = grad12[gi][0] * dx + grad12[gi][1] * dy + grad12[gi][2] * dz;
+  double a2 = a * a, a3 = a2 * a;
+  return v + a3 * a * t;
+}
+
+static void z0_block(row_cache *rc, const double *x, const double *y, size_t n,
+                     double *out) {
+  double X0[ZB], Y0[ZB], Z0[ZB], FI[ZB], FJ[ZB], FK[ZB];
+  double O1[3][ZB], O2[3][ZB]; /* the second and third corners' steps */
+  long long G[4][ZB];          /* the four corners' gradient indices */
+  /* (is_huge for z = 0: skewed coordinates then stay below 2^51) */
+  size_t m = 0;
+  for (; m + 2 <= n; m += 2) {
+    const v2d f3 = {F3, F3}, g3 = {G3, G3}, zero = {0, 0};
+    v2d px = {x[m], x[m + 1]}, py = {y[m], y[m + 1]}, pz = zero;
+    v2d s = (px + py + pz) * f3;
+    v2d xs = px + s, ys = py + s, zs = pz + s;
+    v2d fi = floor_v(xs), fj = floor_v(ys), fk = floor_v(zs);
+    v2d fx = xs - fi, fy = ys - fj, fz = zs - fk;
+    v2d t = (fx + fy + fz) * g3;
+    v2d x0 = fx - t, y0 = fy - t, z0 = fz - t;
+    for (int l = 0; l < 2; l++) {
+      X0[m + l] = x0[l], Y0[m + l] = y0[l], Z0[m + l] = z0[l];
+      FI[m + l] = fi[l], FJ[m + l] = fj[l], FK[m + l] = fk[l];
     }
-    simplex S;
-    simplex_locate(p.x, p.y, p.z, &S);
-    if (S.i != ci || S.j != cj || S.k != ck)
-      ci = S.i, cj = S.j, ck = S.k, valid = 0;
-    unsigned c[4] = {0, S.i1 | S.j1 << 1 | S.k1 << 2,
-                     S.i2 | S.j2 << 1 | S.k2 << 2, 7},
-             gi[4];
+  }
+  for (; m < n; m++)
+    locate_z0(x[m], y[m], &X0[m], &Y0[m], &Z0[m], &FI[m], &FJ[m], &FK[m]);
+  for (m = 0; m < n; m++) {
+    uint64_t i = (uint64_t)(int64_t)FI[m], j = (uint64_t)(int64_t)FJ[m],
+             k = (uint64_t)(int64_t)FK[m];
+    double x0 = X0[m], y0 = Y0[m], z0 = Z0[m];
+    unsigned xy = x0 >= y0, xz = x0 >= z0, yz = y0 >= z0;
+    unsigned i1 = xy & xz, j1 = (!xy) & yz, k1 = (!xz) & (!yz);
+    unsigned i2 = xy | xz, j2 = (!xy) | yz, k2 = (!xz) | (!yz);
+    O1[0][m] = i1, O1[1][m] = j1, O1[2][m] = k1;
+    O2[0][m] = i2, O2[1][m] = j2, O2[2][m] = k2;
+    if (i != rc->ci || j != rc->cj || k != rc->ck)
+      rc->ci = i, rc->cj = j, rc->ck = k, rc->valid = 0;
+    unsigned c[4] = {0, i1 | j1 << 1 | k1 << 2, i2 | j2 << 1 | k2 << 2, 7};
     for (int q = 0; q < 4; q++) {
       unsigned b = c[q];
-      if (!(valid >> b & 1)) {
-        cg[b] = (unsigned char)corner_grad(key, ci + (b & 1), cj + (b >> 1 & 1),
-                                           ck + (b >> 2));
-        valid |= 1u << b;
+      if (!(rc->valid >> b & 1)) {
+        rc->cg[b] = (unsigned char)corner_grad(rc->key, i + (b & 1),
+                                               j + (b >> 1 & 1), k + (b >> 2));
+        rc->valid |= 1u << b;
       }
-      gi[q] = cg[b];
+      G[q][m] = rc->cg[b];
     }
-    out[m] = 0.5 + SCALE * simplex_sum(&S, gi, NULL, 0);
+  }
+#pragma omp simd
+  for (m = 0; m < n; m++) {
+    double x0 = X0[m], y0 = Y0[m], z0 = Z0[m], v = 0;
+    v = corner_term(G[0][m], x0, y0, z0, v);
+    v = corner_term(G[1][m], x0 - O1[0][m] + G3, y0 - O1[1][m] + G3,
+                    z0 - O1[2][m] + G3, v);
+    v = corner_term(G[2][m], x0 - O2[0][m] + 2 * G3, y0 - O2[1][m] + 2 * G3,
+                    z0 - O2[2][m] + 2 * G3, v);
+    v = corner_term(G[3][m], x0 - 1 + 3 * G3, y0 - 1 + 3 * G3, z0 - 1 + 3 * G3,
+                    v);
+    out[m] = 0.5 + SCALE * v;
+  }
+}
+
+void oc_noise3_z0_row(uint64_t seed, const double *x, const double *y, size_t n,
+                      double *out) {
+  row_cache rc = {noise_key(seed), 0, 0, 0, 0, {0}};
+  for (size_t b = 0; b < n; b += ZB) {
+    size_t cnt = n - b < ZB ? n - b : ZB, m = 0;
+    while (m < cnt && !is_huge((oc_vec3){x[b + m], y[b + m], 0}))
+      m++;
+    if (m == cnt) {
+      z0_block(&rc, x + b, y + b, cnt, out + b);
+      continue;
+    }
+    for (m = 0; m < cnt; m++) /* (huge or not finite: rare) */
+      out[b + m] = noise3(seed, (oc_vec3){x[b + m], y[b + m], 0}, NULL, 0);
   }
 }
 
