@@ -29,11 +29,9 @@ size_t oc_enode_size(const oc_enode *n) {
   case OC_E_BLEND:
     return offsetof(oc_eblend, kids) + OC_EBLEND(n)->nkids * sizeof(oc_enode *);
   case OC_E_REPLACE:
-    return offsetof(oc_ebin, par) + OC_EREPLACE_NPAR * sizeof(double);
+    return offsetof(oc_ebin, par);
   case OC_E_ADD:
-    return offsetof(oc_ebin, par) +
-           (n->flags & OC_EF_SLOPE ? OC_EADD_SLOPE_NPAR : OC_EADD_NPAR) *
-               sizeof(double);
+    return oc_eadd_size(n->flags);
   case OC_E_LOD:
     return offsetof(oc_ebin, par) + OC_ELOD_NPAR * sizeof(double);
   case OC_E_XFORM:

@@ -81,14 +81,19 @@ struct oc_enode {
 };
 
 /* Flags. */
-#define OC_EF_GLF 1   /* disc: gain and lacunarity are floats exactly */
-#define OC_EF_GLDEF 2 /* disc: they are 1/2 and 2 (not stored) */
-#define OC_EF_SLOPE 4 /* add: with a slope weight (OC_EADD_SLOPE_NPAR) */
+#define OC_EF_GLF 1    /* disc: gain and lacunarity are floats exactly */
+#define OC_EF_GLDEF 2  /* disc: they are 1/2 and 2 (not stored) */
+#define OC_EF_SLOPE 4  /* add: with a slope weight (its angle, fade, step) */
+#define OC_EF_SUMW 8   /* add: alpha = alpha_A + w^2 */
+#define OC_EF_BELOW 16 /* add: with an altitude weight (below_z, fade) */
+#define OC_EF_STEPF 32 /* add: the slope weight's step a float exactly */
+#define OC_EF_LERP 64  /* replace: the lerped weight */
 
-/* The parameters (doubles) operators store (eops.c, lod.c). */
-#define OC_EREPLACE_NPAR 1
-#define OC_EADD_NPAR 4
-#define OC_EADD_SLOPE_NPAR 7 /* with a slope weight: its angle, fade, step */
+/* The parameters (doubles) operators store (eops.c, lod.c). A replace
+** stores none (its weight is a flag); an add the altitude weight's
+** below_z and fade when it has one, then the slope weight's angle and
+** fade (radians) and its step (a float when OC_EF_STEPF) when it has one
+** (oc_eadd_size). */
 #define OC_ELOD_NPAR 3
 #define OC_EXFORM_NPAR 8
 #define OC_EWARP_NPAR 5
@@ -136,7 +141,8 @@ typedef struct oc_eblend {
   oc_enode *kids[]; /* retained */
 } oc_eblend;
 
-/* replace (72 bytes), add (96; 120 with a slope weight), lod (88). */
+/* replace (64 bytes), add (64; 80 with an altitude weight, 88 with a slope
+** weight, 100 with both and a step that is a float, else 104), lod (88). */
 typedef struct oc_ebin {
   oc_enode h;
   oc_erectf box;
@@ -152,6 +158,11 @@ typedef struct oc_eun {
   oc_enode *kid; /* retained */
   double par[];  /* eops.c */
 } oc_eun;
+
+static inline size_t oc_eadd_size(int flags) {
+  return offsetof(oc_ebin, par) + (flags & OC_EF_BELOW ? 16 : 0) +
+         (flags & OC_EF_SLOPE ? (flags & OC_EF_STEPF ? 20 : 24) : 0);
+}
 
 #define OC_EDISC(n) ((const oc_edisc *)(n))
 #define OC_EPRIM(n) ((const oc_eprim *)(n))
