@@ -360,6 +360,31 @@ static double below_w(const double *par, double z, double *d) {
   return t * t * (3 - 2 * t);
 }
 
+/* The altitude weight W(t), t = (below_z - f_A) / fade, over a region
+** where f_A lies in [A->flo, A->fhi]: t in [tlo, thi] (padded for the
+** rounding of t), W nondecreasing in t, so W <= W(thi), the return value;
+** and |dW/df_A| = 6 t (1 - t) / fade, largest at t = 1/2, so at most its
+** value at the point of [tlo, thi] nearest 1/2 (0 where the interval
+** misses (0, 1)), in *dw. With w = c W (c = clamp(alpha_B) <= chi),
+** |grad w| <= |grad c| W + c |dW/df_A| |grad f_A| <= lambda_c W(thi) +
+** chi *dw lambda_A: the 1.5 / fade lambda_A of the whole plane, times the
+** weight of B and the altitude weight's slope where f_A can be. */
+static double below_w_hi(double bz, double fade, const oc_ebound *A,
+                         double *dw) {
+  double pad =
+      1e-9 * (1 + (fabs(bz) + fmax(fabs(A->flo), fabs(A->fhi))) / fade);
+  double a = fmax((bz - A->fhi) / fade - pad, 0);
+  double b = fmin((bz - A->flo) / fade + pad, 1);
+  double d = 0;
+  if (a <= b) { /* (else t stays out of (0, 1): W is constant) */
+    double t = b < 0.5 ? b : a > 0.5 ? a : 0.5;
+    d = 6 * t * (1 - t) / fade * (1 + 1e-12);
+  }
+  *dw = d;
+  if (!(b < 1)) return 1;
+  return b <= 0 ? 0 : fmin(1, b * b * (3 - 2 * b) * (1 + 1e-12));
+}
+
 /* An add's parameters (enode.h): the altitude weight's, and the slope
 ** weight's after them, with its step. */
 static const double *add_below(const oc_enode *n) {
@@ -501,7 +526,8 @@ static void add_combine(const oc_enode *n, const oc_ebound *A,
     double wlo = clo, whi = fchi, lw = lc;
     if (below) {
       wlo = 0; /* the altitude weight may be 0 */
-      lw = lc + 1.5 / fade * A->lf;
+      double dw, Whi = below_w_hi(bz, fade, A, &dw);
+      lw = lc * Whi + chi * dw * A->lf;
     }
     if (slope) {
       /* |D| <= sqrt(2) lah keeps t below tmax, where the smoothstep's

@@ -649,6 +649,50 @@ START_TEST(bad_input) {
 }
 END_TEST
 
+/* The altitude weight's slope term of add in a box: chi |W'| lambda_A +
+** lambda_c W(thi), |W'| at most its value where f_A can be (6 t (1 - t) /
+** fade at the t nearest 1/2), against the whole plane's lambda_c + 1.5 /
+** fade lambda_A: never looser, often much tighter, and sound (every box's
+** bound holds on random pairs and gradients in it). */
+START_TEST(add_altitude_slope_bound) {
+  oc_error err;
+  oc_enode *a = disc(0, 0, 60, 10, OC_ENOISE_RIDGED, 12, 15, 4);
+  oc_enode *b = disc(8, -4, 30, 25, OC_ENOISE_PLAIN, 3, 8, 3);
+  oc_enode_add_params bp = {0, 1, 16, 5, 0, 0, 0, 0};
+  oc_enode *e = EOK(oc_enode_add(a, b, &bp, &err));
+  check_bounds(e, 5, 0, 35);
+  check_bounds(e, 5, 0, 4);
+  oct_rng r = oct_rng_new(31);
+  double sum = 0;
+  int n = 0, tighter = 0;
+  for (int i = 0; i < 400; i++) {
+    double w = pow(10, oct_unif(&r, -1, 1));
+    double x0 = oct_unif(&r, -30, 30), y0 = oct_unif(&r, -30, 30);
+    oc_enode_bound A, B, E;
+    oc_enode_bound_in(a, x0, y0, x0 + w, y0 + w, &A);
+    oc_enode_bound_in(b, x0, y0, x0 + w, y0 + w, &B);
+    oc_enode_bound_in(e, x0, y0, x0 + w, y0 + w, &E);
+    double chi = fmin(fmax(B.ahi, 0), 1);
+    /* the region's weight may be 0 (then E = A) or 1 (then no term) */
+    if (!(A.flo < 16 && A.fhi > 11 && chi > 0)) continue;
+    double old = A.lf +
+                 (B.la + 1.5 / 5 * A.lf) * fmax(fabs(B.flo), fabs(B.fhi)) +
+                 chi * B.lf;
+    ck_assert_msg(E.lf <= old * (1 + 1e-9), "box %d: %g > %g", i, E.lf, old);
+    sum += E.lf / old, n++;
+    tighter += E.lf < 0.8 * old;
+  }
+  printf("add: altitude weight's slope bound in %d boxes, mean %.3f of the "
+         "whole plane's rule, %d below 0.8 of it\n",
+         n, sum / n, tighter);
+  ck_assert_int_gt(n, 100);
+  ck_assert_int_gt(tighter, n / 4);
+  oc_enode_release(e);
+  oc_enode_release(a);
+  oc_enode_release(b);
+}
+END_TEST
+
 /* Rows (oc_enode_ev_row, and the source's height_weight_row) give every
 ** point's f and alpha bit for bit, for each kind of row code (discs of
 ** each noise, a lone disc's lazy zeros, blends, replaces plain and
@@ -737,6 +781,7 @@ int main(void) {
   tcase_add_test(tc, curve_river_road);
   tcase_add_test(tc, bad_input);
   tcase_add_test(tc, rows_match_points);
+  tcase_add_test(tc, add_altitude_slope_bound);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }
