@@ -121,7 +121,8 @@ START_TEST(bytes_per_kind) {
   oc_enode *add = EOK(oc_enode_add(plain, noisy, NULL, &err));
   oc_enode *addb = EOK(oc_enode_add(plain, noisy, &ap, &err));
   oc_enode *adds = EOK(oc_enode_add(plain, noisy, &as, &err));
-  oc_enode_add_params as1 = {1, 0, 0, 0, 1, 12, 10, 0.1}, asum = {1, 0, 0, 0, 0, 0, 0, 0};
+  oc_enode_add_params as1 = {1, 0, 0, 0, 1, 12, 10, 0.1},
+                      asum = {1, 0, 0, 0, 0, 0, 0, 0};
   oc_enode *adds1 = EOK(oc_enode_add(noisy, plain, &as1, &err));
   as1.below = 1, as1.below_z = 1e6, as1.fade = 5; /* (a weight of 1) */
   oc_enode *adds2 = EOK(oc_enode_add(noisy, plain, &as1, &err));
@@ -191,7 +192,7 @@ START_TEST(bytes_per_kind) {
                     oc_enode_size(bi) + bytes_of(img) + bytes_of(img2) - gb);
   oc_enode *all[] = {fl,  plain, noisy, odd, riv,  lake,  img,   img2,
                      bl,  rep,   lerp,  add, addb, adds,  moved, warp,
-                     lod, b5,    riv2,  bi,  imgc, adds1, adds2};
+                     lod, b5,    riv2,  bi,  imgc, adds1, adds2, addsum};
   for (size_t i = 0; i < sizeof all / sizeof *all; i++)
     oc_enode_release(all[i]);
   oc_heightfield_release(hf);
