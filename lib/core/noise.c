@@ -258,7 +258,8 @@ typedef struct row_cache {
 ** floor nor int64 conversion; this is two adds and a compare. */
 #define FLOOR_C 0x1.8p52
 static inline double floor_d(double x) {
-  double r = (x + FLOOR_C) - FLOOR_C;
+  double r = x + FLOOR_C; /* (each sum stored: rounded to a double even */
+  r = r - FLOOR_C;        /* where an FPU keeps more bits) */
   return r > x ? r - 1 : r;
 }
 
