@@ -248,7 +248,8 @@ double oc_noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad) {
 /* The corners' gradients of the current cell along a row. */
 typedef struct row_cache {
   uint64_t key, ci, cj, ck;
-  unsigned valid;      /* the cube corners of cell (ci, cj, ck) in cg */
+  unsigned valid;      /* the cube corners of cell (ci, cj, ck) in cg (0:
+                       ** no cell yet) */
   unsigned char cg[8]; /* corner di + 2 dj + 4 dk: its gradient index */
 } row_cache;
 
@@ -329,18 +330,24 @@ static void z0_block(row_cache *rc, const double *x, const double *y, size_t n,
     unsigned i2 = xy | xz, j2 = (!xy) | yz, k2 = (!xz) | (!yz);
     O1[0][m] = i1, O1[1][m] = j1, O1[2][m] = k1;
     O2[0][m] = i2, O2[1][m] = j2, O2[2][m] = k2;
-    if (i != rc->ci || j != rc->cj || k != rc->ck)
-      rc->ci = i, rc->cj = j, rc->ck = k, rc->valid = 0;
-    unsigned c[4] = {0, i1 | j1 << 1 | k1 << 2, i2 | j2 << 1 | k2 << 2, 7};
-    for (int q = 0; q < 4; q++) {
+    if (!rc->valid || i != rc->ci || j != rc->cj || k != rc->ck) {
+      /* a new cell: its first and last corners, which every simplex
+      ** in it has */
+      rc->ci = i, rc->cj = j, rc->ck = k, rc->valid = 0x81;
+      rc->cg[0] = (unsigned char)corner_grad(rc->key, i, j, k);
+      rc->cg[7] = (unsigned char)corner_grad(rc->key, i + 1, j + 1, k + 1);
+    }
+    unsigned c[2] = {i1 | j1 << 1 | k1 << 2, i2 | j2 << 1 | k2 << 2};
+    for (int q = 0; q < 2; q++) {
       unsigned b = c[q];
       if (!(rc->valid >> b & 1)) {
         rc->cg[b] = (unsigned char)corner_grad(rc->key, i + (b & 1),
                                                j + (b >> 1 & 1), k + (b >> 2));
         rc->valid |= 1u << b;
       }
-      G[q][m] = rc->cg[b];
     }
+    G[0][m] = rc->cg[0], G[1][m] = rc->cg[c[0]];
+    G[2][m] = rc->cg[c[1]], G[3][m] = rc->cg[7];
   }
 #pragma omp simd
   for (m = 0; m < n; m++) {
