@@ -245,6 +245,10 @@ double oc_noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad) {
 ** gradients, hashed once per lattice cell along the row. */
 #define ZB 64
 
+/* Cube corner di + 2 dj + 4 dk: (di, dj, dk). */
+static const double cube[8][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0},
+                                  {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
+
 /* The corners' gradients of the current cell along a row. */
 typedef struct row_cache {
   uint64_t key, ci, cj, ck;
@@ -301,8 +305,8 @@ static inline double corner_term(long long gi, double dx, double dy, double dz,
 static void z0_block(row_cache *rc, const double *x, const double *y, size_t n,
                      double *out) {
   double X0[ZB], Y0[ZB], Z0[ZB], FI[ZB], FJ[ZB], FK[ZB];
-  double O1[3][ZB], O2[3][ZB]; /* the second and third corners' steps */
-  long long G[4][ZB];          /* the four corners' gradient indices */
+  long long C1[ZB], C2[ZB]; /* the second and third corners (cube) */
+  long long G[4][ZB];       /* the four corners' gradient indices */
   /* (is_huge for z = 0: skewed coordinates then stay below 2^51) */
   size_t m = 0;
   for (; m + 2 <= n; m += 2) {
@@ -328,8 +332,6 @@ static void z0_block(row_cache *rc, const double *x, const double *y, size_t n,
     unsigned xy = x0 >= y0, xz = x0 >= z0, yz = y0 >= z0;
     unsigned i1 = xy & xz, j1 = (!xy) & yz, k1 = (!xz) & (!yz);
     unsigned i2 = xy | xz, j2 = (!xy) | yz, k2 = (!xz) | (!yz);
-    O1[0][m] = i1, O1[1][m] = j1, O1[2][m] = k1;
-    O2[0][m] = i2, O2[1][m] = j2, O2[2][m] = k2;
     if (!rc->valid || i != rc->ci || j != rc->cj || k != rc->ck) {
       /* a new cell: its first and last corners, which every simplex
       ** in it has */
@@ -346,6 +348,7 @@ static void z0_block(row_cache *rc, const double *x, const double *y, size_t n,
         rc->valid |= 1u << b;
       }
     }
+    C1[m] = c[0], C2[m] = c[1];
     G[0][m] = rc->cg[0], G[1][m] = rc->cg[c[0]];
     G[2][m] = rc->cg[c[1]], G[3][m] = rc->cg[7];
   }
@@ -353,10 +356,11 @@ static void z0_block(row_cache *rc, const double *x, const double *y, size_t n,
   for (m = 0; m < n; m++) {
     double x0 = X0[m], y0 = Y0[m], z0 = Z0[m], v = 0;
     v = corner_term(G[0][m], x0, y0, z0, v);
-    v = corner_term(G[1][m], x0 - O1[0][m] + G3, y0 - O1[1][m] + G3,
-                    z0 - O1[2][m] + G3, v);
-    v = corner_term(G[2][m], x0 - O2[0][m] + 2 * G3, y0 - O2[1][m] + 2 * G3,
-                    z0 - O2[2][m] + 2 * G3, v);
+    v = corner_term(G[1][m], x0 - cube[C1[m]][0] + G3, y0 - cube[C1[m]][1] + G3,
+                    z0 - cube[C1[m]][2] + G3, v);
+    v = corner_term(G[2][m], x0 - cube[C2[m]][0] + 2 * G3,
+                    y0 - cube[C2[m]][1] + 2 * G3, z0 - cube[C2[m]][2] + 2 * G3,
+                    v);
     v = corner_term(G[3][m], x0 - 1 + 3 * G3, y0 - 1 + 3 * G3, z0 - 1 + 3 * G3,
                     v);
     out[m] = 0.5 + SCALE * v;
