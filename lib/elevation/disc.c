@@ -261,21 +261,26 @@ static void noise_sum_row(const oc_enoise *nz, const double *u, double v,
   for (int j = 0; j < cnt; j++)
     sum[j] = 0, prev[j] = 1;
   for (int i = 0; i < nz->octaves; i++) {
+#pragma omp simd
     for (int j = 0; j < cnt; j++)
       px[j] = s * u[j], py[j] = s * v;
     oc_noise3_z0_row(octave_seed(nz->seed, i), px, py, (size_t)cnt, e);
+#pragma omp simd
     for (int j = 0; j < cnt; j++)
       e[j] = 2 * e[j] - 1; /* (oc_eta) */
     switch (nz->kind) {
     case OC_ENOISE_PLAIN:
+#pragma omp simd
       for (int j = 0; j < cnt; j++)
         sum[j] += a * e[j];
       break;
     case OC_ENOISE_TURBULENCE:
+#pragma omp simd
       for (int j = 0; j < cnt; j++)
         sum[j] += a * fabs(e[j]);
       break;
     default: /* ridged */
+#pragma omp simd
       for (int j = 0; j < cnt; j++) {
         double r = 1 - fabs(e[j]), w = 1;
         if (i > 0) {
