@@ -208,6 +208,10 @@ void oc_enode_ev_row(const oc_enode *n, const double *x, double y, int cnt,
     oc_edisc_ev_row(n, x, y, cnt, want, f, a);
     return;
   }
+  if (n->kind == OC_E_CURVE) {
+    oc_ecurve_ev_row(n, x, y, cnt, want, f, a);
+    return;
+  }
   if (oc_eop_ev_row(n, x, y, cnt, want, f, a)) return;
   for (int m = 0; m < cnt; m++) {
     oc_enode_sample s;

@@ -333,14 +333,17 @@ void oc_enode_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
 ** &s), want a mix of OC_EV_LAZY and OC_EV_ALPHA (f is not written under
 ** OC_EV_ALPHA); x finite and non-decreasing, y finite, cnt <= OC_EROW.
 ** A row shares per-row work (which children's boxes it crosses, the noise
-** octaves' keys, lattice corners' hashes) that points repeat. Discs,
-** blends and replaces have row code; other kinds take their points one
-** by one. */
+** octaves' keys, lattice corners' hashes, a curve's distance) that points
+** repeat. Discs, curves, blends and replaces have row code; other kinds
+** take their points one by one. */
 #define OC_EROW 64
 void oc_enode_ev_row(const oc_enode *n, const double *x, double y, int cnt,
                      int want, double *f, double *a);
 void oc_edisc_ev_row(const oc_enode *n, const double *x, double y, int cnt,
                      int want, double *f, double *a);
+/* a curve's: a row farther than its reach at once, else point by point */
+void oc_ecurve_ev_row(const oc_enode *n, const double *x, double y, int cnt,
+                      int want, double *f, double *a);
 /* blend and replace; 0 for the other operators (no row code) */
 int oc_eop_ev_row(const oc_enode *n, const double *x, double y, int cnt,
                   int want, double *f, double *a);
