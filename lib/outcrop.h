@@ -1156,6 +1156,12 @@ typedef struct oc_elevation {
   ** on every segment. */
   void (*bound)(void *ud, double x0, double y0, double x1, double y1,
                 double *lo, double *hi, double *slope);
+  /* Optional (NULL: height_weight point by point): for m < n, h[m] and
+  ** alpha[m] as height_weight(ud, x[m], y, NULL, &alpha[m], NULL) gives
+  ** them, bit for bit, x finite and non-decreasing (a row of a grid:
+  ** sampling shares per-row work). */
+  void (*height_weight_row)(void *ud, const double *x, double y, int n,
+                            double *h, double *alpha);
 } oc_elevation;
 
 /* The source of a heightfield: its Catmull-Rom interpolant over the grid's

@@ -156,6 +156,30 @@ static double dist2_at(const oc_vec3 *p, int n, double x, double y, double t) {
   return (q.x - x) * (q.x - x) + (q.y - y) * (q.y - y);
 }
 
+/* Whether the hull of the control points q (relative to the query point,
+** the origin) is provably farther than sqrt(best): their box in the frame
+** of the chord q0 qn (a tight box where an axis-aligned one is loose, as
+** for a diagonal piece), less a margin of 1e-9 of the points' size that
+** dwarfs the rounding of the frame, of the projections and of any curve
+** point's distance computed later. Then no point of the piece can improve
+** on best, so skipping it changes no result. */
+static int hull_far(const double *qx, const double *qy, int n, double best) {
+  double ux = qx[n] - qx[0], uy = qy[n] - qy[0], l = hypot(ux, uy), M = 0;
+  if (!(l > 0)) return 0;
+  ux /= l, uy /= l;
+  double alo = INFINITY, ahi = -INFINITY, clo = INFINITY, chi = -INFINITY;
+  for (int i = 0; i <= n; i++) {
+    double a = qx[i] * ux + qy[i] * uy, c = qy[i] * ux - qx[i] * uy;
+    alo = a < alo ? a : alo, ahi = a > ahi ? a : ahi;
+    clo = c < clo ? c : clo, chi = c > chi ? c : chi;
+    M = fmax(M, fmax(fabs(qx[i]), fabs(qy[i])));
+  }
+  double ga = alo > 0 ? alo : ahi < 0 ? -ahi : 0;
+  double gc = clo > 0 ? clo : chi < 0 ? -chi : 0;
+  double d = sqrt(ga * ga + gc * gc) - 1e-9 * M;
+  return d > 0 && d * d >= best;
+}
+
 double oc_bez_closest(const oc_vec3 *p, int n, double x, double y, double best2,
                       double *t) {
   double best = best2;
@@ -168,14 +192,15 @@ double oc_bez_closest(const oc_vec3 *p, int n, double x, double y, double best2,
     if (d2 < best) *t = u;
     return d2;
   }
-  double d0 = dist2_at(p, n, x, y, 0), d1 = dist2_at(p, n, x, y, 1);
-  if (d0 < best) best = d0, *t = 0;
-  if (d1 < best) best = d1, *t = 1;
-
   int m = 2 * n - 1;
   double qx[4], qy[4], dx[3], dy[3], f[6] = {0}, df[5];
   for (int i = 0; i <= n; i++)
     qx[i] = p[i].x - x, qy[i] = p[i].y - y;
+  if (hull_far(qx, qy, n, best)) return best2; /* (what the search gives) */
+  double d0 = dist2_at(p, n, x, y, 0), d1 = dist2_at(p, n, x, y, 1);
+  if (d0 < best) best = d0, *t = 0;
+  if (d1 < best) best = d1, *t = 1;
+
   for (int j = 0; j < n; j++)
     dx[j] = n * (qx[j + 1] - qx[j]), dy[j] = n * (qy[j + 1] - qy[j]);
   for (int i = 0; i <= n; i++)
@@ -203,7 +228,7 @@ double oc_bez_closest(const oc_vec3 *p, int n, double x, double y, double best2,
       ly = fmin(ly, s.qy[i]), hy = fmax(hy, s.qy[i]);
     }
     double bx = fmax(0, fmax(lx, -hx)), by = fmax(0, fmax(ly, -hy));
-    if (bx * bx + by * by >= best) continue;
+    if (bx * bx + by * by >= best || hull_far(s.qx, s.qy, n, best)) continue;
     /* A root on a split point may leave no sign change on either side. */
     if (s.f[0] == 0 && s.a > 0) {
       double d2 = dist2_at(p, n, x, y, s.a);

@@ -73,6 +73,15 @@ double oc_curve_length(const oc_pcurve *c);
 ** tangents. Returns 0 (out untouched) when s is NaN. */
 int oc_curve_at(const oc_pcurve *c, double s, oc_curve_point *out);
 
+/* 1 when every point of the segment (xa, ya) (xb, yb) is provably farther
+** than r from the curve in xy, so that oc_curve_closest(c, x, y, r, ...)
+** returns 0 at each of them; 0 when that is not shown. Each piece's
+** control points are boxed in the frame of its chord (tight for a
+** diagonal piece), the segment's distance to that box taken exactly, less
+** a margin of 1e-9 of the coordinates' size. */
+int oc_curve_far_from_segment(const oc_pcurve *c, double xa, double ya,
+                              double xb, double yb, double r);
+
 /* The closest point of the curve to (x, y) in xy, if it lies within r
 ** (r may be INFINITY): returns 1 and fills out (s, q, tangent, normal,
 ** signed d), else 0. The global minimum: pieces are pruned through a box

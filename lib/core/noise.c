@@ -155,6 +155,57 @@ static oc_vec3 reduce(oc_vec3 p) {
   return r;
 }
 
+/* The simplex of a point: its cell (skewed lattice coordinates), the
+** second and third corners' steps from it, and the offset to the first
+** corner. */
+typedef struct simplex {
+  uint64_t i, j, k;
+  unsigned i1, j1, k1, i2, j2, k2;
+  double x0, y0, z0;
+} simplex;
+
+/* Locates (x, y, z), a point that is not huge. */
+static inline void simplex_locate(double x, double y, double z, simplex *S) {
+  /* The cell, and p's offset in it, all in skewed space: fractional parts
+  ** are exact there, so large coordinates lose nothing more than the
+  ** rounding of x + s itself. */
+  double s = (x + y + z) * F3;
+  double xs = x + s, ys = y + s, zs = z + s;
+  int64_t ci = floor_i64(xs), cj = floor_i64(ys), ck = floor_i64(zs);
+  double fx = xs - (double)ci, fy = ys - (double)cj, fz = zs - (double)ck;
+  S->i = (uint64_t)ci, S->j = (uint64_t)cj, S->k = (uint64_t)ck;
+  double t = (fx + fy + fz) * G3;
+  double x0 = fx - t, y0 = fy - t, z0 = fz - t;
+  S->x0 = x0, S->y0 = y0, S->z0 = z0;
+
+  /* The simplex: the axes in decreasing order of the offset, the second
+  ** and third corners stepping along the first one and the first two.
+  ** Computed without branches, which would be mispredicted half the time. */
+  unsigned xy = x0 >= y0, xz = x0 >= z0, yz = y0 >= z0;
+  S->i1 = xy & xz, S->j1 = (!xy) & yz, S->k1 = (!xz) & (!yz);
+  S->i2 = xy | xz, S->j2 = (!xy) | yz, S->k2 = (!xz) | (!yz);
+}
+
+/* The raw sum of the four corners' terms, gi their gradient indices; the
+** gradient's in g when wg. */
+static inline double simplex_sum(const simplex *S, const unsigned gi[4],
+                                 double g[3], int wg) {
+  double x0 = S->x0, y0 = S->y0, z0 = S->z0, v = 0;
+  unsigned i1 = S->i1, j1 = S->j1, k1 = S->k1;
+  unsigned i2 = S->i2, j2 = S->j2, k2 = S->k2;
+  corner_add(gi[0], x0, y0, z0, &v, g, wg);
+  corner_add(gi[1], x0 - i1 + G3, y0 - j1 + G3, z0 - k1 + G3, &v, g, wg);
+  corner_add(gi[2], x0 - i2 + 2 * G3, y0 - j2 + 2 * G3, z0 - k2 + 2 * G3, &v, g,
+             wg);
+  corner_add(gi[3], x0 - 1 + 3 * G3, y0 - 1 + 3 * G3, z0 - 1 + 3 * G3, &v, g,
+             wg);
+  return v;
+}
+
+static inline uint64_t noise_key(uint64_t seed) {
+  return oc_mix64(seed ^ 0x8a5cd789635d2dffull);
+}
+
 /* n(p), with the gradient when wg (then grad is not NULL). */
 static inline double noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad, int wg) {
   if (is_huge(p)) {
@@ -164,35 +215,16 @@ static inline double noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad, int wg) {
     }
     p = reduce(p);
   }
-  double x = p.x, y = p.y, z = p.z;
-  /* The cell, and p's offset in it, all in skewed space: fractional parts
-  ** are exact there, so large coordinates lose nothing more than the
-  ** rounding of x + s itself. */
-  double s = (x + y + z) * F3;
-  double xs = x + s, ys = y + s, zs = z + s;
-  int64_t ci = floor_i64(xs), cj = floor_i64(ys), ck = floor_i64(zs);
-  double fx = xs - (double)ci, fy = ys - (double)cj, fz = zs - (double)ck;
-  uint64_t i = (uint64_t)ci, j = (uint64_t)cj, k = (uint64_t)ck;
-  double t = (fx + fy + fz) * G3;
-  double x0 = fx - t, y0 = fy - t, z0 = fz - t;
-
-  /* The simplex: the axes in decreasing order of the offset, the second
-  ** and third corners stepping along the first one and the first two.
-  ** Computed without branches, which would be mispredicted half the time. */
-  unsigned xy = x0 >= y0, xz = x0 >= z0, yz = y0 >= z0;
-  unsigned i1 = xy & xz, j1 = (!xy) & yz, k1 = (!xz) & (!yz);
-  unsigned i2 = xy | xz, j2 = (!xy) | yz, k2 = (!xz) | (!yz);
-
-  uint64_t key = oc_mix64(seed ^ 0x8a5cd789635d2dffull);
-  double v = 0, g[3] = {0, 0, 0};
-  corner_add(corner_grad(key, i, j, k), x0, y0, z0, &v, g, wg);
-  corner_add(corner_grad(key, i + i1, j + j1, k + k1), x0 - i1 + G3,
-             y0 - j1 + G3, z0 - k1 + G3, &v, g, wg);
-  corner_add(corner_grad(key, i + i2, j + j2, k + k2), x0 - i2 + 2 * G3,
-             y0 - j2 + 2 * G3, z0 - k2 + 2 * G3, &v, g, wg);
-  corner_add(corner_grad(key, i + 1, j + 1, k + 1), x0 - 1 + 3 * G3,
-             y0 - 1 + 3 * G3, z0 - 1 + 3 * G3, &v, g, wg);
-
+  simplex S;
+  simplex_locate(p.x, p.y, p.z, &S);
+  uint64_t key = noise_key(seed), i = S.i, j = S.j, k = S.k;
+  unsigned gi[4] = {
+      corner_grad(key, i, j, k),
+      corner_grad(key, i + S.i1, j + S.j1, k + S.k1),
+      corner_grad(key, i + S.i2, j + S.j2, k + S.k2),
+      corner_grad(key, i + 1, j + 1, k + 1),
+  };
+  double g[3] = {0, 0, 0}, v = simplex_sum(&S, gi, g, wg);
   if (wg) {
     grad->x = SCALE * g[0];
     grad->y = SCALE * g[1];
@@ -203,6 +235,152 @@ static inline double noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad, int wg) {
 
 double oc_noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad) {
   return grad ? noise3(seed, p, grad, 1) : noise3(seed, p, NULL, 0);
+}
+
+/* Rows go in blocks of ZB points, in three passes: locating the points in
+** the skewed lattice and summing the corners' terms are the same
+** arithmetic for every point (vector loops: `omp simd` asks for them, and
+** a vector lane rounds as the scalar code does, -ffp-contract=off keeping
+** products and sums apart); between them, the simplexes and the corners'
+** gradients, hashed once per lattice cell along the row. */
+#define ZB 64
+
+/* Cube corner di + 2 dj + 4 dk: (di, dj, dk). */
+static const double cube[8][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0},
+                                  {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
+
+/* The corners' gradients of the current cell along a row. */
+typedef struct row_cache {
+  uint64_t key, ci, cj, ck;
+  unsigned valid;      /* the cube corners of cell (ci, cj, ck) in cg (0:
+                       ** no cell yet) */
+  unsigned char cg[8]; /* corner di + 2 dj + 4 dk: its gradient index */
+} row_cache;
+
+/* floor(x) for |x| < 2^51 as a double, exactly (= (double)floor_i64(x)):
+** x + 1.5 2^52 rounds x to an integer, which the subtraction gives back
+** exactly, one less where it rounded up. Baseline x86-64 has no vector
+** floor nor int64 conversion; this is two adds and a compare. */
+#define FLOOR_C 0x1.8p52
+static inline double floor_d(double x) {
+  double r = x + FLOOR_C; /* (each sum stored: rounded to a double even */
+  r = r - FLOOR_C;        /* where an FPU keeps more bits) */
+  return r > x ? r - 1 : r;
+}
+
+/* Two points at a time (GCC's vector extensions, which clang shares): the
+** same operations as the scalar code, lane by lane. */
+typedef double v2d __attribute__((vector_size(16)));
+typedef long long v2l __attribute__((vector_size(16)));
+static inline v2d floor_v(v2d x) {
+  const v2d c = {FLOOR_C, FLOOR_C}, one = {1, 1};
+  v2d r = (x + c) - c;
+  v2l up = r > x; /* all ones where r rounded up */
+  return r - (v2d)((v2l)one & up);
+}
+
+/* The offset to the first corner and the cell of (x, y, 0) (not huge): a
+** point's simplex_locate, in parts. */
+static inline void locate_z0(double px, double py, double *x0, double *y0,
+                             double *z0, double *fi, double *fj, double *fk) {
+  double pz = 0, s = (px + py + pz) * F3;
+  double xs = px + s, ys = py + s, zs = pz + s;
+  *fi = floor_d(xs), *fj = floor_d(ys), *fk = floor_d(zs);
+  double fx = xs - *fi, fy = ys - *fj, fz = zs - *fk;
+  double t = (fx + fy + fz) * G3;
+  *x0 = fx - t, *y0 = fy - t, *z0 = fz - t;
+}
+
+/* v plus one corner's term, as corner_add adds it (value alone), its
+** gradient gr[.][m]. */
+static inline double corner_term(long long gi, double dx, double dy, double dz,
+                                 double v) {
+  double a = 0.5 - (dx * dx + dy * dy + dz * dz);
+  a = 0.5 * (a + fabs(a));
+  double t = grad12[gi][0] * dx + grad12[gi][1] * dy + grad12[gi][2] * dz;
+  double a2 = a * a, a3 = a2 * a;
+  return v + a3 * a * t;
+}
+
+static void z0_block(row_cache *rc, const double *x, const double *y, size_t n,
+                     double *out) {
+  double X0[ZB], Y0[ZB], Z0[ZB], FI[ZB], FJ[ZB], FK[ZB];
+  long long C1[ZB], C2[ZB]; /* the second and third corners (cube) */
+  long long G[4][ZB];       /* the four corners' gradient indices */
+  /* (is_huge for z = 0: skewed coordinates then stay below 2^51) */
+  size_t m = 0;
+  for (; m + 2 <= n; m += 2) {
+    const v2d f3 = {F3, F3}, g3 = {G3, G3}, zero = {0, 0};
+    v2d px = {x[m], x[m + 1]}, py = {y[m], y[m + 1]}, pz = zero;
+    v2d s = (px + py + pz) * f3;
+    v2d xs = px + s, ys = py + s, zs = pz + s;
+    v2d fi = floor_v(xs), fj = floor_v(ys), fk = floor_v(zs);
+    v2d fx = xs - fi, fy = ys - fj, fz = zs - fk;
+    v2d t = (fx + fy + fz) * g3;
+    v2d x0 = fx - t, y0 = fy - t, z0 = fz - t;
+    for (int l = 0; l < 2; l++) {
+      X0[m + l] = x0[l], Y0[m + l] = y0[l], Z0[m + l] = z0[l];
+      FI[m + l] = fi[l], FJ[m + l] = fj[l], FK[m + l] = fk[l];
+    }
+  }
+  for (; m < n; m++)
+    locate_z0(x[m], y[m], &X0[m], &Y0[m], &Z0[m], &FI[m], &FJ[m], &FK[m]);
+  for (m = 0; m < n; m++) {
+    uint64_t i = (uint64_t)(int64_t)FI[m], j = (uint64_t)(int64_t)FJ[m],
+             k = (uint64_t)(int64_t)FK[m];
+    double x0 = X0[m], y0 = Y0[m], z0 = Z0[m];
+    unsigned xy = x0 >= y0, xz = x0 >= z0, yz = y0 >= z0;
+    unsigned i1 = xy & xz, j1 = (!xy) & yz, k1 = (!xz) & (!yz);
+    unsigned i2 = xy | xz, j2 = (!xy) | yz, k2 = (!xz) | (!yz);
+    if (!rc->valid || i != rc->ci || j != rc->cj || k != rc->ck) {
+      /* a new cell: its first and last corners, which every simplex
+      ** in it has */
+      rc->ci = i, rc->cj = j, rc->ck = k, rc->valid = 0x81;
+      rc->cg[0] = (unsigned char)corner_grad(rc->key, i, j, k);
+      rc->cg[7] = (unsigned char)corner_grad(rc->key, i + 1, j + 1, k + 1);
+    }
+    unsigned c[2] = {i1 | j1 << 1 | k1 << 2, i2 | j2 << 1 | k2 << 2};
+    for (int q = 0; q < 2; q++) {
+      unsigned b = c[q];
+      if (!(rc->valid >> b & 1)) {
+        rc->cg[b] = (unsigned char)corner_grad(rc->key, i + (b & 1),
+                                               j + (b >> 1 & 1), k + (b >> 2));
+        rc->valid |= 1u << b;
+      }
+    }
+    C1[m] = c[0], C2[m] = c[1];
+    G[0][m] = rc->cg[0], G[1][m] = rc->cg[c[0]];
+    G[2][m] = rc->cg[c[1]], G[3][m] = rc->cg[7];
+  }
+#pragma omp simd
+  for (m = 0; m < n; m++) {
+    double x0 = X0[m], y0 = Y0[m], z0 = Z0[m], v = 0;
+    v = corner_term(G[0][m], x0, y0, z0, v);
+    v = corner_term(G[1][m], x0 - cube[C1[m]][0] + G3, y0 - cube[C1[m]][1] + G3,
+                    z0 - cube[C1[m]][2] + G3, v);
+    v = corner_term(G[2][m], x0 - cube[C2[m]][0] + 2 * G3,
+                    y0 - cube[C2[m]][1] + 2 * G3, z0 - cube[C2[m]][2] + 2 * G3,
+                    v);
+    v = corner_term(G[3][m], x0 - 1 + 3 * G3, y0 - 1 + 3 * G3, z0 - 1 + 3 * G3,
+                    v);
+    out[m] = 0.5 + SCALE * v;
+  }
+}
+
+void oc_noise3_z0_row(uint64_t seed, const double *x, const double *y, size_t n,
+                      double *out) {
+  row_cache rc = {noise_key(seed), 0, 0, 0, 0, {0}};
+  for (size_t b = 0; b < n; b += ZB) {
+    size_t cnt = n - b < ZB ? n - b : ZB, m = 0;
+    while (m < cnt && !is_huge((oc_vec3){x[b + m], y[b + m], 0}))
+      m++;
+    if (m == cnt) {
+      z0_block(&rc, x + b, y + b, cnt, out + b);
+      continue;
+    }
+    for (m = 0; m < cnt; m++) /* (huge or not finite: rare) */
+      out[b + m] = noise3(seed, (oc_vec3){x[b + m], y[b + m], 0}, NULL, 0);
+  }
 }
 
 double oc_turb3(uint64_t seed, int octaves, oc_vec3 p, oc_vec3 *grad) {

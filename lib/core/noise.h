@@ -10,6 +10,7 @@
 #ifndef OC_NOISE_H
 #define OC_NOISE_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "outcrop.h"
@@ -24,6 +25,12 @@ extern const double oc_noise3_hessian;
 
 /* n(p) in [0, 1]; stores the gradient in *grad when grad != NULL. */
 double oc_noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad);
+
+/* n(x[m], y[m], 0) for m < n, in out: oc_noise3's values bit for bit,
+** the lattice corners' hashes shared by consecutive points in one cell
+** (a row of nearby points: sampling elevation trees). */
+void oc_noise3_z0_row(uint64_t seed, const double *x, const double *y, size_t n,
+                      double *out);
 
 /* t(p); gradient when grad != NULL. octaves >= 1. */
 double oc_turb3(uint64_t seed, int octaves, oc_vec3 p, oc_vec3 *grad);

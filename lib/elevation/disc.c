@@ -251,6 +251,84 @@ void oc_edisc_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
   s->fy = g[1];
 }
 
+/* noise_sum without lod or gradient over the cnt points (u[j], v), into
+** sum[j]: per octave one key and one row of noise (corners' hashes shared
+** along the row), each point's sum the same octave by octave. */
+static void noise_sum_row(const oc_enoise *nz, const double *u, double v,
+                          int cnt, double *sum) {
+  double a = nz->amplitude, s = 1 / nz->wavelength;
+  double px[OC_EROW], py[OC_EROW], e[OC_EROW], prev[OC_EROW];
+  for (int j = 0; j < cnt; j++)
+    sum[j] = 0, prev[j] = 1;
+  for (int i = 0; i < nz->octaves; i++) {
+#pragma omp simd
+    for (int j = 0; j < cnt; j++)
+      px[j] = s * u[j], py[j] = s * v;
+    oc_noise3_z0_row(octave_seed(nz->seed, i), px, py, (size_t)cnt, e);
+#pragma omp simd
+    for (int j = 0; j < cnt; j++)
+      e[j] = 2 * e[j] - 1; /* (oc_eta) */
+    switch (nz->kind) {
+    case OC_ENOISE_PLAIN:
+#pragma omp simd
+      for (int j = 0; j < cnt; j++)
+        sum[j] += a * e[j];
+      break;
+    case OC_ENOISE_TURBULENCE:
+#pragma omp simd
+      for (int j = 0; j < cnt; j++)
+        sum[j] += a * fabs(e[j]);
+      break;
+    default: /* ridged */
+#pragma omp simd
+      for (int j = 0; j < cnt; j++) {
+        double r = 1 - fabs(e[j]), w = 1;
+        if (i > 0) {
+          w = RIDGE_GAIN * prev[j];
+          w = w >= 1 ? 1 : w <= 0 ? 0 : w;
+        }
+        double t = w * r * r;
+        sum[j] += a * t;
+        prev[j] = t;
+      }
+    }
+    a = a * nz->gain;
+    s *= nz->lacunarity;
+  }
+}
+
+void oc_edisc_ev_row(const oc_enode *n, const double *x, double y, int cnt,
+                     int want, double *f, double *a) {
+  const double *p = OC_EDISC(n)->par; /* cx, cy, r, height */
+  double v = y - p[1], r = p[2], u[OC_EROW], sum[OC_EROW];
+  int idx[OC_EROW], nn = 0; /* the points whose f is wanted */
+  for (int m = 0; m < cnt; m++) {
+    double um = x[m] - p[0], q = (um * um + v * v) / (r * r);
+    if (q < 1) {
+      double k = 1 - q;
+      a[m] = k * k * k;
+    } else {
+      a[m] = q == q ? 0 : q; /* NaN stays NaN */
+      if (want & OC_EV_LAZY && a[m] == 0) {
+        if (!(want & OC_EV_ALPHA)) f[m] = 0;
+        continue;
+      }
+    }
+    u[nn] = um, idx[nn++] = m;
+  }
+  if (want & OC_EV_ALPHA || !nn) return;
+  oc_enoise noise;
+  oc_edisc_noise(n, &noise);
+  if (noise.kind == OC_ENOISE_NONE) {
+    for (int j = 0; j < nn; j++)
+      f[idx[j]] = p[3] + 0;
+    return;
+  }
+  noise_sum_row(&noise, u, v, nn, sum);
+  for (int j = 0; j < nn; j++)
+    f[idx[j]] = p[3] + sum[j];
+}
+
 /* Distances from (cx, cy) to the nearest and farthest points of b. */
 static void rect_dist(const oc_erect *b, double cx, double cy, double *dmin,
                       double *dmax) {

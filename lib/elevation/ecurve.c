@@ -76,6 +76,27 @@ static size_t interval(const ecurve *d, double s, double *t, size_t *j) {
   return a;
 }
 
+void oc_ecurve_ev_row(const oc_enode *n, const double *x, double y, int cnt,
+                      int want, double *f, double *a) {
+  const ecurve *d = OC_EPRIM(n)->data;
+  /* lazy or alpha alone: the points farther than R have alpha = 0 and f
+  ** = 0, as oc_ecurve_ev finds (no closest point within R) */
+  if (want & (OC_EV_LAZY | OC_EV_ALPHA) && cnt > 0 &&
+      oc_curve_far_from_segment(d->c, x[0], y, x[cnt - 1], y, d->R)) {
+    for (int m = 0; m < cnt; m++) {
+      a[m] = 0;
+      if (!(want & OC_EV_ALPHA)) f[m] = 0;
+    }
+    return;
+  }
+  for (int m = 0; m < cnt; m++) {
+    oc_enode_sample s;
+    oc_ecurve_ev(n, x[m], y, NULL, want, &s);
+    a[m] = s.a;
+    if (!(want & OC_EV_ALPHA)) f[m] = s.f;
+  }
+}
+
 /* (No scale of a curve is dropped by the level of detail: ft unused.) */
 void oc_ecurve_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                   int want, oc_enode_sample *s) {

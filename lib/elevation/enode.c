@@ -29,11 +29,9 @@ size_t oc_enode_size(const oc_enode *n) {
   case OC_E_BLEND:
     return offsetof(oc_eblend, kids) + OC_EBLEND(n)->nkids * sizeof(oc_enode *);
   case OC_E_REPLACE:
-    return offsetof(oc_ebin, par) + OC_EREPLACE_NPAR * sizeof(double);
+    return offsetof(oc_ebin, par);
   case OC_E_ADD:
-    return offsetof(oc_ebin, par) +
-           (n->flags & OC_EF_SLOPE ? OC_EADD_SLOPE_NPAR : OC_EADD_NPAR) *
-               sizeof(double);
+    return oc_eadd_size(n->flags);
   case OC_E_LOD:
     return offsetof(oc_ebin, par) + OC_ELOD_NPAR * sizeof(double);
   case OC_E_XFORM:
@@ -202,6 +200,41 @@ void oc_enode_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
     oc_elod_ev(n, x, y, ft, want, s);
   else
     oc_eop_ev(n, x, y, ft, want, s);
+}
+
+void oc_enode_ev_row(const oc_enode *n, const double *x, double y, int cnt,
+                     int want, double *f, double *a) {
+  if (n->kind == OC_E_DISC) {
+    oc_edisc_ev_row(n, x, y, cnt, want, f, a);
+    return;
+  }
+  if (n->kind == OC_E_CURVE) {
+    oc_ecurve_ev_row(n, x, y, cnt, want, f, a);
+    return;
+  }
+  if (oc_eop_ev_row(n, x, y, cnt, want, f, a)) return;
+  for (int m = 0; m < cnt; m++) {
+    oc_enode_sample s;
+    oc_enode_ev(n, x[m], y, NULL, want, &s);
+    a[m] = s.a;
+    if (!(want & OC_EV_ALPHA)) f[m] = s.f;
+  }
+}
+
+void oc_enode_row_span(const oc_enode *k, const double *x, double y, int cnt,
+                       int *i0, int *i1) {
+  oc_erect b = oc_enode_box(k); /* (the doubles oc_enode_holds compares) */
+  int m = 0;
+  if (y >= b.y0 && y <= b.y1) {
+    while (m < cnt && !(x[m] >= b.x0))
+      m++;
+    *i0 = m;
+    while (m < cnt && x[m] <= b.x1)
+      m++;
+    *i1 = m;
+    return;
+  }
+  *i0 = *i1 = 0;
 }
 
 void oc_enode_bnd(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
@@ -388,6 +421,15 @@ static double src_height_weight(void *ud, double x, double y, double grad[2],
   return s.f;
 }
 
+/* Rows of height_weight (oc_elevation.height_weight_row), OC_EROW
+** samples at a time. */
+static void src_height_weight_row(void *ud, const double *x, double y, int n,
+                                  double *h, double *alpha) {
+  for (int m = 0; m < n; m += OC_EROW)
+    oc_enode_ev_row(ud, x + m, y, n - m < OC_EROW ? n - m : OC_EROW, 0, h + m,
+                    alpha + m);
+}
+
 static void src_weight_range(void *ud, double x0, double y0, double x1,
                              double y1, double *alo, double *ahi,
                              double *alip) {
@@ -446,6 +488,7 @@ int oc_enode_elevation(oc_enode *e, const double *domain, oc_elevation *src,
   src->retain = src_retain;
   src->release = src_release;
   src->height_weight = src_height_weight; /* Omega_T: where alpha >= 1/2 */
+  src->height_weight_row = src_height_weight_row;
   src->weight_range = src_weight_range;
   src->ud = e;
   src->x0 = d[0];

@@ -81,14 +81,19 @@ struct oc_enode {
 };
 
 /* Flags. */
-#define OC_EF_GLF 1   /* disc: gain and lacunarity are floats exactly */
-#define OC_EF_GLDEF 2 /* disc: they are 1/2 and 2 (not stored) */
-#define OC_EF_SLOPE 4 /* add: with a slope weight (OC_EADD_SLOPE_NPAR) */
+#define OC_EF_GLF 1    /* disc: gain and lacunarity are floats exactly */
+#define OC_EF_GLDEF 2  /* disc: they are 1/2 and 2 (not stored) */
+#define OC_EF_SLOPE 4  /* add: with a slope weight (its angle, fade, step) */
+#define OC_EF_SUMW 8   /* add: alpha = alpha_A + w^2 */
+#define OC_EF_BELOW 16 /* add: with an altitude weight (below_z, fade) */
+#define OC_EF_STEPF 32 /* add: the slope weight's step a float exactly */
+#define OC_EF_LERP 64  /* replace: the lerped weight */
 
-/* The parameters (doubles) operators store (eops.c, lod.c). */
-#define OC_EREPLACE_NPAR 1
-#define OC_EADD_NPAR 4
-#define OC_EADD_SLOPE_NPAR 7 /* with a slope weight: its angle, fade, step */
+/* The parameters (doubles) operators store (eops.c, lod.c). A replace
+** stores none (its weight is a flag); an add the altitude weight's
+** below_z and fade when it has one, then the slope weight's angle and
+** fade (radians) and its step (a float when OC_EF_STEPF) when it has one
+** (oc_eadd_size). */
 #define OC_ELOD_NPAR 3
 #define OC_EXFORM_NPAR 8
 #define OC_EWARP_NPAR 5
@@ -136,7 +141,8 @@ typedef struct oc_eblend {
   oc_enode *kids[]; /* retained */
 } oc_eblend;
 
-/* replace (72 bytes), add (96; 120 with a slope weight), lod (88). */
+/* replace (64 bytes), add (64; 80 with an altitude weight, 88 with a slope
+** weight, 100 with both and a step that is a float, else 104), lod (88). */
 typedef struct oc_ebin {
   oc_enode h;
   oc_erectf box;
@@ -152,6 +158,11 @@ typedef struct oc_eun {
   oc_enode *kid; /* retained */
   double par[];  /* eops.c */
 } oc_eun;
+
+static inline size_t oc_eadd_size(int flags) {
+  return offsetof(oc_ebin, par) + (flags & OC_EF_BELOW ? 16 : 0) +
+         (flags & OC_EF_SLOPE ? (flags & OC_EF_STEPF ? 20 : 24) : 0);
+}
 
 #define OC_EDISC(n) ((const oc_edisc *)(n))
 #define OC_EPRIM(n) ((const oc_eprim *)(n))
@@ -316,6 +327,30 @@ typedef struct oc_efootb {
 
 void oc_enode_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                  int want, oc_enode_sample *s);
+
+/* Rows (sampling: full detail, no gradients). For m < cnt, f[m] and a[m]
+** are bit for bit the f and alpha of oc_enode_ev(n, x[m], y, NULL, want,
+** &s), want a mix of OC_EV_LAZY and OC_EV_ALPHA (f is not written under
+** OC_EV_ALPHA); x finite and non-decreasing, y finite, cnt <= OC_EROW.
+** A row shares per-row work (which children's boxes it crosses, the noise
+** octaves' keys, lattice corners' hashes, a curve's distance) that points
+** repeat. Discs, curves, blends and replaces have row code; other kinds
+** take their points one by one. */
+#define OC_EROW 64
+void oc_enode_ev_row(const oc_enode *n, const double *x, double y, int cnt,
+                     int want, double *f, double *a);
+void oc_edisc_ev_row(const oc_enode *n, const double *x, double y, int cnt,
+                     int want, double *f, double *a);
+/* a curve's: a row farther than its reach at once, else point by point */
+void oc_ecurve_ev_row(const oc_enode *n, const double *x, double y, int cnt,
+                      int want, double *f, double *a);
+/* blend and replace; 0 for the other operators (no row code) */
+int oc_eop_ev_row(const oc_enode *n, const double *x, double y, int cnt,
+                  int want, double *f, double *a);
+/* The range [*i0, *i1) of x[0..cnt) that k's box holds on the line y
+** (oc_enode_holds' comparisons; x non-decreasing). */
+void oc_enode_row_span(const oc_enode *k, const double *x, double y, int cnt,
+                       int *i0, int *i1);
 
 /* Kinds' parts (disc.c, eops.c): evaluation and bounds in a box. */
 void oc_edisc_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,

@@ -32,13 +32,12 @@
 
 /* par slots */
 enum {
-  /* replace: 1 with the lerped weight */
-  P_LERP = 0,
-  /* add: sum weight, below, below_z, fade */
-  P_SUMW = 0,
-  P_BELOW = 1,
-  P_BZ = 2,
-  P_FADE = 3,
+  /* add, with an altitude weight: below_z, fade (add_below) */
+  P_BZ = 0,
+  P_FADE = 1,
+  /* add, with a slope weight: its angle and fade (add_slope) */
+  P_SLOPE = 0,
+  P_SFADE = 1,
   /* transform: the first row (cos, sin) / scale of the inverse rotation
   ** and scaling Minv = R^T / scale (its second row is (-sin, cos) /
   ** scale), translation, vscale, voffset, scale and angle; p' = Minv (p
@@ -251,7 +250,7 @@ static void replace_ev(const oc_enode *n, double x, double y,
   int grad = want & OC_EV_GRAD, in;
   const oc_enode *A = OC_EBIN(n)->kids[0], *B = OC_EBIN(n)->kids[1];
   oc_enode_sample a, b;
-  int lerp = OC_EBIN(n)->par[P_LERP] != 0;
+  int lerp = (n->flags & OC_EF_LERP) != 0;
   if (want & OC_EV_ALPHA) { /* alpha_A, or lerped with B's */
     oc_enode_ev(A, x, y, ft, OC_EV_ALPHA, &a);
     s->a = a.a;
@@ -299,7 +298,7 @@ static void replace_ev(const oc_enode *n, double x, double y,
 /* Bounds from A's and B's over one region. */
 static void replace_combine(const oc_enode *n, const oc_ebound *A,
                             const oc_ebound *B, int bmeets, oc_ebound *o) {
-  int lerp = OC_EBIN(n)->par[P_LERP] != 0;
+  int lerp = (n->flags & OC_EF_LERP) != 0;
   double wlo = bmeets ? fmin(fmax(B->alo, 0), 1) : 0;
   double whi = bmeets ? fmin(fmax(B->ahi, 0), 1) : 0;
   double law = bmeets ? B->la : 0;
@@ -319,7 +318,7 @@ static void replace_combine(const oc_enode *n, const oc_ebound *A,
   }
 }
 
-static oc_enode *binary(oc_ekind kind, oc_enode *a, oc_enode *b, size_t npar,
+static oc_enode *binary(oc_ekind kind, oc_enode *a, oc_enode *b, size_t size,
                         oc_error *err) {
   if (!a || !b) {
     oc_seterr(err, OC_EINVAL, "%s needs two elevation nodes",
@@ -327,8 +326,7 @@ static oc_enode *binary(oc_ekind kind, oc_enode *a, oc_enode *b, size_t npar,
     return NULL;
   }
   oc_enode *k[2] = {a, b};
-  return oc_enode_alloc(kind, offsetof(oc_ebin, par) + npar * sizeof(double), k,
-                        2, err);
+  return oc_enode_alloc(kind, size, k, 2, err);
 }
 
 /* Stores a binary operator's bound and box from its children's. */
@@ -341,9 +339,9 @@ static void store_binary(oc_enode *n, const oc_enode *a, const oc_enode *b) {
 }
 
 oc_enode *oc_enode_replace(oc_enode *a, oc_enode *b, int lerp, oc_error *err) {
-  oc_enode *n = binary(OC_E_REPLACE, a, b, OC_EREPLACE_NPAR, err);
+  oc_enode *n = binary(OC_E_REPLACE, a, b, offsetof(oc_ebin, par), err);
   if (!n) return NULL;
-  ((oc_ebin *)n)->par[P_LERP] = lerp != 0;
+  n->flags = lerp ? OC_EF_LERP : 0;
   store_binary(n, a, b);
   return n;
 }
@@ -362,9 +360,46 @@ static double below_w(const double *par, double z, double *d) {
   return t * t * (3 - 2 * t);
 }
 
-/* add's par slots after P_FADE: the slope weight's angle and fade
-** (radians) and step (0: none) */
-enum { P_SLOPE = 4, P_SFADE = 5, P_SSTEP = 6 };
+/* The altitude weight W(t), t = (below_z - f_A) / fade, over a region
+** where f_A lies in [A->flo, A->fhi]: t in [tlo, thi] (padded for the
+** rounding of t), W nondecreasing in t, so W <= W(thi), the return value;
+** and |dW/df_A| = 6 t (1 - t) / fade, largest at t = 1/2, so at most its
+** value at the point of [tlo, thi] nearest 1/2 (0 where the interval
+** misses (0, 1)), in *dw. With w = c W (c = clamp(alpha_B) <= chi),
+** |grad w| <= |grad c| W + c |dW/df_A| |grad f_A| <= lambda_c W(thi) +
+** chi *dw lambda_A: the 1.5 / fade lambda_A of the whole plane, times the
+** weight of B and the altitude weight's slope where f_A can be. */
+static double below_w_hi(double bz, double fade, const oc_ebound *A,
+                         double *dw) {
+  double pad =
+      1e-9 * (1 + (fabs(bz) + fmax(fabs(A->flo), fabs(A->fhi))) / fade);
+  double a = fmax((bz - A->fhi) / fade - pad, 0);
+  double b = fmin((bz - A->flo) / fade + pad, 1);
+  double d = 0;
+  if (a <= b) { /* (else t stays out of (0, 1): W is constant) */
+    double t = b < 0.5 ? b : a > 0.5 ? a : 0.5;
+    d = 6 * t * (1 - t) / fade * (1 + 1e-12);
+  }
+  *dw = d;
+  if (!(b < 1)) return 1;
+  return b <= 0 ? 0 : fmin(1, b * b * (3 - 2 * b) * (1 + 1e-12));
+}
+
+/* An add's parameters (enode.h): the altitude weight's, and the slope
+** weight's after them, with its step. */
+static const double *add_below(const oc_enode *n) {
+  return OC_EBIN(n)->par;
+}
+static const double *add_slope(const oc_enode *n) {
+  return OC_EBIN(n)->par + (n->flags & OC_EF_BELOW ? 2 : 0);
+}
+static double add_step(const oc_enode *n) {
+  const double *q = add_slope(n) + 2;
+  if (!(n->flags & OC_EF_STEPF)) return *q;
+  float f;
+  memcpy(&f, q, sizeof f);
+  return f;
+}
 
 /* The slope weight (Génevaux et al. 2015, section 5: an add weighted by
 ** the slope of A). A's slope is measured by central differences of f_A
@@ -386,8 +421,8 @@ enum { P_SLOPE = 4, P_SFADE = 5, P_SSTEP = 6 };
 ** *wy (want: OC_EV_GRAD or 0). */
 static double slope_w(const oc_enode *n, const oc_enode *A, double x, double y,
                       const oc_efoot *ft, int want, double *wx, double *wy) {
-  const double *par = OC_EBIN(n)->par;
-  double h = par[P_SSTEP];
+  const double *par = add_slope(n);
+  double h = add_step(n);
   oc_enode_sample e, w, no, so;
   /* every f is needed, also where alpha_A = 0: no OC_EV_LAZY; the
   ** footprint is p's, so each term is a function of p whose gradient the
@@ -419,7 +454,7 @@ static void add_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
   int grad = want & OC_EV_GRAD, in;
   const oc_enode *A = OC_EBIN(n)->kids[0], *B = OC_EBIN(n)->kids[1];
   oc_enode_sample a, b;
-  int sumw = OC_EBIN(n)->par[P_SUMW] != 0;
+  int sumw = (n->flags & OC_EF_SUMW) != 0;
   if (want & OC_EV_ALPHA) { /* alpha_A, or plus w_B^2 */
     oc_enode_ev(A, x, y, ft, OC_EV_ALPHA, &a);
     s->a = a.a;
@@ -442,8 +477,8 @@ static void add_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
   double c = clamp01(b.a, &in), cx = grad && in ? b.ax : 0,
          cy = grad && in ? b.ay : 0;
   double w = c, wx = cx, wy = cy;
-  if (OC_EBIN(n)->par[P_BELOW] != 0) {
-    double dW, W = below_w(OC_EBIN(n)->par, a.f, &dW);
+  if (n->flags & OC_EF_BELOW) {
+    double dW, W = below_w(add_below(n), a.f, &dW);
     w = c * W;
     wx = cx * W + c * dW * a.fx;
     wy = cy * W + c * dW * a.fy;
@@ -476,26 +511,28 @@ static void add_combine(const oc_enode *n, const oc_ebound *A,
   *o = *A;
   /* the altitude weight is 0 on the region where f_A >= below_z, 1
   ** where f_A <= below_z - fade (with a hair for the rounding of t) */
-  const double *par = OC_EBIN(n)->par;
-  int below = par[P_BELOW] != 0;
-  double bz = par[P_BZ], fade = par[P_FADE], fchi = chi;
+  const double *par = add_below(n), *sp = add_slope(n);
+  int below = (n->flags & OC_EF_BELOW) != 0;
+  double bz = below ? par[P_BZ] : 0, fade = below ? par[P_FADE] : 1;
+  double fchi = chi;
   if (below && A->flo >= bz) fchi = 0;
   if (below && A->fhi < bz - fade * (1 + 1e-9) - 1e-9 * fabs(bz)) below = 0;
   /* the slope weight is 1 on the region where |D| <= sqrt(2) lah stays
   ** below tan theta0 (with a hair for the rounding of D and atan) */
   int slope = (n->flags & OC_EF_SLOPE) != 0;
-  double h = slope ? par[P_SSTEP] : 0, th0 = slope ? par[P_SLOPE] : 0;
+  double h = slope ? add_step(n) : 0, th0 = slope ? sp[P_SLOPE] : 0;
   slope = slope && !(sqrt(2.0) * lah * (1 + 1e-9) < tan(th0) * (1 - 1e-9));
   if (fchi > 0) {
     double wlo = clo, whi = fchi, lw = lc;
     if (below) {
       wlo = 0; /* the altitude weight may be 0 */
-      lw = lc + 1.5 / par[P_FADE] * A->lf;
+      double dw, Whi = below_w_hi(bz, fade, A, &dw);
+      lw = lc * Whi + chi * dw * A->lf;
     }
     if (slope) {
       /* |D| <= sqrt(2) lah keeps t below tmax, where the smoothstep's
       ** slope 6 t (1 - t) is at most its value at tmax if tmax < 1/2 */
-      double c0 = cos(th0), phi = par[P_SFADE];
+      double c0 = cos(th0), phi = sp[P_SFADE];
       double tmax = (atan(sqrt(2.0) * lah) - th0) / phi * (1 + 1e-9) + 1e-9;
       tmax = fmax(tmax, 0);
       double ss = tmax < 0.5 ? 6 * tmax * (1 - tmax) : 1.5;
@@ -510,7 +547,7 @@ static void add_combine(const oc_enode *n, const oc_ebound *A,
     o->fhi = A->fhi + phi;
     o->lf = A->lf + lw * fmax(fabs(B->flo), fabs(B->fhi)) + whi * B->lf;
   }
-  if (par[P_SUMW] != 0) {
+  if (n->flags & OC_EF_SUMW) {
     o->alo = A->alo + clo * clo;
     o->ahi = A->ahi + chi * chi;
     o->la = A->la + 2 * chi * lc;
@@ -544,8 +581,8 @@ static void add_bound_in(const oc_enode *n, const oc_erect *b,
   double lah = 0;
   /* A's slope over the stencil's reach, where the slope weight counts */
   if ((n->flags & OC_EF_SLOPE) && meets && B.ahi > 0 &&
-      !(bn->par[P_BELOW] != 0 && A.flo >= bn->par[P_BZ])) {
-    double h = bn->par[P_SSTEP];
+      !(n->flags & OC_EF_BELOW && A.flo >= add_below(n)[P_BZ])) {
+    double h = add_step(n);
     oc_erect g = {b->x0 - h, b->y0 - h, b->x1 + h, b->y1 + h};
     oc_enode_bnd(bn->kids[0], &g, fb, &G);
     lah = G.lf;
@@ -590,19 +627,24 @@ oc_enode *oc_enode_add(oc_enode *a, oc_enode *b, const oc_enode_add_params *p,
       return NULL;
     }
   }
-  oc_enode *n =
-      binary(OC_E_ADD, a, b, p->slope ? OC_EADD_SLOPE_NPAR : OC_EADD_NPAR, err);
+  int flags = (p->sum_weight ? OC_EF_SUMW : 0) | (p->below ? OC_EF_BELOW : 0) |
+              (p->slope ? OC_EF_SLOPE : 0) |
+              (p->slope && (double)(float)step == step ? OC_EF_STEPF : 0);
+  oc_enode *n = binary(OC_E_ADD, a, b, oc_eadd_size(flags), err);
   if (!n) return NULL;
+  n->flags = (uint8_t)flags;
   double *par = ((oc_ebin *)n)->par;
-  par[P_SUMW] = p->sum_weight != 0;
-  par[P_BELOW] = p->below != 0;
-  par[P_BZ] = p->below_z;
-  par[P_FADE] = p->fade;
+  if (p->below) par[P_BZ] = p->below_z, par[P_FADE] = p->fade;
   if (p->slope) {
-    n->flags |= OC_EF_SLOPE;
-    par[P_SLOPE] = p->slope_deg * DEG;
-    par[P_SFADE] = p->slope_fade * DEG;
-    par[P_SSTEP] = step;
+    double *sp = par + (p->below ? 2 : 0);
+    sp[P_SLOPE] = p->slope_deg * DEG;
+    sp[P_SFADE] = p->slope_fade * DEG;
+    if (flags & OC_EF_STEPF) {
+      float f = (float)step;
+      memcpy(sp + 2, &f, sizeof f);
+    } else {
+      sp[2] = step;
+    }
   }
   store_binary(n, a, b);
   return n;
@@ -916,7 +958,8 @@ void oc_eop_derive(const oc_enode *n, const oc_ebound *kb, const oc_erect *kbox,
   case OC_E_ADD: {
     /* alpha may be > 0 where B alone is, with the summed or lerped
     ** weight */
-    int both = OC_EBIN(n)->par[n->kind == OC_E_REPLACE ? P_LERP : P_SUMW] != 0;
+    int both =
+        (n->flags & (n->kind == OC_E_REPLACE ? OC_EF_LERP : OC_EF_SUMW)) != 0;
     *box = both ? rect_union(kbox[0], kbox[1]) : kbox[0];
     oc_ebound B = kb[1];
     B.alo = 0;
@@ -939,6 +982,87 @@ void oc_eop_derive(const oc_enode *n, const oc_ebound *kb, const oc_erect *kbox,
     glob->la *= 1 + lip;
   }
   }
+}
+
+/* ---- rows (oc_enode_ev_row) -------------------------------------------- */
+
+/* blend_ev without gradients, a row at a time: each child on the span of
+** the row its box holds, the sums taken child by child as there. */
+static void blend_ev_row(const oc_enode *n, const double *x, double y, int cnt,
+                         int want, double *f, double *a) {
+  int only = want & OC_EV_ALPHA;
+  double N[OC_EROW], S[OC_EROW], kf[OC_EROW], ka[OC_EROW];
+  const oc_eblend *bl = OC_EBLEND(n);
+  for (int m = 0; m < cnt; m++)
+    N[m] = S[m] = 0;
+  for (size_t i = 0; i < bl->nkids; i++) {
+    const oc_enode *k = bl->kids[i];
+    int i0, i1;
+    oc_enode_row_span(k, x, y, cnt, &i0, &i1);
+    if (i0 >= i1) continue;
+    oc_enode_ev_row(k, x + i0, y, i1 - i0, OC_EV_LAZY | only, kf + i0, ka + i0);
+    for (int m = i0; m < i1; m++) {
+      if (only) {
+        S[m] += ka[m];
+        continue;
+      }
+      if (ka[m] == 0) continue;
+      N[m] += ka[m] * kf[m];
+      S[m] += ka[m];
+    }
+  }
+  for (int m = 0; m < cnt; m++) {
+    a[m] = S[m];
+    if (!only) f[m] = S[m] >= T ? N[m] / S[m] : N[m] / T;
+  }
+}
+
+/* replace_ev without gradients, a row at a time. A is evaluated lazily
+** only where the point would be (its f is not read where w >= 1). */
+static void replace_ev_row(const oc_enode *n, const double *x, double y,
+                           int cnt, int want, double *f, double *a) {
+  const oc_enode *A = OC_EBIN(n)->kids[0], *B = OC_EBIN(n)->kids[1];
+  int lerp = (n->flags & OC_EF_LERP) != 0, in, i0, i1;
+  double bf[OC_EROW], ba[OC_EROW], af[OC_EROW];
+  int only = want & OC_EV_ALPHA;
+  for (int m = 0; m < cnt; m++)
+    ba[m] = bf[m] = 0;
+  oc_enode_row_span(B, x, y, cnt, &i0, &i1);
+  if (only) {
+    oc_enode_ev_row(A, x, y, cnt, OC_EV_ALPHA, NULL, a);
+    if (!lerp) return;
+    if (i0 < i1)
+      oc_enode_ev_row(B, x + i0, y, i1 - i0, OC_EV_ALPHA, NULL, ba + i0);
+    for (int m = 0; m < cnt; m++) {
+      double w = clamp01(ba[m], &in);
+      a[m] = (1 - w) * a[m] + w * w;
+    }
+    return;
+  }
+  if (i0 < i1)
+    oc_enode_ev_row(B, x + i0, y, i1 - i0, OC_EV_LAZY, bf + i0, ba + i0);
+  int lazy = want & OC_EV_LAZY && !lerp;
+  oc_enode_ev_row(A, x, y, cnt, lazy ? OC_EV_LAZY : 0, af, a);
+  for (int m = 0; m < cnt; m++) {
+    double w = clamp01(ba[m], &in), fa = w >= 1 ? 0 : af[m];
+    if (lazy && a[m] == 0) {
+      f[m] = 0;
+      continue;
+    }
+    f[m] = (1 - w) * fa + w * bf[m];
+    if (lerp) a[m] = (1 - w) * a[m] + w * w;
+  }
+}
+
+int oc_eop_ev_row(const oc_enode *n, const double *x, double y, int cnt,
+                  int want, double *f, double *a) {
+  if (n->kind == OC_E_BLEND)
+    blend_ev_row(n, x, y, cnt, want, f, a);
+  else if (n->kind == OC_E_REPLACE)
+    replace_ev_row(n, x, y, cnt, want, f, a);
+  else
+    return 0;
+  return 1;
 }
 
 /* ---- dispatch --------------------------------------------------------- */

@@ -5,7 +5,8 @@
 ** over a source's domain and the sampling of a source into a grid.
 **
 ** Sampling calls height_weight (or height) once per sample, f and alpha
-** coming from one traversal of the tree; each sample depends on its
+** coming from one traversal of the tree (or height_weight_row, the same
+** values a row at a time); each sample depends on its
 ** position alone, so rows run on all cores and the grid is the same to
 ** the byte for any thread count.
 */
@@ -105,19 +106,33 @@ typedef struct sample_ctx {
   float hole;
 } sample_ctx;
 
+/* Samples along a row at a time, from the source's rows when it has them
+** (the same values as its points). */
+#define ROW_CHUNK 256
+
 static void sample_row(const void *ctx, oc_heightfield *out, int j) {
   const sample_ctx *c = ctx;
   const oc_elevation *s = c->src;
   int nx = oc_heightfield_nx(out);
   float *row = oc_heightfield_samples_mut(out) + (size_t)j * (size_t)nx;
   double y = c->y0 + j * c->cell;
-  for (int i = 0; i < nx; i++) {
-    double x = c->x0 + i * c->cell, a = 1, f;
-    if (s->height_weight)
-      f = s->height_weight(s->ud, x, y, NULL, &a, NULL);
-    else
-      f = s->height(s->ud, x, y, NULL);
-    row[i] = c->holes && !(a >= 0.5) ? c->hole : oc_heightfield_float(f);
+  double xs[ROW_CHUNK], fs[ROW_CHUNK], as[ROW_CHUNK];
+  for (int i0 = 0; i0 < nx; i0 += ROW_CHUNK) {
+    int n = nx - i0 < ROW_CHUNK ? nx - i0 : ROW_CHUNK;
+    for (int i = 0; i < n; i++) {
+      double x = c->x0 + (i0 + i) * c->cell;
+      xs[i] = x;
+      as[i] = 1;
+      if (s->height_weight_row) continue;
+      if (s->height_weight)
+        fs[i] = s->height_weight(s->ud, x, y, NULL, &as[i], NULL);
+      else
+        fs[i] = s->height(s->ud, x, y, NULL);
+    }
+    if (s->height_weight_row) s->height_weight_row(s->ud, xs, y, n, fs, as);
+    for (int i = 0; i < n; i++)
+      row[i0 + i] =
+          c->holes && !(as[i] >= 0.5) ? c->hole : oc_heightfield_float(fs[i]);
   }
 }
 

@@ -204,6 +204,53 @@ START_TEST(closest_matches_brute_force) {
 }
 END_TEST
 
+/* A segment said to be farther than r from the curve: every point of it
+** finds no closest point within r (and the reference distance is above
+** r); the test says so for most far segments, not for near ones. */
+#ifdef __SANITIZE_ADDRESS__ /* (fewer segments in the sanitizer pass) */
+#define FAR_SEGMENTS 100
+#else
+#define FAR_SEGMENTS 300
+#endif
+
+START_TEST(far_from_segment_is_sound) {
+  oct_rng r = oct_rng_new(23);
+  oc_curve_piece pcs[8];
+  int n = make_wiggle(pcs, 6, &r);
+  oc_pcurve *c = new_ok(pcs, n);
+  oc_aabb b = oc_curve_bounds(c, 40);
+  int far = 0, near = 0;
+  for (int k = 0; k < FAR_SEGMENTS; k++) {
+    double xa = oct_unif(&r, b.lo.x, b.hi.x), ya = oct_unif(&r, b.lo.y, b.hi.y);
+    double xb = xa + oct_unif(&r, -20, 20), yb = ya + oct_unif(&r, -3, 3);
+    double rad = oct_unif(&r, 0.5, 8);
+    if (!oc_curve_far_from_segment(c, xa, ya, xb, yb, rad)) {
+      near++;
+      continue;
+    }
+    far++;
+    for (int i = 0; i <= 40; i++) {
+      double t = i / 40.0, x = xa + t * (xb - xa), y = ya + t * (yb - ya);
+      oc_curve_point cp;
+      int bp;
+      double bt;
+      ck_assert(!oc_curve_closest(c, x, y, rad, &cp));
+      if (far <= 10 && i % 20 == 0) /* (the reference is slow) */
+        ck_assert(ref_closest(pcs, n, x, y, &bp, &bt) > rad);
+    }
+  }
+  ck_assert_msg(far > FAR_SEGMENTS / 6 && near > FAR_SEGMENTS / 15,
+                "far %d, near %d", far, near);
+  /* a segment through the curve, and a point on it, are never far */
+  oc_vec3 q = pcs[1].p[0];
+  ck_assert(!oc_curve_far_from_segment(c, q.x - 5, q.y, q.x + 5, q.y, 0.1));
+  ck_assert(!oc_curve_far_from_segment(c, q.x, q.y, q.x, q.y, 0));
+  ck_assert(
+      !oc_curve_far_from_segment(c, q.x + 50, q.y, q.x + 60, q.y, INFINITY));
+  oc_curve_free(c);
+}
+END_TEST
+
 START_TEST(closest_within_radius) {
   oc_curve_piece seg = {1, {{0, 0, 0}, {10, 0, 2}}};
   oc_pcurve *c = new_ok(&seg, 1);
@@ -600,6 +647,7 @@ int main(void) {
   tcase_set_timeout(tc, 300);
   tcase_add_test(tc, closest_matches_brute_force);
   tcase_add_test(tc, closest_within_radius);
+  tcase_add_test(tc, far_from_segment_is_sound);
   tcase_add_test(tc, signed_distance_sign);
   tcase_add_test(tc, arclength_quarter_circle);
   tcase_add_test(tc, frames_are_unit_and_left);

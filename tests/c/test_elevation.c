@@ -649,6 +649,138 @@ START_TEST(bad_input) {
 }
 END_TEST
 
+/* The altitude weight's slope term of add in a box: chi |W'| lambda_A +
+** lambda_c W(thi), |W'| at most its value where f_A can be (6 t (1 - t) /
+** fade at the t nearest 1/2), against the whole plane's lambda_c + 1.5 /
+** fade lambda_A: never looser, often much tighter, and sound (every box's
+** bound holds on random pairs and gradients in it). */
+/* The sanitizer pass checks memory on fewer rows and boxes (the release
+** pass runs them all). */
+#ifdef __SANITIZE_ADDRESS__
+#define ROWS_N 3
+#define ALT_BOXES 150
+#else
+#define ROWS_N 9
+#define ALT_BOXES 400
+#endif
+
+START_TEST(add_altitude_slope_bound) {
+  oc_error err;
+  oc_enode *a = disc(0, 0, 60, 10, OC_ENOISE_RIDGED, 12, 15, 4);
+  oc_enode *b = disc(8, -4, 30, 25, OC_ENOISE_PLAIN, 3, 8, 3);
+  oc_enode_add_params bp = {0, 1, 16, 5, 0, 0, 0, 0};
+  oc_enode *e = EOK(oc_enode_add(a, b, &bp, &err));
+#ifndef __SANITIZE_ADDRESS__ /* (the release pass checks soundness) */
+  check_bounds(e, 5, 0, 35);
+  check_bounds(e, 5, 0, 4);
+#endif
+  oct_rng r = oct_rng_new(31);
+  double sum = 0;
+  int n = 0, tighter = 0;
+  for (int i = 0; i < ALT_BOXES; i++) {
+    double w = pow(10, oct_unif(&r, -1, 1));
+    double x0 = oct_unif(&r, -30, 30), y0 = oct_unif(&r, -30, 30);
+    oc_enode_bound A, B, E;
+    oc_enode_bound_in(a, x0, y0, x0 + w, y0 + w, &A);
+    oc_enode_bound_in(b, x0, y0, x0 + w, y0 + w, &B);
+    oc_enode_bound_in(e, x0, y0, x0 + w, y0 + w, &E);
+    double chi = fmin(fmax(B.ahi, 0), 1);
+    /* the region's weight may be 0 (then E = A) or 1 (then no term) */
+    if (!(A.flo < 16 && A.fhi > 11 && chi > 0)) continue;
+    double old = A.lf +
+                 (B.la + 1.5 / 5 * A.lf) * fmax(fabs(B.flo), fabs(B.fhi)) +
+                 chi * B.lf;
+    ck_assert_msg(E.lf <= old * (1 + 1e-9), "box %d: %g > %g", i, E.lf, old);
+    sum += E.lf / old, n++;
+    tighter += E.lf < 0.8 * old;
+  }
+  printf("add: altitude weight's slope bound in %d boxes, mean %.3f of the "
+         "whole plane's rule, %d below 0.8 of it\n",
+         n, sum / n, tighter);
+  ck_assert_int_gt(n, ALT_BOXES / 4);
+  ck_assert_int_gt(tighter, n / 4);
+  oc_enode_release(e);
+  oc_enode_release(a);
+  oc_enode_release(b);
+}
+END_TEST
+
+/* Rows (oc_enode_ev_row, and the source's height_weight_row) give every
+** point's f and alpha bit for bit, for each kind of row code (discs of
+** each noise, a lone disc's lazy zeros, blends, replaces plain and
+** lerped) and the kinds that take points one by one, under each want;
+** rows crossing the children's boxes at their edges and beyond. */
+static int same(double a, double b) {
+  return !memcmp(&a, &b, sizeof a);
+}
+
+START_TEST(rows_match_points) {
+  oc_error err;
+  oc_enode *d[4] = {disc(0, 0, 600, 50, OC_ENOISE_PLAIN, 30, 200, 5),
+                    disc(150, 40, 180, 120, OC_ENOISE_RIDGED, 40, 60, 6),
+                    disc(-200, -60, 150, 80, OC_ENOISE_TURBULENCE, 20, 40, 4),
+                    disc(60, -30, 90, 30, OC_ENOISE_NONE, 0, 0, 0)};
+  oc_enode *land = EOK(oc_enode_blend(d, 4, &err));
+  oc_vec3 pts[3] = {{-500, -100, 40}, {0, 10, 45}, {500, 120, 50}};
+  oc_enode_river_params rp = {pts, 3, OC_ECURVE_CATMULL, OC_RIVER_RIVER, 0,
+                              0,   0};
+  oc_enode *river = EOK(oc_enode_river(&rp, &err));
+  oc_enode *rep = EOK(oc_enode_replace(land, river, 0, &err));
+  oc_enode *lrep = EOK(oc_enode_replace(land, d[1], 1, &err));
+  oc_enode_add_params ap = {0};
+  oc_enode *add = EOK(oc_enode_add(rep, d[2], &ap, &err));
+  oc_enode *top[3] = {add, lrep, d[3]};
+  oc_enode *mix = EOK(oc_enode_blend(top, 3, &err));
+  oc_enode *all[] = {d[0], d[1], d[2], d[3], land, rep, lrep, add, mix};
+  int wants[4] = {0, OC_EV_LAZY, OC_EV_ALPHA, OC_EV_LAZY | OC_EV_ALPHA};
+  size_t n = sizeof all / sizeof *all, checked = 0;
+  for (size_t t = 0; t < n; t++)
+    for (int row = 0; row < ROWS_N; row++) {
+#ifdef __SANITIZE_ADDRESS__
+      if (t % 3 != 2) continue; /* a disc, a replace, the whole tree */
+#endif
+      /* rows 1.3 m apart (points in one lattice cell share corners) or
+      ** 23 m, from outside the base disc across it */
+      double y = -650 + (row + 0.5) * 1300 / ROWS_N, dx = row % 2 ? 1.3 : 23;
+      double x[OC_EROW], f[OC_EROW], a[OC_EROW];
+      for (int m = 0; m < OC_EROW; m++)
+        x[m] = (row % 2 ? -40 : -700) + m * dx;
+      for (int w = 0; w < 4; w++) {
+        oc_enode_ev_row(all[t], x, y, OC_EROW, wants[w], f, a);
+        for (int m = 0; m < OC_EROW; m++) {
+          oc_enode_sample s;
+          oc_enode_ev(all[t], x[m], y, NULL, wants[w], &s);
+          ck_assert_msg(same(a[m], s.a), "%s alpha at (%g, %g): %.17g vs %.17g",
+                        oc_enode_kind(all[t]), x[m], y, a[m], s.a);
+          if (wants[w] & OC_EV_ALPHA) continue;
+          ck_assert_msg(same(f[m], s.f), "%s f at (%g, %g): %.17g vs %.17g",
+                        oc_enode_kind(all[t]), x[m], y, f[m], s.f);
+          checked += s.a > 0 && s.f != 0;
+        }
+      }
+    }
+  /* most points inside: real values */
+  ck_assert_uint_gt(checked, ROWS_N == 9 ? 2000 : 150);
+  /* the source's rows: any length (chunks of OC_EROW), = height_weight */
+  oc_elevation src;
+  ck_assert_int_eq(oc_enode_elevation(mix, NULL, &src, &err), OC_OK);
+  ck_assert(src.height_weight_row != NULL);
+  enum { LEN = 150 };
+  double x[LEN], h[LEN], al[LEN];
+  for (int m = 0; m < LEN; m++)
+    x[m] = -300 + 4 * m;
+  src.height_weight_row(src.ud, x, 25, LEN, h, al);
+  for (int m = 0; m < LEN; m++) {
+    double am, hm = src.height_weight(src.ud, x[m], 25, NULL, &am, NULL);
+    ck_assert(same(hm, h[m]) && same(am, al[m]));
+  }
+  src.release(src.ud);
+  for (size_t t = 0; t < n; t++)
+    oc_enode_release(all[t]);
+  oc_enode_release(river);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("elevation");
   TCase *tc = tcase_create("elevation");
@@ -664,6 +796,8 @@ int main(void) {
   tcase_add_test(tc, dag_stats_and_source);
   tcase_add_test(tc, curve_river_road);
   tcase_add_test(tc, bad_input);
+  tcase_add_test(tc, rows_match_points);
+  tcase_add_test(tc, add_altitude_slope_bound);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }

@@ -121,6 +121,12 @@ START_TEST(bytes_per_kind) {
   oc_enode *add = EOK(oc_enode_add(plain, noisy, NULL, &err));
   oc_enode *addb = EOK(oc_enode_add(plain, noisy, &ap, &err));
   oc_enode *adds = EOK(oc_enode_add(plain, noisy, &as, &err));
+  oc_enode_add_params as1 = {1, 0, 0, 0, 1, 12, 10, 0.1},
+                      asum = {1, 0, 0, 0, 0, 0, 0, 0};
+  oc_enode *adds1 = EOK(oc_enode_add(noisy, plain, &as1, &err));
+  as1.below = 1, as1.below_z = 1e6, as1.fade = 5; /* (a weight of 1) */
+  oc_enode *adds2 = EOK(oc_enode_add(noisy, plain, &as1, &err));
+  oc_enode *addsum = EOK(oc_enode_add(noisy, plain, &asum, &err));
   oc_enode_xform xf = {3, 4, 30, 2, 1.5, 2};
   oc_enode *moved = EOK(oc_enode_transform(noisy, &xf, &err));
   oc_enode_warp_params wp = {2, 200, 3, 9};
@@ -131,21 +137,37 @@ START_TEST(bytes_per_kind) {
   struct {
     oc_enode *e;
     size_t bytes;
-  } want[] = {{plain, 40}, {noisy, 80}, {fl, 88},    {odd, 96},  {riv, 96},
-              {lake, 96},  {img, 96},   {bl, 72},    {rep, 72},  {lerp, 72},
-              {add, 96},   {addb, 96},  {moved, 96}, {warp, 72}, {lod, 88}};
+  } want[] = {{plain, 40}, {noisy, 80}, {fl, 88},    {odd, 96},   {riv, 96},
+              {lake, 96},  {img, 96},   {bl, 72},    {rep, 64},   {lerp, 64},
+              {add, 64},   {addb, 80},  {adds, 100}, {adds1, 88}, {moved, 96},
+              {warp, 72},  {lod, 88}};
   for (size_t i = 0; i < sizeof want / sizeof *want; i++) {
     ck_assert_msg(oc_enode_size(want[i].e) == want[i].bytes,
                   "%s (%zu): %zu bytes, want %zu", oc_enode_kind(want[i].e), i,
                   oc_enode_size(want[i].e), want[i].bytes);
     ck_assert_uint_le(oc_enode_size(want[i].e), 100);
   }
-  /* an add with a slope weight: its three parameters (angle, fade, step)
-  ** past the other four, 24 bytes more; counted in the statistics */
-  ck_assert_uint_eq(oc_enode_size(adds), 96 + 3 * 8);
+  /* a replace keeps its weight in a flag; an add its weights' flags, the
+  ** altitude weight's two parameters and the slope weight's three (the
+  ** step a float when it is one exactly, as 3 is; 0.1 is not, and with
+  ** both weights that add is the one node over 100 bytes); counted in
+  ** the statistics, and each add evaluates as its parameters say */
+  ck_assert_uint_eq(oc_enode_size(adds2), 64 + 2 * 8 + 3 * 8);
   ck_assert_uint_eq(bytes_of(adds),
                     oc_enode_size(adds) + bytes_of(plain) + bytes_of(noisy));
-  ck_assert_uint_eq(bytes_of(addb), 96 + bytes_of(plain) + bytes_of(noisy));
+  ck_assert_uint_eq(bytes_of(addb), 80 + bytes_of(plain) + bytes_of(noisy));
+  int differ = 0, sloped = 0;
+  for (int i = 0; i < 400; i++) {
+    double x = -60 + (i % 20) * 6, y = -60 + (i / 20) * 6;
+    oc_enode_sample s1, s2, s0;
+    oc_enode_eval(adds1, x, y, &s1);
+    oc_enode_eval(adds2, x, y, &s2);
+    oc_enode_eval(addsum, x, y, &s0);
+    differ += s1.f != s2.f || s1.a != s2.a || s1.fx != s2.fx || s1.fy != s2.fy;
+    sloped += s1.f != s0.f; /* where the slope weight lets noisy in */
+  }
+  ck_assert_int_eq(differ, 0);
+  ck_assert_int_gt(sloped, 20);
   /* a blend: 56 bytes and 8 a child */
   oc_enode *k5[5] = {plain, noisy, odd, rep, add};
   oc_enode *b5 = EOK(oc_enode_blend(k5, 5, &err));
@@ -168,9 +190,9 @@ START_TEST(bytes_per_kind) {
   oc_enode *bi = EOK(oc_enode_blend(ki, 3, &err));
   ck_assert_uint_eq(bytes_of(bi),
                     oc_enode_size(bi) + bytes_of(img) + bytes_of(img2) - gb);
-  oc_enode *all[] = {fl,    plain, noisy, odd,  riv,  lake, img,
-                     img2,  bl,    rep,   lerp, add,  addb, adds,
-                     moved, warp,  lod,   b5,   riv2, bi,   imgc};
+  oc_enode *all[] = {fl,  plain, noisy, odd, riv,  lake,  img,   img2,
+                     bl,  rep,   lerp,  add, addb, adds,  moved, warp,
+                     lod, b5,    riv2,  bi,  imgc, adds1, adds2, addsum};
   for (size_t i = 0; i < sizeof all / sizeof *all; i++)
     oc_enode_release(all[i]);
   oc_heightfield_release(hf);

@@ -1003,6 +1003,43 @@ START_TEST(noise_huge_coordinates) {
 }
 END_TEST
 
+/* Rows on z = 0 are oc_noise3's values bit for bit: rows of every length
+** (odd ones take the scalar tail), dense (many points per lattice cell:
+** shared corners) and sparse, across zero and negative coordinates and
+** signed zeros, near the lattice's integers, and past the range where
+** coordinates are used as given (huge, infinite and NaN points). */
+static int same_bits(double a, double b) {
+  return !memcmp(&a, &b, sizeof a);
+}
+
+START_TEST(noise_rows_on_plane) {
+  oc_rng r = oc_rng_stream(21, 3);
+  enum { L = 150 };
+  double x[L], y[L], v[L];
+  int differ = 0, rows = 0;
+  for (int k = 0; k < 60; k++) {
+    int n = 1 + (int)(oc_rng_uniform(&r) * L);
+    double step = k % 3 == 0 ? 0.013 : k % 3 == 1 ? 0.4 : 3.7;
+    double x0 = (oc_rng_uniform(&r) - 0.5) * (k < 50 ? 40 : 1e15);
+    double y0 = (oc_rng_uniform(&r) - 0.5) * 40;
+    for (int m = 0; m < n; m++)
+      x[m] = x0 + m * step, y[m] = k % 2 ? y0 : y0 - m * step / 3;
+    if (k == 55) x[n / 2] = NAN, y[0] = INFINITY;
+    if (k == 56) x[0] = -0.0, y[0] = -0.0, x[n - 1] = 3 * 0x1p48;
+    if (k == 57) /* integers and their neighbours in skewed space */
+      for (int m = 0; m < n; m++)
+        x[m] = (m / 3) + (m % 3 - 1) * 0x1p-40, y[m] = 0;
+    oc_noise3_z0_row((uint64_t)k, x, y, (size_t)n, v);
+    for (int m = 0; m < n; m++)
+      differ +=
+          !same_bits(v[m], oc_noise3((uint64_t)k, oc_v3(x[m], y[m], 0), NULL));
+    rows++;
+  }
+  ck_assert_int_eq(rows, 60);
+  ck_assert_int_eq(differ, 0);
+}
+END_TEST
+
 /* ---- turbulence ------------------------------------------------------ */
 
 START_TEST(turbulence_bounds_and_definition) {
@@ -1129,6 +1166,7 @@ int main(void) {
   tcase_add_test(tc, noise_continuous_across_boundaries);
   tcase_add_test(tc, noise_matches_reference);
   tcase_add_test(tc, noise_huge_coordinates);
+  tcase_add_test(tc, noise_rows_on_plane);
   tcase_add_test(tc, turbulence_bounds_and_definition);
   tcase_add_test(tc, turbulence_gradient_and_lipschitz);
   tcase_add_test(tc, noise_hessian_on_planes);
