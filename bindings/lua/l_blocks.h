@@ -10,4 +10,9 @@
 /* Adds outcrop.blocks to the module table at the stack top. */
 void oclua_open_blocks(lua_State *L);
 
+/* Reads field `blocks` of a tile's options (authored blocks: box, points
+** or planes each, l_blocks_shapes.c) into Lua-owned memory held by one
+** value left on the stack (nil when absent); the count in *n. */
+const oc_block_shape *oclua_read_block_shapes(const oclua_fields *f, size_t *n);
+
 #endif

@@ -69,6 +69,8 @@ struct oc_btile {
   size_t thick;  /* degenerate clusters made thick polygons or points */
   size_t ncut;   /* pairs of blocks cut apart (separate.c) */
   size_t merged; /* small clusters merged into a neighbour (merge.c) */
+  size_t nauth;  /* authored blocks (authored.c), the last nauth of block */
+  oc_bblock *auth;
   double seconds;
 };
 
@@ -97,6 +99,21 @@ int oc_bclusters_merge(oc_btile *t, oc_error *err);
 /* Convex hulls of the clusters (hull.c): fills t->block, t->nb. */
 int oc_bhulls_make(oc_btile *t, oc_error *err);
 void oc_bblock_free(oc_bblock *b);
+
+/* qhull of the n points xyz into b's planes and vertices (hull.c): 0,
+** 1 when qhull failed (fewer than 4 points, flat), OC_ENOMEM. */
+int oc_bhull_points(double *xyz, size_t n, oc_bblock *b);
+/* b's box and thickness from its vertices and planes. */
+void oc_bblock_measure(oc_bblock *b);
+
+/* Authored blocks (authored.c): their hulls into t->auth (before the
+** points), the tile points inside them removed, the graph's edges
+** across them cut, and at the end generated blocks cut back by their
+** faces and the authored blocks appended to t->block. */
+int oc_bauthored_make(oc_btile *t, oc_error *err);
+void oc_bauthored_points(oc_btile *t);
+void oc_bauthored_cut(oc_btile *t);
+int oc_bauthored_finish(oc_btile *t, oc_error *err);
 
 /* Cuts overlapping blocks apart with a plane each (separate.c). */
 int oc_bblocks_separate(oc_btile *t, oc_error *err);

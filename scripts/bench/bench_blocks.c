@@ -32,7 +32,7 @@ static double cpu(void) {
 }
 
 static int tiles(void) {
-  for (int ty = 0; ty < OC_BLOCKS_NTYPES; ty++) {
+  for (int ty = 0; ty < OC_BLOCKS_TABLE1; ty++) {
     oc_btile_params pp;
     oc_btile_defaults((oc_block_type)ty, &pp);
     pp.seed = 2026;
