@@ -788,6 +788,9 @@ oc_node *oc_blocks_replicate(oc_node *terrain, const oc_replicate_params *rp,
 /* 1 and the count of instances (Table 2's #R) when n is a replication
 ** node, else 0. */
 int oc_blocks_instances(const oc_node *n, size_t *count);
+/* 1 and the bytes a replication node holds (Table 2's memory: the
+** blocks' fields, the instances and their grid), else 0. */
+int oc_blocks_memory(const oc_node *n, size_t *bytes);
 
 /* ---- heightfields ----------------------------------------------------- */
 

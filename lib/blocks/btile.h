@@ -125,6 +125,8 @@ oc_bfield *oc_bfield_new(const oc_bblock *b, double R, double W);
 /* The hull's box grown by W (f = 0 outside), and W. */
 oc_aabb oc_bfield_support(const oc_bfield *b);
 double oc_bfield_width(const oc_bfield *b);
+/* Bytes the field holds. */
+size_t oc_bfield_bytes(const oc_bfield *b);
 /* The rounded distance d (<= 0 inside) and its gradient. */
 double oc_bfield_dist(const oc_bfield *b, oc_vec3 p, oc_vec3 *g);
 /* sigma's constants for threshold T and width W, then f = sigma(-d). */
