@@ -12,9 +12,9 @@
 **  - steep walls only: |g . z| < slope, g the unit gradient;
 **  - with a geology node, its value (resistance) in the tile's range.
 ** The instances are kept in a uniform grid over their supports (cells of
-** GRID_CELL = 4 metres or more, about a block: 2 m cells took twice the
-** memory of the scenes of Table 2 for a query 10 % faster), so a query visits
-*only the instances of its
+** GRID_CELL = 4 metres or more, about a block: 2 m cells took 0.53 MB
+** instead of 0.22 MB for bench_blocks' sea spire, for a query 5 % faster),
+** so a query visits only the instances of its
 ** cell, and never evaluates presence. Blocks straddling a tile's faces are
 ** instances of the cell of their centroid and reach into the next cells
 ** as they are.

@@ -103,6 +103,21 @@ static int mesh(void) {
   return 0;
 }
 
+/* Blocks of the tiles rt over the terrain's steep walls (slope 0.5,
+** distance -2 .. 2): the replication node, or NULL with err. */
+static oc_node *on_walls(oc_node *ter, const oc_replicate_tile *rt, size_t n,
+                         oc_node *geo, oc_error *err) {
+  oc_replicate_params rp;
+  oc_replicate_defaults(&rp);
+  rp.tiles = rt;
+  rp.ntiles = n;
+  rp.geology = geo;
+  rp.slope = 0.5;
+  rp.va = -2;
+  rp.vb = 2;
+  return ter ? oc_blocks_replicate(ter, &rp, err) : NULL;
+}
+
 /* A 100 x 100 x 30 m box (falloff 8) with equidimensional blocks on its
 ** walls: the mean time of oc_program_eval at points of the slab x in
 ** [-4, 1] along the wall x = 0, one thread. */
@@ -115,14 +130,7 @@ static int query(void) {
   oc_node *box =
       oc_box((oc_vec3){0, 0, 0}, (oc_vec3){100, 100, 30}, 8, 1, &err);
   oc_replicate_tile rt = {t, 0, 0};
-  oc_replicate_params rp;
-  oc_replicate_defaults(&rp);
-  rp.tiles = &rt;
-  rp.ntiles = 1;
-  rp.slope = 0.5;
-  rp.va = -2;
-  rp.vb = 2;
-  oc_node *rep = t && box ? oc_blocks_replicate(box, &rp, &err) : NULL;
+  oc_node *rep = t ? on_walls(box, &rt, 1, NULL, &err) : NULL;
   oc_program *pr = rep ? oc_compile(rep, NULL, &err) : NULL;
   size_t ni = 0;
   if (rep) oc_blocks_instances(rep, &ni);
@@ -227,16 +235,8 @@ static int scenes(void) {
   for (int k = 0; k < 3 && !rc; k++) {
     oc_node *geo, *ter = scene_terrain(k, &geo, &err);
     oc_replicate_tile rt[2] = {{k == 2 ? rh : eq, 0.9, 2}, {tab, 0.4, 0.6}};
-    oc_replicate_params rp;
-    oc_replicate_defaults(&rp);
-    rp.tiles = rt;
-    rp.ntiles = k == 1 ? 2 : 1;
-    rp.geology = geo;
-    rp.slope = 0.5;
-    rp.va = -2;
-    rp.vb = 2;
     double c0 = cpu();
-    oc_node *rep = ter ? oc_blocks_replicate(ter, &rp, &err) : NULL;
+    oc_node *rep = on_walls(ter, rt, k == 1 ? 2 : 1, geo, &err);
     double c = cpu() - c0;
     size_t ni = 0, bytes = 0;
     if (rep) {
@@ -269,15 +269,7 @@ static int cliff_mesh(void) {
   oc_node *geo, *ter = scene_terrain(0, &geo, &err);
   oc_btile *eq = ter ? scene_tile(OC_BLOCKS_EQUIDIMENSIONAL, &err) : NULL;
   oc_replicate_tile rt = {eq, 0.9, 2};
-  oc_replicate_params rp;
-  oc_replicate_defaults(&rp);
-  rp.tiles = &rt;
-  rp.ntiles = 1;
-  rp.slope = 0.5;
-  rp.va = -2;
-  rp.vb = 2;
-  rp.geology = geo;
-  oc_node *rep = eq ? oc_blocks_replicate(ter, &rp, &err) : NULL;
+  oc_node *rep = eq ? on_walls(ter, &rt, 1, geo, &err) : NULL;
   oc_program *pr = rep ? oc_compile(rep, NULL, &err) : NULL;
   oc_node_release(rep);
   oc_node_release(ter);
