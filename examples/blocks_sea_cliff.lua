@@ -32,11 +32,8 @@ local wet = oc.box{min = {-40, -80, -20}, max = {160, 80, 0.5}, falloff = 0.1,
                    energy = 4}
 local palette = {{0.0, {0.42, 0.36, 0.30}}, {1.0, {0.42, 0.36, 0.30}},
                  {1.5, {0.10, 0.25, 0.35}}, {4.0, {0.10, 0.25, 0.35}}}
-local view = oc.intersection{oc.union{rock, sea},
-                             oc.box{min = {0, -80, -20}, max = {120, 80, 60},
-                                    falloff = 0.05}}
-oc.render(view, {camera = {eye = {60, -95, 34}, target = {60, 0, 10}, fov = 40},
-                 size = {480, 270}, color = wet, palette = palette,
-                 sun = {direction = {-0.5, -0.6, 0.6}, intensity = 1.3}})
+oc.render(oc.union{rock, sea},
+          {camera = {eye = {60, -95, 34}, target = {60, 0, 10}, fov = 40},
+           size = {480, 270}, color = wet, palette = palette})
   :write("blocks_sea_cliff.png")
 print("blocks_sea_cliff: wrote blocks_sea_cliff.png")
