@@ -23,16 +23,42 @@
 
 #define KEY_ORDER 0x6f72646572ull
 #define NONE UINT32_MAX
+/* the candidate images are those near the cluster's box grown by this
+** many k r (remade when the box leaves it) */
+#define CACHE_GROW 2.0
 
 typedef struct grow {
   oc_btile *t;
   const oc_bimage *im;
   size_t nim;
   const oc_bimage **near; /* the images meeting the cluster's box */
-  uint32_t *mem;          /* members, in order of joining */
+  /* the images meeting the box clo .. chi (the cluster's box grown by
+  ** CACHE_GROW k r when last made), in the order of im: may_join looks
+  ** through these only */
+  const oc_bimage **cand;
+  size_t ncand;
+  double clo[3], chi[3];
+  uint32_t *mem; /* members, in order of joining */
   size_t nm;
   double lo[3], hi[3];
 } grow;
+
+/* Remakes the list of candidate images for the box lo .. hi grown. */
+static void cache(grow *w, const double *lo, const double *hi) {
+  double g = CACHE_GROW * w->t->pp.neighbour * w->t->pp.radius;
+  for (int a = 0; a < 3; a++) {
+    w->clo[a] = lo[a] - g;
+    w->chi[a] = hi[a] + g;
+  }
+  w->ncand = 0;
+  for (size_t d = 0; d < w->nim; d++) {
+    const oc_aabb *b = &w->im[d].box;
+    if (b->lo.x > w->chi[0] || b->hi.x < w->clo[0] || b->lo.y > w->chi[1] ||
+        b->hi.y < w->clo[1] || b->lo.z > w->chi[2] || b->hi.z < w->clo[2])
+      continue;
+    w->cand[w->ncand++] = &w->im[d];
+  }
+}
 
 /* May the point at q (unwrapped) join the cluster? */
 static int may_join(grow *w, const double *q) {
@@ -43,14 +69,17 @@ static int may_join(grow *w, const double *q) {
     hi[a] = fmax(w->hi[a], q[a]);
     if (hi[a] - lo[a] > most) return 0;
   }
+  if (lo[0] < w->clo[0] || lo[1] < w->clo[1] || lo[2] < w->clo[2] ||
+      hi[0] > w->chi[0] || hi[1] > w->chi[1] || hi[2] > w->chi[2])
+    cache(w, lo, hi);
   size_t nn = 0;
-  for (size_t d = 0; d < w->nim; d++) {
-    const oc_aabb *b = &w->im[d].box;
+  for (size_t d = 0; d < w->ncand; d++) {
+    const oc_aabb *b = &w->cand[d]->box;
     if (b->lo.x > hi[0] || b->hi.x < lo[0] || b->lo.y > hi[1] ||
         b->hi.y < lo[1] || b->lo.z > hi[2] || b->hi.z < lo[2])
       continue;
     /* the disc's plane must cross the box too */
-    const oc_bimage *D = &w->im[d];
+    const oc_bimage *D = w->cand[d];
     double ctr = (0.5 * (lo[0] + hi[0]) - D->c.x) * D->n.x +
                  (0.5 * (lo[1] + hi[1]) - D->c.y) * D->n.y +
                  (0.5 * (lo[2] + hi[2]) - D->c.z) * D->n.z;
@@ -96,6 +125,7 @@ static void flood(grow *w, uint32_t i, uint32_t c, uint32_t *tried) {
   w->nm = 0;
   for (int a = 0; a < 3; a++)
     w->lo[a] = w->hi[a] = t->pts[3 * (size_t)i + a];
+  cache(w, w->lo, w->hi);
   join(w, i, c, t->pts + 3 * (size_t)i);
   for (size_t head = 0; head < w->nm; head++) {
     uint32_t u = w->mem[head];
@@ -136,7 +166,8 @@ int oc_bclusters_make(oc_btile *t, oc_error *err) {
   if (oc_bdiscs_images(t, in, &im, &w.nim, err)) goto done;
   w.im = im;
   w.near = malloc((w.nim ? w.nim : 1) * sizeof *w.near);
-  if (!w.near) goto done;
+  w.cand = malloc((w.nim ? w.nim : 1) * sizeof *w.cand);
+  if (!w.near || !w.cand) goto done;
   for (size_t i = 0; i < n; i++) {
     order[i] = (uint32_t)i;
     t->label[i] = NONE;
@@ -160,6 +191,7 @@ done:
   free(tried);
   free(w.mem);
   free(w.near);
+  free(w.cand);
   free(im);
   return rc;
 }
