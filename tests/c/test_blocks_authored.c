@@ -16,9 +16,9 @@
 #include "outcrop.h"
 
 #ifdef __SANITIZE_ADDRESS__
-#define SAMPLES 4000
+#define SAMPLES 2000
 #else
-#define SAMPLES 20000
+#define SAMPLES 8000
 #endif
 
 static void small(oc_block_type type, oc_btile_params *pp) {
