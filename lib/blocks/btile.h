@@ -82,6 +82,9 @@ int oc_bdiscs_images(const oc_btile *t, oc_aabb in, oc_bimage **out, size_t *n,
                      oc_error *err);
 /* 1 when segment [p, q] crosses the image's disc. */
 int oc_bimage_cuts(const oc_bimage *d, const double *p, const double *q);
+/* The same with p's and q's signed distances a, b to the plane known. */
+int oc_bimage_cuts_at(const oc_bimage *d, const double *p, const double *q,
+                      double a, double b);
 
 /* Builds t->g (edges shorter than neighbour * radius, periodic) and marks
 ** the edges the discs cut (graph.c). */

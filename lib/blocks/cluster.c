@@ -122,7 +122,7 @@ static int may_join(grow *w, const double *q) {
       const double *p = w->t->unwrap + 3 * (size_t)w->mem[m];
       double a = side(D, p);
       if ((a > 0 && b > 0) || (a < 0 && b < 0)) continue;
-      if (oc_bimage_cuts(D, p, q)) return 0;
+      if (oc_bimage_cuts_at(D, p, q, a, b)) return 0;
     }
   }
   return 1;
