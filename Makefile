@@ -295,7 +295,11 @@ PICTURES := demo_arch_render.png:demo:arch_render.png \
   example_layers_arches.png:layers_arches:layers_arches.png \
   example_layers_caves.png:layers_caves:layers_caves.png \
   example_layers_canyon.png:layers_canyon:layers_canyon.png \
-  example_blocks_types.png:blocks_types:blocks_types.png
+  example_blocks_types.png:blocks_types:blocks_types.png \
+  example_blocks_authored.png:blocks_authored:blocks_authored.png \
+  example_blocks_canyon.png:blocks_canyon:blocks_canyon.png \
+  example_blocks_sea_cliff.png:blocks_sea_cliff:blocks_sea_cliff.png \
+  example_blocks_sea_spire.png:blocks_sea_spire:blocks_sea_spire.png
 PICTURE_SCENES := $(sort $(foreach p,$(PICTURES),$(word 2,$(subst :, ,$(p)))))
 
 pictures: all

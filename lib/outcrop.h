@@ -694,14 +694,33 @@ typedef enum oc_block_type {
   OC_BLOCKS_POLYHEDRAL,      /* random normals, more discs */
   OC_BLOCKS_TABULAR,         /* bedding discs of radius s, rare small cross
                              ** discs of radius s / 10 */
+  /* extensions (not in Table 1): */
+  OC_BLOCKS_PRISMATIC, /* axis-aligned sets tilted up to 20 degrees */
+  OC_BLOCKS_COLUMNAR,  /* three vertical sets 60 degrees apart, sparse
+                       ** horizontal joints */
   OC_BLOCKS_NTYPES
 } oc_block_type;
+/* The four types of Table 1 are the first OC_BLOCKS_TABLE1. */
+#define OC_BLOCKS_TABLE1 4
 
 /* A user-placed fracture disc. */
 typedef struct oc_block_disc {
   oc_vec3 center, normal; /* normal: any non-zero length */
   double radius;
 } oc_block_disc;
+
+/* An authored block: the convex hull of `points` (3 doubles each, at
+** least 4 not coplanar), or, when npoints is 0, the intersection of the
+** half-spaces n . p + d <= 0 of `planes` (4 doubles each, bounded). Tile
+** points inside it are removed, edges across its boundary cut, generated
+** blocks reaching into it cut back by its faces, and it becomes a block
+** of the tile itself (the last ones, in order). */
+typedef struct oc_block_shape {
+  const double *points;
+  size_t npoints;
+  const double *planes;
+  size_t nplanes;
+} oc_block_shape;
 
 typedef struct oc_btile_params {
   oc_block_type type;
@@ -719,6 +738,8 @@ typedef struct oc_btile_params {
   uint64_t seed;
   const oc_block_disc *discs; /* user discs, added to the thrown ones */
   size_t ndiscs;
+  const oc_block_shape *blocks; /* authored blocks (borrowed, copied) */
+  size_t nblocks;
 } oc_btile_params;
 
 /* The defaults of type `type` (Table 1) into *pp. */
@@ -738,6 +759,7 @@ typedef struct oc_btile_stats {
   size_t points, fractures, blocks, edges, cut, thick;
   size_t separated;        /* pairs of overlapping hulls cut apart */
   size_t merged;           /* clusters of < 8 points merged into another */
+  size_t authored;         /* authored blocks (the last ones) */
   double points_per_block; /* mean points of a block */
   double seconds;          /* wall time of oc_btile_new */
 } oc_btile_stats;
@@ -797,6 +819,9 @@ int oc_blocks_instances(const oc_node *n, size_t *count);
 ** out of range. */
 int oc_blocks_instance(const oc_node *n, size_t i, size_t *block,
                        double off[3]);
+/* 1 and the bytes a replication node holds (Table 2's memory: the
+** blocks' fields, the instances and their grid), else 0. */
+int oc_blocks_memory(const oc_node *n, size_t *bytes);
 
 /* ---- heightfields ----------------------------------------------------- */
 

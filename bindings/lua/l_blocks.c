@@ -5,12 +5,15 @@
 **
 ** outcrop.blocks.tile{type =, size =, radius =, neighbour =, fractures =,
 **   spacing =, disc_radius = {lo, hi}, rounding =, width =, seed =,
-**   discs = {{center =, normal =, radius =}, ...}}
+**   discs = {{center =, normal =, radius =}, ...}, blocks = {{box =} or
+**   {points =} or {planes =}, ...}}
 ** Defaults: type "equidimensional" (or "rhombohedral", "polyhedral",
 ** "tabular"), size 20, radius 0.75, neighbour 2, fractures Table 1's
 ** (15, 24, 44, 30), spacing 2 (1 polyhedral), disc_radius {7, 11}
 ** equidimensional, {4, 6} rhombohedral, {2.5, 3.5} polyhedral,
-** rounding 0.25, width 0.75, seed = the scene seed, discs none.
+** rounding 0.25, width 0.75, seed = the scene seed, discs none, blocks
+** none (authored blocks: l_blocks_shapes.c). Also "prismatic" and
+** "columnar" (extensions).
 **
 ** outcrop.blocks.replicate(terrain, {tiles = {{tile =, resistance = {lo,
 **   hi}}, ...}, geology =, slope = 1, distance = {-1, 1}, anchors = 9})
@@ -80,10 +83,12 @@ static oc_block_disc *read_discs(const oclua_fields *f, size_t *n) {
 
 static int l_tile(lua_State *L) {
   static const char *const known[] = {
-      "type",        "size",     "radius", "neighbour", "fractures", "spacing",
-      "disc_radius", "rounding", "width",  "seed",      "discs",     NULL};
-  static const char *const types[] = {"equidimensional", "rhombohedral",
-                                      "polyhedral", "tabular", NULL};
+      "type",    "size",        "radius",   "neighbour", "fractures",
+      "spacing", "disc_radius", "rounding", "width",     "seed",
+      "discs",   "blocks",      NULL};
+  static const char *const types[] = {
+      "equidimensional", "rhombohedral", "polyhedral", "tabular",
+      "prismatic",       "columnar",     NULL};
   const char *fname = "outcrop.blocks.tile";
   oclua_fields f;
   oc_btile_params pp;
@@ -113,6 +118,7 @@ static int l_tile(lua_State *L) {
   pp.width = oclua_field_optnumber(&f, "width", OCLUA_POSITIVE, pp.width);
   pp.seed = oclua_field_seed(&f, "seed");
   pp.discs = read_discs(&f, &pp.ndiscs);
+  pp.blocks = oclua_read_block_shapes(&f, &pp.nblocks);
   oclua_btile *u = lua_newuserdatauv(L, sizeof *u, 0);
   oclua_handle_init(&u->h, "tile", btile_release);
   u->t = NULL;
@@ -144,6 +150,8 @@ static int tile_stats(lua_State *L) {
   lua_setfield(L, -2, "thick");
   lua_pushinteger(L, (lua_Integer)st.separated);
   lua_setfield(L, -2, "separated");
+  lua_pushinteger(L, (lua_Integer)st.authored);
+  lua_setfield(L, -2, "authored");
   return 1;
 }
 

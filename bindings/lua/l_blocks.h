@@ -16,4 +16,9 @@ oc_btile **oclua_newtile(lua_State *L);
 oc_btile *oclua_checktile(lua_State *L, int idx, const char *fname,
                           const char *what);
 
+/* Reads field `blocks` of a tile's options (authored blocks: box, points
+** or planes each, l_blocks_shapes.c) into Lua-owned memory held by one
+** value left on the stack (nil when absent); the count in *n. */
+const oc_block_shape *oclua_read_block_shapes(const oclua_fields *f, size_t *n);
+
 #endif

@@ -193,6 +193,10 @@ static int node_stats(lua_State *L) {
     lua_pushinteger(L, (lua_Integer)inst);
     lua_setfield(L, -2, "instances"); /* Table 2's #R */
   }
+  if (oc_blocks_memory(oclua_testnode(L, 1)->node, &inst)) {
+    lua_pushinteger(L, (lua_Integer)inst);
+    lua_setfield(L, -2, "block_bytes"); /* Table 2's memory */
+  }
   return 1;
 }
 

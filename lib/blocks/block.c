@@ -153,6 +153,10 @@ oc_aabb oc_bfield_support(const oc_bfield *b) {
                    {b->box.hi.x + W, b->box.hi.y + W, b->box.hi.z + W}};
 }
 
+size_t oc_bfield_bytes(const oc_bfield *b) {
+  return sizeof *b + 4 * b->n * sizeof(double);
+}
+
 double oc_bfield_width(const oc_bfield *b) {
   return b->W;
 }

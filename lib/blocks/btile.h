@@ -69,6 +69,8 @@ struct oc_btile {
   size_t thick;  /* degenerate clusters made thick polygons or points */
   size_t ncut;   /* pairs of blocks cut apart (separate.c) */
   size_t merged; /* small clusters merged into a neighbour (merge.c) */
+  size_t nauth;  /* authored blocks (authored.c), the last nauth of block */
+  oc_bblock *auth;
   double seconds;
 };
 
@@ -80,6 +82,9 @@ int oc_bdiscs_images(const oc_btile *t, oc_aabb in, oc_bimage **out, size_t *n,
                      oc_error *err);
 /* 1 when segment [p, q] crosses the image's disc. */
 int oc_bimage_cuts(const oc_bimage *d, const double *p, const double *q);
+/* The same with p's and q's signed distances a, b to the plane known. */
+int oc_bimage_cuts_at(const oc_bimage *d, const double *p, const double *q,
+                      double a, double b);
 
 /* Builds t->g (edges shorter than neighbour * radius, periodic) and marks
 ** the edges the discs cut (graph.c). */
@@ -102,6 +107,21 @@ void oc_bblock_free(oc_bblock *b);
 ** them flat (or n < 4), OC_ENOMEM; b is then empty. */
 int oc_bblock_hull(double *xyz, size_t n, oc_bblock *b, oc_error *err);
 
+/* qhull of the n points xyz into b's planes and vertices (hull.c): 0,
+** 1 when qhull failed (fewer than 4 points, flat), OC_ENOMEM. */
+int oc_bhull_points(double *xyz, size_t n, oc_bblock *b);
+/* b's box and thickness from its vertices and planes. */
+void oc_bblock_measure(oc_bblock *b);
+
+/* Authored blocks (authored.c): their hulls into t->auth (before the
+** points), the tile points inside them removed, the graph's edges
+** across them cut, and at the end generated blocks cut back by their
+** faces and the authored blocks appended to t->block. */
+int oc_bauthored_make(oc_btile *t, oc_error *err);
+void oc_bauthored_points(oc_btile *t);
+void oc_bauthored_cut(oc_btile *t);
+int oc_bauthored_finish(oc_btile *t, oc_error *err);
+
 /* Cuts overlapping blocks apart with a plane each (separate.c). */
 int oc_bblocks_separate(oc_btile *t, oc_error *err);
 
@@ -112,6 +132,8 @@ oc_bfield *oc_bfield_new(const oc_bblock *b, double R, double W);
 /* The hull's box grown by W (f = 0 outside), and W. */
 oc_aabb oc_bfield_support(const oc_bfield *b);
 double oc_bfield_width(const oc_bfield *b);
+/* Bytes the field holds. */
+size_t oc_bfield_bytes(const oc_bfield *b);
 /* The rounded distance d (<= 0 inside) and its gradient. */
 double oc_bfield_dist(const oc_bfield *b, oc_vec3 p, oc_vec3 *g);
 /* sigma's constants for threshold T and width W, then f = sigma(-d). */

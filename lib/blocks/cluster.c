@@ -23,16 +23,62 @@
 
 #define KEY_ORDER 0x6f72646572ull
 #define NONE UINT32_MAX
+/* the candidate images are those near the cluster's box grown by this
+** many k r (remade when the box leaves it) */
+#define CACHE_GROW 2.0
 
 typedef struct grow {
   oc_btile *t;
   const oc_bimage *im;
   size_t nim;
-  const oc_bimage **near; /* the images meeting the cluster's box */
-  uint32_t *mem;          /* members, in order of joining */
+  size_t *near; /* the images meeting the cluster's box (places in cand) */
+  /* the images meeting the box clo .. chi (the cluster's box grown by
+  ** CACHE_GROW k r when last made), in the order of im: may_join looks
+  ** through these only */
+  const oc_bimage **cand;
+  size_t ncand;
+  /* per candidate: the members strictly above its plane and below it (a
+  ** disc with all members on q's side cannot separate q from them) */
+  uint32_t *above, *below;
+  double clo[3], chi[3];
+  uint32_t *mem; /* members, in order of joining */
   size_t nm;
   double lo[3], hi[3];
 } grow;
+
+/* The signed distance of p to D's plane, as oc_bimage_cuts has it. */
+static double side(const oc_bimage *D, const double *p) {
+  return (p[0] - D->c.x) * D->n.x + (p[1] - D->c.y) * D->n.y +
+         (p[2] - D->c.z) * D->n.z;
+}
+
+/* Counts member p on the sides of candidate d's plane. */
+static void count(grow *w, size_t d, const double *p) {
+  double a = side(w->cand[d], p);
+  w->above[d] += a > 0;
+  w->below[d] += a < 0;
+}
+
+/* Remakes the list of candidate images for the box lo .. hi grown. */
+static void cache(grow *w, const double *lo, const double *hi) {
+  double g = CACHE_GROW * w->t->pp.neighbour * w->t->pp.radius;
+  for (int a = 0; a < 3; a++) {
+    w->clo[a] = lo[a] - g;
+    w->chi[a] = hi[a] + g;
+  }
+  w->ncand = 0;
+  for (size_t d = 0; d < w->nim; d++) {
+    const oc_aabb *b = &w->im[d].box;
+    if (b->lo.x > w->chi[0] || b->hi.x < w->clo[0] || b->lo.y > w->chi[1] ||
+        b->hi.y < w->clo[1] || b->lo.z > w->chi[2] || b->hi.z < w->clo[2])
+      continue;
+    w->above[w->ncand] = w->below[w->ncand] = 0;
+    w->cand[w->ncand++] = &w->im[d];
+  }
+  for (size_t d = 0; d < w->ncand; d++)
+    for (size_t m = 0; m < w->nm; m++)
+      count(w, d, w->t->unwrap + 3 * (size_t)w->mem[m]);
+}
 
 /* May the point at q (unwrapped) join the cluster? */
 static int may_join(grow *w, const double *q) {
@@ -43,14 +89,17 @@ static int may_join(grow *w, const double *q) {
     hi[a] = fmax(w->hi[a], q[a]);
     if (hi[a] - lo[a] > most) return 0;
   }
+  if (lo[0] < w->clo[0] || lo[1] < w->clo[1] || lo[2] < w->clo[2] ||
+      hi[0] > w->chi[0] || hi[1] > w->chi[1] || hi[2] > w->chi[2])
+    cache(w, lo, hi);
   size_t nn = 0;
-  for (size_t d = 0; d < w->nim; d++) {
-    const oc_aabb *b = &w->im[d].box;
+  for (size_t d = 0; d < w->ncand; d++) {
+    const oc_aabb *b = &w->cand[d]->box;
     if (b->lo.x > hi[0] || b->hi.x < lo[0] || b->lo.y > hi[1] ||
         b->hi.y < lo[1] || b->lo.z > hi[2] || b->hi.z < lo[2])
       continue;
     /* the disc's plane must cross the box too */
-    const oc_bimage *D = &w->im[d];
+    const oc_bimage *D = w->cand[d];
     double ctr = (0.5 * (lo[0] + hi[0]) - D->c.x) * D->n.x +
                  (0.5 * (lo[1] + hi[1]) - D->c.y) * D->n.y +
                  (0.5 * (lo[2] + hi[2]) - D->c.z) * D->n.z;
@@ -58,20 +107,22 @@ static int may_join(grow *w, const double *q) {
         0.5 * (fabs(D->n.x) * (hi[0] - lo[0]) + fabs(D->n.y) * (hi[1] - lo[1]) +
                fabs(D->n.z) * (hi[2] - lo[2]));
     if (fabs(ctr) > ext) continue;
-    w->near[nn++] = D;
+    w->near[nn++] = d;
   }
-  /* per disc image: q's side once, then only the members on the other
-  ** side (or on the plane) get the full test (oc_bimage_cuts' arithmetic) */
+  /* per disc image: q's side once, none of the members when all are on
+  ** that side, else only those on the other side (or on the plane) get
+  ** the full test (oc_bimage_cuts' arithmetic) */
   for (size_t d = 0; d < nn; d++) {
-    const oc_bimage *D = w->near[d];
-    double b = (q[0] - D->c.x) * D->n.x + (q[1] - D->c.y) * D->n.y +
-               (q[2] - D->c.z) * D->n.z;
+    size_t k = w->near[d];
+    const oc_bimage *D = w->cand[k];
+    double b = side(D, q);
+    if ((b > 0 && w->above[k] == w->nm) || (b < 0 && w->below[k] == w->nm))
+      continue;
     for (size_t m = 0; m < w->nm; m++) {
       const double *p = w->t->unwrap + 3 * (size_t)w->mem[m];
-      double a = (p[0] - D->c.x) * D->n.x + (p[1] - D->c.y) * D->n.y +
-                 (p[2] - D->c.z) * D->n.z;
+      double a = side(D, p);
       if ((a > 0 && b > 0) || (a < 0 && b < 0)) continue;
-      if (oc_bimage_cuts(D, p, q)) return 0;
+      if (oc_bimage_cuts_at(D, p, q, a, b)) return 0;
     }
   }
   return 1;
@@ -86,6 +137,8 @@ static void join(grow *w, uint32_t i, uint32_t c, const double *q) {
   }
   w->t->label[i] = c;
   w->mem[w->nm++] = i;
+  for (size_t d = 0; d < w->ncand; d++)
+    count(w, d, u);
 }
 
 /* Grows cluster c from point i. */
@@ -96,6 +149,7 @@ static void flood(grow *w, uint32_t i, uint32_t c, uint32_t *tried) {
   w->nm = 0;
   for (int a = 0; a < 3; a++)
     w->lo[a] = w->hi[a] = t->pts[3 * (size_t)i + a];
+  cache(w, w->lo, w->hi);
   join(w, i, c, t->pts + 3 * (size_t)i);
   for (size_t head = 0; head < w->nm; head++) {
     uint32_t u = w->mem[head];
@@ -136,7 +190,10 @@ int oc_bclusters_make(oc_btile *t, oc_error *err) {
   if (oc_bdiscs_images(t, in, &im, &w.nim, err)) goto done;
   w.im = im;
   w.near = malloc((w.nim ? w.nim : 1) * sizeof *w.near);
-  if (!w.near) goto done;
+  w.cand = malloc((w.nim ? w.nim : 1) * sizeof *w.cand);
+  w.above = malloc((w.nim ? w.nim : 1) * sizeof *w.above);
+  w.below = malloc((w.nim ? w.nim : 1) * sizeof *w.below);
+  if (!w.near || !w.cand || !w.above || !w.below) goto done;
   for (size_t i = 0; i < n; i++) {
     order[i] = (uint32_t)i;
     t->label[i] = NONE;
@@ -160,6 +217,9 @@ done:
   free(tried);
   free(w.mem);
   free(w.near);
+  free(w.cand);
+  free(w.above);
+  free(w.below);
   free(im);
   return rc;
 }

@@ -15,6 +15,17 @@
 **    radius s, centres at least min(spacing, s / (2 #beds)) apart in z),
 **    the rest cross
 **    discs with a normal along x or y and radius s / 10.
+** Extensions (documented in the README, not in Table 1):
+**  - prismatic: "similar in shape [to equidimensional] but formed under
+**    slightly more irregular fracture distributions": each normal is a
+**    random axis tilted by up to 20 degrees in a random direction, radius
+**    in [disc_lo, disc_hi] (7 .. 11 m), 12 discs (about 100 blocks of
+**    130 points at the defaults, as Table 1's equidimensional);
+**  - columnar: "several sets of continuous, parallel fractures", columns
+**    much longer than wide: three vertical sets, normals horizontal at 0,
+**    60 and 120 degrees, and every 8th disc a horizontal joint; radii
+**    10 .. 14 m, 12 discs 1.5 m apart (about 130 blocks, their height
+**    2.7 times their width on average).
 ** Darts: up to DART_TRIES throws per disc; fewer discs than asked is an
 ** error naming 'fractures' and 'spacing'.
 */
@@ -28,6 +39,10 @@
 #define DART_TRIES 2000
 #define PI 3.14159265358979323846
 #define KEY_DISCS 0x6469736373ull
+/* prismatic: largest tilt of a set from its axis (20 degrees) */
+#define PRISM_TILT (PI / 9)
+/* columnar: every COLUMN_JOINT-th disc is a horizontal joint */
+#define COLUMN_JOINT 8
 
 static double wrapd(double d, double s) {
   d = fabs(d);
@@ -75,6 +90,30 @@ static void shape(const oc_btile_params *pp, size_t i, size_t nbed, oc_rng *u,
       d->n = axis & 1 ? (oc_vec3){1, 0, 0} : (oc_vec3){0, 1, 0};
       d->r = pp->size / 10;
     }
+    break;
+  case OC_BLOCKS_PRISMATIC: {
+    /* the axis tilted by up to PRISM_TILT towards a random direction */
+    double tilt = oc_rng_range(u, 0, PRISM_TILT),
+           a = oc_rng_range(u, 0, 2 * PI);
+    double e[3] = {0, 0, 0}, q[3], w[3];
+    e[axis] = 1;
+    q[(axis + 1) % 3] = 1, q[axis] = q[(axis + 2) % 3] = 0;
+    w[(axis + 2) % 3] = 1, w[axis] = w[(axis + 1) % 3] = 0;
+    double c = cos(tilt), sn = sin(tilt);
+    d->n = unit(c * e[0] + sn * (cos(a) * q[0] + sin(a) * w[0]),
+                c * e[1] + sn * (cos(a) * q[1] + sin(a) * w[1]),
+                c * e[2] + sn * (cos(a) * q[2] + sin(a) * w[2]));
+    d->r = r;
+    break;
+  }
+  case OC_BLOCKS_COLUMNAR:
+    if (i % COLUMN_JOINT == COLUMN_JOINT - 1) {
+      d->n = (oc_vec3){0, 0, 1};
+    } else {
+      double a = axis * PI / 3;
+      d->n = (oc_vec3){cos(a), sin(a), 0};
+    }
+    d->r = r;
     break;
   default:
     d->n = (oc_vec3){axis == 0, axis == 1, axis == 2};
@@ -183,15 +222,20 @@ int oc_bdiscs_images(const oc_btile *t, oc_aabb in, oc_bimage **out, size_t *n,
   return 0;
 }
 
-int oc_bimage_cuts(const oc_bimage *d, const double *p, const double *q) {
-  double a = (p[0] - d->c.x) * d->n.x + (p[1] - d->c.y) * d->n.y +
-             (p[2] - d->c.z) * d->n.z;
-  double b = (q[0] - d->c.x) * d->n.x + (q[1] - d->c.y) * d->n.y +
-             (q[2] - d->c.z) * d->n.z;
+int oc_bimage_cuts_at(const oc_bimage *d, const double *p, const double *q,
+                      double a, double b) {
   if ((a > 0 && b > 0) || (a < 0 && b < 0) || a == b) return 0;
   double w = a / (a - b);
   double x = p[0] + w * (q[0] - p[0]) - d->c.x,
          y = p[1] + w * (q[1] - p[1]) - d->c.y,
          z = p[2] + w * (q[2] - p[2]) - d->c.z;
   return x * x + y * y + z * z <= d->r2;
+}
+
+int oc_bimage_cuts(const oc_bimage *d, const double *p, const double *q) {
+  double a = (p[0] - d->c.x) * d->n.x + (p[1] - d->c.y) * d->n.y +
+             (p[2] - d->c.z) * d->n.z;
+  double b = (q[0] - d->c.x) * d->n.x + (q[1] - d->c.y) * d->n.y +
+             (q[2] - d->c.z) * d->n.z;
+  return oc_bimage_cuts_at(d, p, q, a, b);
 }

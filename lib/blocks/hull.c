@@ -28,7 +28,8 @@ void oc_bblock_free(oc_bblock *b) {
 }
 
 /* Runs qhull on the n points xyz; fills b's planes and vertices. Returns
-** 0, 1 when qhull failed (flat input), OC_ENOMEM. */
+** 0, 1 when qhull failed (flat input), OC_ENOMEM. qhull's messages go to
+** `quiet`. */
 static int hull(double *xyz, size_t n, oc_bblock *b, FILE *quiet) {
   qhT qh_qh, *qh = &qh_qh;
   char cmd[] = "qhull";
@@ -67,8 +68,16 @@ static int hull(double *xyz, size_t n, oc_bblock *b, FILE *quiet) {
   return rc;
 }
 
+int oc_bhull_points(double *xyz, size_t n, oc_bblock *b) {
+  FILE *quiet = fopen("/dev/null", "w");
+  if (!quiet) return OC_ENOMEM;
+  int rc = hull(xyz, n, b, quiet);
+  fclose(quiet);
+  return rc;
+}
+
 /* Box, thickness (the least extent of the hull across a face's normal). */
-static void measure(oc_bblock *b) {
+void oc_bblock_measure(oc_bblock *b) {
   b->box.lo = (oc_vec3){INFINITY, INFINITY, INFINITY};
   b->box.hi = (oc_vec3){-INFINITY, -INFINITY, -INFINITY};
   for (size_t v = 0; v < b->nvert; v++) {
@@ -135,7 +144,7 @@ int oc_bhulls_make(oc_btile *t, oc_error *err) {
         g[a] += p[3 * i + a];
     b->centroid = (oc_vec3){g[0] / m, g[1] / m, g[2] / m};
     b->npts = m;
-    measure(b);
+    oc_bblock_measure(b);
     t->nb++;
   }
   rc = 0;

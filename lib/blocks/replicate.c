@@ -12,7 +12,9 @@
 **  - steep walls only: |g . z| < slope, g the unit gradient;
 **  - with a geology node, its value (resistance) in the tile's range.
 ** The instances are kept in a uniform grid over their supports (cells of
-** GRID_CELL metres or more), so a query visits only the instances of its
+** GRID_CELL = 4 metres or more, about a block: 2 m cells took 0.53 MB
+** instead of 0.22 MB for bench_blocks' sea spire, for a query 5 % faster),
+** so a query visits only the instances of its
 ** cell, and never evaluates presence. Blocks straddling a tile's faces are
 ** instances of the cell of their centroid and reach into the next cells
 ** as they are.
@@ -25,7 +27,7 @@
 #include "core/error.h"
 #include "field/kind.h"
 
-#define GRID_CELL 2.0
+#define GRID_CELL 4.0
 #define GRID_MAX 4000000.0
 /* cells x blocks examined at most */
 #define WORK_MAX 5e7
@@ -49,7 +51,7 @@ typedef struct rdata {
   oc_aabb all; /* union of the instances' supports */
   double g0[3], gc;
   int gn[3];
-  size_t *gstart;
+  uint32_t *gstart; /* (the grid's entries are checked < 2^32) */
   uint32_t *gidx;
 } rdata;
 
@@ -116,9 +118,11 @@ static int grid_make(rdata *r) {
   size_t nc = (size_t)r->gn[0] * r->gn[1] * r->gn[2];
   r->gstart = calloc(nc + 1, sizeof *r->gstart);
   if (!r->gstart) return OC_ENOMEM;
+  size_t total = 0;
   for (int pass = 0; pass < 2; pass++) {
-    size_t *fill = NULL;
+    uint32_t *fill = NULL;
     if (pass == 1) {
+      if (total > UINT32_MAX) return OC_ENOMEM;
       for (size_t c = 0; c < nc; c++)
         r->gstart[c + 1] += r->gstart[c];
       r->gidx = malloc((r->gstart[nc] ? r->gstart[nc] : 1) * sizeof *r->gidx);
@@ -136,7 +140,7 @@ static int grid_make(rdata *r) {
           for (int x = c0[0]; x <= c1[0]; x++) {
             size_t c = gcell(r, x, y, z);
             if (pass == 0)
-              r->gstart[c + 1]++;
+              r->gstart[c + 1] += total++ < UINT32_MAX;
             else
               r->gidx[r->gstart[c] + fill[c]++] = (uint32_t)i;
           }
@@ -195,7 +199,7 @@ static double rep_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
     if (c[a] < 0 || c[a] >= r->gn[a]) return f;
   }
   size_t cell = gcell(r, c[0], c[1], c[2]);
-  for (size_t m = r->gstart[cell]; m < r->gstart[cell + 1]; m++) {
+  for (uint32_t m = r->gstart[cell]; m < r->gstart[cell + 1]; m++) {
     const rinst *in = &r->in[r->gidx[m]];
     if (!in_box(&in->box, p)) continue;
     oc_vec3 lp = {p.x - in->off[0], p.y - in->off[1], p.z - in->off[2]}, gb;
@@ -219,7 +223,7 @@ static int rep_zero_in(const oc_kctx *k, const oc_aabb *b) {
     for (int y = c0[1]; y <= c1[1]; y++)
       for (int x = c0[0]; x <= c1[0]; x++) {
         size_t c = gcell(r, x, y, z);
-        for (size_t m = r->gstart[c]; m < r->gstart[c + 1]; m++)
+        for (uint32_t m = r->gstart[c]; m < r->gstart[c + 1]; m++)
           if (boxes_meet(&r->in[r->gidx[m]].box, b)) return 0;
       }
   return 1;
@@ -237,7 +241,7 @@ static int rep_column(const oc_kctx *k, const oc_foot *f, oc_colq *q) {
     for (int y = c0[1]; y <= c1[1]; y++)
       for (int x = c0[0]; x <= c1[0]; x++) {
         size_t c = gcell(r, x, y, z);
-        for (size_t m = r->gstart[c]; m < r->gstart[c + 1]; m++) {
+        for (uint32_t m = r->gstart[c]; m < r->gstart[c + 1]; m++) {
           const oc_aabb *ib = &r->in[r->gidx[m]].box;
           if (boxes_meet(ib, &b)) oc_col_add(q, ib->lo.z, ib->hi.z);
         }
@@ -448,5 +452,20 @@ int oc_blocks_instance(const oc_node *n, size_t i, size_t *block,
   if (i >= r->ni) return 0;
   *block = r->in[i].b;
   memcpy(off, r->in[i].off, sizeof r->in[i].off);
+  return 1;
+}
+
+int oc_blocks_memory(const oc_node *n, size_t *bytes) {
+  if (oc_node_def(n) != &replicate_kind) return 0;
+  const rdata *r = oc_node_data(n);
+  size_t b = sizeof *r + r->nb * (sizeof *r->bf + sizeof *r->tile) +
+             r->ntile * sizeof *r->W + r->ni * sizeof *r->in;
+  for (size_t i = 0; i < r->nb; i++)
+    b += oc_bfield_bytes(r->bf[i]);
+  if (r->gstart) {
+    size_t nc = (size_t)r->gn[0] * r->gn[1] * r->gn[2];
+    b += (nc + 1) * sizeof *r->gstart + r->gstart[nc] * sizeof *r->gidx;
+  }
+  *bytes = b;
   return 1;
 }

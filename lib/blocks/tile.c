@@ -19,9 +19,10 @@
 #define MAX_FRACTURES 100000
 
 static const char *const names[OC_BLOCKS_NTYPES] = {
-    "equidimensional", "rhombohedral", "polyhedral", "tabular"};
-/* Table 1's #D */
-static const size_t table_discs[OC_BLOCKS_NTYPES] = {15, 24, 44, 30};
+    "equidimensional", "rhombohedral", "polyhedral",
+    "tabular",         "prismatic",    "columnar"};
+/* Table 1's #D; the extensions' chosen like them (discs.c) */
+static const size_t table_discs[OC_BLOCKS_NTYPES] = {15, 24, 44, 30, 12, 12};
 
 const char *oc_block_type_name(oc_block_type type) {
   return (unsigned)type < OC_BLOCKS_NTYPES ? names[type] : NULL;
@@ -40,11 +41,13 @@ void oc_btile_defaults(oc_block_type type, oc_btile_params *pp) {
   pp->radius = 0.75;
   pp->neighbour = 2;
   pp->fractures = (unsigned)type < OC_BLOCKS_NTYPES ? table_discs[type] : 0;
-  pp->spacing = type == OC_BLOCKS_POLYHEDRAL ? 1 : 2;
+  pp->spacing = type == OC_BLOCKS_POLYHEDRAL ? 1
+                : type == OC_BLOCKS_COLUMNAR ? 1.5
+                                             : 2;
   /* disc radii, tuned to Table 1's #B and #Pi at the defaults (the
   ** paper's "about 5 m" gives equidimensional blocks twice too large) */
   static const double radii[OC_BLOCKS_NTYPES][2] = {
-      {7, 11}, {4, 6}, {2.5, 3.5}, {4, 6}};
+      {7, 11}, {4, 6}, {2.5, 3.5}, {4, 6}, {7, 11}, {10, 14}};
   int ty = (unsigned)type < OC_BLOCKS_NTYPES ? (int)type : 0;
   pp->disc_lo = radii[ty][0];
   pp->disc_hi = radii[ty][1];
@@ -127,6 +130,9 @@ void oc_btile_free(oc_btile *t) {
   for (size_t i = 0; i < t->ncl && t->block; i++)
     oc_bblock_free(&t->block[i]);
   free(t->block);
+  for (size_t i = 0; i < t->nauth && t->auth; i++)
+    oc_bblock_free(&t->auth[i]);
+  free(t->auth);
   free(t);
 }
 
@@ -170,14 +176,20 @@ oc_btile *oc_btile_new(const oc_btile_params *pp, oc_error *err) {
     return NULL;
   }
   t->pp = *pp;
-  int rc = points(t, err);
+  int rc = oc_bauthored_make(t, err);
+  if (!rc) rc = points(t, err);
+  if (!rc) oc_bauthored_points(t);
   if (!rc) rc = oc_bdiscs_make(t, err);
-  t->pp.discs = NULL; /* copied into t->disc: the caller's may go */
+  /* copied into t->disc and t->auth: the caller's may go */
+  t->pp.discs = NULL;
+  t->pp.blocks = NULL;
   if (!rc) rc = oc_bgraph_make(t, err);
+  if (!rc) oc_bauthored_cut(t);
   if (!rc) rc = oc_bclusters_make(t, err);
   if (!rc) rc = oc_bclusters_merge(t, err);
   if (!rc) rc = oc_bhulls_make(t, err);
   if (!rc) rc = oc_bblocks_separate(t, err);
+  if (!rc) rc = oc_bauthored_finish(t, err);
   if (rc) {
     oc_btile_free(t);
     return NULL;
@@ -197,6 +209,7 @@ void oc_btile_stats_get(const oc_btile *t, oc_btile_stats *st) {
   st->thick = t->thick;
   st->separated = t->ncut;
   st->merged = t->merged;
+  st->authored = t->nauth;
   size_t in = 0;
   for (size_t i = 0; i < t->nb; i++)
     in += t->block[i].npts;

@@ -44,7 +44,7 @@ static double hull_dist(const oc_btile *t, size_t i, const double *p) {
 START_TEST(table1_statistics) {
   /* Table 1: #P about 14 500, #D as given, #B and #Pi */
   static const double B[4] = {125, 78, 100, 82}, Pi[4] = {110, 161, 140, 143};
-  for (int ty = 0; ty < OC_BLOCKS_NTYPES; ty++) {
+  for (int ty = 0; ty < OC_BLOCKS_TABLE1; ty++) {
     oc_btile *t = tile_of((oc_block_type)ty, 3);
     oc_btile_stats st;
     oc_btile_stats_get(t, &st);
