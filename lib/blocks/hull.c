@@ -160,10 +160,7 @@ done:
 
 int oc_bblock_hull(double *xyz, size_t n, oc_bblock *b, oc_error *err) {
   memset(b, 0, sizeof *b);
-  FILE *quiet = fopen("/dev/null", "w");
-  if (!quiet) return oc_seterr(err, OC_ENOMEM, "out of memory for a hull");
-  int h = hull(xyz, n, b, quiet);
-  fclose(quiet);
+  int h = oc_bhull_points(xyz, n, b);
   if (h) {
     oc_bblock_free(b);
     return h == OC_ENOMEM
@@ -176,6 +173,6 @@ int oc_bblock_hull(double *xyz, size_t n, oc_bblock *b, oc_error *err) {
       g[a] += xyz[3 * i + a];
   b->centroid = (oc_vec3){g[0] / n, g[1] / n, g[2] / n};
   b->npts = n;
-  measure(b);
+  oc_bblock_measure(b);
   return OC_OK;
 }
