@@ -118,30 +118,35 @@ static void read_colors(const oclua_fields *f, colors *c) {
     oclua_field_error(f, "colors", -1,
                       "must be a function or a table {field =, palette =}");
   oclua_fields_open(&cf, L, -1, f->fname, "colors.", known, 0);
-  if (oclua_field_push(&cf, "blend") != LUA_TNIL) { /* by material */
-    c->kind = COLORS_BLEND;
-    c->idx = lua_gettop(L);
-    c->nblend =
-        oclua_read_blend(L, c->idx, f->fname, "colors.blend", &c->blend);
-    c->texture = oclua_field_optnumber(&cf, "texture", OCLUA_FINITE, 0.3);
-    if (!(c->texture >= 0 && c->texture <= 1))
-      oclua_error(L, f->fname, "'colors.texture' must be in [0, 1] (got %f)",
-                  (LUAI_UACNUMBER)c->texture);
-    c->texture_scale =
-        oclua_field_optnumber(&cf, "texture_scale", OCLUA_POSITIVE, 8);
-    return;
+  /* `field` first: once read, the node stays on the stack whatever the
+  ** table's __index does when the other fields are read */
+  if (oclua_field_push(&cf, "field") == LUA_TNIL) {
+    lua_pop(L, 1);
+    if (oclua_field_push(&cf, "blend") != LUA_TNIL) { /* by material */
+      c->kind = COLORS_BLEND;
+      c->idx = lua_gettop(L);
+      c->nblend =
+          oclua_read_blend(L, c->idx, f->fname, "colors.blend", &c->blend);
+      c->texture = oclua_field_optnumber(&cf, "texture", OCLUA_FINITE, 0.3);
+      if (!(c->texture >= 0 && c->texture <= 1))
+        oclua_error(L, f->fname, "'colors.texture' must be in [0, 1] (got %f)",
+                    (LUAI_UACNUMBER)c->texture);
+      c->texture_scale =
+          oclua_field_optnumber(&cf, "texture_scale", OCLUA_POSITIVE, 8);
+      return;
+    }
+    lua_pop(L, 1);
+    oclua_field_missing(&cf, "field", "an outcrop node");
   }
-  lua_pop(L, 1);
+  if (oclua_testnode(L, -1) == NULL)
+    oclua_field_error(&cf, "field", -1, "must be an outcrop node");
+  int node = lua_gettop(L);
   if (oclua_field_push(&cf, "texture") != LUA_TNIL ||
       oclua_field_push(&cf, "texture_scale") != LUA_TNIL)
     oclua_error(L, f->fname, "'colors.texture' goes with 'colors.blend'");
-  lua_pop(L, 2);
-  if (oclua_field_push(&cf, "field") == LUA_TNIL)
-    oclua_field_missing(&cf, "field", "an outcrop node");
-  if (oclua_testnode(L, -1) == NULL)
-    oclua_field_error(&cf, "field", -1, "must be an outcrop node");
+  lua_settop(L, node);
   c->kind = COLORS_FIELD;
-  c->idx = lua_gettop(L);
+  c->idx = node;
   read_palette(&cf, c);
 }
 
