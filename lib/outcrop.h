@@ -767,6 +767,38 @@ oc_node *oc_blocks_replicate(oc_node *terrain, const oc_replicate_params *rp,
 ** node, else 0. */
 int oc_blocks_instances(const oc_node *n, size_t *count);
 
+/* Gradient-based warping (Paris et al. 2020, section 4.2), a node over any
+** field: f(p + u(p) s(p)), u the direction of the field's gradient (a
+** tetrahedral difference of step `step`, fading to 0 where the field is
+** less than half as steep as its Lipschitz bound), s the relief d on the
+** planes xy, xz, yz weighted by |u.z|, |u.y|, |u.x| (normalised to sum
+** 1), d in [-|amplitude|, |amplitude|] metres at world coordinates (d > 0
+** moves the surface outwards). Lipschitz bound: L (1 + L_d + 2 (1 + 2
+** sqrt 3) |amplitude| / step), L the field's, L_d the relief's
+** (lib/blocks/relief.c derives it). */
+typedef enum oc_relief_kind {
+  OC_RELIEF_TURBULENCE, /* d = A (2 t(x / wavelength) / t_max - 1) */
+  OC_RELIEF_IMAGE       /* d = A (2 v - 1), v the image's first channel
+                        ** clamped to [0, 1], bilinear, repeated every
+                        ** `wavelength` metres along the image's width */
+} oc_relief_kind;
+
+typedef struct oc_relief_params {
+  oc_relief_kind kind;
+  double wavelength; /* > 0 (default 1) */
+  int octaves;       /* turbulence: 1 .. 16 (default 4) */
+  uint64_t seed;     /* turbulence (default 1) */
+  const char *path;  /* image: PNG, TIFF, EXR or JPEG (read now) */
+  double amplitude;  /* A, metres, finite */
+  double step;       /* the gradient's step; 0: 4 |A| (0.01 for A = 0) */
+} oc_relief_params;
+
+void oc_relief_defaults(oc_relief_params *rp);
+/* A new node retaining child, or NULL with err (OC_EINVAL naming the
+** parameter, OC_EIO naming an unreadable image). */
+oc_node *oc_relief_warp(oc_node *child, const oc_relief_params *rp,
+                        oc_error *err);
+
 /* ---- heightfields ----------------------------------------------------- */
 
 /* A grid of float elevations: sample (i, j), 0 <= i < nx, 0 <= j < ny,

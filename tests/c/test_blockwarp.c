@@ -1,0 +1,261 @@
+/*
+** test_blockwarp.c — gradient-based warping (Paris et al. 2020, section
+** 4.2): the warp's formula against a reference written here, its
+** analytic gradient, its stated Lipschitz bound (the formula, and random
+** pairs), its support, an image relief displacing a plane by the
+** bilinear relief exactly; and the errors naming the parameter.
+*/
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "core/noise.h"
+#include "ocheck.h"
+#include "outcrop.h"
+
+/* a sphere of radius 1 with a 0.5 m falloff, energy 1: f = T = 0.5 about
+** 1.2 m from its centre */
+static oc_node *ball(void) {
+  oc_error e = {0};
+  return OCT_OK(oc_sphere(oct_v(0, 0, 0), 1, 0.5, 1, &e));
+}
+
+static oc_node *warped(oc_node *child, double amp, double wl, int oct) {
+  oc_relief_params rp;
+  oc_relief_defaults(&rp);
+  rp.amplitude = amp;
+  rp.wavelength = wl;
+  rp.octaves = oct;
+  rp.seed = 5;
+  oc_error e = {0};
+  return OCT_OK(oc_relief_warp(child, &rp, &e));
+}
+
+/* The warp's formula, written again from the paper's definition (with
+** the tetrahedral gradient and the fading of relief.c): f(p + u s). */
+static double reference(const oc_program *child, double L, oc_vec3 p,
+                        double amp, double wl, int oct, uint64_t seed) {
+  static const double E[4][3] = {
+      {1, -1, -1}, {-1, -1, 1}, {-1, 1, -1}, {1, 1, 1}};
+  double h = 4 * amp, G[3] = {0, 0, 0};
+  for (int k = 0; k < 4; k++) {
+    double f = oc_program_eval(
+        child, oct_v(p.x + h * E[k][0], p.y + h * E[k][1], p.z + h * E[k][2]));
+    for (int a = 0; a < 3; a++)
+      G[a] += E[k][a] * f / (4 * h);
+  }
+  double n = sqrt(G[0] * G[0] + G[1] * G[1] + G[2] * G[2]);
+  double m = fmax(n, L / 2), u[3] = {G[0] / m, G[1] / m, G[2] / m};
+  double l1 = fabs(u[0]) + fabs(u[1]) + fabs(u[2]);
+  if (l1 == 0) return oc_program_eval(child, p); /* no gradient: no warp */
+  double tmax = 2 - pow(2, 1 - oct);
+#define D(x, y)                                                                \
+  (amp *                                                                       \
+   (2 * oc_turb3(seed, oct, oct_v((x) / wl, (y) / wl, 0), NULL) / tmax - 1))
+  double s = fabs(u[2]) / l1 * D(p.x, p.y) + fabs(u[1]) / l1 * D(p.x, p.z) +
+             fabs(u[0]) / l1 * D(p.y, p.z);
+#undef D
+  return oc_program_eval(child,
+                         oct_v(p.x + u[0] * s, p.y + u[1] * s, p.z + u[2] * s));
+}
+
+START_TEST(relief_formula) {
+  oc_node *b = ball();
+  oc_node_retain(b);
+  oc_program *pc = oct_compile(b, 0.5, 0);
+  double L = oc_program_lipschitz(pc);
+  oc_program *pw = oct_compile(warped(b, 0.08, 0.3, 3), 0.5, 0);
+  oc_node_release(b);
+  oct_rng r = oct_rng_new(3);
+  double moved = 0;
+  for (int k = 0; k < 500; k++) {
+    oc_vec3 p = oct_in_box(&r, oct_v(-1.6, -1.6, -1.6), oct_v(1.6, 1.6, 1.6));
+    double want = reference(pc, L, p, 0.08, 0.3, 3, 5),
+           got = oc_program_eval(pw, p);
+    ck_assert_double_eq_tol(got, want, 1e-12);
+    moved = fmax(moved, fabs(got - oc_program_eval(pc, p)));
+  }
+  /* the relief shows: somewhere the field changed by a good part of
+  ** A times the slope (about 1.7) */
+  ck_assert_double_gt(moved, 0.05);
+  oc_program_free(pc);
+  oc_program_free(pw);
+}
+END_TEST
+
+/* amplitude 0: the field itself, bit for bit */
+START_TEST(relief_zero_amplitude) {
+  oc_node *b = ball();
+  oc_node_retain(b);
+  oc_program *pc = oct_compile(b, 0.5, 0);
+  oc_program *pw = oct_compile(warped(b, 0, 1, 2), 0.5, 0);
+  oc_node_release(b);
+  oct_rng r = oct_rng_new(4);
+  for (int k = 0; k < 300; k++) {
+    oc_vec3 p = oct_in_box(&r, oct_v(-2, -2, -2), oct_v(2, 2, 2));
+    ck_assert(oc_program_eval(pw, p) == oc_program_eval(pc, p));
+  }
+  ck_assert_double_eq(oc_program_lipschitz(pw), oc_program_lipschitz(pc));
+  oc_program_free(pc);
+  oc_program_free(pw);
+}
+END_TEST
+
+/* The analytic gradient, the Lipschitz bound (its formula and random
+** pairs), the support (the child's grown by A), on a sphere and on a
+** block of a tile. */
+START_TEST(relief_gradient_lipschitz_support) {
+  oc_btile_params tp;
+  oc_btile_defaults(OC_BLOCKS_POLYHEDRAL, &tp);
+  tp.size = 8;
+  tp.radius = 0.5;
+  tp.disc_lo = 2;
+  tp.disc_hi = 3;
+  tp.spacing = 1;
+  oc_error e = {0};
+  oc_btile *t = oc_btile_new(&tp, &e);
+  ck_assert_msg(t != NULL, "%s", e.msg);
+  oc_node *kids[2] = {ball(), OCT_OK(oc_btile_block(t, 0, &e))};
+  oc_btile_free(t);
+  for (int i = 0; i < 2; i++) {
+    oc_node_retain(kids[i]);
+    oc_program *pc = oct_compile(kids[i], 0.5, 0);
+    double amp = 0.06, wl = 0.4;
+    int oct = 3;
+    oc_program *pw = oct_compile(warped(kids[i], amp, wl, oct), 0.5, 0);
+    oc_node_release(kids[i]);
+    oc_aabb cb = oc_program_bounds(pc), wb = oc_program_bounds(pw);
+    ck_assert_double_eq_tol(wb.lo.x, cb.lo.x - amp, 1e-9);
+    ck_assert_double_eq_tol(wb.hi.z, cb.hi.z + amp, 1e-9);
+    /* the stated bound: L (1 + L_d + 2 (1 + 2 sqrt 3) A / h), h = 4 A */
+    double L = oc_program_lipschitz(pc);
+    double tmax = oc_turb3_max(oct);
+    double Ld = 2 * amp * oc_turb3_lipschitz(oct) / (tmax * wl);
+    double want = L * (1 + Ld + 2 * (1 + 2 * sqrt(3)) * amp / (4 * amp));
+    ck_assert_double_eq_tol(oc_program_lipschitz(pw), want, 1e-9 * want);
+    oct_rng r = oct_rng_new(7 + i);
+    double ratio = oct_check_lipschitz(pw, wb.lo, wb.hi, 3000, &r);
+    printf("relief_warp %s: L %.3f, bound %.3f, largest seen / bound %.3f\n",
+           i ? "block" : "sphere", L, want, ratio);
+    ck_assert_double_le(ratio, 1);
+    /* the warp steepens the field: pairs beat the child's own bound */
+    ck_assert_double_gt(ratio * want, L);
+    ck_assert_int_gt(oct_check_bounds(pw, wb.lo, wb.hi, 2000, &r), 0);
+    for (int k = 0; k < 300; k++)
+      oct_check_grad(pw, oct_in_box(&r, wb.lo, wb.hi), 1e-6, 1e-4);
+    oc_program_free(pc);
+    oc_program_free(pw);
+  }
+}
+END_TEST
+
+/* An image relief on a horizontal plane: the surface rises by the
+** bilinear relief d(x, y) = A (2 v - 1) exactly. */
+START_TEST(relief_image_plane) {
+  const char *dir = oct_tmpdir("relief");
+  char path[256];
+  snprintf(path, sizeof path, "%s/r.png", dir);
+  /* 4 x 4 grey, values k / 255; image row 0 is the top (v = 3 cells) */
+  static const int px[4][4] = {{0, 255, 51, 102},
+                               {204, 153, 0, 255},
+                               {17, 34, 68, 136},
+                               {255, 0, 0, 85}};
+  oc_error e = {0};
+  oc_image *im = oc_image_new(4, 4, 1, &e);
+  ck_assert_ptr_nonnull(im);
+  for (int j = 0; j < 4; j++)
+    for (int i = 0; i < 4; i++)
+      oc_image_data(im)[j * 4 + i] = px[j][i] / 255.0f;
+  ck_assert_int_eq(oc_image_write(im, path, 8, &e), OC_OK);
+  oc_image_free(im);
+  oc_node *plane = OCT_OK(oc_plane(oct_v(0, 0, 0), oct_v(0, 0, 1), 1, 1, &e));
+  oc_node_retain(plane);
+  oc_program *pc = oct_compile(plane, 0.5, 0);
+  oc_relief_params rp;
+  oc_relief_defaults(&rp);
+  rp.kind = OC_RELIEF_IMAGE;
+  rp.path = path;
+  rp.wavelength = 2; /* 4 pixels over 2 m: cell 0.5 */
+  rp.amplitude = 0.1;
+  oc_program *pw = oct_compile(OCT_OK(oc_relief_warp(plane, &rp, &e)), 0.5, 0);
+  oc_node_release(plane);
+  /* the unwarped surface: f = 0.5 at z0 */
+  double lo = -1, hi = 1;
+  for (int k = 0; k < 60; k++) {
+    double m = 0.5 * (lo + hi);
+    *(oc_program_eval(pc, oct_v(0, 0, m)) > 0.5 ? &lo : &hi) = m;
+  }
+  double z0 = 0.5 * (lo + hi);
+  oct_rng r = oct_rng_new(9);
+  for (int k = 0; k < 40; k++) {
+    double x = oct_unif(&r, -3, 3), y = oct_unif(&r, -3, 3);
+    /* bilinear, periodic, sample (i, j) at (0.5 i, 0.5 j), j from the
+    ** bottom row */
+    double u = x / 0.5, v = y / 0.5, fu = floor(u), fv = floor(v);
+    int i0 = (int)(fu - 4 * floor(fu / 4)), j0 = (int)(fv - 4 * floor(fv / 4));
+    int i1 = (i0 + 1) % 4, j1 = (j0 + 1) % 4;
+#define P(i, j) (px[3 - (j)][(i)] / 255.0)
+    double b0 = P(i0, j0) + (u - fu) * (P(i1, j0) - P(i0, j0)),
+           b1 = P(i0, j1) + (u - fu) * (P(i1, j1) - P(i0, j1));
+#undef P
+    double d = 0.1 * (2 * (b0 + (v - fv) * (b1 - b0)) - 1);
+    lo = -1, hi = 1;
+    for (int it = 0; it < 60; it++) {
+      double m = 0.5 * (lo + hi);
+      *(oc_program_eval(pw, oct_v(x, y, m)) > 0.5 ? &lo : &hi) = m;
+    }
+    ck_assert_double_eq_tol(0.5 * (lo + hi), z0 + d, 1e-7);
+  }
+  /* L_d = 2 A |(m_x, m_y)| / cell: m_x = 1 (0 -> 255), m_y = 1 */
+  double L = oc_program_lipschitz(pc);
+  double want =
+      L * (1 + 2 * 0.1 * sqrt(2) / 0.5 + 2 * (1 + 2 * sqrt(3)) * 0.1 / 0.4);
+  ck_assert_double_eq_tol(oc_program_lipschitz(pw), want, 1e-9 * want);
+  oc_program_free(pc);
+  oc_program_free(pw);
+  unlink(path);
+  rmdir(dir);
+}
+END_TEST
+
+START_TEST(relief_errors) {
+  oc_node *b = ball();
+  oc_relief_params rp;
+  oc_error e = {0};
+  oc_relief_defaults(&rp);
+  rp.amplitude = NAN;
+  OCT_EINVAL(oc_relief_warp(b, &rp, &e), e, "amplitude");
+  oc_relief_defaults(&rp);
+  rp.wavelength = 0;
+  OCT_EINVAL(oc_relief_warp(b, &rp, &e), e, "relief.wavelength");
+  oc_relief_defaults(&rp);
+  rp.octaves = 17;
+  OCT_EINVAL(oc_relief_warp(b, &rp, &e), e, "relief.octaves");
+  oc_relief_defaults(&rp);
+  rp.step = -1;
+  OCT_EINVAL(oc_relief_warp(b, &rp, &e), e, "step");
+  oc_relief_defaults(&rp);
+  rp.kind = OC_RELIEF_IMAGE;
+  rp.path = "/nonexistent/relief.png";
+  ck_assert_ptr_null(oc_relief_warp(b, &rp, &e));
+  ck_assert_int_eq(e.code, OC_EIO);
+  ck_assert_msg(strstr(e.msg, "/nonexistent/relief.png") != NULL, "%s", e.msg);
+  oc_node_release(b);
+}
+END_TEST
+
+int main(void) {
+  Suite *s = suite_create("blockwarp");
+  TCase *tc = tcase_create("relief");
+  tcase_set_timeout(tc, 120);
+  tcase_add_test(tc, relief_formula);
+  tcase_add_test(tc, relief_zero_amplitude);
+  tcase_add_test(tc, relief_gradient_lipschitz_support);
+  tcase_add_test(tc, relief_image_plane);
+  tcase_add_test(tc, relief_errors);
+  suite_add_tcase(s, tc);
+  return oct_run(s);
+}
