@@ -754,6 +754,10 @@ typedef struct oc_replicate_params {
   double va, vb;    /* distance estimate (f - T) / |grad f| (> 0 inside)
                     ** in [va, vb] (default -1 .. 1) */
   int anchors;      /* centroid + hull vertices voting (default 9) */
+  double inset;     /* >= 0: the terrain sinks by about this many metres
+                    ** where blocks are (f - inset L min(1, t / T), L its
+                    ** Lipschitz bound, t the blocks), so the wall does
+                    ** not fill the joints; default 0 (the paper's) */
   double threshold; /* T of the criteria; 0: OC_DEFAULT_THRESHOLD */
 } oc_replicate_params;
 

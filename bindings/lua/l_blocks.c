@@ -13,7 +13,8 @@
 ** rounding 0.25, width 0.75, seed = the scene seed, discs none.
 **
 ** outcrop.blocks.replicate(terrain, {tiles = {{tile =, resistance = {lo,
-**   hi}}, ...}, geology =, slope = 1, distance = {-1, 1}, anchors = 9})
+**   hi}}, ...}, geology =, slope = 1, distance = {-1, 1}, anchors = 9,
+**   inset = 0})
 ** builds the replication node (presence decided now, with the current
 ** outcrop.threshold); resistance defaults to everything. node:stats()
 ** then has `instances`.
@@ -208,8 +209,8 @@ static const luaL_Reg tile_meta[] = {{"__gc", tile_gc},
 /* outcrop.blocks.replicate(terrain, {tiles = {{tile =, resistance = {lo,
 ** hi}}, ...}, geology =, slope =, distance = {va, vb}, anchors =}) */
 static int l_replicate(lua_State *L) {
-  static const char *const known[] = {"tiles",    "geology", "slope",
-                                      "distance", "anchors", NULL};
+  static const char *const known[] = {"tiles",   "geology", "slope", "distance",
+                                      "anchors", "inset",   NULL};
   static const char *const none[] = {NULL};
   static const char *const tknown[] = {"tile", "resistance", NULL};
   const char *fname = "outcrop.blocks.replicate";
@@ -227,6 +228,7 @@ static int l_replicate(lua_State *L) {
     rp.vb = d[1];
   }
   rp.anchors = (int)oclua_field_optint(&f, "anchors", 1, 64, rp.anchors);
+  rp.inset = oclua_field_optnumber(&f, "inset", OCLUA_FINITE, rp.inset);
   if (oclua_field_push(&f, "geology") != LUA_TNIL)
     rp.geology = oclua_checknode(L, -1, fname, "'geology'");
   /* the geology stays on the stack (reachable) */

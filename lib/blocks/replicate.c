@@ -73,6 +73,7 @@ void oc_replicate_defaults(oc_replicate_params *rp) {
   rp->va = -1;
   rp->vb = 1;
   rp->anchors = 9;
+  rp->inset = 0;
 }
 
 /* ---- grid ---------------------------------------------------------------- */
@@ -163,12 +164,19 @@ static int rep_compile(oc_kcompile *c, oc_error *err) {
   (void)err;
   const oc_kinfo *k = &c->kid[0];
   c->par[0] = c->T;
-  double lip = k->lip;
+  double lip = k->lip, lipt = 0;
   for (size_t t = 0; t < r->ntile; t++) {
     oc_bfield_sigma(c->T, r->W[t], c->par + 1 + OC_BSIGMA_N * t);
-    lip = fmax(lip, c->par[1 + OC_BSIGMA_N * t + 3]);
+    lipt = fmax(lipt, c->par[1 + OC_BSIGMA_N * t + 3]);
   }
+  lip = fmax(lip, lipt);
   c->npar = 1 + OC_BSIGMA_N * r->ntile;
+  /* inset: the terrain sinks by k m(t), k = inset L (inset metres where
+  ** its slope is its bound), m = min(1, t / T); Lipschitz L + k lip_t / T */
+  double kin =
+      c->node_npar ? c->node_par[0] * (isfinite(k->lip) ? k->lip : 1) : 0;
+  c->par[c->npar++] = kin;
+  if (kin > 0) lip = fmax(lip, k->lip + kin * lipt / c->T);
   c->info.lo = fmin(k->lo, 0);
   c->info.hi = fmax(k->hi, 2 * c->T);
   c->info.lip = lip;
@@ -184,6 +192,36 @@ static int rep_compile(oc_kcompile *c, oc_error *err) {
   return OC_OK;
 }
 
+/* With an inset: t = the largest block at p, f~ = max(f - kin m, t),
+** m = min(1, t / T), so the terrain sinks where blocks are and the joints
+** between them stay open. */
+static double rep_inset(const oc_kctx *k, const rdata *r, size_t cell,
+                        oc_vec3 p, double f, oc_vec3 *g, double kin) {
+  double t = 0, T = k->par[0];
+  oc_vec3 gt = {0, 0, 0};
+  for (size_t m = r->gstart[cell]; m < r->gstart[cell + 1]; m++) {
+    const rinst *in = &r->in[r->gidx[m]];
+    if (!in_box(&in->box, p)) continue;
+    oc_vec3 lp = {p.x - in->off[0], p.y - in->off[1], p.z - in->off[2]}, gb;
+    const double *sp = k->par + 1 + OC_BSIGMA_N * r->tile[in->b];
+    double v = oc_bfield_eval(r->bf[in->b], sp, lp, g ? &gb : NULL);
+    if (v > t) {
+      t = v;
+      if (g) gt = gb;
+    }
+  }
+  if (!(t > 0)) return f;
+  double m = t < T ? t / T : 1, fs = f - kin * m;
+  if (t > fs) {
+    if (g) *g = gt;
+    return t;
+  }
+  if (g && t < T)
+    *g = (oc_vec3){g->x - kin / T * gt.x, g->y - kin / T * gt.y,
+                   g->z - kin / T * gt.z};
+  return fs;
+}
+
 static double rep_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
   const rdata *r = k->data;
   double f = oc_child_eval(k, 0, p, g);
@@ -195,6 +233,8 @@ static double rep_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
     if (c[a] < 0 || c[a] >= r->gn[a]) return f;
   }
   size_t cell = gcell(r, c[0], c[1], c[2]);
+  double kin = k->par[1 + OC_BSIGMA_N * r->ntile];
+  if (kin > 0) return rep_inset(k, r, cell, p, f, g, kin);
   for (size_t m = r->gstart[cell]; m < r->gstart[cell + 1]; m++) {
     const rinst *in = &r->in[r->gidx[m]];
     if (!in_box(&in->box, p)) continue;
@@ -383,6 +423,10 @@ oc_node *oc_blocks_replicate(oc_node *terrain, const oc_replicate_params *rp,
               rp->anchors);
     return NULL;
   }
+  if (!(rp->inset >= 0) || !isfinite(rp->inset)) {
+    oc_seterr(err, OC_EINVAL, "'inset' must be >= 0 (got %g)", rp->inset);
+    return NULL;
+  }
   oc_compile_options co = {rp->threshold, 0};
   oc_program *tp = oc_compile(terrain, &co, err);
   if (!tp) return NULL;
@@ -418,7 +462,7 @@ oc_node *oc_blocks_replicate(oc_node *terrain, const oc_replicate_params *rp,
             -INFINITY, INFINITY};
   if (place(r, rp, &c, tb, err)) goto done;
   if (grid_make(r)) goto nomem;
-  out = oc_kind_node(&replicate_kind, &terrain, 1, NULL, 0, r, err);
+  out = oc_kind_node(&replicate_kind, &terrain, 1, &rp->inset, 1, r, err);
   r = NULL; /* the node owns it, also on failure */
   goto done;
 nomem:

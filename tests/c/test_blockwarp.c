@@ -247,6 +247,90 @@ START_TEST(relief_errors) {
 }
 END_TEST
 
+/* ---- replication with an inset ------------------------------------------ */
+
+static oc_btile *small_tile(uint64_t seed) {
+  oc_btile_params pp;
+  oc_btile_defaults(OC_BLOCKS_EQUIDIMENSIONAL, &pp);
+  pp.size = 8;
+  pp.radius = 0.5;
+  pp.disc_lo = 2;
+  pp.disc_hi = 3;
+  pp.spacing = 1;
+  pp.seed = seed;
+  oc_error e = {0};
+  oc_btile *t = oc_btile_new(&pp, &e);
+  ck_assert_msg(t != NULL, "oc_btile_new: %s", e.msg);
+  return t;
+}
+
+static oc_node *replicated(oc_node *ter, const oc_btile *t, double inset,
+                           oc_error *e) {
+  oc_replicate_tile rt = {t, 0, 0};
+  oc_replicate_params rp;
+  oc_replicate_defaults(&rp);
+  rp.tiles = &rt;
+  rp.ntiles = 1;
+  rp.slope = 0.5;
+  rp.inset = inset;
+  return oc_blocks_replicate(ter, &rp, e);
+}
+
+START_TEST(replicate_inset) {
+  oc_error e = {0};
+  /* a 16 x 16 x 10 m box: its wall x = 0 has its surface (f = T) at
+  ** x = -0.454 (falloff 1) */
+  oc_node *ter = OCT_OK(oc_box(oct_v(0, 0, 0), oct_v(16, 16, 10), 1, 1, &e));
+  oc_btile *t = small_tile(4);
+  oc_program *pt = oct_compile(ter, 0.5, 0);
+  oc_node_retain(ter);
+  oc_program *p0 = oct_compile(OCT_OK(replicated(ter, t, 0, &e)), 0.5, 0);
+  oc_program *pi = oct_compile(OCT_OK(replicated(ter, t, 0.3, &e)), 0.5, 0);
+  /* the bound: L + inset L lip_b / T, lip_b = 1 (sigma's slope) */
+  double L = oc_program_lipschitz(pt);
+  ck_assert_double_eq_tol(oc_program_lipschitz(pi), L + 0.3 * L / 0.5, 1e-9);
+  /* far from blocks (the top's middle) the terrain as it is */
+  for (double z = 9; z < 11.5; z += 0.25)
+    ck_assert(oc_program_eval(pi, oct_v(8, 8, z)) ==
+              oc_program_eval(pt, oct_v(8, 8, z)));
+  oct_rng r = oct_rng_new(5);
+  for (int k = 0; k < 2000; k++) {
+    oc_vec3 p = oct_in_box(&r, oct_v(-2, -2, -2), oct_v(18, 18, 12));
+    double f = oc_program_eval(pt, p), f0 = oc_program_eval(p0, p),
+           fi = oc_program_eval(pi, p);
+    ck_assert_double_le(fi, f0);
+    /* where a block wins, it wins the same with an inset */
+    if (f0 > f) ck_assert(fi == f0);
+    if (k < 300) oct_check_grad(pi, p, 1e-6, 1e-5);
+  }
+  ck_assert_double_le(
+      oct_check_lipschitz(pi, oct_v(-2, -2, -2), oct_v(18, 18, 12), 2000, &r),
+      1);
+  /* the plane x = -0.3 lies inside the wall: without an inset all of it
+  ** is solid; with one, the joints between the blocks open */
+  int n = 0, open0 = 0, openi = 0;
+  for (double y = 1; y < 15; y += 0.1)
+    for (double z = 1; z < 9; z += 0.1, n++) {
+      open0 += oc_program_eval(p0, oct_v(-0.3, y, z)) < 0.5;
+      openi += oc_program_eval(pi, oct_v(-0.3, y, z)) < 0.5;
+    }
+  printf("replicate inset 0.3: %d of %d points of the wall open (0 without)\n",
+         openi, n);
+  ck_assert_int_eq(open0, 0);
+  ck_assert_int_gt(openi, n / 50);
+  ck_assert_int_lt(openi, n / 2);
+  /* a negative inset is refused */
+  oc_node *bad = replicated(ter, t, -1, &e);
+  ck_assert_ptr_null(bad);
+  ck_assert_msg(strstr(e.msg, "'inset'") != NULL, "%s", e.msg);
+  oc_node_release(ter);
+  oc_program_free(pt);
+  oc_program_free(p0);
+  oc_program_free(pi);
+  oc_btile_free(t);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("blockwarp");
   TCase *tc = tcase_create("relief");
@@ -256,6 +340,7 @@ int main(void) {
   tcase_add_test(tc, relief_gradient_lipschitz_support);
   tcase_add_test(tc, relief_image_plane);
   tcase_add_test(tc, relief_errors);
+  tcase_add_test(tc, replicate_inset);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }
