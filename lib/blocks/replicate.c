@@ -192,34 +192,22 @@ static int rep_compile(oc_kcompile *c, oc_error *err) {
   return OC_OK;
 }
 
-/* With an inset: t = the largest block at p, f~ = max(f - kin m, t),
-** m = min(1, t / T), so the terrain sinks where blocks are and the joints
-** between them stay open. */
-static double rep_inset(const oc_kctx *k, const rdata *r, size_t cell,
-                        oc_vec3 p, double f, oc_vec3 *g, double kin) {
-  double t = 0, T = k->par[0];
-  oc_vec3 gt = {0, 0, 0};
+/* max(f, the blocks of the cell at p); *g (when g) becomes the gradient of
+** the first block above f. */
+static double top(const oc_kctx *k, const rdata *r, size_t cell, oc_vec3 p,
+                  double f, oc_vec3 *g) {
   for (size_t m = r->gstart[cell]; m < r->gstart[cell + 1]; m++) {
     const rinst *in = &r->in[r->gidx[m]];
     if (!in_box(&in->box, p)) continue;
     oc_vec3 lp = {p.x - in->off[0], p.y - in->off[1], p.z - in->off[2]}, gb;
     const double *sp = k->par + 1 + OC_BSIGMA_N * r->tile[in->b];
     double v = oc_bfield_eval(r->bf[in->b], sp, lp, g ? &gb : NULL);
-    if (v > t) {
-      t = v;
-      if (g) gt = gb;
+    if (v > f) {
+      f = v;
+      if (g) *g = gb;
     }
   }
-  if (!(t > 0)) return f;
-  double m = t < T ? t / T : 1, fs = f - kin * m;
-  if (t > fs) {
-    if (g) *g = gt;
-    return t;
-  }
-  if (g && t < T)
-    *g = (oc_vec3){g->x - kin / T * gt.x, g->y - kin / T * gt.y,
-                   g->z - kin / T * gt.z};
-  return fs;
+  return f;
 }
 
 static double rep_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
@@ -234,19 +222,23 @@ static double rep_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
   }
   size_t cell = gcell(r, c[0], c[1], c[2]);
   double kin = k->par[1 + OC_BSIGMA_N * r->ntile];
-  if (kin > 0) return rep_inset(k, r, cell, p, f, g, kin);
-  for (size_t m = r->gstart[cell]; m < r->gstart[cell + 1]; m++) {
-    const rinst *in = &r->in[r->gidx[m]];
-    if (!in_box(&in->box, p)) continue;
-    oc_vec3 lp = {p.x - in->off[0], p.y - in->off[1], p.z - in->off[2]}, gb;
-    const double *sp = k->par + 1 + OC_BSIGMA_N * r->tile[in->b];
-    double v = oc_bfield_eval(r->bf[in->b], sp, lp, g ? &gb : NULL);
-    if (v > f) {
-      f = v;
-      if (g) *g = gb;
-    }
+  if (!(kin > 0)) return top(k, r, cell, p, f, g);
+  /* with an inset: t the largest block at p, f~ = max(f - kin m, t),
+  ** m = min(1, t / T): the terrain sinks where blocks are and the joints
+  ** between them stay open */
+  double T = k->par[0];
+  oc_vec3 gt = {0, 0, 0};
+  double t = top(k, r, cell, p, 0, g ? &gt : NULL);
+  if (!(t > 0)) return f;
+  double m = t < T ? t / T : 1, fs = f - kin * m;
+  if (t > fs) {
+    if (g) *g = gt;
+    return t;
   }
-  return f;
+  if (g && t < T)
+    *g = (oc_vec3){g->x - kin / T * gt.x, g->y - kin / T * gt.y,
+                   g->z - kin / T * gt.z};
+  return fs;
 }
 
 static int rep_zero_in(const oc_kctx *k, const oc_aabb *b) {

@@ -34,6 +34,21 @@ static oc_node *warped(oc_node *child, double amp, double wl, int oct) {
   return OCT_OK(oc_relief_warp(child, &rp, &e));
 }
 
+static oc_btile *small_tile(uint64_t seed) {
+  oc_btile_params pp;
+  oc_btile_defaults(OC_BLOCKS_EQUIDIMENSIONAL, &pp);
+  pp.size = 8;
+  pp.radius = 0.5;
+  pp.disc_lo = 2;
+  pp.disc_hi = 3;
+  pp.spacing = 1;
+  pp.seed = seed;
+  oc_error e = {0};
+  oc_btile *t = oc_btile_new(&pp, &e);
+  ck_assert_msg(t != NULL, "oc_btile_new: %s", e.msg);
+  return t;
+}
+
 /* The warp's formula, written again from the paper's definition (with
 ** the tetrahedral gradient and the fading of relief.c): f(p + u s). */
 static double reference(const oc_program *child, double L, oc_vec3 p,
@@ -108,16 +123,8 @@ END_TEST
 ** pairs), the support (the child's grown by A), on a sphere and on a
 ** block of a tile. */
 START_TEST(relief_gradient_lipschitz_support) {
-  oc_btile_params tp;
-  oc_btile_defaults(OC_BLOCKS_POLYHEDRAL, &tp);
-  tp.size = 8;
-  tp.radius = 0.5;
-  tp.disc_lo = 2;
-  tp.disc_hi = 3;
-  tp.spacing = 1;
   oc_error e = {0};
-  oc_btile *t = oc_btile_new(&tp, &e);
-  ck_assert_msg(t != NULL, "%s", e.msg);
+  oc_btile *t = small_tile(3);
   oc_node *kids[2] = {ball(), OCT_OK(oc_btile_block(t, 0, &e))};
   oc_btile_free(t);
   for (int i = 0; i < 2; i++) {
@@ -248,21 +255,6 @@ START_TEST(relief_errors) {
 END_TEST
 
 /* ---- replication with an inset ------------------------------------------ */
-
-static oc_btile *small_tile(uint64_t seed) {
-  oc_btile_params pp;
-  oc_btile_defaults(OC_BLOCKS_EQUIDIMENSIONAL, &pp);
-  pp.size = 8;
-  pp.radius = 0.5;
-  pp.disc_lo = 2;
-  pp.disc_hi = 3;
-  pp.spacing = 1;
-  pp.seed = seed;
-  oc_error e = {0};
-  oc_btile *t = oc_btile_new(&pp, &e);
-  ck_assert_msg(t != NULL, "oc_btile_new: %s", e.msg);
-  return t;
-}
 
 static oc_node *replicated(oc_node *ter, const oc_btile *t, double inset,
                            oc_error *e) {
