@@ -738,6 +738,19 @@ oc_node *oc_btile_node(const oc_btile *t, oc_error *err);
 const double *oc_btile_planes(const oc_btile *t, size_t i, size_t *nplane);
 const double *oc_btile_vertices(const oc_btile *t, size_t i, size_t *nvert);
 
+/* Saves the tile (its parameters, points, discs, blocks and statistics)
+** to a versioned binary file, atomically: whole or absent (OC_EIO naming
+** the path). _at: path relative to the folder descriptor dirfd. */
+int oc_btile_save(const oc_btile *t, const char *path, oc_error *err);
+int oc_btile_save_at(const oc_btile *t, int dirfd, const char *path,
+                     oc_error *err);
+/* A tile saved by oc_btile_save (free with oc_btile_free): its blocks are
+** the saved ones bit for bit. NULL with err: OC_EIO naming an unreadable
+** path, OC_EINVAL saying what is wrong with a file that is not a tile, of
+** another version, damaged (checksum) or crafted (every count and number
+** is checked before use), OC_ENOMEM. */
+oc_btile *oc_btile_load(const char *path, oc_error *err);
+
 /* Replication (Paris et al. 2020, section 5): a tile's blocks placed over
 ** a terrain where they are present. */
 typedef struct oc_replicate_tile {

@@ -323,6 +323,148 @@ START_TEST(replicate_inset) {
 }
 END_TEST
 
+/* ---- save and load ------------------------------------------------------ */
+
+static unsigned char *read_all(const char *path, size_t *n) {
+  FILE *f = fopen(path, "rb");
+  ck_assert_ptr_nonnull(f);
+  fseek(f, 0, SEEK_END);
+  *n = (size_t)ftell(f);
+  fseek(f, 0, SEEK_SET);
+  unsigned char *b = malloc(*n);
+  ck_assert_uint_eq(fread(b, 1, *n, f), *n);
+  fclose(f);
+  return b;
+}
+
+/* Writes b with bytes [at, at + 8) set to v and the checksum made anew (a
+** crafted file), then loads it: NULL, OC_EINVAL, `what` in the message. */
+static void crafted(const char *path, const unsigned char *b, size_t n,
+                    size_t at, uint64_t v, const char *what) {
+  unsigned char *c = malloc(n);
+  memcpy(c, b, n);
+  for (int i = 0; i < 8; i++)
+    c[at + (size_t)i] = (unsigned char)(v >> (8 * i));
+  oc_sha256 h;
+  oc_sha256_init(&h);
+  oc_sha256_update(&h, c, n - OC_SHA256_BYTES);
+  oc_sha256_final(&h, c + n - OC_SHA256_BYTES);
+  FILE *f = fopen(path, "wb");
+  ck_assert_uint_eq(fwrite(c, 1, n, f), n);
+  fclose(f);
+  free(c);
+  oc_error e = {0};
+  ck_assert_ptr_null(oc_btile_load(path, &e));
+  ck_assert_int_eq(e.code, OC_EINVAL);
+  ck_assert_msg(strstr(e.msg, what) != NULL, "'%s' not in: %s", what, e.msg);
+}
+
+static uint64_t bits(double v) {
+  uint64_t u;
+  memcpy(&u, &v, 8);
+  return u;
+}
+
+START_TEST(tile_save_load) {
+  const char *dir = oct_tmpdir("btile");
+  char path[256], bad[256];
+  snprintf(path, sizeof path, "%s/t.octile", dir);
+  snprintf(bad, sizeof bad, "%s/bad.octile", dir);
+  oc_btile_params pp;
+  oc_btile_defaults(OC_BLOCKS_POLYHEDRAL, &pp);
+  pp.size = 8, pp.radius = 0.5, pp.disc_lo = 2, pp.disc_hi = 3;
+  pp.spacing = 1, pp.seed = 6;
+  oc_block_disc ud = {{4, 4, 4.1}, {0, 0, 1}, 9};
+  pp.discs = &ud, pp.ndiscs = 1;
+  oc_error e = {0};
+  oc_btile *t = oc_btile_new(&pp, &e);
+  ck_assert_msg(t != NULL, "%s", e.msg);
+  ck_assert_int_eq(oc_btile_save(t, path, &e), OC_OK);
+  oc_btile *l = oc_btile_load(path, &e);
+  ck_assert_msg(l != NULL, "%s", e.msg);
+  oc_btile_stats a, b;
+  oc_btile_stats_get(t, &a);
+  oc_btile_stats_get(l, &b);
+  ck_assert_uint_eq(a.points, b.points);
+  ck_assert_uint_eq(a.fractures, b.fractures);
+  ck_assert_uint_eq(a.blocks, b.blocks);
+  ck_assert_uint_eq(a.edges, b.edges);
+  ck_assert_uint_eq(a.cut, b.cut);
+  ck_assert_uint_eq(a.thick, b.thick);
+  ck_assert_uint_eq(a.separated, b.separated);
+  ck_assert_uint_eq(a.merged, b.merged);
+  ck_assert(a.points_per_block == b.points_per_block);
+  ck_assert(a.seconds == b.seconds);
+  ck_assert_uint_gt(a.cut, 0);
+  for (size_t i = 0; i < a.blocks; i++) {
+    size_t na, nb;
+    const double *pa = oc_btile_planes(t, i, &na),
+                 *pb = oc_btile_planes(l, i, &nb);
+    ck_assert_uint_eq(na, nb);
+    ck_assert_int_eq(memcmp(pa, pb, 4 * na * sizeof *pa), 0);
+    pa = oc_btile_vertices(t, i, &na);
+    pb = oc_btile_vertices(l, i, &nb);
+    ck_assert_uint_eq(na, nb);
+    ck_assert_int_eq(memcmp(pa, pb, 3 * na * sizeof *pa), 0);
+  }
+  /* the loaded tile's field equals the original's, bit for bit */
+  oc_program *pa = oct_compile(OCT_OK(oc_btile_node(t, &e)), 0.5, 0),
+             *pb = oct_compile(OCT_OK(oc_btile_node(l, &e)), 0.5, 0);
+  oct_rng r = oct_rng_new(11);
+  for (int k = 0; k < 3000; k++) {
+    oc_vec3 p = oct_in_box(&r, oct_v(-1, -1, -1), oct_v(9, 9, 9)), ga, gb;
+    ck_assert(oc_program_gradient(pa, p, &ga) ==
+              oc_program_gradient(pb, p, &gb));
+    ck_assert(ga.x == gb.x && ga.y == gb.y && ga.z == gb.z);
+  }
+  oc_program_free(pa);
+  oc_program_free(pb);
+  /* saving the loaded tile gives the same bytes */
+  ck_assert_int_eq(oc_btile_save(l, bad, &e), OC_OK);
+  size_t n, n2;
+  unsigned char *buf = read_all(path, &n), *buf2 = read_all(bad, &n2);
+  ck_assert_uint_eq(n, n2);
+  ck_assert_int_eq(memcmp(buf, buf2, n), 0);
+  free(buf2);
+  oc_btile_free(l);
+  /* an unwritable path: OC_EIO naming it, nothing left */
+  char nodir[300];
+  snprintf(nodir, sizeof nodir, "%s/no/t.octile", dir);
+  ck_assert_int_eq(oc_btile_save(t, nodir, &e), OC_EIO);
+  ck_assert_msg(strstr(e.msg, "t.octile") != NULL, "%s", e.msg);
+  /* refused: not a file, not a tile, another version, damaged, crafted */
+  ck_assert_ptr_null(oc_btile_load(dir, &e));
+  ck_assert_int_eq(e.code, OC_EIO);
+  ck_assert_msg(strstr(e.msg, "not a regular file") != NULL, "%s", e.msg);
+  FILE *f = fopen(bad, "wb");
+  fwrite(buf, 1, n / 2, f);
+  fclose(f);
+  ck_assert_ptr_null(oc_btile_load(bad, &e));
+  ck_assert_msg(strstr(e.msg, "damaged") != NULL, "%s", e.msg);
+  f = fopen(bad, "wb");
+  fwrite("P6\n", 1, 3, f);
+  fclose(f);
+  ck_assert_ptr_null(oc_btile_load(bad, &e));
+  ck_assert_msg(strstr(e.msg, "no tile header") != NULL, "%s", e.msg);
+  /* offsets: version 8, radius 28, width 84, counts from 108 (points,
+  ** discs, blocks, ...), points from 180 */
+  crafted(bad, buf, n, 8, 2 | (uint64_t)0 << 32, "version 2");
+  crafted(bad, buf, n, 28, bits(NAN), "not finite");
+  crafted(bad, buf, n, 84, bits(0), "'width' must be > 0");
+  crafted(bad, buf, n, 108, (uint64_t)1 << 40, "counts are out of range");
+  crafted(bad, buf, n, 124, a.blocks + 1000, "truncated");
+  size_t b0 = 180 + 24 * a.points + 56 * a.fractures;
+  crafted(bad, buf, n, b0, (uint64_t)1 << 62, "a block's counts");
+  crafted(bad, buf, n, b0 + 24 + 80, bits(2.0), "unit normal");
+  crafted(bad, buf, n, 180, bits(-3.0), "a point lies outside");
+  free(buf);
+  oc_btile_free(t);
+  unlink(path);
+  unlink(bad);
+  rmdir(dir);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("blockwarp");
   TCase *tc = tcase_create("relief");
@@ -333,6 +475,7 @@ int main(void) {
   tcase_add_test(tc, relief_image_plane);
   tcase_add_test(tc, relief_errors);
   tcase_add_test(tc, replicate_inset);
+  tcase_add_test(tc, tile_save_load);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }
