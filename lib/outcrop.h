@@ -738,6 +738,15 @@ oc_node *oc_btile_node(const oc_btile *t, oc_error *err);
 const double *oc_btile_planes(const oc_btile *t, size_t i, size_t *nplane);
 const double *oc_btile_vertices(const oc_btile *t, size_t i, size_t *nvert);
 
+/* Block i as a mesh: its field (oc_btile_block) compiled at threshold T
+** (0: the default) and polygonized with cubic cells of `cell` over its
+** support, where the tile has it (at its centroid's cell: move a copy by
+** size (i, j, k) for cell (i, j, k)). Closed and convex up to the
+** polygonizer's error. A new mesh, or NULL with err (OC_EINVAL for i out
+** of range or a bad cell, the polygonizer's errors). */
+oc_mesh *oc_btile_mesh(const oc_btile *t, size_t i, double cell, double T,
+                       oc_progress progress, oc_error *err);
+
 /* Saves the tile (its parameters, points, discs, blocks and statistics)
 ** to a versioned binary file, atomically: whole or absent (OC_EIO naming
 ** the path). _at: path relative to the folder descriptor dirfd. */
