@@ -465,6 +465,151 @@ START_TEST(tile_save_load) {
 }
 END_TEST
 
+/* ---- meshes ------------------------------------------------------------- */
+
+/* 1 when every directed edge (a, b) of the mesh has its (b, a): closed
+** and consistently oriented. */
+static int closed(const oc_mesh *m) {
+  size_t nt = oc_mesh_triangle_count(m);
+  const uint32_t *ix = oc_mesh_indices(m);
+  uint64_t fw = 0, bw = 0;
+  for (size_t k = 0; k < nt; k++)
+    for (int j = 0; j < 3; j++) {
+      uint64_t a = ix[3 * k + j], b = ix[3 * k + (j + 1) % 3];
+      fw += (a * 0x9E3779B97F4A7C15ull) ^ (b * 0xC2B2AE3D27D4EB4Full);
+      bw += (b * 0x9E3779B97F4A7C15ull) ^ (a * 0xC2B2AE3D27D4EB4Full);
+    }
+  return fw == bw;
+}
+
+/* A mesh per block: closed, convex (midpoints of vertex pairs inside up to
+** the polygonizer's error), within the block's support, at the place of
+** the block's hull. */
+START_TEST(tile_meshes_closed_convex) {
+  oc_btile *t = small_tile(8);
+  oc_error e = {0};
+  for (size_t i = 0; i < 5; i++) {
+    oc_mesh *m = oc_btile_mesh(t, i, 0.1, 0.5, (oc_progress){0}, &e);
+    ck_assert_msg(m != NULL, "%s", e.msg);
+    size_t nv = oc_mesh_vertex_count(m);
+    const float *x = oc_mesh_positions(m);
+    ck_assert_uint_gt(oc_mesh_triangle_count(m), 100);
+    ck_assert_msg(closed(m), "block %zu: mesh not closed", i);
+    oc_program *pr = oct_compile(OCT_OK(oc_btile_block(t, i, &e)), 0.5, 0);
+    oc_aabb b = oc_program_bounds(pr);
+    oct_rng r = oct_rng_new(i);
+    double worst = 0;
+    for (int k = 0; k < 5000; k++) {
+      size_t a = (size_t)oct_unif(&r, 0, (double)nv) % nv,
+             c = (size_t)oct_unif(&r, 0, (double)nv) % nv;
+      oc_vec3 p = oct_v(0.5 * (x[3 * a] + x[3 * c]),
+                        0.5 * (x[3 * a + 1] + x[3 * c + 1]),
+                        0.5 * (x[3 * a + 2] + x[3 * c + 2]));
+      worst = fmax(worst, 0.5 - oc_program_eval(pr, p));
+    }
+    ck_assert_double_le(worst, 0.01);
+    for (size_t k = 0; k < nv; k++) {
+      ck_assert(x[3 * k] > b.lo.x && x[3 * k] < b.hi.x);
+      ck_assert(x[3 * k + 2] > b.lo.z && x[3 * k + 2] < b.hi.z);
+    }
+    oc_mesh_free(m);
+    oc_program_free(pr);
+  }
+  ck_assert_ptr_null(oc_btile_mesh(t, 100000, 0.1, 0.5, (oc_progress){0}, &e));
+  ck_assert_ptr_null(oc_btile_mesh(t, 0, 0, 0.5, (oc_progress){0}, &e));
+  ck_assert_msg(strstr(e.msg, "'cell'") != NULL, "%s", e.msg);
+  oc_btile_free(t);
+}
+END_TEST
+
+/* ---- seamless replication ----------------------------------------------- */
+
+static oc_mesh *mesh_box(const oc_program *pr, double y0, double y1) {
+  oc_polygonize_params pp = {0};
+  pp.box = (oc_aabb){{-3, y0, 4}, {0, y1, 12}};
+  pp.cell = 0.125;
+  pp.open = 1;
+  oc_error e = {0};
+  oc_mesh *m = oc_polygonize(pr, &pp, &e);
+  ck_assert_msg(m != NULL, "%s", e.msg);
+  return m;
+}
+
+static int cmp3(const void *a, const void *b) {
+  const float *p = a, *q = b;
+  for (int i = 0; i < 3; i++)
+    if (p[i] != q[i]) return p[i] < q[i] ? -1 : 1;
+  return 0;
+}
+
+/* The vertices of m on the plane y = w, sorted; their count in *n. */
+static float *seam(const oc_mesh *m, float w, size_t *n) {
+  size_t nv = oc_mesh_vertex_count(m);
+  const float *x = oc_mesh_positions(m);
+  float *s = malloc(3 * (nv ? nv : 1) * sizeof *s);
+  *n = 0;
+  for (size_t k = 0; k < nv; k++)
+    if (x[3 * k + 1] == w) memcpy(s + 3 * (*n)++, x + 3 * k, 3 * sizeof *s);
+  qsort(s, *n, 3 * sizeof *s, cmp3);
+  return s;
+}
+
+/* Blocks replicated on a long wall (8 m tiles; the wall's surface at
+** x = -1.35 with a falloff of 3 m): the meshes of two boxes
+** meeting on the tile border y = 24 share their seam vertices, blocks
+** straddle that border (seam vertices stand out of the wall), and the
+** blocks repeat with the tile: the box across the next border, y = 32,
+** is the same mesh moved by 8 m. */
+START_TEST(replicate_seamless) {
+  oc_error e = {0};
+  oc_node *ter = OCT_OK(oc_box(oct_v(0, 0, 0), oct_v(16, 48, 16), 3, 1, &e));
+  oc_btile *t = small_tile(4);
+  oc_program *pr = oct_compile(OCT_OK(replicated(ter, t, 0, &e)), 0.5, 0);
+  oc_node_release(ter);
+  oc_mesh *a = mesh_box(pr, 20, 24), *b = mesh_box(pr, 24, 28);
+  size_t na, nb;
+  float *sa = seam(a, 24, &na), *sb = seam(b, 24, &nb);
+  size_t out = 0;
+  for (size_t k = 0; k < na; k++)
+    out += sa[3 * k] < -1.6f;
+  printf("replicate seam y = 24: %zu vertices (%zu on blocks standing out "
+         "of the wall)\n",
+         na, out);
+  ck_assert_uint_gt(na, 50);
+  ck_assert_uint_gt(out, 8);
+  /* the field is continuous across the border (blocks are not cut by it) */
+  double L = oc_program_lipschitz(pr), jump = 0;
+  for (double x = -3; x <= 0; x += 0.05)
+    for (double z = 4; z <= 12; z += 0.05)
+      jump = fmax(jump, fabs(oc_program_eval(pr, oct_v(x, 24 - 1e-6, z)) -
+                             oc_program_eval(pr, oct_v(x, 24 + 1e-6, z))));
+  ck_assert_double_le(jump, 2e-6 * L + 1e-12);
+  ck_assert_uint_eq(na, nb);
+  ck_assert_int_eq(memcmp(sa, sb, 3 * na * sizeof *sa), 0);
+  free(sa);
+  free(sb);
+  /* periodic: the box across y = 32 is box a moved by 8 m */
+  oc_mesh *c = mesh_box(pr, 28, 32);
+  ck_assert_uint_eq(oc_mesh_vertex_count(a), oc_mesh_vertex_count(c));
+  ck_assert_uint_eq(oc_mesh_triangle_count(a), oc_mesh_triangle_count(c));
+  const float *xa = oc_mesh_positions(a), *xc = oc_mesh_positions(c);
+  double worst = 0;
+  for (size_t k = 0; k < oc_mesh_vertex_count(a); k++)
+    worst = fmax(worst, fabs(xa[3 * k] - xc[3 * k]) +
+                            fabs(xa[3 * k + 1] + 8 - xc[3 * k + 1]) +
+                            fabs(xa[3 * k + 2] - xc[3 * k + 2]));
+  ck_assert_double_le(worst, 1e-4);
+  ck_assert_int_eq(memcmp(oc_mesh_indices(a), oc_mesh_indices(c),
+                          3 * oc_mesh_triangle_count(a) * sizeof(uint32_t)),
+                   0);
+  oc_mesh_free(a);
+  oc_mesh_free(b);
+  oc_mesh_free(c);
+  oc_program_free(pr);
+  oc_btile_free(t);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("blockwarp");
   TCase *tc = tcase_create("relief");
@@ -476,6 +621,8 @@ int main(void) {
   tcase_add_test(tc, relief_errors);
   tcase_add_test(tc, replicate_inset);
   tcase_add_test(tc, tile_save_load);
+  tcase_add_test(tc, tile_meshes_closed_convex);
+  tcase_add_test(tc, replicate_seamless);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }
