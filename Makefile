@@ -281,7 +281,6 @@ PICTURES := demo_arch_render.png:demo:arch_render.png \
   example_diffusion_canyon3d.png:diffusion_canyon3d:diffusion_canyon3d.png \
   example_layers_sand.png:layers_sand:layers_sand.png \
   example_blocks_types.png:blocks_types:blocks_types.png \
-  example_blocks_warp.png:blocks_warp:blocks_warp.png \
   example_blocks_inset.png:blocks_inset:blocks_inset.png
 PICTURE_SCENES := $(sort $(foreach p,$(PICTURES),$(word 2,$(subst :, ,$(p)))))
 
