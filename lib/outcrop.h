@@ -778,6 +778,28 @@ oc_node *oc_btile_node(const oc_btile *t, oc_error *err);
 const double *oc_btile_planes(const oc_btile *t, size_t i, size_t *nplane);
 const double *oc_btile_vertices(const oc_btile *t, size_t i, size_t *nvert);
 
+/* Block i as a mesh: its field (oc_btile_block) compiled at threshold T
+** (0: the default) and polygonized with cubic cells of `cell` over its
+** support, where the tile has it (at its centroid's cell: move a copy by
+** size (i, j, k) for cell (i, j, k)). Closed and convex up to the
+** polygonizer's error. A new mesh, or NULL with err (OC_EINVAL for i out
+** of range or a bad cell, the polygonizer's errors). */
+oc_mesh *oc_btile_mesh(const oc_btile *t, size_t i, double cell, double T,
+                       oc_progress progress, oc_error *err);
+
+/* Saves the tile (its parameters, points, discs, blocks and statistics)
+** to a versioned binary file, atomically: whole or absent (OC_EIO naming
+** the path). _at: path relative to the folder descriptor dirfd. */
+int oc_btile_save(const oc_btile *t, const char *path, oc_error *err);
+int oc_btile_save_at(const oc_btile *t, int dirfd, const char *path,
+                     oc_error *err);
+/* A tile saved by oc_btile_save (free with oc_btile_free): its blocks are
+** the saved ones bit for bit. NULL with err: OC_EIO naming an unreadable
+** path, OC_EINVAL saying what is wrong with a file that is not a tile, of
+** another version, damaged (checksum) or crafted (every count and number
+** is checked before use), OC_ENOMEM. */
+oc_btile *oc_btile_load(const char *path, oc_error *err);
+
 /* Replication (Paris et al. 2020, section 5): a tile's blocks placed over
 ** a terrain where they are present. */
 typedef struct oc_replicate_tile {
@@ -794,6 +816,10 @@ typedef struct oc_replicate_params {
   double va, vb;    /* distance estimate (f - T) / |grad f| (> 0 inside)
                     ** in [va, vb] (default -1 .. 1) */
   int anchors;      /* centroid + hull vertices voting (default 9) */
+  double inset;     /* >= 0: the terrain sinks by about this many metres
+                    ** where blocks are (f - inset L min(1, t / T), L its
+                    ** Lipschitz bound, t the blocks), so the wall does
+                    ** not fill the joints; default 0 (the paper's) */
   double threshold; /* T of the criteria; 0: OC_DEFAULT_THRESHOLD */
   /* Optional (NULL: unused): present(ctx, anchor) decides each anchor's
   ** vote instead of the criteria above (called from the calling thread),
@@ -822,6 +848,38 @@ int oc_blocks_instance(const oc_node *n, size_t i, size_t *block,
 /* 1 and the bytes a replication node holds (Table 2's memory: the
 ** blocks' fields, the instances and their grid), else 0. */
 int oc_blocks_memory(const oc_node *n, size_t *bytes);
+
+/* Gradient-based warping (Paris et al. 2020, section 4.2), a node over any
+** field: f(p + u(p) s(p)), u the direction of the field's gradient (a
+** tetrahedral difference of step `step`, fading to 0 where the field is
+** less than half as steep as its Lipschitz bound), s the relief d on the
+** planes xy, xz, yz weighted by |u.z|, |u.y|, |u.x| (normalised to sum
+** 1), d in [-|amplitude|, |amplitude|] metres at world coordinates (d > 0
+** moves the surface outwards). Lipschitz bound: L (1 + L_d + 2 (1 + 2
+** sqrt 3) |amplitude| / step), L the field's, L_d the relief's
+** (lib/blocks/relief.c derives it). */
+typedef enum oc_relief_kind {
+  OC_RELIEF_TURBULENCE, /* d = A (2 t(x / wavelength) / t_max - 1) */
+  OC_RELIEF_IMAGE       /* d = A (2 v - 1), v the image's first channel
+                        ** clamped to [0, 1], bilinear, repeated every
+                        ** `wavelength` metres along the image's width */
+} oc_relief_kind;
+
+typedef struct oc_relief_params {
+  oc_relief_kind kind;
+  double wavelength; /* > 0 (default 1) */
+  int octaves;       /* turbulence: 1 .. 16 (default 4) */
+  uint64_t seed;     /* turbulence (default 1) */
+  const char *path;  /* image: PNG, TIFF, EXR or JPEG (read now) */
+  double amplitude;  /* A, metres, finite */
+  double step;       /* the gradient's step; 0: 4 |A| (0.01 for A = 0) */
+} oc_relief_params;
+
+void oc_relief_defaults(oc_relief_params *rp);
+/* A new node retaining child, or NULL with err (OC_EINVAL naming the
+** parameter, OC_EIO naming an unreadable image). */
+oc_node *oc_relief_warp(oc_node *child, const oc_relief_params *rp,
+                        oc_error *err);
 
 /* ---- heightfields ----------------------------------------------------- */
 

@@ -16,17 +16,22 @@
 ** "columnar" (extensions).
 **
 ** outcrop.blocks.replicate(terrain, {tiles = {{tile =, resistance = {lo,
-**   hi}}, ...}, geology =, slope = 1, distance = {-1, 1}, anchors = 9})
+**   hi}}, ...}, geology =, slope = 1, distance = {-1, 1}, anchors = 9,
+**   inset = 0})
 ** builds the replication node (presence decided now, with the current
 ** outcrop.threshold); resistance defaults to everything. node:stats()
 ** then has `instances`.
 */
+#include <errno.h>
 #include <math.h>
 #include <string.h>
 
 #include "l_blocks.h"
+#include "l_config.h"
 #include "l_field.h"
 #include "l_handle.h"
+#include "l_mesh.h"
+#include "l_progress.h"
 
 #define OCLUA_BTILE "outcrop.blocktile"
 
@@ -185,6 +190,62 @@ static int tile_node(lua_State *L) {
   return oclua_setnode(L, u, oc_btile_node(t, &err), &err, fname);
 }
 
+/* tile:meshes([{cell = 0.1}]): {mesh, ...}, one per block. */
+static int tile_meshes(lua_State *L) {
+  static const char *const known[] = {"cell", NULL};
+  const char *fname = "tile:meshes";
+  oc_error err = {OC_OK, ""};
+  oclua_checkargs(L, 2, fname, "([{cell =}])");
+  check_tile(L, fname);
+  double cell = 0.1;
+  if (!lua_isnoneornil(L, 2)) {
+    oclua_fields f;
+    oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
+    cell = oclua_field_optnumber(&f, "cell", OCLUA_POSITIVE, cell);
+  }
+  double T = oclua_threshold(L, fname);
+  oc_btile *t = check_tile(L, fname); /* again, after any Lua code */
+  oclua_pin(L, 1, &((oclua_btile *)lua_touserdata(L, 1))->h, fname);
+  oc_btile_stats st;
+  oc_btile_stats_get(t, &st);
+  lua_createtable(L, (int)st.blocks, 0);
+  for (size_t i = 0; i < st.blocks; i++) {
+    oclua_progress pl;
+    oc_progress pr = oclua_progress_start(L, &pl, fname);
+    oclua_mesh *u = oclua_newmesh(L);
+    u->mesh = oc_btile_mesh(t, i, cell, T, pr, &err);
+    oclua_progress_end(&pl);
+    if (!u->mesh && err.code == OC_ECANCEL) return luaL_error(L, "interrupted");
+    if (!u->mesh) oclua_liberror(L, fname, &err);
+    lua_rawseti(L, -2, (lua_Integer)i + 1);
+  }
+  return 1;
+}
+
+/* tile:save(path): true, or fail and a message when it cannot be
+** written. */
+static int tile_save(lua_State *L) {
+  const char *fname = "tile:save";
+  oc_error err = {OC_OK, ""};
+  oclua_checkargs(L, 2, fname, "(path)");
+  oc_btile *t = check_tile(L, fname);
+  if (lua_type(L, 2) != LUA_TSTRING)
+    oclua_error(L, fname, "the path must be a string (got %s)",
+                oclua_got(L, 2));
+  oclua_target tg;
+  int e = oclua_output_target(L, fname, lua_tostring(L, 2), OCLUA_TARGET_CREATE,
+                              &tg);
+  if (e) return oclua_output_fail(L, &tg, strerror(e));
+  int rc = oc_btile_save_at(t, tg.dir, tg.name, &err);
+  oclua_target_close(L, &tg);
+  if (rc != OC_OK) {
+    if (err.code == OC_EIO) return oclua_output_fail(L, &tg, err.msg);
+    oclua_liberror(L, fname, &err);
+  }
+  lua_pushboolean(L, 1);
+  return 1;
+}
+
 static int tile_gc(lua_State *L) {
   oclua_handle_close(luaL_checkudata(L, 1, OCLUA_BTILE));
   return 0;
@@ -202,11 +263,10 @@ static int tile_tostring(lua_State *L) {
   return 1;
 }
 
-static const luaL_Reg tile_methods[] = {{"stats", tile_stats},
-                                        {"count", tile_count},
-                                        {"block", tile_block},
-                                        {"node", tile_node},
-                                        {NULL, NULL}};
+static const luaL_Reg tile_methods[] = {
+    {"stats", tile_stats}, {"count", tile_count},   {"block", tile_block},
+    {"node", tile_node},   {"meshes", tile_meshes}, {"save", tile_save},
+    {NULL, NULL}};
 
 static const luaL_Reg tile_meta[] = {{"__gc", tile_gc},
                                      {"__close", tile_gc},
@@ -216,8 +276,8 @@ static const luaL_Reg tile_meta[] = {{"__gc", tile_gc},
 /* outcrop.blocks.replicate(terrain, {tiles = {{tile =, resistance = {lo,
 ** hi}}, ...}, geology =, slope =, distance = {va, vb}, anchors =}) */
 static int l_replicate(lua_State *L) {
-  static const char *const known[] = {"tiles",    "geology", "slope",
-                                      "distance", "anchors", NULL};
+  static const char *const known[] = {"tiles",   "geology", "slope", "distance",
+                                      "anchors", "inset",   NULL};
   static const char *const none[] = {NULL};
   static const char *const tknown[] = {"tile", "resistance", NULL};
   const char *fname = "outcrop.blocks.replicate";
@@ -235,6 +295,7 @@ static int l_replicate(lua_State *L) {
     rp.vb = d[1];
   }
   rp.anchors = (int)oclua_field_optint(&f, "anchors", 1, 64, rp.anchors);
+  rp.inset = oclua_field_optnumber(&f, "inset", OCLUA_FINITE, rp.inset);
   if (oclua_field_push(&f, "geology") != LUA_TNIL)
     rp.geology = oclua_checknode(L, -1, fname, "'geology'");
   /* the geology stays on the stack (reachable) */
@@ -299,8 +360,25 @@ oc_btile *oclua_checktile(lua_State *L, int idx, const char *fname,
   return u->t;
 }
 
-static const luaL_Reg blocks_funcs[] = {
-    {"tile", l_tile}, {"replicate", l_replicate}, {NULL, NULL}};
+/* outcrop.blocks.load(path): a tile saved by tile:save. */
+static int l_load(lua_State *L) {
+  const char *fname = "outcrop.blocks.load";
+  oc_error err = {OC_OK, ""};
+  oclua_checkargs(L, 1, fname, "(path)");
+  if (lua_type(L, 1) != LUA_TSTRING)
+    oclua_error(L, fname, "the path must be a string (got %s)",
+                oclua_got(L, 1));
+  oc_btile **t = oclua_newtile(L);
+  *t = oc_btile_load(lua_tostring(L, 1), &err);
+  if (!*t) oclua_liberror(L, fname, &err);
+  oclua_record_input(L, lua_tostring(L, 1), fname);
+  return 1;
+}
+
+static const luaL_Reg blocks_funcs[] = {{"tile", l_tile},
+                                        {"replicate", l_replicate},
+                                        {"load", l_load},
+                                        {NULL, NULL}};
 
 void oclua_open_blocks(lua_State *L) {
   oclua_newmeta(L, OCLUA_BTILE, tile_meta, tile_methods);

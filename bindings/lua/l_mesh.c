@@ -52,7 +52,7 @@ static void mesh_release(oclua_handle *h) {
   u->mesh = NULL;
 }
 
-static oclua_mesh *newmesh(lua_State *L) {
+oclua_mesh *oclua_newmesh(lua_State *L) {
   oclua_mesh *u = lua_newuserdatauv(L, sizeof *u, 0);
   oclua_handle_init(&u->h, "mesh", mesh_release);
   u->mesh = NULL;
@@ -477,7 +477,7 @@ static int l_polygonize(lua_State *L) {
   pp.warning_size = sizeof warning;
   pp.progress = oclua_progress_start(L, &pl, fname);
   /* The userdata first, so that nothing can leak once the mesh exists. */
-  oclua_mesh *u = newmesh(L);
+  oclua_mesh *u = oclua_newmesh(L);
   int midx = lua_gettop(L);
   u->mesh = oc_polygonize(prog, &pp, &err);
   oclua_progress_end(&pl);

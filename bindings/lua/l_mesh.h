@@ -13,6 +13,10 @@ typedef struct oclua_mesh {
   oc_mesh *mesh;  /* NULL while being made, or once freed */
 } oclua_mesh;
 
+/* Pushes a new mesh userdata holding no mesh yet (set u->mesh at once:
+** the userdata frees it). */
+oclua_mesh *oclua_newmesh(lua_State *L);
+
 /* Adds outcrop.polygonize to the module table at the stack top and sets
 ** up the mesh metatable. */
 void oclua_open_mesh(lua_State *L);

@@ -23,6 +23,7 @@
 #include "l_image.h"
 #include "l_layers.h"
 #include "l_mesh.h"
+#include "l_relief.h"
 #include "l_render.h"
 #include "l_terrain.h"
 #include "l_gen.h"
@@ -64,6 +65,7 @@ int luaopen_outcrop(lua_State *L) {
   oclua_open_elevation(L); /* outcrop.elevation */
   oclua_open_diffusion(L); /* outcrop.feature_curve, outcrop.diffusion */
   oclua_open_blocks(L);    /* outcrop.blocks */
+  oclua_open_relief(L);    /* outcrop.relief_warp */
   oclua_open_layers(L);    /* outcrop.layers */
   lua_pushliteral(L, OC_VERSION);
   lua_setfield(L, -2, "version");

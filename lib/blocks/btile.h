@@ -71,8 +71,14 @@ struct oc_btile {
   size_t merged; /* small clusters merged into a neighbour (merge.c) */
   size_t nauth;  /* authored blocks (authored.c), the last nauth of block */
   oc_bblock *auth;
+  size_t gcut;   /* a loaded tile's cut edges (tio.c): its g holds only
+                 ** the count of edges, g.ne, and no arrays */
   double seconds;
 };
+
+/* The checks of oc_btile_new: 0, or OC_EINVAL with err naming the
+** parameter (tile.c). */
+int oc_btile_check(const oc_btile_params *pp, oc_error *err);
 
 /* Fills t->disc with the type's discs then the user's (discs.c). */
 int oc_bdiscs_make(oc_btile *t, oc_error *err);

@@ -75,6 +75,7 @@ void oc_replicate_defaults(oc_replicate_params *rp) {
   rp->va = -1;
   rp->vb = 1;
   rp->anchors = 9;
+  rp->inset = 0;
 }
 
 /* ---- grid ---------------------------------------------------------------- */
@@ -167,12 +168,19 @@ static int rep_compile(oc_kcompile *c, oc_error *err) {
   (void)err;
   const oc_kinfo *k = &c->kid[0];
   c->par[0] = c->T;
-  double lip = k->lip;
+  double lip = k->lip, lipt = 0;
   for (size_t t = 0; t < r->ntile; t++) {
     oc_bfield_sigma(c->T, r->W[t], c->par + 1 + OC_BSIGMA_N * t);
-    lip = fmax(lip, c->par[1 + OC_BSIGMA_N * t + 3]);
+    lipt = fmax(lipt, c->par[1 + OC_BSIGMA_N * t + 3]);
   }
+  lip = fmax(lip, lipt);
   c->npar = 1 + OC_BSIGMA_N * r->ntile;
+  /* inset: the terrain sinks by k m(t), k = inset L (inset metres where
+  ** its slope is its bound), m = min(1, t / T); Lipschitz L + k lip_t / T */
+  double kin =
+      c->node_npar ? c->node_par[0] * (isfinite(k->lip) ? k->lip : 1) : 0;
+  c->par[c->npar++] = kin;
+  if (kin > 0) lip = fmax(lip, k->lip + kin * lipt / c->T);
   c->info.lo = fmin(k->lo, 0);
   c->info.hi = fmax(k->hi, 2 * c->T);
   c->info.lip = lip;
@@ -188,17 +196,10 @@ static int rep_compile(oc_kcompile *c, oc_error *err) {
   return OC_OK;
 }
 
-static double rep_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
-  const rdata *r = k->data;
-  double f = oc_child_eval(k, 0, p, g);
-  if (!r->ni || !in_box(&r->all, p)) return f;
-  int c[3];
-  const double q[3] = {p.x, p.y, p.z};
-  for (int a = 0; a < 3; a++) {
-    c[a] = (int)floor((q[a] - r->g0[a]) / r->gc);
-    if (c[a] < 0 || c[a] >= r->gn[a]) return f;
-  }
-  size_t cell = gcell(r, c[0], c[1], c[2]);
+/* max(f, the blocks of the cell at p); *g (when g) becomes the gradient of
+** the first block above f. */
+static double top(const oc_kctx *k, const rdata *r, size_t cell, oc_vec3 p,
+                  double f, oc_vec3 *g) {
   for (uint32_t m = r->gstart[cell]; m < r->gstart[cell + 1]; m++) {
     const rinst *in = &r->in[r->gidx[m]];
     if (!in_box(&in->box, p)) continue;
@@ -211,6 +212,37 @@ static double rep_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
     }
   }
   return f;
+}
+
+static double rep_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
+  const rdata *r = k->data;
+  double f = oc_child_eval(k, 0, p, g);
+  if (!r->ni || !in_box(&r->all, p)) return f;
+  int c[3];
+  const double q[3] = {p.x, p.y, p.z};
+  for (int a = 0; a < 3; a++) {
+    c[a] = (int)floor((q[a] - r->g0[a]) / r->gc);
+    if (c[a] < 0 || c[a] >= r->gn[a]) return f;
+  }
+  size_t cell = gcell(r, c[0], c[1], c[2]);
+  double kin = k->par[1 + OC_BSIGMA_N * r->ntile];
+  if (!(kin > 0)) return top(k, r, cell, p, f, g);
+  /* with an inset: t the largest block at p, f~ = max(f - kin m, t),
+  ** m = min(1, t / T): the terrain sinks where blocks are and the joints
+  ** between them stay open */
+  double T = k->par[0];
+  oc_vec3 gt = {0, 0, 0};
+  double t = top(k, r, cell, p, 0, g ? &gt : NULL);
+  if (!(t > 0)) return f;
+  double m = t < T ? t / T : 1, fs = f - kin * m;
+  if (t > fs) {
+    if (g) *g = gt;
+    return t;
+  }
+  if (g && t < T)
+    *g = (oc_vec3){g->x - kin / T * gt.x, g->y - kin / T * gt.y,
+                   g->z - kin / T * gt.z};
+  return fs;
 }
 
 static int rep_zero_in(const oc_kctx *k, const oc_aabb *b) {
@@ -390,6 +422,10 @@ oc_node *oc_blocks_replicate(oc_node *terrain, const oc_replicate_params *rp,
               rp->anchors);
     return NULL;
   }
+  if (!(rp->inset >= 0) || !isfinite(rp->inset)) {
+    oc_seterr(err, OC_EINVAL, "'inset' must be >= 0 (got %g)", rp->inset);
+    return NULL;
+  }
   oc_compile_options co = {rp->threshold, 0};
   oc_program *tp = oc_compile(terrain, &co, err);
   if (!tp) return NULL;
@@ -427,7 +463,7 @@ oc_node *oc_blocks_replicate(oc_node *terrain, const oc_replicate_params *rp,
             rp->ctx};
   if (place(r, rp, &c, tb, err)) goto done;
   if (grid_make(r)) goto nomem;
-  out = oc_kind_node(&replicate_kind, &terrain, 1, NULL, 0, r, err);
+  out = oc_kind_node(&replicate_kind, &terrain, 1, &rp->inset, 1, r, err);
   r = NULL; /* the node owns it, also on failure */
   goto done;
 nomem:

@@ -120,6 +120,10 @@ static int check(const oc_btile_params *pp, oc_error *err) {
   return 0;
 }
 
+int oc_btile_check(const oc_btile_params *pp, oc_error *err) {
+  return check(pp, err);
+}
+
 void oc_btile_free(oc_btile *t) {
   if (!t) return;
   free(t->pts);
@@ -204,8 +208,9 @@ void oc_btile_stats_get(const oc_btile *t, oc_btile_stats *st) {
   st->fractures = t->nd;
   st->blocks = t->nb;
   st->edges = t->g.ne;
-  for (size_t e = 0; e < t->g.ne; e++)
+  for (size_t e = 0; e < t->g.ne && t->g.cut; e++)
     st->cut += t->g.cut[e];
+  if (!t->g.cut) st->cut = t->gcut; /* a loaded tile (tio.c) */
   st->thick = t->thick;
   st->separated = t->ncut;
   st->merged = t->merged;
