@@ -9,7 +9,7 @@
 **   parameters: u32 type, f64 size, radius, neighbour, u64 fractures,
 **     f64 spacing, disc_lo, disc_hi, rounding, width, u64 seed, ndiscs
 **   counts: u64 points, discs, blocks, edges, cut, thick, separated,
-**     merged; f64 seconds
+**     merged, authored (the last blocks); f64 seconds
 **   points: 3 f64 each; discs: 7 f64 each (centre, normal, radius)
 **   blocks: u64 nplane, nvert, npts; f64 centroid (3), box (6),
 **     thickness; planes (4 f64 each); vertices (3 f64 each)
@@ -98,9 +98,9 @@ int oc_btile_save_at(const oc_btile *t, int dirfd, const char *path,
   put_u64(&w, pp->ndiscs);
   oc_btile_stats st;
   oc_btile_stats_get(t, &st);
-  const uint64_t counts[8] = {t->np,  t->nd,    t->nb,   st.edges,
-                              st.cut, t->thick, t->ncut, t->merged};
-  for (int i = 0; i < 8; i++)
+  const uint64_t counts[9] = {t->np,    t->nd,   t->nb,     st.edges, st.cut,
+                              t->thick, t->ncut, t->merged, t->nauth};
+  for (int i = 0; i < 9; i++)
     put_u64(&w, counts[i]);
   put_f64s(&w, &t->seconds, 1);
   put_f64s(&w, t->pts, 3 * t->np);
@@ -325,8 +325,8 @@ oc_btile *oc_btile_load(const char *path, oc_error *err) {
   uint64_t fractures = get_u64(&r);
   get_f64s(&r, p2, 5);
   uint64_t seed = get_u64(&r), ndiscs = get_u64(&r);
-  uint64_t c[8];
-  for (int i = 0; i < 8; i++)
+  uint64_t c[9];
+  for (int i = 0; i < 9; i++)
     c[i] = get_u64(&r);
   get_f64s(&r, &t->seconds, 1);
   if (r.bad) goto done;
@@ -348,8 +348,9 @@ oc_btile *oc_btile_load(const char *path, oc_error *err) {
     goto done;
   }
   pp->ndiscs = (size_t)ndiscs; /* (the discs are in t->disc) */
-  /* counts: points, discs, blocks, edges, cut, thick, separated, merged */
-  if (c[0] > MAX_POINTS || c[1] > MAX_DISCS || c[2] > c[0] ||
+  /* counts: points, discs, blocks, edges, cut, thick, separated, merged,
+  ** authored */
+  if (c[0] > MAX_POINTS || c[1] > MAX_DISCS || c[2] > c[0] || c[8] > c[2] ||
       c[3] > 64 * c[0] || c[4] > c[3] || c[5] > c[2] || c[7] > c[0] ||
       c[6] > c[2] * c[2] || t->seconds < 0) {
     fail(&r, "its counts are out of range");
@@ -363,6 +364,7 @@ oc_btile *oc_btile_load(const char *path, oc_error *err) {
   t->thick = (size_t)c[5];
   t->ncut = (size_t)c[6];
   t->merged = (size_t)c[7];
+  t->nauth = (size_t)c[8]; /* the count only: t->auth is for building */
   t->pts = malloc((t->np ? t->np : 1) * 3 * sizeof *t->pts);
   t->disc = malloc((t->nd ? t->nd : 1) * sizeof *t->disc);
   t->block = calloc(c[2] ? c[2] : 1, sizeof *t->block);

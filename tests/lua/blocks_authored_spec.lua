@@ -37,6 +37,19 @@ describe("authored blocks", function()
     end
   end)
 
+  it("are still authored in a tile saved and loaded", function()
+    local t = small{seed = 2, type = "columnar", blocks = {{box = {2, 2, 2, 5, 4, 3.5}}}}
+    local dir = R.tmpdir()
+    assert.is_true(t:save(dir .. "/a.octile"))
+    local l = B.load(dir .. "/a.octile")
+    local a, b = t:stats(), l:stats()
+    assert.are.equal(1, b.authored)
+    assert.are.equal(a.blocks, b.blocks)
+    local p = {3.5, 3, 2.75}
+    assert.are.equal(t:block(a.blocks):eval(p), l:block(b.blocks):eval(p))
+    R.rmdir(dir)
+  end)
+
   it("takes points and planes", function()
     local t = small{seed = 2, blocks = {
       {points = {{1, 1, 1}, {3, 1, 1}, {1, 3, 1}, {1, 1, 3}}},
