@@ -447,16 +447,17 @@ START_TEST(tile_save_load) {
   ck_assert_ptr_null(oc_btile_load(bad, &e));
   ck_assert_msg(strstr(e.msg, "no tile header") != NULL, "%s", e.msg);
   /* offsets: version 8, radius 28, width 84, counts from 108 (points,
-  ** discs, blocks, ...), points from 180 */
+  ** discs, blocks, ..., authored at 172), points from 188 */
   crafted(bad, buf, n, 8, 2 | (uint64_t)0 << 32, "version 2");
   crafted(bad, buf, n, 28, bits(NAN), "not finite");
   crafted(bad, buf, n, 84, bits(0), "'width' must be > 0");
   crafted(bad, buf, n, 108, (uint64_t)1 << 40, "counts are out of range");
   crafted(bad, buf, n, 124, a.blocks + 1000, "truncated");
-  size_t b0 = 180 + 24 * a.points + 56 * a.fractures;
+  crafted(bad, buf, n, 172, a.blocks + 1, "counts are out of range");
+  size_t b0 = 188 + 24 * a.points + 56 * a.fractures;
   crafted(bad, buf, n, b0, (uint64_t)1 << 62, "a block's counts");
   crafted(bad, buf, n, b0 + 24 + 80, bits(2.0), "unit normal");
-  crafted(bad, buf, n, 180, bits(-3.0), "a point lies outside");
+  crafted(bad, buf, n, 188, bits(-3.0), "a point lies outside");
   free(buf);
   oc_btile_free(t);
   unlink(path);
