@@ -1,7 +1,8 @@
 /*
 ** lfield.c — the convolution surface of a set of materials (Peytavie et
 ** al. 2009, section 3.3) as a node kind on the node-family seam
-** (field/kind.h).
+** (field/kind.h), and the visible material ratio for texturing (section
+** 6) as another, at the end.
 **
 ** The kernel is the cube Omega of half-side sigma (the paper's infinity
 ** norm), so the convolution is the volume V_M of the materials inside the
