@@ -5,8 +5,8 @@
 -- between them, an arch swept through the fin and another through the
 -- ledge, a few carving
 -- strokes to break the walls, and the walls' surface eroded into sand and
--- rocks that settle at the foot. Rendered and meshed textured by
--- material (section 6).
+-- rocks that settle at the foot. Rendered and meshed textured by the
+-- visible material ratio (section 6) with the surface's sigma.
 --
 --   outcrop run examples/layers_arches.lua [--set cell=0.5] [--out DIR]
 
@@ -69,7 +69,7 @@ print(string.format("layers_arches: %d stacks, %d layers, %d bytes",
                     st.stacks, st.layers, st.bytes))
 
 local solid = s:field{sigma = 1.5 * cell}
-local colors = s:colors{bedrock = {0.36, 0.22, 0.14}}
+local colors = s:colors{sigma = 1.5 * cell, bedrock = {0.36, 0.22, 0.14}}
 local box = {0, 0, 0.5, 60, 40, 30}
 local mesh = oc.polygonize(solid, {box = box, cell = cell})
 mesh:write("layers_arches.ply", {colors = colors})

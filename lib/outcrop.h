@@ -2356,6 +2356,20 @@ oc_stacks *oc_stacks_from_program(const oc_program *prog,
 oc_node *oc_stacks_field(const oc_stacks *s, unsigned mask, double sigma,
                          oc_error *err);
 
+/* The visible ratio of `material` (OC_MAT_*, not air) around p, a weight
+** for texturing (Peytavie et al. 2009, section 6): the share of the
+** surface inside the cube of half-side sigma around p whose exposed
+** material is `material`. The surface is each stack's exposed boundaries
+** (a solid layer's top under air or water, its underside over them),
+** counted by the stack's overlap with the cube's footprint times the tent
+** 1 - |b - z| / sigma of its height b; plus 1e-6 times the volume ratio,
+** which decides where no boundary is within sigma (a cliff face). Weights
+** of the materials are meant to be normalised (as a colour blend does):
+** f = sum over boundaries / (4 sigma^2) is not a distance. A snapshot;
+** sigma > 0 (NaN: one cell). */
+oc_node *oc_stacks_visible(const oc_stacks *s, int material, double sigma,
+                           oc_error *err);
+
 /* Stabilisation by the angle of repose (section 3.4). For sand, then
 ** rocks, until no transfer exceeds `tolerance`: every stack with material
 ** m at height h (the top of m in its segment between bedrock layers)

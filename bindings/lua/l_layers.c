@@ -33,11 +33,14 @@
 **        profiles = {{u, v}, ...} or {{{u, v}, ...}, ...},
 **        mode = "crack" | "tunnel", stabilize = true | false | {...}}
 **        -> bedrock volume added (negative), {...}
-**   s:colors{sigma = 1 cell, sand = {r, g, b}, ...} -> {blend = {{node,
-**        {r, g, b}}, ...}}: each material present (bedrock first) with
-**        its convolution surface of half-side sigma (its share of the box
-**        around a point) and its colour, for render's `color =` and a
-**        mesh's `colors =` (texturing by material)
+**   s:colors{sigma = 1 cell, ratio = "visible" | "volume", sand = {r, g,
+**        b}, ...} -> {blend = {{node, {r, g, b}}, ...}}: each material
+**        present (bedrock first) with its weight around a point and its
+**        colour, for render's `color =` and a mesh's `colors =`
+**        (texturing by material). visible: the share of the surface
+**        within the box of half-side sigma that exposes the material
+**        (oc_stacks_visible); volume: its share of the box's volume
+**        (its convolution surface, oc_stacks_field)
 **   outcrop.layers.rocks{...} and s:rocks(tile, {...}): rock piles
 **        (l_rocks.c)
 **
@@ -736,18 +739,22 @@ static const double MAT_RGB[OC_MAT_COUNT][3] = {{0, 0, 0},
                                                 {0.22, 0.18, 0.15}};
 
 static int m_colors(lua_State *L) {
-  static const char *const known[] = {"sigma", "water",   "sand",
+  static const char *const known[] = {"sigma", "ratio",   "water", "sand",
                                       "rocks", "bedrock", NULL};
+  static const char *const ratios[] = {"visible", "volume", NULL};
   const char *fname = "layers:colors";
-  oclua_checkargs(L, 2, fname, "([{sigma=, water=, sand=, rocks=, bedrock=}])");
+  oclua_checkargs(L, 2, fname,
+                  "([{sigma=, ratio=, water=, sand=, rocks=, bedrock=}])");
   lua_settop(L, 2);
   oc_stacks *s = pinlayers(L, 1, fname);
   double sigma = oc_stacks_cell(s), rgb[OC_MAT_COUNT][3];
+  int volume = 0;
   memcpy(rgb, MAT_RGB, sizeof rgb);
   if (!lua_isnil(L, 2)) {
     oclua_fields f;
     oclua_fields_open(&f, L, 2, fname, NULL, known, 0);
     sigma = oclua_field_optnumber(&f, "sigma", OCLUA_POSITIVE, sigma);
+    volume = oclua_field_optoption(&f, "ratio", ratios, 0) == 1;
     for (int m = OC_MAT_WATER; m < OC_MAT_COUNT; m++) {
       const char *name = oc_material_name(m);
       if (!oclua_field_numbers(&f, name, 3, rgb[m], "must be {r, g, b}"))
@@ -766,7 +773,10 @@ static int m_colors(lua_State *L) {
     lua_createtable(L, 2, 0);
     oclua_node *u = oclua_newnode(L);
     oc_error err = {OC_OK, ""};
-    oclua_setnode(L, u, oc_stacks_field(s, 1u << m, sigma, &err), &err, fname);
+    oclua_setnode(L, u,
+                  volume ? oc_stacks_field(s, 1u << m, sigma, &err)
+                         : oc_stacks_visible(s, m, sigma, &err),
+                  &err, fname);
     lua_rawseti(L, -2, 1);
     lua_createtable(L, 3, 0);
     for (int c = 0; c < 3; c++) {

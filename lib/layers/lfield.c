@@ -1,7 +1,8 @@
 /*
 ** lfield.c — the convolution surface of a set of materials (Peytavie et
 ** al. 2009, section 3.3) as a node kind on the node-family seam
-** (field/kind.h).
+** (field/kind.h), and the visible material ratio for texturing (section
+** 6) as another, at the end.
 **
 ** The kernel is the cube Omega of half-side sigma (the paper's infinity
 ** norm), so the convolution is the volume V_M of the materials inside the
@@ -69,11 +70,11 @@ static int axis_range(double lo, double hi, double X0, double s, int n, int *i0,
   return lo < X0 || hi > X0 + n * s;
 }
 
-static double lf_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
-  const lfield *d = k->data;
+/* V_M in the cube of half-side sigma around p, and its gradient in *g
+** when g (unscaled: K f = K V). */
+static double lf_volume(const lfield *d, oc_vec3 p, oc_vec3 *g) {
   double sg = d->sigma, s = d->cell;
   if (g) *g = (oc_vec3){0, 0, 0};
-  if (!(p.x == p.x && p.y == p.y && p.z == p.z)) return NAN;
   if (p.z + sg <= d->zlo || p.z - sg >= d->zhi) return 0;
   int i0, i1, j0, j1;
   axis_range(p.x - sg, p.x + sg, d->X0, s, d->nx, &i0, &i1);
@@ -103,8 +104,15 @@ static double lf_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
       }
     }
   }
-  double K = k->par[P_K];
-  if (g) *g = (oc_vec3){K * gx, K * gy, K * gz};
+  if (g) *g = (oc_vec3){gx, gy, gz};
+  return V;
+}
+
+static double lf_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
+  if (g) *g = (oc_vec3){0, 0, 0};
+  if (!(p.x == p.x && p.y == p.y && p.z == p.z)) return NAN;
+  double K = k->par[P_K], V = lf_volume(k->data, p, g);
+  if (g) *g = (oc_vec3){K * g->x, K * g->y, K * g->z};
   return K * V;
 }
 
@@ -209,6 +217,14 @@ static int lf_column(const oc_kctx *k, const oc_foot *f, oc_colq *q) {
 
 /* ---- the kind ------------------------------------------------------------ */
 
+/* The support: the grid and the materials' z-range grown by sigma. */
+static oc_aabb lf_box(const lfield *d) {
+  double sg = d->sigma;
+  return (oc_aabb){{d->X0 - sg, d->Y0 - sg, d->zlo - sg},
+                   {d->X0 + d->nx * d->cell + sg, d->Y0 + d->ny * d->cell + sg,
+                    d->zhi + sg}};
+}
+
 static int lf_compile(oc_kcompile *c, oc_error *err) {
   const lfield *d = c->data;
   double sg = d->sigma;
@@ -219,9 +235,7 @@ static int lf_compile(oc_kcompile *c, oc_error *err) {
   c->info.lo = 0;
   c->info.hi = 2 * c->T;
   c->info.lip = sqrt(3.0) * c->T / sg * (1 + 1e-9);
-  c->info.box = (oc_aabb){{d->X0 - sg, d->Y0 - sg, d->zlo - sg},
-                          {d->X0 + d->nx * d->cell + sg,
-                           d->Y0 + d->ny * d->cell + sg, d->zhi + sg}};
+  c->info.box = lf_box(d);
   return OC_OK;
 }
 
@@ -244,8 +258,10 @@ static const oc_kind_def layers_kind = {
     .release = lf_release,
 };
 
-oc_node *oc_stacks_field(const oc_stacks *s, unsigned mask, double sigma,
-                         oc_error *err) {
+/* The intervals of the materials in mask (checked) with sigma (checked;
+** NaN: one cell), or NULL with err. */
+static lfield *lf_build(const oc_stacks *s, unsigned mask, double sigma,
+                        oc_error *err) {
   if (mask == 0 || mask >= (1u << OC_MAT_COUNT) || (mask & 1u << OC_MAT_AIR)) {
     oc_seterr(err, OC_EINVAL,
               "'materials' must name at least one of water, sand, rocks, "
@@ -297,5 +313,177 @@ oc_node *oc_stacks_field(const oc_stacks *s, unsigned mask, double sigma,
   }
   d->off[ns] = n;
   if (n == 0) d->zlo = d->zhi = s->zbase;
-  return oc_kind_node(&layers_kind, NULL, 0, NULL, 0, d, err);
+  return d;
+}
+
+oc_node *oc_stacks_field(const oc_stacks *s, unsigned mask, double sigma,
+                         oc_error *err) {
+  lfield *d = lf_build(s, mask, sigma, err);
+  return d ? oc_kind_node(&layers_kind, NULL, 0, NULL, 0, d, err) : NULL;
+}
+
+/* ---- the visible material ratio (section 6) ------------------------------
+**
+** The share of the surface within the cube of half-side sigma around p
+** whose exposed material is M. The surface of a stack is its exposed
+** boundaries: the top of each solid run under air or water (or the stack's
+** top) and the underside of each run over air or water (not at the base),
+** each with the material of its solid layer. A stack counts by the area it
+** shares with the cube's footprint (as the volume field) and each boundary
+** at height b by the tent 1 - |b - z| / sigma, so that the weights are
+** continuous in p:
+**   S_M(p) = sum_stacks wx wy / (4 sigma^2) sum_{b of M} max(0, 1 - |b - z| /
+*sigma)
+** and f = S_M + EPS V_M / V_Omega: where no boundary is within sigma (a
+** cliff face between its top and foot) the volume ratio decides, which
+** the tiny EPS leaves unseen wherever a boundary is near. The blend
+** normalises over the materials, so f is a weight, not a distance. */
+
+#define VIS_EPS 1e-6
+
+typedef struct vfield {
+  lfield *v;     /* the intervals of M: V_M, support and zero tests */
+  uint32_t *off; /* stack k: boundaries off[k] .. off[k + 1] - 1 */
+  double *b;     /* the heights of M's exposed boundaries, bottom-up */
+  int maxb;      /* the most boundaries of M in a stack */
+} vfield;
+
+static double vf_eval(const oc_kctx *k, oc_vec3 p, oc_vec3 *g) {
+  const vfield *d = k->data;
+  const lfield *l = d->v;
+  double sg = l->sigma, s = l->cell, A = 4 * sg * sg;
+  if (g) *g = (oc_vec3){0, 0, 0};
+  if (!(p.x == p.x && p.y == p.y && p.z == p.z)) return NAN;
+  if (p.z + sg <= l->zlo || p.z - sg >= l->zhi) return 0;
+  int i0, i1, j0, j1;
+  axis_range(p.x - sg, p.x + sg, l->X0, s, l->nx, &i0, &i1);
+  axis_range(p.y - sg, p.y + sg, l->Y0, s, l->ny, &j0, &j1);
+  double S = 0, gx = 0, gy = 0, gz = 0;
+  for (int j = j0; j <= j1; j++) {
+    double c0 = l->Y0 + j * s, c1 = c0 + s;
+    double wy = fmin(p.y + sg, c1) - fmax(p.y - sg, c0);
+    if (!(wy > 0)) continue;
+    double dwy = (p.y + sg < c1) - (p.y - sg > c0);
+    for (int i = i0; i <= i1; i++) {
+      double e0 = l->X0 + i * s, e1 = e0 + s;
+      double wx = fmin(p.x + sg, e1) - fmax(p.x - sg, e0);
+      if (!(wx > 0)) continue;
+      size_t q = (size_t)j * l->nx + i;
+      double t = 0, dt = 0;
+      for (uint32_t r = d->off[q]; r < d->off[q + 1]; r++) {
+        double u = (d->b[r] - p.z) / sg;
+        if (u >= 1) break;
+        if (u <= -1) continue;
+        t += 1 - fabs(u);
+        dt += (u > 0) - (u < 0);
+      }
+      if (t == 0) continue;
+      S += wx * wy * t;
+      if (g) {
+        double dwx = (p.x + sg < e1) - (p.x - sg > e0);
+        gx += dwx * wy * t;
+        gy += wx * dwy * t;
+        gz += wx * wy * dt / sg;
+      }
+    }
+  }
+  oc_vec3 gv;
+  double K = VIS_EPS / (2 * sg * A), V = lf_volume(l, p, g ? &gv : NULL);
+  if (g)
+    *g = (oc_vec3){gx / A + K * gv.x, gy / A + K * gv.y, gz / A + K * gv.z};
+  return S / A + K * V;
+}
+
+static int vf_zero_in(const oc_kctx *k, const oc_aabb *b) {
+  const vfield *d = k->data;
+  return lf_zero_box(d->v, b->lo.x, b->lo.y, b->hi.x, b->hi.y, b->lo.z,
+                     b->hi.z);
+}
+
+static double vf_lip_in(const oc_kctx *k, const oc_aabb *b) {
+  return vf_zero_in(k, b) ? 0 : k->lip;
+}
+
+static int vf_compile(oc_kcompile *c, oc_error *err) {
+  const vfield *d = c->data;
+  const lfield *l = d->v;
+  double sg = l->sigma;
+  (void)err;
+  c->npar = 0;
+  c->info.lo = 0;
+  c->info.hi = d->maxb + VIS_EPS;
+  /* per stack |d t / dz| <= maxb / sigma, the overlap's slopes <= 1 over
+  ** a footprint of side 2 sigma: each component <= maxb / sigma */
+  c->info.lip = sqrt(3.0) * (d->maxb + VIS_EPS) / sg * (1 + 1e-9);
+  c->info.box = lf_box(l);
+  return OC_OK;
+}
+
+static void vf_release(void *data) {
+  vfield *d = data;
+  if (!d) return;
+  lf_release(d->v);
+  free(d->off);
+  free(d->b);
+  free(d);
+}
+
+static const oc_kind_def visible_kind = {
+    .name = "layers_visible",
+    .flags = OC_KF_PRIM,
+    .compile = vf_compile,
+    .eval = vf_eval,
+    .lipschitz_in = vf_lip_in,
+    .zero_in = vf_zero_in,
+    .release = vf_release,
+};
+
+/* Air and water are gaps: what lies under a lake shows through it. */
+static int is_gap(int m) {
+  return m == OC_MAT_AIR || m == OC_MAT_WATER;
+}
+
+oc_node *oc_stacks_visible(const oc_stacks *s, int material, double sigma,
+                           oc_error *err) {
+  if (material <= OC_MAT_AIR || material >= OC_MAT_COUNT) {
+    oc_seterr(err, OC_EINVAL,
+              "'material' must be water, sand, rocks or "
+              "bedrock");
+    return NULL;
+  }
+  lfield *l = lf_build(s, 1u << material, sigma, err);
+  if (!l) return NULL;
+  size_t ns = (size_t)s->nx * s->ny, nl = oc_soff(s, ns);
+  vfield *d = calloc(1, sizeof *d);
+  if (d) {
+    d->v = l;
+    d->off = malloc((ns + 1) * sizeof *d->off);
+    d->b = malloc((2 * nl + 1) * sizeof *d->b);
+  }
+  if (!d || !d->off || !d->b) {
+    if (!d) lf_release(l);
+    vf_release(d);
+    oc_seterr(err, OC_ENOMEM, "out of memory");
+    return NULL;
+  }
+  uint32_t n = 0;
+  for (size_t k = 0; k < ns; k++) {
+    d->off[k] = n;
+    size_t l0 = oc_soff(s, k), lend = l0 + oc_scount(s, k);
+    double z = s->zbase;
+    for (size_t r = l0; r < lend; r++) {
+      int m = oc_lay_m(s->lay[r]);
+      double z1 = z + oc_lay_t(s->lay[r]);
+      if (m == material && z1 > z) {
+        /* the underside, over a gap (not the base) */
+        if (r > l0 && is_gap(oc_lay_m(s->lay[r - 1]))) d->b[n++] = z;
+        /* the top, under a gap or the sky */
+        if (r + 1 == lend || is_gap(oc_lay_m(s->lay[r + 1]))) d->b[n++] = z1;
+      }
+      z = z1;
+    }
+    if ((int)(n - d->off[k]) > d->maxb) d->maxb = (int)(n - d->off[k]);
+  }
+  d->off[ns] = n;
+  return oc_kind_node(&visible_kind, NULL, 0, NULL, 0, d, err);
 }

@@ -3,10 +3,10 @@
 ** the colour at a point is T(p) = a T(y, z) + b T(x, z) + c T(x, y), the
 ** weights |n_x|^p, |n_y|^p, |n_z|^p normalised with p = 8 (each paired
 ** with the plane orthogonal to its axis), and materials blend by their
-** ratio around the point. The ratio is the weight programs' value there:
-** for material stacks, each material's convolution surface (the share of
-** the box of half-side sigma around p that the material fills), so the
-** blend follows the materials that show at the surface within sigma.
+** ratio around the point. The ratio is the weight programs' value there,
+** normalised: for material stacks, each material's visible ratio (its
+** share of the exposed surface in the box of half-side sigma around p,
+** oc_stacks_visible), or its volume ratio (oc_stacks_field).
 ** Renders use it as a colour source (OC_COLOR_BLEND), meshes as vertex
 ** colours (oc_mesh_color_by_blend).
 */

@@ -4,7 +4,8 @@
 ** surface within a cell, from_program's progress and cancellation, and
 ** the sweep tool (a crack's cross-section equal to its profile, branches,
 ** tunnels, volume bookkeeping, thread independence, bad input), and mesh
-** vertex colours textured by material (oc_mesh_color_by_blend).
+** vertex colours textured by material (oc_mesh_color_by_blend), and the
+** visible material ratio (oc_stacks_visible).
 */
 #include <omp.h>
 #include <string.h>
@@ -437,6 +438,73 @@ START_TEST(texture_by_material) {
 }
 END_TEST
 
+/* The visible ratio (oc_stacks_visible, sigma 1) on a 6 x 6 grid of
+** stacks of bedrock 3, air 2, bedrock 1 (a roof), three rows of them
+** then bedrock 3 under water 1: the roof's underside counts (over air),
+** water is a gap (the bedrock under it shows), tents halve with half a
+** sigma, and the gradient matches central differences. */
+START_TEST(visible_ratio) {
+  oc_error err;
+  oc_stacks *s = slab(6, 1, 3);
+  uint8_t m[3] = {OC_MAT_BEDROCK, OC_MAT_AIR, OC_MAT_BEDROCK};
+  double t[3] = {3, 2, 1};
+  for (int j = 0; j < 6; j++)
+    for (int i = 0; i < 6; i++)
+      ck_assert(oc_stacks_set(s, i, j, m, t, 3, &err) == OC_OK);
+  oc_program *bd =
+      oct_compile(OCT_OK(oc_stacks_visible(s, OC_MAT_BEDROCK, 1, &err)), T, 0);
+  /* the underside at z 5: S = 1, the box [4, 6] half bedrock */
+  ck_assert_double_eq_tol(oc_program_eval(bd, (oc_vec3){2.3, 2.6, 5}),
+                          1 + 1e-6 * 0.5, 1e-12);
+  /* between the underside 5 and the top 6 both tents count */
+  ck_assert_double_eq_tol(oc_program_eval(bd, (oc_vec3){2.3, 2.6, 5.5}),
+                          1 + 1e-6 * 0.5, 1e-12);
+  ck_assert_double_eq_tol(oc_program_eval(bd, (oc_vec3){2.3, 2.6, 3.5}),
+                          0.5 + 1e-6 * 0.25, 1e-12);
+  /* a sigma from every boundary, no material in the box */
+  ck_assert_double_eq_tol(oc_program_eval(bd, (oc_vec3){2.3, 2.6, 4}), 0,
+                          1e-15);
+  /* water is a gap: the bedrock top under it is the surface */
+  uint8_t mw[2] = {OC_MAT_BEDROCK, OC_MAT_WATER};
+  double tw[2] = {3, 1};
+  for (int j = 3; j < 6; j++)
+    for (int i = 0; i < 6; i++)
+      ck_assert(oc_stacks_set(s, i, j, mw, tw, 2, &err) == OC_OK);
+  oc_program *bw =
+      oct_compile(OCT_OK(oc_stacks_visible(s, OC_MAT_BEDROCK, 1, &err)), T, 0);
+  oc_program *ww =
+      oct_compile(OCT_OK(oc_stacks_visible(s, OC_MAT_WATER, 1, &err)), T, 0);
+  ck_assert_double_eq_tol(oc_program_eval(bw, (oc_vec3){2.3, 4, 3}),
+                          1 + 1e-6 * 0.5, 1e-12);
+  ck_assert_double_eq_tol(oc_program_eval(ww, (oc_vec3){2.3, 4, 3.5}),
+                          0.5 + 1e-6 * 0.5, 1e-12);
+  /* the gradient, off the stack boundaries */
+  const oc_vec3 ps[3] = {{2.3, 4.2, 3.4}, {1.1, 2.7, 5.3}, {3.6, 4.9, 2.8}};
+  for (int k = 0; k < 3; k++) {
+    oc_vec3 g, p = ps[k];
+    oc_program_gradient(bw, p, &g);
+    double h = 1e-6, d[3];
+    for (int a = 0; a < 3; a++) {
+      oc_vec3 u = p, v = p;
+      (&u.x)[a] += h;
+      (&v.x)[a] -= h;
+      d[a] = (oc_program_eval(bw, u) - oc_program_eval(bw, v)) / (2 * h);
+    }
+    ck_assert_double_eq_tol(g.x, d[0], 1e-6);
+    ck_assert_double_eq_tol(g.y, d[1], 1e-6);
+    ck_assert_double_eq_tol(g.z, d[2], 1e-6);
+  }
+  ck_assert(oc_stacks_visible(s, OC_MAT_AIR, 1, &err) == NULL);
+  ck_assert(strstr(err.msg, "'material'"));
+  ck_assert(oc_stacks_visible(s, OC_MAT_SAND, -1, &err) == NULL);
+  ck_assert(strstr(err.msg, "'sigma'"));
+  oc_program_free(bd);
+  oc_program_free(bw);
+  oc_program_free(ww);
+  oc_stacks_free(s);
+}
+END_TEST
+
 /* ---- storage ---------------------------------------------------------------
  */
 
@@ -489,6 +557,7 @@ int main(void) {
   tcase_add_test(tc, sweep_bend_mitred);
   tcase_add_test(tc, sweep_sand_threads_errors);
   tcase_add_test(tc, texture_by_material);
+  tcase_add_test(tc, visible_ratio);
   tcase_add_test(tc, compact_offsets);
   suite_add_tcase(s, tc);
   return oct_run(s);

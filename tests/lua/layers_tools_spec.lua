@@ -130,6 +130,49 @@ describe("texturing by material", function()
     assert.is_true(sum / k <= 2e-3, "mean difference " .. sum / k)
     assert.is_true(max <= 0.05, "largest difference " .. max)
   end)
+  -- the weights of a blend at a point, and their shares
+  local function shares(c, x, y, z)
+    local w, sum, r = {}, 0, {}
+    for k, e in ipairs(c.blend) do
+      w[k] = e[1]:eval(x, y, z)
+      sum = sum + w[k]
+    end
+    for k = 1, #w do r[k] = w[k] / sum end
+    return r, w
+  end
+  it("colours a cover thinner than sigma by the visible ratio", function()
+    -- bedrock 4 m under 0.25 m of sand, sigma 1 m: the box around a point
+    -- of the surface holds 1 m^3 of sand and 3 of bedrock
+    local s = L.new{size = {8, 8}, layers = {{"bedrock", 4}, {"sand", 0.25}}}
+    local vis, vol = s:colors(), s:colors{ratio = "volume"}
+    local r, w = shares(vis, 4.2, 3.7, 4.25) -- blend: bedrock, sand
+    -- S_sand = 1 (the top at the point), plus 1e-6 V / V_Omega
+    assert.is_true(math.abs(w[2] - (1 + 1e-6 / 8)) < 1e-12)
+    assert.is_true(math.abs(w[1] - 1e-6 * 3 / 8) < 1e-15)
+    assert.is_true(r[2] > 1 - 1e-6, "visible sand " .. r[2])
+    -- half a sigma above, the tent halves the sand's weight
+    local _, wh = shares(vis, 4.2, 3.7, 4.75)
+    assert.is_true(math.abs(wh[2] - (0.5 + 1e-6 / 8)) < 1e-12)
+    -- the volume ratio sees the bedrock under the cover: 25 % sand
+    local rv = shares(vol, 4.2, 3.7, 4.25)
+    assert.is_true(math.abs(rv[2] - 0.25) < 1e-12, "volume sand " .. rv[2])
+    -- far from the surface nothing is visible: the volume ratio decides
+    local rd = shares(vis, 4.2, 3.7, 2.5)
+    assert.is_true(math.abs(rd[1] - 1) < 1e-12)
+  end)
+  it("splits a vertical boundary between two materials 50/50", function()
+    -- sand in the stacks i <= 4 (x < 3.5), bedrock beyond, both 4 m high
+    local s = L.new{size = {8, 8}, layers = {{"bedrock", 4}}}
+    for j = 1, 8 do
+      for i = 1, 4 do s:set(i, j, {{"sand", 4}}) end
+    end
+    local c = s:colors()
+    local r = shares(c, 3.5, 3.7, 4) -- blend: bedrock, sand
+    assert.is_true(math.abs(r[1] - 0.5) < 1e-12 and math.abs(r[2] - 0.5) < 1e-12)
+    -- half a sigma into the sand: the footprint [2.5, 4.5] is 3/4 sand
+    r = shares(c, 3, 3.7, 4.2)
+    assert.is_true(math.abs(r[2] - 0.75) < 1e-12, "sand " .. r[2])
+  end)
   it("names the field and the line in errors", function()
     local s = L.new{size = {4, 4}, layers = {{"bedrock", 2}}}
     local f = s:field()
@@ -140,6 +183,7 @@ describe("texturing by material", function()
     check(function() s:colors{sand = {2, 0, 0}} end, "layers:colors",
           "'sand' must be {r, g, b} in [0, 1]")
     check(function() s:colors{sigma = 0} end, "layers:colors", "'sigma'")
+    check(function() s:colors{ratio = "area"} end, "layers:colors", "'ratio'")
     check(function() L.new{size = {2, 2}}:colors() end, "layers:colors",
           "the stacks hold no material")
   end)
