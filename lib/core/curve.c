@@ -615,6 +615,32 @@ int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
   return 1;
 }
 
+int oc_curve_within(const oc_pcurve *c, double x, double y, double r) {
+  if (!(r >= 0) || isnan(x) || isnan(y)) return 0;
+  double lim = nextafter(r * r, INFINITY);
+  size_t st[128];
+  int top = 0;
+  st[top++] = 0;
+  while (top > 0) {
+    const bnode *b = &c->bvh[st[--top]];
+    if (box_d2(b, x, y) >= lim) continue;
+    if (b->right) {
+      st[top++] = b->right;
+      st[top++] = (size_t)(b - c->bvh) + 1;
+      continue;
+    }
+    const piece *pc = &c->pc[b->piece];
+    /* the ends lie on the curve: no root finding when one is near */
+    for (int k = 0; k <= pc->deg; k += pc->deg) {
+      double dx = pc->p[k].x - x, dy = pc->p[k].y - y;
+      if (dx * dx + dy * dy < lim) return 1;
+    }
+    double t;
+    if (oc_bez_closest(pc->p, pc->deg, x, y, lim, &t) < lim) return 1;
+  }
+  return 0;
+}
+
 /* ---- flattening ------------------------------------------------------- */
 
 typedef struct flat_ctx {
