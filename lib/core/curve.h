@@ -84,8 +84,8 @@ int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
 
 /* Whether some point of the curve lies within r of (x, y) in xy: what
 ** oc_curve_closest returns, without finding the closest point (the
-** first piece within r answers; a piece whose end is within r needs no
-** root finding). */
+** first piece within r answers; a piece whose end, middle or quarter
+** point is within r needs no root finding). */
 int oc_curve_within(const oc_pcurve *c, double x, double y, double r);
 
 /* An upper bound of the planar curvature |kappa| inside the pieces,
