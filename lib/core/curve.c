@@ -578,43 +578,6 @@ static double box_d2(const bnode *b, double x, double y) {
   return dx * dx + dy * dy;
 }
 
-int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
-                     oc_curve_point *out) {
-  if (!(r >= 0) || isnan(x) || isnan(y)) return 0;
-  double lim = nextafter(r * r, INFINITY), best = lim, bt = 0;
-  size_t bp = 0;
-  int found = 0;
-  size_t st[128];
-  int top = 0;
-  st[top++] = 0;
-  while (top > 0) {
-    const bnode *b = &c->bvh[st[--top]];
-    if (box_d2(b, x, y) >= best) continue;
-    if (!b->right) {
-      const piece *pc = &c->pc[b->piece];
-      double t, d2 = oc_bez_closest(pc->p, pc->deg, x, y, best, &t);
-      if (d2 < best) best = d2, bp = b->piece, bt = t, found = 1;
-      continue;
-    }
-    size_t l = (size_t)(b - c->bvh) + 1, rr = b->right;
-    double dl = box_d2(&c->bvh[l], x, y), dr = box_d2(&c->bvh[rr], x, y);
-    /* nearer child on top; the tree is balanced, so 2 log2 n entries */
-    if (dl <= dr) {
-      st[top++] = rr;
-      st[top++] = l;
-    } else {
-      st[top++] = l;
-      st[top++] = rr;
-    }
-  }
-  if (!found) return 0;
-  fill(c, bp, bt, out);
-  double cr = out->tx * (y - out->q.y) - out->ty * (x - out->q.x);
-  double dist = sqrt(best);
-  out->d = cr < 0 ? -dist : dist;
-  return 1;
-}
-
 /* Whether the piece is at least sqrt(lim) from (x, y): the control points'
 ** box in the frame of the chord p[0] p[deg] (the piece lies in their hull,
 ** so in that box) is that far. */
@@ -637,6 +600,44 @@ static int far_in_frame(const piece *pc, double x, double y, double lim) {
   /* a hair for the rounding of the frame */
   double d2 = ea * ea + eb * eb, pad = 1e-9 * (l + fabs(a) + fabs(b));
   return d2 > lim + 2 * pad * sqrt(lim) + pad * pad;
+}
+
+int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
+                     oc_curve_point *out) {
+  if (!(r >= 0) || isnan(x) || isnan(y)) return 0;
+  double lim = nextafter(r * r, INFINITY), best = lim, bt = 0;
+  size_t bp = 0;
+  int found = 0;
+  size_t st[128];
+  int top = 0;
+  st[top++] = 0;
+  while (top > 0) {
+    const bnode *b = &c->bvh[st[--top]];
+    if (box_d2(b, x, y) >= best) continue;
+    if (!b->right) {
+      const piece *pc = &c->pc[b->piece];
+      if (far_in_frame(pc, x, y, best)) continue; /* (cannot beat best) */
+      double t, d2 = oc_bez_closest(pc->p, pc->deg, x, y, best, &t);
+      if (d2 < best) best = d2, bp = b->piece, bt = t, found = 1;
+      continue;
+    }
+    size_t l = (size_t)(b - c->bvh) + 1, rr = b->right;
+    double dl = box_d2(&c->bvh[l], x, y), dr = box_d2(&c->bvh[rr], x, y);
+    /* nearer child on top; the tree is balanced, so 2 log2 n entries */
+    if (dl <= dr) {
+      st[top++] = rr;
+      st[top++] = l;
+    } else {
+      st[top++] = l;
+      st[top++] = rr;
+    }
+  }
+  if (!found) return 0;
+  fill(c, bp, bt, out);
+  double cr = out->tx * (y - out->q.y) - out->ty * (x - out->q.x);
+  double dist = sqrt(best);
+  out->d = cr < 0 ? -dist : dist;
+  return 1;
 }
 
 int oc_curve_within(const oc_pcurve *c, double x, double y, double r) {
