@@ -597,8 +597,12 @@ static int far_in_frame(const piece *pc, double x, double y, double lim) {
   double a = dx * ux + dy * uy, b = dy * ux - dx * uy;
   double ea = a < a0 ? a0 - a : a > a1 ? a - a1 : 0;
   double eb = b < b0 ? b0 - b : b > b1 ? b - b1 : 0;
-  /* a hair for the rounding of the frame */
-  double d2 = ea * ea + eb * eb, pad = 1e-9 * (l + fabs(a) + fabs(b));
+  /* a hair for the rounding of the frame (and of the differences of
+  ** coordinates far from the origin) */
+  double d2 = ea * ea + eb * eb,
+         pad =
+             1e-9 * (l + fabs(a) + fabs(b)) +
+             1e-14 * (fabs(x) + fabs(y) + fabs(pc->p[0].x) + fabs(pc->p[0].y));
   return d2 > lim + 2 * pad * sqrt(lim) + pad * pad;
 }
 
