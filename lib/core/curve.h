@@ -91,6 +91,12 @@ int oc_curve_far_from_segment(const oc_pcurve *c, double xa, double ya,
 int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
                      oc_curve_point *out);
 
+/* Whether some point of the curve lies within r of (x, y) in xy: what
+** oc_curve_closest returns, without finding the closest point (the
+** first piece within r answers; a piece whose end, middle or quarter
+** point is within r needs no root finding). */
+int oc_curve_within(const oc_pcurve *c, double x, double y, double r);
+
 /* An upper bound of the planar curvature |kappa| inside the pieces,
 ** rigorous up to rounding and within about 1 % of the true maximum
 ** (bezier.h); 0 for a polyline, INFINITY where a Bézier piece's

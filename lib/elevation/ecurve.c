@@ -165,7 +165,6 @@ void oc_ecurve_bound_in(const oc_enode *n, const oc_erect *b,
                         const oc_efootb *fb, oc_ebound *o) {
   (void)fb;
   const ecurve *d = OC_EPRIM(n)->data;
-  oc_curve_point pt;
   *o = OC_EPRIM(n)->glob;
   if (!oc_erect_meets(&OC_EPRIM(n)->box, b)) {
     o->alo = o->ahi = o->la = 0;
@@ -177,7 +176,7 @@ void oc_ecurve_bound_in(const oc_enode *n, const oc_erect *b,
   double cx = 0.5 * (b->x0 + b->x1), cy = 0.5 * (b->y0 + b->y1);
   double rho = 0.5 * hypot(b->x1 - b->x0, b->y1 - b->y0);
   double r = (d->R + rho) * (1 + 1e-12) + 1e-9;
-  if (!oc_curve_closest(d->c, cx, cy, r, &pt)) o->alo = o->ahi = o->la = 0;
+  if (!oc_curve_within(d->c, cx, cy, r)) o->alo = o->ahi = o->la = 0;
 }
 
 oc_pcurve *oc_ecurve_skeleton(const oc_vec3 *P, size_t m,

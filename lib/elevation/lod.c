@@ -316,6 +316,17 @@ static double vsrc_slope(void *ud, double x0, double y0, double x1, double y1) {
   return b.lf;
 }
 
+/* Both at once, from one traversal (the tracer asks for both on every
+** segment). */
+static void vsrc_both(void *ud, double x0, double y0, double x1, double y1,
+                      double *lo, double *hi, double *slope) {
+  oc_ebound b;
+  vsrc_bound(ud, x0, y0, x1, y1, &b);
+  *lo = b.flo;
+  *hi = b.fhi;
+  *slope = b.lf;
+}
+
 static void vsrc_retain(void *ud) {
   ((vsrc *)ud)->refs++;
 }
@@ -355,6 +366,7 @@ int oc_enode_elevation_view(oc_enode *e, const double *domain,
   *src = (oc_elevation){.height = vsrc_height,
                         .range = vsrc_range,
                         .slope = vsrc_slope,
+                        .bound = vsrc_both,
                         .retain = vsrc_retain,
                         .release = vsrc_release,
                         .ud = q,

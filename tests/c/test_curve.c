@@ -197,6 +197,11 @@ START_TEST(closest_matches_brute_force) {
     s += ref_arclen(&pcs[cp.piece], 0, cp.t, 2000);
     ck_assert_msg(fabs(s - cp.s) < 1e-8 * oc_curve_length(c),
                   "s %.12g vs %.12g", cp.s, s);
+    /* within r: the reference distance against r (away from the tie) */
+    for (int m = 0; m < 3; m++) {
+      double rad = ref * (m == 0 ? 0.97 : m == 1 ? 1.03 : 2.5);
+      ck_assert_int_eq(oc_curve_within(c, x, y, rad), m > 0);
+    }
   }
   printf("curve: closest vs brute force, worst |difference| %.3g\n", worst);
   ck_assert_int_eq(signs_bad, 0);
@@ -262,6 +267,27 @@ START_TEST(closest_within_radius) {
   ck_assert_double_eq_tol(cp.q.z, 1, 1e-15);
   ck_assert(!oc_curve_closest(c, NAN, 0, 1, &cp));
   ck_assert(!oc_curve_closest(c, 0, 0, -1, &cp));
+  ck_assert(!oc_curve_within(c, 5, 3, 2.9));
+  ck_assert(oc_curve_within(c, 5, 3, 3.0));
+  ck_assert(oc_curve_within(c, 10.5, 0, 0.6)); /* an end */
+  ck_assert(!oc_curve_within(c, NAN, 0, 1));
+  ck_assert(!oc_curve_within(c, 0, 0, -1));
+  oc_curve_free(c);
+  /* a diagonal cubic bulging to the upper left: (9, 1) is inside its
+  ** axis-aligned box, 5.66 from its chord's frame (the line y = x) */
+  oc_curve_piece cub = {3, {{0, 0, 0}, {3, 5, 0}, {7, 9, 0}, {10, 10, 0}}};
+  c = new_ok(&cub, 1);
+  double x = 9, y = 1, ref = INFINITY; /* the distance by dense sampling */
+  for (int k = 0; k <= 100000; k++) {
+    double t = k / 100000.0, u = 1 - t;
+    double bx = 3 * u * u * t * 3 + 3 * u * t * t * 7 + t * t * t * 10;
+    double by = 3 * u * u * t * 5 + 3 * u * t * t * 9 + t * t * t * 10;
+    ref = fmin(ref, hypot(bx - x, by - y));
+  }
+  ck_assert(ref > 5.66);
+  ck_assert(!oc_curve_within(c, x, y, 5.0));
+  ck_assert(!oc_curve_within(c, x, y, 0.999 * ref));
+  ck_assert(oc_curve_within(c, x, y, 1.001 * ref));
   oc_curve_free(c);
 }
 END_TEST

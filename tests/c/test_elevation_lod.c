@@ -479,6 +479,16 @@ START_TEST(lod_trace_against_march) {
   ck_assert_msg(oc_enode_elevation_view(e, NULL, &v, &src, &err) == OC_OK, "%s",
                 err.msg);
   oc_esurface es = {&src, oc_enode_view_weight, src.ud, OC_ENODE_T};
+  /* the joint query (one traversal a step) answers range and slope */
+  ck_assert(src.bound);
+  for (int k = 0; k < 40; k++) {
+    double x0 = -2000 + 97.3 * k, y0 = -1500 + 71.9 * k, sz = 3.0 * (k + 1);
+    double lo, hi, lam, rlo, rhi;
+    src.bound(src.ud, x0, y0, x0 + sz, y0 + 0.5 * sz, &lo, &hi, &lam);
+    src.range(src.ud, x0, y0, x0 + sz, y0 + 0.5 * sz, &rlo, &rhi);
+    ck_assert(lo == rlo && hi == rhi && lo < hi);
+    ck_assert(lam == src.slope(src.ud, x0, y0, x0 + sz, y0 + 0.5 * sz));
+  }
   oc_vec3 w = oct_sub(target, eye);
   w = oct_mul(w, 1 / oct_len(w));
   oc_vec3 rt = oct_cross(w, oct_v(0, 0, 1));

@@ -218,6 +218,33 @@ START_TEST(analytic_against_march) {
 }
 END_TEST
 
+/* A hit is located to 1/1000 of the tolerance, on the near side: from
+** straight above (h falls along every ray, one crossing), h > 0 at the
+** hit and h <= 0 that much further. */
+START_TEST(hits_located) {
+  oc_elevation src = wave_source();
+  oc_esurface es = {&src, NULL, NULL, 0.5};
+  oc_render_params rp = view(oct_v(1, 2, 400), oct_v(0, 0, 0), 16, 16);
+  double eps_k = 0.25 * 2 * tan(rp.camera.fov * PI / 360) / 1080;
+  double eps_min = 1e-7 * 400, ev = 0;
+  oc_etracer tr;
+  oc_etracer_init(&tr, &es, OC_TRACE_SEGMENT, eps_k, eps_min);
+  for (int j = 0; j < rp.height; j++)
+    for (int i = 0; i < rp.width; i++) {
+      oc_vec3 d = pixel_ray(&rp, i, j), o = rp.camera.eye;
+      double t;
+      ck_assert_int_eq(oc_etrace(&tr, o, d, 0, 1e5, 0, &t, &ev), 1);
+      double q = t + 1e-3 * (eps_k * t + eps_min) * (1 + 1e-9);
+      oc_vec3 p = oct_add(o, oct_mul(d, t)), r = oct_add(o, oct_mul(d, q));
+      ck_assert_msg(p.z - wave_h(&WAVE, p.x, p.y, NULL) > 0, "pixel %d %d", i,
+                    j);
+      ck_assert_msg(r.z - wave_h(&WAVE, r.x, r.y, NULL) <= 0,
+                    "pixel %d %d: the hit %.9f is short of the surface", i, j,
+                    t);
+    }
+}
+END_TEST
+
 /* No surface where x < 0: those rays go on to the far side of the hole,
 ** or out. */
 static double half(void *wud, double x, double y) {
@@ -466,6 +493,7 @@ static Suite *suite(void) {
   tcase_set_timeout(t, 300);
   tcase_add_test(t, heightfield_against_march);
   tcase_add_test(t, analytic_against_march);
+  tcase_add_test(t, hits_located);
   tcase_add_test(t, weight_makes_holes);
   tcase_add_test(t, beams_conservative);
   suite_add_tcase(s, t);
