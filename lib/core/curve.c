@@ -647,6 +647,8 @@ int oc_curve_far_from_segment(const oc_pcurve *c, double xa, double ya,
     if (!(D - 1e-9 * Mp > r * (1 + 1e-9))) return 0;
   }
   return 1;
+}
+
 /* Whether the piece is at least sqrt(lim) from (x, y): the control points'
 ** box in the frame of the chord p[0] p[deg] (the piece lies in their hull,
 ** so in that box) is that far. */
