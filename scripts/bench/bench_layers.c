@@ -3,8 +3,9 @@
 ** scenes at the effective resolutions of the paper's Table 1, and the
 ** stabilisation after a large sand deposit, on all threads.
 **
-**   layers.mb                  the cave scene (1000 x 750 stacks); the
-**                              canyon and cliff scenes as context lines
+**   layers.mb                  the cave scene (1000 x 750 stacks); also
+**                              per scene, layers.mb.cave, .canyon
+**                              (1000 x 500) and .cliff (2000 x 500)
 **   layers.stabilize_seconds_2t  1000 x 750 stacks of 1 m, a 10^5 m^3
 **                              sand deposit (R = 50 m) stabilised
 **   layers.edit_ms             a sculpt stroke of radius 10 cells on the
@@ -207,9 +208,12 @@ static double mesh_seconds(double *cpu, size_t *tris) {
 int main(void) {
   if (bench_wanted("mb")) {
     double cave = memory(0, 1000, 750, "cave");
-    memory(1, 1000, 500, "canyon");
-    memory(2, 2000, 500, "cliff");
+    double canyon = memory(1, 1000, 500, "canyon");
+    double cliff = memory(2, 2000, 500, "cliff");
     printf("layers.mb: %.2f MB\n", cave);
+    printf("layers.mb.cave: %.2f MB\n", cave);
+    printf("layers.mb.canyon: %.2f MB\n", canyon);
+    printf("layers.mb.cliff: %.2f MB\n", cliff);
   }
   if (bench_wanted("edit")) printf("layers.edit_ms: %.1f ms\n", edit_ms());
   if (bench_wanted("stabilize")) {
