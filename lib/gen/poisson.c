@@ -83,6 +83,26 @@ static int periodic_cells(oc_pgrid *g, int d, const double *len,
   return 0;
 }
 
+/* Lists the offsets within reach by their least gap (in cells), nearest
+** first; equal gaps keep their order. */
+static void near_order(oc_pgrid *g) {
+  g->nnear = 0;
+  for (int gap = 0; gap <= 3 * 2 * 2; gap++)
+    for (int z = 0; z < OC_PREACH; z++)
+      for (int y = 0; y < OC_PREACH; y++)
+        for (int x = 0; x < OC_PREACH; x++) {
+          int o[3] = {x - 2, y - 2, z - 2}, q = 0;
+          for (int a = 0; a < 3; a++) {
+            int gp = abs(o[a]) > 1 ? abs(o[a]) - 1 : 0;
+            q += gp * gp;
+          }
+          if (q != gap || !g->reach[z][y][x]) continue;
+          for (int a = 0; a < 3; a++)
+            g->near[g->nnear][a] = (signed char)o[a];
+          g->nnear++;
+        }
+}
+
 static int setup(const oc_poisson_params *pp, int d, oc_pgrid *g,
                  oc_error *err) {
   const char *fname = d == 2 ? "poisson2d" : "poisson3d";
@@ -172,6 +192,7 @@ static int setup(const oc_poisson_params *pp, int d, oc_pgrid *g,
         }
         g->reach[z][y][x] = (d == 3 || o[2] == 0) && gap2 < g->r2;
       }
+  near_order(g);
   g->pos = malloc(bytes);
   if (!g->pos)
     return oc_seterr(err, OC_ENOMEM,

@@ -55,6 +55,10 @@ typedef struct oc_pgrid {
   /* reach[dz][dy][dx] (offset + 2) is 1 when a point of that neighbour
   ** cell may be closer than r to a point of the centre cell */
   unsigned char reach[OC_PREACH][OC_PREACH][OC_PREACH];
+  /* the offsets within reach, nearest first (the dart test stops at the
+  ** first sample too near, most often in an adjacent cell) */
+  signed char near[OC_PREACH * OC_PREACH * OC_PREACH][3];
+  int nnear;
 } oc_pgrid;
 
 static inline size_t oc_pcell(const oc_pgrid *g, int i, int j, int k) {
