@@ -83,9 +83,20 @@ static int periodic_cells(oc_pgrid *g, int d, const double *len,
   return 0;
 }
 
+static ptrdiff_t offset(const oc_pgrid *g, int x, int y, int z) {
+  return (ptrdiff_t)g->d *
+         (((ptrdiff_t)z * g->n[1] + (ptrdiff_t)y) * g->n[0] + (ptrdiff_t)x);
+}
+
 /* Lists the offsets within reach by their least gap (in cells), nearest
-** first; equal gaps keep their order. */
+** first (equal gaps keep their order), and in their order. */
 static void near_order(oc_pgrid *g) {
+  g->nreach = 0;
+  for (int z = 0; z < OC_PREACH; z++)
+    for (int y = 0; y < OC_PREACH; y++)
+      for (int x = 0; x < OC_PREACH; x++)
+        if (g->reach[z][y][x])
+          g->reachoff[g->nreach++] = offset(g, x - 2, y - 2, z - 2);
   g->nnear = 0;
   for (int gap = 0; gap <= 3 * 2 * 2; gap++)
     for (int z = 0; z < OC_PREACH; z++)
@@ -99,7 +110,7 @@ static void near_order(oc_pgrid *g) {
           if (q != gap || !g->reach[z][y][x]) continue;
           for (int a = 0; a < 3; a++)
             g->near[g->nnear][a] = (signed char)o[a];
-          g->nnear++;
+          g->nearoff[g->nnear++] = offset(g, o[0], o[1], o[2]);
         }
 }
 

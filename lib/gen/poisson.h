@@ -59,6 +59,12 @@ typedef struct oc_pgrid {
   ** first sample too near, most often in an adjacent cell) */
   signed char near[OC_PREACH * OC_PREACH * OC_PREACH][3];
   int nnear;
+  /* in doubles of pos, from a cell at least two cells from every face:
+  ** those of near, and of the offsets within reach in the order dz, dy,
+  ** dx */
+  ptrdiff_t nearoff[OC_PREACH * OC_PREACH * OC_PREACH];
+  ptrdiff_t reachoff[OC_PREACH * OC_PREACH * OC_PREACH];
+  int nreach;
 } oc_pgrid;
 
 static inline size_t oc_pcell(const oc_pgrid *g, int i, int j, int k) {

@@ -96,6 +96,13 @@ static void cell_coords(const oc_pgrid *g, size_t c, int ijk[3]) {
     }                                                                          \
   } while (0)
 
+/* Is cell (i, j, k) two cells or more from every face (so that the cells
+** within reach are found at fixed offsets, unwrapped)? */
+static int inner(const oc_pgrid *g, int i, int j, int k) {
+  return i >= 2 && i + 2 < g->n[0] && j >= 2 && j + 2 < g->n[1] &&
+         (g->d == 2 || (k >= 2 && k + 2 < g->n[2]));
+}
+
 /* Is p, in cell (i, j, k), farther than r from every sample? The cells
 ** within reach are visited nearest first; the answer does not depend on
 ** the order. */
@@ -103,6 +110,18 @@ static int is_free(const oc_pgrid *g, const double *p, int i, int j, int k) {
   int d = g->d;
   double r2 = g->r2;
   const int c[3] = {i, j, k};
+  if (inner(g, i, j, k)) {
+    const double *base = g->pos + (size_t)d * oc_pcell(g, i, j, k);
+    for (int q = 0; q < g->nnear; q++) {
+      const double *s = base + g->nearoff[q];
+      if (isnan(s[0])) continue;
+      double d2 = 0;
+      for (int a = 0; a < d; a++)
+        d2 += (s[a] - p[a]) * (s[a] - p[a]);
+      if (d2 <= r2) return 0;
+    }
+    return 1;
+  }
   for (int q = 0; q < g->nnear; q++) {
     const signed char *o = g->near[q];
     int x[3], w[3];
@@ -136,6 +155,17 @@ static int is_free(const oc_pgrid *g, const double *p, int i, int j, int k) {
 
 int oc_pgather(const oc_pgrid *g, int i, int j, int k, double *nb) {
   int n = 0, d = g->d;
+  if (inner(g, i, j, k)) {
+    const double *base = g->pos + (size_t)d * oc_pcell(g, i, j, k);
+    for (int q = 0; q < g->nreach; q++) {
+      const double *s = base + g->reachoff[q];
+      if (isnan(s[0])) continue;
+      for (int a = 0; a < d; a++)
+        nb[d * n + a] = s[a];
+      n++;
+    }
+    return n;
+  }
   if (g->periodic) {
     FOR_NEAR_PERIODIC(g, i, j, k, s, {
       for (int a = 0; a < d; a++)
@@ -166,9 +196,10 @@ static void dart(oc_pgrid *g, size_t c, const double *lo, double side, int clip,
   double *slot = g->pos + (size_t)d * c;
   for (int a = 0; a < d; a++) {
     double a0 = lo[a], len = side;
-    if (clip) {
-      a0 = fmax(lo[a], g->lo[a]);
-      len = fmin(lo[a] + side, g->hi[a]) - a0;
+    if (clip) { /* fmax and fmin, inline */
+      double b = lo[a] + side;
+      a0 = lo[a] > g->lo[a] ? lo[a] : g->lo[a];
+      len = (b < g->hi[a] ? b : g->hi[a]) - a0;
     }
     p[a] = a0 + len * oc_rng_uniform(rng);
     if (p[a] < g->lo[a] || p[a] > g->hi[a]) return;
@@ -217,6 +248,28 @@ void oc_pwork_free(oc_pwork *w) {
   w->capcur = w->capnext = 0;
 }
 
+/* The samples within reach of cell ijk (oc_pgather) less those at r or
+** more from it (with a margin far above rounding), which no box of the
+** cell can meet: the coverage test would drop them; returns their count. */
+static int near_cell(const oc_pgrid *g, const int ijk[3], double *nb) {
+  int d = g->d, n = oc_pgather(g, ijk[0], ijk[1], ijk[2], nb), m = 0;
+  double lim = g->r2 * (1 + 1e-9);
+  for (int q = 0; q < n; q++) {
+    const double *s = nb + d * q;
+    double d2 = 0;
+    for (int a = 0; a < d; a++) {
+      double lo = g->lo[a] + ijk[a] * g->h, hi = lo + g->h;
+      double v = s[a] < lo ? lo - s[a] : s[a] > hi ? s[a] - hi : 0;
+      d2 += v * v;
+    }
+    if (!(d2 < lim)) continue;
+    for (int a = 0; a < d; a++)
+      nb[d * m + a] = s[a];
+    m++;
+  }
+  return m;
+}
+
 /* Keeps the boxes of w->cur that may hold an uncovered point; returns
 ** their count. */
 static size_t keep_open(const oc_pgrid *g, oc_pwork *w, size_t ncur,
@@ -237,7 +290,7 @@ static size_t keep_open(const oc_pgrid *g, oc_pwork *w, size_t ncur,
     if (s->cell != last) {
       int ijk[3];
       cell_coords(g, s->cell, ijk);
-      nnb = oc_pgather(g, ijk[0], ijk[1], ijk[2], w->nb);
+      nnb = near_cell(g, ijk, w->nb);
       last = s->cell;
     }
     if (oc_pcover(d, g->r, lo, hi, w->nb, nnb, g->cover_max, g->cover_depth))
