@@ -110,8 +110,8 @@ static int may_join(grow *w, const double *q) {
   double lo[3], hi[3],
       most = w->t->pp.size - 2 * w->t->pp.neighbour * w->t->pp.radius;
   for (int a = 0; a < 3; a++) {
-    lo[a] = fmin(w->lo[a], q[a]);
-    hi[a] = fmax(w->hi[a], q[a]);
+    lo[a] = q[a] < w->lo[a] ? q[a] : w->lo[a];
+    hi[a] = q[a] > w->hi[a] ? q[a] : w->hi[a];
     if (hi[a] - lo[a] > most) return 0;
   }
   if (lo[0] < w->clo[0] || lo[1] < w->clo[1] || lo[2] < w->clo[2] ||
@@ -163,8 +163,8 @@ static void join(grow *w, uint32_t i, uint32_t c, const double *q) {
   double *u = w->t->unwrap + 3 * (size_t)i;
   for (int a = 0; a < 3; a++) {
     u[a] = q[a];
-    w->lo[a] = fmin(w->lo[a], q[a]);
-    w->hi[a] = fmax(w->hi[a], q[a]);
+    w->lo[a] = q[a] < w->lo[a] ? q[a] : w->lo[a];
+    w->hi[a] = q[a] > w->hi[a] ? q[a] : w->hi[a];
   }
   w->t->label[i] = c;
   w->mem[w->nm++] = i;
