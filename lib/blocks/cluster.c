@@ -28,11 +28,17 @@
 ** many k r (remade when the box leaves it) */
 #define CACHE_GROW 2.0
 
+/* A member and its signed distance to a candidate's plane. */
+typedef struct held {
+  double a;
+  uint32_t m;
+} held;
+
 /* A candidate's members not strictly above its plane (side <= 0) and not
 ** strictly below it, in order of joining: a point above the plane can
 ** only be cut off from the first, one below from the second. */
 typedef struct sides {
-  uint32_t *le, *ge;
+  held *le, *ge;
   size_t nle, nge, caple, capge;
 } sides;
 
@@ -73,13 +79,13 @@ static void count(grow *w, size_t d, uint32_t m, const double *p) {
     if (!OC_GROW(sd->le, sd->nle, sd->caple, 1))
       w->nomem = 1;
     else
-      sd->le[sd->nle++] = m;
+      sd->le[sd->nle++] = (held){a, m};
   }
   if (!(a < 0)) {
     if (!OC_GROW(sd->ge, sd->nge, sd->capge, 1))
       w->nomem = 1;
     else
-      sd->ge[sd->nge++] = m;
+      sd->ge[sd->nge++] = (held){a, m};
   }
 }
 
@@ -143,17 +149,20 @@ static int may_join(grow *w, const double *q) {
     double b = side(D, q);
     if ((b > 0 && w->above[k] == w->nm) || (b < 0 && w->below[k] == w->nm))
       continue;
-    const uint32_t *list = w->mem;
-    size_t nl = w->nm;
-    if (b > 0)
-      list = w->sd[k].le, nl = w->sd[k].nle;
-    else if (b < 0)
-      list = w->sd[k].ge, nl = w->sd[k].nge;
-    for (size_t m = 0; m < nl; m++) {
-      const double *p = w->t->unwrap + 3 * (size_t)list[m];
-      double a = side(D, p);
-      if ((a > 0 && b > 0) || (a < 0 && b < 0)) continue;
-      if (oc_bimage_cuts_at(D, p, q, a, b)) return 0;
+    if (b > 0 || b < 0) {
+      /* the members on the other side or on the plane, their distances
+      ** as side() gave them when they joined */
+      const held *h = b > 0 ? w->sd[k].le : w->sd[k].ge;
+      size_t nh = b > 0 ? w->sd[k].nle : w->sd[k].nge;
+      for (size_t m = 0; m < nh; m++)
+        if (oc_bimage_cuts_at(D, w->t->unwrap + 3 * (size_t)h[m].m, q, h[m].a,
+                              b))
+          return 0;
+      continue;
+    }
+    for (size_t m = 0; m < w->nm; m++) {
+      const double *p = w->t->unwrap + 3 * (size_t)w->mem[m];
+      if (oc_bimage_cuts_at(D, p, q, side(D, p), b)) return 0;
     }
   }
   return 1;
