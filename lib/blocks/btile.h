@@ -88,9 +88,17 @@ int oc_bdiscs_images(const oc_btile *t, oc_aabb in, oc_bimage **out, size_t *n,
                      oc_error *err);
 /* 1 when segment [p, q] crosses the image's disc. */
 int oc_bimage_cuts(const oc_bimage *d, const double *p, const double *q);
-/* The same with p's and q's signed distances a, b to the plane known. */
-int oc_bimage_cuts_at(const oc_bimage *d, const double *p, const double *q,
-                      double a, double b);
+/* The same with p's and q's signed distances a, b to the plane known
+** (inline: clustering calls it tens of millions of times per tile). */
+static inline int oc_bimage_cuts_at(const oc_bimage *d, const double *p,
+                                    const double *q, double a, double b) {
+  if ((a > 0 && b > 0) || (a < 0 && b < 0) || a == b) return 0;
+  double w = a / (a - b);
+  double x = p[0] + w * (q[0] - p[0]) - d->c.x,
+         y = p[1] + w * (q[1] - p[1]) - d->c.y,
+         z = p[2] + w * (q[2] - p[2]) - d->c.z;
+  return x * x + y * y + z * z <= d->r2;
+}
 
 /* Builds t->g (edges shorter than neighbour * radius, periodic) and marks
 ** the edges the discs cut (graph.c). */

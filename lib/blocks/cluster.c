@@ -19,6 +19,7 @@
 
 #include "blocks/btile.h"
 #include "core/error.h"
+#include "core/grow.h"
 #include "core/rng.h"
 
 #define KEY_ORDER 0x6f72646572ull
@@ -26,6 +27,20 @@
 /* the candidate images are those near the cluster's box grown by this
 ** many k r (remade when the box leaves it) */
 #define CACHE_GROW 2.0
+
+/* A member and its signed distance to a candidate's plane. */
+typedef struct held {
+  double a;
+  uint32_t m;
+} held;
+
+/* A candidate's members not strictly above its plane (side <= 0) and not
+** strictly below it, in order of joining: a point above the plane can
+** only be cut off from the first, one below from the second. */
+typedef struct sides {
+  held *le, *ge;
+  size_t nle, nge, caple, capge;
+} sides;
 
 typedef struct grow {
   oc_btile *t;
@@ -40,6 +55,8 @@ typedef struct grow {
   /* per candidate: the members strictly above its plane and below it (a
   ** disc with all members on q's side cannot separate q from them) */
   uint32_t *above, *below;
+  sides *sd; /* per candidate */
+  int nomem;
   double clo[3], chi[3];
   uint32_t *mem; /* members, in order of joining */
   size_t nm;
@@ -53,10 +70,23 @@ static double side(const oc_bimage *D, const double *p) {
 }
 
 /* Counts member p on the sides of candidate d's plane. */
-static void count(grow *w, size_t d, const double *p) {
+static void count(grow *w, size_t d, uint32_t m, const double *p) {
   double a = side(w->cand[d], p);
+  sides *sd = &w->sd[d];
   w->above[d] += a > 0;
   w->below[d] += a < 0;
+  if (!(a > 0)) {
+    if (!OC_GROW(sd->le, sd->nle, sd->caple, 1))
+      w->nomem = 1;
+    else
+      sd->le[sd->nle++] = (held){a, m};
+  }
+  if (!(a < 0)) {
+    if (!OC_GROW(sd->ge, sd->nge, sd->capge, 1))
+      w->nomem = 1;
+    else
+      sd->ge[sd->nge++] = (held){a, m};
+  }
 }
 
 /* Remakes the list of candidate images for the box lo .. hi grown. */
@@ -73,11 +103,12 @@ static void cache(grow *w, const double *lo, const double *hi) {
         b->hi.y < w->clo[1] || b->lo.z > w->chi[2] || b->hi.z < w->clo[2])
       continue;
     w->above[w->ncand] = w->below[w->ncand] = 0;
+    w->sd[w->ncand].nle = w->sd[w->ncand].nge = 0;
     w->cand[w->ncand++] = &w->im[d];
   }
   for (size_t d = 0; d < w->ncand; d++)
     for (size_t m = 0; m < w->nm; m++)
-      count(w, d, w->t->unwrap + 3 * (size_t)w->mem[m]);
+      count(w, d, w->mem[m], w->t->unwrap + 3 * (size_t)w->mem[m]);
 }
 
 /* May the point at q (unwrapped) join the cluster? */
@@ -85,8 +116,8 @@ static int may_join(grow *w, const double *q) {
   double lo[3], hi[3],
       most = w->t->pp.size - 2 * w->t->pp.neighbour * w->t->pp.radius;
   for (int a = 0; a < 3; a++) {
-    lo[a] = fmin(w->lo[a], q[a]);
-    hi[a] = fmax(w->hi[a], q[a]);
+    lo[a] = q[a] < w->lo[a] ? q[a] : w->lo[a];
+    hi[a] = q[a] > w->hi[a] ? q[a] : w->hi[a];
     if (hi[a] - lo[a] > most) return 0;
   }
   if (lo[0] < w->clo[0] || lo[1] < w->clo[1] || lo[2] < w->clo[2] ||
@@ -118,11 +149,20 @@ static int may_join(grow *w, const double *q) {
     double b = side(D, q);
     if ((b > 0 && w->above[k] == w->nm) || (b < 0 && w->below[k] == w->nm))
       continue;
+    if (b > 0 || b < 0) {
+      /* the members on the other side or on the plane, their distances
+      ** as side() gave them when they joined */
+      const held *h = b > 0 ? w->sd[k].le : w->sd[k].ge;
+      size_t nh = b > 0 ? w->sd[k].nle : w->sd[k].nge;
+      for (size_t m = 0; m < nh; m++)
+        if (oc_bimage_cuts_at(D, w->t->unwrap + 3 * (size_t)h[m].m, q, h[m].a,
+                              b))
+          return 0;
+      continue;
+    }
     for (size_t m = 0; m < w->nm; m++) {
       const double *p = w->t->unwrap + 3 * (size_t)w->mem[m];
-      double a = side(D, p);
-      if ((a > 0 && b > 0) || (a < 0 && b < 0)) continue;
-      if (oc_bimage_cuts_at(D, p, q, a, b)) return 0;
+      if (oc_bimage_cuts_at(D, p, q, side(D, p), b)) return 0;
     }
   }
   return 1;
@@ -132,13 +172,13 @@ static void join(grow *w, uint32_t i, uint32_t c, const double *q) {
   double *u = w->t->unwrap + 3 * (size_t)i;
   for (int a = 0; a < 3; a++) {
     u[a] = q[a];
-    w->lo[a] = fmin(w->lo[a], q[a]);
-    w->hi[a] = fmax(w->hi[a], q[a]);
+    w->lo[a] = q[a] < w->lo[a] ? q[a] : w->lo[a];
+    w->hi[a] = q[a] > w->hi[a] ? q[a] : w->hi[a];
   }
   w->t->label[i] = c;
   w->mem[w->nm++] = i;
   for (size_t d = 0; d < w->ncand; d++)
-    count(w, d, u);
+    count(w, d, i, u);
 }
 
 /* Grows cluster c from point i. */
@@ -193,7 +233,8 @@ int oc_bclusters_make(oc_btile *t, oc_error *err) {
   w.cand = malloc((w.nim ? w.nim : 1) * sizeof *w.cand);
   w.above = malloc((w.nim ? w.nim : 1) * sizeof *w.above);
   w.below = malloc((w.nim ? w.nim : 1) * sizeof *w.below);
-  if (!w.near || !w.cand || !w.above || !w.below) goto done;
+  w.sd = calloc(w.nim ? w.nim : 1, sizeof *w.sd);
+  if (!w.near || !w.cand || !w.above || !w.below || !w.sd) goto done;
   for (size_t i = 0; i < n; i++) {
     order[i] = (uint32_t)i;
     t->label[i] = NONE;
@@ -207,10 +248,10 @@ int oc_bclusters_make(oc_btile *t, oc_error *err) {
     order[j] = x;
   }
   t->ncl = 0;
-  for (size_t k = 0; k < n; k++)
+  for (size_t k = 0; k < n && !w.nomem; k++)
     if (t->label[order[k]] == NONE)
       flood(&w, order[k], (uint32_t)t->ncl++, tried);
-  rc = 0;
+  if (!w.nomem) rc = 0;
 done:
   if (rc == OC_ENOMEM) oc_seterr(err, OC_ENOMEM, "out of memory for clusters");
   free(order);
@@ -220,6 +261,11 @@ done:
   free(w.cand);
   free(w.above);
   free(w.below);
+  for (size_t d = 0; w.sd && d < w.nim; d++) {
+    free(w.sd[d].le);
+    free(w.sd[d].ge);
+  }
+  free(w.sd);
   free(im);
   return rc;
 }

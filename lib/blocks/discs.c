@@ -222,16 +222,6 @@ int oc_bdiscs_images(const oc_btile *t, oc_aabb in, oc_bimage **out, size_t *n,
   return 0;
 }
 
-int oc_bimage_cuts_at(const oc_bimage *d, const double *p, const double *q,
-                      double a, double b) {
-  if ((a > 0 && b > 0) || (a < 0 && b < 0) || a == b) return 0;
-  double w = a / (a - b);
-  double x = p[0] + w * (q[0] - p[0]) - d->c.x,
-         y = p[1] + w * (q[1] - p[1]) - d->c.y,
-         z = p[2] + w * (q[2] - p[2]) - d->c.z;
-  return x * x + y * y + z * z <= d->r2;
-}
-
 int oc_bimage_cuts(const oc_bimage *d, const double *p, const double *q) {
   double a = (p[0] - d->c.x) * d->n.x + (p[1] - d->c.y) * d->n.y +
              (p[2] - d->c.z) * d->n.z;

@@ -43,15 +43,17 @@ static int push(cuts *c, size_t b, double nx, double ny, double nz, double o) {
 /* Range of n . (v + sh) over the vertices. */
 static void range(const oc_bblock *b, const double *n, const double *sh,
                   double *lo, double *hi) {
-  *lo = INFINITY;
-  *hi = -INFINITY;
+  double l = INFINITY, h = -INFINITY;
   for (size_t k = 0; k < b->nvert; k++) {
     const double *v = b->vert + 3 * k;
     double x =
         n[0] * (v[0] + sh[0]) + n[1] * (v[1] + sh[1]) + n[2] * (v[2] + sh[2]);
-    *lo = fmin(*lo, x);
-    *hi = fmax(*hi, x);
+    /* fmin and fmax, inline (NaN x skipped as they skip it) */
+    l = x < l ? x : l;
+    h = x > h ? x : h;
   }
+  *lo = l;
+  *hi = h;
 }
 
 /* Tests one candidate direction n: keeps the best gap (B above A). */

@@ -83,6 +83,37 @@ static int periodic_cells(oc_pgrid *g, int d, const double *len,
   return 0;
 }
 
+static ptrdiff_t offset(const oc_pgrid *g, int x, int y, int z) {
+  return (ptrdiff_t)g->d *
+         (((ptrdiff_t)z * g->n[1] + (ptrdiff_t)y) * g->n[0] + (ptrdiff_t)x);
+}
+
+/* Lists the offsets within reach by their least gap (in cells), nearest
+** first (equal gaps keep their order), and in their order. */
+static void near_order(oc_pgrid *g) {
+  g->nreach = 0;
+  for (int z = 0; z < OC_PREACH; z++)
+    for (int y = 0; y < OC_PREACH; y++)
+      for (int x = 0; x < OC_PREACH; x++)
+        if (g->reach[z][y][x])
+          g->reachoff[g->nreach++] = offset(g, x - 2, y - 2, z - 2);
+  g->nnear = 0;
+  for (int gap = 0; gap <= 3 * 2 * 2; gap++)
+    for (int z = 0; z < OC_PREACH; z++)
+      for (int y = 0; y < OC_PREACH; y++)
+        for (int x = 0; x < OC_PREACH; x++) {
+          int o[3] = {x - 2, y - 2, z - 2}, q = 0;
+          for (int a = 0; a < 3; a++) {
+            int gp = abs(o[a]) > 1 ? abs(o[a]) - 1 : 0;
+            q += gp * gp;
+          }
+          if (q != gap || !g->reach[z][y][x]) continue;
+          for (int a = 0; a < 3; a++)
+            g->near[g->nnear][a] = (signed char)o[a];
+          g->nearoff[g->nnear++] = offset(g, o[0], o[1], o[2]);
+        }
+}
+
 static int setup(const oc_poisson_params *pp, int d, oc_pgrid *g,
                  oc_error *err) {
   const char *fname = d == 2 ? "poisson2d" : "poisson3d";
@@ -172,6 +203,7 @@ static int setup(const oc_poisson_params *pp, int d, oc_pgrid *g,
         }
         g->reach[z][y][x] = (d == 3 || o[2] == 0) && gap2 < g->r2;
       }
+  near_order(g);
   g->pos = malloc(bytes);
   if (!g->pos)
     return oc_seterr(err, OC_ENOMEM,

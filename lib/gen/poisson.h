@@ -55,6 +55,16 @@ typedef struct oc_pgrid {
   /* reach[dz][dy][dx] (offset + 2) is 1 when a point of that neighbour
   ** cell may be closer than r to a point of the centre cell */
   unsigned char reach[OC_PREACH][OC_PREACH][OC_PREACH];
+  /* the offsets within reach, nearest first (the dart test stops at the
+  ** first sample too near, most often in an adjacent cell) */
+  signed char near[OC_PREACH * OC_PREACH * OC_PREACH][3];
+  int nnear;
+  /* in doubles of pos, from a cell at least two cells from every face:
+  ** those of near, and of the offsets within reach in the order dz, dy,
+  ** dx */
+  ptrdiff_t nearoff[OC_PREACH * OC_PREACH * OC_PREACH];
+  ptrdiff_t reachoff[OC_PREACH * OC_PREACH * OC_PREACH];
+  int nreach;
 } oc_pgrid;
 
 static inline size_t oc_pcell(const oc_pgrid *g, int i, int j, int k) {

@@ -63,25 +63,32 @@ static void cell_coords(const oc_pgrid *g, size_t c, int ijk[3]) {
 
 /* Periodic mode: calls body with `s` pointing at the periodic image (a
 ** shifted copy in sp_) of each sample of the cells within reach of cell
-** (i, j, k), wrapping across the faces of the torus. */
+** (i, j, k), wrapping across the faces of the torus. The wrapped index
+** and shift of each offset are worked out once per axis. */
 #define FOR_NEAR_PERIODIC(g, i, j, k, s, body)                                 \
   do {                                                                         \
-    int zr_ = (g)->d == 3 ? 2 : 0;                                             \
+    int zr_ = (g)->d == 3 ? 2 : 0, ix_[3][OC_PREACH];                          \
+    double sh_[3][OC_PREACH];                                                  \
+    const int c_[3] = {(i), (j), (k)};                                         \
+    for (int a_ = 0; a_ < 3; a_++)                                             \
+      for (int o_ = -2; o_ <= 2; o_++) {                                       \
+        int x_ = c_[a_] + o_, w_ = x_ < 0 ? -1 : x_ >= (g)->n[a_];             \
+        ix_[a_][o_ + 2] = x_ - w_ * (g)->n[a_];                                \
+        sh_[a_][o_ + 2] = w_ * (g)->len;                                       \
+      }                                                                        \
     for (int dz_ = -zr_; dz_ <= zr_; dz_++) {                                  \
-      int kk_ = (k) + dz_, wz_ = kk_ < 0 ? -1 : kk_ >= (g)->n[2];              \
-      kk_ -= wz_ * (g)->n[2];                                                  \
+      double shz_ = (g)->d == 3 ? sh_[2][dz_ + 2] : 0;                         \
       for (int dy_ = -2; dy_ <= 2; dy_++) {                                    \
-        int jj_ = (j) + dy_, wy_ = jj_ < 0 ? -1 : jj_ >= (g)->n[1];            \
-        jj_ -= wy_ * (g)->n[1];                                                \
-        for (int dx_ = -2; dx_ <= 2; dx_++) {                                  \
-          int ii_ = (i) + dx_, wx_ = ii_ < 0 ? -1 : ii_ >= (g)->n[0];          \
-          if (!(g)->reach[dz_ + 2][dy_ + 2][dx_ + 2]) continue;                \
-          ii_ -= wx_ * (g)->n[0];                                              \
-          const double *q_ =                                                   \
-              (g)->pos + (size_t)(g)->d * oc_pcell((g), ii_, jj_, kk_);        \
+        const unsigned char *m_ = (g)->reach[dz_ + 2][dy_ + 2];                \
+        const double *row_ =                                                   \
+            (g)->pos + (size_t)(g)->d *                                        \
+                           oc_pcell((g), 0, ix_[1][dy_ + 2], ix_[2][dz_ + 2]); \
+        for (int dx_ = 0; dx_ < OC_PREACH; dx_++) {                            \
+          if (!m_[dx_]) continue;                                              \
+          const double *q_ = row_ + (size_t)(g)->d * (size_t)ix_[0][dx_];      \
           if (isnan(q_[0])) continue;                                          \
-          double sp_[3] = {q_[0] + wx_ * (g)->len, q_[1] + wy_ * (g)->len,     \
-                           (g)->d == 3 ? q_[2] + wz_ * (g)->len : 0};          \
+          double sp_[3] = {q_[0] + sh_[0][dx_], q_[1] + sh_[1][dy_ + 2],       \
+                           (g)->d == 3 ? q_[2] + shz_ : 0};                    \
           const double *s = sp_;                                               \
           body;                                                                \
         }                                                                      \
@@ -89,30 +96,76 @@ static void cell_coords(const oc_pgrid *g, size_t c, int ijk[3]) {
     }                                                                          \
   } while (0)
 
-/* Is p, in cell (i, j, k), farther than r from every sample? */
+/* Is cell (i, j, k) two cells or more from every face (so that the cells
+** within reach are found at fixed offsets, unwrapped)? */
+static int inner(const oc_pgrid *g, int i, int j, int k) {
+  return i >= 2 && i + 2 < g->n[0] && j >= 2 && j + 2 < g->n[1] &&
+         (g->d == 2 || (k >= 2 && k + 2 < g->n[2]));
+}
+
+/* Is p, in cell (i, j, k), farther than r from every sample? The cells
+** within reach are visited nearest first; the answer does not depend on
+** the order. */
 static int is_free(const oc_pgrid *g, const double *p, int i, int j, int k) {
   int d = g->d;
   double r2 = g->r2;
-  if (g->periodic) {
-    FOR_NEAR_PERIODIC(g, i, j, k, s, {
+  const int c[3] = {i, j, k};
+  if (inner(g, i, j, k)) {
+    const double *base = g->pos + (size_t)d * oc_pcell(g, i, j, k);
+    for (int q = 0; q < g->nnear; q++) {
+      const double *s = base + g->nearoff[q];
+      if (isnan(s[0])) continue;
       double d2 = 0;
       for (int a = 0; a < d; a++)
         d2 += (s[a] - p[a]) * (s[a] - p[a]);
       if (d2 <= r2) return 0;
-    });
+    }
     return 1;
   }
-  FOR_NEAR(g, i, j, k, s, {
+  for (int q = 0; q < g->nnear; q++) {
+    const signed char *o = g->near[q];
+    int x[3], w[3];
+    for (int a = 0; a < 3; a++) {
+      x[a] = c[a] + o[a];
+      w[a] = x[a] < 0 ? -1 : x[a] >= g->n[a];
+    }
+    if (g->periodic) {
+      for (int a = 0; a < 3; a++)
+        x[a] -= w[a] * g->n[a];
+    } else if (w[0] | w[1] | w[2]) {
+      continue;
+    }
+    const double *s = g->pos + (size_t)d * oc_pcell(g, x[0], x[1], x[2]);
+    if (isnan(s[0])) continue;
     double d2 = 0;
-    for (int a = 0; a < d; a++)
-      d2 += (s[a] - p[a]) * (s[a] - p[a]);
+    if (g->periodic) {
+      /* the periodic image, as FOR_NEAR_PERIODIC has it */
+      for (int a = 0; a < d; a++) {
+        double sa = s[a] + w[a] * g->len;
+        d2 += (sa - p[a]) * (sa - p[a]);
+      }
+    } else {
+      for (int a = 0; a < d; a++)
+        d2 += (s[a] - p[a]) * (s[a] - p[a]);
+    }
     if (d2 <= r2) return 0;
-  });
+  }
   return 1;
 }
 
 int oc_pgather(const oc_pgrid *g, int i, int j, int k, double *nb) {
   int n = 0, d = g->d;
+  if (inner(g, i, j, k)) {
+    const double *base = g->pos + (size_t)d * oc_pcell(g, i, j, k);
+    for (int q = 0; q < g->nreach; q++) {
+      const double *s = base + g->reachoff[q];
+      if (isnan(s[0])) continue;
+      for (int a = 0; a < d; a++)
+        nb[d * n + a] = s[a];
+      n++;
+    }
+    return n;
+  }
   if (g->periodic) {
     FOR_NEAR_PERIODIC(g, i, j, k, s, {
       for (int a = 0; a < d; a++)
@@ -143,9 +196,10 @@ static void dart(oc_pgrid *g, size_t c, const double *lo, double side, int clip,
   double *slot = g->pos + (size_t)d * c;
   for (int a = 0; a < d; a++) {
     double a0 = lo[a], len = side;
-    if (clip) {
-      a0 = fmax(lo[a], g->lo[a]);
-      len = fmin(lo[a] + side, g->hi[a]) - a0;
+    if (clip) { /* fmax and fmin, inline */
+      double b = lo[a] + side;
+      a0 = lo[a] > g->lo[a] ? lo[a] : g->lo[a];
+      len = (b < g->hi[a] ? b : g->hi[a]) - a0;
     }
     p[a] = a0 + len * oc_rng_uniform(rng);
     if (p[a] < g->lo[a] || p[a] > g->hi[a]) return;
@@ -194,6 +248,28 @@ void oc_pwork_free(oc_pwork *w) {
   w->capcur = w->capnext = 0;
 }
 
+/* The samples within reach of cell ijk (oc_pgather) less those at r or
+** more from it (with a margin far above rounding), which no box of the
+** cell can meet: the coverage test would drop them; returns their count. */
+static int near_cell(const oc_pgrid *g, const int ijk[3], double *nb) {
+  int d = g->d, n = oc_pgather(g, ijk[0], ijk[1], ijk[2], nb), m = 0;
+  double lim = g->r2 * (1 + 1e-9);
+  for (int q = 0; q < n; q++) {
+    const double *s = nb + d * q;
+    double d2 = 0;
+    for (int a = 0; a < d; a++) {
+      double lo = g->lo[a] + ijk[a] * g->h, hi = lo + g->h;
+      double v = s[a] < lo ? lo - s[a] : s[a] > hi ? s[a] - hi : 0;
+      d2 += v * v;
+    }
+    if (!(d2 < lim)) continue;
+    for (int a = 0; a < d; a++)
+      nb[d * m + a] = s[a];
+    m++;
+  }
+  return m;
+}
+
 /* Keeps the boxes of w->cur that may hold an uncovered point; returns
 ** their count. */
 static size_t keep_open(const oc_pgrid *g, oc_pwork *w, size_t ncur,
@@ -214,7 +290,7 @@ static size_t keep_open(const oc_pgrid *g, oc_pwork *w, size_t ncur,
     if (s->cell != last) {
       int ijk[3];
       cell_coords(g, s->cell, ijk);
-      nnb = oc_pgather(g, ijk[0], ijk[1], ijk[2], w->nb);
+      nnb = near_cell(g, ijk, w->nb);
       last = s->cell;
     }
     if (oc_pcover(d, g->r, lo, hi, w->nb, nnb, g->cover_max, g->cover_depth))
