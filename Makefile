@@ -300,7 +300,8 @@ PICTURES := demo_arch_render.png:demo:arch_render.png \
   example_blocks_canyon.png:blocks_canyon:blocks_canyon.png \
   example_blocks_sea_cliff.png:blocks_sea_cliff:blocks_sea_cliff.png \
   example_blocks_sea_spire.png:blocks_sea_spire:blocks_sea_spire.png \
-  example_blocks_inset.png:blocks_inset:blocks_inset.png
+  example_blocks_inset.png:blocks_inset:blocks_inset.png \
+  example_blocks_warp.png:blocks_warp:blocks_warp.png
 PICTURE_SCENES := $(sort $(foreach p,$(PICTURES),$(word 2,$(subst :, ,$(p)))))
 
 pictures: all
