@@ -251,6 +251,12 @@ static int scenes(void) {
            sc[k].R);
     printf("blocks.scene_mb.%s: %.3f MB (Table 2: %g)\n", sc[k].name,
            bytes / 1e6, sc[k].mb);
+    if (k == 0) { /* the names without a scene: the sea cliff */
+      printf("blocks.scene_instances: %zu (sea cliff; Table 2: %g)\n", ni,
+             sc[k].R);
+      printf("blocks.scene_mb: %.3f MB (sea cliff; Table 2: %g)\n", bytes / 1e6,
+             sc[k].mb);
+    }
     oc_node_release(rep);
     oc_node_release(ter);
     oc_node_release(geo);
