@@ -544,17 +544,17 @@ static double group_lipschitz(const group *g) {
 ** into the program's arrays. */
 static uint32_t group_emit(comp *c, oc_kind kind, const group *g, double lipv) {
   uint32_t op = new_op(c, kind);
-  if (op == OC_NONE) return (uint32_t)nomem(c), OC_NONE;
+  if (op == OC_NONE) return (void)nomem(c), OC_NONE;
   oc_program *P = c->P;
   oc_op *o = &P->ops[op];
   o->ntotal = (uint32_t)g->ncount;
   o->nobvh = (uint8_t)c->nobvh;
   o->kid = add_kids(c, g->unb, g->nunb);
-  if (o->kid == OC_NONE) return (uint32_t)nomem(c), OC_NONE;
+  if (o->kid == OC_NONE) return (void)nomem(c), OC_NONE;
   o->nkid = (uint32_t)g->nunb;
   if (!GROW(P->ent, P->nent, c->capent, g->nent) ||
       !GROW(P->bvh, P->nbvh, c->capbvh, g->nnodes))
-    return (uint32_t)nomem(c), OC_NONE;
+    return (void)nomem(c), OC_NONE;
   o = &P->ops[op];
   o->ent = (uint32_t)P->nent;
   o->nent = (uint32_t)g->nent;
@@ -705,7 +705,7 @@ static uint32_t compile_diff(comp *c, const oc_node *n) {
     kb = compile_node(c, n->kids[1]);
   } else {
     leaf *lv = malloc(nb * sizeof *lv);
-    if (!lv) return (uint32_t)nomem(c), OC_NONE;
+    if (!lv) return (void)nomem(c), OC_NONE;
     size_t i = 0;
     for (const oc_node *x = n; x->kind == OC_K_DIFF; x = x->kids[0]) {
       lv[nb - 1 - i].node = x->kids[1];
@@ -764,7 +764,7 @@ static uint32_t compile_warp(comp *c, const oc_node *n) {
   uint32_t op = emit(c, OC_K_WARP, k, n->nkids, NULL, 0);
   if (op == OC_NONE) return op;
   uint32_t at = pack_noise(c, &n->noise);
-  if (at == OC_NONE) return (uint32_t)nomem(c), OC_NONE;
+  if (at == OC_NONE) return (void)nomem(c), OC_NONE;
   c->P->ops[op].par = at;
   const oc_noise *nz = &n->noise;
   double A = fabs(nz->amplitude), half = tmax_of(nz->octaves) / 2;
@@ -799,11 +799,11 @@ static uint32_t compile_xform(comp *c, const oc_node *n) {
 static uint32_t compile_perturb(comp *c, const oc_node *n) {
   const oc_node *p = n->kids[0];
   uint32_t op = new_op(c, OC_K_PERTURB);
-  if (op == OC_NONE) return (uint32_t)nomem(c), OC_NONE;
+  if (op == OC_NONE) return (void)nomem(c), OC_NONE;
   size_t np = oc_prim_npar(p);
   uint32_t at = add_par(c, NULL, np);
   if (at == OC_NONE || pack_noise(c, &n->noise) == OC_NONE)
-    return (uint32_t)nomem(c), OC_NONE;
+    return (void)nomem(c), OC_NONE;
   oc_prim_pack(p, c->P->par + at);
   oc_op *o = &c->P->ops[op];
   o->par = at;
@@ -935,7 +935,7 @@ static uint32_t compile_node(comp *c, const oc_node *n) {
     return OC_NONE;
   }
   uint32_t *slot = oc_pmap_slot(&c->memo, n, 1);
-  if (!slot) return (uint32_t)nomem(c), OC_NONE;
+  if (!slot) return (void)nomem(c), OC_NONE;
   *slot = op;
   return op;
 }
