@@ -98,12 +98,7 @@ static int l_tile(lua_State *L) {
   oclua_fields f;
   oc_btile_params pp;
   oc_error err = {OC_OK, ""};
-  oclua_checkargs(L, 1, fname, "a table of named fields");
-  if (lua_isnoneornil(L, 1)) {
-    lua_settop(L, 0);
-    lua_newtable(L);
-  }
-  oclua_fields_open(&f, L, 1, fname, NULL, known, 0);
+  oclua_fields_open_args(&f, L, fname, known);
   int type = oclua_field_optoption(&f, "type", types, 0);
   oc_btile_defaults((oc_block_type)type, &pp);
   pp.size = oclua_field_optnumber(&f, "size", OCLUA_POSITIVE, pp.size);

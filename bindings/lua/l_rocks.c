@@ -31,12 +31,7 @@ static int l_rocks(lua_State *L) {
   oclua_fields f;
   oc_rocks_params rp;
   oc_error err = {OC_OK, ""};
-  oclua_checkargs(L, 1, fname, "a table of named fields");
-  if (lua_isnoneornil(L, 1)) {
-    lua_settop(L, 0);
-    lua_newtable(L);
-  }
-  oclua_fields_open(&f, L, 1, fname, NULL, known, 0);
+  oclua_fields_open_args(&f, L, fname, known);
   oc_rocks_defaults(&rp);
   rp.size = oclua_field_optnumber(&f, "size", OCLUA_POSITIVE, rp.size);
   rp.radius = oclua_field_optnumber(&f, "radius", OCLUA_POSITIVE, rp.radius);

@@ -132,6 +132,16 @@ static const char *in_field(const oclua_fields *f) {
                          lua_pushlstring(f->L, f->prefix, n - 1));
 }
 
+void oclua_fields_open_args(oclua_fields *f, lua_State *L, const char *fname,
+                            const char *const *known) {
+  oclua_checkargs(L, 1, fname, "a table of named fields");
+  if (lua_isnoneornil(L, 1)) {
+    lua_settop(L, 0);
+    lua_newtable(L);
+  }
+  oclua_fields_open(f, L, 1, fname, NULL, known, 0);
+}
+
 void oclua_fields_open(oclua_fields *f, lua_State *L, int idx,
                        const char *fname, const char *prefix,
                        const char *const *known, int array) {

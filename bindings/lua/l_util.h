@@ -52,6 +52,11 @@ void oclua_fields_open(oclua_fields *f, lua_State *L, int idx,
                        const char *fname, const char *prefix,
                        const char *const *known, int array);
 
+/* The sole argument of fname: a table of named fields, as
+** oclua_fields_open checks it, or nothing (an empty table: all defaults). */
+void oclua_fields_open_args(oclua_fields *f, lua_State *L, const char *fname,
+                            const char *const *known);
+
 /* Pushes t[name] and returns its type. */
 int oclua_field_push(const oclua_fields *f, const char *name);
 /* Raises "'name' <what> (got <value at idx>)". */
