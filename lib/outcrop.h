@@ -1245,6 +1245,15 @@ typedef struct oc_elevation {
   ** sampling shares per-row work). */
   void (*height_weight_row)(void *ud, const double *x, double y, int n,
                             double *h, double *alpha);
+  /* Optional (NULL: height, then bound or range and slope): h at p = (x,
+  ** y), as height gives it, and a first-order model of h around p from the
+  ** same traversal: a linear part g and a remainder e[0] + e[1] r + e[2]
+  ** r^2 (e[k] >= 0) with |h(q) - h(p) - g.(q - p)| <= e[0] + e[1] r +
+  ** e[2] r^2 for every q with r = |q - p| <= R (Euclidean). *boxes (when
+  ** not NULL) grows by the box queries it made (elevation trees:
+  ** lib/elevation/etaylor.h). */
+  double (*taylor)(void *ud, double x, double y, double R, double g[2],
+                   double e[3], int *boxes);
 } oc_elevation;
 
 /* The source of a heightfield: its Catmull-Rom interpolant over the grid's

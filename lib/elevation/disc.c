@@ -17,6 +17,7 @@
 #include "core/rng.h"
 #include "core/vec.h"
 #include "elevation/enode.h"
+#include "elevation/etaylor.h"
 
 /* Ridged octaves: w_i = clamp(RIDGE_GAIN s_(i-1), 0, 1). */
 #define RIDGE_GAIN 2.0
@@ -589,4 +590,125 @@ oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err) {
     }
   }
   return n; /* (its box and bound: oc_enode_box, oc_edisc_glob) */
+}
+
+/* ---- first-order models (etaylor.h) -------------------------------------
+** With L = lambda_eta and H the proved bound of eta's Hessian on the plane
+** (as noise_local), an octave eta(s q) of the model around p, for |d| <=
+** r <= R, is
+**  - quadratic: linear part s grad eta(p), remainder H s^2 r^2 / 2
+**    (Taylor with the integral remainder, |Hessian| <= H s^2);
+**  - or flat (no linear part): |eta(s q) - eta(s p)| <= L s r, and <= 1 +
+**    |eta(s p)| (eta lies in [-1, 1]);
+** whichever bounds the remainder lower at R. Octaves coarser than R are
+** quadratic (tiny near p), finer ones flat. |eta| (turbulence) is eta
+** times its sign where that sign is proved constant on the disc (|eta(s
+** p)| above its first-order deviation s |grad eta| R + H s^2 R^2 / 2),
+** else flat (|eta| is L-Lipschitz and in [0, 1]). A ridged octave t_i =
+** w_i rho_i^2, rho_i = 1 - |eta_i|, w_i = clamp(2 t_(i-1), 0, 1), is
+** composed by the product and clamp rules (etaylor.h) from rho_i's model
+** (as |eta|'s) and the previous term's. */
+
+/* eta (or |eta| with abs, its sign proved constant) in the octave's world
+** units: value e, octave gradient g (in lattice units), frequency s. */
+static oc_etay octave_model(double e, const double g[2], double s, double R,
+                            int absval) {
+  const double L = 2 * oc_noise3_lipschitz, H = 2 * oc_noise3_hessian;
+  double sg = 1, ae = e;
+  double quad = 0.5 * H * s * s, flat1 = L * s, flat0 = 1 + fabs(e);
+  int can_quad = 1;
+  if (absval) {
+    sg = e < 0 ? -1 : 1, ae = fabs(e);
+    flat0 = fmax(ae, 1 - ae);
+    can_quad = ae > s * hypot(g[0], g[1]) * R + quad * R * R;
+  }
+  double Rk = R * OC_ETAY_CHOICE;
+  if (can_quad && quad * Rk * Rk <= fmin(flat1 * Rk, flat0))
+    return (oc_etay){ae, sg * s * g[0], sg * s * g[1], 0, 0, quad};
+  return oc_etay_flat(ae, flat1, flat0, R);
+}
+
+static void noise_taylor(const oc_enoise *nz, double u, double v, double R,
+                         oc_etay *o) {
+  double sum = 0, a = nz->amplitude, s = 1 / nz->wavelength, prev = 1;
+  oc_etay m = oc_etay_const(0), tprev = oc_etay_const(1);
+  for (int i = 0; i < nz->octaves; i++) {
+    double ge[2];
+    double e = oc_eta(octave_seed(nz->seed, i), s * u, s * v, ge);
+    oc_etay t;
+    switch (nz->kind) {
+    case OC_ENOISE_PLAIN:
+      sum += a * e;
+      t = octave_model(e, ge, s, R, 0);
+      break;
+    case OC_ENOISE_TURBULENCE:
+      sum += a * fabs(e);
+      t = octave_model(e, ge, s, R, 1);
+      break;
+    default: { /* ridged: the value as noise_sum computes it */
+      double r = 1 - fabs(e), w = 1;
+      if (i > 0) {
+        w = RIDGE_GAIN * prev;
+        w = w >= 1 ? 1 : w <= 0 ? 0 : w;
+      }
+      double tv = w * r * r;
+      sum += a * tv;
+      prev = tv;
+      /* rho = 1 - |eta|: |eta|'s model negated, plus 1 */
+      oc_etay rho = octave_model(e, ge, s, R, 1);
+      rho.v = r, rho.gx = -rho.gx, rho.gy = -rho.gy;
+      oc_etay rho2 = oc_etay_mul(&rho, &rho, R), wm = oc_etay_const(1);
+      if (i > 0) {
+        oc_etay x = oc_etay_scale(&tprev, RIDGE_GAIN);
+        wm = oc_etay_clamp01(&x, R);
+      }
+      t = oc_etay_mul(&wm, &rho2, R);
+      t.v = tv;
+      tprev = t;
+    }
+    }
+    oc_etay at = oc_etay_scale(&t, a);
+    oc_etay_add(&m, &at);
+    a = a * nz->gain;
+    s *= nz->lacunarity;
+  }
+  m.v = sum; /* bit for bit noise_sum's (no level of detail) */
+  *o = m;
+}
+
+void oc_edisc_taylor_alpha(const oc_enode *n, double x, double y, double R,
+                           oc_etay *a) {
+  const double *p = OC_EDISC(n)->par; /* cx, cy, r, height */
+  double u = x - p[0], v = y - p[1], r = p[2];
+  double q = (u * u + v * v) / (r * r);
+  /* alpha = G(|p - c|^2 / r^2), G(q) = (1 - q)^3 on [0, 1], 0 beyond, is
+  ** C2 (G, G', G'' vanish at q = 1); its Hessian's eigenvalues are 2 G' /
+  ** r^2 = -6 (1 - q)^2 / r^2 across and (1 - q)(30 q - 6) / r^2 along
+  ** p - c, both in [-6, 4.8] / r^2: the remainder is at most 3 |d|^2 /
+  ** r^2. Beyond |p - c| >= r + R alpha is 0 on the whole disc. */
+  if (sqrt(u * u + v * v) >= (r + R) * (1 + 1e-12)) {
+    *a = oc_etay_const(0);
+  } else if (q < 1) {
+    double k = 1 - q, c = -6 * k * k / (r * r);
+    *a = (oc_etay){k * k * k, c * u, c * v, 0, 0, 3 / (r * r)};
+  } else {
+    *a = (oc_etay){0, 0, 0, 0, 0, 3 / (r * r)};
+  }
+  /* alpha lies in [0, 1]: at most the gap to the far end (flat) */
+  double gap = fmax(a->v, 1 - a->v);
+  if (oc_etay_dev(a, R) > gap) *a = (oc_etay){a->v, 0, 0, gap, 0, 0};
+}
+
+void oc_edisc_taylor(const oc_enode *n, double x, double y, double R,
+                     oc_etaylor *o) {
+  const double *p = OC_EDISC(n)->par; /* cx, cy, r, height */
+  oc_edisc_taylor_alpha(n, x, y, R, &o->a);
+  oc_enoise noise;
+  oc_edisc_noise(n, &noise);
+  if (noise.kind == OC_ENOISE_NONE) {
+    o->f = oc_etay_const(p[3] + 0);
+    return;
+  }
+  noise_taylor(&noise, x - p[0], y - p[1], R, &o->f);
+  o->f.v = p[3] + o->f.v;
 }

@@ -253,6 +253,30 @@ void oc_enode_bnd(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
     oc_eop_bound_in(n, b, fb, o);
 }
 
+void oc_enode_taylor_flat(const oc_enode *n, double x, double y, double R,
+                          oc_etaylor *o, int *boxes) {
+  oc_enode_sample s;
+  oc_ebound b;
+  oc_erect r = {x - R, y - R, x + R, y + R};
+  oc_enode_ev(n, x, y, NULL, 0, &s);
+  oc_enode_bnd(n, &r, NULL, &b);
+  (*boxes)++;
+  o->f = oc_etay_flat(s.f, b.lf, fmax(b.fhi - s.f, s.f - b.flo), R);
+  o->a = oc_etay_flat(s.a, b.la, fmax(b.ahi - s.a, s.a - b.alo), R);
+}
+
+void oc_enode_taylor(const oc_enode *n, double x, double y, double R,
+                     oc_etaylor *o, int *boxes) {
+  if (n->kind == OC_E_DISC) {
+    oc_edisc_taylor(n, x, y, R, o);
+    return;
+  }
+  if (n->kind != OC_E_LOD && !OC_EPRIM_KIND(n->kind) &&
+      oc_eop_taylor(n, x, y, R, o, boxes))
+    return;
+  oc_enode_taylor_flat(n, x, y, R, o, boxes);
+}
+
 /* ---- public queries --------------------------------------------------- */
 
 void oc_enode_eval(const oc_enode *e, double x, double y, oc_enode_sample *s) {
@@ -451,6 +475,22 @@ static void src_bound(void *ud, double x0, double y0, double x1, double y1,
   *slope = b.lf;
 }
 
+/* oc_elevation.taylor: the tree's model of f, padded for rounding (the
+** evaluators' sums err by a few ulps of their terms; a relative hair of
+** the value and of the coefficients covers that). */
+static double src_taylor(void *ud, double x, double y, double R, double g[2],
+                         double e[3], int *boxes) {
+  oc_etaylor m;
+  int nb = 0;
+  oc_enode_taylor(ud, x, y, R, &m, &nb);
+  if (boxes) *boxes += nb;
+  g[0] = m.f.gx, g[1] = m.f.gy;
+  e[0] = m.f.e0 * (1 + 1e-9) + 1e-11 * (1 + fabs(m.f.v));
+  e[1] = m.f.e1 * (1 + 1e-9) + 1e-12 * (fabs(m.f.gx) + fabs(m.f.gy));
+  e[2] = m.f.e2 * (1 + 1e-9);
+  return m.f.v;
+}
+
 static void src_retain(void *ud) {
   oc_enode_retain(ud);
 }
@@ -485,6 +525,7 @@ int oc_enode_elevation(oc_enode *e, const double *domain, oc_elevation *src,
   src->range = src_range;
   src->slope = src_slope;
   src->bound = src_bound;
+  src->taylor = src_taylor;
   src->retain = src_retain;
   src->release = src_release;
   src->height_weight = src_height_weight; /* Omega_T: where alpha >= 1/2 */

@@ -22,6 +22,7 @@
 #include <stdint.h>
 
 #include "core/pmap.h"
+#include "elevation/etaylor.h"
 #include "outcrop.h"
 
 typedef enum oc_ekind {
@@ -382,6 +383,29 @@ void oc_eop_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                int want, oc_enode_sample *s);
 void oc_eop_bound_in(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
                      oc_ebound *o);
+
+/* First-order models (etaylor.h) of f and alpha around (x, y) for the
+** radius R, full detail: f and alpha at (x, y) are the bits oc_enode_ev
+** gives. Discs, blends, replaces, adds (without a slope weight) and
+** transforms have rules; other nodes, and those rules where they have none
+** (a blend whose weight crosses T on the disc...), take the flat model of
+** oc_enode_taylor_flat: their value, no linear part, and the box bound on
+** [x - R, x + R] x [y - R, y + R] (its slope times r, or its range). A
+** curve's, lake's or image's f model holds only where its weight is > 0,
+** as their bounds: operators compose it apart (eops.c). *boxes counts
+** the box queries made. */
+void oc_enode_taylor(const oc_enode *n, double x, double y, double R,
+                     oc_etaylor *o, int *boxes);
+void oc_enode_taylor_flat(const oc_enode *n, double x, double y, double R,
+                          oc_etaylor *o, int *boxes);
+void oc_edisc_taylor(const oc_enode *n, double x, double y, double R,
+                     oc_etaylor *o);
+/* alpha's model alone (its value 0 where (x, y) is outside the disc) */
+void oc_edisc_taylor_alpha(const oc_enode *n, double x, double y, double R,
+                           oc_etay *a);
+/* 0 where the operator has no rule */
+int oc_eop_taylor(const oc_enode *n, double x, double y, double R,
+                  oc_etaylor *o, int *boxes);
 
 /* The bound of n in box b (dispatch), under the footprint fb. */
 void oc_enode_bnd(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,

@@ -26,6 +26,7 @@
 #include "core/noise.h"
 #include "core/rng.h"
 #include "elevation/enode.h"
+#include "elevation/etaylor.h"
 
 #define T OC_ENODE_T
 #define DEG (3.14159265358979323846 / 180)
@@ -1063,6 +1064,279 @@ int oc_eop_ev_row(const oc_enode *n, const double *x, double y, int cnt,
   else
     return 0;
   return 1;
+}
+
+/* ---- first-order models (etaylor.h) ------------------------------------
+** Each returns 0 when it has no rule there (the caller then falls back to
+** the node's box bound, oc_enode_taylor_flat). The values are computed as
+** the evaluators compute them (the same bits). */
+
+/* At most this many children of a blend meet the disc (else fallback). */
+#define TAY_KIDS 64
+
+/* A child's f model counts only where its weight is > 0: a curve's, lake's
+** or image's bounds hold there alone (ecurve.c), so their f models are not
+** composed as they stand. */
+static int tay_partial(const oc_enode *n) {
+  while (n->kind == OC_E_XFORM)
+    n = OC_EUN(n)->kid;
+  return OC_EPRIM_KIND(n->kind) != 0;
+}
+
+/* blend, f = N / S where S = sum alpha_k >= T on the whole disc: with
+** f the value at p, N' - f S' = sum alpha_k' (f_k' - f) and, writing each
+** child's alpha_k' = a_k + A_k.d + x_k, f_k' = f_k + F_k.d + y_k, this is
+** (sum a_k F_k + (f_k - f) A_k).d + Q = S G.d + Q with G the linear part
+** below and |Q| <= sum a_k E_fk + |f_k - f| E_ak + (|A_k| r + E_ak)(|F_k|
+** r + E_fk) (sum a_k (f_k - f) = 0). Then f' - f - G.d = (S G.d + Q) / S'
+** - G.d = (Q - G.d (S' - S)) / S', at most (Q + |G| r (|A_S| r + E_S)) /
+** inf S'. Where S <= T on the whole disc f = N / T, N the sum of the
+** products alpha_k f_k (product rule, etaylor.h). */
+/* Whether alpha > 0 at (x, y) for a disc (oc_edisc_ev's test). */
+static int disc_inside(const oc_enode *k, double x, double y) {
+  const double *p = OC_EDISC(k)->par;
+  double u = x - p[0], v = y - p[1];
+  return (u * u + v * v) / (p[2] * p[2]) < 1;
+}
+
+static int blend_taylor(const oc_enode *n, double x, double y, double R,
+                        oc_etaylor *o, int *boxes) {
+  const oc_eblend *bl = OC_EBLEND(n);
+  oc_erect ball = {x - R, y - R, x + R, y + R};
+  /* per child: f_k, or (out) the range of f_k, and alpha_k's remainder */
+  double fk[TAY_KIDS], fhi[TAY_KIDS], ea[TAY_KIDS][3], rest[3] = {0, 0, 0};
+  unsigned char out[TAY_KIDS];
+  double N = 0, Nx = 0, Ny = 0; /* N and sum a_k F_k + f_k A_k */
+  oc_etay S = oc_etay_const(0);
+  int m = 0;
+  for (size_t i = 0; i < bl->nkids; i++) {
+    const oc_enode *k = bl->kids[i];
+    if (!oc_enode_meets(k, &ball)) continue; /* alpha_k = 0 on the disc */
+    if (m == TAY_KIDS || tay_partial(k)) return 0;
+    oc_etaylor c;
+    if (k->kind == OC_E_DISC && !disc_inside(k, x, y)) {
+      /* alpha_k(p) = 0 and grad alpha_k(p) = 0: alpha_k' (f_k' - f) is at
+      ** most E_ak(r) sup|f_k - f|, f_k's range from its bound over the
+      ** plane (no noise evaluated) */
+      oc_edisc_taylor_alpha(k, x, y, R, &c.a);
+      if (oc_etay_is_const(&c.a)) continue;
+      oc_ebound g;
+      oc_edisc_glob(k, &g);
+      fk[m] = g.flo, fhi[m] = g.fhi, out[m] = 1;
+      oc_etay_add(&S, &c.a);
+      ea[m][0] = c.a.e0, ea[m][1] = c.a.e1, ea[m][2] = c.a.e2;
+      m++;
+      continue;
+    }
+    oc_enode_taylor(k, x, y, R, &c, boxes);
+    if (c.a.v == 0 && oc_etay_is_const(&c.a)) continue;
+    if (oc_enode_holds(k, x, y) && c.a.v != 0) N += c.a.v * c.f.v; /* (ev) */
+    Nx += c.a.v * c.f.gx + c.f.v * c.a.gx;
+    Ny += c.a.v * c.f.gy + c.f.v * c.a.gy;
+    oc_etay_add(&S, &c.a);
+    double pa[3] = {c.a.e0, oc_etay_gnorm(&c.a) + c.a.e1, c.a.e2};
+    double pf[3] = {c.f.e0, oc_etay_gnorm(&c.f) + c.f.e1, c.f.e2}, q[3];
+    oc_etay_polymul(pa, pf, R, q);
+    double ak = fabs(c.a.v);
+    rest[0] += ak * c.f.e0 + q[0];
+    rest[1] += ak * c.f.e1 + q[1];
+    rest[2] += ak * c.f.e2 + q[2];
+    fk[m] = c.f.v, out[m] = 0;
+    ea[m][0] = c.a.e0, ea[m][1] = c.a.e1, ea[m][2] = c.a.e2;
+    m++;
+  }
+  o->a = S;
+  if (m == 0) {
+    o->f = oc_etay_const(0);
+    return 1;
+  }
+  double dev = oc_etay_dev(&S, R), Slo = S.v - dev;
+  int conv = Slo >= T; /* else S <= T on the whole disc, or no rule */
+  if (!conv && !(S.v + dev <= T)) return 0; /* max(S, T) has a kink */
+  double f = conv ? N / S.v : 0, Q[3] = {rest[0], rest[1], rest[2]};
+  for (int j = 0; j < m; j++) {
+    /* |f_k - f| (|f_k| where S <= T), or its bound for an outer child */
+    double d = out[j] ? fmax(fhi[j] - f, f - fk[j]) : fabs(fk[j] - f);
+    if (out[j] && !conv) d = fmax(fabs(fk[j]), fabs(fhi[j]));
+    Q[0] += d * ea[j][0], Q[1] += d * ea[j][1], Q[2] += d * ea[j][2];
+  }
+  if (!conv) {
+    o->f = (oc_etay){N / T, Nx / T, Ny / T, Q[0] / T, Q[1] / T, Q[2] / T};
+    return 1;
+  }
+  double gx = (Nx - f * S.gx) / S.v, gy = (Ny - f * S.gy) / S.v;
+  double g = sqrt(gx * gx + gy * gy);
+  /* r (|A_S| r + E_S(r)), truncated at R */
+  double P1 = S.e0, P2 = oc_etay_gnorm(&S) + S.e1 + R * S.e2;
+  o->f = (oc_etay){
+      f, gx, gy, Q[0] / Slo, (Q[1] + g * P1) / Slo, (Q[2] + g * P2) / Slo};
+  return 1;
+}
+
+/* The flat model (no linear part) of psi = w (f_B - c) for a child B
+** whose f bounds hold only where its weight is > 0 (tay_partial), w =
+** clamp(alpha_B), from B's bound Bb on the disc's box: psi is continuous,
+** 0 where w = 0, and where w > 0 its gradient is at most lambda_w sup|f_B
+** - c| + sup w lambda_B; so psi is Lipschitz with that on every segment
+** (on each stretch where w > 0, by the mean value theorem, its ends being
+** the segment's or points where psi = 0), and its values lie in the hull
+** of 0 and [0, w_hi] [flo - c, fhi - c]. pv: psi at p. */
+static oc_etay psi_flat(const oc_ebound *Bb, double c, double pv, double R) {
+  double whi = fmin(fmax(Bb->ahi, 0), 1);
+  double dlo = Bb->flo - c, dhi = Bb->fhi - c;
+  double lip = Bb->la * fmax(fabs(dlo), fabs(dhi)) + whi * Bb->lf;
+  double lo = fmin(0, whi * dlo), hi = fmax(0, whi * dhi);
+  return oc_etay_flat(pv, lip * (1 + 1e-12), fmax(hi - pv, pv - lo), R);
+}
+
+/* w = clamp(alpha_B)'s model and, for a partial B, B's bound on the
+** disc's box. 0: w = 0 on the whole disc. */
+static int weight_taylor(const oc_enode *B, double x, double y, double R,
+                         oc_etaylor *b, oc_etay *w, oc_ebound *Bb, int *boxes) {
+  oc_erect ball = {x - R, y - R, x + R, y + R};
+  if (!oc_enode_meets(B, &ball)) return 0;
+  if (tay_partial(B)) {
+    oc_enode_sample s;
+    oc_enode_bnd(B, &ball, NULL, Bb);
+    (*boxes)++;
+    if (!(Bb->ahi > 0)) return 0;
+    /* (lazy: f may be 0 where alpha_B = 0, where w = 0 and psi = 0) */
+    oc_enode_ev(B, x, y, NULL, OC_EV_LAZY, &s);
+    b->f = oc_etay_const(s.f);
+    b->a = oc_etay_flat(s.a, Bb->la, fmax(Bb->ahi - s.a, s.a - Bb->alo), R);
+  } else {
+    oc_enode_taylor(B, x, y, R, b, boxes);
+  }
+  *w = oc_etay_clamp01(&b->a, R);
+  return !(w->v == 0 && oc_etay_is_const(w));
+}
+
+/* replace, f = f_A + w (f_B - f_A): the product rule on w and f_B - f_A;
+** for a partial B, f = f_A + psi - w (f_A - c) with c = f_A(p) (psi_flat,
+** and the product rule on w and f_A - c, whose value is 0). The lerped
+** weight (1 - w) alpha_A + w^2 = alpha_A + w (w - alpha_A), by the
+** product rule. */
+static int replace_taylor(const oc_enode *n, double x, double y, double R,
+                          oc_etaylor *o, int *boxes) {
+  const oc_enode *A = OC_EBIN(n)->kids[0], *B = OC_EBIN(n)->kids[1];
+  if (tay_partial(A)) return 0;
+  oc_etaylor a, b;
+  oc_etay w;
+  oc_ebound Bb;
+  oc_enode_taylor(A, x, y, R, &a, boxes);
+  *o = a;
+  if (!weight_taylor(B, x, y, R, &b, &w, &Bb, boxes)) return 1;
+  double fv = (1 - w.v) * a.f.v + w.v * b.f.v;
+  if (tay_partial(B)) {
+    oc_etay psi = psi_flat(&Bb, a.f.v, w.v * (b.f.v - a.f.v), R);
+    oc_etay d = a.f;
+    d.v = 0;
+    oc_etay wd = oc_etay_mul(&w, &d, R);
+    wd = oc_etay_scale(&wd, -1);
+    oc_etay_add(&o->f, &psi);
+    oc_etay_add(&o->f, &wd);
+  } else {
+    oc_etay d = oc_etay_scale(&a.f, -1);
+    oc_etay_add(&d, &b.f);
+    oc_etay wd = oc_etay_mul(&w, &d, R);
+    oc_etay_add(&o->f, &wd);
+  }
+  o->f.v = fv;
+  if (n->flags & OC_EF_LERP) {
+    oc_etay d = oc_etay_scale(&a.a, -1);
+    oc_etay_add(&d, &w);
+    oc_etay wd = oc_etay_mul(&w, &d, R);
+    oc_etay_add(&o->a, &wd);
+    o->a.v = (1 - w.v) * a.a.v + w.v * w.v;
+  }
+  return 1;
+}
+
+/* add, f = f_A + w f_B, w = clamp(alpha_B) times the altitude weight
+** W(f_A) when there is one: W is C1 in f_A with |W''| <= 6 / fade^2
+** (the smoothstep's second derivative 6 - 12 t over fade^2), so the
+** composition rule holds, and W is constant where f_A's range on the
+** disc keeps t out of (0, 1). alpha_A + w_B^2 by the product rule. A slope
+** weight, or a partial child, has no rule. */
+static int add_taylor(const oc_enode *n, double x, double y, double R,
+                      oc_etaylor *o, int *boxes) {
+  const oc_enode *A = OC_EBIN(n)->kids[0], *B = OC_EBIN(n)->kids[1];
+  if (n->flags & OC_EF_SLOPE || tay_partial(A) || tay_partial(B)) return 0;
+  oc_etaylor a, b;
+  oc_etay c;
+  oc_ebound Bb;
+  oc_enode_taylor(A, x, y, R, &a, boxes);
+  *o = a;
+  if (!weight_taylor(B, x, y, R, &b, &c, &Bb, boxes)) return 1;
+  oc_etay w = c;
+  if (n->flags & OC_EF_BELOW) {
+    const double *par = add_below(n);
+    double bz = par[P_BZ], fade = par[P_FADE], dW;
+    double W = below_w(par, a.f.v, &dW), dev = oc_etay_dev(&a.f, R);
+    oc_etay Wm;
+    if (a.f.v - dev >= bz)
+      Wm = oc_etay_const(0);
+    else if (a.f.v + dev < bz - fade * (1 + 1e-9) - 1e-9 * fabs(bz))
+      Wm = oc_etay_const(1);
+    else
+      Wm = oc_etay_compose(&a.f, W, dW, 6 / (fade * fade) * (1 + 1e-9), R);
+    Wm.v = W;
+    w = oc_etay_mul(&c, &Wm, R);
+    w.v = c.v * W;
+  }
+  oc_etay wf = oc_etay_mul(&w, &b.f, R);
+  oc_etay_add(&o->f, &wf);
+  o->f.v = a.f.v + w.v * b.f.v;
+  if (n->flags & OC_EF_SUMW) {
+    oc_etay cc = oc_etay_mul(&c, &c, R);
+    oc_etay_add(&o->a, &cc);
+    o->a.v = a.a.v + c.v * c.v;
+  }
+  return 1;
+}
+
+/* transform: the child's model at p' = Minv (p - t) for R / scale (|Minv
+** d| = |d| / scale): f = vs f_c + vo, its linear part vs Minv^T F_c, its
+** remainder |vs| E_c(r / scale). */
+static int xform_taylor(const oc_enode *n, double x, double y, double R,
+                        oc_etaylor *o, int *boxes) {
+  const double *par = OC_EUN(n)->par;
+  double m[4];
+  minv(n, m);
+  double u = x - par[P_TX], v = y - par[P_TY], is = 1 / par[P_SCALE];
+  oc_etaylor c;
+  oc_enode_taylor(OC_EUN(n)->kid, m[0] * u + m[1] * v, m[2] * u + m[3] * v,
+                  R * is * (1 + 1e-12), &c, boxes);
+  double vs = par[P_VS], k = fabs(vs), is2 = is * is;
+  o->f = (oc_etay){vs * c.f.v + par[P_VO],
+                   vs * (m[0] * c.f.gx + m[2] * c.f.gy),
+                   vs * (m[1] * c.f.gx + m[3] * c.f.gy),
+                   k * c.f.e0,
+                   k * c.f.e1 * is,
+                   k * c.f.e2 * is2};
+  o->a = (oc_etay){c.a.v,
+                   m[0] * c.a.gx + m[2] * c.a.gy,
+                   m[1] * c.a.gx + m[3] * c.a.gy,
+                   c.a.e0,
+                   c.a.e1 * is,
+                   c.a.e2 * is2};
+  return 1;
+}
+
+int oc_eop_taylor(const oc_enode *n, double x, double y, double R,
+                  oc_etaylor *o, int *boxes) {
+  switch (n->kind) {
+  case OC_E_BLEND:
+    return blend_taylor(n, x, y, R, o, boxes);
+  case OC_E_REPLACE:
+    return replace_taylor(n, x, y, R, o, boxes);
+  case OC_E_ADD:
+    return add_taylor(n, x, y, R, o, boxes);
+  case OC_E_XFORM:
+    return xform_taylor(n, x, y, R, o, boxes);
+  default:
+    return 0; /* warp */
+  }
 }
 
 /* ---- dispatch --------------------------------------------------------- */

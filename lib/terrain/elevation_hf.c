@@ -266,6 +266,7 @@ int oc_heightfield_elevation(oc_heightfield *hf, oc_elevation *src,
   src->weight_range = NULL;
   src->bound = NULL; /* range and slope, each from the pyramid */
   src->height_weight_row = NULL;
+  src->taylor = NULL; /* the tracer asks for slopes */
   src->ud = s;
   src->x0 = s->x0;
   src->y0 = s->y0;

@@ -18,9 +18,13 @@
 ** The scenes are plausible terrains, not copies of the paper's: a base
 ** disc covering the scene (alpha >= 1/2 everywhere), noisy hills, rocks
 ** added, rivers and roads replaced in; counts are checked against Table
-** 1. Calls count height calls only (the tracer's range and slope
-** queries, one per step, are not counted, as the paper counts calls of
-** f). `bench_elev [-q | -qq] [hf] [fig1 ...]`: those scenes only, every
+** 1. Calls count height calls, as the paper counts calls of f: a step of
+** the tracer is one query of the tree's first-order model (value,
+** gradient and remainder in one traversal: a call, also printed as
+** `elev.model_steps_per_pixel`), besides the hits' refinement and
+** normals; `elev.bounds_per_pixel` counts the box queries made besides
+** (beams, and those inside the models' fallbacks: curves, lakes...).
+*`bench_elev [-q | -qq] [hf] [fig1 ...]`: those scenes only, every
 ** image 4 or 8 times smaller in each axis with -q and -qq (for work on
 ** the code: the figures then are not the HD ones). `bench_elev --bytes
 ** [fig1 ...]`: the trees' memory alone (`elev.bytes.<scene>`, the nodes
@@ -452,6 +456,22 @@ static void counted_bound(void *ud, double x0, double y0, double x1, double y1,
   counted_inner->bound(ud, x0, y0, x1, y1, lo, hi, slope);
 }
 
+/* The first-order models' queries (the tracer's steps, each one height
+** call) and the box queries they make inside (fallbacks: curves...). */
+static long counted_models, counted_model_boxes;
+
+static double counted_taylor(void *ud, double x, double y, double R,
+                             double g[2], double e[3], int *boxes) {
+  int nb = 0;
+  double h = counted_inner->taylor(ud, x, y, R, g, e, &nb);
+  if (boxes) *boxes += nb;
+#pragma omp atomic
+  counted_models++;
+#pragma omp atomic
+  counted_model_boxes += nb;
+  return h;
+}
+
 static void print_bytes(const char *name, const oc_enode_stats *st) {
   printf("elev.bytes.%s: %zu B\n", name, st->bytes);
   printf("elev.bytes_per_node.%s: %.1f B\n", name,
@@ -492,8 +512,9 @@ static void run_scene(const char *name, void (*build)(scene *), int prims,
   ** then the shading (shadow rays, ambient occlusion) on its own */
   oc_elevation counted = src;
   counted_inner = &src;
-  counted_bounds = 0;
+  counted_bounds = counted_models = counted_model_boxes = 0;
   counted.bound = counted_bound;
+  if (src.taylor) counted.taylor = counted_taylor;
   es.src = &counted;
   double t0 = omp_get_wtime();
   clock_t c0 = clock();
@@ -501,7 +522,8 @@ static void run_scene(const char *name, void (*build)(scene *), int prims,
   double secs = omp_get_wtime() - t0;
   double cpu = (double)(clock() - c0) / CLOCKS_PER_SEC;
   if (!geo) die(name, &err);
-  double bounds = (double)counted_bounds;
+  double bounds = (double)(counted_bounds + counted_model_boxes);
+  double models = (double)counted_models;
   es.src = &src;
   t0 = omp_get_wtime();
   oc_image *img = oc_render_surface_shade(&es, &rp, geo, NULL, &err);
@@ -521,6 +543,7 @@ static void run_scene(const char *name, void (*build)(scene *), int prims,
          oc_enode_lipschitz(s.root));
   printf("elev.calls_per_pixel.%s: %.1f calls\n", name, calls / n);
   printf("elev.bounds_per_pixel.%s: %.1f queries\n", name, bounds / n);
+  printf("elev.model_steps_per_pixel.%s: %.1f steps\n", name, models / n);
   printf("elev.render_hd_seconds_2t.%s: %.2f s\n", name, secs);
   printf("elev.render_hd_shaded_seconds_2t.%s: %.2f s\n", name,
          secs + shade_secs);
