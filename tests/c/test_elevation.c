@@ -781,6 +781,111 @@ START_TEST(rows_match_points) {
 }
 END_TEST
 
+/* First-order models (etaylor.h): at random points p and radii R, f and
+** alpha at p are the evaluator's bits, and the remainders hold on random
+** q in the disc |q - p| <= R (near p, where the linear part must be the
+** gradient, and out to R), for every rule: discs of each noise, blends
+** (weights above T on the disc, below T, crossing it: the fallback),
+** replace by a river (the zero-set rule) and lerped by a disc, add with
+** an altitude weight and with alpha_A + w^2, a transform, and a warp and a
+** lake (fallbacks). A quadratic remainder is checked at small r too, where
+** a wrong gradient would exceed it. */
+#ifdef __SANITIZE_ADDRESS__
+#define TAY_POINTS 12
+#else
+#define TAY_POINTS 60
+#endif
+
+static double tay_worst; /* largest |error| / remainder seen */
+
+static void check_taylor(const oc_enode *e, oct_rng *r, double half) {
+  for (int i = 0; i < TAY_POINTS; i++) {
+    double x = oct_unif(r, -half, half), y = oct_unif(r, -half, half);
+    double R = half * pow(10, oct_unif(r, -4, -0.5));
+    oc_etaylor m;
+    int boxes = 0;
+    oc_enode_taylor(e, x, y, R, &m, &boxes);
+    oc_enode_sample s, sa;
+    oc_enode_ev(e, x, y, NULL, 0, &s);
+    oc_enode_ev(e, x, y, NULL, OC_EV_ALPHA, &sa);
+    ck_assert_msg(same(m.f.v, s.f), "%s at (%g, %g): f %.17g, eval %.17g",
+                  oc_enode_kind(e), x, y, m.f.v, s.f);
+    ck_assert_msg(same(m.a.v, sa.a), "%s at (%g, %g): alpha %.17g, eval %.17g",
+                  oc_enode_kind(e), x, y, m.a.v, sa.a);
+    const oc_etay *mm[2] = {&m.f, &m.a};
+    for (int k = 0; k < 2; k++)
+      ck_assert(mm[k]->e0 >= 0 && mm[k]->e1 >= 0 && mm[k]->e2 >= 0);
+    for (int j = 0; j < 40; j++) {
+      double r0 =
+          R * (j < 10 ? pow(10, oct_unif(r, -4, -1)) : oct_unif(r, 0, 1));
+      double th = oct_unif(r, 0, 2 * PI);
+      double dx = r0 * cos(th), dy = r0 * sin(th), d = hypot(dx, dy);
+      oc_enode_sample q;
+      oc_enode_ev(e, x + dx, y + dy, NULL, 0, &q);
+      double got[2] = {q.f, q.a};
+      for (int k = 0; k < 2; k++) {
+        const oc_etay *t = mm[k];
+        double err = fabs(got[k] - t->v - t->gx * dx - t->gy * dy);
+        double bound = oc_etay_rem(t, d);
+        double pad =
+            1e-9 * (1 + fabs(t->v) + fabs(t->gx * dx) + fabs(t->gy * dy));
+        ck_assert_msg(err <= bound * (1 + 1e-9) + pad,
+                      "%s %s at (%g, %g), R %g, r %g: error %g > %g "
+                      "(%g + %g r + %g r^2)",
+                      oc_enode_kind(e), k ? "alpha" : "f", x, y, R, d, err,
+                      bound, t->e0, t->e1, t->e2);
+        if (bound > 1e-6) tay_worst = fmax(tay_worst, err / bound);
+      }
+    }
+  }
+}
+
+START_TEST(taylor_models) {
+  oc_error err;
+  oc_enode *d[5] = {disc(0, 0, 900, 50, OC_ENOISE_PLAIN, 30, 200, 6),
+                    disc(150, 40, 180, 120, OC_ENOISE_RIDGED, 40, 60, 6),
+                    disc(-200, -60, 150, 80, OC_ENOISE_TURBULENCE, 20, 40, 5),
+                    disc(60, -30, 90, 30, OC_ENOISE_NONE, 0, 0, 0),
+                    disc(-60, 120, 70, 60, OC_ENOISE_PLAIN, 8, 25, 4)};
+  oc_enode *land = EOK(oc_enode_blend(d, 5, &err));
+  oc_enode *islets = EOK(oc_enode_blend(d + 1, 4, &err)); /* S < T too */
+  oc_vec3 pts[3] = {{-500, -100, 40}, {0, 10, 45}, {500, 120, 50}};
+  oc_enode_river_params rp = {pts, 3, OC_ECURVE_CATMULL, OC_RIVER_RIVER, 0,
+                              0,   0};
+  oc_enode *river = EOK(oc_enode_river(&rp, &err));
+  oc_enode *rep = EOK(oc_enode_replace(land, river, 0, &err));
+  oc_enode *lrep = EOK(oc_enode_replace(land, d[1], 1, &err));
+  oc_enode_add_params below = {0, 1, 90, 20, 0, 0, 0, 0};
+  oc_enode *crag = EOK(oc_enode_add(rep, d[2], &below, &err));
+  oc_enode_add_params sumw = {1, 0, 0, 0, 0, 0, 0, 0};
+  oc_enode *sadd = EOK(oc_enode_add(d[0], d[4], &sumw, &err));
+  oc_enode_xform xf = {30, -20, 35, 1.7, 0.6, 5};
+  oc_enode *moved = EOK(oc_enode_transform(crag, &xf, &err));
+  oc_enode_warp_params wp = {10, 200, 2, 7};
+  oc_enode *warped = EOK(oc_enode_warp(land, &wp, &err));
+  double radii[3] = {100, 140, 120};
+  oc_enode_lake_params lp = {0};
+  lp.cx = 10, lp.cy = 20, lp.radii = radii, lp.nradii = 3, lp.level = 40;
+  oc_enode *lake = EOK(oc_enode_lake(&lp, &err));
+  oc_enode *top[3] = {moved, lrep, lake};
+  oc_enode *mix = EOK(oc_enode_blend(top, 3, &err));
+  oc_enode *all[] = {d[0], d[1], d[2], d[3],  d[4],   land, islets, rep,
+                     lrep, crag, sadd, moved, warped, lake, mix};
+  oct_rng r = oct_rng_new(123);
+  tay_worst = 0;
+  for (size_t t = 0; t < sizeof all / sizeof *all; t++)
+    check_taylor(all[t], &r, 400);
+  printf("taylor: the largest error is %.3f of its remainder\n", tay_worst);
+  ck_assert(tay_worst > 0.01); /* (the checks do reach the bounds) */
+  oc_enode *rel[] = {land, islets, river,  rep,  lrep, crag,
+                     sadd, moved,  warped, lake, mix};
+  for (size_t t = 0; t < sizeof rel / sizeof *rel; t++)
+    oc_enode_release(rel[t]);
+  for (int i = 0; i < 5; i++)
+    oc_enode_release(d[i]);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("elevation");
   TCase *tc = tcase_create("elevation");
@@ -798,6 +903,7 @@ int main(void) {
   tcase_add_test(tc, bad_input);
   tcase_add_test(tc, rows_match_points);
   tcase_add_test(tc, add_altitude_slope_bound);
+  tcase_add_test(tc, taylor_models);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }

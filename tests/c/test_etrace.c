@@ -219,6 +219,67 @@ START_TEST(analytic_against_march) {
 }
 END_TEST
 
+/* An elevation tree, traced on its first-order models (oc_elevation's
+** taylor: model steps, over-relaxed), against the dense march and the
+** sphere tracer: noisy hills blended on a base, a river replaced in (the
+** zero-set rule and a box-bound fallback), crags added below an altitude,
+** the whole moved by a transform; its holes from the weight. */
+#ifdef __SANITIZE_ADDRESS__
+#define TREE_W 8
+#define TREE_H 6
+#else
+#define TREE_W 14
+#define TREE_H 10
+#endif
+
+static double tree_weight(void *wud, double x, double y) {
+  return oc_enode_weight(wud, x, y);
+}
+
+START_TEST(tree_models_against_march) {
+  oc_error err;
+  oc_enode *k[4];
+  oc_enode_disc_params dp[4] = {
+      {0, 0, 900, 40, {OC_ENOISE_PLAIN, 20, 250, 6, 0, 0, 1}},
+      {120, 80, 220, 110, {OC_ENOISE_PLAIN, 25, 120, 5, 0, 0, 2}},
+      {-150, 60, 160, 90, {OC_ENOISE_RIDGED, 20, 90, 5, 0, 0, 3}},
+      {60, -140, 130, 60, {OC_ENOISE_TURBULENCE, 15, 60, 5, 0, 0, 4}}};
+  for (int i = 0; i < 4; i++)
+    ck_assert_ptr_nonnull(k[i] = oc_enode_disc(&dp[i], &err));
+  oc_enode *land = oc_enode_blend(k, 4, &err);
+  oc_vec3 pts[3] = {{-400, -300, 35}, {0, -20, 40}, {400, 250, 45}};
+  oc_enode_river_params rp = {pts, 3, OC_ECURVE_CATMULL, OC_RIVER_RIVER, 0,
+                              0,   0};
+  oc_enode *river = oc_enode_river(&rp, &err);
+  oc_enode *rep = oc_enode_replace(land, river, 0, &err);
+  oc_enode_disc_params cp = {
+      -80, -60, 120, 12, {OC_ENOISE_TURBULENCE, 8, 30, 4, 0, 0, 5}};
+  oc_enode *crags = oc_enode_disc(&cp, &err);
+  oc_enode_add_params ap = {0, 1, 70, 15, 0, 0, 0, 0};
+  oc_enode *add = oc_enode_add(rep, crags, &ap, &err);
+  oc_enode_xform xf = {20, -10, 20, 1.2, 1, 0};
+  oc_enode *tree = oc_enode_transform(add, &xf, &err);
+  ck_assert_ptr_nonnull(tree);
+  oc_elevation src;
+  double dom[4] = {-450, -450, 450, 450};
+  ck_assert_int_eq(oc_enode_elevation(tree, dom, &src, &err), OC_OK);
+  ck_assert_ptr_nonnull(src.taylor);
+  oc_esurface es = {&src, tree_weight, tree, 0.5};
+  oc_render_params v = view(oct_v(-600, -550, 380), oct_v(60, 60, -150), TREE_W, TREE_H);
+  double ev[2];
+  compare(&es, &v, 0.25, ev);
+  ck_assert_msg(ev[0] * 2 < ev[1], "models %g calls, sphere %g", ev[0], ev[1]);
+  /* grazing, from low down */
+  v = view(oct_v(-500, 420, 150), oct_v(100, -100, -20), TREE_W, TREE_H / 2);
+  compare(&es, &v, 0.25, ev);
+  src.release(src.ud);
+  oc_enode *rel[] = {k[0],  k[1], k[2],  k[3], land,
+                     river, rep,  crags, add,  tree};
+  for (size_t i = 0; i < sizeof rel / sizeof *rel; i++)
+    oc_enode_release(rel[i]);
+}
+END_TEST
+
 /* A hit is located to 1/1000 of the tolerance, on the near side: from
 ** straight above (h falls along every ray, one crossing), h > 0 at the
 ** hit and h <= 0 that much further. */
@@ -494,6 +555,7 @@ static Suite *suite(void) {
   tcase_set_timeout(t, 300);
   tcase_add_test(t, heightfield_against_march);
   tcase_add_test(t, analytic_against_march);
+  tcase_add_test(t, tree_models_against_march);
   tcase_add_test(t, hits_located);
   tcase_add_test(t, weight_makes_holes);
   tcase_add_test(t, beams_conservative);
