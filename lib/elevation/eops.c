@@ -1074,13 +1074,23 @@ int oc_eop_ev_row(const oc_enode *n, const double *x, double y, int cnt,
 /* At most this many children of a blend meet the disc (else fallback). */
 #define TAY_KIDS 64
 
-/* A child's f model counts only where its weight is > 0: a curve's, lake's
-** or image's bounds hold there alone (ecurve.c), so their f models are not
-** composed as they stand. */
+/* A node whose f model counts only where its weight is > 0: a curve's,
+** lake's or image's bounds hold there alone (ecurve.c), and so do those of
+** a transform, warp, level of detail, replace or add of one (in A's place:
+** their weight is A's). Their f models are not composed as they stand. */
 static int tay_partial(const oc_enode *n) {
-  while (n->kind == OC_E_XFORM)
-    n = OC_EUN(n)->kid;
-  return OC_EPRIM_KIND(n->kind) != 0;
+  switch (n->kind) {
+  case OC_E_XFORM:
+  case OC_E_WARP:
+    return tay_partial(OC_EUN(n)->kid);
+  case OC_E_LOD:
+    return tay_partial(OC_EBIN(n)->kids[0]) || tay_partial(OC_EBIN(n)->kids[1]);
+  case OC_E_REPLACE:
+  case OC_E_ADD:
+    return tay_partial(OC_EBIN(n)->kids[0]);
+  default:
+    return OC_EPRIM_KIND(n->kind) != 0;
+  }
 }
 
 /* blend, f = N / S where S = sum alpha_k >= T on the whole disc: with
