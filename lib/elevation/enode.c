@@ -265,6 +265,16 @@ void oc_enode_taylor_flat(const oc_enode *n, double x, double y, double R,
   o->a = oc_etay_flat(s.a, b.la, fmax(b.ahi - s.a, s.a - b.alo), R);
 }
 
+int oc_enode_taylor_alpha(const oc_enode *n, double x, double y, double R,
+                          oc_etay *a, int *boxes) {
+  if (n->kind == OC_E_DISC) {
+    oc_edisc_taylor_alpha(n, x, y, R, a);
+    return 1;
+  }
+  if (n->kind == OC_E_LOD || OC_EPRIM_KIND(n->kind)) return 0;
+  return oc_eop_taylor_alpha(n, x, y, R, a, boxes);
+}
+
 void oc_enode_taylor(const oc_enode *n, double x, double y, double R,
                      oc_etaylor *o, int *boxes) {
   if (n->kind == OC_E_DISC) {

@@ -406,6 +406,13 @@ void oc_edisc_taylor_alpha(const oc_enode *n, double x, double y, double R,
 /* 0 where the operator has no rule */
 int oc_eop_taylor(const oc_enode *n, double x, double y, double R,
                   oc_etaylor *o, int *boxes);
+/* alpha's model alone, as oc_enode_taylor's (discs, and operators whose
+** weight has its own rule: blends, transforms, replaces and adds with A's
+** weight); 0 for the others. */
+int oc_enode_taylor_alpha(const oc_enode *n, double x, double y, double R,
+                          oc_etay *a, int *boxes);
+int oc_eop_taylor_alpha(const oc_enode *n, double x, double y, double R,
+                        oc_etay *a, int *boxes);
 
 /* The bound of n in box b (dispatch), under the footprint fb. */
 void oc_enode_bnd(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,

@@ -1102,13 +1102,6 @@ static int tay_partial(const oc_enode *n) {
 ** - G.d = (Q - G.d (S' - S)) / S', at most (Q + |G| r (|A_S| r + E_S)) /
 ** inf S'. Where S <= T on the whole disc f = N / T, N the sum of the
 ** products alpha_k f_k (product rule, etaylor.h). */
-/* Whether alpha > 0 at (x, y) for a disc (oc_edisc_ev's test). */
-static int disc_inside(const oc_enode *k, double x, double y) {
-  const double *p = OC_EDISC(k)->par;
-  double u = x - p[0], v = y - p[1];
-  return (u * u + v * v) / (p[2] * p[2]) < 1;
-}
-
 static int blend_taylor(const oc_enode *n, double x, double y, double R,
                         oc_etaylor *o, int *boxes) {
   const oc_eblend *bl = OC_EBLEND(n);
@@ -1124,14 +1117,15 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
     if (!oc_enode_meets(k, &ball)) continue; /* alpha_k = 0 on the disc */
     if (m == TAY_KIDS || tay_partial(k)) return 0;
     oc_etaylor c;
-    if (k->kind == OC_E_DISC && !disc_inside(k, x, y)) {
-      /* alpha_k(p) = 0 and grad alpha_k(p) = 0: alpha_k' (f_k' - f) is at
-      ** most E_ak(r) sup|f_k - f|, f_k's range from its bound over the
-      ** plane (no noise evaluated) */
-      oc_edisc_taylor_alpha(k, x, y, R, &c.a);
+    /* alpha_k's model first where it is cheap (no noise) */
+    int have = oc_enode_taylor_alpha(k, x, y, R, &c.a, boxes);
+    if (have && c.a.v == 0 && c.a.gx == 0 && c.a.gy == 0) {
+      /* alpha_k(p) = 0 (so grad alpha_k(p) = 0: alpha_k >= 0 is C1):
+      ** alpha_k' (f_k' - f) is at most E_ak(r) sup|f_k - f|, f_k's range
+      ** from its bound over the plane (no noise evaluated) */
       if (oc_etay_is_const(&c.a)) continue;
       oc_ebound g;
-      oc_edisc_glob(k, &g);
+      oc_enode_glob(k, &g);
       fk[m] = g.flo, fhi[m] = g.fhi, out[m] = 1;
       oc_etay_add(&S, &c.a);
       ea[m][0] = c.a.e0, ea[m][1] = c.a.e1, ea[m][2] = c.a.e2;
@@ -1331,6 +1325,54 @@ static int xform_taylor(const oc_enode *n, double x, double y, double R,
                    c.a.e1 * is,
                    c.a.e2 * is2};
   return 1;
+}
+
+/* alpha's model alone (no f, no noise): a blend's the sum of its
+** children's, a transform's mapped, a replace's or add's A's (the lerped
+** and summed weights have none: 0). */
+int oc_eop_taylor_alpha(const oc_enode *n, double x, double y, double R,
+                        oc_etay *a, int *boxes) {
+  switch (n->kind) {
+  case OC_E_BLEND: {
+    const oc_eblend *bl = OC_EBLEND(n);
+    oc_erect ball = {x - R, y - R, x + R, y + R};
+    *a = oc_etay_const(0);
+    for (size_t i = 0; i < bl->nkids; i++) {
+      const oc_enode *k = bl->kids[i];
+      oc_etay c;
+      if (!oc_enode_meets(k, &ball)) continue;
+      if (!oc_enode_taylor_alpha(k, x, y, R, &c, boxes)) return 0;
+      oc_etay_add(a, &c);
+    }
+    return 1;
+  }
+  case OC_E_REPLACE:
+    if (n->flags & OC_EF_LERP) return 0;
+    return oc_enode_taylor_alpha(OC_EBIN(n)->kids[0], x, y, R, a, boxes);
+  case OC_E_ADD:
+    if (n->flags & OC_EF_SUMW) return 0;
+    return oc_enode_taylor_alpha(OC_EBIN(n)->kids[0], x, y, R, a, boxes);
+  case OC_E_XFORM: {
+    const double *par = OC_EUN(n)->par;
+    double m[4];
+    minv(n, m);
+    double u = x - par[P_TX], v = y - par[P_TY], is = 1 / par[P_SCALE];
+    oc_etay c;
+    if (!oc_enode_taylor_alpha(OC_EUN(n)->kid, m[0] * u + m[1] * v,
+                               m[2] * u + m[3] * v, R * is * (1 + 1e-12), &c,
+                               boxes))
+      return 0;
+    *a = (oc_etay){c.v,
+                   m[0] * c.gx + m[2] * c.gy,
+                   m[1] * c.gx + m[3] * c.gy,
+                   c.e0,
+                   c.e1 * is,
+                   c.e2 * is * is};
+    return 1;
+  }
+  default:
+    return 0;
+  }
 }
 
 int oc_eop_taylor(const oc_enode *n, double x, double y, double R,

@@ -867,18 +867,22 @@ START_TEST(taylor_models) {
   oc_enode_lake_params lp = {0};
   lp.cx = 10, lp.cy = 20, lp.radii = radii, lp.nradii = 3, lp.level = 40;
   oc_enode *lake = EOK(oc_enode_lake(&lp, &err));
+  oc_enode_xform xg = {-250, 180, -50, 0.5, 1.3, 0};
+  oc_enode *small = EOK(oc_enode_transform(islets, &xg, &err));
+  oc_enode *inst[3] = {d[0], moved, small}; /* children by their weight */
+  oc_enode *insts = EOK(oc_enode_blend(inst, 3, &err));
   oc_enode *top[3] = {moved, lrep, lake};
   oc_enode *mix = EOK(oc_enode_blend(top, 3, &err));
   oc_enode *all[] = {d[0], d[1], d[2], d[3],  d[4],   land, islets, rep,
-                     lrep, crag, sadd, moved, warped, lake, mix};
+                     lrep, crag, sadd, moved, warped, lake, mix,    insts};
   oct_rng r = oct_rng_new(123);
   tay_worst = 0;
   for (size_t t = 0; t < sizeof all / sizeof *all; t++)
     check_taylor(all[t], &r, 400);
   printf("taylor: the largest error is %.3f of its remainder\n", tay_worst);
   ck_assert(tay_worst > 0.01); /* (the checks do reach the bounds) */
-  oc_enode *rel[] = {land, islets, river,  rep,  lrep, crag,
-                     sadd, moved,  warped, lake, mix};
+  oc_enode *rel[] = {land,  islets, river, rep, lrep,  crag, sadd,
+                     moved, warped, lake,  mix, small, insts};
   for (size_t t = 0; t < sizeof rel / sizeof *rel; t++)
     oc_enode_release(rel[t]);
   for (int i = 0; i < 5; i++)
