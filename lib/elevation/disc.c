@@ -600,8 +600,9 @@ oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err) {
 **    (Taylor with the integral remainder, |Hessian| <= H s^2);
 **  - or flat (no linear part): |eta(s q) - eta(s p)| <= L s r, and <= 1 +
 **    |eta(s p)| (eta lies in [-1, 1]);
-** whichever bounds the remainder lower at R. Octaves coarser than R are
-** quadratic (tiny near p), finer ones flat. |eta| (turbulence) is eta
+** whichever bounds the remainder lower at r = OC_ETAY_CHOICE R (each
+** holds up to R). Octaves coarser than R are quadratic (tiny near p),
+** finer ones flat. |eta| (turbulence) is eta
 ** times its sign where that sign is proved constant on the disc (|eta(s
 ** p)| above its first-order deviation s |grad eta| R + H s^2 R^2 / 2),
 ** else flat (|eta| is L-Lipschitz and in [0, 1]). A ridged octave t_i =

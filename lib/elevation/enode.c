@@ -253,6 +253,10 @@ void oc_enode_bnd(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
     oc_eop_bound_in(n, b, fb, o);
 }
 
+/* The box [x - R, x + R] x [y - R, y + R] holds the disc: on it f moves
+** from its value at p by at most lf r and stays in [flo, fhi], so either
+** bounds |f(q) - f(p)| with no linear part (etaylor.h, oc_etay_flat); the
+** same for alpha. */
 void oc_enode_taylor_flat(const oc_enode *n, double x, double y, double R,
                           oc_etaylor *o, int *boxes) {
   oc_enode_sample s;

@@ -16,6 +16,11 @@
 **    (kept only when the slope proves the stretch behind its sample free
 **    too), and the range and slope come from one query (oc_elevation's
 **    bound, when the source has it).
+**    A source with first-order models (oc_elevation's taylor: elevation
+**    trees) steps on them instead (march_taylor): at each sample one query
+**    gives h, a linear part and a remainder on a disc around it, and the
+**    step goes to the first zero of the height above that model, which
+**    near the surface is Newton-like (the remainder is quadratic there).
 **  - Sphere tracing (`OC_TRACE_SPHERE`, section 7.1) uses the slope bound of
 **    the whole domain for every step: the baseline the paper compares to.
 ** Both clip the ray to the domain x [min f, max f] first, never step below
@@ -179,7 +184,11 @@ static double model_step(double h, const double g[2], const double E[3],
 
 /* The accelerated march with the source's first-order models: one query
 ** per sample gives h there and the step (model_step) over a candidate
-** segment whose length doubles after each step. */
+** segment TGROW times the last step. A relaxed step's sample is kept only
+** when its own model, asked over a disc reaching back to where the last
+** proof ended, proves the stretch behind it free (a descending ray is
+** rising backwards, so this usually holds); else the ray takes the plain
+** step. Steps, hits, holes and walls are march's. */
 static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
                         double t1, double d0, double *thit, double *n) {
   const oc_elevation *src = tr->s->src;

@@ -265,7 +265,8 @@ START_TEST(tree_models_against_march) {
   ck_assert_int_eq(oc_enode_elevation(tree, dom, &src, &err), OC_OK);
   ck_assert_ptr_nonnull(src.taylor);
   oc_esurface es = {&src, tree_weight, tree, 0.5};
-  oc_render_params v = view(oct_v(-600, -550, 380), oct_v(60, 60, -150), TREE_W, TREE_H);
+  oc_render_params v =
+      view(oct_v(-600, -550, 380), oct_v(60, 60, -150), TREE_W, TREE_H);
   double ev[2];
   compare(&es, &v, 0.25, ev);
   ck_assert_msg(ev[0] * 2 < ev[1], "models %g calls, sphere %g", ev[0], ev[1]);
