@@ -578,103 +578,12 @@ static double box_d2(const bnode *b, double x, double y) {
   return dx * dx + dy * dy;
 }
 
-/* The distance from (a, c) to the box [alo, ahi] x [clo, chi]. */
-static double box_dist(double a, double c, const double b[4]) {
-  double da = fmax(fmax(b[0] - a, a - b[1]), 0);
-  double dc = fmax(fmax(b[2] - c, c - b[3]), 0);
-  return hypot(da, dc);
-}
-
-/* The distance from (a, c) to the segment (a1, c1) (a2, c2). */
-static double seg_dist(double a, double c, double a1, double c1, double a2,
-                       double c2) {
-  double da = a2 - a1, dc = c2 - c1, l2 = da * da + dc * dc;
-  double t = l2 > 0 ? ((a - a1) * da + (c - c1) * dc) / l2 : 0;
-  t = t < 0 ? 0 : t > 1 ? 1 : t;
-  return hypot(a - a1 - t * da, c - c1 - t * dc);
-}
-
-/* The distance from a segment to a box (both convex): 0 where they meet,
-** else the least of its ends' distances to the box and the box corners'
-** to it. Whether they meet: the segment clipped to the box's slabs. */
-static double seg_box_dist(double a1, double c1, double a2, double c2,
-                           const double b[4]) {
-  double t0 = 0, t1 = 1, d[2] = {a2 - a1, c2 - c1}, o[2] = {a1, c1};
-  int meets = 1;
-  for (int k = 0; k < 2 && meets; k++) {
-    double lo = b[2 * k], hi = b[2 * k + 1];
-    if (d[k] == 0) {
-      meets = o[k] >= lo && o[k] <= hi;
-      continue;
-    }
-    double u = (lo - o[k]) / d[k], v = (hi - o[k]) / d[k];
-    if (u > v) {
-      double w = u;
-      u = v, v = w;
-    }
-    t0 = fmax(t0, u), t1 = fmin(t1, v);
-    meets = t0 <= t1;
-  }
-  if (meets) return 0;
-  double m = fmin(box_dist(a1, c1, b), box_dist(a2, c2, b));
-  for (int i = 0; i < 4; i++)
-    m = fmin(m, seg_dist(b[i & 1], b[2 + (i >> 1)], a1, c1, a2, c2));
-  return m;
-}
-
 int oc_curve_far_from_segment(const oc_pcurve *c, double xa, double ya,
                               double xb, double yb, double r) {
   if (!(r >= 0 && r < INFINITY)) return 0;
-  double M = fmax(fmax(fabs(xa), fabs(ya)), fmax(fabs(xb), fabs(yb)));
-  for (size_t i = 0; i < c->n; i++) {
-    const piece *pc = &c->pc[i];
-    const oc_vec3 *p = pc->p;
-    int n = pc->deg;
-    double ux = p[n].x - p[0].x, uy = p[n].y - p[0].y, l = hypot(ux, uy);
-    if (l > 0)
-      ux /= l, uy /= l;
-    else
-      ux = 1, uy = 0;
-    double b[4] = {INFINITY, -INFINITY, INFINITY, -INFINITY}, Mp = M;
-    for (int k = 0; k <= n; k++) {
-      double a = p[k].x * ux + p[k].y * uy, cc = p[k].y * ux - p[k].x * uy;
-      b[0] = fmin(b[0], a), b[1] = fmax(b[1], a);
-      b[2] = fmin(b[2], cc), b[3] = fmax(b[3], cc);
-      Mp = fmax(Mp, fmax(fabs(p[k].x), fabs(p[k].y)));
-    }
-    double D = seg_box_dist(xa * ux + ya * uy, ya * ux - xa * uy,
-                            xb * ux + yb * uy, yb * ux - xb * uy, b);
-    if (!(D - 1e-9 * Mp > r * (1 + 1e-9))) return 0;
-  }
+  for (size_t i = 0; i < c->n; i++)
+    if (!oc_bez_far(c->pc[i].p, c->pc[i].deg, xa, ya, xb, yb, r)) return 0;
   return 1;
-}
-
-/* Whether the piece is at least sqrt(lim) from (x, y): the control points'
-** box in the frame of the chord p[0] p[deg] (the piece lies in their hull,
-** so in that box) is that far. */
-static int far_in_frame(const piece *pc, double x, double y, double lim) {
-  double ux = pc->p[pc->deg].x - pc->p[0].x, uy = pc->p[pc->deg].y - pc->p[0].y;
-  double l = sqrt(ux * ux + uy * uy);
-  if (!(l > 0)) return 0;
-  ux /= l, uy /= l;
-  double a0 = INFINITY, a1 = -INFINITY, b0 = INFINITY, b1 = -INFINITY;
-  for (int k = 0; k <= pc->deg; k++) {
-    double dx = pc->p[k].x - pc->p[0].x, dy = pc->p[k].y - pc->p[0].y;
-    double a = dx * ux + dy * uy, b = dy * ux - dx * uy;
-    a0 = a < a0 ? a : a0, a1 = a > a1 ? a : a1;
-    b0 = b < b0 ? b : b0, b1 = b > b1 ? b : b1;
-  }
-  double dx = x - pc->p[0].x, dy = y - pc->p[0].y;
-  double a = dx * ux + dy * uy, b = dy * ux - dx * uy;
-  double ea = a < a0 ? a0 - a : a > a1 ? a - a1 : 0;
-  double eb = b < b0 ? b0 - b : b > b1 ? b - b1 : 0;
-  /* a hair for the rounding of the frame (and of the differences of
-  ** coordinates far from the origin) */
-  double d2 = ea * ea + eb * eb,
-         pad =
-             1e-9 * (l + fabs(a) + fabs(b)) +
-             1e-14 * (fabs(x) + fabs(y) + fabs(pc->p[0].x) + fabs(pc->p[0].y));
-  return d2 > lim + 2 * pad * sqrt(lim) + pad * pad;
 }
 
 int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
@@ -691,7 +600,7 @@ int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
     if (box_d2(b, x, y) >= best) continue;
     if (!b->right) {
       const piece *pc = &c->pc[b->piece];
-      if (far_in_frame(pc, x, y, best)) continue; /* (cannot beat best) */
+      /* (oc_bez_closest first tests whether the piece is out of reach) */
       double t, d2 = oc_bez_closest(pc->p, pc->deg, x, y, best, &t);
       if (d2 < best) best = d2, bp = b->piece, bt = t, found = 1;
       continue;
@@ -744,8 +653,7 @@ int oc_curve_within(const oc_pcurve *c, double x, double y, double r) {
       double dx = m.x - x, dy = m.y - y;
       if (dx * dx + dy * dy < lim) return 1;
     }
-    if (far_in_frame(pc, x, y, lim)) continue;
-    double t;
+    double t; /* (out of reach: one test, oc_bez_closest's) */
     if (oc_bez_closest(pc->p, pc->deg, x, y, lim, &t) < lim) return 1;
   }
   return 0;

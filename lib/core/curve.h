@@ -75,10 +75,10 @@ int oc_curve_at(const oc_pcurve *c, double s, oc_curve_point *out);
 
 /* 1 when every point of the segment (xa, ya) (xb, yb) is provably farther
 ** than r from the curve in xy, so that oc_curve_closest(c, x, y, r, ...)
-** returns 0 at each of them; 0 when that is not shown. Each piece's
-** control points are boxed in the frame of its chord (tight for a
-** diagonal piece), the segment's distance to that box taken exactly, less
-** a margin of 1e-9 of the coordinates' size. */
+** returns 0 at each of them; 0 when that is not shown. Each piece passes
+** oc_bez_far (its control points boxed in the frame of its chord, tight
+** for a diagonal piece; the segment's distance to that box taken exactly,
+** less a margin for rounding): the test oc_curve_closest runs per piece. */
 int oc_curve_far_from_segment(const oc_pcurve *c, double xa, double ya,
                               double xb, double yb, double r);
 
