@@ -247,8 +247,8 @@ int oc_bez_far(const oc_vec3 *p, int n, double xa, double ya, double xb,
   double px[OC_BEZ_MAXDEG + 1], py[OC_BEZ_MAXDEG + 1];
   for (int k = 0; k <= n; k++)
     px[k] = p[k].x, py[k] = p[k].y;
-  double mag = fabs(xa) + fabs(ya) + fabs(xb) + fabs(yb) + fabs(p[0].x) +
-               fabs(p[0].y);
+  double mag =
+      fabs(xa) + fabs(ya) + fabs(xb) + fabs(yb) + fabs(p[0].x) + fabs(p[0].y);
   return frame_far(px, py, n, xa, ya, xb, yb, r, mag);
 }
 
