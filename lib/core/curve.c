@@ -47,23 +47,27 @@ typedef struct rawpiece {
   double scale;
 } rawpiece;
 
-/* One block: this header, then s (n + 1 doubles: the arc length at each
-** piece's start, s[n] the length), the inner knots' arc lengths (nk
+/* One block: this header, then the box tree (2 n - 1 boxes: first, so
+** the tree walks find it at once), s (n + 1 doubles: the arc length at
+** each piece's start, s[n] the length), the inner knots' arc lengths (nk
 ** doubles, from their piece's start), the points (control points with
 ** shared ends once, or a Catmull-Rom spline's through-points), the inner
-** knots' first index per piece (n + 1, when nk > 0), mixed degrees'
-** first point per piece (n + 1), the knots' parameters (nk floats:
-** dyadic, so exact) and the box tree (2 n - 1 boxes). */
+** knots' first index per piece (n + 1, when nk > 0), mixed degrees' first
+** point per piece (n + 1) and the knots' parameters (nk floats: dyadic,
+** so exact). (Boxes are 16 bytes: the doubles after them stay aligned.) */
 struct oc_pcurve {
   uint32_t n, npts, nk;
   uint8_t deg;     /* every piece's degree, or 0 (mixed: off) */
   uint8_t catmull; /* pts are through-points of a Catmull-Rom spline */
   uint8_t closed;
-  double s[];
+  fbox bvh[];
 };
 
+static double *c_s(const oc_pcurve *c) {
+  return (double *)(c->bvh + 2 * (size_t)c->n - 1);
+}
 static double *c_ts(const oc_pcurve *c) {
-  return (double *)c->s + c->n + 1;
+  return c_s(c) + c->n + 1;
 }
 static oc_vec3 *c_pts(const oc_pcurve *c) {
   return (oc_vec3 *)(c_ts(c) + c->nk);
@@ -82,9 +86,6 @@ static uint32_t *c_off(const oc_pcurve *c) {
 }
 static float *c_tt(const oc_pcurve *c) {
   return (float *)(c_off(c) + c_noff(c));
-}
-static fbox *c_bvh(const oc_pcurve *c) {
-  return (fbox *)(c_tt(c) + c->nk);
 }
 
 static size_t curve_bytes(size_t n, size_t npts, size_t nk, size_t noff) {
@@ -120,7 +121,7 @@ static void piece_at(const oc_pcurve *c, size_t i, piece *pc) {
 }
 
 static double piece_len(const oc_pcurve *c, size_t i) {
-  return c->s[i + 1] - c->s[i];
+  return c_s(c)[i + 1] - c_s(c)[i];
 }
 
 /* Inner knots of piece i: how many, and the first's index. */
@@ -266,7 +267,7 @@ static void piece_box(const piece *pc, oc_aabb *box) {
 }
 
 static void build_bvh(oc_pcurve *c, size_t lo, size_t hi, size_t i) {
-  fbox *bvh = c_bvh(c), *b = &bvh[i];
+  fbox *bvh = c->bvh, *b = &bvh[i];
   if (hi - lo == 1) {
     piece pc;
     piece_at(c, lo, &pc);
@@ -432,11 +433,11 @@ static oc_pcurve *build(rawpiece *raw, size_t nraw, int closed,
   }
   double s = 0;
   for (size_t i = 0; i < nraw; i++) {
-    c->s[i] = s;
+    c_s(c)[i] = s;
     s += len[i];
     if (nk) c_tab(c)[i] = kfirst[i];
   }
-  c->s[nraw] = s;
+  c_s(c)[nraw] = s;
   if (nk) c_tab(c)[nraw] = (uint32_t)nk;
   for (size_t j = 0; j < nk; j++) /* (dyadic parameters: exact floats) */
     c_tt(c)[j] = (float)k.t[j], c_ts(c)[j] = k.s[j];
@@ -531,10 +532,10 @@ int oc_curve_closed(const oc_pcurve *c) {
   return c->closed;
 }
 double oc_curve_length(const oc_pcurve *c) {
-  return c->s[c->n];
+  return c_s(c)[c->n];
 }
 double oc_curve_kappa_max(const oc_pcurve *c) {
-  double k = 0, s = c->s[c->n];
+  double k = 0, s = c_s(c)[c->n];
   for (size_t i = 0; i < c->n; i++) {
     piece pc;
     piece_at(c, i, &pc);
@@ -689,7 +690,7 @@ static void fill(const oc_pcurve *c, const piece *pc, double t,
   size_t i = pc->i;
   out->piece = i;
   out->t = t;
-  out->s = c->s[i] + s_of_t(c, pc, t);
+  out->s = c_s(c)[i] + s_of_t(c, pc, t);
   out->q = t >= 1 ? pc->p[pc->deg] : oc_bez_eval(pc->p, pc->deg, t);
   tangent(c, pc, t, &out->tx, &out->ty);
   out->nx = -out->ty, out->ny = out->tx;
@@ -703,19 +704,19 @@ static void fill(const oc_pcurve *c, const piece *pc, double t,
 
 int oc_curve_at(const oc_pcurve *c, double s, oc_curve_point *out) {
   if (isnan(s)) return 0;
-  double length = c->s[c->n];
+  double length = c_s(c)[c->n];
   s = s < 0 ? 0 : s > length ? length : s;
   size_t lo = 0, hi = c->n;
   while (hi - lo > 1) {
     size_t m = lo + (hi - lo) / 2;
-    if (c->s[m] <= s)
+    if (c_s(c)[m] <= s)
       lo = m;
     else
       hi = m;
   }
   piece pc;
   piece_at(c, lo, &pc);
-  fill(c, &pc, t_of_s(c, &pc, s - c->s[lo]), out);
+  fill(c, &pc, t_of_s(c, &pc, s - c_s(c)[lo]), out);
   out->end = 0;
   return 1;
 }
@@ -750,7 +751,7 @@ int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
   double lim = nextafter(r * r, INFINITY), best = lim, bt = 0;
   piece bp, pc;
   int found = 0;
-  const fbox *bvh = c_bvh(c);
+  const fbox *bvh = c->bvh;
   pending st[128];
   int top = 0;
   st[top++] = (pending){0, 0, c->n};
@@ -789,7 +790,7 @@ int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
 int oc_curve_within(const oc_pcurve *c, double x, double y, double r) {
   if (!(r >= 0) || isnan(x) || isnan(y)) return 0;
   double lim = nextafter(r * r, INFINITY);
-  const fbox *bvh = c_bvh(c);
+  const fbox *bvh = c->bvh;
   pending st[128];
   int top = 0;
   st[top++] = (pending){0, 0, c->n};
@@ -838,7 +839,7 @@ static void flat_emit(void *ud, double t) {
   if (f->out && f->k < f->cap) {
     const piece *pc = &f->pc;
     oc_vec3 q = t >= 1 ? pc->p[pc->deg] : oc_bez_eval(pc->p, pc->deg, t);
-    oc_curve_vertex v = {q.x, q.y, q.z, f->c->s[pc->i] + s_of_t(f->c, pc, t)};
+    oc_curve_vertex v = {q.x, q.y, q.z, c_s(f->c)[pc->i] + s_of_t(f->c, pc, t)};
     f->out[f->k] = v;
   }
   f->k++;
@@ -846,7 +847,7 @@ static void flat_emit(void *ud, double t) {
 
 int oc_curve_flatten(const oc_pcurve *c, double tol, oc_curve_vertex *out,
                      size_t cap, size_t *count, oc_error *err) {
-  double length = c->s[c->n];
+  double length = c_s(c)[c->n];
   if (!(tol >= 1e-9 * length) || !isfinite(tol))
     return oc_seterr(err, OC_EINVAL,
                      "'tolerance' must be finite and >= %g (1e-9 of the "
