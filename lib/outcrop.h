@@ -1636,6 +1636,7 @@ typedef struct oc_enode_stats {
   size_t primitives; /* distinct primitives */
   size_t bytes;      /* their memory, with the data of curves, lakes and
                      ** images (skeletons, profiles, grids: each once) */
+  size_t node_bytes; /* the nodes alone (bytes less that data) */
 } oc_enode_stats;
 /* OC_OK, or OC_ENOMEM with err. */
 int oc_enode_get_stats(const oc_enode *e, oc_enode_stats *st, oc_error *err);

@@ -156,28 +156,100 @@ static double dist2_at(const oc_vec3 *p, int n, double x, double y, double t) {
   return (q.x - x) * (q.x - x) + (q.y - y) * (q.y - y);
 }
 
-/* Whether the hull of the control points q (relative to the query point,
-** the origin) is provably farther than sqrt(best): their box in the frame
-** of the chord q0 qn (a tight box where an axis-aligned one is loose, as
-** for a diagonal piece), less a margin of 1e-9 of the points' size that
-** dwarfs the rounding of the frame, of the projections and of any curve
-** point's distance computed later. Then no point of the piece can improve
-** on best, so skipping it changes no result. */
-static int hull_far(const double *qx, const double *qy, int n, double best) {
-  double ux = qx[n] - qx[0], uy = qy[n] - qy[0], l = hypot(ux, uy), M = 0;
-  if (!(l > 0)) return 0;
-  ux /= l, uy /= l;
-  double alo = INFINITY, ahi = -INFINITY, clo = INFINITY, chi = -INFINITY;
-  for (int i = 0; i <= n; i++) {
-    double a = qx[i] * ux + qy[i] * uy, c = qy[i] * ux - qx[i] * uy;
-    alo = a < alo ? a : alo, ahi = a > ahi ? a : ahi;
-    clo = c < clo ? c : clo, chi = c > chi ? c : chi;
-    M = fmax(M, fmax(fabs(qx[i]), fabs(qy[i])));
+/* ---- out of reach ------------------------------------------------------ */
+
+/* The distance from (a, c) to the box [b0, b1] x [b2, b3]. */
+static double box_dist(double a, double c, const double b[4]) {
+  double da = fmax(fmax(b[0] - a, a - b[1]), 0);
+  double dc = fmax(fmax(b[2] - c, c - b[3]), 0);
+  return hypot(da, dc);
+}
+
+/* The distance from (a, c) to the segment (a1, c1) (a2, c2). */
+static double seg_dist(double a, double c, double a1, double c1, double a2,
+                       double c2) {
+  double da = a2 - a1, dc = c2 - c1, l2 = da * da + dc * dc;
+  double t = l2 > 0 ? ((a - a1) * da + (c - c1) * dc) / l2 : 0;
+  t = t < 0 ? 0 : t > 1 ? 1 : t;
+  return hypot(a - a1 - t * da, c - c1 - t * dc);
+}
+
+/* The distance from a segment to a box (both convex): 0 where they meet,
+** else the least of its ends' distances to the box and the box corners'
+** to it. Whether they meet: the segment clipped to the box's slabs. */
+static double seg_box_dist(double a1, double c1, double a2, double c2,
+                           const double b[4]) {
+  double t0 = 0, t1 = 1, d[2] = {a2 - a1, c2 - c1}, o[2] = {a1, c1};
+  int meets = 1;
+  for (int k = 0; k < 2 && meets; k++) {
+    double lo = b[2 * k], hi = b[2 * k + 1];
+    if (d[k] == 0) {
+      meets = o[k] >= lo && o[k] <= hi;
+      continue;
+    }
+    double u = (lo - o[k]) / d[k], v = (hi - o[k]) / d[k];
+    if (u > v) {
+      double w = u;
+      u = v, v = w;
+    }
+    t0 = fmax(t0, u), t1 = fmin(t1, v);
+    meets = t0 <= t1;
   }
-  double ga = alo > 0 ? alo : ahi < 0 ? -ahi : 0;
-  double gc = clo > 0 ? clo : chi < 0 ? -chi : 0;
-  double d = sqrt(ga * ga + gc * gc) - 1e-9 * M;
-  return d > 0 && d * d >= best;
+  if (meets) return 0;
+  double m = fmin(box_dist(a1, c1, b), box_dist(a2, c2, b));
+  for (int i = 0; i < 4; i++)
+    m = fmin(m, seg_dist(b[i & 1], b[2 + (i >> 1)], a1, c1, a2, c2));
+  return m;
+}
+
+/* The one "out of reach" test (oc_bez_far): the control points (px, py)
+** of a piece of degree n >= 1 are boxed in the frame of their chord p0
+** pn, relative to p0 (tight where an axis-aligned box is loose, as for a
+** diagonal piece; the piece lies in their hull, so in that box). 1 when
+** the segment (xa, ya) (xb, yb), a point when both ends are one, is
+** farther than r + pad from the box: pad is 1e-9 of the sizes in the
+** frame (the box's and the query's coordinates relative to p0),
+** which dwarfs the rounding of the frame, of the projections and of any
+** distance computed later, plus 1e-14 of mag, the size of the absolute
+** coordinates the points and the query were taken from (the rounding of
+** their differences far from the origin). */
+static int frame_far(const double *px, const double *py, int n, double xa,
+                     double ya, double xb, double yb, double r, double mag) {
+  double ux = px[n] - px[0], uy = py[n] - py[0], l = hypot(ux, uy);
+  if (!(l > 0) || !(r < INFINITY)) return 0;
+  ux /= l, uy /= l;
+  double b[4] = {INFINITY, -INFINITY, INFINITY, -INFINITY};
+  for (int k = 0; k <= n; k++) {
+    double dx = px[k] - px[0], dy = py[k] - py[0];
+    double a = dx * ux + dy * uy, c = dy * ux - dx * uy;
+    b[0] = a < b[0] ? a : b[0], b[1] = a > b[1] ? a : b[1];
+    b[2] = c < b[2] ? c : b[2], b[3] = c > b[3] ? c : b[3];
+  }
+  double dx = xa - px[0], dy = ya - py[0];
+  double a1 = dx * ux + dy * uy, c1 = dy * ux - dx * uy;
+  double pad = 1e-9 * (fabs(b[0]) + fabs(b[1]) + fabs(b[2]) + fabs(b[3]) +
+                       fabs(a1) + fabs(c1)) +
+               1e-14 * mag,
+         d;
+  if (xa == xb && ya == yb) {
+    d = box_dist(a1, c1, b);
+  } else {
+    dx = xb - px[0], dy = yb - py[0];
+    double a2 = dx * ux + dy * uy, c2 = dy * ux - dx * uy;
+    pad += 1e-9 * (fabs(a2) + fabs(c2));
+    d = seg_box_dist(a1, c1, a2, c2, b);
+  }
+  return d > r + pad;
+}
+
+int oc_bez_far(const oc_vec3 *p, int n, double xa, double ya, double xb,
+               double yb, double r) {
+  double px[OC_BEZ_MAXDEG + 1], py[OC_BEZ_MAXDEG + 1];
+  for (int k = 0; k <= n; k++)
+    px[k] = p[k].x, py[k] = p[k].y;
+  double mag =
+      fabs(xa) + fabs(ya) + fabs(xb) + fabs(yb) + fabs(p[0].x) + fabs(p[0].y);
+  return frame_far(px, py, n, xa, ya, xb, yb, r, mag);
 }
 
 double oc_bez_closest(const oc_vec3 *p, int n, double x, double y, double best2,
@@ -196,7 +268,10 @@ double oc_bez_closest(const oc_vec3 *p, int n, double x, double y, double best2,
   double qx[4], qy[4], dx[3], dy[3], f[6] = {0}, df[5];
   for (int i = 0; i <= n; i++)
     qx[i] = p[i].x - x, qy[i] = p[i].y - y;
-  if (hull_far(qx, qy, n, best)) return best2; /* (what the search gives) */
+  /* the piece out of reach: what the search would give (one test, the
+  ** whole span's; sub-spans below take their own) */
+  double mag = fabs(x) + fabs(y) + fabs(p[0].x) + fabs(p[0].y);
+  if (frame_far(qx, qy, n, 0, 0, 0, 0, sqrt(best), mag)) return best2;
   double d0 = dist2_at(p, n, x, y, 0), d1 = dist2_at(p, n, x, y, 1);
   if (d0 < best) best = d0, *t = 0;
   if (d1 < best) best = d1, *t = 1;
@@ -228,7 +303,9 @@ double oc_bez_closest(const oc_vec3 *p, int n, double x, double y, double best2,
       ly = fmin(ly, s.qy[i]), hy = fmax(hy, s.qy[i]);
     }
     double bx = fmax(0, fmax(lx, -hx)), by = fmax(0, fmax(ly, -hy));
-    if (bx * bx + by * by >= best || hull_far(s.qx, s.qy, n, best)) continue;
+    if (bx * bx + by * by >= best ||
+        (s.depth > 0 && frame_far(s.qx, s.qy, n, 0, 0, 0, 0, sqrt(best), mag)))
+      continue;
     /* A root on a split point may leave no sign change on either side. */
     if (s.f[0] == 0 && s.a > 0) {
       double d2 = dist2_at(p, n, x, y, s.a);

@@ -39,6 +39,16 @@ double oc_bez_arclen(const oc_vec3 *p, int n, double a, double b);
 double oc_bez_closest(const oc_vec3 *p, int n, double x, double y, double best2,
                       double *t);
 
+/* 1 when every point of the piece is provably farther than r (finite) in
+** xy from the segment (xa, ya) (xb, yb), a point when both ends are one:
+** the control points' box in the frame of the chord p[0] p[n] (the piece
+** lies in their hull) is farther than r plus a margin of 1e-9 of the
+** frame's sizes and 1e-14 of the coordinates' (rounding far from the
+** origin). 0 when that is not shown (and for a piece with p[0] = p[n]).
+** oc_bez_closest runs the same test on the whole piece and on each span. */
+int oc_bez_far(const oc_vec3 *p, int n, double xa, double ya, double xb,
+               double yb, double r);
+
 /* The planar curvature (signed, > 0 turning left) at t; +-INFINITY where
 ** the derivative vanishes with a turning second derivative. */
 double oc_bez_curvature(const oc_vec3 *p, int n, double t);

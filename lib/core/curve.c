@@ -12,24 +12,33 @@
 #include "core/checked.h"
 #include "core/curve.h"
 #include "core/error.h"
+#include "core/fround.h"
 #include "core/vec.h"
 
-/* A piece's control points are deg + 1 consecutive points of the curve's
-** pts, its first the previous piece's last (so each is stored once). */
+/* Storage (what oc_curve_bytes counts): the points; per piece its start's
+** arc length (s[n], the length) and, where it has any, the inner knots
+** of its arc-length table; a box tree. A Catmull-Rom curve
+** (oc_curve_catmull) keeps its through-points alone and derives each
+** piece's inner control points as it reads the piece (the same
+** arithmetic that built them, so the same bits); other curves keep their
+** control points, each shared end once. The curvature bound, the
+** largest turn and the box are computed when asked (builders ask once). */
+
+/* A piece as read (piece_at): its control points, degree and index. */
 typedef struct piece {
-  const oc_vec3 *p;   /* in pts */
-  double s0, len;     /* arc length at the start, and of the piece */
-  double scale;       /* xy length of the control polygon */
-  uint32_t tab, ntab; /* Bézier: ntab spans, their inner knots at tt/ts[tab] */
+  oc_vec3 p[4];
   int deg;
+  size_t i;
 } piece;
 
-/* Box tree node: a leaf (right = 0) holds piece `piece`; else its left
-** child follows it and `right` is the index of the right child. */
-typedef struct bnode {
-  double x0, y0, x1, y1;
-  uint32_t right, piece;
-} bnode;
+/* Box tree node, floats rounded outward: a balanced tree over the pieces
+** laid out in preorder, so the node covering pieces [lo, hi) with mid = lo
+** + (hi - lo) / 2 has its left child next and its right child 2 (mid -
+** lo) nodes after it; a leaf (hi - lo = 1) holds the control points' box
+** of piece lo. */
+typedef struct fbox {
+  float x0, y0, x1, y1;
+} fbox;
 
 /* A piece while the curve is built. */
 typedef struct rawpiece {
@@ -38,18 +47,87 @@ typedef struct rawpiece {
   double scale;
 } rawpiece;
 
+/* One block: this header, then the box tree (2 n - 1 boxes: first, so
+** the tree walks find it at once), s (n + 1 doubles: the arc length at
+** each piece's start, s[n] the length), the inner knots' arc lengths (nk
+** doubles, from their piece's start), the points (control points with
+** shared ends once, or a Catmull-Rom spline's through-points), the inner
+** knots' first index per piece (n + 1, when nk > 0), mixed degrees' first
+** point per piece (n + 1) and the knots' parameters (nk floats: dyadic,
+** so exact). (Boxes are 16 bytes: the doubles after them stay aligned.) */
 struct oc_pcurve {
-  size_t n;
-  piece *pc;
-  oc_vec3 *pts; /* the pieces' control points, shared ends once */
-  size_t npts;
-  double *tt, *ts; /* knots: parameter and arc length from the piece start */
-  size_t nknots;
-  bnode *bvh;
-  double length, kappa, turn;
-  int closed;
-  oc_aabb box;
+  uint32_t n, npts, nk;
+  uint8_t deg;     /* every piece's degree, or 0 (mixed: off) */
+  uint8_t catmull; /* pts are through-points of a Catmull-Rom spline */
+  uint8_t closed;
+  fbox bvh[];
 };
+
+static double *c_s(const oc_pcurve *c) {
+  return (double *)(c->bvh + 2 * (size_t)c->n - 1);
+}
+static double *c_ts(const oc_pcurve *c) {
+  return c_s(c) + c->n + 1;
+}
+static oc_vec3 *c_pts(const oc_pcurve *c) {
+  return (oc_vec3 *)(c_ts(c) + c->nk);
+}
+static size_t c_ntab(const oc_pcurve *c) {
+  return c->nk ? c->n + 1 : 0;
+}
+static size_t c_noff(const oc_pcurve *c) {
+  return c->deg || c->catmull ? 0 : c->n + 1;
+}
+static uint32_t *c_tab(const oc_pcurve *c) {
+  return (uint32_t *)(c_pts(c) + c->npts);
+}
+static uint32_t *c_off(const oc_pcurve *c) {
+  return c_tab(c) + c_ntab(c);
+}
+static float *c_tt(const oc_pcurve *c) {
+  return (float *)(c_off(c) + c_noff(c));
+}
+
+static size_t curve_bytes(size_t n, size_t npts, size_t nk, size_t noff) {
+  return sizeof(oc_pcurve) + (n + 1 + nk) * sizeof(double) +
+         npts * sizeof(oc_vec3) +
+         ((nk ? n + 1 : 0) + noff + nk) * sizeof(uint32_t) +
+         (2 * n - 1) * sizeof(fbox);
+}
+
+/* Piece i of a Catmull-Rom spline through P[0 .. m-1] as a cubic Bézier;
+** the ends reflect their neighbour. */
+static void catmull_piece(const oc_vec3 *P, size_t m, size_t i, oc_vec3 *q) {
+  oc_vec3 a = i > 0 ? P[i - 1] : oc_sub(oc_mul(P[0], 2), P[1]);
+  oc_vec3 e = i + 2 < m ? P[i + 2] : oc_sub(oc_mul(P[m - 1], 2), P[m - 2]);
+  q[0] = P[i];
+  q[1] = oc_add(P[i], oc_mul(oc_sub(P[i + 1], a), 1.0 / 6));
+  q[2] = oc_sub(P[i + 1], oc_mul(oc_sub(e, P[i]), 1.0 / 6));
+  q[3] = P[i + 1];
+}
+
+static void piece_at(const oc_pcurve *c, size_t i, piece *pc) {
+  pc->i = i;
+  if (c->catmull) {
+    pc->deg = 3;
+    catmull_piece(c_pts(c), c->npts, i, pc->p);
+    return;
+  }
+  const oc_vec3 *pts = c_pts(c);
+  size_t o = c->deg ? i * c->deg : c_off(c)[i];
+  pc->deg = c->deg ? c->deg : (int)(c_off(c)[i + 1] - o);
+  for (int k = 0; k <= pc->deg; k++)
+    pc->p[k] = pts[o + (size_t)k];
+}
+
+static double piece_len(const oc_pcurve *c, size_t i) {
+  return c_s(c)[i + 1] - c_s(c)[i];
+}
+
+/* Inner knots of piece i: how many, and the first's index. */
+static size_t ninner(const oc_pcurve *c, size_t i) {
+  return c->nk ? c_tab(c)[i + 1] - c_tab(c)[i] : 0;
+}
 
 /* ---- construction ------------------------------------------------------ */
 
@@ -66,7 +144,7 @@ typedef struct knots {
 } knots;
 
 static int knots_push(knots *k, double t, double s) {
-  if (k->n >= UINT32_MAX) return 0; /* (piece.tab's range) */
+  if (k->n >= UINT32_MAX - 1) return 0; /* (tab's range) */
   if (k->n == k->cap) {
     size_t cap = k->cap ? 2 * k->cap : 64, bytes;
     if (!oc_mul_size(cap, sizeof(double), &bytes)) return 0;
@@ -82,29 +160,21 @@ static int knots_push(knots *k, double t, double s) {
   return 1;
 }
 
-/* a, of n items of size or more, cut to n (kept as it is if realloc
-** fails or n is 0). */
-static void *shrink(void *a, size_t n, size_t size) {
-  void *b = n ? realloc(a, n * size) : NULL;
-  return b ? b : a;
-}
-
 /* Tabulates the arc length of a Bézier piece: [0, 1] is split until the
 ** 8-point rule on a span agrees with the rule on its halves to 1e-14 of
 ** the piece's scale (a span then carries ~1e-16 of error, well inside the
 ** documented 1e-9); depth is capped at 24 (cusps, where the speed has a
-** kink). The knots between spans are appended in order (the ends, (0, 0)
-** and (1, length), are not stored: knot_t, knot_s); the piece's length is
-** returned. */
-static int tabulate(piece *pc, knots *k, double *len) {
+** kink), so the knots are dyadic and exact in floats. The knots between
+** spans are appended in order (the ends, (0, 0) and (1, length), are not
+** stored: knot_t, knot_s); most pieces of a smooth spline are one span.
+** The piece's length is returned. */
+static int tabulate(const rawpiece *pc, knots *k, double *len) {
   struct {
     double a, b;
     int depth;
   } st[32];
   int top = 0;
   double s = 0, tol = 1e-14 * pc->scale;
-  uint32_t spans = 0;
-  pc->tab = (uint32_t)k->n;
   st[top].a = 0, st[top].b = 1, st[top].depth = 0, top++;
   while (top > 0) {
     double a = st[top - 1].a, b = st[top - 1].b, m = 0.5 * (a + b);
@@ -113,18 +183,27 @@ static int tabulate(piece *pc, knots *k, double *len) {
     double whole = oc_bez_arclen(pc->p, pc->deg, a, b);
     double halves = oc_bez_arclen(pc->p, pc->deg, a, m) +
                     oc_bez_arclen(pc->p, pc->deg, m, b);
-    if (depth >= 24 || (depth >= 2 && fabs(whole - halves) <= tol)) {
+    if (depth >= 24 || fabs(whole - halves) <= tol) {
       s += halves;
-      spans++;
       if (top > 0 && !knots_push(k, b, s)) return 0; /* (the last: b = 1) */
       continue;
     }
     st[top].a = m, st[top].b = b, st[top].depth = depth + 1, top++;
     st[top].a = a, st[top].b = m, st[top].depth = depth + 1, top++;
   }
-  pc->ntab = spans;
   *len = s;
   return 1;
+}
+
+/* The xy length of a piece's control polygon, only where it decides: v >
+** 1e-12 of it (the L1 length bounds it above, so most calls need no
+** hypot). */
+static int above_scale(const piece *pc, double v) {
+  double l1 = 0;
+  for (int i = 0; i < pc->deg; i++)
+    l1 += fabs(pc->p[i + 1].x - pc->p[i].x) + fabs(pc->p[i + 1].y - pc->p[i].y);
+  if (v > 1e-12 * l1) return 1;
+  return v > 1e-12 * poly_len_xy(pc->p, pc->deg);
 }
 
 /* Unit direction of travel of one piece at t (xy); where the derivative
@@ -133,7 +212,7 @@ static int tabulate(piece *pc, knots *k, double *len) {
 static void piece_dir(const piece *pc, double t, double *tx, double *ty) {
   oc_vec3 d = oc_bez_d1(pc->p, pc->deg, t);
   double v = hypot(d.x, d.y);
-  if (!(v > 1e-12 * pc->scale)) {
+  if (!above_scale(pc, v)) {
     int n = pc->deg;
     if (t < 0.5) {
       int k = 1;
@@ -187,28 +266,27 @@ static void piece_box(const piece *pc, oc_aabb *box) {
     }
 }
 
-static size_t build_bvh(oc_pcurve *c, size_t lo, size_t hi, size_t *next) {
-  size_t i = (*next)++;
-  bnode *b = &c->bvh[i];
-  b->right = 0, b->piece = (uint32_t)lo;
+static void build_bvh(oc_pcurve *c, size_t lo, size_t hi, size_t i) {
+  fbox *bvh = c->bvh, *b = &bvh[i];
   if (hi - lo == 1) {
-    const piece *pc = &c->pc[lo];
-    b->x0 = b->x1 = pc->p[0].x, b->y0 = b->y1 = pc->p[0].y;
-    for (int k = 1; k <= pc->deg; k++) {
-      b->x0 = fmin(b->x0, pc->p[k].x), b->x1 = fmax(b->x1, pc->p[k].x);
-      b->y0 = fmin(b->y0, pc->p[k].y), b->y1 = fmax(b->y1, pc->p[k].y);
+    piece pc;
+    piece_at(c, lo, &pc);
+    double x0 = pc.p[0].x, x1 = x0, y0 = pc.p[0].y, y1 = y0;
+    for (int k = 1; k <= pc.deg; k++) {
+      x0 = fmin(x0, pc.p[k].x), x1 = fmax(x1, pc.p[k].x);
+      y0 = fmin(y0, pc.p[k].y), y1 = fmax(y1, pc.p[k].y);
     }
-    return i;
+    b->x0 = oc_float_down(x0), b->y0 = oc_float_down(y0);
+    b->x1 = oc_float_up(x1), b->y1 = oc_float_up(y1);
+    return;
   }
-  size_t mid = lo + (hi - lo) / 2;
-  size_t l = build_bvh(c, lo, mid, next), r = build_bvh(c, mid, hi, next);
-  b = &c->bvh[i];
-  b->right = (uint32_t)r;
-  b->x0 = fmin(c->bvh[l].x0, c->bvh[r].x0);
-  b->y0 = fmin(c->bvh[l].y0, c->bvh[r].y0);
-  b->x1 = fmax(c->bvh[l].x1, c->bvh[r].x1);
-  b->y1 = fmax(c->bvh[l].y1, c->bvh[r].y1);
-  return i;
+  size_t mid = lo + (hi - lo) / 2, l = i + 1, r = i + 2 * (mid - lo);
+  build_bvh(c, lo, mid, l);
+  build_bvh(c, mid, hi, r);
+  b->x0 = fminf(bvh[l].x0, bvh[r].x0);
+  b->y0 = fminf(bvh[l].y0, bvh[r].y0);
+  b->x1 = fmaxf(bvh[l].x1, bvh[r].x1);
+  b->y1 = fmaxf(bvh[l].y1, bvh[r].y1);
 }
 
 static double turn_at(const piece *a, const piece *b) {
@@ -223,7 +301,14 @@ static int same_point(oc_vec3 a, oc_vec3 b, double tol) {
          fabs(a.z - b.z) <= tol;
 }
 
-oc_pcurve *oc_curve_new(const oc_curve_piece *pieces, size_t n, oc_error *err) {
+static int same_vec(oc_vec3 a, oc_vec3 b) {
+  return a.x == b.x && a.y == b.y && a.z == b.z;
+}
+
+/* The checked pieces, snapped, without those of no length, and whether
+** the curve closes: NULL (err set) when refused. */
+static rawpiece *raw_pieces(const oc_curve_piece *pieces, size_t n,
+                            size_t *nout, int *closed, oc_error *err) {
   if (n == 0 || !pieces) {
     oc_seterr(err, OC_EINVAL, "'pieces' must hold at least one piece");
     return NULL;
@@ -256,11 +341,10 @@ oc_pcurve *oc_curve_new(const oc_curve_piece *pieces, size_t n, oc_error *err) {
       return NULL;
     }
   }
-  oc_pcurve *c = calloc(1, sizeof *c);
   rawpiece *raw = NULL;
   size_t bytes, nraw = 0;
-  if (!c || !oc_mul_size(n, sizeof *raw, &bytes) || !(raw = malloc(bytes))) {
-    free(c);
+  if (n >= UINT32_MAX / 4 || !oc_mul_size(n, sizeof *raw, &bytes) ||
+      !(raw = malloc(bytes))) {
     oc_seterr(err, OC_ENOMEM, "out of memory for a curve of %zu pieces", n);
     return NULL;
   }
@@ -278,7 +362,6 @@ oc_pcurve *oc_curve_new(const oc_curve_piece *pieces, size_t n, oc_error *err) {
       for (int k = 1; k <= pc.deg; k++)
         if (pc.p[k].z != pc.p[0].z) {
           free(raw);
-          oc_curve_free(c);
           oc_seterr(err, OC_EINVAL,
                     "piece %zu has no length in xy but its z changes", i);
           return NULL;
@@ -289,84 +372,89 @@ oc_pcurve *oc_curve_new(const oc_curve_piece *pieces, size_t n, oc_error *err) {
   }
   if (nraw == 0) {
     free(raw);
-    oc_curve_free(c);
     oc_seterr(err, OC_EINVAL,
               "the curve has no length (every piece is a point in xy)");
     return NULL;
   }
   rawpiece *rfirst = &raw[0], *rend = &raw[nraw - 1];
+  *closed = 0;
   if (same_point(rend->p[rend->deg], rfirst->p[0], jtol) &&
       (nraw > 1 || rend->deg > 1)) {
-    c->closed = 1;
+    *closed = 1;
     rend->p[rend->deg] = rfirst->p[0];
   }
-  /* the points, each shared end once, and the pieces on them */
-  c->npts = 1;
-  for (size_t i = 0; i < nraw; i++)
-    c->npts += (size_t)raw[i].deg;
-  if (!(c->pc = malloc(nraw * sizeof *c->pc)) ||
-      !(c->pts = malloc(c->npts * sizeof *c->pts))) {
-    free(raw);
-    oc_curve_free(c);
-    oc_seterr(err, OC_ENOMEM, "out of memory for a curve of %zu pieces", n);
-    return NULL;
-  }
-  size_t at = 0;
-  c->pts[0] = raw[0].p[0];
-  for (size_t i = 0; i < nraw; i++) {
-    piece *pc = &c->pc[i];
-    memset(pc, 0, sizeof *pc);
-    pc->deg = raw[i].deg;
-    pc->scale = raw[i].scale;
-    pc->p = &c->pts[at];
-    for (int k = 1; k <= pc->deg; k++)
-      c->pts[at + (size_t)k] = raw[i].p[k];
-    at += (size_t)pc->deg;
-  }
-  c->n = nraw;
-  free(raw);
-  piece *first = &c->pc[0], *end = &c->pc[c->n - 1];
+  *nout = nraw;
+  return raw;
+}
 
+/* The curve on raw pieces; with through (m points), a Catmull-Rom spline
+** whose pieces raw are (then only the points are kept). raw is freed. */
+static oc_pcurve *build(rawpiece *raw, size_t nraw, int closed,
+                        const oc_vec3 *through, size_t m, oc_error *err) {
+  /* the tables first (their size is known after) */
   knots k = {0};
-  double s = 0;
-  c->kappa = 0;
-  c->box = oc_aabb_empty();
-  for (size_t i = 0; i < c->n; i++) {
-    piece *pc = &c->pc[i];
-    double len;
-    if (pc->deg == 1) {
-      len = pc->scale;
-    } else if (!tabulate(pc, &k, &len)) {
-      free(k.t), free(k.s);
-      oc_curve_free(c);
-      oc_seterr(err, OC_ENOMEM, "out of memory for a curve's arc lengths");
-      return NULL;
+  double *len = malloc(nraw * sizeof *len);
+  uint32_t *kfirst = malloc(nraw * sizeof *kfirst);
+  if (!len || !kfirst) goto nomem;
+  for (size_t i = 0; i < nraw; i++) {
+    kfirst[i] = (uint32_t)k.n;
+    if (raw[i].deg == 1)
+      len[i] = raw[i].scale;
+    else if (!tabulate(&raw[i], &k, &len[i]))
+      goto nomem;
+  }
+  int mixed = 0;
+  size_t npts = through ? m : 1;
+  for (size_t i = 0; i < nraw; i++) {
+    mixed |= raw[i].deg != raw[0].deg;
+    if (!through) npts += (size_t)raw[i].deg;
+  }
+  size_t nk = k.n, noff = mixed && !through ? nraw + 1 : 0;
+  oc_pcurve *c = malloc(curve_bytes(nraw, npts, nk, noff));
+  if (!c) goto nomem;
+  c->n = (uint32_t)nraw, c->npts = (uint32_t)npts, c->nk = (uint32_t)nk;
+  c->deg = (uint8_t)(through ? 3 : mixed ? 0 : raw[0].deg);
+  c->catmull = through != NULL;
+  c->closed = (uint8_t)closed;
+  oc_vec3 *pts = c_pts(c);
+  if (through) {
+    memcpy(pts, through, m * sizeof *through);
+  } else {
+    uint32_t *off = noff ? c_off(c) : NULL;
+    size_t o = 0;
+    pts[0] = raw[0].p[0];
+    for (size_t i = 0; i < nraw; i++) {
+      if (off) off[i] = (uint32_t)o;
+      for (int q = 1; q <= raw[i].deg; q++)
+        pts[o + (size_t)q] = raw[i].p[q];
+      o += (size_t)raw[i].deg;
     }
-    pc->s0 = s, pc->len = len;
-    s += len;
-    piece_box(pc, &c->box);
+    if (off) off[nraw] = (uint32_t)o;
   }
-  /* the tables' spare capacity, given back */
-  c->tt = shrink(k.t, k.n, sizeof *k.t);
-  c->ts = shrink(k.s, k.n, sizeof *k.s);
-  c->nknots = k.n;
-  c->length = s;
-  for (size_t i = 0; i < c->n; i++)
-    c->kappa = fmax(
-        c->kappa, oc_bez_kappa_bound(c->pc[i].p, c->pc[i].deg, 1e-2, 1e-9 / s));
-  for (size_t i = 1; i < c->n; i++)
-    c->turn = fmax(c->turn, turn_at(&c->pc[i - 1], &c->pc[i]));
-  if (c->closed) c->turn = fmax(c->turn, turn_at(end, first));
-
-  if (!oc_mul_size(2 * c->n - 1, sizeof(bnode), &bytes) ||
-      !(c->bvh = malloc(bytes))) {
-    oc_curve_free(c);
-    oc_seterr(err, OC_ENOMEM, "out of memory for a curve of %zu pieces", n);
-    return NULL;
+  double s = 0;
+  for (size_t i = 0; i < nraw; i++) {
+    c_s(c)[i] = s;
+    s += len[i];
+    if (nk) c_tab(c)[i] = kfirst[i];
   }
-  size_t next = 0;
-  build_bvh(c, 0, c->n, &next);
+  c_s(c)[nraw] = s;
+  if (nk) c_tab(c)[nraw] = (uint32_t)nk;
+  for (size_t j = 0; j < nk; j++) /* (dyadic parameters: exact floats) */
+    c_tt(c)[j] = (float)k.t[j], c_ts(c)[j] = k.s[j];
+  build_bvh(c, 0, nraw, 0);
+  free(k.t), free(k.s), free(len), free(kfirst), free(raw);
   return c;
+nomem:
+  free(k.t), free(k.s), free(len), free(kfirst), free(raw);
+  oc_seterr(err, OC_ENOMEM, "out of memory for a curve of %zu pieces", nraw);
+  return NULL;
+}
+
+oc_pcurve *oc_curve_new(const oc_curve_piece *pieces, size_t n, oc_error *err) {
+  size_t nraw;
+  int closed;
+  rawpiece *raw = raw_pieces(pieces, n, &nraw, &closed, err);
+  return raw ? build(raw, nraw, closed, NULL, 0, err) : NULL;
 }
 
 oc_pcurve *oc_curve_from_points(const oc_vec3 *pts, size_t n, int degree,
@@ -396,20 +484,45 @@ oc_pcurve *oc_curve_from_points(const oc_vec3 *pts, size_t n, int degree,
   return c;
 }
 
+oc_pcurve *oc_curve_catmull(const oc_vec3 *pts, size_t n, oc_error *err) {
+  if (n < 2 || !pts) {
+    oc_seterr(err, OC_EINVAL, "'points' must hold at least 2 points (got %zu)",
+              n);
+    return NULL;
+  }
+  size_t bytes;
+  oc_curve_piece *pcs;
+  if (!oc_mul_size(n - 1, sizeof *pcs, &bytes) || !(pcs = malloc(bytes))) {
+    oc_seterr(err, OC_ENOMEM, "out of memory (%zu points)", n);
+    return NULL;
+  }
+  for (size_t i = 0; i + 1 < n; i++) {
+    pcs[i].degree = 3;
+    catmull_piece(pts, n, i, pcs[i].p);
+  }
+  size_t nraw;
+  int closed;
+  rawpiece *raw = raw_pieces(pcs, n - 1, &nraw, &closed, err);
+  free(pcs);
+  if (!raw) return NULL;
+  /* the points alone when the pieces are exactly those they give (none
+  ** dropped, no end snapped) */
+  int derived = nraw == n - 1;
+  for (size_t i = 0; derived && i < nraw; i++) {
+    oc_vec3 q[4];
+    catmull_piece(pts, n, i, q);
+    for (int k = 0; k < 4; k++)
+      derived &= same_vec(q[k], raw[i].p[k]);
+  }
+  return build(raw, nraw, closed, derived ? pts : NULL, n, err);
+}
+
 void oc_curve_free(oc_pcurve *c) {
-  if (!c) return;
-  free(c->pc);
-  free(c->pts);
-  free(c->tt);
-  free(c->ts);
-  free(c->bvh);
-  free(c);
+  free(c); /* (one block) */
 }
 
 size_t oc_curve_bytes(const oc_pcurve *c) {
-  return sizeof *c + c->n * sizeof *c->pc + c->npts * sizeof *c->pts +
-         c->nknots * (sizeof *c->tt + sizeof *c->ts) +
-         (2 * c->n - 1) * sizeof *c->bvh;
+  return curve_bytes(c->n, c->npts, c->nk, c_noff(c));
 }
 
 size_t oc_curve_npieces(const oc_pcurve *c) {
@@ -419,54 +532,84 @@ int oc_curve_closed(const oc_pcurve *c) {
   return c->closed;
 }
 double oc_curve_length(const oc_pcurve *c) {
-  return c->length;
+  return c_s(c)[c->n];
 }
 double oc_curve_kappa_max(const oc_pcurve *c) {
-  return c->kappa;
+  double k = 0, s = c_s(c)[c->n];
+  for (size_t i = 0; i < c->n; i++) {
+    piece pc;
+    piece_at(c, i, &pc);
+    k = fmax(k, oc_bez_kappa_bound(pc.p, pc.deg, 1e-2, 1e-9 / s));
+  }
+  return k;
 }
 double oc_curve_max_turn(const oc_pcurve *c) {
-  return c->turn;
+  double turn = 0;
+  piece a, b, first;
+  piece_at(c, 0, &first);
+  a = first;
+  for (size_t i = 1; i < c->n; i++) {
+    piece_at(c, i, &b);
+    turn = fmax(turn, turn_at(&a, &b));
+    a = b;
+  }
+  if (c->closed) turn = fmax(turn, turn_at(&a, &first));
+  return turn;
 }
 
 double oc_curve_grade_max(const oc_pcurve *c) {
   double g = 0;
-  for (size_t i = 0; i < c->n; i++)
-    g = fmax(g, oc_bez_grade_bound(c->pc[i].p, c->pc[i].deg));
+  for (size_t i = 0; i < c->n; i++) {
+    piece pc;
+    piece_at(c, i, &pc);
+    g = fmax(g, oc_bez_grade_bound(pc.p, pc.deg));
+  }
   return g;
 }
 
 double oc_curve_curvature_at(const oc_pcurve *c, const oc_curve_point *pt) {
-  const piece *pc = &c->pc[pt->piece];
-  return pc->deg < 2 ? 0 : oc_bez_curvature(pc->p, pc->deg, pt->t);
+  piece pc;
+  piece_at(c, pt->piece, &pc);
+  return pc.deg < 2 ? 0 : oc_bez_curvature(pc.p, pc.deg, pt->t);
 }
 
 double oc_curve_grade_at(const oc_pcurve *c, const oc_curve_point *pt) {
-  const piece *pc = &c->pc[pt->piece];
-  oc_vec3 d = oc_bez_d1(pc->p, pc->deg, pt->t);
+  piece pc;
+  piece_at(c, pt->piece, &pc);
+  oc_vec3 d = oc_bez_d1(pc.p, pc.deg, pt->t);
   double v = hypot(d.x, d.y);
   return v > 0 ? d.z / v : 0;
 }
 
 oc_aabb oc_curve_bounds(const oc_pcurve *c, double r) {
-  oc_aabb b = c->box;
+  oc_aabb b = oc_aabb_empty();
+  for (size_t i = 0; i < c->n; i++) {
+    piece pc;
+    piece_at(c, i, &pc);
+    piece_box(&pc, &b);
+  }
   b.lo.x -= r, b.lo.y -= r, b.hi.x += r, b.hi.y += r;
   return b;
 }
 
 /* ---- arc length <-> parameter ------------------------------------------ */
 
-/* Knot j (0 .. ntab) of a Bézier piece: its parameter and its arc
+/* Knot j (0 .. ninner + 1) of a Bézier piece: its parameter and its arc
 ** length (the ends are 0 and 0, 1 and the piece's length). */
 static double knot_t(const oc_pcurve *c, const piece *pc, size_t j) {
-  return j == 0 ? 0 : j == pc->ntab ? 1 : c->tt[pc->tab + j - 1];
+  return j == 0                 ? 0
+         : j > ninner(c, pc->i) ? 1
+                                : c_tt(c)[c_tab(c)[pc->i] + j - 1];
 }
 static double knot_s(const oc_pcurve *c, const piece *pc, size_t j) {
-  return j == 0 ? 0 : j == pc->ntab ? pc->len : c->ts[pc->tab + j - 1];
+  return j == 0                 ? 0
+         : j > ninner(c, pc->i) ? piece_len(c, pc->i)
+                                : c_ts(c)[c_tab(c)[pc->i] + j - 1];
 }
 
 /* The knot span k of a Bézier piece with knot k <= t < knot k + 1. */
 static size_t span_of_t(const oc_pcurve *c, const piece *pc, double t) {
-  size_t lo = 0, hi = pc->ntab;
+  size_t lo = 0, hi = ninner(c, pc->i) + 1;
   while (hi - lo > 1) {
     size_t m = lo + (hi - lo) / 2;
     if (knot_t(c, pc, m) <= t)
@@ -479,9 +622,9 @@ static size_t span_of_t(const oc_pcurve *c, const piece *pc, double t) {
 
 /* Arc length from the start of the piece to t. */
 static double s_of_t(const oc_pcurve *c, const piece *pc, double t) {
-  if (t >= 1) return pc->len;
+  if (t >= 1) return piece_len(c, pc->i);
   if (t <= 0) return 0;
-  if (pc->deg == 1) return t * pc->len;
+  if (pc->deg == 1) return t * piece_len(c, pc->i);
   size_t k = span_of_t(c, pc, t);
   return knot_s(c, pc, k) + oc_bez_arclen(pc->p, pc->deg, knot_t(c, pc, k), t);
 }
@@ -489,10 +632,11 @@ static double s_of_t(const oc_pcurve *c, const piece *pc, double t) {
 /* The parameter at arc length sl from the start of the piece: Newton on
 ** the tabulated span, safeguarded by bisection (the speed may vanish). */
 static double t_of_s(const oc_pcurve *c, const piece *pc, double sl) {
+  double len = piece_len(c, pc->i);
   if (sl <= 0) return 0;
-  if (sl >= pc->len) return 1;
-  if (pc->deg == 1) return sl / pc->len;
-  size_t lo = 0, hi = pc->ntab;
+  if (sl >= len) return 1;
+  if (pc->deg == 1) return sl / len;
+  size_t lo = 0, hi = ninner(c, pc->i) + 1;
   while (hi - lo > 1) {
     size_t m = lo + (hi - lo) / 2;
     if (knot_s(c, pc, m) <= sl)
@@ -522,28 +666,33 @@ static double t_of_s(const oc_pcurve *c, const piece *pc, double sl) {
   return t;
 }
 
-/* The tangent at (piece i, t); at a join, the bisector of both sides. */
-static void tangent(const oc_pcurve *c, size_t i, double t, double *tx,
+/* The tangent at (piece pc, t); at a join, the bisector of both sides. */
+static void tangent(const oc_pcurve *c, const piece *pc, double t, double *tx,
                     double *ty) {
-  piece_dir(&c->pc[i], t, tx, ty);
-  const piece *other = NULL;
-  if (t <= 0 && (i > 0 || c->closed)) other = &c->pc[i > 0 ? i - 1 : c->n - 1];
-  if (t >= 1 && (i + 1 < c->n || c->closed))
-    other = &c->pc[i + 1 < c->n ? i + 1 : 0];
-  if (!other) return;
+  size_t i = pc->i, o;
+  piece_dir(pc, t, tx, ty);
+  if (t <= 0 && (i > 0 || c->closed))
+    o = i > 0 ? i - 1 : c->n - 1;
+  else if (t >= 1 && (i + 1 < c->n || c->closed))
+    o = i + 1 < c->n ? i + 1 : 0;
+  else
+    return;
+  piece other;
+  piece_at(c, o, &other);
   double ox, oy;
-  piece_dir(other, t <= 0 ? 1 : 0, &ox, &oy);
+  piece_dir(&other, t <= 0 ? 1 : 0, &ox, &oy);
   double sx = *tx + ox, sy = *ty + oy, v = hypot(sx, sy);
   if (v > 1e-12) *tx = sx / v, *ty = sy / v;
 }
 
-static void fill(const oc_pcurve *c, size_t i, double t, oc_curve_point *out) {
-  const piece *pc = &c->pc[i];
+static void fill(const oc_pcurve *c, const piece *pc, double t,
+                 oc_curve_point *out) {
+  size_t i = pc->i;
   out->piece = i;
   out->t = t;
-  out->s = pc->s0 + s_of_t(c, pc, t);
+  out->s = c_s(c)[i] + s_of_t(c, pc, t);
   out->q = t >= 1 ? pc->p[pc->deg] : oc_bez_eval(pc->p, pc->deg, t);
-  tangent(c, i, t, &out->tx, &out->ty);
+  tangent(c, pc, t, &out->tx, &out->ty);
   out->nx = -out->ty, out->ny = out->tx;
   out->d = 0;
   out->end = 0;
@@ -555,149 +704,72 @@ static void fill(const oc_pcurve *c, size_t i, double t, oc_curve_point *out) {
 
 int oc_curve_at(const oc_pcurve *c, double s, oc_curve_point *out) {
   if (isnan(s)) return 0;
-  s = s < 0 ? 0 : s > c->length ? c->length : s;
+  double length = c_s(c)[c->n];
+  s = s < 0 ? 0 : s > length ? length : s;
   size_t lo = 0, hi = c->n;
   while (hi - lo > 1) {
     size_t m = lo + (hi - lo) / 2;
-    if (c->pc[m].s0 <= s)
+    if (c_s(c)[m] <= s)
       lo = m;
     else
       hi = m;
   }
-  const piece *pc = &c->pc[lo];
-  fill(c, lo, t_of_s(c, pc, s - pc->s0), out);
+  piece pc;
+  piece_at(c, lo, &pc);
+  fill(c, &pc, t_of_s(c, &pc, s - c_s(c)[lo]), out);
   out->end = 0;
   return 1;
 }
 
 /* ---- closest point --------------------------------------------------- */
 
-static double box_d2(const bnode *b, double x, double y) {
+static double box_d2(const fbox *b, double x, double y) {
   double dx = fmax(0, fmax(b->x0 - x, x - b->x1));
   double dy = fmax(0, fmax(b->y0 - y, y - b->y1));
   return dx * dx + dy * dy;
 }
 
-/* The distance from (a, c) to the box [alo, ahi] x [clo, chi]. */
-static double box_dist(double a, double c, const double b[4]) {
-  double da = fmax(fmax(b[0] - a, a - b[1]), 0);
-  double dc = fmax(fmax(b[2] - c, c - b[3]), 0);
-  return hypot(da, dc);
-}
-
-/* The distance from (a, c) to the segment (a1, c1) (a2, c2). */
-static double seg_dist(double a, double c, double a1, double c1, double a2,
-                       double c2) {
-  double da = a2 - a1, dc = c2 - c1, l2 = da * da + dc * dc;
-  double t = l2 > 0 ? ((a - a1) * da + (c - c1) * dc) / l2 : 0;
-  t = t < 0 ? 0 : t > 1 ? 1 : t;
-  return hypot(a - a1 - t * da, c - c1 - t * dc);
-}
-
-/* The distance from a segment to a box (both convex): 0 where they meet,
-** else the least of its ends' distances to the box and the box corners'
-** to it. Whether they meet: the segment clipped to the box's slabs. */
-static double seg_box_dist(double a1, double c1, double a2, double c2,
-                           const double b[4]) {
-  double t0 = 0, t1 = 1, d[2] = {a2 - a1, c2 - c1}, o[2] = {a1, c1};
-  int meets = 1;
-  for (int k = 0; k < 2 && meets; k++) {
-    double lo = b[2 * k], hi = b[2 * k + 1];
-    if (d[k] == 0) {
-      meets = o[k] >= lo && o[k] <= hi;
-      continue;
-    }
-    double u = (lo - o[k]) / d[k], v = (hi - o[k]) / d[k];
-    if (u > v) {
-      double w = u;
-      u = v, v = w;
-    }
-    t0 = fmax(t0, u), t1 = fmin(t1, v);
-    meets = t0 <= t1;
-  }
-  if (meets) return 0;
-  double m = fmin(box_dist(a1, c1, b), box_dist(a2, c2, b));
-  for (int i = 0; i < 4; i++)
-    m = fmin(m, seg_dist(b[i & 1], b[2 + (i >> 1)], a1, c1, a2, c2));
-  return m;
-}
-
 int oc_curve_far_from_segment(const oc_pcurve *c, double xa, double ya,
                               double xb, double yb, double r) {
   if (!(r >= 0 && r < INFINITY)) return 0;
-  double M = fmax(fmax(fabs(xa), fabs(ya)), fmax(fabs(xb), fabs(yb)));
   for (size_t i = 0; i < c->n; i++) {
-    const piece *pc = &c->pc[i];
-    const oc_vec3 *p = pc->p;
-    int n = pc->deg;
-    double ux = p[n].x - p[0].x, uy = p[n].y - p[0].y, l = hypot(ux, uy);
-    if (l > 0)
-      ux /= l, uy /= l;
-    else
-      ux = 1, uy = 0;
-    double b[4] = {INFINITY, -INFINITY, INFINITY, -INFINITY}, Mp = M;
-    for (int k = 0; k <= n; k++) {
-      double a = p[k].x * ux + p[k].y * uy, cc = p[k].y * ux - p[k].x * uy;
-      b[0] = fmin(b[0], a), b[1] = fmax(b[1], a);
-      b[2] = fmin(b[2], cc), b[3] = fmax(b[3], cc);
-      Mp = fmax(Mp, fmax(fabs(p[k].x), fabs(p[k].y)));
-    }
-    double D = seg_box_dist(xa * ux + ya * uy, ya * ux - xa * uy,
-                            xb * ux + yb * uy, yb * ux - xb * uy, b);
-    if (!(D - 1e-9 * Mp > r * (1 + 1e-9))) return 0;
+    piece pc;
+    piece_at(c, i, &pc);
+    if (!oc_bez_far(pc.p, pc.deg, xa, ya, xb, yb, r)) return 0;
   }
   return 1;
 }
 
-/* Whether the piece is at least sqrt(lim) from (x, y): the control points'
-** box in the frame of the chord p[0] p[deg] (the piece lies in their hull,
-** so in that box) is that far. */
-static int far_in_frame(const piece *pc, double x, double y, double lim) {
-  double ux = pc->p[pc->deg].x - pc->p[0].x, uy = pc->p[pc->deg].y - pc->p[0].y;
-  double l = sqrt(ux * ux + uy * uy);
-  if (!(l > 0)) return 0;
-  ux /= l, uy /= l;
-  double a0 = INFINITY, a1 = -INFINITY, b0 = INFINITY, b1 = -INFINITY;
-  for (int k = 0; k <= pc->deg; k++) {
-    double dx = pc->p[k].x - pc->p[0].x, dy = pc->p[k].y - pc->p[0].y;
-    double a = dx * ux + dy * uy, b = dy * ux - dx * uy;
-    a0 = a < a0 ? a : a0, a1 = a > a1 ? a : a1;
-    b0 = b < b0 ? b : b0, b1 = b > b1 ? b : b1;
-  }
-  double dx = x - pc->p[0].x, dy = y - pc->p[0].y;
-  double a = dx * ux + dy * uy, b = dy * ux - dx * uy;
-  double ea = a < a0 ? a0 - a : a > a1 ? a - a1 : 0;
-  double eb = b < b0 ? b0 - b : b > b1 ? b - b1 : 0;
-  /* a hair for the rounding of the frame (and of the differences of
-  ** coordinates far from the origin) */
-  double d2 = ea * ea + eb * eb,
-         pad =
-             1e-9 * (l + fabs(a) + fabs(b)) +
-             1e-14 * (fabs(x) + fabs(y) + fabs(pc->p[0].x) + fabs(pc->p[0].y));
-  return d2 > lim + 2 * pad * sqrt(lim) + pad * pad;
-}
+/* A pending node of the box tree: its index and its pieces [lo, hi). */
+typedef struct pending {
+  uint32_t node, lo, hi;
+} pending;
 
 int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
                      oc_curve_point *out) {
   if (!(r >= 0) || isnan(x) || isnan(y)) return 0;
   double lim = nextafter(r * r, INFINITY), best = lim, bt = 0;
-  size_t bp = 0;
+  piece bp, pc;
   int found = 0;
-  size_t st[128];
+  const fbox *bvh = c->bvh;
+  pending st[128];
   int top = 0;
-  st[top++] = 0;
+  st[top++] = (pending){0, 0, c->n};
   while (top > 0) {
-    const bnode *b = &c->bvh[st[--top]];
+    pending e = st[--top];
+    const fbox *b = &bvh[e.node];
     if (box_d2(b, x, y) >= best) continue;
-    if (!b->right) {
-      const piece *pc = &c->pc[b->piece];
-      if (far_in_frame(pc, x, y, best)) continue; /* (cannot beat best) */
-      double t, d2 = oc_bez_closest(pc->p, pc->deg, x, y, best, &t);
-      if (d2 < best) best = d2, bp = b->piece, bt = t, found = 1;
+    if (e.hi - e.lo == 1) {
+      piece_at(c, e.lo, &pc);
+      /* (oc_bez_closest first tests whether the piece is out of reach) */
+      double t, d2 = oc_bez_closest(pc.p, pc.deg, x, y, best, &t);
+      if (d2 < best) best = d2, bp = pc, bt = t, found = 1;
       continue;
     }
-    size_t l = (size_t)(b - c->bvh) + 1, rr = b->right;
-    double dl = box_d2(&c->bvh[l], x, y), dr = box_d2(&c->bvh[rr], x, y);
+    uint32_t mid = e.lo + (e.hi - e.lo) / 2;
+    pending l = {e.node + 1, e.lo, mid},
+            rr = {e.node + 2 * (mid - e.lo), mid, e.hi};
+    double dl = box_d2(&bvh[l.node], x, y), dr = box_d2(&bvh[rr.node], x, y);
     /* nearer child on top; the tree is balanced, so 2 log2 n entries */
     if (dl <= dr) {
       st[top++] = rr;
@@ -708,7 +780,7 @@ int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
     }
   }
   if (!found) return 0;
-  fill(c, bp, bt, out);
+  fill(c, &bp, bt, out);
   double cr = out->tx * (y - out->q.y) - out->ty * (x - out->q.x);
   double dist = sqrt(best);
   out->d = cr < 0 ? -dist : dist;
@@ -718,35 +790,37 @@ int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
 int oc_curve_within(const oc_pcurve *c, double x, double y, double r) {
   if (!(r >= 0) || isnan(x) || isnan(y)) return 0;
   double lim = nextafter(r * r, INFINITY);
-  size_t st[128];
+  const fbox *bvh = c->bvh;
+  pending st[128];
   int top = 0;
-  st[top++] = 0;
+  st[top++] = (pending){0, 0, c->n};
   while (top > 0) {
-    const bnode *b = &c->bvh[st[--top]];
-    if (box_d2(b, x, y) >= lim) continue;
-    if (b->right) {
-      st[top++] = b->right;
-      st[top++] = (size_t)(b - c->bvh) + 1;
+    pending e = st[--top];
+    if (box_d2(&bvh[e.node], x, y) >= lim) continue;
+    if (e.hi - e.lo > 1) {
+      uint32_t mid = e.lo + (e.hi - e.lo) / 2;
+      st[top++] = (pending){e.node + 2 * (mid - e.lo), mid, e.hi};
+      st[top++] = (pending){e.node + 1, e.lo, mid};
       continue;
     }
-    const piece *pc = &c->pc[b->piece];
+    piece pc;
+    piece_at(c, e.lo, &pc);
     /* the ends lie on the curve: no root finding when one is near */
-    for (int k = 0; k <= pc->deg; k += pc->deg) {
-      double dx = pc->p[k].x - x, dy = pc->p[k].y - y;
+    for (int k = 0; k <= pc.deg; k += pc.deg) {
+      double dx = pc.p[k].x - x, dy = pc.p[k].y - y;
       if (dx * dx + dy * dy < lim) return 1;
     }
     /* and its middle and quarters (on fig3's and fig22's traces, these
     ** answer 53 % of what would be root findings, and the chord's frame
     ** 75 % of the rest) */
     static const double at[3] = {0.5, 0.25, 0.75};
-    for (int k = 0; pc->deg > 1 && k < 3; k++) {
-      oc_vec3 m = oc_bez_eval(pc->p, pc->deg, at[k]);
+    for (int k = 0; pc.deg > 1 && k < 3; k++) {
+      oc_vec3 m = oc_bez_eval(pc.p, pc.deg, at[k]);
       double dx = m.x - x, dy = m.y - y;
       if (dx * dx + dy * dy < lim) return 1;
     }
-    if (far_in_frame(pc, x, y, lim)) continue;
-    double t;
-    if (oc_bez_closest(pc->p, pc->deg, x, y, lim, &t) < lim) return 1;
+    double t; /* (out of reach: one test, oc_bez_closest's) */
+    if (oc_bez_closest(pc.p, pc.deg, x, y, lim, &t) < lim) return 1;
   }
   return 0;
 }
@@ -755,7 +829,7 @@ int oc_curve_within(const oc_pcurve *c, double x, double y, double r) {
 
 typedef struct flat_ctx {
   const oc_pcurve *c;
-  const piece *pc;
+  piece pc;
   oc_curve_vertex *out;
   size_t cap, k;
 } flat_ctx;
@@ -763,9 +837,9 @@ typedef struct flat_ctx {
 static void flat_emit(void *ud, double t) {
   flat_ctx *f = ud;
   if (f->out && f->k < f->cap) {
-    oc_vec3 q =
-        t >= 1 ? f->pc->p[f->pc->deg] : oc_bez_eval(f->pc->p, f->pc->deg, t);
-    oc_curve_vertex v = {q.x, q.y, q.z, f->pc->s0 + s_of_t(f->c, f->pc, t)};
+    const piece *pc = &f->pc;
+    oc_vec3 q = t >= 1 ? pc->p[pc->deg] : oc_bez_eval(pc->p, pc->deg, t);
+    oc_curve_vertex v = {q.x, q.y, q.z, c_s(f->c)[pc->i] + s_of_t(f->c, pc, t)};
     f->out[f->k] = v;
   }
   f->k++;
@@ -773,16 +847,18 @@ static void flat_emit(void *ud, double t) {
 
 int oc_curve_flatten(const oc_pcurve *c, double tol, oc_curve_vertex *out,
                      size_t cap, size_t *count, oc_error *err) {
-  if (!(tol >= 1e-9 * c->length) || !isfinite(tol))
+  double length = c_s(c)[c->n];
+  if (!(tol >= 1e-9 * length) || !isfinite(tol))
     return oc_seterr(err, OC_EINVAL,
                      "'tolerance' must be finite and >= %g (1e-9 of the "
                      "curve's length; got %g)",
-                     1e-9 * c->length, tol);
-  flat_ctx f = {c, c->pc, out, cap, 0};
+                     1e-9 * length, tol);
+  flat_ctx f = {c, {{{0, 0, 0}}, 0, 0}, out, cap, 0};
+  piece_at(c, 0, &f.pc);
   flat_emit(&f, 0);
   for (size_t i = 0; i < c->n; i++) {
-    f.pc = &c->pc[i];
-    oc_bez_flatten(f.pc->p, f.pc->deg, tol, flat_emit, &f);
+    piece_at(c, i, &f.pc);
+    oc_bez_flatten(f.pc.p, f.pc.deg, tol, flat_emit, &f);
   }
   *count = f.k;
   return OC_OK;

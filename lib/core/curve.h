@@ -58,10 +58,22 @@ oc_pcurve *oc_curve_new(const oc_curve_piece *pieces, size_t n, oc_error *err);
 oc_pcurve *oc_curve_from_points(const oc_vec3 *pts, size_t n, int degree,
                                 oc_error *err);
 
+/* The uniform Catmull-Rom spline through n >= 2 points, as cubic pieces
+** (piece i from pts[i] to pts[i + 1], its inner control points pts[i] +
+** (pts[i + 1] - pts[i - 1]) / 6 and pts[i + 1] - (pts[i + 2] - pts[i]) /
+** 6, the ends reflecting their neighbour). Same checks as oc_curve_new
+** (errors name 'points' for the count). The curve keeps its points alone
+** and derives the control points as it reads a piece (unless a piece was
+** dropped or an end snapped: then it keeps them as oc_curve_new does). */
+oc_pcurve *oc_curve_catmull(const oc_vec3 *pts, size_t n, oc_error *err);
+
 void oc_curve_free(oc_pcurve *c);
 
 size_t oc_curve_npieces(const oc_pcurve *c); /* pieces kept */
-size_t oc_curve_bytes(const oc_pcurve *c);   /* the memory it holds */
+/* The memory it holds: its points, an arc length per piece, the inner
+** knots of pieces whose arc length one 8-point rule does not give to
+** 1e-14, a box tree of floats (2 pieces - 1 boxes of 16 bytes). */
+size_t oc_curve_bytes(const oc_pcurve *c);
 int oc_curve_closed(const oc_pcurve *c);
 /* Total xy arc length. Each Bézier piece's arc length is tabulated at
 ** build (adaptive Gauss–Legendre); the length and every s below are
@@ -75,10 +87,10 @@ int oc_curve_at(const oc_pcurve *c, double s, oc_curve_point *out);
 
 /* 1 when every point of the segment (xa, ya) (xb, yb) is provably farther
 ** than r from the curve in xy, so that oc_curve_closest(c, x, y, r, ...)
-** returns 0 at each of them; 0 when that is not shown. Each piece's
-** control points are boxed in the frame of its chord (tight for a
-** diagonal piece), the segment's distance to that box taken exactly, less
-** a margin of 1e-9 of the coordinates' size. */
+** returns 0 at each of them; 0 when that is not shown. Each piece passes
+** oc_bez_far (its control points boxed in the frame of its chord, tight
+** for a diagonal piece; the segment's distance to that box taken exactly,
+** less a margin for rounding): the test oc_curve_closest runs per piece. */
 int oc_curve_far_from_segment(const oc_pcurve *c, double xa, double ya,
                               double xb, double yb, double r);
 
@@ -102,13 +114,14 @@ int oc_curve_within(const oc_pcurve *c, double x, double y, double r);
 ** (bezier.h); 0 for a polyline, INFINITY where a Bézier piece's
 ** derivative vanishes: a cusp, or an end control point doubled (p[1] =
 ** p[0]), whose curvature is generally unbounded near that end.
-** Joins are not included: see oc_curve_max_turn. Computed at build. */
+** Joins are not included: see oc_curve_max_turn. Computed when asked
+** (a branch and bound over the pieces: callers ask once). */
 double oc_curve_kappa_max(const oc_pcurve *c);
 
 /* The largest angle (radians, in [0, pi]) between the tangents meeting at
 ** a join (and at the closing point of a closed curve): 0 for a G1 curve.
 ** A corner has infinite curvature, so a profile of half-width w is safe
-** (w kappa_max < 1) only on a curve without corners. */
+** (w kappa_max < 1) only on a curve without corners. Computed when asked. */
 double oc_curve_max_turn(const oc_pcurve *c);
 
 /* An upper bound of the grade |dz/ds| along the whole curve (rigorous up
@@ -120,7 +133,8 @@ double oc_curve_grade_max(const oc_pcurve *c);
 double oc_curve_curvature_at(const oc_pcurve *c, const oc_curve_point *pt);
 double oc_curve_grade_at(const oc_pcurve *c, const oc_curve_point *pt);
 
-/* The tight box of the curve (x, y and z) with x and y grown by r >= 0. */
+/* The tight box of the curve (x, y and z) with x and y grown by r >= 0
+** (computed when asked, O(pieces)). */
 oc_aabb oc_curve_bounds(const oc_pcurve *c, double r);
 
 /* A vertex of a flattened curve: the point and its arc length. */

@@ -4,42 +4,67 @@
 ** slopes, linear blends of two profiles.
 */
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 
 #include "core/checked.h"
 #include "core/error.h"
 #include "core/profile.h"
 
-/* Piece k covers [bx[k], bx[k + 1]] with v = pv + u (ps + u pc), u = x - bx[k];
-** beyond bx[0] and bx[np] the profile is constant. */
+/* A profile holds its knots alone (x then v; as floats when every one is
+** a float exactly, else doubles): the spline's pieces on a knot interval
+** are derived when it is read (pieces_on), by the arithmetic that defines
+** them, so every value is the same whichever way it is stored. */
 struct oc_profile {
-  size_t np;
-  double *bx; /* np + 1 breakpoints */
-  double *pv, *ps, *pc;
-  double vfirst, vlast;
-  double slo, shi; /* support */
+  uint32_t n;   /* knots */
+  uint32_t f32; /* knots stored as floats */
+  double k[];   /* (or 2 n floats) */
 };
 
-static void set_piece(oc_profile *p, double x0, double v0, double s0, double s1,
-                      double x1) {
-  size_t k = p->np++;
-  p->bx[k] = x0, p->pv[k] = v0, p->ps[k] = s0;
-  p->pc[k] = (s1 - s0) / (2 * (x1 - x0));
+static double kx(const oc_profile *p, size_t i) {
+  return p->f32 ? (double)((const float *)p->k)[i] : p->k[i];
+}
+static double kv(const oc_profile *p, size_t i) {
+  return p->f32 ? (double)((const float *)p->k)[p->n + i] : p->k[p->n + i];
 }
 
-/* One knot interval [a, b] with values va, vb and end slopes sa, sb: one
-** quadratic when the slopes' mean is the secant, else two joined at xi
-** with slope sbar there. xi is the midpoint unless the slopes straddle
-** the secant (convex or concave data) and the midpoint's sbar would leave
-** [sa, sb]; then xi is where sbar equals the nearer end slope, so the
-** slope stays monotone (Schumaker 1983's lemma: any xi whose sbar lies
-** between sa and sb keeps the shape). */
-static void interval(oc_profile *p, double a, double b, double va, double vb,
-                     double sa, double sb) {
+/* One quadratic piece: v = v0 + u (s0 + u c), u = x - x0. */
+typedef struct qpiece {
+  double x0, v0, s0, c;
+} qpiece;
+
+static qpiece make_piece(double x0, double v0, double s0, double s1,
+                         double x1) {
+  qpiece q = {x0, v0, s0, (s1 - s0) / (2 * (x1 - x0))};
+  return q;
+}
+
+/* The slope at knot i: the harmonic mean of the neighbouring secant
+** slopes where they have the same sign (written so it cannot overflow),
+** else 0; 0 at both ends. */
+static double knot_slope(const oc_profile *p, size_t i) {
+  if (i == 0 || i + 1 >= p->n) return 0;
+  double d0 = (kv(p, i) - kv(p, i - 1)) / (kx(p, i) - kx(p, i - 1));
+  double d1 = (kv(p, i + 1) - kv(p, i)) / (kx(p, i + 1) - kx(p, i));
+  if ((d0 > 0 && d1 > 0) || (d0 < 0 && d1 < 0)) return 2 / (1 / d0 + 1 / d1);
+  return 0;
+}
+
+/* The pieces on knot interval i, [a, b] with values va, vb and end
+** slopes sa, sb (1 or 2, returned): one quadratic when the slopes' mean
+** is the secant, else two joined at xi with slope sbar there. xi is the
+** midpoint unless the slopes straddle the secant (convex or concave data)
+** and the midpoint's sbar would leave [sa, sb]; then xi is where sbar
+** equals the nearer end slope, so the slope stays monotone (Schumaker
+** 1983's lemma: any xi whose sbar lies between sa and sb keeps the
+** shape). */
+static int pieces_on(const oc_profile *p, size_t i, qpiece q[2]) {
+  double a = kx(p, i), b = kx(p, i + 1), va = kv(p, i), vb = kv(p, i + 1);
+  double sa = knot_slope(p, i), sb = knot_slope(p, i + 1);
   double h = b - a, d = (vb - va) / h;
   if (sa + sb == 2 * d) {
-    set_piece(p, a, va, sa, sb, b);
-    return;
+    q[0] = make_piece(a, va, sa, sb, b);
+    return 1;
   }
   double xi = a + 0.5 * h, sbar = 2 * d - 0.5 * (sa + sb);
   if ((sa - d) * (sb - d) < 0 && (sbar - sa) * (sbar - sb) > 0) {
@@ -51,14 +76,23 @@ static void interval(oc_profile *p, double a, double b, double va, double vb,
       sbar = 2 * d - sb + u * (sb - sa) / h;
     }
   }
-  set_piece(p, a, va, sa, sbar, xi);
-  set_piece(p, xi, va + (xi - a) * 0.5 * (sa + sbar), sbar, sb, b);
+  q[0] = make_piece(a, va, sa, sbar, xi);
+  q[1] = make_piece(xi, va + (xi - a) * 0.5 * (sa + sbar), sbar, sb, b);
+  return 2;
 }
 
-/* a, of n doubles or more, cut to n (kept as it is if realloc fails). */
-static double *shrink(double *a, size_t n) {
-  double *b = realloc(a, n * sizeof *a);
-  return b ? b : a;
+/* The knot interval holding x (knot i <= x < knot i + 1), for x strictly
+** inside the knots' span. */
+static size_t interval_of(const oc_profile *p, double x) {
+  size_t lo = 0, hi = p->n - 1;
+  while (hi - lo > 1) {
+    size_t m = lo + (hi - lo) / 2;
+    if (kx(p, m) <= x)
+      lo = m;
+    else
+      hi = m;
+  }
+  return lo;
 }
 
 oc_profile *oc_profile_new(const double *x, const double *v, size_t n,
@@ -67,6 +101,12 @@ oc_profile *oc_profile_new(const double *x, const double *v, size_t n,
     oc_seterr(err, OC_EINVAL, "'knots' must number at least 2 (got %zu)", n);
     return NULL;
   }
+  if (n > UINT32_MAX / 2) {
+    oc_seterr(err, OC_EINVAL, "'knots' must number at most %u (got %zu)",
+              UINT32_MAX / 2, n);
+    return NULL;
+  }
+  int f32 = 1;
   for (size_t i = 0; i < n; i++) {
     if (!isfinite(x[i]) || !isfinite(v[i])) {
       oc_seterr(err, OC_EINVAL, "'knots': knot %zu is not finite (%g, %g)", i,
@@ -85,91 +125,82 @@ oc_profile *oc_profile_new(const double *x, const double *v, size_t n,
                 i);
       return NULL;
     }
+    f32 &= (double)(float)x[i] == x[i] && (double)(float)v[i] == v[i];
   }
-  oc_profile *p = calloc(1, sizeof *p);
-  size_t m, bytes;
-  if (!p || !oc_mul_size(n - 1, 2, &m) ||
-      !oc_mul_size(m + 1, sizeof(double), &bytes) || !(p->bx = malloc(bytes)) ||
-      !(p->pv = malloc(bytes)) || !(p->ps = malloc(bytes)) ||
-      !(p->pc = malloc(bytes))) {
-    oc_profile_free(p);
+  size_t bytes;
+  oc_profile *p = NULL;
+  if (!oc_mul_size(2 * n, f32 ? sizeof(float) : sizeof(double), &bytes) ||
+      !oc_add_size(bytes, sizeof *p, &bytes) || !(p = malloc(bytes))) {
     oc_seterr(err, OC_ENOMEM, "out of memory for a profile of %zu knots", n);
     return NULL;
   }
-  double sprev = 0; /* slope at knot i */
-  for (size_t i = 0; i + 1 < n; i++) {
-    double snext = 0;
-    if (i + 2 < n) {
-      double d0 = (v[i + 1] - v[i]) / (x[i + 1] - x[i]);
-      double d1 = (v[i + 2] - v[i + 1]) / (x[i + 2] - x[i + 1]);
-      /* harmonic mean, written so it cannot overflow */
-      if ((d0 > 0 && d1 > 0) || (d0 < 0 && d1 < 0))
-        snext = 2 / (1 / d0 + 1 / d1);
+  p->n = (uint32_t)n, p->f32 = (uint32_t)f32;
+  for (size_t i = 0; i < n; i++) {
+    if (f32) {
+      float *k = (float *)p->k;
+      k[i] = (float)x[i], k[n + i] = (float)v[i];
+    } else {
+      p->k[i] = x[i], p->k[n + i] = v[i];
     }
-    interval(p, x[i], x[i + 1], v[i], v[i + 1], sprev, snext);
-    sprev = snext;
   }
-  p->bx[p->np] = x[n - 1];
-  /* the capacity of breakpoints not inserted, given back */
-  p->bx = shrink(p->bx, p->np + 1);
-  p->pv = shrink(p->pv, p->np + 1);
-  p->ps = shrink(p->ps, p->np + 1);
-  p->pc = shrink(p->pc, p->np + 1);
-  p->vfirst = v[0], p->vlast = v[n - 1];
-  /* flat runs of equal values at the ends are exactly constant */
-  size_t j = 0, k = n - 1;
-  while (j + 1 < n && v[j + 1] == v[0])
-    j++;
-  while (k > 0 && v[k - 1] == v[n - 1])
-    k--;
-  if (j == n - 1)
-    p->slo = p->shi = 0;
-  else
-    p->slo = x[j], p->shi = x[k];
   return p;
 }
 
 void oc_profile_free(oc_profile *p) {
-  if (!p) return;
-  free(p->bx);
-  free(p->pv);
-  free(p->ps);
-  free(p->pc);
   free(p);
 }
 
 size_t oc_profile_bytes(const oc_profile *p) {
-  return sizeof *p + 4 * (p->np + 1) * sizeof(double);
+  return sizeof *p +
+         2 * (size_t)p->n * (p->f32 ? sizeof(float) : sizeof(double));
+}
+
+int oc_profile_same(const oc_profile *a, const oc_profile *b) {
+  if (a->n != b->n) return 0;
+  for (size_t i = 0; i < a->n; i++)
+    if (kx(a, i) != kx(b, i) || kv(a, i) != kv(b, i)) return 0;
+  return 1;
 }
 
 size_t oc_profile_nbreaks(const oc_profile *p) {
-  return p->np + 1;
+  size_t nb = 1;
+  for (size_t i = 0; i + 1 < p->n; i++) {
+    qpiece q[2];
+    nb += (size_t)pieces_on(p, i, q);
+  }
+  return nb;
 }
 
 double oc_profile_eval(const oc_profile *p, double x, double *dv) {
   if (dv) *dv = 0;
   if (isnan(x)) return x;
-  if (x <= p->bx[0]) return p->vfirst;
-  if (x >= p->bx[p->np]) return p->vlast;
-  size_t lo = 0, hi = p->np;
-  while (hi - lo > 1) {
-    size_t m = lo + (hi - lo) / 2;
-    if (p->bx[m] <= x)
-      lo = m;
-    else
-      hi = m;
-  }
-  double u = x - p->bx[lo];
-  if (dv) *dv = p->ps[lo] + 2 * p->pc[lo] * u;
-  return p->pv[lo] + u * (p->ps[lo] + u * p->pc[lo]);
+  if (x <= kx(p, 0)) return kv(p, 0);
+  if (x >= kx(p, p->n - 1)) return kv(p, p->n - 1);
+  qpiece q[2];
+  int m = pieces_on(p, interval_of(p, x), q);
+  const qpiece *k = m == 2 && x >= q[1].x0 ? &q[1] : &q[0];
+  double u = x - k->x0;
+  if (dv) *dv = k->s0 + 2 * k->c * u;
+  return k->v0 + u * (k->s0 + u * k->c);
 }
 
 void oc_profile_support(const oc_profile *p, double *lo, double *hi) {
-  *lo = p->slo, *hi = p->shi;
+  /* flat runs of equal values at the ends are exactly constant */
+  size_t n = p->n, j = 0, k = n - 1;
+  while (j + 1 < n && kv(p, j + 1) == kv(p, 0))
+    j++;
+  while (k > 0 && kv(p, k - 1) == kv(p, n - 1))
+    k--;
+  if (j == n - 1)
+    *lo = *hi = 0;
+  else
+    *lo = kx(p, j), *hi = kx(p, k);
 }
 
 double oc_profile_half_width(const oc_profile *p) {
-  return fmax(fabs(p->slo), fabs(p->shi));
+  double lo, hi;
+  oc_profile_support(p, &lo, &hi);
+  return fmax(fabs(lo), fabs(hi));
 }
 
 double oc_profile_lerp(const oc_profile *a, const oc_profile *b, double t,
@@ -180,17 +211,15 @@ double oc_profile_lerp(const oc_profile *a, const oc_profile *b, double t,
   return (1 - t) * va + t * vb;
 }
 
-/* The first breakpoint index of p strictly after x (np + 1 if none). */
-static size_t first_after(const oc_profile *p, double x) {
-  size_t lo = 0, hi = p->np + 1;
-  while (lo < hi) {
-    size_t m = lo + (hi - lo) / 2;
-    if (p->bx[m] <= x)
-      lo = m + 1;
-    else
-      hi = m;
-  }
-  return lo;
+/* The first breakpoint (a knot or a join inside a knot interval) strictly
+** after x; INFINITY if none. */
+static double next_break(const oc_profile *p, double x) {
+  if (x < kx(p, 0)) return kx(p, 0);
+  if (x >= kx(p, p->n - 1)) return INFINITY;
+  size_t i = interval_of(p, x);
+  qpiece q[2];
+  if (pieces_on(p, i, q) == 2 && q[1].x0 > x) return q[1].x0;
+  return kx(p, i + 1);
 }
 
 /* Walks the union of both breakpoint lists over [a, b]: the blend is one
@@ -204,14 +233,11 @@ static void walk(const oc_profile *pa, const oc_profile *pb, double t, double a,
     a = b, b = s;
   }
   double vlo = INFINITY, vhi = -INFINITY, sm = 0;
-  size_t i = first_after(pa, a), j = first_after(pb, a);
   double u = a, du, fu = oc_profile_lerp(pa, pb, t, a, &du);
   for (;;) {
     vlo = fmin(vlo, fu), vhi = fmax(vhi, fu), sm = fmax(sm, fabs(du));
     if (u >= b) break;
-    double w = b;
-    if (i <= pa->np) w = fmin(w, pa->bx[i]);
-    if (j <= pb->np) w = fmin(w, pb->bx[j]);
+    double w = fmin(b, fmin(next_break(pa, u), next_break(pb, u)));
     double dw, fw = oc_profile_lerp(pa, pb, t, w, &dw);
     if ((du > 0 && dw < 0) || (du < 0 && dw > 0)) {
       double xs = u + (w - u) * du / (du - dw);
@@ -220,10 +246,6 @@ static void walk(const oc_profile *pa, const oc_profile *pb, double t, double a,
         vlo = fmin(vlo, fs), vhi = fmax(vhi, fs);
       }
     }
-    while (i <= pa->np && pa->bx[i] <= w)
-      i++;
-    while (j <= pb->np && pb->bx[j] <= w)
-      j++;
     u = w, fu = fw, du = dw;
   }
   if (lo) *lo = vlo;

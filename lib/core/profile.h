@@ -52,8 +52,13 @@ double oc_profile_max_slope(const oc_profile *p, double a, double b);
 void oc_profile_support(const oc_profile *p, double *lo, double *hi);
 double oc_profile_half_width(const oc_profile *p);
 
-/* The bytes p holds. */
+/* The bytes p holds: a header of 8 and its knots (as floats when every
+** coordinate is one exactly, else as doubles; the spline's pieces are
+** derived from them as they are read, with the same values either way). */
 size_t oc_profile_bytes(const oc_profile *p);
+
+/* 1 when a and b have the same knots (so the same values everywhere). */
+int oc_profile_same(const oc_profile *a, const oc_profile *b);
 
 /* Breakpoints of the spline (knots plus inserted points), for tests. */
 size_t oc_profile_nbreaks(const oc_profile *p);

@@ -43,8 +43,9 @@ void oc_ecurve_free(void *data) {
   ecurve *d = data;
   if (!d) return;
   oc_curve_free(d->c);
-  for (size_t i = 0; i < d->np; i++)
-    oc_profile_free(d->prof[i]);
+  for (size_t i = 0; d->prof && i < d->np; i++)
+    if (i == 0 || d->prof[i] != d->prof[i - 1]) /* (shared: once) */
+      oc_profile_free(d->prof[i]);
   free(d->prof);
   free(d->at);
   free(d);
@@ -183,30 +184,7 @@ oc_pcurve *oc_ecurve_skeleton(const oc_vec3 *P, size_t m,
                               oc_ecurve_spline spline, oc_error *err) {
   if (spline != OC_ECURVE_CATMULL)
     return oc_curve_from_points(P, m, spline == OC_ECURVE_BEZIER ? 3 : 1, err);
-  if (m < 2) {
-    oc_seterr(err, OC_EINVAL, "'points' must hold at least 2 points (got %zu)",
-              m);
-    return NULL;
-  }
-  oc_curve_piece *pc = malloc((m - 1) * sizeof *pc);
-  if (!pc) {
-    oc_seterr(err, OC_ENOMEM, "out of memory (%zu points)", m);
-    return NULL;
-  }
-  /* uniform Catmull-Rom through the points, as cubic Béziers; the ends
-  ** reflect their neighbour */
-  for (size_t i = 0; i + 1 < m; i++) {
-    oc_vec3 a = i > 0 ? P[i - 1] : oc_sub(oc_mul(P[0], 2), P[1]);
-    oc_vec3 e = i + 2 < m ? P[i + 2] : oc_sub(oc_mul(P[m - 1], 2), P[m - 2]);
-    pc[i].degree = 3;
-    pc[i].p[0] = P[i];
-    pc[i].p[1] = oc_add(P[i], oc_mul(oc_sub(P[i + 1], a), 1.0 / 6));
-    pc[i].p[2] = oc_sub(P[i + 1], oc_mul(oc_sub(e, P[i]), 1.0 / 6));
-    pc[i].p[3] = P[i + 1];
-  }
-  oc_pcurve *c = oc_curve_new(pc, m - 1, err);
-  free(pc);
-  return c;
+  return oc_curve_catmull(P, m, err);
 }
 
 oc_enode *oc_enode_curve(const oc_enode_curve_params *p, oc_error *err) {
@@ -286,6 +264,11 @@ oc_enode *oc_enode_curve(const oc_enode_curve_params *p, oc_error *err) {
       snprintf(m, sizeof m, "%s", err->msg);
       oc_seterr(err, OC_EINVAL, "'profiles[%zu]': %s", i + 1, m);
       goto fail;
+    }
+    /* a profile the same as the one before is stored once */
+    if (i > 0 && oc_profile_same(d->prof[i], d->prof[i - 1])) {
+      oc_profile_free(d->prof[i]);
+      d->prof[i] = d->prof[i - 1];
     }
     double lo, hi;
     oc_profile_range(d->prof[i], -INFINITY, INFINITY, &lo, &hi);
@@ -385,6 +368,7 @@ size_t oc_ecurve_bytes(const void *data) {
   size_t b = sizeof *d + oc_curve_bytes(d->c) +
              d->np * (sizeof *d->at + sizeof *d->prof);
   for (size_t i = 0; i < d->np; i++)
-    b += oc_profile_bytes(d->prof[i]);
+    if (i == 0 || d->prof[i] != d->prof[i - 1])
+      b += oc_profile_bytes(d->prof[i]);
   return b;
 }

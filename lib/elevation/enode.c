@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/fround.h"
 #include "core/grow.h"
 #include "core/pmap.h"
 #include "elevation/enode.h"
@@ -64,13 +65,11 @@ oc_enode *oc_enode_alloc(oc_ekind kind, size_t size, oc_enode *const *kids,
 /* ---- floats rounded outward ------------------------------------------- */
 
 float oc_efloat_down(double v) {
-  float f = (float)v;
-  return (double)f > v ? nextafterf(f, -INFINITY) : f;
+  return oc_float_down(v);
 }
 
 float oc_efloat_up(double v) {
-  float f = (float)v;
-  return (double)f < v ? nextafterf(f, INFINITY) : f;
+  return oc_float_up(v);
 }
 
 void oc_erect_round(const oc_erect *r, oc_erectf *o) {
@@ -355,6 +354,7 @@ int oc_enode_get_stats(const oc_enode *e, oc_enode_stats *st, oc_error *err) {
     st->primitives += x->kind == OC_E_DISC || x->kind == OC_E_CURVE ||
                       x->kind == OC_E_LAKE || x->kind == OC_E_IMAGE;
     st->bytes += oc_enode_size(x);
+    st->node_bytes += oc_enode_size(x);
     size_t db = 0;
     if (x->kind == OC_E_CURVE) db = oc_ecurve_bytes(OC_EPRIM(x)->data);
     if (x->kind == OC_E_LAKE) db = oc_elake_bytes(OC_EPRIM(x)->data);

@@ -51,8 +51,9 @@ void oc_elake_free(void *data) {
   elake *d = data;
   if (!d) return;
   oc_profile_free(d->shore);
-  for (size_t i = 0; i < d->np; i++)
-    oc_profile_free(d->prof[i]);
+  for (size_t i = 0; d->prof && i < d->np; i++)
+    if (i == 0 || d->prof[i] != d->prof[i - 1]) /* (shared: once) */
+      oc_profile_free(d->prof[i]);
   free(d->prof);
   free(d->ang);
   free(d);
@@ -403,6 +404,11 @@ oc_enode *oc_enode_lake(const oc_enode_lake_params *p, oc_error *err) {
       oc_elake_free(d);
       return NULL;
     }
+    /* a sector's profile the same as the one before is stored once */
+    if (i > 0 && oc_profile_same(d->prof[i], d->prof[i - 1])) {
+      oc_profile_free(d->prof[i]);
+      d->prof[i] = d->prof[i - 1];
+    }
     double lo, hi;
     oc_profile_support(d->prof[i], &lo, &hi);
     if (lo < hi) dlo = fmin(dlo, lo);
@@ -456,6 +462,7 @@ size_t oc_elake_bytes(const void *data) {
   size_t b = sizeof *d + oc_profile_bytes(d->shore) +
              d->np * (sizeof *d->ang + sizeof *d->prof);
   for (size_t i = 0; i < d->np; i++)
-    b += oc_profile_bytes(d->prof[i]);
+    if (i == 0 || d->prof[i] != d->prof[i - 1])
+      b += oc_profile_bytes(d->prof[i]);
   return b;
 }

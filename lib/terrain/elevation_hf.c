@@ -19,6 +19,7 @@
 #include <stdlib.h>
 
 #include "core/error.h"
+#include "core/fround.h"
 #include "outcrop.h"
 #include "terrain/terrain.h"
 
@@ -39,15 +40,6 @@ typedef struct hfsrc {
   int nlev;
   level lev[MAX_LEVELS];
 } hfsrc;
-
-static float down(double v) {
-  float f = (float)v;
-  return (double)f > v ? nextafterf(f, -INFINITY) : f;
-}
-static float up(double v) {
-  float f = (float)v;
-  return (double)f < v ? nextafterf(f, INFINITY) : f;
-}
 
 /* Hull and derivative bounds of the patch of cell (ci, cj). */
 static void cell_bounds(const hfsrc *s, int ci, int cj, double *lo, double *hi,
@@ -121,9 +113,9 @@ static int build(hfsrc *s) {
       double lo, hi, gs;
       cell_bounds(s, ci, cj, &lo, &hi, &gs);
       size_t q = (size_t)cj * w + ci;
-      L0->lo[q] = down(lo);
-      L0->hi[q] = up(hi);
-      L0->gs[q] = up(gs);
+      L0->lo[q] = oc_float_down(lo);
+      L0->hi[q] = oc_float_up(hi);
+      L0->gs[q] = oc_float_up(gs);
     }
   while ((w > 1 || h > 1) && s->nlev < MAX_LEVELS) {
     level *P = &s->lev[s->nlev - 1], *L = &s->lev[s->nlev];

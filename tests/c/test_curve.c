@@ -666,6 +666,150 @@ START_TEST(queries_are_thread_safe) {
 }
 END_TEST
 
+static int same_cp(const oc_curve_point *a, const oc_curve_point *b) {
+  return a->s == b->s && a->q.x == b->q.x && a->q.y == b->q.y &&
+         a->q.z == b->q.z && a->tx == b->tx && a->ty == b->ty &&
+         a->nx == b->nx && a->ny == b->ny && a->d == b->d &&
+         a->piece == b->piece && a->t == b->t && a->end == b->end;
+}
+
+/* Two curves answer the same bits: closest points (near and far, within
+** r or not), points at arc lengths, flattening, bounds and the bounds
+** of curvature, turn and grade. */
+static void same_answers(const oc_pcurve *a, const oc_pcurve *b, oct_rng *r) {
+  ck_assert_uint_eq(oc_curve_npieces(a), oc_curve_npieces(b));
+  ck_assert(oc_curve_length(a) == oc_curve_length(b));
+  ck_assert(oc_curve_kappa_max(a) == oc_curve_kappa_max(b));
+  ck_assert(oc_curve_max_turn(a) == oc_curve_max_turn(b));
+  ck_assert(oc_curve_grade_max(a) == oc_curve_grade_max(b));
+  oc_aabb ba = oc_curve_bounds(a, 5), bb = oc_curve_bounds(b, 5);
+  ck_assert(memcmp(&ba, &bb, sizeof ba) == 0);
+  for (int k = 0; k < 300; k++) {
+    double x = oct_unif(r, ba.lo.x - 20, ba.hi.x + 20);
+    double y = oct_unif(r, ba.lo.y - 20, ba.hi.y + 20), rad = k % 2 ? 6 : 1e9;
+    oc_curve_point pa, pb;
+    int ha = oc_curve_closest(a, x, y, rad, &pa);
+    ck_assert_int_eq(ha, oc_curve_closest(b, x, y, rad, &pb));
+    ck_assert_int_eq(oc_curve_within(a, x, y, 6), oc_curve_within(b, x, y, 6));
+    ck_assert_int_eq(oc_curve_far_from_segment(a, x, y, x + 9, y + 2, 4),
+                     oc_curve_far_from_segment(b, x, y, x + 9, y + 2, 4));
+    if (ha) {
+      ck_assert(same_cp(&pa, &pb));
+      ck_assert(oc_curve_curvature_at(a, &pa) == oc_curve_curvature_at(b, &pb));
+      ck_assert(oc_curve_grade_at(a, &pa) == oc_curve_grade_at(b, &pb));
+    }
+    double s = oct_unif(r, -1, 1.1) * oc_curve_length(a);
+    ck_assert(oc_curve_at(a, s, &pa) && oc_curve_at(b, s, &pb));
+    ck_assert(same_cp(&pa, &pb));
+  }
+  oc_error err;
+  oc_curve_vertex va[400], vb[400];
+  size_t na, nb;
+  ck_assert_int_eq(oc_curve_flatten(a, 0.05, va, 400, &na, &err), OC_OK);
+  ck_assert_int_eq(oc_curve_flatten(b, 0.05, vb, 400, &nb, &err), OC_OK);
+  ck_assert(na == nb && na <= 400 && memcmp(va, vb, na * sizeof *va) == 0);
+}
+
+/* A Catmull-Rom curve keeps its through-points and derives the control
+** points: it answers as the same pieces given explicitly, in fewer bytes
+** (the layout of curve.c: a 16-byte header, an arc length per piece and
+** at the end, the points, 2 n - 1 float boxes, and 12 bytes an inner
+** arc-length knot plus 4 a piece when some piece has one). */
+START_TEST(catmull_keeps_its_points) {
+  oct_rng r = oct_rng_new(41);
+  oc_vec3 P[9];
+  for (int i = 0; i < 9; i++)
+    P[i] = oct_v(30 * i, 25 * sin(0.9 * i) + oct_unif(&r, -3, 3), 10 - i);
+  oc_error err = {0};
+  for (int m = 2; m <= 9; m += 7) {
+    oc_pcurve *c = oc_curve_catmull(P, (size_t)m, &err);
+    ck_assert_msg(c, "%s", err.msg);
+    oc_curve_piece pcs[8];
+    for (int i = 0; i + 1 < m; i++) {
+      oc_vec3 a = i > 0 ? P[i - 1] : oct_sub(oct_mul(P[0], 2), P[1]);
+      oc_vec3 e =
+          i + 2 < m ? P[i + 2] : oct_sub(oct_mul(P[m - 1], 2), P[m - 2]);
+      pcs[i].degree = 3;
+      pcs[i].p[0] = P[i], pcs[i].p[3] = P[i + 1];
+      pcs[i].p[1] = oct_add(P[i], oct_mul(oct_sub(P[i + 1], a), 1.0 / 6));
+      pcs[i].p[2] = oct_sub(P[i + 1], oct_mul(oct_sub(e, P[i]), 1.0 / 6));
+    }
+    oc_pcurve *x = new_ok(pcs, m - 1);
+    same_answers(c, x, &r);
+    size_t n = (size_t)m - 1, base = 16 + (n + 1) * 8 + (2 * n - 1) * 16;
+    size_t bc = oc_curve_bytes(c), bx = oc_curve_bytes(x);
+    ck_assert_uint_ge(bc, base + (size_t)m * 24);
+    ck_assert_uint_eq((bc - base - (size_t)m * 24) % 4, 0);
+    /* the explicit curve holds 3 n + 1 control points, the same knots */
+    ck_assert_uint_eq(bx - bc, (3 * n + 1 - (size_t)m) * 24);
+    if (m == 9) ck_assert_uint_eq(bc, 640); /* (golden: five inner knots) */
+    oc_curve_free(c);
+    oc_curve_free(x);
+  }
+  /* a last point within 1e-9 of the first closes the curve, snapped to
+  ** it: the pieces are no longer those the points give, so the curve
+  ** keeps their control points (3 n + 1 of them) */
+  oc_vec3 Q[5] = {P[0], P[1], P[2], P[3], oct_add(P[0], oct_v(1e-12, 0, 0))};
+  oc_pcurve *c = oc_curve_catmull(Q, 5, &err);
+  ck_assert_msg(c, "%s", err.msg);
+  ck_assert(oc_curve_closed(c) && oc_curve_npieces(c) == 4);
+  oc_pcurve *q = oc_curve_catmull(Q, 4, &err);
+  ck_assert_uint_ge(oc_curve_bytes(c), 16 + 5 * 8 + 13 * 24 + 7 * 16);
+  ck_assert_uint_lt(oc_curve_bytes(q), 16 + 4 * 8 + 10 * 24 + 5 * 16);
+  oc_curve_point pt;
+  ck_assert(oc_curve_closest(c, P[0].x, P[0].y - 1, INFINITY, &pt));
+  ck_assert(fabs(pt.d) <= 1 && pt.end == 0);
+  oc_curve_free(c);
+  oc_curve_free(q);
+  ck_assert(!oc_curve_catmull(P, 1, &err));
+  ck_assert_msg(strstr(err.msg, "'points'"), "%s", err.msg);
+}
+END_TEST
+
+/* Curves of one degree and of mixed degrees store their control points
+** (each shared end once) and answer as before: a polyline, a quadratic
+** spline, and mixed pieces (their degrees kept per piece). */
+START_TEST(stored_layouts_answer_alike) {
+  oct_rng r = oct_rng_new(43);
+  oc_vec3 pts[7];
+  for (int i = 0; i < 7; i++)
+    pts[i] = oct_v(20 * i, oct_unif(&r, -15, 15), i);
+  oc_error err = {0};
+  for (int deg = 1; deg <= 3; deg++) {
+    oc_pcurve *c = oc_curve_from_points(pts, 7, deg, &err);
+    ck_assert_msg(c, "%s", err.msg);
+    size_t n = 6 / (size_t)deg;
+    oc_curve_piece pcs[6];
+    for (size_t i = 0; i < n; i++) {
+      pcs[i].degree = deg;
+      for (int k = 0; k <= deg; k++)
+        pcs[i].p[k] = pts[i * (size_t)deg + (size_t)k];
+    }
+    oc_pcurve *x = new_ok(pcs, (int)n);
+    same_answers(c, x, &r);
+    if (deg == 1) /* header, n + 1 arc lengths, 7 points, 2 n - 1 boxes */
+      ck_assert_uint_eq(oc_curve_bytes(c), 16 + 7 * 8 + 7 * 24 + 11 * 16);
+    oc_curve_free(c);
+    oc_curve_free(x);
+  }
+  /* mixed: a cubic, a segment, a quadratic; 7 points and n + 1 offsets */
+  oc_curve_piece mix[3] = {{3, {pts[0], pts[1], pts[2], pts[3]}},
+                           {1, {pts[3], pts[4]}},
+                           {2, {pts[4], pts[5], pts[6]}}};
+  oc_pcurve *c = new_ok(mix, 3);
+  ck_assert_uint_ge(oc_curve_bytes(c), 16 + 4 * 8 + 7 * 24 + 4 * 4 + 5 * 16);
+  for (int k = 0; k < 200; k++) {
+    double x = oct_unif(&r, -10, 130), y = oct_unif(&r, -25, 25);
+    oc_curve_point p;
+    int bp;
+    double bt, ref = ref_closest(mix, 3, x, y, &bp, &bt);
+    ck_assert(oc_curve_closest(c, x, y, INFINITY, &p));
+    ck_assert(fabs(fabs(p.d) - ref) <= 1e-9 * (1 + ref));
+  }
+  oc_curve_free(c);
+}
+END_TEST
+
 int main(void) {
   setvbuf(stdout, NULL, _IOLBF, 0);
   Suite *s = suite_create("curve");
@@ -684,6 +828,8 @@ int main(void) {
   tcase_add_test(tc, many_pieces_answer_fast);
   tcase_add_test(tc, hard_closest_cases);
   tcase_add_test(tc, queries_are_thread_safe);
+  tcase_add_test(tc, catmull_keeps_its_points);
+  tcase_add_test(tc, stored_layouts_answer_alike);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }

@@ -190,6 +190,40 @@ START_TEST(bytes_per_kind) {
   oc_enode *bi = EOK(oc_enode_blend(ki, 3, &err));
   ck_assert_uint_eq(bytes_of(bi),
                     oc_enode_size(bi) + bytes_of(img) + bytes_of(img2) - gb);
+  /* the nodes alone, and a river's data: its record and its profile's
+  ** place (64), the profile's 6 knots (doubles: the stream's depth 0.8 is
+  ** no float; 8 + 96) and the skeleton (572: 8 points kept, control
+  ** points derived); a profile the same as the one before is stored once,
+  ** and knots that are floats exactly take 4 bytes each */
+  oc_enode_stats st;
+  ck_assert_int_eq(oc_enode_get_stats(riv, &st, &err), OC_OK);
+  ck_assert_uint_eq(st.node_bytes, 96);
+  ck_assert_uint_eq(st.bytes, 96 + 64 + 104 + 572);
+  ck_assert_int_eq(oc_enode_get_stats(bi, &st, &err), OC_OK);
+  ck_assert_uint_eq(st.node_bytes, oc_enode_size(bi) + oc_enode_size(img) +
+                                       oc_enode_size(img2));
+  oc_vec3 pts[8];
+  for (int i = 0; i < 8; i++)
+    pts[i] = (oc_vec3){50.0 * i, 20 * sin(i), 5};
+  double kx[6] = {-30, -10, -5, 5, 10, 30}, kv[6] = {0, -1, -2, -2, -1, 0};
+  double kx3[6] = {-30, -10, -5, 5, 10, 30.1};
+  oc_enode_profile pr[3] = {{0, kx, kv, 6}, {0.5, kx, kv, 6}, {1, kx3, kv, 6}};
+  oc_enode_curve_params cp = {pts, 8, OC_ECURVE_CATMULL, 40, 5, pr, 2};
+  oc_enode *one = EOK(oc_enode_curve(&cp, &err));
+  cp.nprofiles = 1;
+  oc_enode *single = EOK(oc_enode_curve(&cp, &err));
+  cp.nprofiles = 3;
+  oc_enode *three = EOK(oc_enode_curve(&cp, &err));
+  /* (16 bytes a profile's place and arc length; 30.1 is no float: 8 + 96) */
+  ck_assert_uint_eq(bytes_of(one), bytes_of(single) + 16);
+  ck_assert_uint_eq(bytes_of(three), bytes_of(single) + 32 + 8 + 96);
+  oc_pcurve *sk = oc_ecurve_skeleton(pts, 8, OC_ECURVE_CATMULL, &err);
+  ck_assert_msg(sk != NULL, "%s", err.msg);
+  ck_assert_uint_eq(bytes_of(single), 96 + 64 + 8 + 48 + oc_curve_bytes(sk));
+  oc_curve_free(sk);
+  oc_enode_release(one);
+  oc_enode_release(single);
+  oc_enode_release(three);
   oc_enode *all[] = {fl,  plain, noisy, odd, riv,  lake,  img,   img2,
                      bl,  rep,   lerp,  add, addb, adds,  moved, warp,
                      lod, b5,    riv2,  bi,  imgc, adds1, adds2, addsum};
