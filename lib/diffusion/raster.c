@@ -140,6 +140,16 @@ static void paint_row(const rctx *rc, const ritem *it, int j) {
     if (fabs(dy) > w) return;
     double hw = sqrt(w * w - dy * dy);
     xlo = it->vx - hw, xhi = it->vx + hw;
+    /* the sector between the two directions: along the previous one > 0,
+    ** along the next < 0 (each a half-plane, so an interval of the row;
+    ** widened by a cell, the test below stays exact) */
+    if (!clip(it->tx, -it->vx * it->tx + dy * it->ty, 0, INFINITY, &xlo,
+              &xhi) ||
+        !clip(it->t2x, -it->vx * it->t2x + dy * it->t2y, -INFINITY, 0, &xlo,
+              &xhi)) {
+      if (!(xlo <= xhi + 2 * cell)) return;
+    }
+    xlo -= cell, xhi += cell;
   } else {
     /* along = (x - vx) tx + (y - vy) ty, across = -(x - vx) ty + (y - vy) tx */
     double dy = y - it->vy;
