@@ -64,38 +64,48 @@ typedef struct rctx {
 
 #define DEG (3.14159265358979323846 / 180)
 
+/* Attribute q of item it's curve fc at the fraction f of the item
+** (normalised arc length u): interpolated between the item's ends when
+** it is linear there (the slope angles then in degrees), else looked up
+** (the angles as tan). */
+static inline double attr(const oc_fcurve *fc, const ritem *it, int q, double f,
+                          double u) {
+  if (it->linear) return it->a0[q] + f * (it->a1[q] - it->a0[q]);
+  double v[FA_COUNT];
+  oc_fcurve_attrs(fc, u, 1u << q, v);
+  return v[q];
+}
+
 /* The contributions of item it's curve to cell k at the fraction f of
 ** the item (arc length s), distance dist on the left (or right) side,
 ** outward normal (nox, noy); no slope when !slopes (conservative cells
-** beyond an end). */
+** beyond an end). Each attribute is looked up only where it is used
+** (most cells lie in a slope band and need 3 of them). */
 static void deposit(const rctx *rc, size_t k, const ritem *it, double f,
                     double s, double dist, int left, double nox, double noy,
                     int slopes) {
   uint32_t ci = it->curve;
   const oc_fcurve *fc = rc->cv[ci].fc;
-  double a[FA_COUNT], u = fc->length > 0 ? s / fc->length : 0;
-  if (it->linear) {
-    for (int q = FA_RADIUS; q < FA_COUNT; q++)
-      a[q] = it->a0[q] + f * (it->a1[q] - it->a0[q]);
-  } else { /* (the angles as tan) */
-    oc_fcurve_attrs(fc, u, ((1u << FA_COUNT) - 1) & ~(1u << FA_HEIGHT), a);
-  }
-  double r = a[FA_RADIUS];
+  unsigned has = fc->has;
+  double u = !it->linear && fc->length > 0 ? s / fc->length : 0;
+  double r = attr(fc, it, FA_RADIUS, f, u);
   double ws = fmax(r, 0.5 * rc->lv->cell * (fabs(nox) + fabs(noy)));
-  if (dist <= ws && (fc->has & (OC_FC_HEIGHT | OC_FC_NOISE))) {
-    if (fc->has & OC_FC_HEIGHT) {
+  if (dist <= ws && (has & (OC_FC_HEIGHT | OC_FC_NOISE))) {
+    if (it->linear) u = fc->length > 0 ? s / fc->length : 0;
+    if (has & OC_FC_HEIGHT) {
+      double a[FA_COUNT];
       oc_fcurve_attrs(fc, u, 1u << FA_HEIGHT, a);
       rc->h[k] += (float)a[FA_HEIGHT];
       if (rc->hc[k] < 0xffffu) rc->hc[k]++;
     }
-    if (fc->has & OC_FC_NOISE) {
-      rc->A[k] += (float)a[FA_AMP];
-      rc->R[k] += (float)a[FA_ROUGH];
+    if (has & OC_FC_NOISE) {
+      rc->A[k] += (float)attr(fc, it, FA_AMP, f, u);
+      rc->R[k] += (float)attr(fc, it, FA_ROUGH, f, u);
       if (rc->nc[k] < 0xffffu) rc->nc[k]++;
     }
   }
-  if (!slopes || !(fc->has & OC_FC_SLOPE) || !(dist > r)) return;
-  double ext = left ? a[FA_EXTA] : a[FA_EXTB];
+  if (!slopes || !(has & OC_FC_SLOPE) || !(dist > r)) return;
+  double ext = attr(fc, it, left ? FA_EXTA : FA_EXTB, f, u);
   if (!(ext > 0 && dist <= r + ext)) return;
   uint16_t me = (uint16_t)(ci + 1);
   if (rc->owner[k] == CONFLICT_OWNER) return;
@@ -104,10 +114,10 @@ static void deposit(const rctx *rc, size_t k, const ritem *it, double f,
     return;
   }
   rc->owner[k] = me;
-  double tn = left ? a[FA_LEFT] : a[FA_RIGHT];
+  double tn = attr(fc, it, left ? FA_LEFT : FA_RIGHT, f, u);
   if (it->linear) tn = tan(tn * DEG);
   double val = tn * (1 - (dist - r) / ext);
-  double sg = (fc->has & OC_FC_HEIGHT) ? 1 : -1;
+  double sg = (has & OC_FC_HEIGHT) ? 1 : -1;
   rc->gx[k] += (float)(sg * nox);
   rc->gy[k] += (float)(sg * noy);
   rc->gd[k] += (float)(sg * val);
