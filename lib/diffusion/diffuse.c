@@ -117,9 +117,17 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
   int rc = check(p, err);
   if (rc) return rc;
   const oc_heightfield_grid *g = &p->grid;
+  /* the output grid (zero) is the finest level's elevation: the noise
+  ** detail is added to it in place at the end */
+  out->height = grid_of(p, NULL, err);
+  if (!out->height) return err ? err->code : OC_ENOMEM;
   oc_dpyramid py;
-  rc = oc_dpyramid_init(&py, g->nx, g->ny, g->cell, err);
-  if (rc) return rc;
+  rc = oc_dpyramid_init(&py, g->nx, g->ny, g->cell,
+                        oc_heightfield_samples_mut(out->height), err);
+  if (rc) {
+    oc_diffusion_result_clear(out);
+    return rc;
+  }
   oc_draster_stats st;
   rc = oc_draster(&py, g->x0, g->y0, p->curves, p->ncurves, p->progress, 0.05,
                   &st, err);
@@ -136,8 +144,7 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
     rc = oc_seterr(err, OC_ECANCEL, "diffusion cancelled");
     goto done;
   }
-  rc = oc_dpyramid_grow(&py, err);
-  if (rc) goto done;
+  oc_dpyramid_grow(&py);
   oc_dpyramid_restrict(&py);
   /* the elevation reads the guide on slope samples (constrained: their
   ** values stay) and on conflicts: without conflicts nothing to fill */
@@ -160,7 +167,6 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
   if (rc) goto done;
   oc_dpyramid_shrink(&py); /* the finest grid's maps are all that is left */
   const oc_dlevel *lv = &py.lv[0];
-  size_t ns = (size_t)lv->nx * (size_t)lv->ny;
   oc_ddetail dd = {g->x0,
                    g->y0,
                    g->cell,
@@ -169,8 +175,7 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
                    p->ratio > 0 ? p->ratio : 2,
                    p->octaves ? p->octaves : 4,
                    p->seed};
-  float *detail = NULL;
-  if (!st.strict_noise) memset(lv->map[MAP_A], 0, ns * sizeof(float));
+  float *detail = NULL; /* (without strict noise A stayed 0) */
   if (p->maps) {
     out->smooth = grid_of(p, lv->map[MAP_H], err);
     out->amplitude = out->smooth ? grid_of(p, lv->map[MAP_A], err) : NULL;
@@ -182,11 +187,6 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
       goto done;
     }
     detail = oc_heightfield_samples_mut(out->detail);
-  }
-  out->height = grid_of(p, NULL, err);
-  if (!out->height) {
-    rc = err ? err->code : OC_ENOMEM;
-    goto done;
   }
   rc = oc_ddetail_grid(&dd, lv, oc_heightfield_samples_mut(out->height), detail,
                        p->progress, 0.8, 0.2, err);

@@ -324,11 +324,11 @@ int oc_draster(oc_dpyramid *py, double x0, double y0, oc_fcurve *const *curves,
   oc_dlevel *lv = &py->lv[0];
   size_t ns = (size_t)lv->nx * (size_t)lv->ny;
   rcurve *cv = malloc((ncurves ? ncurves : 1) * sizeof *cv);
-  uint16_t *cnt = calloc(4 * ns, sizeof *cnt);
+  uint16_t *cnt = oc_dpyramid_counters(py);
   ritem *it = NULL;
   size_t nit = 0, cap = 0;
   int rc = OC_OK;
-  if (!cv || !cnt) {
+  if (!cv) {
     rc = oc_seterr(err, OC_ENOMEM, "out of memory (%zu samples)", ns);
     goto done;
   }
@@ -343,8 +343,6 @@ int oc_draster(oc_dpyramid *py, double x0, double y0, oc_fcurve *const *curves,
                      err);
     if (rc) goto done;
   }
-  for (int m = 0; m < MAP_COUNT; m++)
-    memset(lv->map[m], 0, ns * sizeof(float));
   rctx x = {lv,
             x0,
             y0,
@@ -362,18 +360,36 @@ int oc_draster(oc_dpyramid *py, double x0, double y0, oc_fcurve *const *curves,
             cnt + 2 * ns,
             cnt + 3 * ns};
   int nb = (lv->ny + BLOCK - 1) / BLOCK, stop = 0, done = 0;
-#pragma omp parallel for schedule(dynamic, 1)
+  size_t nx = (size_t)lv->nx, ss = 0, sl = 0, sc = 0, sn = 0;
+  float *maps[MAP_COUNT] = {x.h, x.gx, x.gy, x.gd, x.A, x.R};
+  /* each block of rows zeroes its maps and counters (written first:
+  ** fresh memory read first faults twice, for the zero page and again
+  ** for the copy), paints the items that reach it, then normalises its
+  ** rows while they are in cache */
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : ss, sl, sc, sn)
   for (int b = 0; b < nb; b++) {
     int halt;
 #pragma omp atomic read
     halt = stop;
     if (halt) continue;
     int j0 = b * BLOCK, j1 = j0 + BLOCK < lv->ny ? j0 + BLOCK : lv->ny;
+    size_t k0 = (size_t)j0 * nx, nk = (size_t)(j1 - j0) * nx;
+    for (int m = 0; m < MAP_COUNT; m++)
+      memset(maps[m] + k0, 0, nk * sizeof(float));
+    for (int m = 0; m < 4; m++)
+      memset(cnt + (size_t)m * ns + k0, 0, nk * sizeof *cnt);
     double ylo = y0 + j0 * lv->cell, yhi = y0 + (j1 - 1) * lv->cell;
     for (size_t t = 0; t < nit; t++) {
       if (it[t].yhi < ylo || it[t].ylo > yhi) continue;
       for (int j = j0; j < j1; j++)
         paint_row(&x, &it[t], j);
+    }
+    for (size_t k = k0; k < k0 + nk; k++) {
+      normalise(&x, k, lv->flags);
+      ss += (lv->flags[k] & DF_H) != 0;
+      sl += (lv->flags[k] & DF_SLOPE) != 0;
+      sc += (lv->flags[k] & DF_CONFLICT) != 0;
+      sn += (lv->flags[k] & DF_NOISE) != 0;
     }
     int d;
 #pragma omp atomic capture
@@ -388,19 +404,9 @@ int oc_draster(oc_dpyramid *py, double x0, double y0, oc_fcurve *const *curves,
     rc = oc_seterr(err, OC_ECANCEL, "diffusion cancelled");
     goto done;
   }
-  size_t ss = 0, sl = 0, sc = 0, sn = 0;
-#pragma omp parallel for schedule(static) reduction(+ : ss, sl, sc, sn)
-  for (size_t k = 0; k < ns; k++) {
-    normalise(&x, k, lv->flags);
-    ss += (lv->flags[k] & DF_H) != 0;
-    sl += (lv->flags[k] & DF_SLOPE) != 0;
-    sc += (lv->flags[k] & DF_CONFLICT) != 0;
-    sn += (lv->flags[k] & DF_NOISE) != 0;
-  }
   st->strict = ss, st->slope = sl, st->conflict = sc, st->strict_noise = sn;
 done:
   free(it);
-  free(cnt);
   free(cv);
   return rc;
 }
