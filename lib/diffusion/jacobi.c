@@ -435,6 +435,35 @@ static inline void split(int i, int nc, int *a, int *b, float *wb) {
   *b = a0 + 1 >= nc ? nc - 1 : a0 + 1;
 }
 
+/* The interior of fine row fr (samples 1 .. 2 nI) from coarse rows ca,
+** cb blended by uy, wy: fine 2I + 1 and 2I + 2 lie between coarse I and
+** I + 1 (weights 1/4 and 3/4 of I + 1); unchanged where fixed. */
+INLINE void prolong_inner(int add, float *fr, const uint8_t *fl, uint8_t fix,
+                          const float *ca, const float *cb, float uy, float wy,
+                          int nI) {
+#pragma omp simd
+  for (int I = 0; I < nI; I++) {
+    float va = uy * ca[I] + wy * cb[I], vb = uy * ca[I + 1] + wy * cb[I + 1];
+    float v1 = 0.75f * va + 0.25f * vb, v2 = 0.25f * va + 0.75f * vb;
+    int i = 2 * I + 1;
+    float o1 = add ? fr[i] + v1 : v1, o2 = add ? fr[i + 1] + v2 : v2;
+    fr[i] = sel(fl[i] & fix, fr[i], o1);
+    fr[i + 1] = sel(fl[i + 1] & fix, fr[i + 1], o2);
+  }
+}
+
+static CLONES void prolong_set(float *fr, const uint8_t *fl, uint8_t fix,
+                               const float *ca, const float *cb, float uy,
+                               float wy, int nI) {
+  prolong_inner(0, fr, fl, fix, ca, cb, uy, wy, nI);
+}
+
+static CLONES void prolong_add(float *fr, const uint8_t *fl, uint8_t fix,
+                               const float *ca, const float *cb, float uy,
+                               float wy, int nI) {
+  prolong_inner(1, fr, fl, fix, ca, cb, uy, wy, nI);
+}
+
 /* Fine sample i of a row from the y-blended coarse values at a, b. */
 INLINE void put_fine(float *fr, const uint8_t *fl, uint8_t fix, int add, int i,
                      float v) {
@@ -446,6 +475,8 @@ void oc_dprolong(const oc_dop *op, const oc_dlevel *lc, const float *c,
                  const oc_dlevel *lf, float *f, int add) {
   uint8_t fix = op->kind == DK_LAPLACE ? op->mask : DF_H;
   int ncx = lc->nx, nfx = lf->nx;
+  /* the interior pairs: coarse I + 1 < ncx and fine 2 I + 2 < nfx */
+  int nI = ncx - 1 < (nfx - 1) / 2 ? ncx - 1 : (nfx - 1) / 2;
 #pragma omp parallel for schedule(static) if (OC_DPAR(lf))
   for (int j = 0; j < lf->ny; j++) {
     int ja, jb;
@@ -456,15 +487,12 @@ void oc_dprolong(const oc_dop *op, const oc_dlevel *lc, const float *c,
     float *fr = f + (size_t)j * (size_t)nfx;
     const uint8_t *fl = lf->flags + (size_t)j * (size_t)nfx;
     float uy = 1 - wy;
-    /* fine 2I + 1 and 2I + 2 lie between coarse I and I + 1 (weights
-    ** 1/4 and 3/4 of I + 1); fine 0 and the last ones are clamped */
-    int I = 0;
-    for (; I + 1 < ncx && 2 * I + 2 < nfx; I++) {
-      float va = uy * ca[I] + wy * cb[I], vb = uy * ca[I + 1] + wy * cb[I + 1];
-      put_fine(fr, fl, fix, add, 2 * I + 1, 0.75f * va + 0.25f * vb);
-      put_fine(fr, fl, fix, add, 2 * I + 2, 0.25f * va + 0.75f * vb);
-    }
-    for (int i = 0; i < nfx; i = i ? i + 1 : 2 * I + 1) {
+    if (add)
+      prolong_add(fr, fl, fix, ca, cb, uy, wy, nI);
+    else
+      prolong_set(fr, fl, fix, ca, cb, uy, wy, nI);
+    /* fine 0 and the last ones, clamped */
+    for (int i = 0; i < nfx; i = i ? i + 1 : 2 * nI + 1) {
       int ia, ib;
       float wx;
       split(i, ncx, &ia, &ib, &wx);
