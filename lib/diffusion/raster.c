@@ -45,6 +45,9 @@ typedef struct ritem {
   ** the item and interpolated; else looked up per sample) */
   double a0[FA_COUNT], a1[FA_COUNT];
   int linear;
+  double w;            /* the farthest a cell it paints lies from it */
+  double tan_l, tan_r; /* linear, the same angle at both ends: its tan */
+  int same_l, same_r;
 } ritem;
 
 typedef struct rcurve {
@@ -114,8 +117,13 @@ static void deposit(const rctx *rc, size_t k, const ritem *it, double f,
     return;
   }
   rc->owner[k] = me;
-  double tn = attr(fc, it, left ? FA_LEFT : FA_RIGHT, f, u);
-  if (it->linear) tn = tan(tn * DEG);
+  double tn;
+  if (it->linear && (left ? it->same_l : it->same_r))
+    tn = left ? it->tan_l : it->tan_r; /* (a0 + f 0 = a0: the same tan) */
+  else {
+    tn = attr(fc, it, left ? FA_LEFT : FA_RIGHT, f, u);
+    if (it->linear) tn = tan(tn * DEG);
+  }
   double val = tn * (1 - (dist - r) / ext);
   double sg = (has & OC_FC_HEIGHT) ? 1 : -1;
   rc->gx[k] += (float)(sg * nox);
@@ -143,7 +151,7 @@ static int clip(double a, double b, double lo, double hi, double *xlo,
 static void paint_row(const rctx *rc, const ritem *it, int j) {
   const oc_dlevel *lv = rc->lv;
   double cell = lv->cell, y = rc->y0 + j * cell;
-  double w = rc->cv[it->curve].reach;
+  double w = it->w;
   double xlo = -INFINITY, xhi = INFINITY;
   if (it->wedge) {
     double dy = y - it->vy;
@@ -206,8 +214,14 @@ static double attr_max(const oc_fattr *t) {
 }
 
 /* The linear attributes of item it at its ends (arc lengths s0, s1), and
-** whether they are linear along it: no knot strictly between. */
-static void item_attrs(const oc_fcurve *fc, ritem *it, double s0, double s1) {
+** whether they are linear along it: no knot strictly between; then its
+** reach (the curve's otherwise: at most reach) from the largest radius
+** and extent at its ends (an attribute linear along the item lies
+** between its end values, to a rounding: the margin) or the
+** conservative half-extent of a cell, and the tan of a slope angle the
+** same at both ends. */
+static void item_attrs(const oc_fcurve *fc, ritem *it, double s0, double s1,
+                       double cell, double reach) {
   double u0 = fc->length > 0 ? s0 / fc->length : 0,
          u1 = fc->length > 0 ? s1 / fc->length : 0;
   it->linear = 1;
@@ -218,6 +232,18 @@ static void item_attrs(const oc_fcurve *fc, ritem *it, double s0, double s1) {
     for (size_t i = 0; i < t->n; i++)
       if (t->u[i] > u0 && t->u[i] < u1) it->linear = 0;
   }
+  it->w = reach;
+  it->same_l = it->same_r = 0;
+  if (!it->linear) return;
+  double r = fmax(it->a0[FA_RADIUS], it->a1[FA_RADIUS]);
+  double e = fmax(fmax(it->a0[FA_EXTA], it->a1[FA_EXTA]),
+                  fmax(it->a0[FA_EXTB], it->a1[FA_EXTB]));
+  double w = fmax(r + fmax(e, 0), cell);
+  it->w = fmin(reach, w + 1e-6 * w);
+  it->same_l = it->a0[FA_LEFT] == it->a1[FA_LEFT];
+  it->same_r = it->a0[FA_RIGHT] == it->a1[FA_RIGHT];
+  it->tan_l = tan(it->a0[FA_LEFT] * DEG);
+  it->tan_r = tan(it->a0[FA_RIGHT] * DEG);
 }
 
 /* Appends the items of one curve (segments, then the wedge after each
@@ -257,11 +283,11 @@ static int curve_items(const oc_fcurve *fc, uint32_t ci, double cell,
     s.curve = ci;
     s.vx = v[k].x, s.vy = v[k].y, s.tx = dx / len, s.ty = dy / len;
     s.len = len, s.s0 = v[k].s, s.s1 = v[k + 1].s;
-    item_attrs(fc, &s, s.s0, s.s1);
+    item_attrs(fc, &s, s.s0, s.s1, cell, reach);
     double half = 0.5 * cell * (fabs(s.tx) + fabs(s.ty));
     s.e0 = (k == 0 && !closed) ? half : 0;
     s.e1 = (k + 2 == nv && !closed) ? half : 0;
-    double e = fmax(s.e0, s.e1) + reach;
+    double e = fmax(s.e0, s.e1) + s.w;
     s.ylo = fmin(v[k].y, v[k + 1].y) - e, s.yhi = fmax(v[k].y, v[k + 1].y) + e;
     if (have_prev) {
       double cr = ptx * s.ty - pty * s.tx;
@@ -269,9 +295,9 @@ static int curve_items(const oc_fcurve *fc, uint32_t ci, double cell,
         ritem w = {0};
         w.curve = ci, w.wedge = 1, w.vx = v[k].x, w.vy = v[k].y;
         w.tx = ptx, w.ty = pty, w.t2x = s.tx, w.t2y = s.ty, w.s0 = v[k].s;
-        item_attrs(fc, &w, w.s0, w.s0);
+        item_attrs(fc, &w, w.s0, w.s0, cell, reach);
         w.convex_left = cr < 0;
-        w.ylo = v[k].y - reach, w.yhi = v[k].y + reach;
+        w.ylo = v[k].y - w.w, w.yhi = v[k].y + w.w;
         (*it)[(*n)++] = w;
       }
     }
@@ -285,9 +311,9 @@ static int curve_items(const oc_fcurve *fc, uint32_t ci, double cell,
     ritem w = {0};
     w.curve = ci, w.wedge = 1, w.vx = v[0].x, w.vy = v[0].y;
     w.tx = ptx, w.ty = pty, w.t2x = ftx, w.t2y = fty, w.s0 = v[0].s;
-    item_attrs(fc, &w, w.s0, w.s0);
+    item_attrs(fc, &w, w.s0, w.s0, cell, reach);
     w.convex_left = cr < 0;
-    w.ylo = v[0].y - reach, w.yhi = v[0].y + reach;
+    w.ylo = v[0].y - w.w, w.yhi = v[0].y + w.w;
     (*it)[(*n)++] = w;
   }
   free(v);
