@@ -69,29 +69,6 @@ static int check(const oc_diffusion_params *p, oc_error *err) {
   return OC_OK;
 }
 
-/* n back to unit length after its diffusion. Where the diffused n is
-** shorter than COHERENT (directions that met from opposite sides and
-** cancel: the sources and sinks of the filled field) it is dropped, so
-** that the elevation follows Laplace there: the upwind equations of two
-** samples each upwind of the other contradict each other and would stall
-** the solver. Only on the finest grid: the coarse grids keep every
-** direction, which their corrections need (measured: dropping there too
-** stalls the V-cycles). */
-static void renormalise(oc_dlevel *lv, double coherent) {
-  float *gx = lv->map[MAP_GX], *gy = lv->map[MAP_GY];
-  size_t ns = (size_t)lv->nx * (size_t)lv->ny;
-#pragma omp parallel for schedule(static) if (OC_DPAR(lv))
-  for (size_t q = 0; q < ns; q++) {
-    double g = sqrt((double)gx[q] * gx[q] + (double)gy[q] * gy[q]);
-    if (g > (lv->flags[q] & DF_SLOPE ? 1e-6 : coherent)) {
-      gx[q] = (float)(gx[q] / g);
-      gy[q] = (float)(gy[q] / g);
-    } else {
-      gx[q] = gy[q] = 0;
-    }
-  }
-}
-
 static oc_heightfield *grid_of(const oc_diffusion_params *p, const float *z,
                                oc_error *err) {
   const oc_heightfield_grid *g = &p->grid;
@@ -154,11 +131,20 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
       rc = solve(&py, p, DK_LAPLACE, maps[q], DF_SLOPE, 0.05 + 0.1 * q, 0.1,
                  out, err);
     if (rc) goto done;
-    for (int k = 0; k < py.nlevels; k++)
-      renormalise(&py.lv[k], k ? 1e-6 : COHERENT);
   }
+  /* n back to unit length after its diffusion (when there was one).
+  ** Where the diffused n is shorter than COHERENT (directions that met
+  ** from opposite sides and cancel: the sources and sinks of the filled
+  ** field) it is dropped, so that the elevation follows Laplace there:
+  ** the upwind equations of two samples each upwind of the other
+  ** contradict each other and would stall the solver. Only on the finest
+  ** grid: the coarse grids keep every direction, which their corrections
+  ** need (measured: dropping there too stalls the V-cycles). */
   for (int k = 0; k < py.nlevels; k++)
-    oc_dguide_prepare(&py.lv[k], p->scheme == OC_DIFFUSION_PAPER);
+    oc_dguide_prepare(&py.lv[k], p->scheme == OC_DIFFUSION_PAPER,
+                      !st.conflict ? -1
+                      : k          ? 1e-6
+                                   : COHERENT);
   rc = solve(&py, p, DK_GUIDED, MAP_H, DF_H, 0.35, 0.3, out, err);
   if (!rc && st.strict_noise)
     rc = solve(&py, p, DK_LAPLACE, MAP_A, DF_NOISE, 0.65, 0.075, out, err);

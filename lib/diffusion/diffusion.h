@@ -157,9 +157,11 @@ enum { DF_GACT = 16, DF_SX = 32, DF_SY = 64 };
 /* Folds the guide of level lv (n in MAP_GX, MAP_GY, the drop per metre
 ** in MAP_GD) into the relaxation's coefficients: MAP_GX becomes the
 ** weight t of the upwind x neighbour, MAP_GY the constant c (see
-** jacobi.c), and the flags get DF_GACT, DF_SX, DF_SY. After the gradient
-** diffusion, before the elevation's. */
-void oc_dguide_prepare(oc_dlevel *lv, int paper);
+** jacobi.c), and the flags get DF_GACT, DF_SX, DF_SY. With coherent >= 0
+** (after the gradient diffusion) n is first set back to unit length, or
+** to 0 where shorter than coherent (1e-6 on slope samples). Before the
+** elevation's diffusion. */
+void oc_dguide_prepare(oc_dlevel *lv, int paper, double coherent);
 
 /* One Jacobi sweep of level lv from x into y: y = M x + c, or with
 ** op->hom (the correction equation of a V-cycle) y = M x + rhs (rhs NULL:

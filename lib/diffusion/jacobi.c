@@ -58,36 +58,67 @@
 #define CLONES __attribute__((noinline))
 #endif
 
-void oc_dguide_prepare(oc_dlevel *lv, int paper) {
-  float *gx = lv->map[MAP_GX], *gy = lv->map[MAP_GY];
-  const float *gd = lv->map[MAP_GD];
-  size_t ns = (size_t)lv->nx * (size_t)lv->ny;
-  double cell = lv->cell;
-#pragma omp parallel for schedule(static) if (OC_DPAR(lv))
-  for (size_t k = 0; k < ns; k++) {
-    uint8_t f = (uint8_t)(lv->flags[k] & ~(DF_GACT | DF_SX | DF_SY));
-    double nx = gx[k], ny = gy[k], ax = fabs(nx), ay = fabs(ny);
-    float t = 0, c = 0;
-    if ((f & DF_GUIDE) && ax + ay > 1e-6) {
-      double G = gd[k] * cell;
-      f |= DF_GACT;
-      if (nx < 0) f |= DF_SX; /* upwind: i + 1 */
-      if (ny < 0) f |= DF_SY; /* upwind: j + 1 */
-      if (paper) {
-        t = (float)(0.5 * nx * nx / (nx * nx + ny * ny));
-        c = (float)(-0.5 * G);
-      } else {
-        t = (float)(0.5 * ax / (ax + ay));
-        c = (float)(-0.5 * G / (ax + ay));
-      }
+#define INLINE static inline __attribute__((always_inline))
+
+/* Samples [k0, k1) of oc_dguide_prepare (after the gradient's diffusion
+** with renorm, as renormalise did and then the folding, in one pass). */
+INLINE void guide_body(int renorm, int paper, uint8_t *flags, float *gx,
+                       float *gy, const float *gd, size_t k0, size_t k1,
+                       double cell, double coherent) {
+#pragma omp simd
+  for (size_t k = k0; k < k1; k++) {
+    uint8_t fl = flags[k];
+    float fx = gx[k], fy = gy[k];
+    if (renorm) {
+      double g = sqrt((double)fx * fx + (double)fy * fy);
+      int keep = g > ((fl & DF_SLOPE) ? 1e-6 : coherent);
+      float ux = (float)(fx / g), uy = (float)(fy / g);
+      fx = keep ? ux : 0;
+      fy = keep ? uy : 0;
     }
-    lv->flags[k] = f;
-    gx[k] = t;
-    gy[k] = c;
+    uint8_t f = (uint8_t)(fl & ~(DF_GACT | DF_SX | DF_SY));
+    double nx = fx, ny = fy, ax = fabs(nx), ay = fabs(ny);
+    int on = ((f & DF_GUIDE) != 0) & (ax + ay > 1e-6);
+    double G = gd[k] * cell;
+    float t, c;
+    if (paper) {
+      t = (float)(0.5 * nx * nx / (nx * nx + ny * ny));
+      c = (float)(-0.5 * G);
+    } else {
+      t = (float)(0.5 * ax / (ax + ay));
+      c = (float)(-0.5 * G / (ax + ay));
+    }
+    uint8_t sx = nx < 0 ? DF_SX : 0, sy = ny < 0 ? DF_SY : 0; /* upwind +1 */
+    flags[k] = on ? (uint8_t)(f | DF_GACT | sx | sy) : f;
+    gx[k] = on ? t : 0;
+    gy[k] = on ? c : 0;
   }
 }
 
-#define INLINE static inline __attribute__((always_inline))
+/* (sqrt of a sum of squares never sets errno: without math-errno the
+** loop vectorises) */
+#define GUIDEFN(RN, PA)                                                        \
+  static CLONES                                                                \
+      __attribute__((optimize("no-math-errno"))) void guide_##RN##PA(          \
+          uint8_t *flags, float *gx, float *gy, const float *gd, size_t k0,    \
+          size_t k1, double cell, double coherent) {                           \
+    guide_body(RN, PA, flags, gx, gy, gd, k0, k1, cell, coherent);             \
+  }
+GUIDEFN(0, 0)
+GUIDEFN(0, 1)
+GUIDEFN(1, 0)
+GUIDEFN(1, 1)
+
+void oc_dguide_prepare(oc_dlevel *lv, int paper, double coherent) {
+  size_t nx = (size_t)lv->nx;
+  void (*fn)(uint8_t *, float *, float *, const float *, size_t, size_t, double,
+             double) = coherent >= 0 ? (paper ? guide_11 : guide_10)
+                                     : (paper ? guide_01 : guide_00);
+#pragma omp parallel for schedule(static) if (OC_DPAR(lv))
+  for (int j = 0; j < lv->ny; j++)
+    fn(lv->flags, lv->map[MAP_GX], lv->map[MAP_GY], lv->map[MAP_GD],
+       (size_t)j * nx, (size_t)j * nx + nx, lv->cell, coherent);
+}
 
 /* a where c != 0, else b, by bit masks: a conditional expression lets
 ** the compiler move the work of one side into a branch, and a loop with
