@@ -84,15 +84,16 @@ static inline double attr(const oc_fcurve *fc, const ritem *it, int q, double f,
 ** outward normal (nox, noy); no slope when !slopes (conservative cells
 ** beyond an end). Each attribute is looked up only where it is used
 ** (most cells lie in a slope band and need 3 of them). */
-static void deposit(const rctx *rc, size_t k, const ritem *it, double f,
-                    double s, double dist, int left, double nox, double noy,
-                    int slopes) {
+static inline __attribute__((always_inline)) void
+deposit(const rctx *rc, size_t k, const ritem *it, double f, double s,
+        double dist, int left, double nox, double noy, int slopes) {
   uint32_t ci = it->curve;
   const oc_fcurve *fc = rc->cv[ci].fc;
   unsigned has = fc->has;
   double u = !it->linear && fc->length > 0 ? s / fc->length : 0;
   double r = attr(fc, it, FA_RADIUS, f, u);
-  double ws = fmax(r, 0.5 * rc->lv->cell * (fabs(nox) + fabs(noy)));
+  double half = 0.5 * rc->lv->cell * (fabs(nox) + fabs(noy));
+  double ws = r > half ? r : half; /* (fmax: a call; neither is NaN) */
   if (dist <= ws && (has & (OC_FC_HEIGHT | OC_FC_NOISE))) {
     if (it->linear) u = fc->length > 0 ? s / fc->length : 0;
     if (has & OC_FC_HEIGHT) {
@@ -331,15 +332,21 @@ static void normalise(const rctx *rc, size_t k, uint8_t *flags) {
     rc->R[k] /= rc->nc[k];
     f |= DF_NOISE;
   }
-  double gx = rc->gx[k], gy = rc->gy[k], g = sqrt(gx * gx + gy * gy);
-  if (rc->owner[k] == CONFLICT_OWNER || (rc->gc[k] && !(g > 1e-6))) {
+  int conflict = rc->owner[k] == CONFLICT_OWNER;
+  if (!conflict && rc->gc[k]) { /* (the norm only where slopes were) */
+    double gx = rc->gx[k], gy = rc->gy[k], g = sqrt(gx * gx + gy * gy);
+    if (g > 1e-6) {
+      rc->gx[k] = (float)(gx / g);
+      rc->gy[k] = (float)(gy / g);
+      rc->gd[k] /= rc->gc[k];
+      f |= DF_SLOPE;
+    } else {
+      conflict = 1;
+    }
+  }
+  if (conflict) {
     f |= DF_CONFLICT;
     rc->gx[k] = rc->gy[k] = rc->gd[k] = 0;
-  } else if (rc->gc[k]) {
-    rc->gx[k] = (float)(gx / g);
-    rc->gy[k] = (float)(gy / g);
-    rc->gd[k] /= rc->gc[k];
-    f |= DF_SLOPE;
   }
   flags[k] = f;
 }
