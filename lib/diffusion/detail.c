@@ -127,7 +127,9 @@ static int init_noise(grid_noise *g, const oc_ddetail *d, int nx, int ny,
     for (int i = 0; i < nx; i++)
       o->col[i] = (int)(node(d->x0 + i * d->cell, o->h, o->wx + 4 * i) - o->i0);
     size_t ni = o->ni;
-#pragma omp parallel for schedule(static) if (o->ni * o->nj > 65536)
+    /* (a node costs a simplex evaluation, some hundred instructions:
+    ** worth two threads from a few thousand on) */
+#pragma omp parallel for schedule(static) if (o->ni * o->nj > 4096)
     for (size_t J = 0; J < o->nj; J++)
       for (size_t I = 0; I < ni; I++) {
         /* node (i0 + I, j0 + J) at S coordinates (i, j) / NODES */

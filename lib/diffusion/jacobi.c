@@ -402,7 +402,9 @@ double oc_djacobi_n(const oc_dop *op, const oc_dlevel *lv, float *x, float *scr,
   int ny = lv->ny, threads = omp_get_max_threads();
   int nb = (ny + FUSED_BLOCK - 1) / FUSED_BLOCK;
   float *ring = NULL;
-  if (n > 1 && n <= FUSED_MAX && OC_DPAR(lv) && !op->hom)
+  /* fused from two blocks and a quarter million updates on: the work of
+  ** the coarser levels' many sweeps is worth a parallel region too */
+  if (n > 1 && n <= FUSED_MAX && nb > 1 && ns * (size_t)n >= 262144 && !op->hom)
     ring = malloc(((size_t)threads * (size_t)(n - 1) * 3 +
                    (size_t)(nb - 1) * 2 * (size_t)n) *
                   nx * sizeof *ring);

@@ -420,7 +420,8 @@ END_TEST
 ** for sweep counts below and above the halo of one row and a last block
 ** shorter than the others. */
 START_TEST(fused_sweeps_match) {
-  enum { NX = 300, NY = 230 }; /* over 65 536 samples: the fused path */
+  /* two blocks or more and n nx ny >= 262 144 (n >= 2): the fused path */
+  enum { NX = 600, NY = 230 };
   size_t ns = (size_t)NX * NY;
   float *m = malloc(MAP_COUNT * ns * sizeof *m), *x = malloc(ns * sizeof *x),
         *y = malloc(ns * sizeof *y), *scr = malloc(ns * sizeof *scr);
