@@ -65,7 +65,6 @@
 INLINE void guide_body(int renorm, int paper, uint8_t *flags, float *gx,
                        float *gy, const float *gd, size_t k0, size_t k1,
                        double cell, double coherent) {
-#pragma omp simd
   for (size_t k = k0; k < k1; k++) {
     uint8_t fl = flags[k];
     float fx = gx[k], fy = gy[k];
@@ -95,13 +94,12 @@ INLINE void guide_body(int renorm, int paper, uint8_t *flags, float *gx,
   }
 }
 
-/* (sqrt of a sum of squares never sets errno: without math-errno the
-** loop vectorises) */
+/* One function per combination, with them constant (no branch on them
+** in the loop). */
 #define GUIDEFN(RN, PA)                                                        \
-  static CLONES                                                                \
-      __attribute__((optimize("no-math-errno"))) void guide_##RN##PA(          \
-          uint8_t *flags, float *gx, float *gy, const float *gd, size_t k0,    \
-          size_t k1, double cell, double coherent) {                           \
+  static CLONES void guide_##RN##PA(uint8_t *flags, float *gx, float *gy,      \
+                                    const float *gd, size_t k0, size_t k1,     \
+                                    double cell, double coherent) {            \
     guide_body(RN, PA, flags, gx, gy, gd, k0, k1, cell, coherent);             \
   }
 GUIDEFN(0, 0)
