@@ -127,7 +127,9 @@ static int init_noise(grid_noise *g, const oc_ddetail *d, int nx, int ny,
     for (int i = 0; i < nx; i++)
       o->col[i] = (int)(node(d->x0 + i * d->cell, o->h, o->wx + 4 * i) - o->i0);
     size_t ni = o->ni;
-#pragma omp parallel for schedule(static) if (o->ni * o->nj > 65536)
+    /* (a node costs a simplex evaluation, some hundred instructions:
+    ** worth two threads from a few thousand on) */
+#pragma omp parallel for schedule(static) if (o->ni * o->nj > 4096)
     for (size_t J = 0; J < o->nj; J++)
       for (size_t I = 0; I < ni; I++) {
         /* node (i0 + I, j0 + J) at S coordinates (i, j) / NODES */
@@ -141,8 +143,15 @@ static int init_noise(grid_noise *g, const oc_ddetail *d, int nx, int ny,
 
 /* Row j of the detail into out (nx), with the thread's scratch (maxni +
 ** 3 nx floats). */
-static void noise_row(const grid_noise *g, int j, const float *A,
-                      const float *R, float *out, float *scr) {
+/* (compiled for AVX-512, AVX2 and the baseline, as the relaxation rows
+** of jacobi.c: the same operations per sample, the same bytes) */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((noinline,
+               target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#endif
+static void
+noise_row(const grid_noise *g, int j, const float *A, const float *R,
+          float *out, float *scr) {
   const oc_ddetail *d = g->d;
   size_t nx = (size_t)g->nx;
   float *q = scr, *w = scr + nx, *sum = scr + 2 * nx, *tmp = scr + 3 * nx;
@@ -167,8 +176,11 @@ static void noise_row(const grid_noise *g, int j, const float *A,
     size_t J = (size_t)(node(y, o->h, wy) - o->j0), ni = o->ni;
     const float *l0 = o->lat + J * ni, *l1 = l0 + ni, *l2 = l1 + ni,
                 *l3 = l2 + ni;
+#pragma omp simd
     for (size_t I = 0; I < ni; I++)
       tmp[I] = wy[0] * l0[I] + wy[1] * l1[I] + wy[2] * l2[I] + wy[3] * l3[I];
+      /* (q, w, sum and tmp are disjoint parts of the scratch) */
+#pragma omp simd
     for (size_t i = 0; i < nx; i++) {
       const float *t = tmp + o->col[i], *wx = o->wx + 4 * i;
       float s = wx[0] * t[0] + wx[1] * t[1] + wx[2] * t[2] + wx[3] * t[3];
@@ -176,6 +188,7 @@ static void noise_row(const grid_noise *g, int j, const float *A,
       w[i] *= q[i];
     }
   }
+#pragma omp simd
   for (size_t i = 0; i < nx; i++)
     out[i] = A[i] * sum[i];
 }

@@ -69,29 +69,6 @@ static int check(const oc_diffusion_params *p, oc_error *err) {
   return OC_OK;
 }
 
-/* n back to unit length after its diffusion. Where the diffused n is
-** shorter than COHERENT (directions that met from opposite sides and
-** cancel: the sources and sinks of the filled field) it is dropped, so
-** that the elevation follows Laplace there: the upwind equations of two
-** samples each upwind of the other contradict each other and would stall
-** the solver. Only on the finest grid: the coarse grids keep every
-** direction, which their corrections need (measured: dropping there too
-** stalls the V-cycles). */
-static void renormalise(oc_dlevel *lv, double coherent) {
-  float *gx = lv->map[MAP_GX], *gy = lv->map[MAP_GY];
-  size_t ns = (size_t)lv->nx * (size_t)lv->ny;
-#pragma omp parallel for schedule(static) if (OC_DPAR(lv))
-  for (size_t q = 0; q < ns; q++) {
-    double g = sqrt((double)gx[q] * gx[q] + (double)gy[q] * gy[q]);
-    if (g > (lv->flags[q] & DF_SLOPE ? 1e-6 : coherent)) {
-      gx[q] = (float)(gx[q] / g);
-      gy[q] = (float)(gy[q] / g);
-    } else {
-      gx[q] = gy[q] = 0;
-    }
-  }
-}
-
 static oc_heightfield *grid_of(const oc_diffusion_params *p, const float *z,
                                oc_error *err) {
   const oc_heightfield_grid *g = &p->grid;
@@ -117,9 +94,17 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
   int rc = check(p, err);
   if (rc) return rc;
   const oc_heightfield_grid *g = &p->grid;
+  /* the output grid (zero) is the finest level's elevation: the noise
+  ** detail is added to it in place at the end */
+  out->height = grid_of(p, NULL, err);
+  if (!out->height) return err ? err->code : OC_ENOMEM;
   oc_dpyramid py;
-  rc = oc_dpyramid_init(&py, g->nx, g->ny, g->cell, err);
-  if (rc) return rc;
+  rc = oc_dpyramid_init(&py, g->nx, g->ny, g->cell,
+                        oc_heightfield_samples_mut(out->height), err);
+  if (rc) {
+    oc_diffusion_result_clear(out);
+    return rc;
+  }
   oc_draster_stats st;
   rc = oc_draster(&py, g->x0, g->y0, p->curves, p->ncurves, p->progress, 0.05,
                   &st, err);
@@ -136,8 +121,7 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
     rc = oc_seterr(err, OC_ECANCEL, "diffusion cancelled");
     goto done;
   }
-  rc = oc_dpyramid_grow(&py, err);
-  if (rc) goto done;
+  oc_dpyramid_grow(&py);
   oc_dpyramid_restrict(&py);
   /* the elevation reads the guide on slope samples (constrained: their
   ** values stay) and on conflicts: without conflicts nothing to fill */
@@ -147,11 +131,20 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
       rc = solve(&py, p, DK_LAPLACE, maps[q], DF_SLOPE, 0.05 + 0.1 * q, 0.1,
                  out, err);
     if (rc) goto done;
-    for (int k = 0; k < py.nlevels; k++)
-      renormalise(&py.lv[k], k ? 1e-6 : COHERENT);
   }
+  /* n back to unit length after its diffusion (when there was one).
+  ** Where the diffused n is shorter than COHERENT (directions that met
+  ** from opposite sides and cancel: the sources and sinks of the filled
+  ** field) it is dropped, so that the elevation follows Laplace there:
+  ** the upwind equations of two samples each upwind of the other
+  ** contradict each other and would stall the solver. Only on the finest
+  ** grid: the coarse grids keep every direction, which their corrections
+  ** need (measured: dropping there too stalls the V-cycles). */
   for (int k = 0; k < py.nlevels; k++)
-    oc_dguide_prepare(&py.lv[k], p->scheme == OC_DIFFUSION_PAPER);
+    oc_dguide_prepare(&py.lv[k], p->scheme == OC_DIFFUSION_PAPER,
+                      !st.conflict ? -1
+                      : k          ? 1e-6
+                                   : COHERENT);
   rc = solve(&py, p, DK_GUIDED, MAP_H, DF_H, 0.35, 0.3, out, err);
   if (!rc && st.strict_noise)
     rc = solve(&py, p, DK_LAPLACE, MAP_A, DF_NOISE, 0.65, 0.075, out, err);
@@ -160,7 +153,6 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
   if (rc) goto done;
   oc_dpyramid_shrink(&py); /* the finest grid's maps are all that is left */
   const oc_dlevel *lv = &py.lv[0];
-  size_t ns = (size_t)lv->nx * (size_t)lv->ny;
   oc_ddetail dd = {g->x0,
                    g->y0,
                    g->cell,
@@ -169,8 +161,7 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
                    p->ratio > 0 ? p->ratio : 2,
                    p->octaves ? p->octaves : 4,
                    p->seed};
-  float *detail = NULL;
-  if (!st.strict_noise) memset(lv->map[MAP_A], 0, ns * sizeof(float));
+  float *detail = NULL; /* (without strict noise A stayed 0) */
   if (p->maps) {
     out->smooth = grid_of(p, lv->map[MAP_H], err);
     out->amplitude = out->smooth ? grid_of(p, lv->map[MAP_A], err) : NULL;
@@ -182,11 +173,6 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
       goto done;
     }
     detail = oc_heightfield_samples_mut(out->detail);
-  }
-  out->height = grid_of(p, NULL, err);
-  if (!out->height) {
-    rc = err ? err->code : OC_ENOMEM;
-    goto done;
   }
   rc = oc_ddetail_grid(&dd, lv, oc_heightfield_samples_mut(out->height), detail,
                        p->progress, 0.8, 0.2, err);

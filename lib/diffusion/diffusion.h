@@ -91,17 +91,26 @@ typedef struct oc_dlevel {
 typedef struct oc_dpyramid {
   int nlevels;
   oc_dlevel *lv;
-  float *scratch; /* nx ny of level 0 */
+  float *own0;    /* level 0's maps but the elevation (if given) */
+  void *block;    /* the rasteriser's counters, then the coarser levels'
+                  ** maps and flags and the scratch grid */
+  float *scratch; /* nx ny of level 0 (in block) */
 } oc_dpyramid;
 
-/* Levels down to a coarsest grid of at most 8 samples a side; allocates
-** the maps of level 0 (filled by the caller) and, with oc_dpyramid_grow,
-** those of the coarser levels and the scratch grid; oc_dpyramid_shrink
-** frees those again (so that the peak holds one of the rasteriser's
-** counters, the pyramid and the output grids at a time). */
-int oc_dpyramid_init(oc_dpyramid *py, int nx, int ny, double cell,
+/* Levels down to a coarsest grid of at most 8 samples a side. Allocates
+** the maps of level 0 (its elevation is h, nx ny floats the caller owns,
+** when not NULL), and one block that holds the rasteriser's counters
+** (oc_dpyramid_counters) until oc_dpyramid_grow lays the
+** coarser levels' maps and the scratch grid over it; oc_dpyramid_shrink
+** frees that block again. So the peak holds level 0, the block and the
+** output grid, and the counters' pages are the coarse levels' (memory
+** touched for the first time costs a page fault, as much as the work on
+** it). */
+int oc_dpyramid_init(oc_dpyramid *py, int nx, int ny, double cell, float *h,
                      oc_error *err);
-int oc_dpyramid_grow(oc_dpyramid *py, oc_error *err);
+/* The rasteriser's 4 nx ny counters, in the block. */
+uint16_t *oc_dpyramid_counters(oc_dpyramid *py);
+void oc_dpyramid_grow(oc_dpyramid *py);
 void oc_dpyramid_shrink(oc_dpyramid *py);
 void oc_dpyramid_free(oc_dpyramid *py);
 /* Coarse flags and constrained values from level k - 1 to k, for every
@@ -115,9 +124,10 @@ typedef struct oc_draster_stats {
   size_t strict, slope, conflict, strict_noise;
 } oc_draster_stats;
 
-/* Paints the curves into level 0 of py (grid origin x0, y0): strict
-** elevation and noise averaged, slopes with their guide direction,
-** conflicts flagged. Reports [0, span] of pr, which may cancel. */
+/* Paints the curves into level 0 of py (grid origin x0, y0; every map
+** and flag written) with the pyramid's counters: strict elevation and
+** noise averaged, slopes with their guide direction, conflicts flagged. Reports
+*[0, span] of pr, which may cancel. */
 int oc_draster(oc_dpyramid *py, double x0, double y0, oc_fcurve *const *curves,
                size_t ncurves, oc_progress pr, double span,
                oc_draster_stats *st, oc_error *err);
@@ -147,9 +157,11 @@ enum { DF_GACT = 16, DF_SX = 32, DF_SY = 64 };
 /* Folds the guide of level lv (n in MAP_GX, MAP_GY, the drop per metre
 ** in MAP_GD) into the relaxation's coefficients: MAP_GX becomes the
 ** weight t of the upwind x neighbour, MAP_GY the constant c (see
-** jacobi.c), and the flags get DF_GACT, DF_SX, DF_SY. After the gradient
-** diffusion, before the elevation's. */
-void oc_dguide_prepare(oc_dlevel *lv, int paper);
+** jacobi.c), and the flags get DF_GACT, DF_SX, DF_SY. With coherent >= 0
+** (after the gradient diffusion) n is first set back to unit length, or
+** to 0 where shorter than coherent (1e-6 on slope samples). Before the
+** elevation's diffusion. */
+void oc_dguide_prepare(oc_dlevel *lv, int paper, double coherent);
 
 /* One Jacobi sweep of level lv from x into y: y = M x + c, or with
 ** op->hom (the correction equation of a V-cycle) y = M x + rhs (rhs NULL:
@@ -217,7 +229,8 @@ typedef struct oc_ddetail {
 ** exactly. */
 double oc_ddetail_at(const oc_ddetail *d, double x, double y, double A,
                      double R);
-/* The final heights z = h + N over the samples of lv (its maps H, A, R),
+/* The final heights z = h + N over the samples of lv (its maps H, A, R;
+** z may be H),
 ** each octave interpolated from a lattice (detail.c); N also into detail
 ** unless NULL. Rows in parallel, the same for any thread count; reports
 ** [lo, lo + span] of pr, which may cancel. OC_OK, OC_ENOMEM, OC_ECANCEL. */

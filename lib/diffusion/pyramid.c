@@ -17,47 +17,44 @@
 #define COARSEST 8
 #define MAX_LEVELS 32
 
-static void free_level(oc_dlevel *lv) {
-  free(lv->map[0]);
-  free(lv->flags);
-  for (int q = 0; q < MAP_COUNT; q++)
-    lv->map[q] = NULL;
-  lv->flags = NULL;
-}
-
 void oc_dpyramid_free(oc_dpyramid *py) {
   if (!py->lv) return;
-  for (int k = 0; k < py->nlevels; k++)
-    free_level(&py->lv[k]);
+  free(py->lv[0].flags);
+  free(py->own0);
+  free(py->block);
   free(py->lv);
-  free(py->scratch);
-  py->lv = NULL;
-  py->scratch = NULL;
+  memset(py, 0, sizeof *py);
 }
 
 void oc_dpyramid_shrink(oc_dpyramid *py) {
-  for (int k = 1; k < py->nlevels; k++)
-    free_level(&py->lv[k]);
-  free(py->scratch);
+  for (int k = 1; k < py->nlevels; k++) {
+    memset(py->lv[k].map, 0, sizeof py->lv[k].map);
+    py->lv[k].flags = NULL;
+  }
+  free(py->block);
+  py->block = NULL;
   py->scratch = NULL;
 }
 
-static int alloc_level(oc_dlevel *lv) {
-  size_t ns = (size_t)lv->nx * (size_t)lv->ny;
-  float *m = malloc(MAP_COUNT * ns * sizeof *m);
-  lv->flags = calloc(ns, 1);
-  if (!m || !lv->flags) {
-    free(m);
-    free(lv->flags);
-    lv->flags = NULL;
-    return OC_ENOMEM;
+/* Bytes of the block: the coarse levels' maps, then their flags, then
+** the scratch grid (each part 64-byte aligned), and at least the
+** counters. */
+static size_t block_size(const oc_dpyramid *py, size_t *flags_at,
+                         size_t *scratch_at) {
+  size_t maps = 0, flags = 0, ns0 = (size_t)py->lv[0].nx * (size_t)py->lv[0].ny;
+  for (int k = 1; k < py->nlevels; k++) {
+    size_t ns = (size_t)py->lv[k].nx * (size_t)py->lv[k].ny;
+    maps += MAP_COUNT * ns * sizeof(float);
+    flags += ns;
   }
-  for (int q = 0; q < MAP_COUNT; q++)
-    lv->map[q] = m + (size_t)q * ns;
-  return OC_OK;
+  maps = (maps + 63) & ~(size_t)63;
+  flags = (flags + 63) & ~(size_t)63;
+  *flags_at = maps, *scratch_at = maps + flags;
+  size_t all = maps + flags + ns0 * sizeof(float), cnt = 4 * ns0 * 2;
+  return all > cnt ? all : cnt;
 }
 
-int oc_dpyramid_init(oc_dpyramid *py, int nx, int ny, double cell,
+int oc_dpyramid_init(oc_dpyramid *py, int nx, int ny, double cell, float *h,
                      oc_error *err) {
   memset(py, 0, sizeof *py);
   int n = 1;
@@ -73,21 +70,41 @@ int oc_dpyramid_init(oc_dpyramid *py, int nx, int ny, double cell,
     lv->ny = k ? (py->lv[k - 1].ny + 1) / 2 : ny;
     lv->cell = k ? 2 * py->lv[k - 1].cell : cell;
   }
-  if (alloc_level(&py->lv[0])) {
+  size_t ns = (size_t)nx * (size_t)ny, fa, sa;
+  int own = MAP_COUNT - (h != NULL);
+  /* (not zeroed: the rasteriser zeroes its rows as it paints them) */
+  py->own0 = malloc((size_t)own * ns * sizeof(float));
+  py->lv[0].flags = malloc(ns);
+  py->block = malloc(block_size(py, &fa, &sa));
+  if (!py->own0 || !py->lv[0].flags || !py->block) {
     oc_dpyramid_free(py);
     return oc_seterr(err, OC_ENOMEM, "out of memory (%d x %d grid)", nx, ny);
   }
+  for (int q = 0, o = 0; q < MAP_COUNT; q++)
+    py->lv[0].map[q] = q == MAP_H && h ? h : py->own0 + (size_t)o++ * ns;
   return OC_OK;
 }
 
-int oc_dpyramid_grow(oc_dpyramid *py, oc_error *err) {
-  for (int k = 1; k < py->nlevels; k++)
-    if (alloc_level(&py->lv[k]))
-      return oc_seterr(err, OC_ENOMEM, "out of memory (level %d)", k);
-  size_t ns = (size_t)py->lv[0].nx * (size_t)py->lv[0].ny;
-  py->scratch = malloc(ns * sizeof *py->scratch);
-  if (!py->scratch) return oc_seterr(err, OC_ENOMEM, "out of memory");
-  return OC_OK;
+uint16_t *oc_dpyramid_counters(oc_dpyramid *py) {
+  return py->block;
+}
+
+void oc_dpyramid_grow(oc_dpyramid *py) {
+  size_t fa, sa;
+  block_size(py, &fa, &sa);
+  char *b = py->block;
+  float *m = (float *)b;
+  uint8_t *f = (uint8_t *)b + fa;
+  for (int k = 1; k < py->nlevels; k++) {
+    oc_dlevel *lv = &py->lv[k];
+    size_t ns = (size_t)lv->nx * (size_t)lv->ny;
+    for (int q = 0; q < MAP_COUNT; q++)
+      lv->map[q] = m + (size_t)q * ns;
+    lv->flags = f;
+    m += MAP_COUNT * ns;
+    f += ns;
+  }
+  py->scratch = (float *)(b + sa);
 }
 
 /* Coarse sample (I, J) of c from the children in f. */

@@ -45,6 +45,9 @@ typedef struct ritem {
   ** the item and interpolated; else looked up per sample) */
   double a0[FA_COUNT], a1[FA_COUNT];
   int linear;
+  double w;            /* the farthest a cell it paints lies from it */
+  double tan_l, tan_r; /* linear, the same angle at both ends: its tan */
+  int same_l, same_r;
 } ritem;
 
 typedef struct rcurve {
@@ -64,38 +67,49 @@ typedef struct rctx {
 
 #define DEG (3.14159265358979323846 / 180)
 
+/* Attribute q of item it's curve fc at the fraction f of the item
+** (normalised arc length u): interpolated between the item's ends when
+** it is linear there (the slope angles then in degrees), else looked up
+** (the angles as tan). */
+static inline double attr(const oc_fcurve *fc, const ritem *it, int q, double f,
+                          double u) {
+  if (it->linear) return it->a0[q] + f * (it->a1[q] - it->a0[q]);
+  double v[FA_COUNT];
+  oc_fcurve_attrs(fc, u, 1u << q, v);
+  return v[q];
+}
+
 /* The contributions of item it's curve to cell k at the fraction f of
 ** the item (arc length s), distance dist on the left (or right) side,
 ** outward normal (nox, noy); no slope when !slopes (conservative cells
-** beyond an end). */
-static void deposit(const rctx *rc, size_t k, const ritem *it, double f,
-                    double s, double dist, int left, double nox, double noy,
-                    int slopes) {
+** beyond an end). Each attribute is looked up only where it is used
+** (most cells lie in a slope band and need 3 of them). */
+static inline __attribute__((always_inline)) void
+deposit(const rctx *rc, size_t k, const ritem *it, double f, double s,
+        double dist, int left, double nox, double noy, int slopes) {
   uint32_t ci = it->curve;
   const oc_fcurve *fc = rc->cv[ci].fc;
-  double a[FA_COUNT], u = fc->length > 0 ? s / fc->length : 0;
-  if (it->linear) {
-    for (int q = FA_RADIUS; q < FA_COUNT; q++)
-      a[q] = it->a0[q] + f * (it->a1[q] - it->a0[q]);
-  } else { /* (the angles as tan) */
-    oc_fcurve_attrs(fc, u, ((1u << FA_COUNT) - 1) & ~(1u << FA_HEIGHT), a);
-  }
-  double r = a[FA_RADIUS];
-  double ws = fmax(r, 0.5 * rc->lv->cell * (fabs(nox) + fabs(noy)));
-  if (dist <= ws && (fc->has & (OC_FC_HEIGHT | OC_FC_NOISE))) {
-    if (fc->has & OC_FC_HEIGHT) {
+  unsigned has = fc->has;
+  double u = !it->linear && fc->length > 0 ? s / fc->length : 0;
+  double r = attr(fc, it, FA_RADIUS, f, u);
+  double half = 0.5 * rc->lv->cell * (fabs(nox) + fabs(noy));
+  double ws = r > half ? r : half; /* (fmax: a call; neither is NaN) */
+  if (dist <= ws && (has & (OC_FC_HEIGHT | OC_FC_NOISE))) {
+    if (it->linear) u = fc->length > 0 ? s / fc->length : 0;
+    if (has & OC_FC_HEIGHT) {
+      double a[FA_COUNT];
       oc_fcurve_attrs(fc, u, 1u << FA_HEIGHT, a);
       rc->h[k] += (float)a[FA_HEIGHT];
       if (rc->hc[k] < 0xffffu) rc->hc[k]++;
     }
-    if (fc->has & OC_FC_NOISE) {
-      rc->A[k] += (float)a[FA_AMP];
-      rc->R[k] += (float)a[FA_ROUGH];
+    if (has & OC_FC_NOISE) {
+      rc->A[k] += (float)attr(fc, it, FA_AMP, f, u);
+      rc->R[k] += (float)attr(fc, it, FA_ROUGH, f, u);
       if (rc->nc[k] < 0xffffu) rc->nc[k]++;
     }
   }
-  if (!slopes || !(fc->has & OC_FC_SLOPE) || !(dist > r)) return;
-  double ext = left ? a[FA_EXTA] : a[FA_EXTB];
+  if (!slopes || !(has & OC_FC_SLOPE) || !(dist > r)) return;
+  double ext = attr(fc, it, left ? FA_EXTA : FA_EXTB, f, u);
   if (!(ext > 0 && dist <= r + ext)) return;
   uint16_t me = (uint16_t)(ci + 1);
   if (rc->owner[k] == CONFLICT_OWNER) return;
@@ -104,10 +118,15 @@ static void deposit(const rctx *rc, size_t k, const ritem *it, double f,
     return;
   }
   rc->owner[k] = me;
-  double tn = left ? a[FA_LEFT] : a[FA_RIGHT];
-  if (it->linear) tn = tan(tn * DEG);
+  double tn;
+  if (it->linear && (left ? it->same_l : it->same_r))
+    tn = left ? it->tan_l : it->tan_r; /* (a0 + f 0 = a0: the same tan) */
+  else {
+    tn = attr(fc, it, left ? FA_LEFT : FA_RIGHT, f, u);
+    if (it->linear) tn = tan(tn * DEG);
+  }
   double val = tn * (1 - (dist - r) / ext);
-  double sg = (fc->has & OC_FC_HEIGHT) ? 1 : -1;
+  double sg = (has & OC_FC_HEIGHT) ? 1 : -1;
   rc->gx[k] += (float)(sg * nox);
   rc->gy[k] += (float)(sg * noy);
   rc->gd[k] += (float)(sg * val);
@@ -133,13 +152,23 @@ static int clip(double a, double b, double lo, double hi, double *xlo,
 static void paint_row(const rctx *rc, const ritem *it, int j) {
   const oc_dlevel *lv = rc->lv;
   double cell = lv->cell, y = rc->y0 + j * cell;
-  double w = rc->cv[it->curve].reach;
+  double w = it->w;
   double xlo = -INFINITY, xhi = INFINITY;
   if (it->wedge) {
     double dy = y - it->vy;
     if (fabs(dy) > w) return;
     double hw = sqrt(w * w - dy * dy);
     xlo = it->vx - hw, xhi = it->vx + hw;
+    /* the sector between the two directions: along the previous one > 0,
+    ** along the next < 0 (each a half-plane, so an interval of the row;
+    ** widened by a cell, the test below stays exact) */
+    if (!clip(it->tx, -it->vx * it->tx + dy * it->ty, 0, INFINITY, &xlo,
+              &xhi) ||
+        !clip(it->t2x, -it->vx * it->t2x + dy * it->t2y, -INFINITY, 0, &xlo,
+              &xhi)) {
+      if (!(xlo <= xhi + 2 * cell)) return;
+    }
+    xlo -= cell, xhi += cell;
   } else {
     /* along = (x - vx) tx + (y - vy) ty, across = -(x - vx) ty + (y - vy) tx */
     double dy = y - it->vy;
@@ -186,8 +215,14 @@ static double attr_max(const oc_fattr *t) {
 }
 
 /* The linear attributes of item it at its ends (arc lengths s0, s1), and
-** whether they are linear along it: no knot strictly between. */
-static void item_attrs(const oc_fcurve *fc, ritem *it, double s0, double s1) {
+** whether they are linear along it: no knot strictly between; then its
+** reach (the curve's otherwise: at most reach) from the largest radius
+** and extent at its ends (an attribute linear along the item lies
+** between its end values, to a rounding: the margin) or the
+** conservative half-extent of a cell, and the tan of a slope angle the
+** same at both ends. */
+static void item_attrs(const oc_fcurve *fc, ritem *it, double s0, double s1,
+                       double cell, double reach) {
   double u0 = fc->length > 0 ? s0 / fc->length : 0,
          u1 = fc->length > 0 ? s1 / fc->length : 0;
   it->linear = 1;
@@ -198,6 +233,18 @@ static void item_attrs(const oc_fcurve *fc, ritem *it, double s0, double s1) {
     for (size_t i = 0; i < t->n; i++)
       if (t->u[i] > u0 && t->u[i] < u1) it->linear = 0;
   }
+  it->w = reach;
+  it->same_l = it->same_r = 0;
+  if (!it->linear) return;
+  double r = fmax(it->a0[FA_RADIUS], it->a1[FA_RADIUS]);
+  double e = fmax(fmax(it->a0[FA_EXTA], it->a1[FA_EXTA]),
+                  fmax(it->a0[FA_EXTB], it->a1[FA_EXTB]));
+  double w = fmax(r + fmax(e, 0), cell);
+  it->w = fmin(reach, w + 1e-6 * w);
+  it->same_l = it->a0[FA_LEFT] == it->a1[FA_LEFT];
+  it->same_r = it->a0[FA_RIGHT] == it->a1[FA_RIGHT];
+  it->tan_l = tan(it->a0[FA_LEFT] * DEG);
+  it->tan_r = tan(it->a0[FA_RIGHT] * DEG);
 }
 
 /* Appends the items of one curve (segments, then the wedge after each
@@ -237,11 +284,11 @@ static int curve_items(const oc_fcurve *fc, uint32_t ci, double cell,
     s.curve = ci;
     s.vx = v[k].x, s.vy = v[k].y, s.tx = dx / len, s.ty = dy / len;
     s.len = len, s.s0 = v[k].s, s.s1 = v[k + 1].s;
-    item_attrs(fc, &s, s.s0, s.s1);
+    item_attrs(fc, &s, s.s0, s.s1, cell, reach);
     double half = 0.5 * cell * (fabs(s.tx) + fabs(s.ty));
     s.e0 = (k == 0 && !closed) ? half : 0;
     s.e1 = (k + 2 == nv && !closed) ? half : 0;
-    double e = fmax(s.e0, s.e1) + reach;
+    double e = fmax(s.e0, s.e1) + s.w;
     s.ylo = fmin(v[k].y, v[k + 1].y) - e, s.yhi = fmax(v[k].y, v[k + 1].y) + e;
     if (have_prev) {
       double cr = ptx * s.ty - pty * s.tx;
@@ -249,9 +296,9 @@ static int curve_items(const oc_fcurve *fc, uint32_t ci, double cell,
         ritem w = {0};
         w.curve = ci, w.wedge = 1, w.vx = v[k].x, w.vy = v[k].y;
         w.tx = ptx, w.ty = pty, w.t2x = s.tx, w.t2y = s.ty, w.s0 = v[k].s;
-        item_attrs(fc, &w, w.s0, w.s0);
+        item_attrs(fc, &w, w.s0, w.s0, cell, reach);
         w.convex_left = cr < 0;
-        w.ylo = v[k].y - reach, w.yhi = v[k].y + reach;
+        w.ylo = v[k].y - w.w, w.yhi = v[k].y + w.w;
         (*it)[(*n)++] = w;
       }
     }
@@ -265,9 +312,9 @@ static int curve_items(const oc_fcurve *fc, uint32_t ci, double cell,
     ritem w = {0};
     w.curve = ci, w.wedge = 1, w.vx = v[0].x, w.vy = v[0].y;
     w.tx = ptx, w.ty = pty, w.t2x = ftx, w.t2y = fty, w.s0 = v[0].s;
-    item_attrs(fc, &w, w.s0, w.s0);
+    item_attrs(fc, &w, w.s0, w.s0, cell, reach);
     w.convex_left = cr < 0;
-    w.ylo = v[0].y - reach, w.yhi = v[0].y + reach;
+    w.ylo = v[0].y - w.w, w.yhi = v[0].y + w.w;
     (*it)[(*n)++] = w;
   }
   free(v);
@@ -285,15 +332,21 @@ static void normalise(const rctx *rc, size_t k, uint8_t *flags) {
     rc->R[k] /= rc->nc[k];
     f |= DF_NOISE;
   }
-  double gx = rc->gx[k], gy = rc->gy[k], g = sqrt(gx * gx + gy * gy);
-  if (rc->owner[k] == CONFLICT_OWNER || (rc->gc[k] && !(g > 1e-6))) {
+  int conflict = rc->owner[k] == CONFLICT_OWNER;
+  if (!conflict && rc->gc[k]) { /* (the norm only where slopes were) */
+    double gx = rc->gx[k], gy = rc->gy[k], g = sqrt(gx * gx + gy * gy);
+    if (g > 1e-6) {
+      rc->gx[k] = (float)(gx / g);
+      rc->gy[k] = (float)(gy / g);
+      rc->gd[k] /= rc->gc[k];
+      f |= DF_SLOPE;
+    } else {
+      conflict = 1;
+    }
+  }
+  if (conflict) {
     f |= DF_CONFLICT;
     rc->gx[k] = rc->gy[k] = rc->gd[k] = 0;
-  } else if (rc->gc[k]) {
-    rc->gx[k] = (float)(gx / g);
-    rc->gy[k] = (float)(gy / g);
-    rc->gd[k] /= rc->gc[k];
-    f |= DF_SLOPE;
   }
   flags[k] = f;
 }
@@ -304,11 +357,11 @@ int oc_draster(oc_dpyramid *py, double x0, double y0, oc_fcurve *const *curves,
   oc_dlevel *lv = &py->lv[0];
   size_t ns = (size_t)lv->nx * (size_t)lv->ny;
   rcurve *cv = malloc((ncurves ? ncurves : 1) * sizeof *cv);
-  uint16_t *cnt = calloc(4 * ns, sizeof *cnt);
+  uint16_t *cnt = oc_dpyramid_counters(py);
   ritem *it = NULL;
   size_t nit = 0, cap = 0;
   int rc = OC_OK;
-  if (!cv || !cnt) {
+  if (!cv) {
     rc = oc_seterr(err, OC_ENOMEM, "out of memory (%zu samples)", ns);
     goto done;
   }
@@ -323,8 +376,6 @@ int oc_draster(oc_dpyramid *py, double x0, double y0, oc_fcurve *const *curves,
                      err);
     if (rc) goto done;
   }
-  for (int m = 0; m < MAP_COUNT; m++)
-    memset(lv->map[m], 0, ns * sizeof(float));
   rctx x = {lv,
             x0,
             y0,
@@ -342,18 +393,36 @@ int oc_draster(oc_dpyramid *py, double x0, double y0, oc_fcurve *const *curves,
             cnt + 2 * ns,
             cnt + 3 * ns};
   int nb = (lv->ny + BLOCK - 1) / BLOCK, stop = 0, done = 0;
-#pragma omp parallel for schedule(dynamic, 1)
+  size_t nx = (size_t)lv->nx, ss = 0, sl = 0, sc = 0, sn = 0;
+  float *maps[MAP_COUNT] = {x.h, x.gx, x.gy, x.gd, x.A, x.R};
+  /* each block of rows zeroes its maps and counters (written first:
+  ** fresh memory read first faults twice, for the zero page and again
+  ** for the copy), paints the items that reach it, then normalises its
+  ** rows while they are in cache */
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : ss, sl, sc, sn)
   for (int b = 0; b < nb; b++) {
     int halt;
 #pragma omp atomic read
     halt = stop;
     if (halt) continue;
     int j0 = b * BLOCK, j1 = j0 + BLOCK < lv->ny ? j0 + BLOCK : lv->ny;
+    size_t k0 = (size_t)j0 * nx, nk = (size_t)(j1 - j0) * nx;
+    for (int m = 0; m < MAP_COUNT; m++)
+      memset(maps[m] + k0, 0, nk * sizeof(float));
+    for (int m = 0; m < 4; m++)
+      memset(cnt + (size_t)m * ns + k0, 0, nk * sizeof *cnt);
     double ylo = y0 + j0 * lv->cell, yhi = y0 + (j1 - 1) * lv->cell;
     for (size_t t = 0; t < nit; t++) {
       if (it[t].yhi < ylo || it[t].ylo > yhi) continue;
       for (int j = j0; j < j1; j++)
         paint_row(&x, &it[t], j);
+    }
+    for (size_t k = k0; k < k0 + nk; k++) {
+      normalise(&x, k, lv->flags);
+      ss += (lv->flags[k] & DF_H) != 0;
+      sl += (lv->flags[k] & DF_SLOPE) != 0;
+      sc += (lv->flags[k] & DF_CONFLICT) != 0;
+      sn += (lv->flags[k] & DF_NOISE) != 0;
     }
     int d;
 #pragma omp atomic capture
@@ -368,19 +437,9 @@ int oc_draster(oc_dpyramid *py, double x0, double y0, oc_fcurve *const *curves,
     rc = oc_seterr(err, OC_ECANCEL, "diffusion cancelled");
     goto done;
   }
-  size_t ss = 0, sl = 0, sc = 0, sn = 0;
-#pragma omp parallel for schedule(static) reduction(+ : ss, sl, sc, sn)
-  for (size_t k = 0; k < ns; k++) {
-    normalise(&x, k, lv->flags);
-    ss += (lv->flags[k] & DF_H) != 0;
-    sl += (lv->flags[k] & DF_SLOPE) != 0;
-    sc += (lv->flags[k] & DF_CONFLICT) != 0;
-    sn += (lv->flags[k] & DF_NOISE) != 0;
-  }
   st->strict = ss, st->slope = sl, st->conflict = sc, st->strict_noise = sn;
 done:
   free(it);
-  free(cnt);
   free(cv);
   return rc;
 }

@@ -17,7 +17,9 @@
 **   diffusion.curves_kb                the largest scene in the compact
 **                                      encoding (oc_fcurve_encode; Table 1:
 **                                      1.30-4.48 kB)
-** Prints `name: value unit` lines; '#' lines are context.
+** Prints `name: value unit` lines; '#' lines are context. Parts
+** (OUTCROP_BENCH_ONLY): peak, curves, schedule (or one size of it:
+** schedule_512, schedule_1024, schedule_2048), converged.
 */
 #define _GNU_SOURCE
 #include <math.h>
@@ -178,8 +180,10 @@ int main(void) {
     }
     printf("diffusion.curves_kb: %.2f kB\n", worst);
   }
-  if (bench_wanted("schedule")) {
-    for (int z = 0; z < 3; z++) {
+  for (int z = 0; z < 3; z++) {
+    char part[32];
+    snprintf(part, sizeof part, "schedule_%d", sides[z]);
+    if (bench_wanted("schedule") || bench_wanted(part)) {
       double worst = 0, wcpu = 0;
       for (int sc = 0; sc < 6; sc++) {
         oc_fcurve *c[MAXC];

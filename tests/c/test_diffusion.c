@@ -415,9 +415,13 @@ START_TEST(deterministic_across_threads) {
 }
 END_TEST
 
-/* The fused sweeps of the cascade give the bytes of separate sweeps. */
+/* The fused sweeps of the cascade (in place, blocks of 64 rows reading
+** their neighbours' rows from copies) give the bytes of separate sweeps,
+** for sweep counts below and above the halo of one row and a last block
+** shorter than the others. */
 START_TEST(fused_sweeps_match) {
-  enum { NX = 300, NY = 230 }; /* over 65 536 samples: the fused path */
+  /* two blocks or more and n nx ny >= 262 144 (n >= 2): the fused path */
+  enum { NX = 600, NY = 230 };
   size_t ns = (size_t)NX * NY;
   float *m = malloc(MAP_COUNT * ns * sizeof *m), *x = malloc(ns * sizeof *x),
         *y = malloc(ns * sizeof *y), *scr = malloc(ns * sizeof *scr);
@@ -438,8 +442,10 @@ START_TEST(fused_sweeps_match) {
     lv.map[MAP_GY][k] = (float)oct_unif(&rg, -1, 1);
     x[k] = (float)oct_unif(&rg, -10, 10);
   }
+  static const int counts[4] = {1, 2, 6, 15};
   for (int kind = 0; kind < 2; kind++)
-    for (int n = 1; n <= 6; n += 5) {
+    for (int q = 0; q < 4; q++) {
+      int n = counts[q];
       oc_dop op = {kind ? DK_GUIDED : DK_LAPLACE, MAP_H, DF_H, 0, 0};
       memcpy(y, x, ns * sizeof *x);
       double b0 = 0;
