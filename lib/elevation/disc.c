@@ -48,33 +48,51 @@ typedef struct octlod {
 ** is 1, the sum is bit for bit the unfiltered one. */
 static double noise_sum(const oc_enoise *nz, double u, double v, double g[2],
                         const octlod *lod) {
+  /* the octaves' points and filters first, then their noise in one call
+  ** (oc_noise3_z0_multi: two octaves at a time, the values and gradients
+  ** oc_eta gives), then the sum octave by octave as it always was */
+  uint64_t seed[OC_ENOISE_MAXOCT];
+  double px[OC_ENOISE_MAXOCT], py[OC_ENOISE_MAXOCT], e[OC_ENOISE_MAXOCT];
+  double ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
+  double bws[OC_ENOISE_MAXOCT], dbs[OC_ENOISE_MAXOCT];
+  int cnt = 0;
+  for (double s = 1 / nz->wavelength; cnt < nz->octaves;
+       cnt++, s *= nz->lacunarity) {
+    double bw = 1, db = 0;
+    if (lod) {
+      bw = oc_elod_b(lod->t0 - cnt * lod->dt, &db);
+      if (bw == 0) break;
+    }
+    bws[cnt] = bw, dbs[cnt] = db;
+    seed[cnt] = octave_seed(nz->seed, cnt);
+    px[cnt] = s * u, py[cnt] = s * v;
+  }
+  oc_noise3_z0_multi(seed, px, py, (size_t)cnt, e, g ? ex : NULL,
+                     g ? ey : NULL);
   double sum = 0, a = nz->amplitude, s = 1 / nz->wavelength;
   double prev = 1, gprev[2] = {0, 0}; /* ridged: s_(i-1) and its gradient */
   if (g) g[0] = g[1] = 0;
-  for (int i = 0; i < nz->octaves; i++) {
-    double ge[2], bw = 1, db = 0, a0 = a;
-    if (lod) {
-      bw = oc_elod_b(lod->t0 - i * lod->dt, &db);
-      if (bw == 0) break;
-      a = a0 * bw;
-    }
-    double e = oc_eta(octave_seed(nz->seed, i), s * u, s * v, g ? ge : NULL);
+  for (int i = 0; i < cnt; i++) {
+    double ge[2] = {0, 0}, bw = bws[i], db = dbs[i], a0 = a;
+    if (lod) a = a0 * bw;
+    e[i] = 2 * e[i] - 1; /* (oc_eta) */
+    if (g) ge[0] = 2 * ex[i], ge[1] = 2 * ey[i];
     double term = 0; /* the octave's unfiltered term, where db != 0 */
     switch (nz->kind) {
     case OC_ENOISE_PLAIN:
-      sum += a * e;
-      term = e;
+      sum += a * e[i];
+      term = e[i];
       if (g) g[0] += a * s * ge[0], g[1] += a * s * ge[1];
       break;
     case OC_ENOISE_TURBULENCE: {
-      double sg = e < 0 ? -1 : 1;
-      sum += a * fabs(e);
-      term = fabs(e);
+      double sg = e[i] < 0 ? -1 : 1;
+      sum += a * fabs(e[i]);
+      term = fabs(e[i]);
       if (g) g[0] += a * s * sg * ge[0], g[1] += a * s * sg * ge[1];
       break;
     }
     default: { /* ridged */
-      double sg = e < 0 ? -1 : 1, r = 1 - fabs(e);
+      double sg = e[i] < 0 ? -1 : 1, r = 1 - fabs(e[i]);
       double w = 1, gw[2] = {0, 0};
       if (i > 0) {
         w = RIDGE_GAIN * prev;
@@ -388,13 +406,25 @@ static int noise_local(const oc_enoise *nz, double u0, double v0, double u1,
   double a = nz->amplitude, s = 1 / nz->wavelength;
   double rho = sqrt(hx * hx + hy * hy) * (1 + 1e-15);
   if (!(H * s * rho < L || L * s * rho < 1)) return 0;
+  /* the octaves that gain, and their noise at the centre in one call */
+  uint64_t seed[OC_ENOISE_MAXOCT];
+  double px[OC_ENOISE_MAXOCT], py[OC_ENOISE_MAXOCT], ev[OC_ENOISE_MAXOCT];
+  double ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
+  int cnt = 0;
+  for (double sc = s; cnt < nz->octaves; cnt++, sc *= nz->lacunarity) {
+    double r = sc * rho;
+    if (!(H * r < L || L * r < 1)) break;
+    seed[cnt] = octave_seed(nz->seed, cnt);
+    px[cnt] = sc * u, py[cnt] = sc * v;
+  }
+  oc_noise3_z0_multi(seed, px, py, (size_t)cnt, ev, ex, ey);
   double l = 0, h = 0, lf = 0;
   double tlo = 1, thi = 1, tl = 0; /* ridged: the previous term's bounds */
   int i = 0;
-  for (; i < nz->octaves; i++, a *= nz->gain, s *= nz->lacunarity) {
+  for (; i < cnt; i++, a *= nz->gain, s *= nz->lacunarity) {
     double r = s * rho;
-    if (!(H * r < L || L * r < 1)) break;
-    double g[2], e = oc_eta(octave_seed(nz->seed, i), s * u, s * v, g);
+    /* (oc_eta) */
+    double g[2] = {2 * ex[i], 2 * ey[i]}, e = 2 * ev[i] - 1;
     double gn = sqrt(g[0] * g[0] + g[1] * g[1]) * (1 + 1e-15);
     double sl = lesser(L, gn + H * r); /* |grad eta| */
     double dv = lesser(L * r, s * (fabs(g[0]) * hx + fabs(g[1]) * hy) +
@@ -507,7 +537,7 @@ static int check_noise(const oc_enode_noise *nz, oc_enoise *out,
     return oc_seterr(err, OC_EINVAL,
                      "'noise.wavelength' must be a positive number (got %g)",
                      nz->wavelength);
-  if (nz->octaves < 1 || nz->octaves > 16)
+  if (nz->octaves < 1 || nz->octaves > OC_ENOISE_MAXOCT)
     return oc_seterr(err, OC_EINVAL,
                      "'noise.octaves' must be an integer in 1..16 (got %d)",
                      nz->octaves);

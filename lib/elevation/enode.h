@@ -48,6 +48,8 @@ typedef struct oc_erect {
 
 /* Noise sums of discs and warps, as evaluation reads them (unpacked from
 ** a node by oc_edisc_noise). */
+/* The most octaves a noise sum has (checked at construction). */
+#define OC_ENOISE_MAXOCT 16
 typedef struct oc_enoise {
   int kind; /* oc_enoise_kind */
   int octaves;
