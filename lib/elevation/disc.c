@@ -350,10 +350,10 @@ void oc_edisc_ev_row(const oc_enode *n, const double *x, double y, int cnt,
 /* Distances from (cx, cy) to the nearest and farthest points of b. */
 static void rect_dist(const oc_erect *b, double cx, double cy, double *dmin,
                       double *dmax) {
-  double dx = fmax(fmax(b->x0 - cx, cx - b->x1), 0);
-  double dy = fmax(fmax(b->y0 - cy, cy - b->y1), 0);
-  double fx = fmax(fabs(b->x0 - cx), fabs(b->x1 - cx));
-  double fy = fmax(fabs(b->y0 - cy), fabs(b->y1 - cy));
+  double dx = oc_efmax(oc_efmax(b->x0 - cx, cx - b->x1), 0);
+  double dy = oc_efmax(oc_efmax(b->y0 - cy, cy - b->y1), 0);
+  double fx = oc_efmax(fabs(b->x0 - cx), fabs(b->x1 - cx));
+  double fy = oc_efmax(fabs(b->y0 - cy), fabs(b->y1 - cy));
   *dmin = sqrt(dx * dx + dy * dy);
   *dmax = sqrt(fx * fx + fy * fy);
 }
@@ -495,24 +495,24 @@ void oc_edisc_bound_in(const oc_enode *node, const oc_erect *b,
   if (!filtered && n->noise.kind != OC_ENOISE_NONE &&
       noise_local(&n->noise, b->x0 - n->par[0], b->y0 - n->par[1],
                   b->x1 - n->par[0], b->y1 - n->par[1], &nlo, &nhi, &nlip)) {
-    o->flo = fmax(o->flo, n->par[3] + nlo);
-    o->fhi = fmin(o->fhi, n->par[3] + nhi);
-    o->lf = fmin(o->lf, nlip);
+    o->flo = oc_efmax(o->flo, n->par[3] + nlo);
+    o->fhi = oc_efmin(o->fhi, n->par[3] + nhi);
+    o->lf = oc_efmin(o->lf, nlip);
   }
   double dmin, dmax, r = n->par[2];
   rect_dist(b, n->par[0], n->par[1], &dmin, &dmax);
   /* rounding: alpha's bounds a hair wider than the formula */
-  o->alo = fmax(0, wyvill(dmax / r) * (1 - 1e-12) - 1e-300);
-  o->ahi = fmin(1, wyvill(dmin / r) * (1 + 1e-12));
+  o->alo = oc_efmax(0, wyvill(dmax / r) * (1 - 1e-12) - 1e-300);
+  o->ahi = oc_efmin(1, wyvill(dmin / r) * (1 + 1e-12));
   /* |grad alpha| = 6 x (1 - x^2)^2 / r at x = d / r rises up to x =
   ** 1/sqrt(5) (the global bound) and falls after: its largest value on
   ** [dmin, dmax] is there or at the end nearer to it */
-  double x0 = dmin / r, x1 = fmin(dmax / r, 1), xs = 1 / sqrt(5.0);
+  double x0 = dmin / r, x1 = oc_efmin(dmax / r, 1), xs = 1 / sqrt(5.0);
   if (x0 >= 1) {
     o->la = 0; /* outside the disc: alpha = 0 on the whole box */
   } else if (x1 < xs || x0 > xs) {
     double x = x1 < xs ? x1 : x0, k = 1 - x * x;
-    o->la = fmin(o->la, 6 * x * k * k / r * (1 + 1e-12));
+    o->la = oc_efmin(o->la, 6 * x * k * k / r * (1 + 1e-12));
   }
 }
 

@@ -270,6 +270,24 @@ START_TEST(disc_matches_octave_sum) {
 }
 END_TEST
 
+START_TEST(efmax_is_fmax) {
+  /* the inline fmax and fmin of the box queries give libm's bits on
+  ** every pair of special and ordinary values (signed zeros, infinities,
+  ** NaN, denormals) */
+  const double v[] = {0.0,      -0.0,      1.0, -1.0, 0x1p-1074, -0x1p-1074,
+                      INFINITY, -INFINITY, NAN, 3.5,  -2.25,     1e300};
+  int n = (int)(sizeof v / sizeof *v), differ = 0, pairs = 0;
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j < n; j++, pairs++) {
+      double a = oc_efmax(v[i], v[j]), b = fmax(v[i], v[j]);
+      double c = oc_efmin(v[i], v[j]), d = fmin(v[i], v[j]);
+      differ += memcmp(&a, &b, sizeof a) != 0 || memcmp(&c, &d, sizeof c) != 0;
+    }
+  ck_assert_int_eq(pairs, 144);
+  ck_assert_int_eq(differ, 0);
+}
+END_TEST
+
 START_TEST(disc_local_bounds) {
   /* In boxes small against the wavelength a disc bounds its noise from
   ** each octave's value and gradient at the box's centre and the proved
@@ -887,6 +905,7 @@ int main(void) {
   tcase_add_test(tc, disc_noises);
   tcase_add_test(tc, disc_local_bounds);
   tcase_add_test(tc, disc_matches_octave_sum);
+  tcase_add_test(tc, efmax_is_fmax);
   tcase_add_test(tc, blend_formula);
   tcase_add_test(tc, replace_and_add_formulas);
   tcase_add_test(tc, add_slope_weight);
