@@ -383,6 +383,119 @@ void oc_noise3_z0_row(uint64_t seed, const double *x, const double *y, size_t n,
   }
 }
 
+/* ---- oc_noise3_z0_multi: noise3 on the plane z = 0, two points at a
+** time, one per lane of the v2d vectors (SSE2 on every x86-64). Each lane
+** does the scalar code's operations in its order (simplex_locate with
+** floor_d's floor, corner_grad's hashes, corner_add's sums), so every
+** value and gradient is noise3's bit for bit; the gradient's z part is
+** not computed. Vector-by-scalar operations broadcast the scalar exactly.
+** (Four lanes under AVX2, the same code with 32-byte vectors, measured
+** slower on an AMD EPYC: 35 ns an octave against 30, the scalar noise3's
+** 49.) */
+
+/* One corner's term added to v, its gradient's x and y parts to gx, gy
+** when wg; gi the lanes' gradient indices. */
+static inline void corner2(const unsigned *gi, v2d dx, v2d dy, v2d dz, v2d *v,
+                           v2d *gx, v2d *gy, int wg) {
+  v2d a = 0.5 - (dx * dx + dy * dy + dz * dz);
+  a = 0.5 * (a + (v2d)((v2l)a & INT64_MAX)); /* max(a, 0) = (a + |a|) / 2 */
+  v2d grx, gry, grz;
+  for (int l = 0; l < 2; l++) {
+    grx[l] = grad12[gi[l]][0];
+    gry[l] = grad12[gi[l]][1];
+    grz[l] = grad12[gi[l]][2];
+  }
+  v2d t = grx * dx + gry * dy + grz * dz;
+  v2d a2 = a * a, a3 = a2 * a;
+  *v += a3 * a * t;
+  if (!wg) return;
+  v2d k = 8 * t;
+  *gx += a3 * (a * grx - k * dx);
+  *gy += a3 * (a * gry - k * dy);
+}
+
+/* noise3 of (px[l], py[l], 0) under seed[l] for the 2 lanes (no point
+** huge), into val, and the gradients' x and y parts into gx, gy when wg. */
+static inline void z0_lanes(const uint64_t *seed, v2d px, v2d py, v2d *val,
+                            v2d *gx, v2d *gy, int wg) {
+  const v2l one = (v2l)((v2d){0} + 1); /* 1.0's bits in every lane */
+  v2d zero = {0}, pz = zero, s = (px + py + pz) * F3;
+  v2d xs = px + s, ys = py + s, zs = pz + s;
+  v2d fi, fj, fk; /* floor_d lane by lane */
+  {
+    v2d r = (xs + FLOOR_C) - FLOOR_C;
+    fi = r - (v2d)(one & (r > xs));
+    r = (ys + FLOOR_C) - FLOOR_C;
+    fj = r - (v2d)(one & (r > ys));
+    r = (zs + FLOOR_C) - FLOOR_C;
+    fk = r - (v2d)(one & (r > zs));
+  }
+  v2d fx = xs - fi, fy = ys - fj, fz = zs - fk;
+  v2d t = (fx + fy + fz) * G3;
+  v2d x0 = fx - t, y0 = fy - t, z0 = fz - t;
+  /* the simplex: simplex_locate's bits as all-ones masks */
+  v2l xy = x0 >= y0, xz = x0 >= z0, yz = y0 >= z0;
+  v2l i1 = xy & xz, j1 = ~xy & yz, k1 = ~xz & ~yz;
+  v2l i2 = xy | xz, j2 = ~xy | yz, k2 = ~xz | ~yz;
+  unsigned gi[4][2];
+  for (int l = 0; l < 2; l++) {
+    uint64_t key = noise_key(seed[l]);
+    uint64_t i = (uint64_t)(int64_t)fi[l], j = (uint64_t)(int64_t)fj[l],
+             k = (uint64_t)(int64_t)fk[l];
+    gi[0][l] = corner_grad(key, i, j, k);
+    gi[1][l] =
+        corner_grad(key, i + (i1[l] & 1), j + (j1[l] & 1), k + (k1[l] & 1));
+    gi[2][l] =
+        corner_grad(key, i + (i2[l] & 1), j + (j2[l] & 1), k + (k2[l] & 1));
+    gi[3][l] = corner_grad(key, i + 1, j + 1, k + 1);
+  }
+  v2d v = zero, g0 = zero, g1 = zero;
+  corner2(gi[0], x0, y0, z0, &v, &g0, &g1, wg);
+  corner2(gi[1], x0 - (v2d)(i1 & one) + G3, y0 - (v2d)(j1 & one) + G3,
+          z0 - (v2d)(k1 & one) + G3, &v, &g0, &g1, wg);
+  corner2(gi[2], x0 - (v2d)(i2 & one) + 2 * G3, y0 - (v2d)(j2 & one) + 2 * G3,
+          z0 - (v2d)(k2 & one) + 2 * G3, &v, &g0, &g1, wg);
+  corner2(gi[3], x0 - 1 + 3 * G3, y0 - 1 + 3 * G3, z0 - 1 + 3 * G3, &v, &g0,
+          &g1, wg);
+  *val = 0.5 + SCALE * v;
+  if (wg) *gx = SCALE * g0, *gy = SCALE * g1;
+}
+
+/* The points m < n, 2 at a time while none is huge, the rest one by one
+** (noise3 itself). */
+static void z0_multi(const uint64_t *seeds, const double *x, const double *y,
+                     size_t n, double *val, double *gx, double *gy, int wg) {
+  size_t m = 0;
+  for (; m + 2 <= n; m += 2) {
+    v2d px, py, v, g0, g1;
+    int huge = 0;
+    for (int l = 0; l < 2; l++) {
+      px[l] = x[m + l], py[l] = y[m + l];
+      huge |= is_huge((oc_vec3){x[m + l], y[m + l], 0});
+    }
+    if (huge) break; /* (rare) */
+    z0_lanes(seeds + m, px, py, &v, &g0, &g1, wg);
+    for (int l = 0; l < 2; l++) {
+      val[m + l] = v[l];
+      if (wg) gx[m + l] = g0[l], gy[m + l] = g1[l];
+    }
+  }
+  for (; m < n; m++) {
+    oc_vec3 g;
+    val[m] = noise3(seeds[m], (oc_vec3){x[m], y[m], 0}, &g, wg);
+    if (wg) gx[m] = g.x, gy[m] = g.y;
+  }
+}
+
+void oc_noise3_z0_multi(const uint64_t *seeds, const double *x, const double *y,
+                        size_t n, double *val, double *gx, double *gy) {
+  int wg = gx && gy;
+  if (wg)
+    z0_multi(seeds, x, y, n, val, gx, gy, 1);
+  else
+    z0_multi(seeds, x, y, n, val, NULL, NULL, 0);
+}
+
 double oc_turb3(uint64_t seed, int octaves, oc_vec3 p, oc_vec3 *grad) {
   /* Octave k is 2^-k n_k(2^k p): its gradient is grad n_k(2^k p) as the two
   ** powers cancel. Both powers are exact, so the octaves stay exact

@@ -32,6 +32,14 @@ double oc_noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad);
 void oc_noise3_z0_row(uint64_t seed, const double *x, const double *y, size_t n,
                       double *out);
 
+/* n(x[m], y[m], 0) under seeds[m] for m < n, in val, with the x and y
+** parts of the gradient in gx and gy when both are not NULL: oc_noise3's
+** values and gradients bit for bit (the z part is not computed). Points
+** go two at a time through the same operations, lane by lane (the octaves
+** of an elevation disc's noise sum: one call per point and sum). */
+void oc_noise3_z0_multi(const uint64_t *seeds, const double *x, const double *y,
+                        size_t n, double *val, double *gx, double *gy);
+
 /* t(p); gradient when grad != NULL. octaves >= 1. */
 double oc_turb3(uint64_t seed, int octaves, oc_vec3 p, oc_vec3 *grad);
 /* Upper bound of t: sum 2^-k = 2 - 2^(1-octaves); t >= 0. */

@@ -49,33 +49,51 @@ typedef struct octlod {
 ** is 1, the sum is bit for bit the unfiltered one. */
 static double noise_sum(const oc_enoise *nz, double u, double v, double g[2],
                         const octlod *lod) {
+  /* the octaves' points and filters first, then their noise in one call
+  ** (oc_noise3_z0_multi: two octaves at a time, the values and gradients
+  ** oc_eta gives), then the sum octave by octave as it always was */
+  uint64_t seed[OC_ENOISE_MAXOCT];
+  double px[OC_ENOISE_MAXOCT], py[OC_ENOISE_MAXOCT], e[OC_ENOISE_MAXOCT];
+  double ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
+  double bws[OC_ENOISE_MAXOCT], dbs[OC_ENOISE_MAXOCT];
+  int cnt = 0;
+  for (double s = 1 / nz->wavelength; cnt < nz->octaves;
+       cnt++, s *= nz->lacunarity) {
+    double bw = 1, db = 0;
+    if (lod) {
+      bw = oc_elod_b(lod->t0 - cnt * lod->dt, &db);
+      if (bw == 0) break;
+    }
+    bws[cnt] = bw, dbs[cnt] = db;
+    seed[cnt] = octave_seed(nz->seed, cnt);
+    px[cnt] = s * u, py[cnt] = s * v;
+  }
+  oc_noise3_z0_multi(seed, px, py, (size_t)cnt, e, g ? ex : NULL,
+                     g ? ey : NULL);
   double sum = 0, a = nz->amplitude, s = 1 / nz->wavelength;
   double prev = 1, gprev[2] = {0, 0}; /* ridged: s_(i-1) and its gradient */
   if (g) g[0] = g[1] = 0;
-  for (int i = 0; i < nz->octaves; i++) {
-    double ge[2], bw = 1, db = 0, a0 = a;
-    if (lod) {
-      bw = oc_elod_b(lod->t0 - i * lod->dt, &db);
-      if (bw == 0) break;
-      a = a0 * bw;
-    }
-    double e = oc_eta(octave_seed(nz->seed, i), s * u, s * v, g ? ge : NULL);
+  for (int i = 0; i < cnt; i++) {
+    double ge[2] = {0, 0}, bw = bws[i], db = dbs[i], a0 = a;
+    if (lod) a = a0 * bw;
+    e[i] = 2 * e[i] - 1; /* (oc_eta) */
+    if (g) ge[0] = 2 * ex[i], ge[1] = 2 * ey[i];
     double term = 0; /* the octave's unfiltered term, where db != 0 */
     switch (nz->kind) {
     case OC_ENOISE_PLAIN:
-      sum += a * e;
-      term = e;
+      sum += a * e[i];
+      term = e[i];
       if (g) g[0] += a * s * ge[0], g[1] += a * s * ge[1];
       break;
     case OC_ENOISE_TURBULENCE: {
-      double sg = e < 0 ? -1 : 1;
-      sum += a * fabs(e);
-      term = fabs(e);
+      double sg = e[i] < 0 ? -1 : 1;
+      sum += a * fabs(e[i]);
+      term = fabs(e[i]);
       if (g) g[0] += a * s * sg * ge[0], g[1] += a * s * sg * ge[1];
       break;
     }
     default: { /* ridged */
-      double sg = e < 0 ? -1 : 1, r = 1 - fabs(e);
+      double sg = e[i] < 0 ? -1 : 1, r = 1 - fabs(e[i]);
       double w = 1, gw[2] = {0, 0};
       if (i > 0) {
         w = RIDGE_GAIN * prev;
@@ -333,10 +351,10 @@ void oc_edisc_ev_row(const oc_enode *n, const double *x, double y, int cnt,
 /* Distances from (cx, cy) to the nearest and farthest points of b. */
 static void rect_dist(const oc_erect *b, double cx, double cy, double *dmin,
                       double *dmax) {
-  double dx = fmax(fmax(b->x0 - cx, cx - b->x1), 0);
-  double dy = fmax(fmax(b->y0 - cy, cy - b->y1), 0);
-  double fx = fmax(fabs(b->x0 - cx), fabs(b->x1 - cx));
-  double fy = fmax(fabs(b->y0 - cy), fabs(b->y1 - cy));
+  double dx = oc_efmax(oc_efmax(b->x0 - cx, cx - b->x1), 0);
+  double dy = oc_efmax(oc_efmax(b->y0 - cy, cy - b->y1), 0);
+  double fx = oc_efmax(fabs(b->x0 - cx), fabs(b->x1 - cx));
+  double fy = oc_efmax(fabs(b->y0 - cy), fabs(b->y1 - cy));
   *dmin = sqrt(dx * dx + dy * dy);
   *dmax = sqrt(fx * fx + fy * fy);
 }
@@ -389,13 +407,25 @@ static int noise_local(const oc_enoise *nz, double u0, double v0, double u1,
   double a = nz->amplitude, s = 1 / nz->wavelength;
   double rho = sqrt(hx * hx + hy * hy) * (1 + 1e-15);
   if (!(H * s * rho < L || L * s * rho < 1)) return 0;
+  /* the octaves that gain, and their noise at the centre in one call */
+  uint64_t seed[OC_ENOISE_MAXOCT];
+  double px[OC_ENOISE_MAXOCT], py[OC_ENOISE_MAXOCT], ev[OC_ENOISE_MAXOCT];
+  double ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
+  int cnt = 0;
+  for (double sc = s; cnt < nz->octaves; cnt++, sc *= nz->lacunarity) {
+    double r = sc * rho;
+    if (!(H * r < L || L * r < 1)) break;
+    seed[cnt] = octave_seed(nz->seed, cnt);
+    px[cnt] = sc * u, py[cnt] = sc * v;
+  }
+  oc_noise3_z0_multi(seed, px, py, (size_t)cnt, ev, ex, ey);
   double l = 0, h = 0, lf = 0;
   double tlo = 1, thi = 1, tl = 0; /* ridged: the previous term's bounds */
   int i = 0;
-  for (; i < nz->octaves; i++, a *= nz->gain, s *= nz->lacunarity) {
+  for (; i < cnt; i++, a *= nz->gain, s *= nz->lacunarity) {
     double r = s * rho;
-    if (!(H * r < L || L * r < 1)) break;
-    double g[2], e = oc_eta(octave_seed(nz->seed, i), s * u, s * v, g);
+    /* (oc_eta) */
+    double g[2] = {2 * ex[i], 2 * ey[i]}, e = 2 * ev[i] - 1;
     double gn = sqrt(g[0] * g[0] + g[1] * g[1]) * (1 + 1e-15);
     double sl = lesser(L, gn + H * r); /* |grad eta| */
     double dv = lesser(L * r, s * (fabs(g[0]) * hx + fabs(g[1]) * hy) +
@@ -466,24 +496,24 @@ void oc_edisc_bound_in(const oc_enode *node, const oc_erect *b,
   if (!filtered && n->noise.kind != OC_ENOISE_NONE &&
       noise_local(&n->noise, b->x0 - n->par[0], b->y0 - n->par[1],
                   b->x1 - n->par[0], b->y1 - n->par[1], &nlo, &nhi, &nlip)) {
-    o->flo = fmax(o->flo, n->par[3] + nlo);
-    o->fhi = fmin(o->fhi, n->par[3] + nhi);
-    o->lf = fmin(o->lf, nlip);
+    o->flo = oc_efmax(o->flo, n->par[3] + nlo);
+    o->fhi = oc_efmin(o->fhi, n->par[3] + nhi);
+    o->lf = oc_efmin(o->lf, nlip);
   }
   double dmin, dmax, r = n->par[2];
   rect_dist(b, n->par[0], n->par[1], &dmin, &dmax);
   /* rounding: alpha's bounds a hair wider than the formula */
-  o->alo = fmax(0, wyvill(dmax / r) * (1 - 1e-12) - 1e-300);
-  o->ahi = fmin(1, wyvill(dmin / r) * (1 + 1e-12));
+  o->alo = oc_efmax(0, wyvill(dmax / r) * (1 - 1e-12) - 1e-300);
+  o->ahi = oc_efmin(1, wyvill(dmin / r) * (1 + 1e-12));
   /* |grad alpha| = 6 x (1 - x^2)^2 / r at x = d / r rises up to x =
   ** 1/sqrt(5) (the global bound) and falls after: its largest value on
   ** [dmin, dmax] is there or at the end nearer to it */
-  double x0 = dmin / r, x1 = fmin(dmax / r, 1), xs = 1 / sqrt(5.0);
+  double x0 = dmin / r, x1 = oc_efmin(dmax / r, 1), xs = 1 / sqrt(5.0);
   if (x0 >= 1) {
     o->la = 0; /* outside the disc: alpha = 0 on the whole box */
   } else if (x1 < xs || x0 > xs) {
     double x = x1 < xs ? x1 : x0, k = 1 - x * x;
-    o->la = fmin(o->la, 6 * x * k * k / r * (1 + 1e-12));
+    o->la = oc_efmin(o->la, 6 * x * k * k / r * (1 + 1e-12));
   }
 }
 
@@ -508,7 +538,7 @@ static int check_noise(const oc_enode_noise *nz, oc_enoise *out,
     return oc_seterr(err, OC_EINVAL,
                      "'noise.wavelength' must be a positive number (got %g)",
                      nz->wavelength);
-  if (nz->octaves < 1 || nz->octaves > 16)
+  if (nz->octaves < 1 || nz->octaves > OC_ENOISE_MAXOCT)
     return oc_seterr(err, OC_EINVAL,
                      "'noise.octaves' must be an integer in 1..16 (got %d)",
                      nz->octaves);
