@@ -21,6 +21,9 @@
 **    gives h, a linear part and a remainder on a disc around it, and the
 **    step goes to the first zero of the height above that model, which
 **    near the surface is Newton-like (the remainder is quadratic there).
+**    Where a model is poor (ridged octaves folded along their ridges) or
+**    not needed (high above the terrain), the ray takes the box bound's
+**    steps on height calls instead.
 **  - Sphere tracing (`OC_TRACE_SPHERE`, section 7.1) uses the slope bound of
 **    the whole domain for every step: the baseline the paper compares to.
 ** Both clip the ray to the domain x [min f, max f] first, never step below
@@ -63,8 +66,9 @@
 ** fig21, fig22): TSW 0.25, 0.5, 0.9 gave 21.9, 15.9, 7.5, 17.8; 19.9,
 ** 14.5, 7.6, 16.9; 19.7, 14.4, 7.6, 16.9 (TBOX 0.25); TBOX 0.1, 0.25,
 ** 0.5 gave 19.9, 14.5, 7.6, 17.0; 19.9, 14.5, 7.6, 16.9; 19.7, 14.4,
-** 7.6, 16.8 with 4 to 13 % more box queries (TSW 0.5); a ray's
-** relaxations are not limited (1 failure: fig3 15.2, fig21 8.1). */
+** 7.6, 16.8 with 4 to 13 % more box queries (TSW 0.5). A ray's
+** relaxations are not limited (before the box steps, one failure a ray
+** took fig3 to 15.2 calls and fig21 to 8.1). */
 #define TSW 0.5
 #define TBOX 0.25
 
