@@ -21,6 +21,9 @@
 **    gives h, a linear part and a remainder on a disc around it, and the
 **    step goes to the first zero of the height above that model, which
 **    near the surface is Newton-like (the remainder is quadratic there).
+**    Where a model is poor (ridged octaves folded along their ridges) or
+**    not needed (high above the terrain), the ray takes the box bound's
+**    steps on height calls instead.
 **  - Sphere tracing (`OC_TRACE_SPHERE`, section 7.1) uses the slope bound of
 **    the whole domain for every step: the baseline the paper compares to.
 ** Both clip the ray to the domain x [min f, max f] first, never step below
@@ -56,6 +59,21 @@
 ** relaxation after 1 or 3 failures 16.5 and 15.6 instead of 15.1. */
 #define TGROW 1.5
 #define TRELAX 1.7
+/* A ray on box steps turns to models where its step is under TSW of the
+** candidate; on models, it asks the box bound too where the model's step
+** is under TBOX of the candidate, and goes back to box steps when that
+** proves more. Measured on bench_elev -qq (calls a pixel, fig1, fig3,
+** fig21, fig22): TSW 0.25, 0.5, 0.9 gave 21.9, 15.9, 7.5, 17.8; 19.9,
+** 14.5, 7.6, 16.9; 19.7, 14.4, 7.6, 16.9 (TBOX 0.25); TBOX 0.1, 0.25,
+** 0.5 gave 19.9, 14.5, 7.6, 17.0; 19.9, 14.5, 7.6, 16.9; 19.7, 14.4,
+** 7.6, 16.8 with 4 to 13 % more box queries (TSW 0.5). Under callgrind
+** (fig3 and fig21) TSW 0.5 with TBOX 0.25 took 3.69 and 1.52 10^9
+** instructions, 0.9 with 0.25 3.64 and 1.53, 0.9 with 0.1 3.44 and 1.51
+** (the box queries cost fig3 more than the calls they save). A ray's
+** relaxations are not limited (before the box steps, one failure a ray
+** took fig3 to 15.2 calls and fig21 to 8.1). */
+#define TSW 0.9
+#define TBOX 0.1
 
 void oc_etracer_init(oc_etracer *tr, const oc_esurface *s,
                      oc_render_tracer mode, double eps_k, double eps_min) {
@@ -182,33 +200,74 @@ static double model_step(double h, const double g[2], const double E[3],
   return lesser(s, e);
 }
 
-/* The accelerated march with the source's first-order models: one query
-** per sample gives h there and the step (model_step) over a candidate
-** segment TGROW times the last step. A relaxed step's sample is kept only
-** when its own model, asked over a disc reaching back to where the last
-** proof ended, proves the stretch behind it free (a descending ray is
-** rising backwards, so this usually holds); else the ray takes the plain
-** step. Steps, hits, holes and walls are march's. */
+/* The step the candidate segment's box bound proves from a sample at
+** height h (march's rule): *slope the slope's step (and *lam its bound),
+** the step returned is that or, for a descending ray, the way down to the
+** highest elevation the box holds when that is longer. */
+static double box_step(const oc_etracer *tr, oc_vec3 p, oc_vec3 u, double uxy,
+                       double h, double e, double *slope, double *lam) {
+  const oc_elevation *src = tr->s->src;
+  oc_vec3 q = at(p, u, e);
+  double x0 = lesser(p.x, q.x), x1 = greater(p.x, q.x);
+  double y0 = lesser(p.y, q.y), y1 = greater(p.y, q.y);
+  double lo, hi;
+  *lam = -1;
+  if (src->bound)
+    src->bound(src->ud, x0, y0, x1, y1, &lo, &hi, lam);
+  else
+    src->range(src->ud, x0, y0, x1, y1, &lo, &hi);
+  if (lesser(p.z, q.z) > hi) { /* above everything the box holds */
+    *slope = -1;
+    return e;
+  }
+  if (*lam < 0) *lam = src->slope(src->ud, x0, y0, x1, y1);
+  double s = safe_step(h, u.z, uxy, *lam, e);
+  *slope = s;
+  if (p.z > hi) s = greater(s, (p.z - hi) / -u.z);
+  return s;
+}
+
+/* The accelerated march with the source's first-order models. A ray
+** samples in one of two ways: a model query (h there and the step
+** model_step proves over a candidate segment TGROW times the last step),
+** or a height call and the candidate's box bound (march's step, RELAX and
+** GROW). A ray starts on box steps (cheap while it is high above the
+** terrain) and turns to models where a box step is short (under TBOX of
+** its candidate: a slope limits it, the model's is Newton-like there);
+** where a model step is that short, the box bound is asked too and the
+** longer step taken, and when the box's wins the ray goes back to box
+** steps (the model is poor there: octaves folded by |eta|, whose sign
+** the model cannot prove). A relaxed step's sample is kept only when its
+** own proof (the model over a disc reaching back to where the last proof
+** ended, a descending ray rising backwards; or the slope as march) shows
+** the stretch behind it free; else the ray takes the plain step. Steps,
+** hits, holes and walls are march's. */
 static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
                         double t1, double d0, double *thit, double *n) {
   const oc_elevation *src = tr->s->src;
   double uxy = hypot(u.x, u.y), delta = (t1 - t) / 16, prev = t, hp = 0;
   oc_vec3 ub = {-u.x, -u.y, -u.z};
-  int have_prev = 0, relaxed = 0;
-  double rsafe = 0; /* a relaxed step's proved part */
+  int have_prev = 0, relaxed = 0, model = 0;
+  double rsafe = 0, rlam = 0; /* a relaxed step's proved part and slope */
   for (long k = 0; k < OC_TRACE_MAX_STEPS; k++) {
     oc_vec3 p = at(o, u, t);
-    double e = lesser(delta, t1 - t), g[2], E[3];
+    double e = lesser(delta, t1 - t), g[2], E[3], h;
     double back = relaxed ? t - (prev + rsafe) : 0;
     (*n)++;
-    double h = p.z - src->taylor(src->ud, p.x, p.y, greater(e, back) * uxy, g,
-                                 E, NULL);
+    if (model)
+      h = p.z -
+          src->taylor(src->ud, p.x, p.y, greater(e, back) * uxy, g, E, NULL);
+    else
+      h = p.z - src->height(src->ud, p.x, p.y, NULL);
     if (h != h) return 0; /* NaN: no surface can be located */
     if (relaxed) {
       relaxed = 0;
-      if (!(h > 0 && model_step(h, g, E, ub, uxy, back) >= back)) {
+      double kb = u.z + uxy * rlam;
+      int ok = model ? h > 0 && model_step(h, g, E, ub, uxy, back) >= back
+                     : h > 0 && (kb <= 0 || prev + rsafe + h / kb >= t);
+      if (!ok) {
         t = prev + rsafe; /* not proved: the plain step */
-        delta = TGROW * rsafe;
+        delta = (model ? TGROW : GROW) * rsafe;
         continue;
       }
     }
@@ -223,16 +282,39 @@ static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
       return 1;
     }
     /* under the surface in a hole: the tolerance (its wall may be near) */
-    double proved = h > 0 ? model_step(h, g, E, u, uxy, e) : 0;
+    double proved = 0, slope = -1, lam = 0;
+    int next = model;
+    if (model) {
+      proved = h > 0 ? model_step(h, g, E, u, uxy, e) : 0;
+      if (h > 0 && proved < TBOX * e) {
+        double b = box_step(tr, p, u, uxy, h, e, &slope, &lam);
+        if (b > proved) proved = b, next = 0;
+      }
+    } else if (h > 0) {
+      proved = box_step(tr, p, u, uxy, h, e, &slope, &lam);
+      if (proved < TSW * e) next = 1;
+    }
+    proved = lesser(proved, e);
     double s = greater(proved, tol(tr, d0, t));
     if (t + s == t || t + proved >= t1 || t >= t1) return 0; /* left it */
     if (t + s > t1) s = t1 - t; /* (as march: sample the box's end) */
     prev = t, hp = h, have_prev = 1;
-    delta = TGROW * s;
-    if (h > 0 && proved < e && s == proved) {
-      double r = lesser(TRELAX * s, t1 - t);
-      if (r > s) relaxed = 1, rsafe = s, s = r;
+    if (next == model && h > 0 && proved < e && s == proved) {
+      /* limited by the model or the slope: try a longer step */
+      if (model) {
+        double r = lesser(TRELAX * s, t1 - t);
+        if (r > s) relaxed = 1, rsafe = s, s = r;
+        delta = TGROW * rsafe;
+      } else if (s == slope) {
+        double r = lesser(RELAX * s, e);
+        if (r > s) relaxed = 1, rsafe = s, rlam = lam, s = r;
+      }
     }
+    if (next)
+      delta = TGROW * (relaxed ? rsafe : s);
+    else
+      delta = GROW * (slope >= 0 ? greater(slope, tol(tr, d0, t + s)) : s);
+    model = next;
     t += s;
   }
   return 0;
