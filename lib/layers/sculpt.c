@@ -223,10 +223,10 @@ int oc_stacks_sculpt(oc_stacks *s, const oc_sculpt_params *p, double *changed,
   ** (found below) grown by the kernel's reach and a margin */
   double c = s->cell, R = p->radius;
   double ext = R + delta + 3 * c;
-  int wi0 = (int)fmax(ceil((p->center.x - ext - s->x0) / c), 0);
-  int wi1 = (int)fmin(floor((p->center.x + ext - s->x0) / c), s->nx - 1);
-  int wj0 = (int)fmax(ceil((p->center.y - ext - s->y0) / c), 0);
-  int wj1 = (int)fmin(floor((p->center.y + ext - s->y0) / c), s->ny - 1);
+  int wi0 = oc_sindex(ceil((p->center.x - ext - s->x0) / c), 0, s->nx);
+  int wi1 = oc_sindex(floor((p->center.x + ext - s->x0) / c), -1, s->nx - 1);
+  int wj0 = oc_sindex(ceil((p->center.y - ext - s->y0) / c), 0, s->ny);
+  int wj1 = oc_sindex(floor((p->center.y + ext - s->y0) / c), -1, s->ny - 1);
   if (wi0 > wi1 || wj0 > wj1) return OC_OK;
   oc_stacks *w = oc_stacks_window(s, wi0, wj0, wi1, wj1, err);
   if (!w) return OC_ENOMEM;
