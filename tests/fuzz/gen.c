@@ -873,12 +873,16 @@ static void elevation(gen *g) {
          "%[, profiles = {{at = 0, knots = %k}, {at = %n, knots = %k}}%]",
          splines[pick(g, 4)], 1, 8);
     break;
-  case 3:
+  case 3: {
+    /* (one pick per call: the order in which a compiler evaluates
+    ** arguments is unspecified, and gcc and clang differ) */
+    const char *spline = splines[pick(g, 4)];
     emit(g, "%T = outcrop.elevation.river%o", "E",
          F_EPTS "%[, kind = '%s'%]%[, width = %n%]%[, depth = %n%]"
                 "%[, bank = %n%]",
-         splines[pick(g, 4)], rivers[pick(g, 5)]);
+         spline, rivers[pick(g, 5)]);
     break;
+  }
   case 4:
     emit(g, "%T = outcrop.elevation.road%o", "E",
          F_EPTS "%[, width = %n%]%[, shoulder = %n%]%[, embankment = %n%]",
