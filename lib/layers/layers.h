@@ -132,6 +132,9 @@ oc_stacks *oc_stacks_alloc(int nx, int ny, double cell, double x0, double y0,
 /* The coarsest stride of the stabilisation (stabilize.c): material moves
 ** at most this many stacks in one transfer. */
 #define OC_LAYERS_STRIDE_MAX 8
+/* The most samples a tool's edit takes along one stack (its window's height
+** over its step): an edit beyond is refused. */
+#define OC_LAYERS_MAX_SAMPLES (1 << 20)
 
 /* Stabilisation over the stacks, with the segments already decoded
 ** (stabilize.c; deposit.c calls it after adding material). */

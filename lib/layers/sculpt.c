@@ -171,6 +171,15 @@ int oc_layers_rebuild_grid(oc_stacks *w, const oc_layers_edit *e,
       rc = oc_builder_push(&bd, in, n0, err);
       continue;
     }
+    if (!((z1 - fmax(z0, w->zbase)) / e->step <= OC_LAYERS_MAX_SAMPLES)) {
+      /* (a sweep profile of 1e30 m: a count of samples beyond long, and
+      ** work without end) */
+      rc = oc_seterr(err, OC_EINVAL,
+                     "the edit spans %g m of height at (%g, %g): more than "
+                     "%d samples of %g m",
+                     z1 - z0, px, py, OC_LAYERS_MAX_SAMPLES, e->step);
+      break;
+    }
     if (rebuild(e->after, e->ctx, px, py, in, n0, w->zbase, z0, z1, e->step,
                 &b)) {
       rc = oc_seterr(err, OC_ENOMEM, "out of memory");

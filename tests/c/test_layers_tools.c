@@ -106,7 +106,8 @@ END_TEST
 ** node that never reaches T in the box, or new without layers) holds no
 ** layer array, and sculpting or converting it offset that NULL array; a
 ** grid far from the tool (origin 1e308) made window bounds beyond int.
-** Each is now a no-op that leaves the grid as it was. */
+** Each is now a no-op that leaves the grid as it was; a sweep whose
+** profile is 1e30 m across is refused. */
 START_TEST(empty_and_far_grids) {
   oc_error err;
   oc_node *ball = OCT_OK(oc_sphere(oct_v(100, 100, 100), 1, 0.5, 1, &err));
@@ -145,6 +146,16 @@ START_TEST(empty_and_far_grids) {
   ck_assert_double_eq(dv, 0);
   ck_assert_double_eq(oc_stacks_volume(far, OC_MAT_BEDROCK), 23 * 8 * 3);
   oc_stacks_free(far);
+  /* a profile 1e30 m across: refused (it took 1e30 / step samples a
+  ** stack, a count beyond long), the grid as it was */
+  oc_stacks *g = slab(21, 2, 3);
+  double huge[] = {1e30, 0, 1e30, 2, -1, 20};
+  oc_vec3 crack[2] = {{4, 0.1, 0}, {-1, 10, 0}};
+  oc_sweep_params hp = {crack, prof, 2, edges, 1, huge, off, 1, 0, 0, NULL};
+  ck_assert_int_eq(oc_stacks_sweep(g, &hp, &dv, NULL, &err), OC_EINVAL);
+  ck_assert_msg(strstr(err.msg, "samples"), "%s", err.msg);
+  ck_assert_double_eq(oc_stacks_volume(g, OC_MAT_BEDROCK), 21 * 21 * 3 * 4);
+  oc_stacks_free(g);
 }
 END_TEST
 
