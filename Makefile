@@ -356,6 +356,9 @@ compare-revisions:
 # libFuzzer target (clang, FUZZ=1) and the corpus replayer (any build)
 # share it with the runner (a sandboxed state with a heap cap and an
 # instruction budget). scripts/fuzz-show FILE prints the scene of a file.
+# Inputs starting with the bytes FE 02 are read by the grammar's version 2
+# (elevation trees, diffusion, blocks, layers); every other input by
+# version 1, which never changes, so stored cases keep their scenes.
 
 FUZZ_SUPPORT := tests/fuzz/gen.c tests/fuzz/runner.c
 # (of the interpreter only the sandbox and the stop: memory.c's wrappers

@@ -356,6 +356,17 @@ static rawpiece *raw_pieces(const oc_curve_piece *pieces, size_t n,
     pc.p[0] = last; /* snap to the previous end */
     pc.scale = poly_len_xy(pc.p, pc.deg);
     last = pc.p[pc.deg];
+    if (!(pc.scale <= 1e300)) {
+      /* (the derivatives would overflow, and the arc length's subdivision
+      ** then never meets its tolerance) */
+      free(raw);
+      oc_curve_free(c);
+      oc_seterr(err, OC_EINVAL,
+                "piece %zu is too long (control polygon %g in xy, at most "
+                "1e300)",
+                i, pc.scale);
+      return NULL;
+    }
     if (pc.scale == 0) {
       /* (all its points are then the previous end: dropping it leaves the
       ** next piece starting where the one before ends) */

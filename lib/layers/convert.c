@@ -228,7 +228,7 @@ oc_stacks *oc_stacks_from_program(const oc_program *P,
       const oc_layer *l = rows[j].l;
       for (int i = 0; i < nx && !fail; i++) {
         fail = oc_builder_push(&bd, l, rows[j].count[i], err) != OC_OK;
-        l += rows[j].count[i];
+        if (rows[j].count[i]) l += rows[j].count[i]; /* l NULL: all air */
       }
     }
     if (!fail)

@@ -53,6 +53,14 @@ void oc_stacks_take_offsets(oc_stacks *s, uint32_t *off);
 ** sign bit is free) moved up one bit, their two lowest mantissa bits
 ** dropped (rounded to nearest: 21 bits of mantissa, a relative error of
 ** at most 2^-22), and the material in the lowest 3 bits. */
+/* x (a stack index in double) clamped to [lo, hi] and converted; NaN
+** gives lo. For windows of stacks around a region, whose bounds can lie
+** anywhere (an origin of 1e308): clamped first, so the conversion to int
+** is defined. */
+static inline int oc_sindex(double x, int lo, int hi) {
+  return x >= hi ? hi : x > lo ? (int)x : lo;
+}
+
 static inline uint32_t oc_lay_pack(double t, int m) {
   float f = (float)t;
   uint32_t b, r;
@@ -124,6 +132,9 @@ oc_stacks *oc_stacks_alloc(int nx, int ny, double cell, double x0, double y0,
 /* The coarsest stride of the stabilisation (stabilize.c): material moves
 ** at most this many stacks in one transfer. */
 #define OC_LAYERS_STRIDE_MAX 8
+/* The most samples a tool's edit takes along one stack (its window's height
+** over its step): an edit beyond is refused. */
+#define OC_LAYERS_MAX_SAMPLES (1 << 20)
 
 /* Stabilisation over the stacks, with the segments already decoded
 ** (stabilize.c; deposit.c calls it after adding material). */

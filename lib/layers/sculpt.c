@@ -171,6 +171,15 @@ int oc_layers_rebuild_grid(oc_stacks *w, const oc_layers_edit *e,
       rc = oc_builder_push(&bd, in, n0, err);
       continue;
     }
+    if (!((z1 - fmax(z0, w->zbase)) / e->step <= OC_LAYERS_MAX_SAMPLES)) {
+      /* (a sweep profile of 1e30 m: a count of samples beyond long, and
+      ** work without end) */
+      rc = oc_seterr(err, OC_EINVAL,
+                     "the edit spans %g m of height at (%g, %g): more than "
+                     "%d samples of %g m",
+                     z1 - z0, px, py, OC_LAYERS_MAX_SAMPLES, e->step);
+      break;
+    }
     if (rebuild(e->after, e->ctx, px, py, in, n0, w->zbase, z0, z1, e->step,
                 &b)) {
       rc = oc_seterr(err, OC_ENOMEM, "out of memory");
@@ -223,10 +232,10 @@ int oc_stacks_sculpt(oc_stacks *s, const oc_sculpt_params *p, double *changed,
   ** (found below) grown by the kernel's reach and a margin */
   double c = s->cell, R = p->radius;
   double ext = R + delta + 3 * c;
-  int wi0 = (int)fmax(ceil((p->center.x - ext - s->x0) / c), 0);
-  int wi1 = (int)fmin(floor((p->center.x + ext - s->x0) / c), s->nx - 1);
-  int wj0 = (int)fmax(ceil((p->center.y - ext - s->y0) / c), 0);
-  int wj1 = (int)fmin(floor((p->center.y + ext - s->y0) / c), s->ny - 1);
+  int wi0 = oc_sindex(ceil((p->center.x - ext - s->x0) / c), 0, s->nx);
+  int wi1 = oc_sindex(floor((p->center.x + ext - s->x0) / c), -1, s->nx - 1);
+  int wj0 = oc_sindex(ceil((p->center.y - ext - s->y0) / c), 0, s->ny);
+  int wj1 = oc_sindex(floor((p->center.y + ext - s->y0) / c), -1, s->ny - 1);
   if (wi0 > wi1 || wj0 > wj1) return OC_OK;
   oc_stacks *w = oc_stacks_window(s, wi0, wj0, wi1, wj1, err);
   if (!w) return OC_ENOMEM;

@@ -58,11 +58,17 @@ oc_stacks *oc_stacks_new(int nx, int ny, double cell, double x0, double y0,
   oc_stacks *s = oc_stacks_alloc(nx, ny, cell, x0, y0, zbase, err);
   if (!s) return NULL;
   uint32_t *off = calloc((size_t)nx * ny + 1, sizeof *off);
-  if (!off) {
+  /* never NULL, as in grids made otherwise: the tools copy and compare
+  ** ranges of it, empty ones too */
+  s->lay = malloc(sizeof *s->lay);
+  if (!off || !s->lay) {
+    free(off);
+    free(s->lay);
     free(s);
     oc_seterr(err, OC_ENOMEM, "out of memory");
     return NULL;
   }
+  s->cap = 1;
   oc_stacks_take_offsets(s, off);
   return s;
 }

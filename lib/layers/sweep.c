@@ -400,10 +400,10 @@ int oc_stacks_sweep(oc_stacks *s, const oc_sweep_params *p, double *changed,
       hi[c] = fmax(hi[c], arc[e].hi[c]);
     }
   double c = s->cell;
-  int i0 = (int)fmax(ceil((lo[0] - s->x0) / c), 0);
-  int i1 = (int)fmin(floor((hi[0] - s->x0) / c), s->nx - 1);
-  int j0 = (int)fmax(ceil((lo[1] - s->y0) / c), 0);
-  int j1 = (int)fmin(floor((hi[1] - s->y0) / c), s->ny - 1);
+  int i0 = oc_sindex(ceil((lo[0] - s->x0) / c), 0, s->nx);
+  int i1 = oc_sindex(floor((hi[0] - s->x0) / c), -1, s->nx - 1);
+  int j0 = oc_sindex(ceil((lo[1] - s->y0) / c), 0, s->ny);
+  int j1 = oc_sindex(floor((hi[1] - s->y0) / c), -1, s->ny - 1);
   int rc = OC_OK;
   oc_stacks *w = NULL;
   double before = 0, after = 0;

@@ -556,6 +556,13 @@ START_TEST(bad_input_is_refused) {
   oc_pcurve *c = oc_curve_new(step, 2, &err);
   ck_assert(c && oc_curve_npieces(c) == 1);
   oc_curve_free(c);
+  /* finite points whose differences overflow (a fuzz finding, tests/corpus/
+  ** elevation-river-huge-points: the arc length's subdivision went to depth
+  ** 24, 25 s): refused at once */
+  oc_vec3 far[4] = {
+      {20, -0x1p63, -2}, {3, 1e308, 20}, {10, 1.5, 2}, {0, -2, 8}};
+  ck_assert(!oc_curve_from_points(far, 4, 3, &err));
+  ck_assert_msg(strstr(err.msg, "piece 0 is too long"), "%s", err.msg);
 }
 END_TEST
 

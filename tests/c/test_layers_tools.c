@@ -102,6 +102,63 @@ START_TEST(from_program_progress) {
 }
 END_TEST
 
+/* Fuzz findings (tests/corpus/layers-*): a grid without layers (from a
+** node that never reaches T in the box, or new without layers) holds no
+** layer array, and sculpting or converting it offset that NULL array; a
+** grid far from the tool (origin 1e308) made window bounds beyond int.
+** Each is now a no-op that leaves the grid as it was; a sweep whose
+** profile is 1e30 m across is refused. */
+START_TEST(empty_and_far_grids) {
+  oc_error err;
+  oc_node *ball = OCT_OK(oc_sphere(oct_v(100, 100, 100), 1, 0.5, 1, &err));
+  oc_program *P = oct_compile(ball, T, 0);
+  oc_stacks_node_params np = {
+      {{-4, -4, -4}, {3, 6, 4}}, 1, 1, OC_MAT_BEDROCK, {NULL, NULL}};
+  oc_stacks *air = oc_stacks_from_program(P, &np, &err);
+  ck_assert_msg(air != NULL, "%s", err.msg);
+  ck_assert_int_eq(oc_stacks_nx(air), 8);
+  ck_assert_double_eq(oc_stacks_volume(air, OC_MAT_BEDROCK), 0);
+  oc_stacks_free(air);
+  oc_program_free(P);
+  oc_stacks *s = oc_stacks_new(10, 15, 1, 0, 0, 0, &err);
+  ck_assert_msg(s != NULL, "%s", err.msg);
+  oc_sculpt_params sp = {{-1, -5, 1}, 2, 1, 8, 1, 0, 0, NULL};
+  double dv = -1;
+  ck_assert_msg(oc_stacks_sculpt(s, &sp, &dv, NULL, &err) == OC_OK, "%s",
+                err.msg);
+  ck_assert_double_eq(dv, 0);
+  oc_stacks_free(s);
+  oc_stacks *far = oc_stacks_new(23, 8, 1, 1e308, -2, 0, &err);
+  ck_assert_msg(far != NULL, "%s", err.msg);
+  uint8_t m = OC_MAT_BEDROCK;
+  double top = 3;
+  ck_assert(oc_stacks_fill(far, &m, &top, 1, &err) == OC_OK);
+  sp = (oc_sculpt_params){{0, 0, 3}, 2, 1, NAN, 1, 0, 0, NULL};
+  ck_assert(oc_stacks_sculpt(far, &sp, &dv, NULL, &err) == OC_OK);
+  ck_assert_double_eq(dv, 0);
+  double uv[] = {-1, 1, 1, 1, 0, -1};
+  size_t off[2] = {0, 3};
+  oc_vec3 pts[2] = {{0, -5, 1}, {5, 16, 1}};
+  int prof[2] = {0, 0}, edges[2] = {0, 1};
+  oc_sweep_params wp = {pts, prof, 2, edges, 1, uv, off, 1, 1, 0, NULL};
+  ck_assert_msg(oc_stacks_sweep(far, &wp, &dv, NULL, &err) == OC_OK, "%s",
+                err.msg);
+  ck_assert_double_eq(dv, 0);
+  ck_assert_double_eq(oc_stacks_volume(far, OC_MAT_BEDROCK), 23 * 8 * 3);
+  oc_stacks_free(far);
+  /* a profile 1e30 m across: refused (it took 1e30 / step samples a
+  ** stack, a count beyond long), the grid as it was */
+  oc_stacks *g = slab(21, 2, 3);
+  double huge[] = {1e30, 0, 1e30, 2, -1, 20};
+  oc_vec3 crack[2] = {{4, 0.1, 0}, {-1, 10, 0}};
+  oc_sweep_params hp = {crack, prof, 2, edges, 1, huge, off, 1, 0, 0, NULL};
+  ck_assert_int_eq(oc_stacks_sweep(g, &hp, &dv, NULL, &err), OC_EINVAL);
+  ck_assert_msg(strstr(err.msg, "samples"), "%s", err.msg);
+  ck_assert_double_eq(oc_stacks_volume(g, OC_MAT_BEDROCK), 21 * 21 * 3 * 4);
+  oc_stacks_free(g);
+}
+END_TEST
+
 /* ---- sweeping ------------------------------------------------------------ */
 
 /* A closed polyline with control points every `h` along its sides (the
@@ -551,6 +608,7 @@ int main(void) {
   tcase_set_timeout(tc, 60);
   tcase_add_test(tc, sculpt_round_trip);
   tcase_add_test(tc, from_program_progress);
+  tcase_add_test(tc, empty_and_far_grids);
   tcase_add_test(tc, sweep_crack_profile);
   tcase_add_test(tc, sweep_crack_follows_surface);
   tcase_add_test(tc, sweep_branches_and_tunnel);
