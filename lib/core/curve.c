@@ -360,7 +360,6 @@ static rawpiece *raw_pieces(const oc_curve_piece *pieces, size_t n,
       /* (the derivatives would overflow, and the arc length's subdivision
       ** then never meets its tolerance) */
       free(raw);
-      oc_curve_free(c);
       oc_seterr(err, OC_EINVAL,
                 "piece %zu is too long (control polygon %g in xy, at most "
                 "1e300)",
