@@ -127,13 +127,18 @@ static int clip(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double *t0,
 /* h at p, one height call; with solid, *solid: the weight allows a
 ** surface there, asked only under the surface (h <= 0 or NaN), the one
 ** place where a caller reads it. */
+/* Whether a sample at height h above the surface at p is solid ground
+** (above it, or where the surface exists: a hole has none). */
+static int solid_at(const oc_esurface *s, oc_vec3 p, double h) {
+  return h > 0 || !s->weight || s->weight(s->wud, p.x, p.y) >= s->T;
+}
+
 static double height_above(const oc_etracer *tr, oc_vec3 p, int *solid,
                            double *n) {
   const oc_esurface *s = tr->s;
   (*n)++;
   double h = p.z - s->src->height(s->src->ud, p.x, p.y, NULL);
-  if (solid)
-    *solid = h > 0 || !s->weight || s->weight(s->wud, p.x, p.y) >= s->T;
+  if (solid) *solid = solid_at(s, p, h);
   return h;
 }
 
@@ -271,8 +276,7 @@ static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
         continue;
       }
     }
-    int solid = h > 0 || !tr->s->weight ||
-                tr->s->weight(tr->s->wud, p.x, p.y) >= tr->s->T;
+    int solid = solid_at(tr->s, p, h);
     if (solid && h <= 0) {
       if (!(have_prev && hp > 0)) {
         *thit = t; /* through a side of the domain or of a hole */

@@ -834,6 +834,14 @@ static int same(double a, double b) {
   return !memcmp(&a, &b, sizeof a);
 }
 
+/* A river crossing the test trees' discs from west to east. */
+static oc_enode *river_across(oc_error *err) {
+  oc_vec3 pts[3] = {{-500, -100, 40}, {0, 10, 45}, {500, 120, 50}};
+  oc_enode_river_params rp = {pts, 3, OC_ECURVE_CATMULL, OC_RIVER_RIVER, 0,
+                              0,   0};
+  return oc_enode_river(&rp, err);
+}
+
 START_TEST(rows_match_points) {
   oc_error err;
   oc_enode *d[4] = {disc(0, 0, 600, 50, OC_ENOISE_PLAIN, 30, 200, 5),
@@ -841,10 +849,7 @@ START_TEST(rows_match_points) {
                     disc(-200, -60, 150, 80, OC_ENOISE_TURBULENCE, 20, 40, 4),
                     disc(60, -30, 90, 30, OC_ENOISE_NONE, 0, 0, 0)};
   oc_enode *land = EOK(oc_enode_blend(d, 4, &err));
-  oc_vec3 pts[3] = {{-500, -100, 40}, {0, 10, 45}, {500, 120, 50}};
-  oc_enode_river_params rp = {pts, 3, OC_ECURVE_CATMULL, OC_RIVER_RIVER, 0,
-                              0,   0};
-  oc_enode *river = EOK(oc_enode_river(&rp, &err));
+  oc_enode *river = EOK(river_across(&err));
   oc_enode *rep = EOK(oc_enode_replace(land, river, 0, &err));
   oc_enode *lrep = EOK(oc_enode_replace(land, d[1], 1, &err));
   oc_enode_add_params ap = {0};
@@ -969,10 +974,7 @@ START_TEST(taylor_models) {
                     disc(-60, 120, 70, 60, OC_ENOISE_PLAIN, 8, 25, 4)};
   oc_enode *land = EOK(oc_enode_blend(d, 5, &err));
   oc_enode *islets = EOK(oc_enode_blend(d + 1, 4, &err)); /* S < T too */
-  oc_vec3 pts[3] = {{-500, -100, 40}, {0, 10, 45}, {500, 120, 50}};
-  oc_enode_river_params rp = {pts, 3, OC_ECURVE_CATMULL, OC_RIVER_RIVER, 0,
-                              0,   0};
-  oc_enode *river = EOK(oc_enode_river(&rp, &err));
+  oc_enode *river = EOK(river_across(&err));
   oc_enode *rep = EOK(oc_enode_replace(land, river, 0, &err));
   oc_enode *lrep = EOK(oc_enode_replace(land, d[1], 1, &err));
   oc_enode_add_params below = {0, 1, 90, 20, 0, 0, 0, 0};
