@@ -661,11 +661,24 @@ static oc_etay octave_model(double e, const double g[2], double s, double R,
 
 static void noise_taylor(const oc_enoise *nz, double u, double v, double R,
                          oc_etay *o) {
-  double sum = 0, a = nz->amplitude, s = 1 / nz->wavelength, prev = 1;
+  /* every octave's noise first, in one call (oc_noise3_z0_multi: two
+  ** octaves at a time, oc_eta's values and gradients bit for bit) */
+  uint64_t seed[OC_ENOISE_MAXOCT];
+  double px[OC_ENOISE_MAXOCT], py[OC_ENOISE_MAXOCT], ev[OC_ENOISE_MAXOCT];
+  double ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
+  int cnt = 0; /* (octaves >= 1: checked when the disc is made) */
+  double s = 1 / nz->wavelength;
+  do {
+    seed[cnt] = octave_seed(nz->seed, cnt);
+    px[cnt] = s * u, py[cnt] = s * v;
+    s *= nz->lacunarity;
+  } while (++cnt < nz->octaves);
+  oc_noise3_z0_multi(seed, px, py, (size_t)cnt, ev, ex, ey);
+  double sum = 0, a = nz->amplitude, prev = 1;
   oc_etay m = oc_etay_const(0), tprev = oc_etay_const(1);
-  for (int i = 0; i < nz->octaves; i++) {
-    double ge[2];
-    double e = oc_eta(octave_seed(nz->seed, i), s * u, s * v, ge);
+  s = 1 / nz->wavelength;
+  for (int i = 0; i < cnt; i++) {
+    double ge[2] = {2 * ex[i], 2 * ey[i]}, e = 2 * ev[i] - 1; /* (oc_eta) */
     oc_etay t;
     switch (nz->kind) {
     case OC_ENOISE_PLAIN:
