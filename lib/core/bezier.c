@@ -92,12 +92,14 @@ double oc_bez_arclen(const oc_vec3 *p, int n, double a, double b) {
 
 /* A polynomial in Bernstein form of degree m <= 5 on some interval. */
 static double bern_eval(const double *c, int m, double t) {
-  double w[6];
-  for (int i = 0; i <= m; i++)
-    w[i] = c[i];
-  for (int k = m; k > 0; k--)
+  /* (de Casteljau; its first level read from c, not a copy of it) */
+  double w[6], u = 1 - t;
+  if (m == 0) return c[0];
+  for (int i = 0; i < m; i++)
+    w[i] = c[i] * u + c[i + 1] * t;
+  for (int k = m - 1; k > 0; k--)
     for (int i = 0; i < k; i++)
-      w[i] = w[i] * (1 - t) + w[i + 1] * t;
+      w[i] = w[i] * u + w[i + 1] * t;
   return w[0];
 }
 
@@ -131,7 +133,15 @@ typedef struct span {
   int depth;
 } span;
 
-/* The root of f in (a, b), where f(a) and f(b) have opposite signs. */
+/* The root of f in (a, b), where f(a) and f(b) have opposite signs:
+** Newton's steps kept inside the bracket (else bisection), until a step
+** or the bracket is under 4e-16 (t lies in [0, 1]), or a step lands on
+** an end of the bracket or a hair past it (under 4e-16: that end is the
+** root, to rounding; Newton's own error is the square of its step).
+** Bisecting there instead, as this did before, halved the bracket
+** towards that end some 40 times: 22 iterations a root on bench_elev
+** -qq fig22, up to 57; 4.4 on random cubics, whose roots moved by at
+** most 2.4e-15 (37 % of them not at all). */
 static double solve_bracketed(const double *f, const double *df, int m,
                               double a, double b) {
   double fa = bern_eval(f, m, a), t = 0.5 * (a + b);
@@ -144,8 +154,14 @@ static double solve_bracketed(const double *f, const double *df, int m,
       b = t;
     double d = bern_eval(df, m - 1, t);
     double tn = t - ft / d;
-    if (!(tn > a && tn < b)) tn = 0.5 * (a + b);
-    if (tn == t || b - a <= 4e-16 * fmax(1, fabs(t))) return tn;
+    if (!(tn > a && tn < b)) {
+      if (tn >= b && tn - b <= 4e-16) return b;
+      if (tn <= a && a - tn <= 4e-16) return a;
+      tn = 0.5 * (a + b);
+    } else if (fabs(tn - t) <= 4e-16) {
+      return tn;
+    }
+    if (tn == t || b - a <= 4e-16) return tn;
     t = tn;
   }
   return t;
