@@ -176,8 +176,8 @@ static double dist2_at(const oc_vec3 *p, int n, double x, double y, double t) {
 
 /* The distance from (a, c) to the box [b0, b1] x [b2, b3]. */
 static double box_dist(double a, double c, const double b[4]) {
-  double da = fmax(fmax(b[0] - a, a - b[1]), 0);
-  double dc = fmax(fmax(b[2] - c, c - b[3]), 0);
+  double da = oc_fmax(oc_fmax(b[0] - a, a - b[1]), 0);
+  double dc = oc_fmax(oc_fmax(b[2] - c, c - b[3]), 0);
   return hypot(da, dc);
 }
 
@@ -315,10 +315,10 @@ double oc_bez_closest(const oc_vec3 *p, int n, double x, double y, double best2,
     span s = st[--top];
     double lx = INFINITY, hx = -INFINITY, ly = INFINITY, hy = -INFINITY;
     for (int i = 0; i <= n; i++) {
-      lx = fmin(lx, s.qx[i]), hx = fmax(hx, s.qx[i]);
-      ly = fmin(ly, s.qy[i]), hy = fmax(hy, s.qy[i]);
+      lx = oc_fmin(lx, s.qx[i]), hx = oc_fmax(hx, s.qx[i]);
+      ly = oc_fmin(ly, s.qy[i]), hy = oc_fmax(hy, s.qy[i]);
     }
-    double bx = fmax(0, fmax(lx, -hx)), by = fmax(0, fmax(ly, -hy));
+    double bx = oc_fmax(0, oc_fmax(lx, -hx)), by = oc_fmax(0, oc_fmax(ly, -hy));
     if (bx * bx + by * by >= best ||
         (s.depth > 0 && frame_far(s.qx, s.qy, n, 0, 0, 0, 0, sqrt(best), mag)))
       continue;

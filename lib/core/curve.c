@@ -734,8 +734,8 @@ int oc_curve_at(const oc_pcurve *c, double s, oc_curve_point *out) {
 /* ---- closest point --------------------------------------------------- */
 
 static double box_d2(const fbox *b, double x, double y) {
-  double dx = fmax(0, fmax(b->x0 - x, x - b->x1));
-  double dy = fmax(0, fmax(b->y0 - y, y - b->y1));
+  double dx = oc_fmax(0, oc_fmax(b->x0 - x, x - b->x1));
+  double dy = oc_fmax(0, oc_fmax(b->y0 - y, y - b->y1));
   return dx * dx + dy * dy;
 }
 

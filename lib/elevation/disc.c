@@ -642,19 +642,19 @@ oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err) {
 
 /* eta (or |eta| with abs, its sign proved constant) in the octave's world
 ** units: value e, octave gradient g (in lattice units), frequency s. */
-static oc_etay octave_model(double e, const double g[2], double s, double R,
-                            int absval) {
+static inline oc_etay octave_model(double e, const double g[2], double s,
+                                   double R, int absval) {
   const double L = 2 * oc_noise3_lipschitz, H = 2 * oc_noise3_hessian;
   double sg = 1, ae = e;
   double quad = 0.5 * H * s * s, flat1 = L * s, flat0 = 1 + fabs(e);
   int can_quad = 1;
   if (absval) {
     sg = e < 0 ? -1 : 1, ae = fabs(e);
-    flat0 = fmax(ae, 1 - ae);
+    flat0 = oc_fmax(ae, 1 - ae);
     can_quad = ae > s * hypot(g[0], g[1]) * R + quad * R * R;
   }
   double Rk = R * OC_ETAY_CHOICE;
-  if (can_quad && quad * Rk * Rk <= fmin(flat1 * Rk, flat0))
+  if (can_quad && quad * Rk * Rk <= oc_fmin(flat1 * Rk, flat0))
     return (oc_etay){ae, sg * s * g[0], sg * s * g[1], 0, 0, quad};
   return oc_etay_flat(ae, flat1, flat0, R);
 }
@@ -739,7 +739,7 @@ void oc_edisc_taylor_alpha(const oc_enode *n, double x, double y, double R,
     *a = (oc_etay){0, 0, 0, 0, 0, 3 / (r * r)};
   }
   /* alpha lies in [0, 1]: at most the gap to the far end (flat) */
-  double gap = fmax(a->v, 1 - a->v);
+  double gap = oc_fmax(a->v, 1 - a->v);
   if (oc_etay_dev(a, R) > gap) *a = (oc_etay){a->v, 0, 0, gap, 0, 0};
 }
 

@@ -22,6 +22,7 @@
 #include <stdint.h>
 
 #include "core/pmap.h"
+#include "core/vec.h"
 #include "elevation/etaylor.h"
 #include "outcrop.h"
 
@@ -420,15 +421,13 @@ int oc_eop_taylor_alpha(const oc_enode *n, double x, double y, double R,
 void oc_enode_bnd(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
                   oc_ebound *o);
 
-/* fmax and fmin as glibc computes them on x86-64 (maxsd and minsd: the
-** second operand where they are equal, the other operand where one is
-** NaN), inline: libm's are calls in this build (no -ffinite-math-only)
-** and box queries make many (2 % of a render's instructions). */
+/* fmax and fmin, inline (core/vec.h): box queries make many (2 % of a
+** render's instructions). */
 static inline double oc_efmax(double x, double y) {
-  return x > y || y != y ? x : y;
+  return oc_fmax(x, y);
 }
 static inline double oc_efmin(double x, double y) {
-  return x < y || y != y ? x : y;
+  return oc_fmin(x, y);
 }
 
 static inline int oc_erect_meets(const oc_erect *a, const oc_erect *b) {

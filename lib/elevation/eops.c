@@ -1161,8 +1161,8 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
   double f = conv ? N / S.v : 0, Q[3] = {rest[0], rest[1], rest[2]};
   for (int j = 0; j < m; j++) {
     /* |f_k - f| (|f_k| where S <= T), or its bound for an outer child */
-    double d = out[j] ? fmax(fhi[j] - f, f - fk[j]) : fabs(fk[j] - f);
-    if (out[j] && !conv) d = fmax(fabs(fk[j]), fabs(fhi[j]));
+    double d = out[j] ? oc_fmax(fhi[j] - f, f - fk[j]) : fabs(fk[j] - f);
+    if (out[j] && !conv) d = oc_fmax(fabs(fk[j]), fabs(fhi[j]));
     Q[0] += d * ea[j][0], Q[1] += d * ea[j][1], Q[2] += d * ea[j][2];
   }
   if (!conv) {
@@ -1187,11 +1187,11 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
 ** the segment's or points where psi = 0), and its values lie in the hull
 ** of 0 and [0, w_hi] [flo - c, fhi - c]. pv: psi at p. */
 static oc_etay psi_flat(const oc_ebound *Bb, double c, double pv, double R) {
-  double whi = fmin(fmax(Bb->ahi, 0), 1);
+  double whi = oc_fmin(oc_fmax(Bb->ahi, 0), 1);
   double dlo = Bb->flo - c, dhi = Bb->fhi - c;
-  double lip = Bb->la * fmax(fabs(dlo), fabs(dhi)) + whi * Bb->lf;
-  double lo = fmin(0, whi * dlo), hi = fmax(0, whi * dhi);
-  return oc_etay_flat(pv, lip * (1 + 1e-12), fmax(hi - pv, pv - lo), R);
+  double lip = Bb->la * oc_fmax(fabs(dlo), fabs(dhi)) + whi * Bb->lf;
+  double lo = oc_fmin(0, whi * dlo), hi = oc_fmax(0, whi * dhi);
+  return oc_etay_flat(pv, lip * (1 + 1e-12), oc_fmax(hi - pv, pv - lo), R);
 }
 
 /* w = clamp(alpha_B)'s model and, for a partial B, B's bound on the
@@ -1208,7 +1208,7 @@ static int weight_taylor(const oc_enode *B, double x, double y, double R,
     /* (lazy: f may be 0 where alpha_B = 0, where w = 0 and psi = 0) */
     oc_enode_ev(B, x, y, NULL, OC_EV_LAZY, &s);
     b->f = oc_etay_const(s.f);
-    b->a = oc_etay_flat(s.a, Bb->la, fmax(Bb->ahi - s.a, s.a - Bb->alo), R);
+    b->a = oc_etay_flat(s.a, Bb->la, oc_fmax(Bb->ahi - s.a, s.a - Bb->alo), R);
   } else {
     oc_enode_taylor(B, x, y, R, b, boxes);
   }

@@ -24,6 +24,8 @@
 
 #include <math.h>
 
+#include "core/vec.h"
+
 typedef struct oc_etay {
   double v, gx, gy;  /* value and linear part at p */
   double e0, e1, e2; /* the remainder's coefficients, >= 0 */
@@ -148,7 +150,7 @@ static inline oc_etay oc_etay_clamp01(const oc_etay *g, double R) {
   if (lo >= 1) return oc_etay_const(1);
   double c = g->v <= 0 ? 0 : g->v >= 1 ? 1 : g->v;
   oc_etay m = {c, 0, 0, g->e0, oc_etay_gnorm(g) + g->e1, g->e2};
-  double gap = fmax(c, 1 - c);
+  double gap = oc_fmax(c, 1 - c);
   if (oc_etay_rem(&m, R) > gap) m.e0 = gap, m.e1 = m.e2 = 0;
   return m;
 }
