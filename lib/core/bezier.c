@@ -288,7 +288,9 @@ double oc_bez_closest(const oc_vec3 *p, int n, double x, double y, double best2,
   ** whole span's; sub-spans below take their own) */
   double mag = fabs(x) + fabs(y) + fabs(p[0].x) + fabs(p[0].y);
   if (frame_far(qx, qy, n, 0, 0, 0, 0, sqrt(best), mag)) return best2;
-  double d0 = dist2_at(p, n, x, y, 0), d1 = dist2_at(p, n, x, y, 1);
+  /* (dist2_at at 0 and 1, the same bits: de Casteljau there gives the
+  ** end points, up to the sign of a zero coordinate, which squares away) */
+  double d0 = qx[0] * qx[0] + qy[0] * qy[0], d1 = qx[n] * qx[n] + qy[n] * qy[n];
   if (d0 < best) best = d0, *t = 0;
   if (d1 < best) best = d1, *t = 1;
 
