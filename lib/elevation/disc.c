@@ -743,16 +743,21 @@ void oc_edisc_taylor_alpha(const oc_enode *n, double x, double y, double R,
   if (oc_etay_dev(a, R) > gap) *a = (oc_etay){a->v, 0, 0, gap, 0, 0};
 }
 
-void oc_edisc_taylor(const oc_enode *n, double x, double y, double R,
-                     oc_etaylor *o) {
+void oc_edisc_taylor_f(const oc_enode *n, double x, double y, double R,
+                       oc_etay *f) {
   const double *p = OC_EDISC(n)->par; /* cx, cy, r, height */
-  oc_edisc_taylor_alpha(n, x, y, R, &o->a);
   oc_enoise noise;
   oc_edisc_noise(n, &noise);
   if (noise.kind == OC_ENOISE_NONE) {
-    o->f = oc_etay_const(p[3] + 0);
+    *f = oc_etay_const(p[3] + 0);
     return;
   }
-  noise_taylor(&noise, x - p[0], y - p[1], R, &o->f);
-  o->f.v = p[3] + o->f.v;
+  noise_taylor(&noise, x - p[0], y - p[1], R, f);
+  f->v = p[3] + f->v;
+}
+
+void oc_edisc_taylor(const oc_enode *n, double x, double y, double R,
+                     oc_etaylor *o) {
+  oc_edisc_taylor_alpha(n, x, y, R, &o->a);
+  oc_edisc_taylor_f(n, x, y, R, &o->f);
 }

@@ -403,9 +403,12 @@ void oc_enode_taylor_flat(const oc_enode *n, double x, double y, double R,
                           oc_etaylor *o, int *boxes);
 void oc_edisc_taylor(const oc_enode *n, double x, double y, double R,
                      oc_etaylor *o);
-/* alpha's model alone (its value 0 where (x, y) is outside the disc) */
+/* alpha's model alone (its value 0 where (x, y) is outside the disc),
+** and f's alone: oc_edisc_taylor is the two */
 void oc_edisc_taylor_alpha(const oc_enode *n, double x, double y, double R,
                            oc_etay *a);
+void oc_edisc_taylor_f(const oc_enode *n, double x, double y, double R,
+                       oc_etay *f);
 /* 0 where the operator has no rule */
 int oc_eop_taylor(const oc_enode *n, double x, double y, double R,
                   oc_etaylor *o, int *boxes);

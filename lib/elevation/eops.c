@@ -1133,7 +1133,10 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
       m++;
       continue;
     }
-    oc_enode_taylor(k, x, y, R, &c, boxes);
+    if (have && k->kind == OC_E_DISC)
+      oc_edisc_taylor_f(k, x, y, R, &c.f); /* (its alpha's model: c.a) */
+    else
+      oc_enode_taylor(k, x, y, R, &c, boxes);
     if (c.a.v == 0 && oc_etay_is_const(&c.a)) continue;
     if (oc_enode_holds(k, x, y) && c.a.v != 0) N += c.a.v * c.f.v; /* (ev) */
     Nx += c.a.v * c.f.gx + c.f.v * c.a.gx;
