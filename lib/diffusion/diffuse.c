@@ -76,10 +76,10 @@ static oc_heightfield *grid_of(const oc_diffusion_params *p, const float *z,
 }
 
 static int solve(oc_dpyramid *py, const oc_diffusion_params *p, oc_dkind kind,
-                 int map, uint8_t mask, double lo, double span,
-                 oc_diffusion_result *out, oc_error *err) {
+                 int map, uint8_t mask, const oc_dgalerkin *gal, double lo,
+                 double span, oc_diffusion_result *out, oc_error *err) {
   oc_dop op = {kind, map, mask, p->scheme == OC_DIFFUSION_PAPER, 0};
-  oc_dsolve s = {p->progress, lo, span, p->tolerance, NULL, NULL};
+  oc_dsolve s = {p->progress, lo, span, p->tolerance, NULL, NULL, gal};
   if (kind == DK_GUIDED) {
     s.residual = out->residual;
     s.cycles = &out->cycles;
@@ -125,11 +125,15 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
   oc_dpyramid_restrict(&py);
   /* the elevation reads the guide on slope samples (constrained: their
   ** values stay) and on conflicts: without conflicts nothing to fill */
+  oc_dgalerkin gal = {0}; /* (converged: the three maps' one operator) */
   if (st.conflict) {
     static const int maps[3] = {MAP_GX, MAP_GY, MAP_GD};
+    oc_dop hom = {DK_LAPLACE, MAP_GX, DF_SLOPE, 0, 1};
+    if (p->tolerance > 0) rc = oc_dgalerkin_build(&gal, &py, &hom, err);
     for (int q = 0; q < 3 && !rc; q++)
-      rc = solve(&py, p, DK_LAPLACE, maps[q], DF_SLOPE, 0.05 + 0.1 * q, 0.1,
-                 out, err);
+      rc = solve(&py, p, DK_LAPLACE, maps[q], DF_SLOPE,
+                 p->tolerance > 0 ? &gal : NULL, 0.05 + 0.1 * q, 0.1, out, err);
+    oc_dgalerkin_free(&gal);
     if (rc) goto done;
   }
   /* n back to unit length after its diffusion (when there was one).
@@ -145,11 +149,18 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
                       !st.conflict ? -1
                       : k          ? 1e-6
                                    : COHERENT);
-  rc = solve(&py, p, DK_GUIDED, MAP_H, DF_H, 0.35, 0.3, out, err);
+  rc = solve(&py, p, DK_GUIDED, MAP_H, DF_H, NULL, 0.35, 0.3, out, err);
+  if (!rc && st.strict_noise && p->tolerance > 0) {
+    oc_dop hom = {DK_LAPLACE, MAP_A, DF_NOISE, 0, 1};
+    rc = oc_dgalerkin_build(&gal, &py, &hom, err);
+  }
   if (!rc && st.strict_noise)
-    rc = solve(&py, p, DK_LAPLACE, MAP_A, DF_NOISE, 0.65, 0.075, out, err);
+    rc = solve(&py, p, DK_LAPLACE, MAP_A, DF_NOISE,
+               p->tolerance > 0 ? &gal : NULL, 0.65, 0.075, out, err);
   if (!rc && st.strict_noise)
-    rc = solve(&py, p, DK_LAPLACE, MAP_R, DF_NOISE, 0.725, 0.075, out, err);
+    rc = solve(&py, p, DK_LAPLACE, MAP_R, DF_NOISE,
+               p->tolerance > 0 ? &gal : NULL, 0.725, 0.075, out, err);
+  oc_dgalerkin_free(&gal);
   if (rc) goto done;
   oc_dpyramid_shrink(&py); /* the finest grid's maps are all that is left */
   const oc_dlevel *lv = &py.lv[0];
