@@ -83,24 +83,18 @@ static void row0(const oc_dop *op, const oc_dlevel *lv, uint8_t fix, int i,
 ** point stencils): W, E, S, N, centre. */
 static const int LQ[5] = {GQ(-1, 0), GQ(1, 0), GQ(0, -1), GQ(0, 1), GQ_C};
 
-/* The weights of fine index g (of a level whose coarse one has nc
-** samples) on the coarse samples C - 1, C, C + 1 into w[3], C the
-** parent of a child next to g: bilinear (oc_dsplit), or with aggregate
-** the parent of g alone (piecewise constant). */
-static inline void weights(int aggregate, int g, int nc, int C, double w[3]) {
+/* The bilinear weights (oc_dsplit) of fine index g (of a level whose
+** coarse one has nc samples) on the coarse samples C - 1, C, C + 1 into
+** w[3], C the parent of a child next to g. */
+static inline void weights(int g, int nc, int C, double w[3]) {
   /* away from the ends, by g - (2 C - 1) in 0 .. 3 */
-  static const double tab[2][4][3] = {
-      {{0.75, 0.25, 0}, {0.25, 0.75, 0}, {0, 0.75, 0.25}, {0, 0.25, 0.75}},
-      {{1, 0, 0}, {0, 1, 0}, {0, 1, 0}, {0, 0, 1}}};
+  static const double tab[4][3] = {
+      {0.75, 0.25, 0}, {0.25, 0.75, 0}, {0, 0.75, 0.25}, {0, 0.25, 0.75}};
   if (C > 0 && C < nc - 1) {
-    memcpy(w, tab[aggregate][g - 2 * C + 1], 3 * sizeof *w);
+    memcpy(w, tab[g - 2 * C + 1], 3 * sizeof *w);
     return;
   }
   w[0] = w[1] = w[2] = 0;
-  if (aggregate) {
-    w[g / 2 - C + 1] = 1;
-    return;
-  }
   int a, b;
   float wb;
   oc_dsplit(g, nc, &a, &b, &wb);
@@ -148,17 +142,20 @@ static void build_one(int aggregate, double half, const oc_dop *op,
           int gi = i + di;
           if (ga &&
               ga[GQ_INV * nsf + (size_t)gj * (size_t)nfx + (size_t)gi] == 0)
-            continue; /* dead: its correction is 0 */
-          if (!wy_done) weights(aggregate, gj, ncy, J, wy), wy_done = 1;
+            continue;      /* dead: its correction is 0 */
+          if (aggregate) { /* one coarse sample: g's parent */
+            int q = (gj / 2 - J + 1) * 3 + (gi / 2 - I + 1);
+            acc[q] += v, accl[q] += vl;
+            continue;
+          }
+          if (!wy_done) weights(gj, ncy, J, wy), wy_done = 1;
           double wx[3];
-          weights(aggregate, gi, ncx, I, wx);
+          weights(gi, ncx, I, wx);
           for (int y = 0; y < 3; y++) {
             if (wy[y] == 0) continue;
-            double vy = v * wy[y], vly = vl * wy[y];
-            for (int x = 0; x < 3; x++) {
-              acc[y * 3 + x] += vy * wx[x];
-              accl[y * 3 + x] += vly * wx[x];
-            }
+            double vy = v * wy[y];
+            for (int x = 0; x < 3; x++)
+              if (wx[x] != 0) acc[y * 3 + x] += vy * wx[x];
           }
         }
       }
