@@ -40,8 +40,9 @@ typedef struct vctx {
   const oc_dgalerkin *gal; /* the coarse levels' operators */
   const oc_dop *op;        /* the problem (level 0) */
   oc_dop hom;              /* its correction equation (levels >= 1) */
-  /* per level: correction and right-hand side (levels >= 1), residual,
-  ** prolonged correction and its image by the operator */
+  /* per level: correction and right-hand side (levels >= 1), residual;
+  ** the finest grid's prolonged correction and its image by the
+  ** operator (c, ac: level 0 only) */
   float **e, **b, **r, **c, **ac;
   double *rows; /* per-row partial sums of the finest grid's height */
   int linear;   /* as BiCGSTAB's preconditioner: the whole correction
@@ -283,8 +284,9 @@ static int vcycles(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
   for (int k = 0; !rc && k < L; k++) {
     size_t ns = (size_t)py->lv[k].nx * (size_t)py->lv[k].ny;
     for (int q = 0; q < 5 && !rc; q++)
-      if ((k > 0 || q >= 2) && !(all[(size_t)q * (size_t)L + (size_t)k] =
-                                     malloc(ns * sizeof(float))))
+      if ((k > 0 ? q <= 2 : q >= 2) &&
+          !(all[(size_t)q * (size_t)L + (size_t)k] =
+                malloc(ns * sizeof(float))))
         rc = oc_seterr(err, OC_ENOMEM, "out of memory");
   }
   double lo, hi;
