@@ -107,9 +107,19 @@ static inline void weights(int g, int nc, int C, double w[3]) {
 ** when ga is NULL, else the Galerkin planes ga of nfx nfy samples. */
 static void build_one(int aggregate, double half, const oc_dop *op,
                       const oc_dlevel *lv0, uint8_t fix, const float *ga,
-                      const float *gl, int nfx, int nfy, float *gc, float *lc,
-                      int ncx, int ncy, size_t nsc, int I, int J) {
+                      const uint8_t *gdead, const float *gl, int nfx, int nfy,
+                      float *gc, float *lc, int ncx, int ncy, size_t nsc, int I,
+                      int J) {
   double acc[9] = {0}, accl[9] = {0};
+  /* the weights of the fine indices 2 I - 1 .. 2 I + 2 (2 J - 1 ..) */
+  double wxs[4][3], wys[4][3];
+  if (!aggregate)
+    for (int q = 0; q < 4; q++) {
+      if (2 * I - 1 + q >= 0 && 2 * I - 1 + q < nfx)
+        weights(2 * I - 1 + q, ncx, I, wxs[q]);
+      if (2 * J - 1 + q >= 0 && 2 * J - 1 + q < nfy)
+        weights(2 * J - 1 + q, ncy, J, wys[q]);
+    }
   int alive = 0;
   size_t nsf = (size_t)nfx * (size_t)nfy;
   for (int b = 0; b < 2; b++)
@@ -119,7 +129,7 @@ static void build_one(int aggregate, double half, const oc_dop *op,
       size_t k = (size_t)j * (size_t)nfx + (size_t)i;
       double row[9], rl[9] = {0};
       if (ga) {
-        if (ga[GQ_INV * nsf + k] == 0) continue;
+        if (gdead[k]) continue;
         for (int q = 0; q < 9; q++)
           row[q] = ga[(size_t)q * nsf + k];
         if (gl)
@@ -134,29 +144,22 @@ static void build_one(int aggregate, double half, const oc_dop *op,
       alive = 1;
       for (int dj = -1; dj <= 1; dj++) {
         int gj = j + dj;
-        double wy[3];
-        int wy_done = 0;
+        const double *wy = wys[gj - 2 * J + 1];
         for (int di = -1; di <= 1; di++) {
           double v = row[GQ(di, dj)], vl = rl[GQ(di, dj)];
           if (v == 0 && vl == 0) continue;
           int gi = i + di;
-          if (ga &&
-              ga[GQ_INV * nsf + (size_t)gj * (size_t)nfx + (size_t)gi] == 0)
+          if (gdead && gdead[(size_t)gj * (size_t)nfx + (size_t)gi])
             continue;      /* dead: its correction is 0 */
           if (aggregate) { /* one coarse sample: g's parent */
             int q = (gj / 2 - J + 1) * 3 + (gi / 2 - I + 1);
             acc[q] += v, accl[q] += vl;
             continue;
           }
-          if (!wy_done) weights(gj, ncy, J, wy), wy_done = 1;
-          double wx[3];
-          weights(gi, ncx, I, wx);
-          for (int y = 0; y < 3; y++) {
-            if (wy[y] == 0) continue;
-            double vy = v * wy[y];
+          const double *wx = wxs[gi - 2 * I + 1];
+          for (int y = 0; y < 3; y++) /* (no branch: zeros add 0) */
             for (int x = 0; x < 3; x++)
-              if (wx[x] != 0) acc[y * 3 + x] += vy * wx[x];
-          }
+              acc[y * 3 + x] += v * wy[y] * wx[x];
         }
       }
     }
@@ -209,8 +212,9 @@ int oc_dgalerkin_build(oc_dgalerkin *g, const oc_dpyramid *py, const oc_dop *op,
 #pragma omp parallel for schedule(static) if (OC_DPAR(c))
     for (int J = 0; J < ncy; J++)
       for (int I = 0; I < ncx; I++)
-        build_one(aggregate, half, op, &py->lv[0], fix, ga, gl, f->nx, f->ny,
-                  at, lc, ncx, ncy, nsc, I, J);
+        build_one(aggregate, half, op, &py->lv[0], fix, ga,
+                  k > 1 ? g->dead[k - 1] : NULL, gl, f->nx, f->ny, at, lc, ncx,
+                  ncy, nsc, I, J);
     g->dead[k] = dead;
     const float *inv = at + GQ_INV * nsc;
     for (size_t q = 0; q < nsc; q++)
