@@ -224,11 +224,13 @@ typedef struct oc_dgalerkin {
   int nlevels, five; /* five: 5-point stencils (the elevation's) */
   float *a[32];
   uint8_t *dead[32]; /* per level: 1 where every child is constrained */
-  float *block;
-  uint8_t *dead_block;
+  float *block;      /* the planes, then the dead flags */
+  size_t cap;        /* its floats */
 } oc_dgalerkin;
 
-/* The coarse operators of op's correction equation. OC_OK or OC_ENOMEM. */
+/* The coarse operators of op's correction equation, into g (zeroed, or
+** holding an earlier build, whose memory is used again when large
+** enough). OC_OK or OC_ENOMEM. */
 int oc_dgalerkin_build(oc_dgalerkin *g, const oc_dpyramid *py, const oc_dop *op,
                        oc_error *err);
 void oc_dgalerkin_free(oc_dgalerkin *g);
@@ -246,6 +248,15 @@ void oc_dgalerkin_restrict(const oc_dlevel *f, const float *r,
 void oc_dgalerkin_prolong(const oc_dgalerkin *g, int kf, const oc_dlevel *lc,
                           const float *c, const oc_dlevel *lf, float *f);
 
+/* A block of floats kept across solves (oc_dsolve's work): memory
+** touched for the first time costs a page fault. */
+typedef struct oc_dwork {
+  float *f;
+  size_t cap;
+} oc_dwork;
+/* At least floats floats (the old contents lost), or NULL (ENOMEM). */
+void *oc_dwork_get(oc_dwork *w, size_t floats);
+
 typedef struct oc_dsolve {
   oc_progress progress;
   double lo, span;  /* this solve's part of the progress range */
@@ -253,6 +264,7 @@ typedef struct oc_dsolve {
   double *residual; /* NULL or OC_DIFFUSION_MAX_CYCLES + 1 values */
   int *cycles;
   const oc_dgalerkin *gal; /* NULL or op's coarse operators (tolerance > 0) */
+  oc_dwork *work;          /* NULL or the V-cycles' buffers, kept */
 } oc_dsolve;
 
 /* Solves op's map on every level: the paper's coarse-to-fine cascade,

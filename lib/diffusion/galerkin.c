@@ -178,7 +178,6 @@ static void build_one(int aggregate, double half, const oc_dop *op,
 
 int oc_dgalerkin_build(oc_dgalerkin *g, const oc_dpyramid *py, const oc_dop *op,
                        oc_error *err) {
-  memset(g, 0, sizeof *g);
   int L = py->nlevels;
   size_t total = 0, samples = 0;
   /* the elevation: piecewise constant P, its Laplace part kept apart (5
@@ -189,16 +188,17 @@ int oc_dgalerkin_build(oc_dgalerkin *g, const oc_dpyramid *py, const oc_dop *op,
     total += ns * (GQ_PLANES + (aggregate ? 5 : 0));
     samples += ns;
   }
-  g->nlevels = L;
-  g->block = malloc((total ? total : 1) * sizeof(float));
-  g->dead_block = malloc(samples ? samples : 1);
-  if (!g->block || !g->dead_block) {
+  /* (a block of an earlier build is used again when large enough) */
+  if (g->cap < total + samples) {
     oc_dgalerkin_free(g);
-    return oc_seterr(err, OC_ENOMEM, "out of memory");
+    g->block = malloc((total + samples) * sizeof(float));
+    if (!g->block) return oc_seterr(err, OC_ENOMEM, "out of memory");
+    g->cap = total + samples;
   }
+  g->nlevels = L;
   uint8_t fix = op->kind == DK_LAPLACE ? op->mask : DF_H;
   float *at = g->block;
-  uint8_t *dead = g->dead_block;
+  uint8_t *dead = (uint8_t *)(g->block + total);
   g->five = aggregate;
   double half = aggregate ? 0.5 : 1;
   float *prevl = NULL;
@@ -228,7 +228,6 @@ int oc_dgalerkin_build(oc_dgalerkin *g, const oc_dpyramid *py, const oc_dop *op,
 
 void oc_dgalerkin_free(oc_dgalerkin *g) {
   free(g->block);
-  free(g->dead_block);
   memset(g, 0, sizeof *g);
 }
 

@@ -266,6 +266,15 @@ static int krylov(const vctx *v, const oc_dsolve *s, double tol, double *res,
   return rc;
 }
 
+void *oc_dwork_get(oc_dwork *w, size_t floats) {
+  if (w->cap < floats) {
+    free(w->f);
+    w->f = malloc(floats * sizeof(float));
+    w->cap = w->f ? floats : 0;
+  }
+  return w->f;
+}
+
 static int vcycles(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
                    double first, oc_error *err) {
   int L = py->nlevels, rc = OC_OK;
@@ -274,20 +283,27 @@ static int vcycles(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
       py, s->gal ? s->gal : &own, op, *op, NULL, NULL, NULL, NULL, NULL, NULL,
       0};
   v.hom.hom = 1;
-  float **all = calloc(5 * (size_t)L, sizeof *all);
-  v.rows = malloc(2 * (size_t)py->lv[0].ny * sizeof *v.rows);
-
-  if (!all || !v.rows) rc = oc_seterr(err, OC_ENOMEM, "out of memory");
-  if (all)
-    v.e = all, v.b = all + L, v.r = all + 2 * L, v.c = all + 3 * L,
-    v.ac = all + 4 * L;
-  for (int k = 0; !rc && k < L; k++) {
-    size_t ns = (size_t)py->lv[k].nx * (size_t)py->lv[k].ny;
-    for (int q = 0; q < 5 && !rc; q++)
-      if ((k > 0 ? q <= 2 : q >= 2) &&
-          !(all[(size_t)q * (size_t)L + (size_t)k] =
-                malloc(ns * sizeof(float))))
-        rc = oc_seterr(err, OC_ENOMEM, "out of memory");
+  /* the buffers in one block, kept across solves when s->work is given
+  ** (memory touched for the first time costs a page fault) */
+  oc_dwork mine = {0}, *w = s->work ? s->work : &mine;
+  size_t need = 2 * (size_t)py->lv[0].ny * sizeof(double) /
+                sizeof(float); /* the rows' sums */
+  for (int k = 0; k < L; k++)
+    need += 3 * (size_t)py->lv[k].nx * (size_t)py->lv[k].ny;
+  float *all[5 * 32] = {NULL};
+  float *at = oc_dwork_get(w, need);
+  if (!at) rc = oc_seterr(err, OC_ENOMEM, "out of memory");
+  v.e = all, v.b = all + L, v.r = all + 2 * L, v.c = all + 3 * L,
+  v.ac = all + 4 * L;
+  if (at) {
+    v.rows = (double *)(void *)at; /* (the block is malloc'd: aligned) */
+    at += 2 * (size_t)py->lv[0].ny * sizeof(double) / sizeof(float);
+    for (int k = 0; k < L; k++) {
+      size_t ns = (size_t)py->lv[k].nx * (size_t)py->lv[k].ny;
+      for (int q = 0; q < 5; q++)
+        if (k > 0 ? q <= 2 : q >= 2)
+          all[(size_t)q * (size_t)L + (size_t)k] = at, at += ns;
+    }
   }
   double lo, hi;
   fixed_range(py, op, &lo, &hi);
@@ -312,10 +328,7 @@ static int vcycles(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
   if (!rc && res > tol && c < OC_DIFFUSION_MAX_CYCLES)
     rc = krylov(&v, s, tol, &res, &c, err);
   if (s->cycles) *s->cycles = c;
-  for (size_t q = 0; all && q < 5 * (size_t)L; q++)
-    free(all[q]);
-  free(all);
-  free(v.rows);
+  free(mine.f);
   oc_dgalerkin_free(&own);
   return rc;
 }

@@ -457,7 +457,7 @@ START_TEST(converged_meets_fine_equations) {
   double res[OC_DIFFUSION_MAX_CYCLES + 1];
   int cycles = 0;
   oc_dop op = {DK_GUIDED, MAP_H, DF_H, 0, 0};
-  oc_dsolve s = {{0}, 0, 1, 1e-5, res, &cycles, NULL};
+  oc_dsolve s = {{0}, 0, 1, 1e-5, res, &cycles, NULL, NULL};
   ck_assert_int_eq(oc_dsolve_map(&py, &op, &s, &err), OC_OK);
   const float *F = lv->map[MAP_H];
   double big = 0;
