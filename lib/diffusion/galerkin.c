@@ -297,25 +297,41 @@ void oc_dgalerkin_smooth(const oc_dgalerkin *g, const oc_dlevel *lv, int k,
       gs_rows(g->five, a, ns, nx, ny, x, b, c, par);
 }
 
+/* r = b - A x on row j (0 where dead). */
+INLINE void res_row(int five, const float *a, size_t ns, int nx, int ny,
+                    const float *x, const float *b, float *r, int j) {
+  size_t rr = (size_t)j * (size_t)nx;
+  const float *xs = j > 0 ? x + rr - nx : x + rr, *xr = x + rr,
+              *xn = j + 1 < ny ? x + rr + nx : x + rr;
+  const float *ac = a + GQ_C * ns, *inv = a + GQ_INV * ns;
+#pragma omp simd
+  for (int i = 1; i < nx - 1; i++) {
+    size_t q = rr + (size_t)i;
+    float s = offsum(five, a, ns, q, xs, xr, xn, b, i, i - 1, i + 1);
+    s -= ac[q] * xr[i];
+    r[q] = inv[q] != 0 ? s : 0;
+  }
+  for (int i = 0; i < nx; i = i ? nx : nx - 1) { /* the border columns */
+    int iw = i > 0 ? i - 1 : i, ie = i + 1 < nx ? i + 1 : i;
+    size_t q = rr + (size_t)i;
+    float s = offsum(five, a, ns, q, xs, xr, xn, b, i, iw, ie);
+    s -= ac[q] * xr[i];
+    r[q] = inv[q] != 0 ? s : 0;
+    if (nx == 1) break;
+  }
+}
+
 void oc_dgalerkin_residual(const oc_dgalerkin *g, const oc_dlevel *lv, int k,
                            const float *x, const float *b, float *r) {
   const float *a = g->a[k];
   int nx = lv->nx, ny = lv->ny, five = g->five;
   size_t ns = (size_t)nx * (size_t)ny;
 #pragma omp parallel for schedule(static) if (OC_DPAR(lv))
-  for (int j = 0; j < ny; j++) {
-    size_t rr = (size_t)j * (size_t)nx;
-    const float *xs = j > 0 ? x + rr - nx : x + rr, *xr = x + rr,
-                *xn = j + 1 < ny ? x + rr + nx : x + rr;
-    for (int i = 0; i < nx; i++) {
-      int iw = i > 0 ? i - 1 : i, ie = i + 1 < nx ? i + 1 : i;
-      size_t q = rr + (size_t)i;
-      float s = five ? offsum(1, a, ns, q, xs, xr, xn, b, i, iw, ie)
-                     : offsum(0, a, ns, q, xs, xr, xn, b, i, iw, ie);
-      s -= a[GQ_C * ns + q] * xr[i];
-      r[q] = a[GQ_INV * ns + q] != 0 ? s : 0;
-    }
-  }
+  for (int j = 0; j < ny; j++)
+    if (five)
+      res_row(1, a, ns, nx, ny, x, b, r, j);
+    else
+      res_row(0, a, ns, nx, ny, x, b, r, j);
 }
 
 void oc_dgalerkin_restrict(const oc_dlevel *f, const float *r,
