@@ -102,6 +102,16 @@ static inline void weights(int g, int nc, int C, double w[3]) {
   w[b - C + 1] += (double)wb;
 }
 
+/* The slots s[2] (ascending) and weights w2[2] of the nonzero weights
+** of w[3] (a second weight 0 on the first slot when there is one). */
+static inline void nonzero(const double w[3], int s[2], double w2[2]) {
+  int n = 0;
+  s[0] = s[1] = 0, w2[0] = w2[1] = 0;
+  for (int q = 0; q < 3 && n < 2; q++)
+    if (w[q] != 0) s[n] = q, w2[n] = w[q], n++;
+  if (n == 1) s[1] = s[0];
+}
+
 /* The stencil of coarse sample (I, J) of a level of ncx ncy samples
 ** (nsc in all) into the planes gc, from the finer level: level 0 (lv0)
 ** when ga is NULL, else the Galerkin planes ga of nfx nfy samples. */
@@ -112,13 +122,20 @@ static void build_one(int aggregate, double half, const oc_dop *op,
                       int J) {
   double acc[9] = {0}, accl[9] = {0};
   /* the weights of the fine indices 2 I - 1 .. 2 I + 2 (2 J - 1 ..) */
-  double wxs[4][3], wys[4][3];
+  /* as the slots and weights of their (at most 2) nonzero weights */
+  int sx[4][2] = {{0}}, sy[4][2] = {{0}};
+  double wxs[4][2] = {{0}}, wys[4][2] = {{0}};
   if (!aggregate)
     for (int q = 0; q < 4; q++) {
-      if (2 * I - 1 + q >= 0 && 2 * I - 1 + q < nfx)
-        weights(2 * I - 1 + q, ncx, I, wxs[q]);
-      if (2 * J - 1 + q >= 0 && 2 * J - 1 + q < nfy)
-        weights(2 * J - 1 + q, ncy, J, wys[q]);
+      double w[3];
+      if (2 * I - 1 + q >= 0 && 2 * I - 1 + q < nfx) {
+        weights(2 * I - 1 + q, ncx, I, w);
+        nonzero(w, sx[q], wxs[q]);
+      }
+      if (2 * J - 1 + q >= 0 && 2 * J - 1 + q < nfy) {
+        weights(2 * J - 1 + q, ncy, J, w);
+        nonzero(w, sy[q], wys[q]);
+      }
     }
   int alive = 0;
   size_t nsf = (size_t)nfx * (size_t)nfy;
@@ -145,6 +162,7 @@ static void build_one(int aggregate, double half, const oc_dop *op,
       for (int dj = -1; dj <= 1; dj++) {
         int gj = j + dj;
         const double *wy = wys[gj - 2 * J + 1];
+        const int *ky = sy[gj - 2 * J + 1];
         for (int di = -1; di <= 1; di++) {
           double v = row[GQ(di, dj)], vl = rl[GQ(di, dj)];
           if (v == 0 && vl == 0) continue;
@@ -157,9 +175,10 @@ static void build_one(int aggregate, double half, const oc_dop *op,
             continue;
           }
           const double *wx = wxs[gi - 2 * I + 1];
-          for (int y = 0; y < 3; y++) /* (no branch: zeros add 0) */
-            for (int x = 0; x < 3; x++)
-              acc[y * 3 + x] += v * wy[y] * wx[x];
+          const int *kx = sx[gi - 2 * I + 1];
+          for (int y = 0; y < 2; y++)
+            for (int x = 0; x < 2; x++)
+              acc[ky[y] * 3 + kx[x]] += v * wy[y] * wx[x];
         }
       }
     }
