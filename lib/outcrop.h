@@ -2184,11 +2184,11 @@ typedef struct oc_diffusion_params {
   uint64_t seed;
   oc_diffusion_scheme scheme;
   /* 0: the paper's cascade, 5 (l - i) Jacobi sweeps at level i of l (0
-  ** the coarsest); > 0: full multigrid instead, then V-cycles (red-black
-  ** Gauss-Seidel smoothing), and once they stall BiCGSTAB preconditioned
-  ** by V-cycles, until the largest update of each diffused map is at
-  ** most tolerance times its constraints' scale (at most
-  ** OC_DIFFUSION_MAX_CYCLES steps) */
+  ** the coarsest); > 0: from the cascade, V-cycles (Gauss-Seidel
+  ** smoothing, Galerkin coarse operators), and once they stall BiCGSTAB
+  ** preconditioned by V-cycles, until the largest update of each
+  ** diffused map is at most tolerance times its constraints' scale (at
+  ** most OC_DIFFUSION_MAX_CYCLES steps) */
   double tolerance;
   double wavelength; /* lambda_0 metres (> 0; 0: the grid's extent / 8) */
   int octaves;       /* n + 1 in 1..16 (0: 4) */
@@ -2205,8 +2205,8 @@ typedef struct oc_diffusion_result {
   oc_heightfield *smooth, *detail, *amplitude, *roughness, *gradient;
   int levels; /* grids of the multigrid pyramid */
   /* steps of the elevation's solve (V-cycles, then BiCGSTAB iterations),
-  ** and its largest update (metres) after the cascade (converged: after
-  ** the full multigrid pass) and after each step */
+  ** and its largest update (metres) after the cascade and after each
+  ** step */
   int cycles;
   double residual[OC_DIFFUSION_MAX_CYCLES + 1];
   size_t strict, slope, conflict; /* constrained samples of the finest grid */

@@ -75,11 +75,28 @@ static oc_heightfield *grid_of(const oc_diffusion_params *p, const float *z,
   return oc_heightfield_new(g->nx, g->ny, g->cell, g->x0, g->y0, z, err);
 }
 
+/* The converged mode's state kept across the maps' solves: the coarse
+** operators (built once for the three gradient maps, once for the
+** elevation, once for amplitude and roughness, in the same memory) and
+** the V-cycles' buffers. */
+typedef struct conv {
+  oc_dgalerkin gal;
+  oc_dwork work;
+} conv;
+
+/* With tolerance > 0 the coarse operators of (kind, mask) into c->gal. */
+static int operators(conv *c, oc_dpyramid *py, const oc_diffusion_params *p,
+                     oc_dkind kind, uint8_t mask, oc_error *err) {
+  oc_dop hom = {kind, MAP_H, mask, p->scheme == OC_DIFFUSION_PAPER, 1};
+  return p->tolerance > 0 ? oc_dgalerkin_build(&c->gal, py, &hom, err) : OC_OK;
+}
+
 static int solve(oc_dpyramid *py, const oc_diffusion_params *p, oc_dkind kind,
-                 int map, uint8_t mask, double lo, double span,
+                 int map, uint8_t mask, conv *c, double lo, double span,
                  oc_diffusion_result *out, oc_error *err) {
   oc_dop op = {kind, map, mask, p->scheme == OC_DIFFUSION_PAPER, 0};
-  oc_dsolve s = {p->progress, lo, span, p->tolerance, NULL, NULL};
+  oc_dsolve s = {p->progress, lo,   span,    p->tolerance,
+                 NULL,        NULL, &c->gal, &c->work};
   if (kind == DK_GUIDED) {
     s.residual = out->residual;
     s.cycles = &out->cycles;
@@ -99,6 +116,7 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
   out->height = grid_of(p, NULL, err);
   if (!out->height) return err ? err->code : OC_ENOMEM;
   oc_dpyramid py;
+  conv cv = {{0}, {0}};
   rc = oc_dpyramid_init(&py, g->nx, g->ny, g->cell,
                         oc_heightfield_samples_mut(out->height), err);
   if (rc) {
@@ -127,9 +145,10 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
   ** values stay) and on conflicts: without conflicts nothing to fill */
   if (st.conflict) {
     static const int maps[3] = {MAP_GX, MAP_GY, MAP_GD};
+    rc = operators(&cv, &py, p, DK_LAPLACE, DF_SLOPE, err);
     for (int q = 0; q < 3 && !rc; q++)
-      rc = solve(&py, p, DK_LAPLACE, maps[q], DF_SLOPE, 0.05 + 0.1 * q, 0.1,
-                 out, err);
+      rc = solve(&py, p, DK_LAPLACE, maps[q], DF_SLOPE, &cv, 0.05 + 0.1 * q,
+                 0.1, out, err);
     if (rc) goto done;
   }
   /* n back to unit length after its diffusion (when there was one).
@@ -145,11 +164,18 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
                       !st.conflict ? -1
                       : k          ? 1e-6
                                    : COHERENT);
-  rc = solve(&py, p, DK_GUIDED, MAP_H, DF_H, 0.35, 0.3, out, err);
+  rc = operators(&cv, &py, p, DK_GUIDED, DF_H, err);
+  if (!rc) rc = solve(&py, p, DK_GUIDED, MAP_H, DF_H, &cv, 0.35, 0.3, out, err);
   if (!rc && st.strict_noise)
-    rc = solve(&py, p, DK_LAPLACE, MAP_A, DF_NOISE, 0.65, 0.075, out, err);
+    rc = operators(&cv, &py, p, DK_LAPLACE, DF_NOISE, err);
   if (!rc && st.strict_noise)
-    rc = solve(&py, p, DK_LAPLACE, MAP_R, DF_NOISE, 0.725, 0.075, out, err);
+    rc = solve(&py, p, DK_LAPLACE, MAP_A, DF_NOISE, &cv, 0.65, 0.075, out, err);
+  if (!rc && st.strict_noise)
+    rc =
+        solve(&py, p, DK_LAPLACE, MAP_R, DF_NOISE, &cv, 0.725, 0.075, out, err);
+  oc_dgalerkin_free(&cv.gal);
+  free(cv.work.f);
+  cv.work.f = NULL;
   if (rc) goto done;
   oc_dpyramid_shrink(&py); /* the finest grid's maps are all that is left */
   const oc_dlevel *lv = &py.lv[0];
@@ -177,6 +203,8 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
   rc = oc_ddetail_grid(&dd, lv, oc_heightfield_samples_mut(out->height), detail,
                        p->progress, 0.8, 0.2, err);
 done:
+  oc_dgalerkin_free(&cv.gal);
+  free(cv.work.f);
   oc_dpyramid_free(&py);
   if (rc) oc_diffusion_result_clear(out);
   return rc;

@@ -188,6 +188,16 @@ double oc_dresidual(const oc_dop *op, const oc_dlevel *lv, const float *x,
 ** or sets (!add) the unconstrained samples of fine values f (level lf). */
 void oc_dprolong(const oc_dop *op, const oc_dlevel *lc, const float *c,
                  const oc_dlevel *lf, float *f, int add);
+/* Fine sample i of a cell-centred level lies at coarse coordinate
+** (i - 1/2) / 2: between coarse samples a and b (of nc) with weight wb
+** on b (1/4 or 3/4), clamped at the ends. */
+static inline void oc_dsplit(int i, int nc, int *a, int *b, float *wb) {
+  int a0 = (i & 1) ? (i - 1) / 2 : i / 2 - 1;
+  *wb = (i & 1) ? 0.25f : 0.75f;
+  *a = a0 < 0 ? 0 : a0 >= nc ? nc - 1 : a0;
+  *b = a0 + 1 >= nc ? nc - 1 : a0 + 1;
+}
+
 /* Loops over a grid of fewer samples run on one thread: a parallel
 ** region costs more than the work there (and much more on a busy
 ** machine, where idle threads spin). */
@@ -203,17 +213,64 @@ static inline int oc_dguided(const oc_dop *op, const oc_dlevel *lv, size_t k) {
   return op->kind == DK_GUIDED && (lv->flags[k] & DF_GACT);
 }
 
+/* ---- Galerkin coarse operators (galerkin.c) ---- */
+
+#define GQ_PLANES 10 /* 3 x 3 stencil coefficients, then 1 / diagonal */
+
+/* A_{k+1} = R A_k P for every level k + 1 >= 1 of a pyramid: per level
+** GQ_PLANES planes of nx ny floats in a[k] (a[0] unused: level 0's
+** operator is the relaxation's). */
+typedef struct oc_dgalerkin {
+  int nlevels, five; /* five: 5-point stencils (the elevation's) */
+  float *a[32];
+  uint8_t *dead[32]; /* per level: 1 where every child is constrained */
+  float *block;      /* the planes, then the dead flags */
+  size_t cap;        /* its floats */
+} oc_dgalerkin;
+
+/* The coarse operators of op's correction equation, into g (zeroed, or
+** holding an earlier build, whose memory is used again when large
+** enough). OC_OK or OC_ENOMEM. */
+int oc_dgalerkin_build(oc_dgalerkin *g, const oc_dpyramid *py, const oc_dop *op,
+                       oc_error *err);
+void oc_dgalerkin_free(oc_dgalerkin *g);
+/* n Gauss-Seidel sweeps of A_k x = b at level k >= 1 (4 colours, or
+** red-black where the stencils have no corners). */
+void oc_dgalerkin_smooth(const oc_dgalerkin *g, const oc_dlevel *lv, int k,
+                         float *x, const float *b, int n);
+/* r = b - A_k x (0 where dead). */
+void oc_dgalerkin_residual(const oc_dgalerkin *g, const oc_dlevel *lv, int k,
+                           const float *x, const float *b, float *r);
+/* b = R r: the sum over the children. */
+void oc_dgalerkin_restrict(const oc_dlevel *f, const float *r,
+                           const oc_dlevel *c, float *b);
+/* f += P c on level kf >= 1 (nothing where dead). */
+void oc_dgalerkin_prolong(const oc_dgalerkin *g, int kf, const oc_dlevel *lc,
+                          const float *c, const oc_dlevel *lf, float *f);
+
+/* A block of floats kept across solves (oc_dsolve's work): memory
+** touched for the first time costs a page fault. */
+typedef struct oc_dwork {
+  float *f;
+  size_t cap;
+} oc_dwork;
+/* At least floats floats (the old contents lost), or NULL (ENOMEM). */
+void *oc_dwork_get(oc_dwork *w, size_t floats);
+
 typedef struct oc_dsolve {
   oc_progress progress;
   double lo, span;  /* this solve's part of the progress range */
-  double tolerance; /* 0: the cascade; > 0: full multigrid and cycles */
+  double tolerance; /* 0: the cascade; > 0: the cascade, then cycles */
   double *residual; /* NULL or OC_DIFFUSION_MAX_CYCLES + 1 values */
   int *cycles;
+  const oc_dgalerkin *gal; /* NULL or op's coarse operators (tolerance > 0) */
+  oc_dwork *work;          /* NULL or the V-cycles' buffers, kept */
 } oc_dsolve;
 
 /* Solves op's map on every level: the paper's coarse-to-fine cascade,
-** or (tolerance > 0) full multigrid, V-cycles and BiCGSTAB to the
-** tolerance. OC_OK, OC_ENOMEM or OC_ECANCEL. */
+** or (tolerance > 0) the cascade, then V-cycles and BiCGSTAB to the
+** tolerance (with gal's coarse operators, or its own when NULL). OC_OK,
+*OC_ENOMEM or OC_ECANCEL. */
 int oc_dsolve_map(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
                   oc_error *err);
 

@@ -456,16 +456,6 @@ double oc_dresidual(const oc_dop *op, const oc_dlevel *lv, const float *x,
   return relax(R_RESIDUAL, op, lv, x, r, rhs);
 }
 
-/* Fine sample i lies at coarse coordinate (i - 1/2) / 2: between coarse
-** samples i/2 - 1 and i/2 with weights 1/4, 3/4 when i is even, between
-** (i-1)/2 and (i+1)/2 with 3/4, 1/4 when odd; clamped at the ends. */
-static inline void split(int i, int nc, int *a, int *b, float *wb) {
-  int a0 = (i & 1) ? (i - 1) / 2 : i / 2 - 1;
-  *wb = (i & 1) ? 0.25f : 0.75f;
-  *a = a0 < 0 ? 0 : a0 >= nc ? nc - 1 : a0;
-  *b = a0 + 1 >= nc ? nc - 1 : a0 + 1;
-}
-
 /* The interior of fine row fr (samples 1 .. 2 nI) from coarse rows ca,
 ** cb blended by uy, wy: fine 2I + 1 and 2I + 2 lie between coarse I and
 ** I + 1 (weights 1/4 and 3/4 of I + 1); unchanged where fixed. */
@@ -512,7 +502,7 @@ void oc_dprolong(const oc_dop *op, const oc_dlevel *lc, const float *c,
   for (int j = 0; j < lf->ny; j++) {
     int ja, jb;
     float wy;
-    split(j, lc->ny, &ja, &jb, &wy);
+    oc_dsplit(j, lc->ny, &ja, &jb, &wy);
     const float *ca = c + (size_t)ja * (size_t)ncx,
                 *cb = c + (size_t)jb * (size_t)ncx;
     float *fr = f + (size_t)j * (size_t)nfx;
@@ -526,7 +516,7 @@ void oc_dprolong(const oc_dop *op, const oc_dlevel *lc, const float *c,
     for (int i = 0; i < nfx; i = i ? i + 1 : 2 * nI + 1) {
       int ia, ib;
       float wx;
-      split(i, ncx, &ia, &ib, &wx);
+      oc_dsplit(i, ncx, &ia, &ib, &wx);
       float va = uy * ca[ia] + wy * cb[ia], vb = uy * ca[ib] + wy * cb[ib];
       put_fine(fr, fl, fix, add, i, (1 - wx) * va + wx * vb);
     }

@@ -4,27 +4,24 @@
 ** cascade with 5 (l - i) Jacobi sweeps at level i of l (0 the coarsest),
 ** each level starting from the bilinear prolongation of the one below.
 **
-** The converged mode (a tolerance given) replaces the cascade by full
-** multigrid: each level, coarsest first, starts from the prolonged
-** solution of the one below and gets one V-cycle; then V-cycles on the
-** finest grid while each removes at least 30 % of its largest update,
-** then BiCGSTAB preconditioned by V-cycles, until that update is below
-** the tolerance. (The elevation's operator is not symmetric, with its
-** upwind gradient terms, and its slowest modes sit where filled
-** gradients meet (conflicts) and coarse levels see thin constraints
-** thickened; the Krylov iteration removes the few modes V-cycles leave.
-** Its dot products are row sums added in row order, so the result does
-** not depend on the thread count.)
+** The converged mode (a tolerance given) starts from that cascade, then
+** runs V-cycles on the finest grid while each removes at least 30 % of
+** its largest update, then BiCGSTAB preconditioned by V-cycles, until
+** that update is below the tolerance. (The elevation's operator is not
+** symmetric, with its upwind gradient terms; the Krylov iteration
+** removes the few modes V-cycles leave. Its dot products are row sums
+** added in row order, so the result does not depend on the thread
+** count.)
 **
-** V-cycle at level k: 2 red-black Gauss-Seidel sweeps (the same for any
-** thread count); the residual r = M x + c - x restricted to level k + 1
-** (the mean over the free children, times 4 where the coarse sample is
-** Laplace and 2 where it follows a gradient: the Laplacian scales with
-** the square of the cell, the first-order gradient term with the cell);
-** the coarse correction solved recursively from 0 (100 sweeps on the
-** coarsest grid), prolonged and added with the step that minimises the
-** residual (the whole of it as BiCGSTAB's preconditioner, which must be
-** a fixed linear map); 2 sweeps.
+** V-cycle: on the finest grid 2 red-black Gauss-Seidel sweeps of the
+** relaxation (jacobi.c; the same for any thread count), the residual
+** r = M x + c - x summed over each coarse sample's children, the coarse
+** correction solved from 0 with the Galerkin operators of galerkin.c
+** (at each coarser level 2 Gauss-Seidel sweeps, the residual summed
+** again, the next correction prolonged and added, 2 sweeps; 100 sweeps
+** on the coarsest grid), prolonged bilinearly and added with the step
+** that minimises the residual (the whole of it as BiCGSTAB's
+** preconditioner, which must be a fixed linear map); 2 sweeps.
 */
 #include <math.h>
 #include <stdlib.h>
@@ -40,10 +37,12 @@
 
 typedef struct vctx {
   oc_dpyramid *py;
-  const oc_dop *op; /* the problem (level 0) */
-  oc_dop hom;       /* its correction equation (levels >= 1) */
-  /* per level: correction and right-hand side (levels >= 1), residual,
-  ** prolonged correction and its image by the operator */
+  const oc_dgalerkin *gal; /* the coarse levels' operators */
+  const oc_dop *op;        /* the problem (level 0) */
+  oc_dop hom;              /* its correction equation (levels >= 1) */
+  /* per level: correction and right-hand side (levels >= 1), residual;
+  ** the finest grid's prolonged correction and its image by the
+  ** operator (c, ac: level 0 only) */
   float **e, **b, **r, **c, **ac;
   double *rows; /* per-row partial sums of the finest grid's height */
   int linear;   /* as BiCGSTAB's preconditioner: the whole correction
@@ -57,37 +56,6 @@ static double smooth(const oc_dop *op, const oc_dlevel *lv, float *x,
   for (int it = 0; it < n; it++)
     big = oc_dgauss_seidel(op, lv, x, rhs);
   return big;
-}
-
-/* b (level k + 1) from the residual r of level k (0 where constrained,
-** so the sum over all children is that over the free ones). */
-static void restrict_residual(const oc_dop *op, const oc_dlevel *f,
-                              const float *r, const oc_dlevel *c, float *b) {
-  uint8_t fix = op->kind == DK_LAPLACE ? op->mask : DF_H;
-  uint8_t gact = op->kind == DK_GUIDED ? DF_GACT : 0;
-  static const float inv[5] = {0, 1, 0.5f, 1.0f / 3, 0.25f};
-  size_t nxf = (size_t)f->nx, nxc = (size_t)c->nx;
-#pragma omp parallel for schedule(static) if (OC_DPAR(f))
-  for (int J = 0; J < c->ny; J++) {
-    size_t j0 = 2 * (size_t)J;
-    int two = (int)j0 + 1 < f->ny;
-    const float *r0 = r + j0 * nxf, *r1 = two ? r0 + nxf : r0;
-    const uint8_t *f0 = f->flags + j0 * nxf, *f1 = two ? f0 + nxf : f0;
-    const uint8_t *fc = c->flags + (size_t)J * nxc;
-    float *br = b + (size_t)J * nxc;
-    for (size_t I = 0; I < nxc; I++) {
-      size_t i0 = 2 * I, i1 = i0 + 1 < nxf ? i0 + 1 : i0;
-      int cols = i1 != i0;
-      float sum = r0[i0] + (cols ? r0[i1] : 0);
-      int n = !(f0[i0] & fix) + (cols && !(f0[i1] & fix));
-      if (two) {
-        sum += r1[i0] + (cols ? r1[i1] : 0);
-        n += !(f1[i0] & fix) + (cols && !(f1[i1] & fix));
-      }
-      float scale = (fc[I] & gact) ? 2.0f : 4.0f;
-      br[I] = (fc[I] & fix) ? 0 : scale * sum * inv[n];
-    }
-  }
 }
 
 /* The residual of x at level lv into r: one sweep's update, 0 where
@@ -129,26 +97,44 @@ static void prolong_correction(const vctx *v, int k, float *c) {
   oc_dprolong(&v->hom, &v->py->lv[k + 1], v->e[k + 1], lv, c, 0);
 }
 
-/* One V-cycle at level k on x (rhs NULL at level 0: the problem itself).
-** The coarse correction is added with the step that minimises the
-** residual: where a grid's side is odd, its coarse grid reaches half a
-** coarse cell beyond it, and a correction taken whole would overshoot in
-** long free (Neumann) regions. */
-static double vcycle(const vctx *v, int k, float *x, const float *rhs) {
+/* One V-cycle of the correction equation A_k x = b at level k >= 1,
+** with the Galerkin operators. */
+static void gcycle(const vctx *v, int k, float *x, const float *b) {
+  oc_dpyramid *py = v->py;
+  const oc_dlevel *lv = &py->lv[k];
+  if (k == py->nlevels - 1) {
+    oc_dgalerkin_smooth(v->gal, lv, k, x, b, COARSE_SWEEPS);
+    return;
+  }
+  oc_dgalerkin_smooth(v->gal, lv, k, x, b, PRE);
+  oc_dgalerkin_residual(v->gal, lv, k, x, b, v->r[k]);
+  const oc_dlevel *lc = &py->lv[k + 1];
+  oc_dgalerkin_restrict(lv, v->r[k], lc, v->b[k + 1]);
+  memset(v->e[k + 1], 0, (size_t)lc->nx * (size_t)lc->ny * sizeof(float));
+  gcycle(v, k + 1, v->e[k + 1], v->b[k + 1]);
+  oc_dgalerkin_prolong(v->gal, k, lc, v->e[k + 1], lv, x);
+  oc_dgalerkin_smooth(v->gal, lv, k, x, b, POST);
+}
+
+/* One V-cycle on the finest grid's x (rhs NULL: the problem itself, else
+** the correction equation A x = rhs). The coarse correction is added
+** with the step that minimises the residual, or whole as BiCGSTAB's
+** preconditioner (a fixed linear map). */
+static double vcycle(const vctx *v, float *x, const float *rhs) {
   oc_dpyramid *py = v->py;
   const oc_dop *op = rhs ? &v->hom : v->op;
-  const oc_dlevel *lv = &py->lv[k];
-  if (k == py->nlevels - 1) return smooth(op, lv, x, rhs, COARSE_SWEEPS);
+  const oc_dlevel *lv = &py->lv[0];
+  if (py->nlevels == 1) return smooth(op, lv, x, rhs, COARSE_SWEEPS);
   smooth(op, lv, x, rhs, PRE);
-  residual(op, lv, x, rhs, v->r[k]);
-  const oc_dlevel *lc = &py->lv[k + 1];
-  restrict_residual(op, lv, v->r[k], lc, v->b[k + 1]);
-  memset(v->e[k + 1], 0, (size_t)lc->nx * (size_t)lc->ny * sizeof(float));
-  vcycle(v, k + 1, v->e[k + 1], v->b[k + 1]);
-  prolong_correction(v, k, v->c[k]);
-  double t = v->linear ? 1 : step(v, lv, v->r[k], v->c[k], v->ac[k]);
+  residual(op, lv, x, rhs, v->r[0]);
+  const oc_dlevel *lc = &py->lv[1];
+  oc_dgalerkin_restrict(lv, v->r[0], lc, v->b[1]);
+  memset(v->e[1], 0, (size_t)lc->nx * (size_t)lc->ny * sizeof(float));
+  gcycle(v, 1, v->e[1], v->b[1]);
+  prolong_correction(v, 0, v->c[0]);
+  double t = v->linear ? 1 : step(v, lv, v->r[0], v->c[0], v->ac[0]);
   size_t ns = (size_t)lv->nx * (size_t)lv->ny;
-  const float *c = v->c[k];
+  const float *c = v->c[0];
 #pragma omp parallel for schedule(static) if (OC_DPAR(lv))
   for (size_t q = 0; q < ns; q++)
     x[q] = (float)(x[q] + t * c[q]);
@@ -206,7 +192,7 @@ static void apply(const vctx *v, const float *x, float *y) {
 static void precond(const vctx *v, const float *q, float *z) {
   const oc_dlevel *lv = &v->py->lv[0];
   memset(z, 0, (size_t)lv->nx * (size_t)lv->ny * sizeof *z);
-  vcycle(v, 0, z, q);
+  vcycle(v, z, q);
 }
 
 static double maxabs(const oc_dlevel *lv, const float *r) {
@@ -280,46 +266,58 @@ static int krylov(const vctx *v, const oc_dsolve *s, double tol, double *res,
   return rc;
 }
 
-static int vcycles(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
-                   oc_error *err) {
-  int L = py->nlevels, rc = OC_OK;
-  vctx v = {py, op, *op, NULL, NULL, NULL, NULL, NULL, NULL, 0};
-  v.hom.hom = 1;
-  float **all = calloc(5 * (size_t)L, sizeof *all);
-  v.rows = malloc(2 * (size_t)py->lv[0].ny * sizeof *v.rows);
+void *oc_dwork_get(oc_dwork *w, size_t floats) {
+  if (w->cap < floats) {
+    free(w->f);
+    w->f = malloc(floats * sizeof(float));
+    w->cap = w->f ? floats : 0;
+  }
+  return w->f;
+}
 
-  if (!all || !v.rows) rc = oc_seterr(err, OC_ENOMEM, "out of memory");
-  if (all)
-    v.e = all, v.b = all + L, v.r = all + 2 * L, v.c = all + 3 * L,
-    v.ac = all + 4 * L;
-  for (int k = 0; !rc && k < L; k++) {
-    size_t ns = (size_t)py->lv[k].nx * (size_t)py->lv[k].ny;
-    for (int q = 0; q < 5 && !rc; q++)
-      if ((k > 0 || q >= 2) && !(all[(size_t)q * (size_t)L + (size_t)k] =
-                                     malloc(ns * sizeof(float))))
-        rc = oc_seterr(err, OC_ENOMEM, "out of memory");
+static int vcycles(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
+                   double first, oc_error *err) {
+  int L = py->nlevels, rc = OC_OK;
+  oc_dgalerkin own = {0};
+  vctx v = {
+      py, s->gal ? s->gal : &own, op, *op, NULL, NULL, NULL, NULL, NULL, NULL,
+      0};
+  v.hom.hom = 1;
+  /* the buffers in one block, kept across solves when s->work is given
+  ** (memory touched for the first time costs a page fault) */
+  oc_dwork mine = {0}, *w = s->work ? s->work : &mine;
+  size_t need = 2 * (size_t)py->lv[0].ny * sizeof(double) /
+                sizeof(float); /* the rows' sums */
+  for (int k = 0; k < L; k++)
+    need += 3 * (size_t)py->lv[k].nx * (size_t)py->lv[k].ny;
+  float *all[5 * 32] = {NULL};
+  float *at = oc_dwork_get(w, need);
+  if (!at) rc = oc_seterr(err, OC_ENOMEM, "out of memory");
+  v.e = all, v.b = all + L, v.r = all + 2 * L, v.c = all + 3 * L,
+  v.ac = all + 4 * L;
+  if (at) {
+    v.rows = (double *)(void *)at; /* (the block is malloc'd: aligned) */
+    at += 2 * (size_t)py->lv[0].ny * sizeof(double) / sizeof(float);
+    for (int k = 0; k < L; k++) {
+      size_t ns = (size_t)py->lv[k].nx * (size_t)py->lv[k].ny;
+      for (int q = 0; q < 5; q++)
+        if (k > 0 ? q <= 2 : q >= 2)
+          all[(size_t)q * (size_t)L + (size_t)k] = at, at += ns;
+    }
   }
   double lo, hi;
   fixed_range(py, op, &lo, &hi);
   double scale = fmax(hi - lo, fmax(fabs(lo), fabs(hi)));
   double tol = s->tolerance * fmax(scale, 1e-6);
-  /* full multigrid: each level from the prolonged solution of the one
-  ** below, one V-cycle there */
-  double res = 0;
-  for (int k = L - 1; !rc && k >= 0; k--) {
-    float *x = py->lv[k].map[op->map];
-    if (k < L - 1)
-      oc_dprolong(op, &py->lv[k + 1], py->lv[k + 1].map[op->map], &py->lv[k], x,
-                  0);
-    res = vcycle(&v, k, x, NULL);
-  }
+  if (!rc && !s->gal) rc = oc_dgalerkin_build(&own, py, &v.hom, err);
+  double res = first;
   if (s->residual) s->residual[0] = res;
   int c = 0;
   /* V-cycles while each removes most of the largest update, then the
   ** Krylov iteration for the modes they leave */
   while (!rc && res > tol && c < OC_DIFFUSION_MAX_CYCLES) {
     double prev = res;
-    res = vcycle(&v, 0, py->lv[0].map[op->map], NULL);
+    res = vcycle(&v, py->lv[0].map[op->map], NULL);
     c++;
     if (s->residual) s->residual[c] = res;
     if (report(s, 0.5 + 0.5 * c / OC_DIFFUSION_MAX_CYCLES))
@@ -330,10 +328,8 @@ static int vcycles(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
   if (!rc && res > tol && c < OC_DIFFUSION_MAX_CYCLES)
     rc = krylov(&v, s, tol, &res, &c, err);
   if (s->cycles) *s->cycles = c;
-  for (size_t q = 0; all && q < 5 * (size_t)L; q++)
-    free(all[q]);
-  free(all);
-  free(v.rows);
+  free(mine.f);
+  oc_dgalerkin_free(&own);
   return rc;
 }
 
@@ -349,10 +345,10 @@ int oc_dsolve_map(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
     if (oc_dfixed(op, top, k)) sum += xt[k], nf++;
   for (size_t k = 0; k < nt; k++)
     if (!oc_dfixed(op, top, k)) xt[k] = nf ? (float)(sum / nf) : 0;
-  if (s->tolerance > 0) return vcycles(py, op, s, err);
   double total = 0, done = 0, last = 0;
   for (int k = 0; k < L; k++)
     total += 5.0 * (k + 1) * py->lv[k].nx * py->lv[k].ny;
+  double part = s->tolerance > 0 ? 0.5 : 1;
   for (int k = L - 1; k >= 0; k--) {
     oc_dlevel *lv = &py->lv[k];
     if (k < L - 1)
@@ -360,9 +356,10 @@ int oc_dsolve_map(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
                   lv->map[op->map], 0);
     last = oc_djacobi_n(op, lv, lv->map[op->map], py->scratch, 5 * (k + 1));
     done += 5.0 * (k + 1) * lv->nx * lv->ny;
-    if (report(s, done / total))
+    if (report(s, part * done / total))
       return oc_seterr(err, OC_ECANCEL, "diffusion cancelled");
   }
+  if (s->tolerance > 0) return vcycles(py, op, s, last, err);
   if (s->residual) s->residual[0] = last;
   if (s->cycles) *s->cycles = 0;
   return OC_OK;
