@@ -562,7 +562,7 @@ static double beam_models(const oc_etracer *tr, const oc_ebeam *b, double d,
 double oc_etrace_beam(const oc_etracer *tr, const oc_ebeam *b, double d,
                       double dmax, double *bounds, double *evals,
                       double *next) {
-  double unused;
+  double unused = 0, from = next ? *next : 0;
   if (!next) next = &unused;
   *next = 0;
   /* past the farthest corner of the domain's box no ray is in it (a ray
@@ -576,6 +576,8 @@ double oc_etrace_beam(const oc_etracer *tr, const oc_ebeam *b, double d,
   }
   far = lesser(far * (1 + 1e-9), dmax);
   double width = greater(b->x1 - b->x0, b->y1 - b->y0), e = (far - d) / 16;
+  int models = tr->mode == OC_TRACE_SEGMENT && tr->s->src->taylor && evals;
+  if (from > 0) e = from; /* a part goes on from its beam's candidate */
   for (long k = 0; k < OC_TRACE_MAX_STEPS && d < far; k++) {
     e = lesser(e, far - d);
     double lo[3], hi[3];
@@ -587,7 +589,7 @@ double oc_etrace_beam(const oc_etracer *tr, const oc_ebeam *b, double d,
       continue;
     }
     if (e <= greater(0.5 * width * d, tol(tr, 0, d))) {
-      if (tr->mode == OC_TRACE_SEGMENT && tr->s->src->taylor && evals)
+      if (models)
         return beam_models(tr, b, d, far, BEAM_STEP * width * d, evals, next);
       return d;
     }

@@ -57,9 +57,11 @@ typedef struct oc_ebeam {
 ** NULL), on models queried on the beam's axis with a margin for its
 ** width (etrace.c, beam_models), each query a height call added to
 ** *evals. INFINITY when every ray leaves the domain, or passes depth
-** dmax, unhit. *bounds (when not NULL) counts the range queries; *next
-** (when not NULL) receives a candidate step (in depth) for the rays'
-** march on models from there, 0 when the beam made no model step. */
+** dmax, unhit. *bounds (when not NULL) counts the range queries. *next
+** (when not NULL): on entry a candidate step (in depth) to begin with, 0
+** for the default (a part of a beam passes its beam's); on return the
+** candidate for the rays' march on models from there, 0 when the beam
+** made no model step. */
 double oc_etrace_beam(const oc_etracer *tr, const oc_ebeam *b, double d,
                       double dmax, double *bounds, double *evals, double *next);
 

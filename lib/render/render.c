@@ -226,11 +226,11 @@ static void geom_pixels(const gctx *g, int i0, int j0, int i1, int j1, double d,
 ** same for any thread count (tiles split alike), so are the images. A
 ** beam's height calls (on models) are shared equally by its pixels:
 ** share is each pixel's part of its enclosing beams' calls, so that the
-** evals channel sums to every call made. */
+** evals channel sums to every call made; step is the candidate step the
+** enclosing beam ended with (0: none). */
 static void beam_block(const gctx *g, int i0, int j0, int i1, int j1, double d,
-                       double share) {
+                       double step, double share) {
   int w = i1 - i0, h = j1 - j0;
-  double step = 0;
   if (d != INFINITY) {
     oc_ebeam b;
     double calls = 0;
@@ -241,11 +241,11 @@ static void beam_block(const gctx *g, int i0, int j0, int i1, int j1, double d,
   if (d != INFINITY && (w > BEAM_MIN || h > BEAM_MIN)) {
     int im = w > BEAM_MIN ? i0 + w / 2 : i1,
         jm = h > BEAM_MIN ? j0 + h / 2 : j1;
-    beam_block(g, i0, j0, im, jm, d, share);
-    if (im < i1) beam_block(g, im, j0, i1, jm, d, share);
+    beam_block(g, i0, j0, im, jm, d, step, share);
+    if (im < i1) beam_block(g, im, j0, i1, jm, d, step, share);
     if (jm < j1) {
-      beam_block(g, i0, jm, im, j1, d, share);
-      if (im < i1) beam_block(g, im, jm, i1, j1, d, share);
+      beam_block(g, i0, jm, im, j1, d, step, share);
+      if (im < i1) beam_block(g, im, jm, i1, j1, d, step, share);
     }
     return;
   }
@@ -255,7 +255,7 @@ static void beam_block(const gctx *g, int i0, int j0, int i1, int j1, double d,
 static void geom_tile(const void *ctx, int x0, int y0, int x1, int y1) {
   const gctx *g = ctx;
   if (g->es && g->etr.mode == OC_TRACE_SEGMENT)
-    beam_block(g, x0, y0, x1, y1, 0, 0);
+    beam_block(g, x0, y0, x1, y1, 0, 0, 0);
   else
     geom_pixels(g, x0, y0, x1, y1, 0, 0, 0);
 }
