@@ -26,12 +26,16 @@
 
 #define TILE 16
 /* Beams of elevation surfaces split down to blocks this many pixels a
-** side; their rays begin on the source's models with PIXEL_STEP times
-** the beam's last candidate step. Measured on bench_elev -qq fig3 (calls
-** a pixel): blocks down to 4, 2 and 1 pixels gave 13.7, 12.9 and 18.8
-** (rays from box steps); PIXEL_STEP 1, 2, 4, 8, 16 gave 12.8, 12.2,
-** 12.1, 12.3, 12.9 against 12.7 from box steps. */
-#define BEAM_MIN 2
+** side: BEAM_MIN_MODELS for sources with first-order models (the beams go
+** on on them), BEAM_MIN for the others (elevation ranges alone); their
+** rays begin on the source's models with PIXEL_STEP times the beam's
+** last candidate step. Measured on bench_elev -qq fig3 (calls a pixel):
+** blocks down to 4, 2 and 1 pixels gave 13.7, 12.9 and 18.8 (rays from
+** box steps); PIXEL_STEP 1, 2, 4, 8, 16 gave 12.8, 12.2, 12.1, 12.3,
+** 12.9 against 12.7 from box steps. On bench_elev hf (no models) 2
+** pixels took 5.0 to 4.5 calls a pixel but 6 % more CPU than 4. */
+#define BEAM_MIN 4
+#define BEAM_MIN_MODELS 2
 #define PIXEL_STEP 4
 #define NAOV 8
 #define GEOM_SHARE 0.7 /* oc_render's progress: tracing, then shading */
@@ -221,8 +225,9 @@ static void geom_pixels(const gctx *g, int i0, int j0, int i1, int j1, double d,
 
 /* The pixels [i0, i1) x [j0, j1), whose rays are free before depth d:
 ** the beam of the block takes them as far as it proves them free
-** together, then its quarters go on from there, down to BEAM_MIN pixels
-** a side, and each ray from where its block stopped. The blocks are the
+** together, then its quarters go on from there, down to BEAM_MIN or
+** BEAM_MIN_MODELS pixels a side, and each ray from where its block
+** stopped. The blocks are the
 ** same for any thread count (tiles split alike), so are the images. A
 ** beam's height calls (on models) are shared equally by its pixels:
 ** share is each pixel's part of its enclosing beams' calls, so that the
@@ -238,9 +243,9 @@ static void beam_block(const gctx *g, int i0, int j0, int i1, int j1, double d,
     d = oc_etrace_beam(&g->etr, &b, d, g->far, NULL, &calls, &step);
     share += calls / ((double)w * h);
   }
-  if (d != INFINITY && (w > BEAM_MIN || h > BEAM_MIN)) {
-    int im = w > BEAM_MIN ? i0 + w / 2 : i1,
-        jm = h > BEAM_MIN ? j0 + h / 2 : j1;
+  int least = g->es->src->taylor ? BEAM_MIN_MODELS : BEAM_MIN;
+  if (d != INFINITY && (w > least || h > least)) {
+    int im = w > least ? i0 + w / 2 : i1, jm = h > least ? j0 + h / 2 : j1;
     beam_block(g, i0, j0, im, jm, d, step, share);
     if (im < i1) beam_block(g, im, j0, i1, jm, d, step, share);
     if (jm < j1) {
