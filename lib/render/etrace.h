@@ -36,6 +36,12 @@ void oc_etracer_init(oc_etracer *tr, const oc_esurface *s,
 int oc_etrace(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0, double t1,
               double d0, double *t, double *evals);
 
+/* oc_etrace from t0, where the ray is known free of the surface, with
+** step (> 0) the candidate step to begin with on the source's models
+** (0: as oc_etrace). */
+int oc_etrace_from(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0,
+                   double t1, double d0, double step, double *t, double *evals);
+
 /* A beam: the rays o + d (w + x r + y v) for (x, y) in [x0, x1] x
 ** [y0, y1] and depth d >= 0 (w, r, v the camera's orthonormal frame, so
 ** that |w + x r + y v| >= 1). */
@@ -46,11 +52,18 @@ typedef struct oc_ebeam {
 
 /* The depth up to which every ray of the beam is proved free of the
 ** surface, from d on: beam tracing (cone marching) with the source's
-** elevation ranges on the boxes of frustum pieces, no height call made.
-** INFINITY when every ray leaves the domain, or passes depth dmax,
-** unhit. *bounds (when not NULL) counts the range queries. */
+** elevation ranges on the boxes of frustum pieces, no height call made;
+** then, for a source with first-order models (and when evals is not
+** NULL), on models queried on the beam's axis with a margin for its
+** width (etrace.c, beam_models), each query a height call added to
+** *evals. INFINITY when every ray leaves the domain, or passes depth
+** dmax, unhit. *bounds (when not NULL) counts the range queries. *next
+** (when not NULL): on entry a candidate step (in depth) to begin with, 0
+** for the default (a part of a beam passes its beam's); on return the
+** candidate for the rays' march on models from there, 0 when the beam
+** made no model step. */
 double oc_etrace_beam(const oc_etracer *tr, const oc_ebeam *b, double d,
-                      double dmax, double *bounds);
+                      double dmax, double *bounds, double *evals, double *next);
 
 /* The outward normal of the wall hit at p by a ray along u: the nearest
 ** face of the box, or -u for a hole's wall. */

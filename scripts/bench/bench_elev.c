@@ -22,8 +22,11 @@
 ** the tracer is one query of the tree's first-order model (value,
 ** gradient and remainder in one traversal: a call, also printed as
 ** `elev.model_steps_per_pixel`), besides the hits' refinement and
-** normals; `elev.bounds_per_pixel` counts the box queries made besides
-** (beams, and those inside the models' fallbacks: curves, lakes...).
+** normals; a block's beam, on models, makes such calls too, shared by
+** the block's pixels in the evals channel (render.c), so that the calls
+** per pixel count every call; `elev.bounds_per_pixel` counts the box
+** queries made besides (beams, and those inside the models' fallbacks:
+** curves, lakes...).
 *`bench_elev [-q | -qq] [hf] [fig1 ...]`: those scenes only, every
 ** image 4 or 8 times smaller in each axis with -q and -qq (for work on
 ** the code: the figures then are not the HD ones). `bench_elev --bytes

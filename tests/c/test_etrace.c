@@ -381,7 +381,7 @@ static void beams_against_march(const oc_esurface *es,
   for (int j0 = 0; j0 < rp->height; j0 += bs)
     for (int i0 = 0; i0 < rp->width; i0 += bs) {
       oc_ebeam b = pixel_beam(rp, i0, j0, i0 + bs, j0 + bs);
-      double nb = 0, d = oc_etrace_beam(&tr, &b, 0, INFINITY, &nb);
+      double nb = 0, d = oc_etrace_beam(&tr, &b, 0, INFINITY, &nb, NULL, NULL);
       double tmin = INFINITY;
       for (int v = 0; v <= 4; v++)
         for (int u = 0; u <= 4; u++) {
@@ -427,6 +427,180 @@ START_TEST(beams_conservative) {
   beams_against_march(&ws, &rp, 4, 0.05);
   ws.weight = half;
   beams_against_march(&ws, &rp, 16, 0.05);
+}
+END_TEST
+
+/* A thin spike on hills: a base disc wide enough that alpha >= 1/2 on the
+** whole domain (no holes), noise of amplitude amp, and a spike 120 m tall
+** and 8 m in radius added at (sx, sy) (f_A + alpha_B f_B); with bump, a
+** second one 100 m tall and 5 m in radius at (bx, by). *made receives
+** the nodes to release (NULL-terminated, released in reverse). */
+static oc_enode *spike_tree(double sx, double sy, double amp,
+                            const double *bump, oc_enode *made[8]) {
+  oc_error err;
+  oc_enode_disc_params bp = {
+      0, 0, 4000, 0, {OC_ENOISE_PLAIN, amp, 150, 4, 0, 0, 7}};
+  oc_enode_disc_params sp = {
+      sx, sy, 8, 120, {OC_ENOISE_PLAIN, 0, 10, 1, 0, 0, 1}};
+  oc_enode_add_params ap = {0, 0, 0, 0, 0, 0, 0, 0};
+  int n = 0;
+  oc_enode *t = made[n++] = oc_enode_disc(&bp, &err);
+  oc_enode *k = made[n++] = oc_enode_disc(&sp, &err);
+  t = made[n++] = oc_enode_add(t, k, &ap, &err);
+  if (bump) {
+    oc_enode_disc_params bb = {
+        bump[0], bump[1], 5, 100, {OC_ENOISE_PLAIN, 0, 10, 1, 0, 0, 1}};
+    k = made[n++] = oc_enode_disc(&bb, &err);
+    t = made[n++] = oc_enode_add(t, k, &ap, &err);
+  }
+  made[n] = NULL;
+  for (int i = 0; i < n; i++)
+    ck_assert_ptr_nonnull(made[i]);
+  return t;
+}
+
+/* The surface of tree on dom (its holes where alpha < 1/2). */
+static oc_esurface tree_surface(oc_enode *tree, const double dom[4],
+                                oc_elevation *src) {
+  oc_error err;
+  ck_assert_int_eq(oc_enode_elevation(tree, dom, src, &err), OC_OK);
+  return (oc_esurface){src, tree_weight, tree, 0.5};
+}
+
+static void release_made(oc_enode **made) {
+  int n = 0;
+  while (made[n])
+    n++;
+  while (n > 0)
+    oc_enode_release(made[--n]);
+}
+
+/* The beam on models must prove every ray of the beam free, not its axis
+** alone: a wide beam looking down onto flat ground whose axis passes far
+** from a thin spike that its corner ray meets (a bump beside the beam
+** stops its elevation ranges early, so its models carry it on). The
+** depth it proves free stays before the spike; a beam proving its axis
+** alone, without the margin for its width, strides on past the spike
+** (its axis meets the ground at depth 400). */
+START_TEST(beam_margin_spike) {
+  oc_enode *made[8];
+  const double bump[2] = {60, 40};
+  const double dom[4] = {-100, -300, 700, 300};
+  oc_elevation src;
+  oc_esurface es =
+      tree_surface(spike_tree(150, 60, 0.2, bump, made), dom, &src);
+  oc_etracer tr;
+  oc_etracer_init(&tr, &es, OC_TRACE_SEGMENT, 1e-4, 1e-6);
+  /* looking along +x from 30 m up: r = -y, v = +z */
+  oc_ebeam b;
+  b.o = oct_v(0, 0, 30), b.w = oct_v(1, 0, 0);
+  b.r = oct_v(0, -1, 0), b.v = oct_v(0, 0, 1);
+  b.x0 = -0.4, b.x1 = 0.4, b.y0 = -0.1, b.y1 = -0.05;
+  double nb = 0, ne = 0, next = 0;
+  double d = oc_etrace_beam(&tr, &b, 0, INFINITY, &nb, &ne, &next);
+  ck_assert(ne > 0 && next > 0);
+  /* the corner ray (x0, y0) = (-0.4, -0.1) passes over the spike's
+  ** centre at depth 150, 15 m up: it meets the spike first */
+  oc_vec3 D = oct_v(1, 0.4, -0.1);
+  double len = oct_len(D);
+  double tc = march(&es, b.o, oct_mul(D, 1 / len), 500, 0.01);
+  ck_assert_msg(tc < 150 * len, "the corner ray meets the spike at %g", tc);
+  ck_assert_msg(d * len <= tc, "beam free to %g, its corner ray hits at %g",
+                d * len, tc);
+  src.release(src.ud);
+  release_made(made);
+}
+END_TEST
+
+/* Whole renders through the blocks' beams (on models) against every ray
+** traced alone from the eye: the same pixels hit and the same depths
+** within the tolerance, on a thin spike seen against hills far behind
+** (its silhouette between widely differing depths inside blocks), and
+** the evals channel counting the beams' calls (fractions of them), the
+** same bytes on one thread and two. */
+#ifdef __SANITIZE_ADDRESS__
+#define SPIKE_W 48
+#define SPIKE_H 32
+#else
+#define SPIKE_W 96
+#define SPIKE_H 64
+#endif
+
+START_TEST(tiles_see_thin_spike) {
+  oc_enode *made[8];
+  const double dom[4] = {-900, -900, 900, 900};
+  oc_elevation src;
+  oc_esurface es = tree_surface(spike_tree(0, 0, 12, NULL, made), dom, &src);
+  oc_error err;
+  oc_render_params rp =
+      view(oct_v(-300, -20, 45), oct_v(0, 0, 40), SPIKE_W, SPIKE_H);
+  omp_set_num_threads(1);
+  oc_image *g1 = oc_render_surface_geometry(&es, &rp, &err);
+  omp_set_num_threads(2);
+  oc_image *g = oc_render_surface_geometry(&es, &rp, &err);
+  ck_assert_msg(g && g1, "%s", err.msg);
+  const float *px = oc_image_cdata(g);
+  /* the blocks and their shares are the same on any thread count */
+  ck_assert(memcmp(px, oc_image_cdata(g1),
+                   (size_t)rp.width * rp.height * OC_RG_COUNT * sizeof *px) ==
+            0);
+  oc_image_free(g1);
+  double pixel = 2 * tan(rp.camera.fov * PI / 360) / rp.height;
+  double eps_k = 0.25 * pixel, eps_min = 1e-7 * oct_len(oct_v(300, 20, 5));
+  oc_etracer tr;
+  oc_etracer_init(&tr, &es, OC_TRACE_SEGMENT, eps_k, eps_min);
+  int spike = 0, far = 0, hits = 0, frac = 0, grazing = 0;
+  double alone = 0, tiled = 0;
+  for (int j = 0; j < rp.height; j++)
+    for (int i = 0; i < rp.width; i++) {
+      const float *q = px + ((size_t)j * rp.width + i) * OC_RG_COUNT;
+      oc_vec3 d = pixel_ray(&rp, i, j);
+      double t, ev = 0;
+      int h = oc_etrace(&tr, rp.camera.eye, d, 0, 1e5, 0, &t, &ev);
+      alone += ev + (h == 1);
+      tiled += q[OC_RG_EVALS];
+      frac += q[OC_RG_EVALS] != floorf(q[OC_RG_EVALS]);
+      double tt = q[OC_RG_HIT] > 0 ? q[OC_RG_Z] : INFINITY;
+      if (!h) t = INFINITY;
+      double near = fmin(t, tt), e = eps_k * near + eps_min;
+      if (tt != t && !(fabs(tt - t) <= 4 * e)) {
+        /* the two differ only where the nearer hit is a crest the ray
+        ** crosses within the tolerance (a step of either may pass over
+        ** it): the dense march meets it there and leaves it so soon */
+        double tm = march(&es, rp.camera.eye, d, 2 * near, 0.02);
+        ck_assert_msg(fabs(tm - near) <= 0.02 + 4 * e,
+                      "pixel %d %d: tiled %g, alone %g, march %g", i, j, tt, t,
+                      tm);
+        double out = tm;
+        while (out < tm + 4 * e) {
+          oc_vec3 p = oct_add(rp.camera.eye, oct_mul(d, out));
+          if (p.z > src.height(src.ud, p.x, p.y, NULL)) break;
+          out += 0.01;
+        }
+        ck_assert_msg(out < tm + 4 * e,
+                      "pixel %d %d: tiled %g, alone %g, not a crest", i, j, tt,
+                      t);
+        grazing++;
+        continue;
+      }
+      if (!h) continue;
+      hits++;
+      oc_vec3 p = oct_add(rp.camera.eye, oct_mul(d, t));
+      spike += hypot(p.x, p.y) < 8 && p.z > 20;
+      far += t > 600;
+    }
+  /* the spike is a few pixels wide, the hills behind it far off */
+  ck_assert_msg(spike >= SPIKE_H / 16, "%d pixels on the spike", spike);
+  ck_assert_msg(far >= 8, "%d pixels far behind", far);
+  ck_assert(hits > rp.width * rp.height / 3);
+  ck_assert_msg(grazing <= rp.width * rp.height / 100, "%d rays differ",
+                grazing);
+  /* the beams' calls are shared by their pixels, and save calls */
+  ck_assert(frac > 0);
+  ck_assert_msg(tiled < alone, "tiled %g calls, alone %g", tiled, alone);
+  oc_image_free(g);
+  src.release(src.ud);
+  release_made(made);
 }
 END_TEST
 
@@ -560,6 +734,8 @@ static Suite *suite(void) {
   tcase_add_test(t, hits_located);
   tcase_add_test(t, weight_makes_holes);
   tcase_add_test(t, beams_conservative);
+  tcase_add_test(t, beam_margin_spike);
+  tcase_add_test(t, tiles_see_thin_spike);
   suite_add_tcase(s, t);
   t = tcase_create("rendering");
   tcase_set_timeout(t, 300);
