@@ -166,6 +166,108 @@ static void noise_bounds(const oc_enoise *nz, const oc_efootb *fb, double *lo,
   *lip = l;
 }
 
+/* ---- first-order models of continuous-LoD discs (etaylor.h) ------------
+** Under a view a disc's noise is sum a_i b(tau - i dt) T_i, tau = log2(w /
+** foot) (w the first wavelength, dt = log2 lacunarity) and T_i octave i's
+** term, unfiltered (the ridged chain runs on those): each octave is the
+** product (etaylor.h) of its filter's model (lod.c, oc_elod_b_taylor: b
+** composed with tau's model) and its term's (noise_taylor's octave
+** models). An octave whose filter is 0 on the whole disc (tau - i dt <= 0
+** there: the finer ones too) is not evaluated; one whose filter is 1
+** there is its term's model alone. */
+
+static oc_etay octave_model(double e, const double g[2], double s, double R,
+                            int absval);
+
+/* Octave i's term at frequency s from its noise e (gradient g, lattice
+** units), as noise_sum computes it, and its model in *t; the ridged
+** chain's previous term and model in *prev and *tprev (updated). */
+static double lod_term(const oc_enoise *nz, int i, double e, const double g[2],
+                       double s, double R, double *prev, oc_etay *tprev,
+                       oc_etay *t) {
+  if (nz->kind != OC_ENOISE_RIDGED) {
+    int turb = nz->kind == OC_ENOISE_TURBULENCE;
+    *t = octave_model(e, g, s, R, turb);
+    return turb ? fabs(e) : e;
+  }
+  /* w rho^2, rho = 1 - |eta| (|eta|'s model negated, plus 1), w =
+  ** clamp(2 t_(i-1)) */
+  double r = 1 - fabs(e), w = 1;
+  oc_etay rho = octave_model(e, g, s, R, 1), wm = oc_etay_const(1);
+  rho.v = r, rho.gx = -rho.gx, rho.gy = -rho.gy;
+  if (i > 0) {
+    w = RIDGE_GAIN * *prev;
+    w = w >= 1 ? 1 : w <= 0 ? 0 : w;
+    oc_etay x = oc_etay_scale(tprev, RIDGE_GAIN);
+    wm = oc_etay_clamp01(&x, R);
+  }
+  oc_etay rho2 = oc_etay_mul(&rho, &rho, R);
+  *t = oc_etay_mul(&wm, &rho2, R);
+  t->v = *prev = w * r * r;
+  *tprev = *t;
+  return t->v;
+}
+
+/* The filtered sum's model at (u, v) = p - c, its value noise_sum's with
+** the footprint tf->p; 0 where a filter ramps and tau has no model. */
+static int noise_taylor_lod(const oc_enoise *nz, double u, double v, double R,
+                            const oc_etfoot *tf, oc_etay *o) {
+  oc_etay tau;
+  double tlo, thi, dt = log2(nz->lacunarity);
+  int curved = oc_elod_tau_taylor(nz->wavelength, tf, R, &tau, &tlo, &thi);
+  /* the octaves whose filter is not 0 on the whole disc, their noise at
+  ** p in one call (as noise_sum) */
+  uint64_t seed[OC_ENOISE_MAXOCT];
+  double px[OC_ENOISE_MAXOCT], py[OC_ENOISE_MAXOCT], ev[OC_ENOISE_MAXOCT];
+  double ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
+  int cnt = 0;
+  for (double s = 1 / nz->wavelength; cnt < nz->octaves && thi - cnt * dt > 0;
+       cnt++, s *= nz->lacunarity) {
+    if (!curved && tlo - cnt * dt < 1) return 0;
+    seed[cnt] = octave_seed(nz->seed, cnt);
+    px[cnt] = s * u, py[cnt] = s * v;
+  }
+  oc_noise3_z0_multi(seed, px, py, (size_t)cnt, ev, ex, ey);
+  double sum = 0, a = nz->amplitude, s = 1 / nz->wavelength, prev = 1;
+  oc_etay m = oc_etay_const(0), tprev = oc_etay_const(1);
+  int live = 1; /* noise_sum adds octave i (its filter at p is not 0) */
+  for (int i = 0; i < cnt; i++, a *= nz->gain, s *= nz->lacunarity) {
+    double g[2] = {2 * ex[i], 2 * ey[i]}, db; /* (oc_eta) */
+    oc_etay ti = tau, T, at;
+    ti.v = tau.v - i * dt;
+    double bw = oc_elod_b(ti.v, &db);
+    double term = lod_term(nz, i, 2 * ev[i] - 1, g, s, R, &prev, &tprev, &T);
+    live = live && bw != 0;
+    if (live) sum += a * bw * term;
+    if (tlo - i * dt >= 1) {
+      at = T;
+    } else {
+      oc_etay bm = oc_elod_b_taylor(&ti, tlo - i * dt, thi - i * dt, R);
+      at = oc_etay_mul(&bm, &T, R);
+    }
+    at = oc_etay_scale(&at, a);
+    oc_etay_add(&m, &at);
+  }
+  m.v = sum;
+  *o = m;
+  return 1;
+}
+
+int oc_edisc_taylor_lod(const oc_enode *n, double x, double y, double R,
+                        const oc_etfoot *tf, oc_etaylor *o) {
+  const double *p = OC_EDISC(n)->par; /* cx, cy, r, height */
+  oc_enoise noise;
+  oc_edisc_noise(n, &noise);
+  if (noise.kind == OC_ENOISE_NONE) {
+    oc_edisc_taylor(n, x, y, R, o);
+    return 1;
+  }
+  if (!noise_taylor_lod(&noise, x - p[0], y - p[1], R, tf, &o->f)) return 0;
+  o->f.v = p[3] + o->f.v;
+  oc_edisc_taylor_alpha(n, x, y, R, &o->a);
+  return 1;
+}
+
 void oc_edisc_noise(const oc_enode *n, oc_enoise *nz) {
   const oc_edisc *d = OC_EDISC(n);
   nz->kind = n->nzkind;
