@@ -132,9 +132,10 @@ static double noise_sum(const oc_enoise *nz, double u, double v, double g[2],
 
 /* Range and Lipschitz bound of the noise sum, under footprints fb (NULL:
 ** full detail): octave i weighted b_i in [0, bh], |grad b_i| <= lb, its
-** term (|term| <= 1) contributing a (bh lambda_term + lb). */
-static void noise_bounds(const oc_enoise *nz, const oc_efootb *fb, double *lo,
-                         double *hi, double *lip) {
+** term (|term| <= 1) contributing a (bh lambda_term + lb). Octaves before
+** from count nothing (the ridged chain runs through them). */
+static void noise_bounds(const oc_enoise *nz, const oc_efootb *fb, int from,
+                         double *lo, double *hi, double *lip) {
   double a = nz->amplitude, s = 1 / nz->wavelength, asum = 0, l = 0, lr = 0;
   double le = 2 * oc_noise3_lipschitz;
   /* t_i = log2(w_i / foot) in [tmin - i dt, tmax - i dt] (one log2 each,
@@ -150,6 +151,12 @@ static void noise_bounds(const oc_enoise *nz, const oc_efootb *fb, double *lo,
       oc_elod_kappa_bound_t(1 / s, tmin - i * dt, tmax - i * dt, fb, &bl, &bh,
                             &lb);
     if (bh == 0) break;
+    if (i < from) { /* (the ridged chain only) */
+      lr = nz->kind == OC_ENOISE_RIDGED ? (i ? RIDGE_GAIN * lr : 0) + 2 * le * s
+                                        : 0;
+      a *= nz->gain, s *= nz->lacunarity;
+      continue;
+    }
     asum += a * bh;
     if (nz->kind == OC_ENOISE_RIDGED) {
       /* |grad s_i| <= G |grad s_(i-1)| + 2 lambda_eta s_i */
@@ -250,6 +257,34 @@ static int noise_taylor_lod(const oc_enoise *nz, double u, double v, double R,
   }
   m.v = sum;
   *o = m;
+  return 1;
+}
+
+static int noise_local(const oc_enoise *nz, double u0, double v0, double u1,
+                       double v1, double *lo, double *hi, double *lip);
+
+/* The noise's range and slope on the box [u0, u1] x [v0, v1] (relative to
+** the centre) under footprints fb: the leading octaves, whose filter is 1
+** on the whole box (t_i >= 1 at its largest footprint), bounded locally
+** (noise_local: where it gains, the coarse octaves), the others by
+** noise_bounds' filtered rule (the ridged chain's global slopes). 0 where
+** no octave is kept whole or noise_local gains nothing. */
+static int noise_local_lod(const oc_enoise *nz, const oc_efootb *fb, double u0,
+                           double v0, double u1, double v1, double *lo,
+                           double *hi, double *lip) {
+  double tmin = log2(nz->wavelength / fb->hi) - 1e-12;
+  double dt = log2(nz->lacunarity), l = 0, h = 0, lf = 0;
+  int j = 0;
+  while (j < nz->octaves && tmin - j * dt >= 1)
+    j++;
+  oc_enoise whole = *nz;
+  whole.octaves = j;
+  if (!j || !noise_local(&whole, u0, v0, u1, v1, lo, hi, lip)) return 0;
+  if (j < nz->octaves) noise_bounds(nz, fb, j, &l, &h, &lf);
+  /* rounding of the sums: a relative hair */
+  double eps = 1e-12 * (fabs(*lo) + fabs(*hi) + fabs(l) + fabs(h));
+  *lo += l - eps, *hi += h + eps;
+  *lip = (*lip + lf) * (1 + 1e-12);
   return 1;
 }
 
@@ -520,7 +555,8 @@ static int noise_local(const oc_enoise *nz, double u0, double v0, double u1,
     seed[cnt] = octave_seed(nz->seed, cnt);
     px[cnt] = sc * u, py[cnt] = sc * v;
   }
-  oc_noise3_z0_multi(seed, px, py, (size_t)cnt, ev, ex, ey);
+  if (cnt) /* (always, the first octave gaining: said for the compiler) */
+    oc_noise3_z0_multi(seed, px, py, (size_t)cnt, ev, ex, ey);
   double l = 0, h = 0, lf = 0;
   double tlo = 1, thi = 1, tl = 0; /* ridged: the previous term's bounds */
   int i = 0;
@@ -570,6 +606,14 @@ static int noise_local(const oc_enoise *nz, double u0, double v0, double u1,
   return 1;
 }
 
+/* noise_local at full detail (fb unused), for oc_edisc_bound_in's choice */
+static int noise_local_full(const oc_enoise *nz, const oc_efootb *fb, double u0,
+                            double v0, double u1, double v1, double *lo,
+                            double *hi, double *lip) {
+  (void)fb;
+  return noise_local(nz, u0, v0, u1, v1, lo, hi, lip);
+}
+
 void oc_edisc_bound_in(const oc_enode *node, const oc_erect *b,
                        const oc_efootb *fb, oc_ebound *o) {
   dview v, *n = &v; /* (the disc unpacked) */
@@ -583,7 +627,7 @@ void oc_edisc_bound_in(const oc_enode *node, const oc_erect *b,
           1) {
     /* the octaves the footprints keep */
     double lo, hi, lip;
-    noise_bounds(&n->noise, fb, &lo, &hi, &lip);
+    noise_bounds(&n->noise, fb, 0, &lo, &hi, &lip);
     o->flo = n->par[3] + lo;
     o->fhi = n->par[3] + hi;
     o->lf = lip;
@@ -594,10 +638,12 @@ void oc_edisc_bound_in(const oc_enode *node, const oc_erect *b,
     return;
   }
   double nlo, nhi, nlip;
-  /* the octaves' values at the centre bound the unfiltered sum only */
-  if (!filtered && n->noise.kind != OC_ENOISE_NONE &&
-      noise_local(&n->noise, b->x0 - n->par[0], b->y0 - n->par[1],
-                  b->x1 - n->par[0], b->y1 - n->par[1], &nlo, &nhi, &nlip)) {
+  /* the octaves' values at the centre bound the unfiltered sum only (or,
+  ** filtered, the octaves kept whole on the box) */
+  if (n->noise.kind != OC_ENOISE_NONE &&
+      (filtered ? noise_local_lod : noise_local_full)(
+          &n->noise, fb, b->x0 - n->par[0], b->y0 - n->par[1],
+          b->x1 - n->par[0], b->y1 - n->par[1], &nlo, &nhi, &nlip)) {
     o->flo = oc_efmax(o->flo, n->par[3] + nlo);
     o->fhi = oc_efmin(o->fhi, n->par[3] + nhi);
     o->lf = oc_efmin(o->lf, nlip);
@@ -676,7 +722,7 @@ oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err) {
   }
   if (check_noise(&p->noise, &nz, err)) return NULL;
   double lo = 0, hi = 0, lip = 0;
-  if (nz.kind != OC_ENOISE_NONE) noise_bounds(&nz, NULL, &lo, &hi, &lip);
+  if (nz.kind != OC_ENOISE_NONE) noise_bounds(&nz, NULL, 0, &lo, &hi, &lip);
   oc_erect box = {p->cx - p->radius, p->cy - p->radius, p->cx + p->radius,
                   p->cy + p->radius};
   if (!isfinite(p->height + lo) || !isfinite(p->height + hi) ||
