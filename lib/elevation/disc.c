@@ -220,7 +220,8 @@ static double lod_term(const oc_enoise *nz, int i, double e, const double g[2],
 static int noise_taylor_lod(const oc_enoise *nz, double u, double v, double R,
                             const oc_etfoot *tf, oc_etay *o) {
   oc_etay tau;
-  double tlo, thi, dt = log2(nz->lacunarity);
+  /* (log2 2 is 1: the default lacunarity spares the call) */
+  double tlo, thi, dt = nz->lacunarity == 2 ? 1 : log2(nz->lacunarity);
   int curved = oc_elod_tau_taylor(nz->wavelength, tf, R, &tau, &tlo, &thi);
   /* the octaves whose filter is not 0 on the whole disc, their noise at
   ** p in one call (as noise_sum) */
@@ -273,7 +274,8 @@ static int noise_local_lod(const oc_enoise *nz, const oc_efootb *fb, double u0,
                            double v0, double u1, double v1, double *lo,
                            double *hi, double *lip) {
   double tmin = log2(nz->wavelength / fb->hi) - 1e-12;
-  double dt = log2(nz->lacunarity), l = 0, h = 0, lf = 0;
+  double dt = nz->lacunarity == 2 ? 1 : log2(nz->lacunarity);
+  double l = 0, h = 0, lf = 0;
   int j = 0;
   while (j < nz->octaves && tmin - j * dt >= 1)
     j++;

@@ -248,7 +248,8 @@ void oc_elod_derive(const oc_enode *n, const oc_ebound *kb,
 ** integral remainder gives
 **   |tau(q) - tau(p) - grad tau(p).d| <= k^2 r^2 / (2 ln 2 fmin^2),
 ** grad tau = -grad foot / (ln 2 foot); tau lies in [log2(w / fmax),
-** log2(w / fmin)] there, fmax = min(fb.hi, foot(p) + k R).
+** log2(w / fmin)] there, fmax = min(fb.hi, foot(p) + k R) (bounded
+** without logarithms: oc_elod_tau_taylor).
 ** The filter b(t) = 1 - (1 - t^2)^3 on [0, 1] (0 below, 1 above) is C1
 ** (b' = 6 t (1 - t^2)^2 vanishes at both ends) with b'' = 6 (1 - t^2)
 ** (1 - 5 t^2) on (0, 1) and 0 outside, so b(t(q)) composes by the
@@ -279,9 +280,12 @@ int oc_elod_tau_taylor(double w, const oc_etfoot *tf, double R, oc_etay *m,
   double flo = fmax(tf->b.lo, ft->v - kr), fhi = fmin(tf->b.hi, ft->v + kr);
   double c = -1 / (ft->v * LN2); /* (as the discs' evaluation) */
   *m = (oc_etay){log2(w / ft->v), c * ft->gx, c * ft->gy, 0, 0, 0};
-  /* padded against the rounding of log2 and of the value */
-  *lo = log2(w / fhi) - 1e-12 * (1 + fabs(m->v));
-  *hi = flo > 0 ? log2(w / flo) + 1e-12 * (1 + fabs(m->v)) : INFINITY;
+  /* tau's range without a log2 each: log2(w / fhi) = tau(p) - log2(fhi /
+  ** foot(p)) and ln(1 + x) <= x; log2(w / flo) = tau(p) - log2(flo /
+  ** foot(p)) and -ln y <= 1 / y - 1; padded against rounding */
+  double pad = 1e-12 * (1 + fabs(m->v));
+  *lo = m->v - (fmax(fhi, ft->v) / ft->v - 1) / LN2 - pad;
+  *hi = flo > 0 ? m->v + (ft->v / fmin(flo, ft->v) - 1) / LN2 + pad : INFINITY;
   if (!(flo > 0)) return 0;
   m->e2 = 0.5 * k * k / (LN2 * flo * flo) * (1 + 1e-12);
   return 1;
