@@ -601,8 +601,9 @@ START_TEST(lod_trace_against_march) {
   ck_assert_msg(oc_enode_elevation_view(e, NULL, &v, &src, &err) == OC_OK, "%s",
                 err.msg);
   oc_esurface es = {&src, oc_enode_view_weight, src.ud, OC_ENODE_T};
-  /* the joint query (one traversal a step) answers range and slope */
-  ck_assert(src.bound);
+  /* the joint query (one traversal a step) answers range and slope; the
+  ** march steps on first-order models */
+  ck_assert(src.bound && src.taylor);
   for (int k = 0; k < 40; k++) {
     double x0 = -2000 + 97.3 * k, y0 = -1500 + 71.9 * k, sz = 3.0 * (k + 1);
     double lo, hi, lam, rlo, rhi;
@@ -641,6 +642,25 @@ START_TEST(lod_trace_against_march) {
     }
   ck_assert_msg(hits > n / 2, "%d of %d hit", hits, n);
   ck_assert_msg(differ <= 2, "%d rays disagree", differ);
+  /* the models save calls against the box bounds' march on those rays
+  ** (where the top node has rules: a slope-weighted add has none, its
+  ** models are the box bound's flat ones) */
+  oc_elevation boxed = src;
+  boxed.taylor = NULL;
+  oc_esurface eb = {&boxed, oc_enode_view_weight, src.ud, OC_ENODE_T};
+  oc_etracer tb;
+  oc_etracer_init(&tb, &eb, OC_TRACE_SEGMENT, eps_k, eps_min);
+  double evb = 0;
+  for (int j = 0; j < MARCH_NY; j++)
+    for (int i = 0; i < MARCH_NX; i++) {
+      double x = (i + 0.5) / MARCH_NX * 2 - 1,
+             y = ((j + 0.5) / MARCH_NY * 2 - 1) * 0.3, t;
+      oc_vec3 d = oct_add(w, oct_add(oct_mul(rt, 0.6 * x), oct_mul(up, y)));
+      oc_etrace(&tb, eye, oct_mul(d, 1 / oct_len(d)), 0, 1e6, 0, &t, &evb);
+    }
+  printf("lod trace%s: %.1f calls a ray on models, %.1f on box bounds\n",
+         _i ? " (slope weight)" : "", ev / n, evb / n);
+  if (!_i) ck_assert_msg(ev < evb, "models %g calls, box bounds %g", ev, evb);
   /* a whole render: the same image on 1 and 2 threads */
   oc_render_params rp;
   oc_render_defaults(&rp);
