@@ -1720,7 +1720,9 @@ int oc_enode_eval_view(const oc_enode *e, double x, double y,
 
 /* oc_enode_elevation under view v: height, ranges and slopes include the
 ** footprint's terms (the domain, when NULL, is where alpha may reach T
-** under the view). The source's weight for oc_esurface is
+** under the view), and so do its first-order models (taylor: the octave
+** filters and the lod operators' t composed with a proved model of
+** log2(w / foot); lib/elevation/lod.c). The source's weight for oc_esurface is
 ** oc_enode_view_weight with wud = src->ud. Holds one reference to e. */
 int oc_enode_elevation_view(oc_enode *e, const double *domain,
                             const oc_enode_view *v, oc_elevation *src,

@@ -132,9 +132,10 @@ static double noise_sum(const oc_enoise *nz, double u, double v, double g[2],
 
 /* Range and Lipschitz bound of the noise sum, under footprints fb (NULL:
 ** full detail): octave i weighted b_i in [0, bh], |grad b_i| <= lb, its
-** term (|term| <= 1) contributing a (bh lambda_term + lb). */
-static void noise_bounds(const oc_enoise *nz, const oc_efootb *fb, double *lo,
-                         double *hi, double *lip) {
+** term (|term| <= 1) contributing a (bh lambda_term + lb). Octaves before
+** from count nothing (the ridged chain runs through them). */
+static void noise_bounds(const oc_enoise *nz, const oc_efootb *fb, int from,
+                         double *lo, double *hi, double *lip) {
   double a = nz->amplitude, s = 1 / nz->wavelength, asum = 0, l = 0, lr = 0;
   double le = 2 * oc_noise3_lipschitz;
   /* t_i = log2(w_i / foot) in [tmin - i dt, tmax - i dt] (one log2 each,
@@ -150,6 +151,12 @@ static void noise_bounds(const oc_enoise *nz, const oc_efootb *fb, double *lo,
       oc_elod_kappa_bound_t(1 / s, tmin - i * dt, tmax - i * dt, fb, &bl, &bh,
                             &lb);
     if (bh == 0) break;
+    if (i < from) { /* (the ridged chain only) */
+      lr = nz->kind == OC_ENOISE_RIDGED ? (i ? RIDGE_GAIN * lr : 0) + 2 * le * s
+                                        : 0;
+      a *= nz->gain, s *= nz->lacunarity;
+      continue;
+    }
     asum += a * bh;
     if (nz->kind == OC_ENOISE_RIDGED) {
       /* |grad s_i| <= G |grad s_(i-1)| + 2 lambda_eta s_i */
@@ -164,6 +171,138 @@ static void noise_bounds(const oc_enoise *nz, const oc_efootb *fb, double *lo,
   *lo = nz->kind == OC_ENOISE_PLAIN ? -asum : 0;
   *hi = asum;
   *lip = l;
+}
+
+/* ---- first-order models of continuous-LoD discs (etaylor.h) ------------
+** Under a view a disc's noise is sum a_i b(tau - i dt) T_i, tau = log2(w /
+** foot) (w the first wavelength, dt = log2 lacunarity) and T_i octave i's
+** term, unfiltered (the ridged chain runs on those): each octave is the
+** product (etaylor.h) of its filter's model (lod.c, oc_elod_b_taylor: b
+** composed with tau's model) and its term's (noise_taylor's octave
+** models). An octave whose filter is 0 on the whole disc (tau - i dt <= 0
+** there: the finer ones too) is not evaluated; one whose filter is 1
+** there is its term's model alone. */
+
+static oc_etay octave_model(double e, const double g[2], double s, double R,
+                            int absval);
+
+/* Octave i's term at frequency s from its noise e (gradient g, lattice
+** units), as noise_sum computes it, and its model in *t; the ridged
+** chain's previous term and model in *prev and *tprev (updated). */
+static double lod_term(const oc_enoise *nz, int i, double e, const double g[2],
+                       double s, double R, double *prev, oc_etay *tprev,
+                       oc_etay *t) {
+  if (nz->kind != OC_ENOISE_RIDGED) {
+    int turb = nz->kind == OC_ENOISE_TURBULENCE;
+    *t = octave_model(e, g, s, R, turb);
+    return turb ? fabs(e) : e;
+  }
+  /* w rho^2, rho = 1 - |eta| (|eta|'s model negated, plus 1), w =
+  ** clamp(2 t_(i-1)) */
+  double r = 1 - fabs(e), w = 1;
+  oc_etay rho = octave_model(e, g, s, R, 1), wm = oc_etay_const(1);
+  rho.v = r, rho.gx = -rho.gx, rho.gy = -rho.gy;
+  if (i > 0) {
+    w = RIDGE_GAIN * *prev;
+    w = w >= 1 ? 1 : w <= 0 ? 0 : w;
+    oc_etay x = oc_etay_scale(tprev, RIDGE_GAIN);
+    wm = oc_etay_clamp01(&x, R);
+  }
+  oc_etay rho2 = oc_etay_mul(&rho, &rho, R);
+  *t = oc_etay_mul(&wm, &rho2, R);
+  t->v = *prev = w * r * r;
+  *tprev = *t;
+  return t->v;
+}
+
+/* The filtered sum's model at (u, v) = p - c, its value noise_sum's with
+** the footprint tf->p; 0 where a filter ramps and tau has no model. */
+static int noise_taylor_lod(const oc_enoise *nz, double u, double v, double R,
+                            const oc_etfoot *tf, oc_etay *o) {
+  oc_etay tau;
+  /* (log2 2 is 1: the default lacunarity spares the call) */
+  double tlo, thi, dt = nz->lacunarity == 2 ? 1 : log2(nz->lacunarity);
+  int curved = oc_elod_tau_taylor(nz->wavelength, tf, R, &tau, &tlo, &thi);
+  /* the octaves whose filter is not 0 on the whole disc, their noise at
+  ** p in one call (as noise_sum) */
+  uint64_t seed[OC_ENOISE_MAXOCT];
+  double px[OC_ENOISE_MAXOCT], py[OC_ENOISE_MAXOCT], ev[OC_ENOISE_MAXOCT];
+  double ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
+  int cnt = 0;
+  for (double s = 1 / nz->wavelength; cnt < nz->octaves && thi - cnt * dt > 0;
+       cnt++, s *= nz->lacunarity) {
+    if (!curved && tlo - cnt * dt < 1) return 0;
+    seed[cnt] = octave_seed(nz->seed, cnt);
+    px[cnt] = s * u, py[cnt] = s * v;
+  }
+  oc_noise3_z0_multi(seed, px, py, (size_t)cnt, ev, ex, ey);
+  double sum = 0, a = nz->amplitude, s = 1 / nz->wavelength, prev = 1;
+  oc_etay m = oc_etay_const(0), tprev = oc_etay_const(1);
+  int live = 1; /* noise_sum adds octave i (its filter at p is not 0) */
+  for (int i = 0; i < cnt; i++, a *= nz->gain, s *= nz->lacunarity) {
+    double g[2] = {2 * ex[i], 2 * ey[i]}, db; /* (oc_eta) */
+    oc_etay ti = tau, T, at;
+    ti.v = tau.v - i * dt;
+    double bw = oc_elod_b(ti.v, &db);
+    double term = lod_term(nz, i, 2 * ev[i] - 1, g, s, R, &prev, &tprev, &T);
+    live = live && bw != 0;
+    if (live) sum += a * bw * term;
+    if (tlo - i * dt >= 1) {
+      at = T;
+    } else {
+      oc_etay bm = oc_elod_b_taylor(&ti, tlo - i * dt, thi - i * dt, R);
+      at = oc_etay_mul(&bm, &T, R);
+    }
+    at = oc_etay_scale(&at, a);
+    oc_etay_add(&m, &at);
+  }
+  m.v = sum;
+  *o = m;
+  return 1;
+}
+
+static int noise_local(const oc_enoise *nz, double u0, double v0, double u1,
+                       double v1, double *lo, double *hi, double *lip);
+
+/* The noise's range and slope on the box [u0, u1] x [v0, v1] (relative to
+** the centre) under footprints fb: the leading octaves, whose filter is 1
+** on the whole box (t_i >= 1 at its largest footprint), bounded locally
+** (noise_local: where it gains, the coarse octaves), the others by
+** noise_bounds' filtered rule (the ridged chain's global slopes). 0 where
+** no octave is kept whole or noise_local gains nothing. */
+static int noise_local_lod(const oc_enoise *nz, const oc_efootb *fb, double u0,
+                           double v0, double u1, double v1, double *lo,
+                           double *hi, double *lip) {
+  double tmin = log2(nz->wavelength / fb->hi) - 1e-12;
+  double dt = nz->lacunarity == 2 ? 1 : log2(nz->lacunarity);
+  double l = 0, h = 0, lf = 0;
+  int j = 0;
+  while (j < nz->octaves && tmin - j * dt >= 1)
+    j++;
+  oc_enoise whole = *nz;
+  whole.octaves = j;
+  if (!j || !noise_local(&whole, u0, v0, u1, v1, lo, hi, lip)) return 0;
+  if (j < nz->octaves) noise_bounds(nz, fb, j, &l, &h, &lf);
+  /* rounding of the sums: a relative hair */
+  double eps = 1e-12 * (fabs(*lo) + fabs(*hi) + fabs(l) + fabs(h));
+  *lo += l - eps, *hi += h + eps;
+  *lip = (*lip + lf) * (1 + 1e-12);
+  return 1;
+}
+
+int oc_edisc_taylor_lod(const oc_enode *n, double x, double y, double R,
+                        const oc_etfoot *tf, oc_etaylor *o) {
+  const double *p = OC_EDISC(n)->par; /* cx, cy, r, height */
+  oc_enoise noise;
+  oc_edisc_noise(n, &noise);
+  if (noise.kind == OC_ENOISE_NONE) {
+    oc_edisc_taylor(n, x, y, R, o);
+    return 1;
+  }
+  if (!noise_taylor_lod(&noise, x - p[0], y - p[1], R, tf, &o->f)) return 0;
+  o->f.v = p[3] + o->f.v;
+  oc_edisc_taylor_alpha(n, x, y, R, &o->a);
+  return 1;
 }
 
 void oc_edisc_noise(const oc_enode *n, oc_enoise *nz) {
@@ -418,7 +557,8 @@ static int noise_local(const oc_enoise *nz, double u0, double v0, double u1,
     seed[cnt] = octave_seed(nz->seed, cnt);
     px[cnt] = sc * u, py[cnt] = sc * v;
   }
-  oc_noise3_z0_multi(seed, px, py, (size_t)cnt, ev, ex, ey);
+  if (cnt) /* (always, the first octave gaining: said for the compiler) */
+    oc_noise3_z0_multi(seed, px, py, (size_t)cnt, ev, ex, ey);
   double l = 0, h = 0, lf = 0;
   double tlo = 1, thi = 1, tl = 0; /* ridged: the previous term's bounds */
   int i = 0;
@@ -468,6 +608,14 @@ static int noise_local(const oc_enoise *nz, double u0, double v0, double u1,
   return 1;
 }
 
+/* noise_local at full detail (fb unused), for oc_edisc_bound_in's choice */
+static int noise_local_full(const oc_enoise *nz, const oc_efootb *fb, double u0,
+                            double v0, double u1, double v1, double *lo,
+                            double *hi, double *lip) {
+  (void)fb;
+  return noise_local(nz, u0, v0, u1, v1, lo, hi, lip);
+}
+
 void oc_edisc_bound_in(const oc_enode *node, const oc_erect *b,
                        const oc_efootb *fb, oc_ebound *o) {
   dview v, *n = &v; /* (the disc unpacked) */
@@ -481,7 +629,7 @@ void oc_edisc_bound_in(const oc_enode *node, const oc_erect *b,
           1) {
     /* the octaves the footprints keep */
     double lo, hi, lip;
-    noise_bounds(&n->noise, fb, &lo, &hi, &lip);
+    noise_bounds(&n->noise, fb, 0, &lo, &hi, &lip);
     o->flo = n->par[3] + lo;
     o->fhi = n->par[3] + hi;
     o->lf = lip;
@@ -492,10 +640,12 @@ void oc_edisc_bound_in(const oc_enode *node, const oc_erect *b,
     return;
   }
   double nlo, nhi, nlip;
-  /* the octaves' values at the centre bound the unfiltered sum only */
-  if (!filtered && n->noise.kind != OC_ENOISE_NONE &&
-      noise_local(&n->noise, b->x0 - n->par[0], b->y0 - n->par[1],
-                  b->x1 - n->par[0], b->y1 - n->par[1], &nlo, &nhi, &nlip)) {
+  /* the octaves' values at the centre bound the unfiltered sum only (or,
+  ** filtered, the octaves kept whole on the box) */
+  if (n->noise.kind != OC_ENOISE_NONE &&
+      (filtered ? noise_local_lod : noise_local_full)(
+          &n->noise, fb, b->x0 - n->par[0], b->y0 - n->par[1],
+          b->x1 - n->par[0], b->y1 - n->par[1], &nlo, &nhi, &nlip)) {
     o->flo = oc_efmax(o->flo, n->par[3] + nlo);
     o->fhi = oc_efmin(o->fhi, n->par[3] + nhi);
     o->lf = oc_efmin(o->lf, nlip);
@@ -574,7 +724,7 @@ oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err) {
   }
   if (check_noise(&p->noise, &nz, err)) return NULL;
   double lo = 0, hi = 0, lip = 0;
-  if (nz.kind != OC_ENOISE_NONE) noise_bounds(&nz, NULL, &lo, &hi, &lip);
+  if (nz.kind != OC_ENOISE_NONE) noise_bounds(&nz, NULL, 0, &lo, &hi, &lip);
   oc_erect box = {p->cx - p->radius, p->cy - p->radius, p->cx + p->radius,
                   p->cy + p->radius};
   if (!isfinite(p->height + lo) || !isfinite(p->height + hi) ||

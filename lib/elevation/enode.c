@@ -255,14 +255,17 @@ void oc_enode_bnd(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
 /* The box [x - R, x + R] x [y - R, y + R] holds the disc: on it f moves
 ** from its value at p by at most lf r and stays in [flo, fhi], so either
 ** bounds |f(q) - f(p)| with no linear part (etaylor.h, oc_etay_flat); the
-** same for alpha. */
+** same for alpha. Under a view the box bound takes the footprints of the
+** disc, tf->b: a bound under footprints in [lo, hi] holds at every point
+** of the box whose footprint is in there (ranges and slopes are bounded
+** point by point), and those of the disc are. */
 void oc_enode_taylor_flat(const oc_enode *n, double x, double y, double R,
-                          oc_etaylor *o, int *boxes) {
+                          const oc_etfoot *tf, oc_etaylor *o, int *boxes) {
   oc_enode_sample s;
   oc_ebound b;
   oc_erect r = {x - R, y - R, x + R, y + R};
-  oc_enode_ev(n, x, y, NULL, 0, &s);
-  oc_enode_bnd(n, &r, NULL, &b);
+  oc_enode_ev(n, x, y, tf ? &tf->p : NULL, 0, &s);
+  oc_enode_bnd(n, &r, tf ? &tf->b : NULL, &b);
   (*boxes)++;
   o->f = oc_etay_flat(s.f, b.lf, fmax(b.fhi - s.f, s.f - b.flo), R);
   o->a = oc_etay_flat(s.a, b.la, fmax(b.ahi - s.a, s.a - b.alo), R);
@@ -278,16 +281,24 @@ int oc_enode_taylor_alpha(const oc_enode *n, double x, double y, double R,
   return oc_eop_taylor_alpha(n, x, y, R, a, boxes);
 }
 
+void oc_enode_taylor_view(const oc_enode *n, double x, double y, double R,
+                          const oc_etfoot *tf, oc_etaylor *o, int *boxes) {
+  if (n->kind == OC_E_DISC) {
+    if (!tf) {
+      oc_edisc_taylor(n, x, y, R, o);
+      return;
+    }
+    if (oc_edisc_taylor_lod(n, x, y, R, tf, o)) return;
+  } else if (n->kind == OC_E_LOD) {
+    if (oc_elod_taylor(n, x, y, R, tf, o, boxes)) return;
+  } else if (!OC_EPRIM_KIND(n->kind) && oc_eop_taylor(n, x, y, R, tf, o, boxes))
+    return;
+  oc_enode_taylor_flat(n, x, y, R, tf, o, boxes);
+}
+
 void oc_enode_taylor(const oc_enode *n, double x, double y, double R,
                      oc_etaylor *o, int *boxes) {
-  if (n->kind == OC_E_DISC) {
-    oc_edisc_taylor(n, x, y, R, o);
-    return;
-  }
-  if (n->kind != OC_E_LOD && !OC_EPRIM_KIND(n->kind) &&
-      oc_eop_taylor(n, x, y, R, o, boxes))
-    return;
-  oc_enode_taylor_flat(n, x, y, R, o, boxes);
+  oc_enode_taylor_view(n, x, y, R, NULL, o, boxes);
 }
 
 /* ---- public queries --------------------------------------------------- */
@@ -492,17 +503,23 @@ static void src_bound(void *ud, double x0, double y0, double x1, double y1,
 /* oc_elevation.taylor: the tree's model of f, padded for rounding (the
 ** evaluators' sums err by a few ulps of their terms; a relative hair of
 ** the value and of the coefficients covers that). */
-static double src_taylor(void *ud, double x, double y, double R, double g[2],
-                         double e[3], int *boxes) {
+double oc_enode_taylor_src(const oc_enode *n, double x, double y, double R,
+                           const oc_etfoot *tf, double g[2], double e[3],
+                           int *boxes) {
   oc_etaylor m;
   int nb = 0;
-  oc_enode_taylor(ud, x, y, R, &m, &nb);
+  oc_enode_taylor_view(n, x, y, R, tf, &m, &nb);
   if (boxes) *boxes += nb;
   g[0] = m.f.gx, g[1] = m.f.gy;
   e[0] = m.f.e0 * (1 + 1e-9) + 1e-11 * (1 + fabs(m.f.v));
   e[1] = m.f.e1 * (1 + 1e-9) + 1e-12 * (fabs(m.f.gx) + fabs(m.f.gy));
   e[2] = m.f.e2 * (1 + 1e-9);
   return m.f.v;
+}
+
+static double src_taylor(void *ud, double x, double y, double R, double g[2],
+                         double e[3], int *boxes) {
+  return oc_enode_taylor_src(ud, x, y, R, NULL, g, e, boxes);
 }
 
 static void src_retain(void *ud) {

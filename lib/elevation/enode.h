@@ -399,19 +399,47 @@ void oc_eop_bound_in(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
 ** the box queries made. */
 void oc_enode_taylor(const oc_enode *n, double x, double y, double R,
                      oc_etaylor *o, int *boxes);
+/* What a model under a view knows of the footprint, in the node's local
+** units: its value and gradient at p (p, as evaluation computes them:
+** p.v > 0) and, over the disc |q - p| <= R, its range and Lipschitz
+** bound (b). NULL: full detail. */
+typedef struct oc_etfoot {
+  oc_efoot p;
+  oc_efootb b;
+} oc_etfoot;
+/* oc_enode_taylor under a view (tf NULL: full detail, oc_enode_taylor):
+** f and alpha at (x, y) are the bits oc_enode_ev gives with the footprint
+** tf->p. Discs (continuous LoD), lod operators and the operators with
+** rules have models under a view too (disc.c, lod.c); the others the flat
+** one from their box bound under the footprints tf->b. */
+void oc_enode_taylor_view(const oc_enode *n, double x, double y, double R,
+                          const oc_etfoot *tf, oc_etaylor *o, int *boxes);
 void oc_enode_taylor_flat(const oc_enode *n, double x, double y, double R,
-                          oc_etaylor *o, int *boxes);
+                          const oc_etfoot *tf, oc_etaylor *o, int *boxes);
+/* The tree's model of f as oc_elevation's taylor gives it (enode.c):
+** returns f at (x, y), the linear part in g, the remainder (padded for
+** rounding) in e; *boxes (when not NULL) grows by the box queries. */
+double oc_enode_taylor_src(const oc_enode *n, double x, double y, double R,
+                           const oc_etfoot *tf, double g[2], double e[3],
+                           int *boxes);
 void oc_edisc_taylor(const oc_enode *n, double x, double y, double R,
                      oc_etaylor *o);
+/* A continuous-LoD disc's model under a view (disc.c); 0 where it has no
+** rule (a filter ramps on a disc reaching a footprint of 0). */
+int oc_edisc_taylor_lod(const oc_enode *n, double x, double y, double R,
+                        const oc_etfoot *tf, oc_etaylor *o);
 /* alpha's model alone (its value 0 where (x, y) is outside the disc),
 ** and f's alone: oc_edisc_taylor is the two */
 void oc_edisc_taylor_alpha(const oc_enode *n, double x, double y, double R,
                            oc_etay *a);
 void oc_edisc_taylor_f(const oc_enode *n, double x, double y, double R,
                        oc_etay *f);
-/* 0 where the operator has no rule */
+/* 0 where the operator has no rule (tf: under a view, or NULL) */
 int oc_eop_taylor(const oc_enode *n, double x, double y, double R,
-                  oc_etaylor *o, int *boxes);
+                  const oc_etfoot *tf, oc_etaylor *o, int *boxes);
+/* Whether n's f model holds only where its weight is > 0 (a curve's,
+** lake's or image's, and operators' in their place; eops.c). */
+int oc_eop_taylor_partial(const oc_enode *n);
 /* alpha's model alone, as oc_enode_taylor's (discs, and operators whose
 ** weight has its own rule: blends, transforms, replaces and adds with A's
 ** weight); 0 for the others. */
@@ -481,6 +509,21 @@ void oc_elod_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                 int want, oc_enode_sample *s);
 void oc_elod_bound_in(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
                       oc_ebound *o);
+
+/* First-order models under a view (lod.c). tau = log2(w / foot) around
+** p: its model (value log2(w / tf->p.v), as evaluation computes it) and
+** its range [*lo, *hi] on the disc |q - p| <= R; returns 0 when the
+** footprint may reach 0 there (no bound of tau's curvature: m's
+** remainder is then left 0 and must not be used). */
+int oc_elod_tau_taylor(double w, const oc_etfoot *tf, double R, oc_etay *m,
+                       double *lo, double *hi);
+/* b(t) for the model t of an argument whose range on the disc is [lo,
+** hi]: its value oc_elod_b(t->v). */
+oc_etay oc_elod_b_taylor(const oc_etay *t, double lo, double hi, double R);
+/* The lod operator's model under a view; 0 where it has no rule (full
+** detail: the box bound, as before; partial children). */
+int oc_elod_taylor(const oc_enode *n, double x, double y, double R,
+                   const oc_etfoot *tf, oc_etaylor *o, int *boxes);
 
 /* Noise: eta on z = 0 remapped to [-1, 1], and its Lipschitz bound. */
 double oc_eta(uint64_t seed, double x, double y, double g[2]);

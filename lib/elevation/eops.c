@@ -654,6 +654,29 @@ oc_enode *oc_enode_add(oc_enode *a, oc_enode *b, const oc_enode_add_params *p,
 
 /* ---- affine transforms ------------------------------------------------ */
 
+/* The footprint in the child's units: foot(M p' + t) / s, whose
+** gradient in p' is R^T grad foot = s Minv grad foot (m = Minv); NULL
+** stays NULL. */
+static const oc_efoot *xform_foot(const oc_enode *n, const double m[4],
+                                  const oc_efoot *ft, oc_efoot *cf) {
+  if (!ft) return NULL;
+  double sc = OC_EUN(n)->par[P_SCALE];
+  cf->v = ft->v * (1 / sc);
+  cf->gx = sc * (m[0] * ft->gx + m[1] * ft->gy);
+  cf->gy = sc * (m[2] * ft->gx + m[3] * ft->gy);
+  return cf;
+}
+
+/* Footprints over a region, in the child's units: a similarity keeps the
+** footprint's Lipschitz bound, in any units. */
+static const oc_efootb *xform_footb(const oc_enode *n, const oc_efootb *fb,
+                                    oc_efootb *cf) {
+  if (!fb) return NULL;
+  double is = 1 / OC_EUN(n)->par[P_SCALE];
+  *cf = (oc_efootb){fb->lo * is, fb->hi * is, fb->k};
+  return cf;
+}
+
 static void xform_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                      int want, oc_enode_sample *s) {
   const double *par = OC_EUN(n)->par;
@@ -661,16 +684,8 @@ static void xform_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
   minv(n, m);
   double u = x - par[P_TX], v = y - par[P_TY];
   oc_enode_sample c;
-  /* the footprint in the child's units: foot(M p' + t) / s, whose
-  ** gradient in p' is R^T grad foot = s Minv grad foot */
-  oc_efoot cf, *cft = NULL;
-  if (ft) {
-    double sc = par[P_SCALE];
-    cf.v = ft->v * (1 / sc);
-    cf.gx = sc * (m[0] * ft->gx + m[1] * ft->gy);
-    cf.gy = sc * (m[2] * ft->gx + m[3] * ft->gy);
-    cft = &cf;
-  }
+  oc_efoot cf;
+  const oc_efoot *cft = xform_foot(n, m, ft, &cf);
   oc_enode_ev(OC_EUN(n)->kid, m[0] * u + m[1] * v, m[2] * u + m[3] * v, cft,
               want, &c);
   double vs = par[P_VS];
@@ -736,14 +751,8 @@ static void xform_bound_in(const oc_enode *n, const oc_erect *b,
                            const oc_efootb *fb, oc_ebound *o) {
   oc_erect r = map_rect(n, b, 1);
   oc_ebound c;
-  /* a similarity keeps the footprint's Lipschitz bound, in any units */
-  oc_efootb cf, *cfb = NULL;
-  if (fb) {
-    double is = 1 / OC_EUN(n)->par[P_SCALE];
-    cf = (oc_efootb){fb->lo * is, fb->hi * is, fb->k};
-    cfb = &cf;
-  }
-  oc_enode_bnd(OC_EUN(n)->kid, &r, cfb, &c);
+  oc_efootb cf;
+  oc_enode_bnd(OC_EUN(n)->kid, &r, xform_footb(n, fb, &cf), &c);
   xform_map_bound(n, &c, o);
 }
 
@@ -1094,6 +1103,10 @@ static int tay_partial(const oc_enode *n) {
   }
 }
 
+int oc_eop_taylor_partial(const oc_enode *n) {
+  return tay_partial(n);
+}
+
 /* blend, f = N / S where S = sum alpha_k >= T on the whole disc: with
 ** f the value at p, N' - f S' = sum alpha_k' (f_k' - f) and, writing each
 ** child's alpha_k' = a_k + A_k.d + x_k, f_k' = f_k + F_k.d + y_k, this is
@@ -1104,7 +1117,7 @@ static int tay_partial(const oc_enode *n) {
 ** inf S'. Where S <= T on the whole disc f = N / T, N the sum of the
 ** products alpha_k f_k (product rule, etaylor.h). */
 static int blend_taylor(const oc_enode *n, double x, double y, double R,
-                        oc_etaylor *o, int *boxes) {
+                        const oc_etfoot *tf, oc_etaylor *o, int *boxes) {
   const oc_eblend *bl = OC_EBLEND(n);
   oc_erect ball = {x - R, y - R, x + R, y + R};
   /* per child: f_k, or (out) the range of f_k, and alpha_k's remainder */
@@ -1133,10 +1146,10 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
       m++;
       continue;
     }
-    if (have && k->kind == OC_E_DISC)
+    if (have && k->kind == OC_E_DISC && !tf)
       oc_edisc_taylor_f(k, x, y, R, &c.f); /* (its alpha's model: c.a) */
     else
-      oc_enode_taylor(k, x, y, R, &c, boxes);
+      oc_enode_taylor_view(k, x, y, R, tf, &c, boxes);
     if (c.a.v == 0 && oc_etay_is_const(&c.a)) continue;
     if (oc_enode_holds(k, x, y) && c.a.v != 0) N += c.a.v * c.f.v; /* (ev) */
     Nx += c.a.v * c.f.gx + c.f.v * c.a.gx;
@@ -1200,20 +1213,21 @@ static oc_etay psi_flat(const oc_ebound *Bb, double c, double pv, double R) {
 /* w = clamp(alpha_B)'s model and, for a partial B, B's bound on the
 ** disc's box. 0: w = 0 on the whole disc. */
 static int weight_taylor(const oc_enode *B, double x, double y, double R,
-                         oc_etaylor *b, oc_etay *w, oc_ebound *Bb, int *boxes) {
+                         const oc_etfoot *tf, oc_etaylor *b, oc_etay *w,
+                         oc_ebound *Bb, int *boxes) {
   oc_erect ball = {x - R, y - R, x + R, y + R};
   if (!oc_enode_meets(B, &ball)) return 0;
   if (tay_partial(B)) {
     oc_enode_sample s;
-    oc_enode_bnd(B, &ball, NULL, Bb);
+    oc_enode_bnd(B, &ball, tf ? &tf->b : NULL, Bb);
     (*boxes)++;
     if (!(Bb->ahi > 0)) return 0;
     /* (lazy: f may be 0 where alpha_B = 0, where w = 0 and psi = 0) */
-    oc_enode_ev(B, x, y, NULL, OC_EV_LAZY, &s);
+    oc_enode_ev(B, x, y, tf ? &tf->p : NULL, OC_EV_LAZY, &s);
     b->f = oc_etay_const(s.f);
     b->a = oc_etay_flat(s.a, Bb->la, oc_fmax(Bb->ahi - s.a, s.a - Bb->alo), R);
   } else {
-    oc_enode_taylor(B, x, y, R, b, boxes);
+    oc_enode_taylor_view(B, x, y, R, tf, b, boxes);
   }
   *w = oc_etay_clamp01(&b->a, R);
   return !(w->v == 0 && oc_etay_is_const(w));
@@ -1225,15 +1239,15 @@ static int weight_taylor(const oc_enode *B, double x, double y, double R,
 ** weight (1 - w) alpha_A + w^2 = alpha_A + w (w - alpha_A), by the
 ** product rule. */
 static int replace_taylor(const oc_enode *n, double x, double y, double R,
-                          oc_etaylor *o, int *boxes) {
+                          const oc_etfoot *tf, oc_etaylor *o, int *boxes) {
   const oc_enode *A = OC_EBIN(n)->kids[0], *B = OC_EBIN(n)->kids[1];
   if (tay_partial(A)) return 0;
   oc_etaylor a, b;
   oc_etay w;
   oc_ebound Bb;
-  oc_enode_taylor(A, x, y, R, &a, boxes);
+  oc_enode_taylor_view(A, x, y, R, tf, &a, boxes);
   *o = a;
-  if (!weight_taylor(B, x, y, R, &b, &w, &Bb, boxes)) return 1;
+  if (!weight_taylor(B, x, y, R, tf, &b, &w, &Bb, boxes)) return 1;
   double fv = (1 - w.v) * a.f.v + w.v * b.f.v;
   if (tay_partial(B)) {
     oc_etay psi = psi_flat(&Bb, a.f.v, w.v * (b.f.v - a.f.v), R);
@@ -1267,15 +1281,15 @@ static int replace_taylor(const oc_enode *n, double x, double y, double R,
 ** disc keeps t out of (0, 1). alpha_A + w_B^2 by the product rule. A slope
 ** weight, or a partial child, has no rule. */
 static int add_taylor(const oc_enode *n, double x, double y, double R,
-                      oc_etaylor *o, int *boxes) {
+                      const oc_etfoot *tf, oc_etaylor *o, int *boxes) {
   const oc_enode *A = OC_EBIN(n)->kids[0], *B = OC_EBIN(n)->kids[1];
   if (n->flags & OC_EF_SLOPE || tay_partial(A) || tay_partial(B)) return 0;
   oc_etaylor a, b;
   oc_etay c;
   oc_ebound Bb;
-  oc_enode_taylor(A, x, y, R, &a, boxes);
+  oc_enode_taylor_view(A, x, y, R, tf, &a, boxes);
   *o = a;
-  if (!weight_taylor(B, x, y, R, &b, &c, &Bb, boxes)) return 1;
+  if (!weight_taylor(B, x, y, R, tf, &b, &c, &Bb, boxes)) return 1;
   oc_etay w = c;
   if (n->flags & OC_EF_BELOW) {
     const double *par = add_below(n);
@@ -1305,16 +1319,22 @@ static int add_taylor(const oc_enode *n, double x, double y, double R,
 
 /* transform: the child's model at p' = Minv (p - t) for R / scale (|Minv
 ** d| = |d| / scale): f = vs f_c + vo, its linear part vs Minv^T F_c, its
-** remainder |vs| E_c(r / scale). */
+** remainder |vs| E_c(r / scale). Under a view, with the footprints in
+** the child's units (as evaluation and bounds map them). */
 static int xform_taylor(const oc_enode *n, double x, double y, double R,
-                        oc_etaylor *o, int *boxes) {
+                        const oc_etfoot *tf, oc_etaylor *o, int *boxes) {
   const double *par = OC_EUN(n)->par;
   double m[4];
   minv(n, m);
   double u = x - par[P_TX], v = y - par[P_TY], is = 1 / par[P_SCALE];
   oc_etaylor c;
-  oc_enode_taylor(OC_EUN(n)->kid, m[0] * u + m[1] * v, m[2] * u + m[3] * v,
-                  R * is * (1 + 1e-12), &c, boxes);
+  oc_etfoot cf;
+  if (tf) {
+    xform_foot(n, m, &tf->p, &cf.p);
+    xform_footb(n, &tf->b, &cf.b);
+  }
+  oc_enode_taylor_view(OC_EUN(n)->kid, m[0] * u + m[1] * v, m[2] * u + m[3] * v,
+                       R * is * (1 + 1e-12), tf ? &cf : NULL, &c, boxes);
   double vs = par[P_VS], k = fabs(vs), is2 = is * is;
   o->f = (oc_etay){vs * c.f.v + par[P_VO],
                    vs * (m[0] * c.f.gx + m[2] * c.f.gy),
@@ -1380,16 +1400,16 @@ int oc_eop_taylor_alpha(const oc_enode *n, double x, double y, double R,
 }
 
 int oc_eop_taylor(const oc_enode *n, double x, double y, double R,
-                  oc_etaylor *o, int *boxes) {
+                  const oc_etfoot *tf, oc_etaylor *o, int *boxes) {
   switch (n->kind) {
   case OC_E_BLEND:
-    return blend_taylor(n, x, y, R, o, boxes);
+    return blend_taylor(n, x, y, R, tf, o, boxes);
   case OC_E_REPLACE:
-    return replace_taylor(n, x, y, R, o, boxes);
+    return replace_taylor(n, x, y, R, tf, o, boxes);
   case OC_E_ADD:
-    return add_taylor(n, x, y, R, o, boxes);
+    return add_taylor(n, x, y, R, tf, o, boxes);
   case OC_E_XFORM:
-    return xform_taylor(n, x, y, R, o, boxes);
+    return xform_taylor(n, x, y, R, tf, o, boxes);
   default:
     return 0; /* warp */
   }

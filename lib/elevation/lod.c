@@ -233,6 +233,127 @@ void oc_elod_derive(const oc_enode *n, const oc_ebound *kb,
   glob->ahi = fmax(kb[0].ahi, kb[1].ahi);
 }
 
+/* ---- first-order models under a view (etaylor.h) -----------------------
+** tau(q) = log2(w / foot(q)) feeds kappa and the discs' octave filters.
+** In world units foot = k rho, rho = |(q - e_xy, dz)|, so ln foot = ln k
+** + ln rho, whose Hessian is I / rho^2 - 2 x x^T / rho^4 (x = q - e_xy):
+** its eigenvalues 1 / rho^2 (across x) and (dz^2 - |x|^2) / rho^4 (along
+** x) lie in [-1 / rho^2, 1 / rho^2], so |Hess ln foot| <= 1 / rho^2 =
+** k^2 / foot^2. A transform's child sees foot(M q' + t) / s (M = s Rot):
+** the Hessian of its log is s^2 Rot^T (Hess ln foot) Rot, at most s^2 k^2
+** / foot^2 = k^2 / foot_c^2 with the same k in its units (xform_footb
+** keeps k). A warp's child has no rule (its box bound). So on the disc
+** |q - p| <= R, where foot >= fmin = max(fb.lo, foot(p) - k R) (foot is
+** k-Lipschitz), |Hess tau| <= k^2 / (ln 2 fmin^2) and Taylor with the
+** integral remainder gives
+**   |tau(q) - tau(p) - grad tau(p).d| <= k^2 r^2 / (2 ln 2 fmin^2),
+** grad tau = -grad foot / (ln 2 foot); tau lies in [log2(w / fmax),
+** log2(w / fmin)] there, fmax = min(fb.hi, foot(p) + k R) (bounded
+** without logarithms: oc_elod_tau_taylor).
+** The filter b(t) = 1 - (1 - t^2)^3 on [0, 1] (0 below, 1 above) is C1
+** (b' = 6 t (1 - t^2)^2 vanishes at both ends) with b'' = 6 (1 - t^2)
+** (1 - 5 t^2) on (0, 1) and 0 outside, so b(t(q)) composes by the
+** chain rule of etaylor.h (oc_etay_compose) with M the largest |b''| on
+** t's range: |b''| falls from 6 at 0 to 0 at 1 / sqrt 5, then rises to
+** 4.8 at sqrt(3/5) and falls to 0 at 1. */
+
+#define SQRT35 0.7745966692414834 /* sqrt(3/5): b'' is -4.8 there */
+
+/* |b''(t)| for t in [0, 1] */
+static double bpp_abs(double t) {
+  double q = t * t;
+  return fabs(6 * (1 - q) * (1 - 5 * q));
+}
+
+/* The largest |b''| on [lo, hi] (b'' is 0 outside [0, 1], 6 next to 0). */
+static double bpp_max(double lo, double hi) {
+  lo = fmin(fmax(lo, 0), 1), hi = fmin(fmax(hi, 0), 1);
+  double m = fmax(bpp_abs(lo), bpp_abs(hi));
+  if (lo <= SQRT35 && hi >= SQRT35) m = fmax(m, 4.8);
+  return m * (1 + 1e-12);
+}
+
+int oc_elod_tau_taylor(double w, const oc_etfoot *tf, double R, oc_etay *m,
+                       double *lo, double *hi) {
+  const oc_efoot *ft = &tf->p;
+  double k = tf->b.k, kr = k * R * (1 + 1e-12);
+  double flo = fmax(tf->b.lo, ft->v - kr), fhi = fmin(tf->b.hi, ft->v + kr);
+  double c = -1 / (ft->v * LN2); /* (as the discs' evaluation) */
+  *m = (oc_etay){log2(w / ft->v), c * ft->gx, c * ft->gy, 0, 0, 0};
+  /* tau's range without a log2 each: log2(w / fhi) = tau(p) - log2(fhi /
+  ** foot(p)) and ln(1 + x) <= x; log2(w / flo) = tau(p) - log2(flo /
+  ** foot(p)) and -ln y <= 1 / y - 1; padded against rounding */
+  double pad = 1e-12 * (1 + fabs(m->v));
+  *lo = m->v - (fmax(fhi, ft->v) / ft->v - 1) / LN2 - pad;
+  *hi = flo > 0 ? m->v + (ft->v / fmin(flo, ft->v) - 1) / LN2 + pad : INFINITY;
+  if (!(flo > 0)) return 0;
+  m->e2 = 0.5 * k * k / (LN2 * flo * flo) * (1 + 1e-12);
+  return 1;
+}
+
+oc_etay oc_elod_b_taylor(const oc_etay *t, double lo, double hi, double R) {
+  double db, bv = oc_elod_b(t->v, &db), d;
+  if (hi <= 0 || lo >= 1) return oc_etay_const(bv);
+  oc_etay m = oc_etay_compose(t, bv, db, bpp_max(lo, hi), R);
+  /* b is non-decreasing: it stays in [b(lo), b(hi)] (the gap to the far
+  ** end, flat, where that is less) */
+  double gap = fmax(bv - oc_elod_b(lo, &d), oc_elod_b(hi, &d) - bv);
+  if (oc_etay_rem(&m, R) > gap) m = (oc_etay){bv, 0, 0, gap, 0, 0};
+  return m;
+}
+
+/* g + t (h - g) for models g, h of the two children and t's: the
+** product rule (etaylor.h) on t and h - g. The value is left to the
+** caller. */
+static oc_etay lerp_taylor(const oc_etay *g, const oc_etay *h, const oc_etay *t,
+                           double R) {
+  oc_etay d = oc_etay_scale(g, -1), o = *g;
+  oc_etay_add(&d, h);
+  oc_etay td = oc_etay_mul(t, &d, R);
+  oc_etay_add(&o, &td);
+  return o;
+}
+
+/* The lod operator, f = (1 - t) f_A + t f_B with t = clamp((kappa - k0)
+** / (k1 - k0)), kappa = b(tau) (the model above), and alpha the same:
+** where t's range on the disc is 1 (0) only B's (A's) model is made;
+** else t's model is kappa's scaled, clamped where its range leaves [0,
+** 1] (etaylor.h, oc_etay_clamp01), and f and alpha lerp by the product
+** rule. Children whose f model holds only where their weight is > 0
+** (oc_eop_taylor_partial) have no rule; nor has full detail (tf NULL:
+** the node is B there, but the exact renders keep the box bound they
+** had). */
+int oc_elod_taylor(const oc_enode *n, double x, double y, double R,
+                   const oc_etfoot *tf, oc_etaylor *o, int *boxes) {
+  const oc_enode *A = OC_EBIN(n)->kids[0], *B = OC_EBIN(n)->kids[1];
+  const double *p = OC_EBIN(n)->par;
+  if (!tf) return 0;
+  oc_etay tau;
+  double tlo, thi, d, c = 1 / (p[P_K1] - p[P_K0]);
+  int curved = oc_elod_tau_taylor(p[P_W], tf, R, &tau, &tlo, &thi);
+  double lo = (oc_elod_b(tlo, &d) - p[P_K0]) * c;
+  double hi = (oc_elod_b(thi, &d) - p[P_K0]) * c;
+  if (lo >= 1 || hi <= 0) {
+    oc_enode_taylor_view(lo >= 1 ? B : A, x, y, R, tf, o, boxes);
+    return 1;
+  }
+  if (!curved || oc_eop_taylor_partial(A) || oc_eop_taylor_partial(B)) return 0;
+  oc_etay kap = oc_elod_b_taylor(&tau, tlo, thi, R);
+  double t = (kap.v - p[P_K0]) / (p[P_K1] - p[P_K0]); /* (as oc_elod_ev) */
+  oc_etay tm = oc_etay_scale(&kap, c);
+  tm.v = t;
+  if (lo < 0 || hi > 1) tm = oc_etay_clamp01(&tm, R);
+  oc_etaylor a, b;
+  oc_enode_taylor_view(A, x, y, R, tf, &a, boxes);
+  oc_enode_taylor_view(B, x, y, R, tf, &b, boxes);
+  o->f = lerp_taylor(&a.f, &b.f, &tm, R);
+  o->a = lerp_taylor(&a.a, &b.a, &tm, R);
+  /* the values as evaluation gives them: one child's alone at either end */
+  o->f.v = t >= 1 ? b.f.v : t <= 0 ? a.f.v : (1 - t) * a.f.v + t * b.f.v;
+  o->a.v = t >= 1 ? b.a.v : t <= 0 ? a.a.v : (1 - t) * a.a.v + t * b.a.v;
+  return 1;
+}
+
 /* ---- queries and the elevation source under a view --------------------- */
 
 static int make_view(const oc_enode *e, const oc_enode_view *v, oc_eview *o,
@@ -327,6 +448,19 @@ static void vsrc_both(void *ud, double x0, double y0, double x1, double y1,
   *slope = b.lf;
 }
 
+/* The tree's model under the view: the footprint at p and over the
+** disc's box (the full-detail model where the view's k is 0). */
+static double vsrc_taylor(void *ud, double x, double y, double R, double g[2],
+                          double e[3], int *boxes) {
+  const vsrc *q = ud;
+  oc_etfoot tf;
+  oc_erect r = {x - R, y - R, x + R, y + R};
+  oc_eview_foot(&q->v, x, y, &tf.p);
+  oc_eview_footb(&q->v, &r, &tf.b);
+  return oc_enode_taylor_src(q->e, x, y, R, tf.p.v > 0 ? &tf : NULL, g, e,
+                             boxes);
+}
+
 static void vsrc_retain(void *ud) {
   ((vsrc *)ud)->refs++;
 }
@@ -367,6 +501,7 @@ int oc_enode_elevation_view(oc_enode *e, const double *domain,
                         .range = vsrc_range,
                         .slope = vsrc_slope,
                         .bound = vsrc_both,
+                        .taylor = vsrc_taylor,
                         .retain = vsrc_retain,
                         .release = vsrc_release,
                         .ud = q,

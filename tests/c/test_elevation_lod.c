@@ -10,11 +10,15 @@
 */
 #include <math.h>
 #include <omp.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "elevation/enode.h"
+#include "etaycheck.h"
 #include "ocheck.h"
 #include "render/etrace.h"
+
+#define PI 3.14159265358979323846
 
 /* Sizes: the sanitizer pass (about 7x slower) samples less, the release
 ** pass the full sets. */
@@ -432,6 +436,124 @@ START_TEST(bounds_with_lod) {
 }
 END_TEST
 
+/* ---- first-order models under a view ---------------------------------- */
+
+#ifdef __SANITIZE_ADDRESS__
+#define TAY_POINTS 8 /* points a tree and view, each with 40 q */
+#else
+#define TAY_POINTS 40
+#endif
+
+/* The largest |error| / remainder seen, and on the step trees' ramps
+** that of the models with a remainder of degree 2 (the footprint's
+** curvature terms alone: its e2 and b''s). */
+static double tay_worst, ramp_worst;
+
+/* f and alpha under a view, with the footprint at the point */
+typedef struct view_ctx {
+  const oc_enode *e;
+  const oc_eview *w;
+} view_ctx;
+static void view_eval(const void *ctx, double x, double y, double fa[2]) {
+  const view_ctx *c = ctx;
+  oc_efoot ft;
+  oc_enode_sample q;
+  oc_eview_foot(c->w, x, y, &ft);
+  oc_enode_ev(c->e, x, y, &ft, 0, &q);
+  fa[0] = q.f, fa[1] = q.a;
+}
+
+/* At random p and R under view v, the model of f and alpha (the view
+** source's: the footprint at p and over the disc's box) holds on random
+** q in the disc, near p (where the linear part must be the gradient) and
+** out to R; its values are the evaluator's bits with p's footprint. With
+** ramp (the step trees), p lies where the lod node's t ramps: its
+** footprint in [170, 225] m. */
+static void check_view_taylor(const oc_enode *e, const oc_enode_view *v,
+                              oct_rng *r, int ramp) {
+  oc_eview w = {v->eye[0], v->eye[1], mid_dz(e, v), v->k};
+  double d0 = 0, d1 = 0, z2 = w.dz * w.dz;
+  if (ramp) {
+    d0 = sqrt(fmax(0, 170 * 170 / (w.k * w.k) - z2));
+    d1 = sqrt(fmax(0, 225 * 225 / (w.k * w.k) - z2));
+  }
+  for (int i = 0; i < TAY_POINTS; i++) {
+    double x = oct_unif(r, -4500, 4000), y = oct_unif(r, -4500, 4000);
+    double R = 4000 * pow(10, oct_unif(r, -3.5, -0.3));
+    if (ramp) {
+      double d = oct_unif(r, d0, d1), th = oct_unif(r, 0, 2 * PI);
+      x = w.ex + d * cos(th), y = w.ey + d * sin(th);
+      R = d1 * pow(10, oct_unif(r, -4, -1));
+    }
+    oc_etfoot tf;
+    oc_erect box = {x - R, y - R, x + R, y + R};
+    oc_eview_foot(&w, x, y, &tf.p);
+    oc_eview_footb(&w, &box, &tf.b);
+    oc_etaylor m;
+    int boxes = 0;
+    oc_enode_taylor_view(e, x, y, R, tf.p.v > 0 ? &tf : NULL, &m, &boxes);
+    oc_enode_sample s, sa;
+    oc_enode_ev(e, x, y, &tf.p, 0, &s);
+    oc_enode_ev(e, x, y, &tf.p, OC_EV_ALPHA, &sa);
+    ck_assert_msg(m.f.v == s.f && m.a.v == sa.a,
+                  "%s at (%g, %g): f %.17g alpha %.17g, eval %.17g %.17g",
+                  oc_enode_kind(e), x, y, m.f.v, m.a.v, s.f, sa.a);
+    char what[64];
+    snprintf(what, sizeof what, "%s under k %g", oc_enode_kind(e), v->k);
+    view_ctx c = {e, &w};
+    tay_worst = fmax(tay_worst, etay_check(&m, x, y, R, r, view_eval, &c, what,
+                                           ramp ? &ramp_worst : NULL));
+  }
+}
+
+/* Models under views (disc.c, lod.c, etaylor.h) on trees with every
+** operator: continuous-LoD discs of each noise, the lod operator between
+** flat discs (all its curvature the footprint's), that tree scaled and
+** rotated by a transform (the footprint in the child's units) and
+** warped (a fallback), the scene of every operator, and an add by a
+** slope weight (a fallback); far, near and grazing views, and one whose
+** eye is level with the tree's middle (the footprint reaches 0: no rule
+** for tau next to the eye). Remainders never exceeded; on the step trees'
+** ramps the errors reach a good part of the remainders, so that zeroing
+** the footprint's terms (tau's curvature or b''s) fails the check. */
+START_TEST(lod_taylor_models) {
+  oc_error err;
+  oc_enode *st = step_tree();
+  oc_enode_xform x = {300, -200, 25, 2.5, 1.3, 5};
+  oc_enode *xst = EOK(oc_enode_transform(st, &x, &err));
+  oc_enode *trees[] = {disc(0, 0, 20000, 50, OC_ENOISE_PLAIN, 100, 400, 8),
+                       disc(0, 0, 20000, 50, OC_ENOISE_TURBULENCE, 100, 400, 8),
+                       disc(0, 0, 20000, 50, OC_ENOISE_RIDGED, 100, 400, 8),
+                       st,
+                       xst,
+                       step_instance(),
+                       scene(),
+                       slope_scene()};
+  size_t nt = sizeof trees / sizeof *trees;
+  oc_enode_view views[] = {{{-500, 300, 900}, 3e-3},
+                           {{3000, 0, 5000}, 0.02},
+                           {{100, 0, 10}, 1},
+                           {{0, 0, 35}, 0.05}};
+  oct_rng r = oct_rng_new(77);
+  tay_worst = ramp_worst = 0;
+  for (size_t t = 0; t < nt; t++)
+    for (int q = 0; q < 4; q++) {
+      if (q == 3 && t != 3) continue; /* level with the step tree's middle */
+      check_view_taylor(trees[t], &views[q], &r, 0);
+      if ((t == 3 || t == 4) && q > 0) /* (the first view has no ramp) */
+        check_view_taylor(trees[t], &views[q], &r, 1);
+    }
+  printf("lod taylor: the largest error is %.3f of its remainder, %.3f "
+         "on the ramps of the footprint's curvature alone\n",
+         tay_worst, ramp_worst);
+  ck_assert(tay_worst <= 1 && tay_worst > 0.01);
+  ck_assert_msg(ramp_worst > 0.2, "ramps: errors reach only %g of remainders",
+                ramp_worst);
+  for (size_t t = 0; t < nt; t++)
+    oc_enode_release(trees[t]);
+}
+END_TEST
+
 /* ---- tracing --------------------------------------------------------- */
 
 /* First t where o + t d is on or below the surface (inside the domain,
@@ -479,8 +601,9 @@ START_TEST(lod_trace_against_march) {
   ck_assert_msg(oc_enode_elevation_view(e, NULL, &v, &src, &err) == OC_OK, "%s",
                 err.msg);
   oc_esurface es = {&src, oc_enode_view_weight, src.ud, OC_ENODE_T};
-  /* the joint query (one traversal a step) answers range and slope */
-  ck_assert(src.bound);
+  /* the joint query (one traversal a step) answers range and slope; the
+  ** march steps on first-order models */
+  ck_assert(src.bound && src.taylor);
   for (int k = 0; k < 40; k++) {
     double x0 = -2000 + 97.3 * k, y0 = -1500 + 71.9 * k, sz = 3.0 * (k + 1);
     double lo, hi, lam, rlo, rhi;
@@ -519,6 +642,25 @@ START_TEST(lod_trace_against_march) {
     }
   ck_assert_msg(hits > n / 2, "%d of %d hit", hits, n);
   ck_assert_msg(differ <= 2, "%d rays disagree", differ);
+  /* the models save calls against the box bounds' march on those rays
+  ** (where the top node has rules: a slope-weighted add has none, its
+  ** models are the box bound's flat ones) */
+  oc_elevation boxed = src;
+  boxed.taylor = NULL;
+  oc_esurface eb = {&boxed, oc_enode_view_weight, src.ud, OC_ENODE_T};
+  oc_etracer tb;
+  oc_etracer_init(&tb, &eb, OC_TRACE_SEGMENT, eps_k, eps_min);
+  double evb = 0;
+  for (int j = 0; j < MARCH_NY; j++)
+    for (int i = 0; i < MARCH_NX; i++) {
+      double x = (i + 0.5) / MARCH_NX * 2 - 1,
+             y = ((j + 0.5) / MARCH_NY * 2 - 1) * 0.3, t;
+      oc_vec3 d = oct_add(w, oct_add(oct_mul(rt, 0.6 * x), oct_mul(up, y)));
+      oc_etrace(&tb, eye, oct_mul(d, 1 / oct_len(d)), 0, 1e6, 0, &t, &evb);
+    }
+  printf("lod trace%s: %.1f calls a ray on models, %.1f on box bounds\n",
+         _i ? " (slope weight)" : "", ev / n, evb / n);
+  if (!_i) ck_assert_msg(ev < evb, "models %g calls, box bounds %g", ev, evb);
   /* a whole render: the same image on 1 and 2 threads */
   oc_render_params rp;
   oc_render_defaults(&rp);
@@ -554,6 +696,7 @@ int main(void) {
   tcase_add_test(tc, continuous_across_thresholds);
   tcase_add_loop_test(tc, gradients_with_lod, 0, 2);
   tcase_add_test(tc, bounds_with_lod);
+  tcase_add_test(tc, lod_taylor_models);
   tcase_add_loop_test(tc, lod_trace_against_march, 0, 2);
   suite_add_tcase(s, tc);
   return oct_run(s);
