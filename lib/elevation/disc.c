@@ -188,10 +188,11 @@ static oc_etay octave_model(double e, const double g[2], double s, double R,
 
 /* Octave i's term at frequency s from its noise e (gradient g, lattice
 ** units), as noise_sum computes it, and its model in *t; the ridged
-** chain's previous term and model in *prev and *tprev (updated). */
-static double lod_term(const oc_enoise *nz, int i, double e, const double g[2],
-                       double s, double R, double *prev, oc_etay *tprev,
-                       oc_etay *t) {
+** chain's previous term and model in *prev and *tprev (updated). Full
+** detail (noise_taylor) and the filtered sum alike. */
+static double octave_term(const oc_enoise *nz, int i, double e,
+                          const double g[2], double s, double R, double *prev,
+                          oc_etay *tprev, oc_etay *t) {
   if (nz->kind != OC_ENOISE_RIDGED) {
     int turb = nz->kind == OC_ENOISE_TURBULENCE;
     *t = octave_model(e, g, s, R, turb);
@@ -244,7 +245,7 @@ static int noise_taylor_lod(const oc_enoise *nz, double u, double v, double R,
     oc_etay ti = tau, T, at;
     ti.v = tau.v - i * dt;
     double bw = oc_elod_b(ti.v, &db);
-    double term = lod_term(nz, i, 2 * ev[i] - 1, g, s, R, &prev, &tprev, &T);
+    double term = octave_term(nz, i, 2 * ev[i] - 1, g, s, R, &prev, &tprev, &T);
     live = live && bw != 0;
     if (live) sum += a * bw * term;
     if (tlo - i * dt >= 1) {
@@ -830,37 +831,7 @@ static void noise_taylor(const oc_enoise *nz, double u, double v, double R,
   for (int i = 0; i < cnt; i++) {
     double ge[2] = {2 * ex[i], 2 * ey[i]}, e = 2 * ev[i] - 1; /* (oc_eta) */
     oc_etay t;
-    switch (nz->kind) {
-    case OC_ENOISE_PLAIN:
-      sum += a * e;
-      t = octave_model(e, ge, s, R, 0);
-      break;
-    case OC_ENOISE_TURBULENCE:
-      sum += a * fabs(e);
-      t = octave_model(e, ge, s, R, 1);
-      break;
-    default: { /* ridged: the value as noise_sum computes it */
-      double r = 1 - fabs(e), w = 1;
-      if (i > 0) {
-        w = RIDGE_GAIN * prev;
-        w = w >= 1 ? 1 : w <= 0 ? 0 : w;
-      }
-      double tv = w * r * r;
-      sum += a * tv;
-      prev = tv;
-      /* rho = 1 - |eta|: |eta|'s model negated, plus 1 */
-      oc_etay rho = octave_model(e, ge, s, R, 1);
-      rho.v = r, rho.gx = -rho.gx, rho.gy = -rho.gy;
-      oc_etay rho2 = oc_etay_mul(&rho, &rho, R), wm = oc_etay_const(1);
-      if (i > 0) {
-        oc_etay x = oc_etay_scale(&tprev, RIDGE_GAIN);
-        wm = oc_etay_clamp01(&x, R);
-      }
-      t = oc_etay_mul(&wm, &rho2, R);
-      t.v = tv;
-      tprev = t;
-    }
-    }
+    sum += a * octave_term(nz, i, e, ge, s, R, &prev, &tprev, &t);
     oc_etay at = oc_etay_scale(&t, a);
     oc_etay_add(&m, &at);
     a = a * nz->gain;
