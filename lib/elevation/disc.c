@@ -36,6 +36,21 @@ static uint64_t octave_seed(uint64_t seed, int i) {
   return oc_mix64(seed + 0x9e3779b97f4a7c15ull * (uint64_t)(i + 1));
 }
 
+/* The noise of octaves [0, n) of nz at (u, v) in one call
+** (oc_noise3_z0_multi: two octaves at a time, oc_noise3's values and
+** gradients bit for bit; oc_eta remaps them), the gradients when ex and
+** ey are not NULL. */
+static void octave_noise(const oc_enoise *nz, double u, double v, int n,
+                         double *ev, double *ex, double *ey) {
+  uint64_t seed[OC_ENOISE_MAXOCT];
+  double px[OC_ENOISE_MAXOCT], py[OC_ENOISE_MAXOCT], s = 1 / nz->wavelength;
+  for (int i = 0; i < n; i++, s *= nz->lacunarity) {
+    seed[i] = octave_seed(nz->seed, i);
+    px[i] = s * u, py[i] = s * v;
+  }
+  if (n) oc_noise3_z0_multi(seed, px, py, (size_t)n, ev, ex, ey);
+}
+
 /* Continuous level of detail (lod.c): octave i weighted b(t_i), t_i =
 ** log2(w_i / foot) = t0 - i dt, all with the gradient (gx, gy) of t. */
 typedef struct octlod {
@@ -52,24 +67,18 @@ static double noise_sum(const oc_enoise *nz, double u, double v, double g[2],
   /* the octaves' points and filters first, then their noise in one call
   ** (oc_noise3_z0_multi: two octaves at a time, the values and gradients
   ** oc_eta gives), then the sum octave by octave as it always was */
-  uint64_t seed[OC_ENOISE_MAXOCT];
-  double px[OC_ENOISE_MAXOCT], py[OC_ENOISE_MAXOCT], e[OC_ENOISE_MAXOCT];
-  double ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
+  double e[OC_ENOISE_MAXOCT], ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
   double bws[OC_ENOISE_MAXOCT], dbs[OC_ENOISE_MAXOCT];
   int cnt = 0;
-  for (double s = 1 / nz->wavelength; cnt < nz->octaves;
-       cnt++, s *= nz->lacunarity) {
+  for (; cnt < nz->octaves; cnt++) {
     double bw = 1, db = 0;
     if (lod) {
       bw = oc_elod_b(lod->t0 - cnt * lod->dt, &db);
       if (bw == 0) break;
     }
     bws[cnt] = bw, dbs[cnt] = db;
-    seed[cnt] = octave_seed(nz->seed, cnt);
-    px[cnt] = s * u, py[cnt] = s * v;
   }
-  oc_noise3_z0_multi(seed, px, py, (size_t)cnt, e, g ? ex : NULL,
-                     g ? ey : NULL);
+  octave_noise(nz, u, v, cnt, e, g ? ex : NULL, g ? ey : NULL);
   double sum = 0, a = nz->amplitude, s = 1 / nz->wavelength;
   double prev = 1, gprev[2] = {0, 0}; /* ridged: s_(i-1) and its gradient */
   if (g) g[0] = g[1] = 0;
@@ -226,17 +235,11 @@ static int noise_taylor_lod(const oc_enoise *nz, double u, double v, double R,
   int curved = oc_elod_tau_taylor(nz->wavelength, tf, R, &tau, &tlo, &thi);
   /* the octaves whose filter is not 0 on the whole disc, their noise at
   ** p in one call (as noise_sum) */
-  uint64_t seed[OC_ENOISE_MAXOCT];
-  double px[OC_ENOISE_MAXOCT], py[OC_ENOISE_MAXOCT], ev[OC_ENOISE_MAXOCT];
-  double ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
+  double ev[OC_ENOISE_MAXOCT], ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
   int cnt = 0;
-  for (double s = 1 / nz->wavelength; cnt < nz->octaves && thi - cnt * dt > 0;
-       cnt++, s *= nz->lacunarity) {
+  for (; cnt < nz->octaves && thi - cnt * dt > 0; cnt++)
     if (!curved && tlo - cnt * dt < 1) return 0;
-    seed[cnt] = octave_seed(nz->seed, cnt);
-    px[cnt] = s * u, py[cnt] = s * v;
-  }
-  oc_noise3_z0_multi(seed, px, py, (size_t)cnt, ev, ex, ey);
+  octave_noise(nz, u, v, cnt, ev, ex, ey);
   double sum = 0, a = nz->amplitude, s = 1 / nz->wavelength, prev = 1;
   oc_etay m = oc_etay_const(0), tprev = oc_etay_const(1);
   int live = 1; /* noise_sum adds octave i (its filter at p is not 0) */
@@ -548,18 +551,13 @@ static int noise_local(const oc_enoise *nz, double u0, double v0, double u1,
   double rho = sqrt(hx * hx + hy * hy) * (1 + 1e-15);
   if (!(H * s * rho < L || L * s * rho < 1)) return 0;
   /* the octaves that gain, and their noise at the centre in one call */
-  uint64_t seed[OC_ENOISE_MAXOCT];
-  double px[OC_ENOISE_MAXOCT], py[OC_ENOISE_MAXOCT], ev[OC_ENOISE_MAXOCT];
-  double ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
+  double ev[OC_ENOISE_MAXOCT], ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
   int cnt = 0;
   for (double sc = s; cnt < nz->octaves; cnt++, sc *= nz->lacunarity) {
     double r = sc * rho;
     if (!(H * r < L || L * r < 1)) break;
-    seed[cnt] = octave_seed(nz->seed, cnt);
-    px[cnt] = sc * u, py[cnt] = sc * v;
   }
-  if (cnt) /* (always, the first octave gaining: said for the compiler) */
-    oc_noise3_z0_multi(seed, px, py, (size_t)cnt, ev, ex, ey);
+  octave_noise(nz, u, v, cnt, ev, ex, ey);
   double l = 0, h = 0, lf = 0;
   double tlo = 1, thi = 1, tl = 0; /* ridged: the previous term's bounds */
   int i = 0;
@@ -812,22 +810,12 @@ static inline oc_etay octave_model(double e, const double g[2], double s,
 
 static void noise_taylor(const oc_enoise *nz, double u, double v, double R,
                          oc_etay *o) {
-  /* every octave's noise first, in one call (oc_noise3_z0_multi: two
-  ** octaves at a time, oc_eta's values and gradients bit for bit) */
-  uint64_t seed[OC_ENOISE_MAXOCT];
-  double px[OC_ENOISE_MAXOCT], py[OC_ENOISE_MAXOCT], ev[OC_ENOISE_MAXOCT];
-  double ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
-  int cnt = 0; /* (octaves >= 1: checked when the disc is made) */
-  double s = 1 / nz->wavelength;
-  do {
-    seed[cnt] = octave_seed(nz->seed, cnt);
-    px[cnt] = s * u, py[cnt] = s * v;
-    s *= nz->lacunarity;
-  } while (++cnt < nz->octaves);
-  oc_noise3_z0_multi(seed, px, py, (size_t)cnt, ev, ex, ey);
-  double sum = 0, a = nz->amplitude, prev = 1;
+  /* every octave's noise first, in one call */
+  double ev[OC_ENOISE_MAXOCT], ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
+  int cnt = nz->octaves;
+  octave_noise(nz, u, v, cnt, ev, ex, ey);
+  double sum = 0, a = nz->amplitude, prev = 1, s = 1 / nz->wavelength;
   oc_etay m = oc_etay_const(0), tprev = oc_etay_const(1);
-  s = 1 / nz->wavelength;
   for (int i = 0; i < cnt; i++) {
     double ge[2] = {2 * ex[i], 2 * ey[i]}, e = 2 * ev[i] - 1; /* (oc_eta) */
     oc_etay t;
