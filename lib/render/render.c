@@ -227,12 +227,12 @@ static void geom_pixels(const gctx *g, int i0, int j0, int i1, int j1, double d,
 ** the beam of the block takes them as far as it proves them free
 ** together, then its quarters go on from there, down to BEAM_MIN or
 ** BEAM_MIN_MODELS pixels a side, and each ray from where its block
-** stopped. The blocks are the
-** same for any thread count (tiles split alike), so are the images. A
-** beam's height calls (on models) are shared equally by its pixels:
-** share is each pixel's part of its enclosing beams' calls, so that the
-** evals channel sums to every call made; step is the candidate step the
-** enclosing beam ended with (0: none). */
+** stopped. The blocks are the same for any thread count (tiles split
+** alike), so are the images. A beam's height calls (on models) are
+** shared equally by its pixels: share is each pixel's part of its
+** enclosing beams' calls, so that the evals channel sums to every call
+** made; step is the candidate step the enclosing beam ended with (0:
+** none). */
 static void beam_block(const gctx *g, int i0, int j0, int i1, int j1, double d,
                        double step, double share) {
   int w = i1 - i0, h = j1 - j0;
