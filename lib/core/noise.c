@@ -102,9 +102,11 @@ static inline int64_t floor_i64(double x) {
 ** 2^31.17 for these A, B), the outer mix separates k. A nested mix per
 ** coordinate cost 15 % more time; a single mix of a sum of three products
 ** would repeat after about 2^21 cells. */
+#define HASH_A 0xd1b54a32d192ed03ull
+#define HASH_B 0xaef17502108ef2d9ull
 static inline unsigned corner_grad(uint64_t key, uint64_t i, uint64_t j,
                                    uint64_t k) {
-  uint64_t ij = key + i * 0xd1b54a32d192ed03ull + j * 0xaef17502108ef2d9ull;
+  uint64_t ij = key + i * HASH_A + j * HASH_B;
   uint64_t h = oc_mix64(oc_mix64(ij) + k);
   return (unsigned)(((h >> 32) * 12) >> 32);
 }
@@ -383,15 +385,60 @@ void oc_noise3_z0_row(uint64_t seed, const double *x, const double *y, size_t n,
   }
 }
 
-/* ---- oc_noise3_z0_multi: noise3 on the plane z = 0, two points at a
-** time, one per lane of the v2d vectors (SSE2 on every x86-64). Each lane
-** does the scalar code's operations in its order (simplex_locate with
-** floor_d's floor, corner_grad's hashes, corner_add's sums), so every
-** value and gradient is noise3's bit for bit; the gradient's z part is
-** not computed. Vector-by-scalar operations broadcast the scalar exactly.
-** (Four lanes under AVX2, the same code with 32-byte vectors, measured
-** slower on an AMD EPYC: 35 ns an octave against 30, the scalar noise3's
-** 49.) */
+/* ---- oc_noise3_z0_multi: noise3 on the plane z = 0, several points at a
+** time, one per lane of a vector. Each lane does the scalar code's
+** operations in its order (simplex_locate with floor_d's floor,
+** corner_grad's hashes, corner_add's sums), so every value and gradient
+** is noise3's bit for bit; the gradient's z part is not computed.
+** Vector-by-scalar operations broadcast the scalar exactly. Two paths:
+** two lanes with GCC's vector extensions (SSE2 on every x86-64), the
+** hashes lane by lane; eight lanes under AVX-512 (F and DQ: 64-bit
+** multiplies, so the hashes too are vector operations), chosen on each
+** call where the processor has it (a bit of the processor's features
+** that the C library read once at start-up). A count that is not a
+** multiple of the lanes fills the last vector with padding lanes whose
+** results are dropped; huge coordinates are reduced before (noise3's
+** reduce), points that are not finite give NaN as in noise3. (Four lanes
+** under AVX2, the two-lane code with 32-byte vectors and the hashes lane
+** by lane, measured slower on an AMD EPYC: 35 ns an octave against 30.) */
+
+/* A lane's point as noise3 uses it: huge finite coordinates reduced; 0
+** (and the origin) for a point that is not finite. */
+static int lane_point_slow(double x, double y, double *px, double *py) {
+  *px = *py = 0;
+  if (!(isfinite(x) && isfinite(y))) return 0;
+  oc_vec3 p = reduce((oc_vec3){x, y, 0});
+  *px = p.x, *py = p.y;
+  return 1;
+}
+
+static inline int lane_point(double x, double y, double *px, double *py) {
+  if (is_huge((oc_vec3){x, y, 0})) return lane_point_slow(x, y, px, py);
+  *px = x, *py = y;
+  return 1;
+}
+
+/* The four corners' gradient indices of a simplex, corner_grad's: the
+** cell's i A + j B once, a corner stepping along i or j adding A or B
+** (the same sums modulo 2^64). */
+static inline unsigned grad_index(uint64_t ij, uint64_t k) {
+  uint64_t h = oc_mix64(oc_mix64(ij) + k);
+  return (unsigned)(((h >> 32) * 12) >> 32);
+}
+
+static inline void simplex_grads(uint64_t key, uint64_t i, uint64_t j,
+                                 uint64_t k, const unsigned st[6],
+                                 unsigned gi[4]) {
+  uint64_t base = key + i * HASH_A + j * HASH_B;
+  gi[0] = grad_index(base, k);
+  gi[1] = grad_index(base + (HASH_A & -(uint64_t)st[0]) +
+                         (HASH_B & -(uint64_t)st[1]),
+                     k + st[2]);
+  gi[2] = grad_index(base + (HASH_A & -(uint64_t)st[3]) +
+                         (HASH_B & -(uint64_t)st[4]),
+                     k + st[5]);
+  gi[3] = grad_index(base + HASH_A + HASH_B, k + 1);
+}
 
 /* One corner's term added to v, its gradient's x and y parts to gx, gy
 ** when wg; gi the lanes' gradient indices. */
@@ -439,15 +486,13 @@ static inline void z0_lanes(const uint64_t *seed, v2d px, v2d py, v2d *val,
   v2l i2 = xy | xz, j2 = ~xy | yz, k2 = ~xz | ~yz;
   unsigned gi[4][2];
   for (int l = 0; l < 2; l++) {
-    uint64_t key = noise_key(seed[l]);
-    uint64_t i = (uint64_t)(int64_t)fi[l], j = (uint64_t)(int64_t)fj[l],
-             k = (uint64_t)(int64_t)fk[l];
-    gi[0][l] = corner_grad(key, i, j, k);
-    gi[1][l] =
-        corner_grad(key, i + (i1[l] & 1), j + (j1[l] & 1), k + (k1[l] & 1));
-    gi[2][l] =
-        corner_grad(key, i + (i2[l] & 1), j + (j2[l] & 1), k + (k2[l] & 1));
-    gi[3][l] = corner_grad(key, i + 1, j + 1, k + 1);
+    unsigned st[6] = {i1[l] & 1, j1[l] & 1, k1[l] & 1,
+                      i2[l] & 1, j2[l] & 1, k2[l] & 1};
+    unsigned g[4];
+    simplex_grads(noise_key(seed[l]), (uint64_t)(int64_t)fi[l],
+                  (uint64_t)(int64_t)fj[l], (uint64_t)(int64_t)fk[l], st, g);
+    for (int c = 0; c < 4; c++)
+      gi[c][l] = g[c];
   }
   v2d v = zero, g0 = zero, g1 = zero;
   corner2(gi[0], x0, y0, z0, &v, &g0, &g1, wg);
@@ -461,39 +506,259 @@ static inline void z0_lanes(const uint64_t *seed, v2d px, v2d py, v2d *val,
   if (wg) *gx = SCALE * g0, *gy = SCALE * g1;
 }
 
-/* The points m < n, 2 at a time while none is huge, the rest one by one
-** (noise3 itself). */
-static void z0_multi(const uint64_t *seeds, const double *x, const double *y,
-                     size_t n, double *val, double *gx, double *gy, int wg) {
+/* val, gx, gy at m + l for l < cnt (1 or 2) from v, g0, g1, NaN where the
+** point was not finite (fin bit l clear). */
+static inline void z0_store2(v2d v, v2d g0, v2d g1, unsigned fin, size_t m,
+                             size_t cnt, double *val, double *gx, double *gy,
+                             int wg) {
+  if (fin != 3) /* (rare) */
+    for (int l = 0; l < 2; l++)
+      if (!(fin >> l & 1)) v[l] = g0[l] = g1[l] = NAN;
+  for (size_t l = 0; l < cnt; l++) {
+    val[m + l] = v[l];
+    if (wg) gx[m + l] = g0[l], gy[m + l] = g1[l];
+  }
+}
+
+/* The points m < n two at a time, an odd last one beside a padding lane
+** (the origin under seed 0). */
+static void z0_multi_sse2(const uint64_t *seeds, const double *x,
+                          const double *y, size_t n, double *val, double *gx,
+                          double *gy, int wg) {
+  v2d v, g0 = {0, 0}, g1 = {0, 0};
   size_t m = 0;
   for (; m + 2 <= n; m += 2) {
-    v2d px, py, v, g0, g1;
-    int huge = 0;
-    for (int l = 0; l < 2; l++) {
-      px[l] = x[m + l], py[l] = y[m + l];
-      huge |= is_huge((oc_vec3){x[m + l], y[m + l], 0});
+    double ax, ay, bx, by;
+    unsigned fin = (unsigned)lane_point(x[m], y[m], &ax, &ay) |
+                   (unsigned)lane_point(x[m + 1], y[m + 1], &bx, &by) << 1;
+    z0_lanes(seeds + m, (v2d){ax, bx}, (v2d){ay, by}, &v, &g0, &g1, wg);
+    z0_store2(v, g0, g1, fin, m, 2, val, gx, gy, wg);
+  }
+  if (m < n) {
+    double ax, ay;
+    unsigned fin = (unsigned)lane_point(x[m], y[m], &ax, &ay) | 2u;
+    uint64_t sd[2] = {seeds[m], 0};
+    z0_lanes(sd, (v2d){ax, 0}, (v2d){ay, 0}, &v, &g0, &g1, wg);
+    z0_store2(v, g0, g1, fin, m, 1, val, gx, gy, wg);
+  }
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#define HAVE_AVX512 1
+#include <immintrin.h>
+
+/* Functions compiled for AVX-512 F and DQ (and nothing else: no FMA, so
+** no contraction even if -ffp-contract allowed it); called only where
+** the processor has both. */
+#define AVX512 __attribute__((target("avx512f,avx512dq")))
+
+static int have_avx512(void) {
+  return __builtin_cpu_supports("avx512f") &&
+         __builtin_cpu_supports("avx512dq");
+}
+
+#define SET1Q(c) _mm512_set1_epi64((long long)(c))
+
+/* oc_mix64 in each lane. */
+AVX512 static inline __m512i mix64_8(__m512i z) {
+  z = _mm512_add_epi64(z, SET1Q(0x9e3779b97f4a7c15ull));
+  z = _mm512_xor_si512(z, _mm512_srli_epi64(z, 30));
+  z = _mm512_mullo_epi64(z, SET1Q(0xbf58476d1ce4e5b9ull));
+  z = _mm512_xor_si512(z, _mm512_srli_epi64(z, 27));
+  z = _mm512_mullo_epi64(z, SET1Q(0x94d049bb133111ebull));
+  return _mm512_xor_si512(z, _mm512_srli_epi64(z, 31));
+}
+
+/* corner_grad of the lanes: ij = key + i A + j B, the k step added. */
+AVX512 static inline __m512i corner_grad8(__m512i ij, __m512i k) {
+  __m512i h = mix64_8(_mm512_add_epi64(mix64_8(ij), k));
+  /* ((h >> 32) * 12) >> 32, h >> 32 < 2^32: an unsigned 32 x 32 bit
+  ** product */
+  h = _mm512_mul_epu32(_mm512_srli_epi64(h, 32), SET1Q(12));
+  return _mm512_srli_epi64(h, 32);
+}
+
+/* floor_d in each lane. */
+AVX512 static inline __m512d floor8(__m512d x) {
+  const __m512d c = _mm512_set1_pd(FLOOR_C);
+  __m512d r = _mm512_sub_pd(_mm512_add_pd(x, c), c);
+  __mmask8 up = _mm512_cmp_pd_mask(r, x, _CMP_GT_OQ);
+  /* r - 1 where it rounded up; elsewhere r, which is r - 0 bit for bit */
+  return _mm512_mask_sub_pd(r, up, r, _mm512_set1_pd(1));
+}
+
+/* One corner's term added to v, its gradient's x and y parts to gx, gy
+** when wg (corner_add, lane by lane: __m512d takes GCC's vector
+** operators, a scalar operand broadcast); gi the gradient indices. The
+** gradients' components are looked up in 16-entry tables (two
+** registers) by one permutation each. */
+AVX512 static inline void corner8(__m512i gi, __m512d dx, __m512d dy,
+                                  __m512d dz, __m512d *v, __m512d *gx,
+                                  __m512d *gy, int wg) {
+  const __m512d x_lo = _mm512_setr_pd(1, -1, 1, -1, 1, -1, 1, -1);
+  const __m512d y_lo = _mm512_setr_pd(1, -1, -1, 1, 0, 0, 0, 0);
+  const __m512d y_hi = _mm512_setr_pd(1, -1, 1, -1, 0, 0, 0, 0);
+  const __m512d z_lo = _mm512_setr_pd(0, 0, 0, 0, 1, -1, -1, 1);
+  const __m512d z_hi = _mm512_setr_pd(1, -1, -1, 1, 0, 0, 0, 0);
+  __m512d grx = _mm512_permutex2var_pd(x_lo, gi, _mm512_setzero_pd());
+  __m512d gry = _mm512_permutex2var_pd(y_lo, gi, y_hi);
+  __m512d grz = _mm512_permutex2var_pd(z_lo, gi, z_hi);
+  __m512d a = 0.5 - (dx * dx + dy * dy + dz * dz);
+  a = 0.5 * (a + _mm512_abs_pd(a));
+  __m512d t = grx * dx + gry * dy + grz * dz;
+  __m512d a2 = a * a, a3 = a2 * a;
+  *v += a3 * a * t;
+  if (!wg) return;
+  __m512d k = 8 * t;
+  *gx += a3 * (a * grx - k * dx);
+  *gy += a3 * (a * gry - k * dy);
+}
+
+/* z0_lanes for 8 lanes: noise3 of (px, py, 0) under the seeds sd (no
+** point huge). */
+AVX512 static inline void z0_lanes8(__m512i sd, __m512d px, __m512d py,
+                                    __m512d *val, __m512d *gx, __m512d *gy,
+                                    int wg) {
+  const __m512d zero = _mm512_setzero_pd(), one = _mm512_set1_pd(1);
+  __m512d pz = zero, s = (px + py + pz) * F3;
+  __m512d xs = px + s, ys = py + s, zs = pz + s;
+  __m512d fi = floor8(xs), fj = floor8(ys), fk = floor8(zs);
+  __m512d fx = xs - fi, fy = ys - fj, fz = zs - fk;
+  __m512d t = (fx + fy + fz) * G3;
+  __m512d x0 = fx - t, y0 = fy - t, z0 = fz - t;
+  /* the simplex: simplex_locate's bits, one per lane */
+  __mmask8 xy = _mm512_cmp_pd_mask(x0, y0, _CMP_GE_OQ),
+           xz = _mm512_cmp_pd_mask(x0, z0, _CMP_GE_OQ),
+           yz = _mm512_cmp_pd_mask(y0, z0, _CMP_GE_OQ);
+  __mmask8 i1 = xy & xz, j1 = (__mmask8)(~xy & yz), k1 = (__mmask8)(~xz & ~yz);
+  __mmask8 i2 = xy | xz, j2 = (__mmask8)(~xy | yz), k2 = (__mmask8)(~xz | ~yz);
+  /* the hashes (corner_grad, i A + j B shared as in simplex_grads) */
+  __m512i key = mix64_8(_mm512_xor_si512(sd, SET1Q(0x8a5cd789635d2dffull)));
+  __m512i ci = _mm512_cvttpd_epi64(fi), cj = _mm512_cvttpd_epi64(fj),
+          ck = _mm512_cvttpd_epi64(fk);
+  const __m512i ha = SET1Q(HASH_A), hb = SET1Q(HASH_B), q1 = SET1Q(1);
+  __m512i base =
+      _mm512_add_epi64(_mm512_add_epi64(key, _mm512_mullo_epi64(ci, ha)),
+                       _mm512_mullo_epi64(cj, hb));
+  __m512i ij1 = _mm512_mask_add_epi64(base, i1, base, ha);
+  __m512i ij2 = _mm512_mask_add_epi64(base, i2, base, ha);
+  ij1 = _mm512_mask_add_epi64(ij1, j1, ij1, hb);
+  ij2 = _mm512_mask_add_epi64(ij2, j2, ij2, hb);
+  __m512i ij3 = _mm512_add_epi64(_mm512_add_epi64(base, ha), hb);
+  __m512i gi0 = corner_grad8(base, ck);
+  __m512i gi1 = corner_grad8(ij1, _mm512_mask_add_epi64(ck, k1, ck, q1));
+  __m512i gi2 = corner_grad8(ij2, _mm512_mask_add_epi64(ck, k2, ck, q1));
+  __m512i gi3 = corner_grad8(ij3, _mm512_add_epi64(ck, q1));
+  /* the corners' offsets: x0 - i1 + G3 ..., x0 - 1 where i1 is set and
+  ** x0 elsewhere (x0 - 0 bit for bit) */
+  __m512d v = zero, g0 = zero, g1 = zero;
+  corner8(gi0, x0, y0, z0, &v, &g0, &g1, wg);
+  corner8(gi1, _mm512_mask_sub_pd(x0, i1, x0, one) + G3,
+          _mm512_mask_sub_pd(y0, j1, y0, one) + G3,
+          _mm512_mask_sub_pd(z0, k1, z0, one) + G3, &v, &g0, &g1, wg);
+  corner8(gi2, _mm512_mask_sub_pd(x0, i2, x0, one) + 2 * G3,
+          _mm512_mask_sub_pd(y0, j2, y0, one) + 2 * G3,
+          _mm512_mask_sub_pd(z0, k2, z0, one) + 2 * G3, &v, &g0, &g1, wg);
+  corner8(gi3, x0 - 1 + 3 * G3, y0 - 1 + 3 * G3, z0 - 1 + 3 * G3, &v, &g0, &g1,
+          wg);
+  *val = 0.5 + SCALE * v;
+  if (wg) *gx = SCALE * g0, *gy = SCALE * g1;
+}
+
+/* The points m < n eight at a time, the last vector's missing points as
+** padding lanes (masked loads and stores: nothing past n is touched). */
+AVX512 static inline __attribute__((always_inline)) void
+z0_multi8(const uint64_t *seeds, const double *x, const double *y, size_t n,
+          double *val, double *gx, double *gy, int wg) {
+  const __m512d period = _mm512_set1_pd(REDUCE_PERIOD);
+  for (size_t m = 0; m < n; m += 8) {
+    __mmask8 lanes = n - m < 8 ? (__mmask8)((1u << (n - m)) - 1) : 0xff;
+    __m512d px = _mm512_maskz_loadu_pd(lanes, x + m),
+            py = _mm512_maskz_loadu_pd(lanes, y + m);
+    __m512i sd = _mm512_maskz_loadu_epi64(lanes, seeds + m);
+    /* is_huge: not |x| <= P and |y| <= P (NaN too); rare */
+    __mmask8 huge =
+        (__mmask8) ~(_mm512_cmp_pd_mask(_mm512_abs_pd(px), period, _CMP_LE_OQ) &
+                     _mm512_cmp_pd_mask(_mm512_abs_pd(py), period, _CMP_LE_OQ));
+    __mmask8 nonfinite = 0;
+    if (huge & lanes) {
+      double bx[8], by[8];
+      _mm512_storeu_pd(bx, px), _mm512_storeu_pd(by, py);
+      for (unsigned l = 0; l < 8; l++)
+        if ((huge & lanes) >> l & 1 &&
+            !lane_point_slow(bx[l], by[l], &bx[l], &by[l]))
+          nonfinite |= (__mmask8)(1u << l);
+      px = _mm512_loadu_pd(bx), py = _mm512_loadu_pd(by);
     }
-    if (huge) break; /* (rare) */
-    z0_lanes(seeds + m, px, py, &v, &g0, &g1, wg);
-    for (int l = 0; l < 2; l++) {
-      val[m + l] = v[l];
-      if (wg) gx[m + l] = g0[l], gy[m + l] = g1[l];
+    __m512d v, g0 = _mm512_setzero_pd(), g1 = g0;
+    z0_lanes8(sd, px, py, &v, &g0, &g1, wg);
+    if (nonfinite) {
+      const __m512d nan = _mm512_set1_pd(NAN);
+      v = _mm512_mask_mov_pd(v, nonfinite, nan);
+      g0 = _mm512_mask_mov_pd(g0, nonfinite, nan);
+      g1 = _mm512_mask_mov_pd(g1, nonfinite, nan);
+    }
+    _mm512_mask_storeu_pd(val + m, lanes, v);
+    if (wg) {
+      _mm512_mask_storeu_pd(gx + m, lanes, g0);
+      _mm512_mask_storeu_pd(gy + m, lanes, g1);
     }
   }
-  for (; m < n; m++) {
-    oc_vec3 g;
-    val[m] = noise3(seeds[m], (oc_vec3){x[m], y[m], 0}, &g, wg);
-    if (wg) gx[m] = g.x, gy[m] = g.y;
+}
+
+/* z0_multi8 with and without the gradients, each compiled for itself. */
+AVX512 static void z0_multi_avx512_g(const uint64_t *seeds, const double *x,
+                                     const double *y, size_t n, double *val,
+                                     double *gx, double *gy) {
+  z0_multi8(seeds, x, y, n, val, gx, gy, 1);
+}
+
+AVX512 static void z0_multi_avx512_v(const uint64_t *seeds, const double *x,
+                                     const double *y, size_t n, double *val) {
+  z0_multi8(seeds, x, y, n, val, NULL, NULL, 0);
+}
+#endif
+
+int oc_noise_isa_supported(oc_noise_isa isa) {
+  switch (isa) {
+  case OC_NOISE_ISA_AUTO:
+  case OC_NOISE_ISA_SSE2:
+    return 1;
+  case OC_NOISE_ISA_AVX512:
+#ifdef HAVE_AVX512
+    return have_avx512();
+#else
+    return 0;
+#endif
   }
+  return 0;
+}
+
+int oc_noise3_z0_multi_isa(oc_noise_isa isa, const uint64_t *seeds,
+                           const double *x, const double *y, size_t n,
+                           double *val, double *gx, double *gy) {
+  if (!oc_noise_isa_supported(isa)) return -1;
+  int wg = gx && gy;
+#ifdef HAVE_AVX512
+  if (isa == OC_NOISE_ISA_AVX512 ||
+      (isa == OC_NOISE_ISA_AUTO && have_avx512())) {
+    if (wg)
+      z0_multi_avx512_g(seeds, x, y, n, val, gx, gy);
+    else
+      z0_multi_avx512_v(seeds, x, y, n, val);
+    return 0;
+  }
+#endif
+  if (wg)
+    z0_multi_sse2(seeds, x, y, n, val, gx, gy, 1);
+  else
+    z0_multi_sse2(seeds, x, y, n, val, NULL, NULL, 0);
+  return 0;
 }
 
 void oc_noise3_z0_multi(const uint64_t *seeds, const double *x, const double *y,
                         size_t n, double *val, double *gx, double *gy) {
-  int wg = gx && gy;
-  if (wg)
-    z0_multi(seeds, x, y, n, val, gx, gy, 1);
-  else
-    z0_multi(seeds, x, y, n, val, NULL, NULL, 0);
+  oc_noise3_z0_multi_isa(OC_NOISE_ISA_AUTO, seeds, x, y, n, val, gx, gy);
 }
 
 double oc_turb3(uint64_t seed, int octaves, oc_vec3 p, oc_vec3 *grad) {

@@ -35,10 +35,29 @@ void oc_noise3_z0_row(uint64_t seed, const double *x, const double *y, size_t n,
 /* n(x[m], y[m], 0) under seeds[m] for m < n, in val, with the x and y
 ** parts of the gradient in gx and gy when both are not NULL: oc_noise3's
 ** values and gradients bit for bit (the z part is not computed). Points
-** go two at a time through the same operations, lane by lane (the octaves
-** of an elevation disc's noise sum: one call per point and sum). */
+** go several at a time through the same operations, lane by lane (the
+** octaves of an elevation disc's noise sum: one call per point and sum):
+** eight under AVX-512 where the processor has it, else two. */
 void oc_noise3_z0_multi(const uint64_t *seeds, const double *x, const double *y,
                         size_t n, double *val, double *gx, double *gy);
+
+/* The paths of oc_noise3_z0_multi: AUTO picks the fastest this processor
+** runs (the choice it makes on every call); the others force one, for
+** tests and benchmarks. Every path gives the same bits. */
+typedef enum oc_noise_isa {
+  OC_NOISE_ISA_AUTO,
+  OC_NOISE_ISA_SSE2,  /* two lanes, portable (GCC vector extensions) */
+  OC_NOISE_ISA_AVX512 /* eight lanes, x86-64 with AVX-512 F and DQ */
+} oc_noise_isa;
+
+/* 1 when this processor runs the path isa (AUTO and SSE2: always). */
+int oc_noise_isa_supported(oc_noise_isa isa);
+
+/* oc_noise3_z0_multi through the path isa; returns 0, or -1 (and does
+** nothing) when this processor lacks it. */
+int oc_noise3_z0_multi_isa(oc_noise_isa isa, const uint64_t *seeds,
+                           const double *x, const double *y, size_t n,
+                           double *val, double *gx, double *gy);
 
 /* t(p); gradient when grad != NULL. octaves >= 1. */
 double oc_turb3(uint64_t seed, int octaves, oc_vec3 p, oc_vec3 *grad);

@@ -1040,11 +1040,12 @@ START_TEST(noise_rows_on_plane) {
 }
 END_TEST
 
-/* oc_noise3_z0_multi (the octaves of an elevation disc, two points a
-** time) gives oc_noise3's values and gradients' x and y parts bit for
-** bit: every count up to 17 (odd ones end on the scalar code), seeds and
-** scales that differ point to point as octaves do, signed zeros, lattice
-** integers, and huge, infinite and NaN points among ordinary ones. */
+/* oc_noise3_z0_multi (the octaves of an elevation disc, several points
+** at a time) gives oc_noise3's values and gradients' x and y parts bit
+** for bit: every count up to 17 (counts that are not a multiple of the
+** lanes end on padding lanes), seeds and scales that differ point to
+** point as octaves do, signed zeros, lattice integers, and huge,
+** infinite and NaN points among ordinary ones. */
 START_TEST(noise_z0_multi_matches) {
   oc_rng r = oc_rng_stream(23, 5);
   enum { L = 17 };
@@ -1073,6 +1074,88 @@ START_TEST(noise_z0_multi_matches) {
   }
   ck_assert_int_eq(points, 3372); /* 22 rounds of 0..17 points, then 0..3 */
   ck_assert_int_eq(differ, 0);
+}
+END_TEST
+
+/* Each path of oc_noise3_z0_multi (oc_noise3_z0_multi_isa: the portable
+** two lanes, AVX-512's eight, and the automatic choice) gives oc_noise3's
+** bits, values alone and with gradients, for every count from 0 to 19
+** (full vectors, padding lanes in the last one), mixed seeds and scales,
+** points at lattice integers and their neighbours, signed zeros, huge
+** points (reduced as noise3 reduces them) and NaN or infinite ones in
+** any lane; and writes nothing past n. AVX-512 is there exactly where the
+** processor has AVX-512 F and DQ; a path it lacks is refused. */
+START_TEST(noise_z0_multi_paths) {
+  enum { L = 19, PAD = 4 };
+  const oc_noise_isa isa[3] = {OC_NOISE_ISA_AUTO, OC_NOISE_ISA_SSE2,
+                               OC_NOISE_ISA_AVX512};
+#if defined(__x86_64__) && defined(__GNUC__)
+  int avx =
+      __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
+  ck_assert_int_eq(oc_noise_isa_supported(OC_NOISE_ISA_AVX512), avx);
+#else
+  ck_assert_int_eq(oc_noise_isa_supported(OC_NOISE_ISA_AVX512), 0);
+#endif
+  ck_assert_int_eq(oc_noise_isa_supported(OC_NOISE_ISA_AUTO), 1);
+  ck_assert_int_eq(oc_noise_isa_supported(OC_NOISE_ISA_SSE2), 1);
+  ck_assert_int_eq(oc_noise_isa_supported((oc_noise_isa)7), 0);
+  double z[1] = {5};
+  ck_assert_int_eq(
+      oc_noise3_z0_multi_isa((oc_noise_isa)7, NULL, z, z, 1, z, NULL, NULL),
+      -1);
+  ck_assert(z[0] == 5);
+  oc_rng r = oc_rng_stream(29, 7);
+  uint64_t seed[L];
+  double x[L], y[L], v[L + PAD], gx[L + PAD], gy[L + PAD], w[L + PAD];
+  int differ = 0, points = 0, spilled = 0, paths = 0;
+  for (int k = 0; k < 200; k++) {
+    int n = k % (L + 1);
+    for (int m = 0; m < n; m++) {
+      double sc = ldexp(1, (int)(oc_rng_uniform(&r) * 40) - 8);
+      seed[m] = k % 7 == 0 ? (uint64_t)m : oc_rng_next(&r);
+      x[m] = (oc_rng_uniform(&r) - 0.5) * sc;
+      y[m] = (oc_rng_uniform(&r) - 0.5) * sc;
+    }
+    if (k % 20 == 5) /* integers of the skewed lattice and neighbours */
+      for (int m = 0; m < n; m++)
+        x[m] = (m / 3) + (m % 3 - 1) * 0x1p-40, y[m] = (m % 2) * 0x1p-50;
+    if (n > 0 && k % 20 == 6) x[n - 1] = 1e300, y[n / 2] = -3 * 0x1p48;
+    if (n > 8 && k % 20 == 7)
+      x[0] = NAN, y[3] = INFINITY, x[7] = -INFINITY, y[8] = -0.0, x[8] = -0.0;
+    if (n > 0 && k % 20 == 8) x[n - 1] = NAN, y[n - 1] = 3 * 0x1p48 + 2e6;
+    if (n > 9 && k % 20 == 9) y[9] = -1e308, x[2] = 0x1p101;
+    for (int p = 0; p < 3; p++) {
+      for (int m = 0; m < L + PAD; m++)
+        v[m] = gx[m] = gy[m] = w[m] = -7;
+      if (!oc_noise_isa_supported(isa[p])) {
+        ck_assert_int_eq(
+            oc_noise3_z0_multi_isa(isa[p], seed, x, y, (size_t)n, v, gx, gy),
+            -1);
+        spilled += v[0] != -7;
+        continue;
+      }
+      paths++;
+      ck_assert_int_eq(
+          oc_noise3_z0_multi_isa(isa[p], seed, x, y, (size_t)n, v, gx, gy), 0);
+      ck_assert_int_eq(
+          oc_noise3_z0_multi_isa(isa[p], seed, x, y, (size_t)n, w, NULL, NULL),
+          0);
+      for (int m = 0; m < n; m++, points++) {
+        oc_vec3 g;
+        double ref = oc_noise3(seed[m], oc_v3(x[m], y[m], 0), &g);
+        differ += !same_bits(v[m], ref) || !same_bits(w[m], ref) ||
+                  !same_bits(gx[m], g.x) || !same_bits(gy[m], g.y);
+      }
+      for (int m = n; m < L + PAD; m++)
+        spilled += v[m] != -7 || gx[m] != -7 || gy[m] != -7 || w[m] != -7;
+    }
+  }
+  /* 10 rounds of 0..19 points per path that runs */
+  ck_assert_int_eq(points, paths / 200 * 1900);
+  ck_assert_int_eq(paths % 200, 0);
+  ck_assert_int_eq(differ, 0);
+  ck_assert_int_eq(spilled, 0);
+  printf("noise_z0_multi_paths: %d paths, %d points\n", paths / 200, points);
 }
 END_TEST
 
@@ -1204,6 +1287,7 @@ int main(void) {
   tcase_add_test(tc, noise_huge_coordinates);
   tcase_add_test(tc, noise_rows_on_plane);
   tcase_add_test(tc, noise_z0_multi_matches);
+  tcase_add_test(tc, noise_z0_multi_paths);
   tcase_add_test(tc, turbulence_bounds_and_definition);
   tcase_add_test(tc, turbulence_gradient_and_lipschitz);
   tcase_add_test(tc, noise_hessian_on_planes);
