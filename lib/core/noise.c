@@ -551,6 +551,8 @@ static void z0_multi_sse2(const uint64_t *seeds, const double *x,
 ** no contraction even if -ffp-contract allowed it); called only where
 ** the processor has both. */
 #define AVX512 __attribute__((target("avx512f,avx512dq")))
+/* (inlined always: wg then is a constant) */
+#define AVX512_INLINE AVX512 static inline __attribute__((always_inline))
 
 static int have_avx512(void) {
   return __builtin_cpu_supports("avx512f") &&
@@ -560,7 +562,7 @@ static int have_avx512(void) {
 #define SET1Q(c) _mm512_set1_epi64((long long)(c))
 
 /* oc_mix64 in each lane. */
-AVX512 static inline __m512i mix64_8(__m512i z) {
+AVX512_INLINE __m512i mix64_8(__m512i z) {
   z = _mm512_add_epi64(z, SET1Q(0x9e3779b97f4a7c15ull));
   z = _mm512_xor_si512(z, _mm512_srli_epi64(z, 30));
   z = _mm512_mullo_epi64(z, SET1Q(0xbf58476d1ce4e5b9ull));
@@ -570,7 +572,7 @@ AVX512 static inline __m512i mix64_8(__m512i z) {
 }
 
 /* corner_grad of the lanes: ij = key + i A + j B, the k step added. */
-AVX512 static inline __m512i corner_grad8(__m512i ij, __m512i k) {
+AVX512_INLINE __m512i corner_grad8(__m512i ij, __m512i k) {
   __m512i h = mix64_8(_mm512_add_epi64(mix64_8(ij), k));
   /* ((h >> 32) * 12) >> 32, h >> 32 < 2^32: an unsigned 32 x 32 bit
   ** product */
@@ -579,7 +581,7 @@ AVX512 static inline __m512i corner_grad8(__m512i ij, __m512i k) {
 }
 
 /* floor_d in each lane. */
-AVX512 static inline __m512d floor8(__m512d x) {
+AVX512_INLINE __m512d floor8(__m512d x) {
   const __m512d c = _mm512_set1_pd(FLOOR_C);
   __m512d r = _mm512_sub_pd(_mm512_add_pd(x, c), c);
   __mmask8 up = _mm512_cmp_pd_mask(r, x, _CMP_GT_OQ);
@@ -592,9 +594,8 @@ AVX512 static inline __m512d floor8(__m512d x) {
 ** operators, a scalar operand broadcast); gi the gradient indices. The
 ** gradients' components are looked up in 16-entry tables (two
 ** registers) by one permutation each. */
-AVX512 static inline void corner8(__m512i gi, __m512d dx, __m512d dy,
-                                  __m512d dz, __m512d *v, __m512d *gx,
-                                  __m512d *gy, int wg) {
+AVX512_INLINE void corner8(__m512i gi, __m512d dx, __m512d dy, __m512d dz,
+                           __m512d *v, __m512d *gx, __m512d *gy, int wg) {
   const __m512d x_lo = _mm512_setr_pd(1, -1, 1, -1, 1, -1, 1, -1);
   const __m512d y_lo = _mm512_setr_pd(1, -1, -1, 1, 0, 0, 0, 0);
   const __m512d y_hi = _mm512_setr_pd(1, -1, 1, -1, 0, 0, 0, 0);
@@ -604,7 +605,10 @@ AVX512 static inline void corner8(__m512i gi, __m512d dx, __m512d dy,
   __m512d gry = _mm512_permutex2var_pd(y_lo, gi, y_hi);
   __m512d grz = _mm512_permutex2var_pd(z_lo, gi, z_hi);
   __m512d a = 0.5 - (dx * dx + dy * dy + dz * dz);
-  a = 0.5 * (a + _mm512_abs_pd(a));
+  /* corner_add's max(a, 0) = (a + |a|) / 2, the same bits in one
+  ** instruction: 2a halved is a; a + |a| is +0 for a <= 0, and so is
+  ** vmaxpd's second operand (a is never NaN) */
+  a = _mm512_max_pd(a, _mm512_setzero_pd());
   __m512d t = grx * dx + gry * dy + grz * dz;
   __m512d a2 = a * a, a3 = a2 * a;
   *v += a3 * a * t;
@@ -616,9 +620,8 @@ AVX512 static inline void corner8(__m512i gi, __m512d dx, __m512d dy,
 
 /* z0_lanes for 8 lanes: noise3 of (px, py, 0) under the seeds sd (no
 ** point huge). */
-AVX512 static inline void z0_lanes8(__m512i sd, __m512d px, __m512d py,
-                                    __m512d *val, __m512d *gx, __m512d *gy,
-                                    int wg) {
+AVX512_INLINE void z0_lanes8(__m512i sd, __m512d px, __m512d py, __m512d *val,
+                             __m512d *gx, __m512d *gy, int wg) {
   const __m512d zero = _mm512_setzero_pd(), one = _mm512_set1_pd(1);
   __m512d pz = zero, s = (px + py + pz) * F3;
   __m512d xs = px + s, ys = py + s, zs = pz + s;
@@ -667,9 +670,9 @@ AVX512 static inline void z0_lanes8(__m512i sd, __m512d px, __m512d py,
 
 /* The points m < n eight at a time, the last vector's missing points as
 ** padding lanes (masked loads and stores: nothing past n is touched). */
-AVX512 static inline __attribute__((always_inline)) void
-z0_multi8(const uint64_t *seeds, const double *x, const double *y, size_t n,
-          double *val, double *gx, double *gy, int wg) {
+AVX512_INLINE void z0_multi8(const uint64_t *seeds, const double *x,
+                             const double *y, size_t n, double *val, double *gx,
+                             double *gy, int wg) {
   const __m512d period = _mm512_set1_pd(REDUCE_PERIOD);
   for (size_t m = 0; m < n; m += 8) {
     __mmask8 lanes = n - m < 8 ? (__mmask8)((1u << (n - m)) - 1) : 0xff;
