@@ -722,17 +722,42 @@ AVX512 static void z0_multi_avx512_v(const uint64_t *seeds, const double *x,
 }
 #endif
 
+#ifndef HAVE_AVX512
+static int have_avx512(void) {
+  return 0;
+}
+#endif
+
+/* The points through AVX-512 when avx (the processor has it), else the
+** two-lane path. */
+static inline void z0_multi(int avx, const uint64_t *seeds, const double *x,
+                            const double *y, size_t n, double *val, double *gx,
+                            double *gy) {
+  int wg = gx && gy;
+#ifdef HAVE_AVX512
+  if (avx) {
+    if (wg)
+      z0_multi_avx512_g(seeds, x, y, n, val, gx, gy);
+    else
+      z0_multi_avx512_v(seeds, x, y, n, val);
+    return;
+  }
+#else
+  (void)avx;
+#endif
+  if (wg)
+    z0_multi_sse2(seeds, x, y, n, val, gx, gy, 1);
+  else
+    z0_multi_sse2(seeds, x, y, n, val, NULL, NULL, 0);
+}
+
 int oc_noise_isa_supported(oc_noise_isa isa) {
   switch (isa) {
   case OC_NOISE_ISA_AUTO:
   case OC_NOISE_ISA_SSE2:
     return 1;
   case OC_NOISE_ISA_AVX512:
-#ifdef HAVE_AVX512
     return have_avx512();
-#else
-    return 0;
-#endif
   }
   return 0;
 }
@@ -741,27 +766,15 @@ int oc_noise3_z0_multi_isa(oc_noise_isa isa, const uint64_t *seeds,
                            const double *x, const double *y, size_t n,
                            double *val, double *gx, double *gy) {
   if (!oc_noise_isa_supported(isa)) return -1;
-  int wg = gx && gy;
-#ifdef HAVE_AVX512
-  if (isa == OC_NOISE_ISA_AVX512 ||
-      (isa == OC_NOISE_ISA_AUTO && have_avx512())) {
-    if (wg)
-      z0_multi_avx512_g(seeds, x, y, n, val, gx, gy);
-    else
-      z0_multi_avx512_v(seeds, x, y, n, val);
-    return 0;
-  }
-#endif
-  if (wg)
-    z0_multi_sse2(seeds, x, y, n, val, gx, gy, 1);
-  else
-    z0_multi_sse2(seeds, x, y, n, val, NULL, NULL, 0);
+  z0_multi(isa == OC_NOISE_ISA_AVX512 ||
+               (isa == OC_NOISE_ISA_AUTO && have_avx512()),
+           seeds, x, y, n, val, gx, gy);
   return 0;
 }
 
 void oc_noise3_z0_multi(const uint64_t *seeds, const double *x, const double *y,
                         size_t n, double *val, double *gx, double *gy) {
-  oc_noise3_z0_multi_isa(OC_NOISE_ISA_AUTO, seeds, x, y, n, val, gx, gy);
+  z0_multi(have_avx512(), seeds, x, y, n, val, gx, gy);
 }
 
 double oc_turb3(uint64_t seed, int octaves, oc_vec3 p, oc_vec3 *grad) {
