@@ -104,11 +104,32 @@ static inline int64_t floor_i64(double x) {
 ** would repeat after about 2^21 cells. */
 #define HASH_A 0xd1b54a32d192ed03ull
 #define HASH_B 0xaef17502108ef2d9ull
-static inline unsigned corner_grad(uint64_t key, uint64_t i, uint64_t j,
-                                   uint64_t k) {
-  uint64_t ij = key + i * HASH_A + j * HASH_B;
+static inline unsigned grad_index(uint64_t ij, uint64_t k) {
   uint64_t h = oc_mix64(oc_mix64(ij) + k);
   return (unsigned)(((h >> 32) * 12) >> 32);
+}
+
+static inline unsigned corner_grad(uint64_t key, uint64_t i, uint64_t j,
+                                   uint64_t k) {
+  return grad_index(key + i * HASH_A + j * HASH_B, k);
+}
+
+/* The four corners' corner_grad in a simplex of cell (i, j, k), st its
+** steps (i1, j1, k1, i2, j2, k2): the cell's key + i A + j B once, a
+** corner stepping along i or j adding A or B (the same sums modulo 2^64;
+** six multiplies fewer). */
+static inline void simplex_grads(uint64_t key, uint64_t i, uint64_t j,
+                                 uint64_t k, const unsigned st[6],
+                                 unsigned gi[4]) {
+  uint64_t base = key + i * HASH_A + j * HASH_B;
+  gi[0] = grad_index(base, k);
+  gi[1] = grad_index(base + (HASH_A & -(uint64_t)st[0]) +
+                         (HASH_B & -(uint64_t)st[1]),
+                     k + st[2]);
+  gi[2] = grad_index(base + (HASH_A & -(uint64_t)st[3]) +
+                         (HASH_B & -(uint64_t)st[4]),
+                     k + st[5]);
+  gi[3] = grad_index(base + HASH_A + HASH_B, k + 1);
 }
 
 /* Adds one corner's term; d is p minus the corner; the gradient's too
@@ -219,13 +240,8 @@ static inline double noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad, int wg) {
   }
   simplex S;
   simplex_locate(p.x, p.y, p.z, &S);
-  uint64_t key = noise_key(seed), i = S.i, j = S.j, k = S.k;
-  unsigned gi[4] = {
-      corner_grad(key, i, j, k),
-      corner_grad(key, i + S.i1, j + S.j1, k + S.k1),
-      corner_grad(key, i + S.i2, j + S.j2, k + S.k2),
-      corner_grad(key, i + 1, j + 1, k + 1),
-  };
+  unsigned gi[4], st[6] = {S.i1, S.j1, S.k1, S.i2, S.j2, S.k2};
+  simplex_grads(noise_key(seed), S.i, S.j, S.k, st, gi);
   double g[3] = {0, 0, 0}, v = simplex_sum(&S, gi, g, wg);
   if (wg) {
     grad->x = SCALE * g[0];
@@ -416,28 +432,6 @@ static inline int lane_point(double x, double y, double *px, double *py) {
   if (is_huge((oc_vec3){x, y, 0})) return lane_point_slow(x, y, px, py);
   *px = x, *py = y;
   return 1;
-}
-
-/* The four corners' gradient indices of a simplex, corner_grad's: the
-** cell's i A + j B once, a corner stepping along i or j adding A or B
-** (the same sums modulo 2^64). */
-static inline unsigned grad_index(uint64_t ij, uint64_t k) {
-  uint64_t h = oc_mix64(oc_mix64(ij) + k);
-  return (unsigned)(((h >> 32) * 12) >> 32);
-}
-
-static inline void simplex_grads(uint64_t key, uint64_t i, uint64_t j,
-                                 uint64_t k, const unsigned st[6],
-                                 unsigned gi[4]) {
-  uint64_t base = key + i * HASH_A + j * HASH_B;
-  gi[0] = grad_index(base, k);
-  gi[1] = grad_index(base + (HASH_A & -(uint64_t)st[0]) +
-                         (HASH_B & -(uint64_t)st[1]),
-                     k + st[2]);
-  gi[2] = grad_index(base + (HASH_A & -(uint64_t)st[3]) +
-                         (HASH_B & -(uint64_t)st[4]),
-                     k + st[5]);
-  gi[3] = grad_index(base + HASH_A + HASH_B, k + 1);
 }
 
 /* One corner's term added to v, its gradient's x and y parts to gx, gy
