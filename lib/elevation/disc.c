@@ -37,9 +37,9 @@ static uint64_t octave_seed(uint64_t seed, int i) {
 }
 
 /* The noise of octaves [0, n) of nz at (u, v) in one call
-** (oc_noise3_z0_multi: two octaves at a time, oc_noise3's values and
-** gradients bit for bit; oc_eta remaps them), the gradients when ex and
-** ey are not NULL. */
+** (oc_noise3_z0_multi: eight octaves at a time under AVX-512, else two,
+** oc_noise3's values and gradients bit for bit; oc_eta remaps them), the
+** gradients when ex and ey are not NULL. */
 static void octave_noise(const oc_enoise *nz, double u, double v, int n,
                          double *ev, double *ex, double *ey) {
   uint64_t seed[OC_ENOISE_MAXOCT];
