@@ -574,15 +574,12 @@ AVX512_INLINE __m512i corner_grad8(__m512i ij, __m512i k) {
   return _mm512_srli_epi64(h, 32);
 }
 
-/* floor_d in each lane. */
+/* floor_d in each lane: floor (exact) plus 0, which turns floor(-0) = -0
+** into floor_d's +0 (floor_d never gives -0) and changes nothing else. */
 AVX512_INLINE __m512d floor8(__m512d x) {
-  const __m512d c = _mm512_set1_pd(FLOOR_C);
-  __m512d r = _mm512_sub_pd(_mm512_add_pd(x, c), c);
-  __mmask8 up = _mm512_cmp_pd_mask(r, x, _CMP_GT_OQ);
-  /* r - 1 where it rounded up; elsewhere r, which is r - 0 bit for bit */
-  return _mm512_mask_sub_pd(r, up, r, _mm512_set1_pd(1));
+  return _mm512_roundscale_pd(x, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC) +
+         0.0;
 }
-
 /* One corner's term added to v, its gradient's x and y parts to gx, gy
 ** when wg (corner_add, lane by lane: __m512d takes GCC's vector
 ** operators, a scalar operand broadcast); gi the gradient indices. The

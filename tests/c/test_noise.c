@@ -1120,8 +1120,9 @@ START_TEST(noise_z0_multi_paths) {
       for (int m = 0; m < n; m++)
         x[m] = (m / 3) + (m % 3 - 1) * 0x1p-40, y[m] = (m % 2) * 0x1p-50;
     if (n > 0 && k % 20 == 6) x[n - 1] = 1e300, y[n / 2] = -3 * 0x1p48;
-    if (n > 8 && k % 20 == 7)
-      x[0] = NAN, y[3] = INFINITY, x[7] = -INFINITY, y[8] = -0.0, x[8] = -0.0;
+    if (n > 8 && k % 20 == 7) /* (x[1], y[1]: skewed x is -0) */
+      x[0] = NAN, y[3] = INFINITY, x[7] = -INFINITY, y[8] = -0.0, x[8] = -0.0,
+      x[1] = -0.0, y[1] = -0x1p-1074;
     if (n > 0 && k % 20 == 8) x[n - 1] = NAN, y[n - 1] = 3 * 0x1p48 + 2e6;
     if (n > 9 && k % 20 == 9) y[9] = -1e308, x[2] = 0x1p101;
     for (int p = 0; p < 3; p++) {
