@@ -225,8 +225,9 @@ static inline double simplex_sum(const simplex *S, const unsigned gi[4],
   return v;
 }
 
+#define KEY_SALT 0x8a5cd789635d2dffull
 static inline uint64_t noise_key(uint64_t seed) {
-  return oc_mix64(seed ^ 0x8a5cd789635d2dffull);
+  return oc_mix64(seed ^ KEY_SALT);
 }
 
 /* n(p), with the gradient when wg (then grad is not NULL). */
@@ -580,6 +581,7 @@ AVX512_INLINE __m512d floor8(__m512d x) {
   return _mm512_roundscale_pd(x, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC) +
          0.0;
 }
+
 /* One corner's term added to v, its gradient's x and y parts to gx, gy
 ** when wg (corner_add, lane by lane: __m512d takes GCC's vector
 ** operators, a scalar operand broadcast); gi the gradient indices. The
@@ -627,7 +629,7 @@ AVX512_INLINE void z0_lanes8(__m512i sd, __m512d px, __m512d py, __m512d *val,
   __mmask8 i1 = xy & xz, j1 = (__mmask8)(~xy & yz), k1 = (__mmask8)(~xz & ~yz);
   __mmask8 i2 = xy | xz, j2 = (__mmask8)(~xy | yz), k2 = (__mmask8)(~xz | ~yz);
   /* the hashes (corner_grad, i A + j B shared as in simplex_grads) */
-  __m512i key = mix64_8(_mm512_xor_si512(sd, SET1Q(0x8a5cd789635d2dffull)));
+  __m512i key = mix64_8(_mm512_xor_si512(sd, SET1Q(KEY_SALT))); /* noise_key */
   __m512i ci = _mm512_cvttpd_epi64(fi), cj = _mm512_cvttpd_epi64(fj),
           ck = _mm512_cvttpd_epi64(fk);
   const __m512i ha = SET1Q(HASH_A), hb = SET1Q(HASH_B), q1 = SET1Q(1);
