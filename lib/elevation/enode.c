@@ -28,7 +28,10 @@ size_t oc_enode_size(const oc_enode *n) {
   case OC_E_IMAGE:
     return sizeof(oc_eprim);
   case OC_E_BLEND:
-    return offsetof(oc_eblend, kids) + OC_EBLEND(n)->nkids * sizeof(oc_enode *);
+    return offsetof(oc_eblend, kids) +
+           OC_EBLEND(n)->nkids * sizeof(oc_enode *) +
+           oc_eblend_grid_words(OC_EBLEND(n)->nkids, n->octaves) *
+               sizeof(uint64_t);
   case OC_E_REPLACE:
     return offsetof(oc_ebin, par);
   case OC_E_ADD:

@@ -97,12 +97,103 @@ static double clamp01(double v, int *inside) {
 
 /* ---- blend ------------------------------------------------------------ */
 
+/* The grid of a blend (enode.h): its masks, after the children. */
+static const uint64_t *grid_masks(const oc_eblend *bl) {
+  return (const uint64_t *)(const void *)(bl->kids + bl->nkids);
+}
+
+/* The cell of v on an axis from lo, s = G / (hi - lo) cells a unit: a
+** monotone function of v (rounded subtraction and product, truncation,
+** clamps), so a child's box and a query's region that share a point
+** share a cell of both their ranges. NaN gives 0 (its box tests fail). */
+static int grid_cell(double v, double lo, double s, int G) {
+  double t = (v - lo) * s;
+  if (!(t >= 0)) return 0;
+  return t >= G ? G - 1 : (int)t;
+}
+
+/* The children a query over [x0, x1] x [y0, y1] may meet: those of the
+** cells that region meets (all when the blend has no grid), in order. */
+typedef struct kid_iter {
+  uint64_t m[OC_EGRID_WORDS];
+  size_t i, n; /* (no grid: the next child, the count) */
+  int w, W;    /* (grid: the word, the words) */
+} kid_iter;
+
+static void kids_in(const oc_eblend *bl, double x0, double y0, double x1,
+                    double y1, kid_iter *it) {
+  int G = bl->h.octaves;
+  it->i = 0, it->n = bl->nkids, it->w = 0, it->W = 0;
+  if (!G) return;
+  int W = (int)((bl->nkids + 63) / 64);
+  double bx = bl->box.x0, by = bl->box.y0;
+  double sx = G / ((double)bl->box.x1 - bx), sy = G / ((double)bl->box.y1 - by);
+  int i0 = grid_cell(x0, bx, sx, G), i1 = grid_cell(x1, bx, sx, G);
+  int j0 = grid_cell(y0, by, sy, G), j1 = grid_cell(y1, by, sy, G);
+  const uint64_t *g = grid_masks(bl);
+  it->W = W, it->n = 0;
+  for (int w = 0; w < W; w++)
+    it->m[w] = 0;
+  for (int j = j0; j <= j1; j++)
+    for (int i = i0; i <= i1; i++)
+      for (int w = 0; w < W; w++)
+        it->m[w] |= g[((size_t)j * G + i) * W + w];
+}
+
+static inline int kid_next(kid_iter *it, size_t *i) {
+  if (!it->W) {
+    if (it->i >= it->n) return 0;
+    *i = it->i++;
+    return 1;
+  }
+  for (; it->w < it->W; it->w++) {
+    uint64_t m = it->m[it->w];
+    if (m) {
+      *i = 64 * (size_t)it->w + (size_t)__builtin_ctzll(m);
+      it->m[it->w] = m & (m - 1);
+      return 1;
+    }
+  }
+  return 0;
+}
+
+/* Cells a side for n children (0: no grid): G^2 W <= n. */
+static int grid_side(size_t n) {
+  size_t W = (n + 63) / 64;
+  if (n < OC_EGRID_MIN || W > OC_EGRID_WORDS) return 0;
+  int G = (int)floor(sqrt((double)(n / W)));
+  while ((size_t)(G + 1) * (G + 1) * W <= n)
+    G++;
+  while ((size_t)G * G * W > n)
+    G--;
+  return G;
+}
+
+/* Fills blend e's grid from its children's boxes kbox (its box stored). */
+static void grid_build(oc_eblend *bl, const oc_erect *kbox) {
+  int G = bl->h.octaves, W = (int)((bl->nkids + 63) / 64);
+  double bx = bl->box.x0, by = bl->box.y0;
+  double sx = G / ((double)bl->box.x1 - bx), sy = G / ((double)bl->box.y1 - by);
+  uint64_t *g = (uint64_t *)(void *)(bl->kids + bl->nkids);
+  for (size_t k = 0; k < bl->nkids; k++) {
+    const oc_erect *b = &kbox[k];
+    int i0 = grid_cell(b->x0, bx, sx, G), i1 = grid_cell(b->x1, bx, sx, G);
+    int j0 = grid_cell(b->y0, by, sy, G), j1 = grid_cell(b->y1, by, sy, G);
+    for (int j = j0; j <= j1; j++)
+      for (int i = i0; i <= i1; i++)
+        g[((size_t)j * G + i) * W + k / 64] |= (uint64_t)1 << (k % 64);
+  }
+}
+
 static void blend_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                      int want, oc_enode_sample *s) {
   int grad = want & OC_EV_GRAD, only = want & OC_EV_ALPHA;
   double N = 0, S = 0, nx = 0, ny = 0, sx = 0, sy = 0;
   const oc_eblend *bl = OC_EBLEND(n);
-  for (size_t i = 0; i < bl->nkids; i++) {
+  kid_iter it;
+  size_t i;
+  kids_in(bl, x, y, x, y, &it);
+  while (kid_next(&it, &i)) {
     const oc_enode *k = bl->kids[i];
     if (!oc_enode_holds(k, x, y))
       continue; /* alpha = 0 there: no contribution */
@@ -195,8 +286,10 @@ static void blend_bound_in(const oc_enode *n, const oc_erect *b,
     oc_enode_glob(n, o); /* (conservative: the whole plane's) */
     return;
   }
-  size_t m = 0;
-  for (size_t i = 0; i < bl->nkids; i++) {
+  size_t m = 0, i;
+  kid_iter it;
+  kids_in(bl, b->x0, b->y0, b->x1, b->y1, &it);
+  while (kid_next(&it, &i)) {
     const oc_enode *k = bl->kids[i];
     if (oc_enode_meets(k, b)) {
       oc_enode_bnd(k, b, fb, &kb[m]);
@@ -230,14 +323,29 @@ oc_enode *oc_enode_blend(oc_enode *const *kids, size_t n, oc_error *err) {
     oc_seterr(err, OC_ENOMEM, "out of memory (%zu children)", n);
     goto done;
   }
-  e = oc_enode_alloc(OC_E_BLEND, offsetof(oc_eblend, kids) + n * sizeof *kids,
+  /* the grid: over a box of positive finite sides (the box as
+  ** store_derived rounds it) */
+  oc_erect u = oc_enode_box(kids[0]);
+  oc_erectf uf;
+  for (size_t i = 0; i < n; i++) {
+    kbox[i] = oc_enode_box(kids[i]);
+    u = rect_union(u, kbox[i]);
+  }
+  oc_erect_round(&u, &uf);
+  int G = grid_side(n);
+  if (!(isfinite(uf.x0) && isfinite(uf.x1) && isfinite(uf.y0) &&
+        isfinite(uf.y1) && uf.x1 > uf.x0 && uf.y1 > uf.y0))
+    G = 0;
+  e = oc_enode_alloc(OC_E_BLEND,
+                     offsetof(oc_eblend, kids) + n * sizeof *kids +
+                         oc_eblend_grid_words(n, G) * sizeof(uint64_t),
                      kids, n, err);
   if (!e) goto done;
-  for (size_t i = 0; i < n; i++) {
+  for (size_t i = 0; i < n; i++)
     oc_enode_glob(kids[i], &kb[i]);
-    kbox[i] = oc_enode_box(kids[i]);
-  }
   store_derived(e, kb, kbox);
+  e->octaves = (uint8_t)G;
+  if (G) grid_build((oc_eblend *)e, kbox);
 done:
   free(kb);
   free(kbox);
@@ -1006,7 +1114,10 @@ static void blend_ev_row(const oc_enode *n, const double *x, double y, int cnt,
   const oc_eblend *bl = OC_EBLEND(n);
   for (int m = 0; m < cnt; m++)
     N[m] = S[m] = 0;
-  for (size_t i = 0; i < bl->nkids; i++) {
+  kid_iter it;
+  size_t i;
+  kids_in(bl, x[0], y, x[cnt > 0 ? cnt - 1 : 0], y, &it);
+  while (cnt > 0 && kid_next(&it, &i)) {
     const oc_enode *k = bl->kids[i];
     int i0, i1;
     oc_enode_row_span(k, x, y, cnt, &i0, &i1);
@@ -1126,7 +1237,10 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
   double N = 0, Nx = 0, Ny = 0; /* N and sum a_k F_k + f_k A_k */
   oc_etay S = oc_etay_const(0);
   int m = 0;
-  for (size_t i = 0; i < bl->nkids; i++) {
+  kid_iter it;
+  size_t i;
+  kids_in(bl, ball.x0, ball.y0, ball.x1, ball.y1, &it);
+  while (kid_next(&it, &i)) {
     const oc_enode *k = bl->kids[i];
     if (!oc_enode_meets(k, &ball)) continue; /* alpha_k = 0 on the disc */
     if (m == TAY_KIDS || tay_partial(k)) return 0;
@@ -1361,7 +1475,10 @@ int oc_eop_taylor_alpha(const oc_enode *n, double x, double y, double R,
     const oc_eblend *bl = OC_EBLEND(n);
     oc_erect ball = {x - R, y - R, x + R, y + R};
     *a = oc_etay_const(0);
-    for (size_t i = 0; i < bl->nkids; i++) {
+    kid_iter it;
+    size_t i;
+    kids_in(bl, ball.x0, ball.y0, ball.x1, ball.y1, &it);
+    while (kid_next(&it, &i)) {
       const oc_enode *k = bl->kids[i];
       oc_etay c;
       if (!oc_enode_meets(k, &ball)) continue;
