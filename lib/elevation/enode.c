@@ -62,6 +62,14 @@ oc_enode *oc_enode_alloc(oc_ekind kind, size_t size, oc_enode *const *kids,
     k[i] = kids[i];
     oc_enode_retain(kids[i]);
   }
+  /* (a transform's, warp's, replace's or add's A is its first child) */
+  int partial = OC_EPRIM_KIND(kind) != 0;
+  if (kind == OC_E_XFORM || kind == OC_E_WARP || kind == OC_E_REPLACE ||
+      kind == OC_E_ADD || kind == OC_E_LOD)
+    partial = nkids > 0 && kids[0]->flags & OC_EF_PARTIAL;
+  if (kind == OC_E_LOD && nkids > 1)
+    partial = partial || kids[1]->flags & OC_EF_PARTIAL;
+  n->flags = partial ? OC_EF_PARTIAL : 0;
   return n;
 }
 

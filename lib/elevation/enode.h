@@ -92,6 +92,10 @@ struct oc_enode {
 #define OC_EF_BELOW 16 /* add: with an altitude weight (below_z, fade) */
 #define OC_EF_STEPF 32 /* add: the slope weight's step a float exactly */
 #define OC_EF_LERP 64  /* replace: the lerped weight */
+/* every kind: its f model holds only where its weight is > 0 (a curve,
+** lake or image, or an operator of one in A's place: eops.c,
+** tay_partial), set by oc_enode_alloc from the kind and the children */
+#define OC_EF_PARTIAL 128
 
 /* The parameters (doubles) operators store (eops.c, lod.c). A replace
 ** stores none (its weight is a flag); an add the altitude weight's

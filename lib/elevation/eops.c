@@ -113,39 +113,52 @@ static int grid_cell(double v, double lo, double s, int G) {
 }
 
 /* The children a query over [x0, x1] x [y0, y1] may meet: those of the
-** cells that region meets (all when the blend has no grid), in order. */
+** cells that region meets, in order; all of them when the blend has no
+** grid (n, one by one, beyond 64 OC_EGRID_WORDS children; else masks). */
 typedef struct kid_iter {
   uint64_t m[OC_EGRID_WORDS];
-  size_t i, n; /* (no grid: the next child, the count) */
-  int w, W;    /* (grid: the word, the words) */
+  size_t i, n; /* (more children than masks hold: the next, the count) */
+  int w, W;    /* (masks: the word, the words) */
 } kid_iter;
 
 static void kids_in(const oc_eblend *bl, double x0, double y0, double x1,
                     double y1, kid_iter *it) {
   int G = bl->h.octaves;
-  it->i = 0, it->n = bl->nkids, it->w = 0, it->W = 0;
-  if (!G) return;
-  int W = (int)((bl->nkids + 63) / 64);
+  size_t n = bl->nkids;
+  it->w = 0;
+  if (!G) {
+    it->i = 0, it->n = n, it->W = 0;
+    if (n > 64 * OC_EGRID_WORDS) return;
+    it->W = (int)((n + 63) / 64);
+    for (int w = 0; w < it->W; w++) /* (n bits set) */
+      it->m[w] = n - 64 * (size_t)w >= 64 ? ~(uint64_t)0
+                                          : ((uint64_t)1 << (n % 64)) - 1;
+    return;
+  }
   double bx = bl->box.x0, by = bl->box.y0;
   double sx = G / ((double)bl->box.x1 - bx), sy = G / ((double)bl->box.y1 - by);
   int i0 = grid_cell(x0, bx, sx, G), i1 = grid_cell(x1, bx, sx, G);
   int j0 = grid_cell(y0, by, sy, G), j1 = grid_cell(y1, by, sy, G);
   const uint64_t *g = grid_masks(bl);
-  it->W = W, it->n = 0;
-  for (int w = 0; w < W; w++)
-    it->m[w] = 0;
+  if (n <= 64) { /* (one word a cell: the common case) */
+    uint64_t m = 0;
+    for (int j = j0; j <= j1; j++)
+      for (int i = i0; i <= i1; i++)
+        m |= g[j * G + i];
+    it->m[0] = m, it->W = 1;
+    return;
+  }
+  int W = (int)((n + 63) / 64);
+  it->W = W;
+  uint64_t m[OC_EGRID_WORDS] = {0};
   for (int j = j0; j <= j1; j++)
     for (int i = i0; i <= i1; i++)
       for (int w = 0; w < W; w++)
-        it->m[w] |= g[((size_t)j * G + i) * W + w];
+        m[w] |= g[((size_t)j * G + i) * W + w];
+  memcpy(it->m, m, sizeof m);
 }
 
 static inline int kid_next(kid_iter *it, size_t *i) {
-  if (!it->W) {
-    if (it->i >= it->n) return 0;
-    *i = it->i++;
-    return 1;
-  }
   for (; it->w < it->W; it->w++) {
     uint64_t m = it->m[it->w];
     if (m) {
@@ -154,7 +167,9 @@ static inline int kid_next(kid_iter *it, size_t *i) {
       return 1;
     }
   }
-  return 0;
+  if (it->i >= it->n || it->W) return 0;
+  *i = it->i++;
+  return 1;
 }
 
 /* Cells a side for n children (0: no grid): G^2 W <= n. */
@@ -451,7 +466,7 @@ static void store_binary(oc_enode *n, const oc_enode *a, const oc_enode *b) {
 oc_enode *oc_enode_replace(oc_enode *a, oc_enode *b, int lerp, oc_error *err) {
   oc_enode *n = binary(OC_E_REPLACE, a, b, offsetof(oc_ebin, par), err);
   if (!n) return NULL;
-  n->flags = lerp ? OC_EF_LERP : 0;
+  n->flags |= lerp ? OC_EF_LERP : 0;
   store_binary(n, a, b);
   return n;
 }
@@ -742,7 +757,7 @@ oc_enode *oc_enode_add(oc_enode *a, oc_enode *b, const oc_enode_add_params *p,
               (p->slope && (double)(float)step == step ? OC_EF_STEPF : 0);
   oc_enode *n = binary(OC_E_ADD, a, b, oc_eadd_size(flags), err);
   if (!n) return NULL;
-  n->flags = (uint8_t)flags;
+  n->flags |= (uint8_t)flags;
   double *par = ((oc_ebin *)n)->par;
   if (p->below) par[P_BZ] = p->below_z, par[P_FADE] = p->fade;
   if (p->slope) {
@@ -1200,18 +1215,7 @@ int oc_eop_ev_row(const oc_enode *n, const double *x, double y, int cnt,
 ** a transform, warp, level of detail, replace or add of one (in A's place:
 ** their weight is A's). Their f models are not composed as they stand. */
 static int tay_partial(const oc_enode *n) {
-  switch (n->kind) {
-  case OC_E_XFORM:
-  case OC_E_WARP:
-    return tay_partial(OC_EUN(n)->kid);
-  case OC_E_LOD:
-    return tay_partial(OC_EBIN(n)->kids[0]) || tay_partial(OC_EBIN(n)->kids[1]);
-  case OC_E_REPLACE:
-  case OC_E_ADD:
-    return tay_partial(OC_EBIN(n)->kids[0]);
-  default:
-    return OC_EPRIM_KIND(n->kind) != 0;
-  }
+  return (n->flags & OC_EF_PARTIAL) != 0; /* (oc_enode_alloc) */
 }
 
 int oc_eop_taylor_partial(const oc_enode *n) {

@@ -988,6 +988,21 @@ START_TEST(taylor_models) {
     check_taylor(all[t], &r, 400);
   printf("taylor: the largest error is %.3f of its remainder\n", tay_worst);
   ck_assert(tay_worst > 0.01); /* (the checks do reach the bounds) */
+  /* partial f models (OC_EF_PARTIAL, set at allocation): a curve's and a
+  ** lake's, and an operator's of one in A's place, a transform's of one */
+  oc_enode *rv = EOK(oc_enode_replace(river, land, 0, &err));
+  oc_enode *rvm = EOK(oc_enode_transform(rv, &xg, &err));
+  oc_enode *rvb[2] = {rvm, d[0]};
+  oc_enode *rvbl = EOK(oc_enode_blend(rvb, 2, &err));
+  const oc_enode *part[] = {river, lake, rv, rvm};
+  const oc_enode *whole[] = {d[0], land, rep, crag, moved, mix, rvbl};
+  for (size_t t = 0; t < 4; t++)
+    ck_assert(oc_eop_taylor_partial(part[t]));
+  for (size_t t = 0; t < 7; t++)
+    ck_assert(!oc_eop_taylor_partial(whole[t]));
+  oc_enode_release(rvbl);
+  oc_enode_release(rvm);
+  oc_enode_release(rv);
   oc_enode *rel[] = {land,  islets, river, rep, lrep,  crag, sadd,
                      moved, warped, lake,  mix, small, insts};
   for (size_t t = 0; t < sizeof rel / sizeof *rel; t++)
