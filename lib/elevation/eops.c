@@ -113,28 +113,23 @@ static int grid_cell(double v, double lo, double s, int G) {
 }
 
 /* The children a query over [x0, x1] x [y0, y1] may meet: those of the
-** cells that region meets, in order; all of them when the blend has no
-** grid (n, one by one, beyond 64 OC_EGRID_WORDS children; else masks). */
+** cells that region meets (all when the blend has no grid), as W words
+** of 64 bits visited in order:
+**   for (int w = 0; w < it.W; w++)
+**     for (uint64_t m = kid_word(&it, w); m; m &= m - 1)
+**       ... bl->kids[KID_INDEX(w, m)] ... */
 typedef struct kid_iter {
-  uint64_t m[OC_EGRID_WORDS];
-  size_t i, n; /* (more children than masks hold: the next, the count) */
-  int w, W;    /* (masks: the word, the words) */
+  uint64_t m[OC_EGRID_WORDS]; /* (with a grid) */
+  size_t n;
+  int W, grid;
 } kid_iter;
 
 static void kids_in(const oc_eblend *bl, double x0, double y0, double x1,
                     double y1, kid_iter *it) {
   int G = bl->h.octaves;
   size_t n = bl->nkids;
-  it->w = 0;
-  if (!G) {
-    it->i = 0, it->n = n, it->W = 0;
-    if (n > 64 * OC_EGRID_WORDS) return;
-    it->W = (int)((n + 63) / 64);
-    for (int w = 0; w < it->W; w++) /* (n bits set) */
-      it->m[w] = n - 64 * (size_t)w >= 64 ? ~(uint64_t)0
-                                          : ((uint64_t)1 << (n % 64)) - 1;
-    return;
-  }
+  it->n = n, it->W = (int)((n + 63) / 64), it->grid = G != 0;
+  if (!G) return;
   double bx = bl->box.x0, by = bl->box.y0;
   double sx = G / ((double)bl->box.x1 - bx), sy = G / ((double)bl->box.y1 - by);
   int i0 = grid_cell(x0, bx, sx, G), i1 = grid_cell(x1, bx, sx, G);
@@ -145,11 +140,10 @@ static void kids_in(const oc_eblend *bl, double x0, double y0, double x1,
     for (int j = j0; j <= j1; j++)
       for (int i = i0; i <= i1; i++)
         m |= g[j * G + i];
-    it->m[0] = m, it->W = 1;
+    it->m[0] = m;
     return;
   }
-  int W = (int)((n + 63) / 64);
-  it->W = W;
+  int W = it->W;
   uint64_t m[OC_EGRID_WORDS] = {0};
   for (int j = j0; j <= j1; j++)
     for (int i = i0; i <= i1; i++)
@@ -158,19 +152,12 @@ static void kids_in(const oc_eblend *bl, double x0, double y0, double x1,
   memcpy(it->m, m, sizeof m);
 }
 
-static inline int kid_next(kid_iter *it, size_t *i) {
-  for (; it->w < it->W; it->w++) {
-    uint64_t m = it->m[it->w];
-    if (m) {
-      *i = 64 * (size_t)it->w + (size_t)__builtin_ctzll(m);
-      it->m[it->w] = m & (m - 1);
-      return 1;
-    }
-  }
-  if (it->i >= it->n || it->W) return 0;
-  *i = it->i++;
-  return 1;
+static inline uint64_t kid_word(const kid_iter *it, int w) {
+  if (it->grid) return it->m[w];
+  size_t left = it->n - 64 * (size_t)w;
+  return left >= 64 ? ~(uint64_t)0 : ((uint64_t)1 << left) - 1;
 }
+#define KID_INDEX(w, m) (64 * (size_t)(w) + (size_t)__builtin_ctzll(m))
 
 /* Cells a side for n children (0: no grid): G^2 W <= n. */
 static int grid_side(size_t n) {
@@ -206,28 +193,28 @@ static void blend_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
   double N = 0, S = 0, nx = 0, ny = 0, sx = 0, sy = 0;
   const oc_eblend *bl = OC_EBLEND(n);
   kid_iter it;
-  size_t i;
   kids_in(bl, x, y, x, y, &it);
-  while (kid_next(&it, &i)) {
-    const oc_enode *k = bl->kids[i];
-    if (!oc_enode_holds(k, x, y))
-      continue; /* alpha = 0 there: no contribution */
-    oc_enode_sample c;
-    oc_enode_ev(k, x, y, ft, grad | OC_EV_LAZY | only, &c);
-    if (only) {
+  for (int w = 0; w < it.W; w++)
+    for (uint64_t mk = kid_word(&it, w); mk; mk &= mk - 1) {
+      const oc_enode *k = bl->kids[KID_INDEX(w, mk)];
+      if (!oc_enode_holds(k, x, y))
+        continue; /* alpha = 0 there: no contribution */
+      oc_enode_sample c;
+      oc_enode_ev(k, x, y, ft, grad | OC_EV_LAZY | only, &c);
+      if (only) {
+        S += c.a;
+        continue;
+      }
+      if (c.a == 0) continue;
+      N += c.a * c.f;
       S += c.a;
-      continue;
+      if (grad) {
+        nx += c.ax * c.f + c.a * c.fx;
+        ny += c.ay * c.f + c.a * c.fy;
+        sx += c.ax;
+        sy += c.ay;
+      }
     }
-    if (c.a == 0) continue;
-    N += c.a * c.f;
-    S += c.a;
-    if (grad) {
-      nx += c.ax * c.f + c.a * c.fx;
-      ny += c.ay * c.f + c.a * c.fy;
-      sx += c.ax;
-      sy += c.ay;
-    }
-  }
   s->a = S;
   s->ax = sx;
   s->ay = sy;
@@ -291,7 +278,7 @@ static void blend_combine(const oc_ebound *kb, size_t n, int plane,
   o->la = lasum;
 }
 
-#define KB_STACK 16
+#define KB_STACK 64 /* (3 kB: blends of up to 64 children allocate nothing) */
 
 static void blend_bound_in(const oc_enode *n, const oc_erect *b,
                            const oc_efootb *fb, oc_ebound *o) {
@@ -301,18 +288,19 @@ static void blend_bound_in(const oc_enode *n, const oc_erect *b,
     oc_enode_glob(n, o); /* (conservative: the whole plane's) */
     return;
   }
-  size_t m = 0, i;
+  size_t m = 0;
   kid_iter it;
   kids_in(bl, b->x0, b->y0, b->x1, b->y1, &it);
-  while (kid_next(&it, &i)) {
-    const oc_enode *k = bl->kids[i];
-    if (oc_enode_meets(k, b)) {
-      oc_enode_bnd(k, b, fb, &kb[m]);
-      /* alpha = 0 on the whole box: neither the child's f nor its
-      ** weight's slope counts there */
-      m += kb[m].ahi > 0;
+  for (int w = 0; w < it.W; w++)
+    for (uint64_t mk = kid_word(&it, w); mk; mk &= mk - 1) {
+      const oc_enode *k = bl->kids[KID_INDEX(w, mk)];
+      if (oc_enode_meets(k, b)) {
+        oc_enode_bnd(k, b, fb, &kb[m]);
+        /* alpha = 0 on the whole box: neither the child's f nor its
+        ** weight's slope counts there */
+        m += kb[m].ahi > 0;
+      }
     }
-  }
   blend_combine(kb, m, 0, o);
   if (kb != stack) free(kb);
 }
@@ -1130,24 +1118,25 @@ static void blend_ev_row(const oc_enode *n, const double *x, double y, int cnt,
   for (int m = 0; m < cnt; m++)
     N[m] = S[m] = 0;
   kid_iter it;
-  size_t i;
   kids_in(bl, x[0], y, x[cnt > 0 ? cnt - 1 : 0], y, &it);
-  while (cnt > 0 && kid_next(&it, &i)) {
-    const oc_enode *k = bl->kids[i];
-    int i0, i1;
-    oc_enode_row_span(k, x, y, cnt, &i0, &i1);
-    if (i0 >= i1) continue;
-    oc_enode_ev_row(k, x + i0, y, i1 - i0, OC_EV_LAZY | only, kf + i0, ka + i0);
-    for (int m = i0; m < i1; m++) {
-      if (only) {
+  for (int w = 0; cnt > 0 && w < it.W; w++)
+    for (uint64_t mk = kid_word(&it, w); mk; mk &= mk - 1) {
+      const oc_enode *k = bl->kids[KID_INDEX(w, mk)];
+      int i0, i1;
+      oc_enode_row_span(k, x, y, cnt, &i0, &i1);
+      if (i0 >= i1) continue;
+      oc_enode_ev_row(k, x + i0, y, i1 - i0, OC_EV_LAZY | only, kf + i0,
+                      ka + i0);
+      for (int m = i0; m < i1; m++) {
+        if (only) {
+          S[m] += ka[m];
+          continue;
+        }
+        if (ka[m] == 0) continue;
+        N[m] += ka[m] * kf[m];
         S[m] += ka[m];
-        continue;
       }
-      if (ka[m] == 0) continue;
-      N[m] += ka[m] * kf[m];
-      S[m] += ka[m];
     }
-  }
   for (int m = 0; m < cnt; m++) {
     a[m] = S[m];
     if (!only) f[m] = S[m] >= T ? N[m] / S[m] : N[m] / T;
@@ -1242,48 +1231,48 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
   oc_etay S = oc_etay_const(0);
   int m = 0;
   kid_iter it;
-  size_t i;
   kids_in(bl, ball.x0, ball.y0, ball.x1, ball.y1, &it);
-  while (kid_next(&it, &i)) {
-    const oc_enode *k = bl->kids[i];
-    if (!oc_enode_meets(k, &ball)) continue; /* alpha_k = 0 on the disc */
-    if (m == TAY_KIDS || tay_partial(k)) return 0;
-    oc_etaylor c;
-    /* alpha_k's model first where it is cheap (no noise) */
-    int have = oc_enode_taylor_alpha(k, x, y, R, &c.a, boxes);
-    if (have && c.a.v == 0 && c.a.gx == 0 && c.a.gy == 0) {
-      /* alpha_k(p) = 0 (so grad alpha_k(p) = 0: alpha_k >= 0 is C1):
-      ** alpha_k' (f_k' - f) is at most E_ak(r) sup|f_k - f|, f_k's range
-      ** from its bound over the plane (no noise evaluated) */
-      if (oc_etay_is_const(&c.a)) continue;
-      oc_ebound g;
-      oc_enode_glob(k, &g);
-      fk[m] = g.flo, fhi[m] = g.fhi, out[m] = 1;
+  for (int w = 0; w < it.W; w++)
+    for (uint64_t mk = kid_word(&it, w); mk; mk &= mk - 1) {
+      const oc_enode *k = bl->kids[KID_INDEX(w, mk)];
+      if (!oc_enode_meets(k, &ball)) continue; /* alpha_k = 0 on the disc */
+      if (m == TAY_KIDS || tay_partial(k)) return 0;
+      oc_etaylor c;
+      /* alpha_k's model first where it is cheap (no noise) */
+      int have = oc_enode_taylor_alpha(k, x, y, R, &c.a, boxes);
+      if (have && c.a.v == 0 && c.a.gx == 0 && c.a.gy == 0) {
+        /* alpha_k(p) = 0 (so grad alpha_k(p) = 0: alpha_k >= 0 is C1):
+        ** alpha_k' (f_k' - f) is at most E_ak(r) sup|f_k - f|, f_k's range
+        ** from its bound over the plane (no noise evaluated) */
+        if (oc_etay_is_const(&c.a)) continue;
+        oc_ebound g;
+        oc_enode_glob(k, &g);
+        fk[m] = g.flo, fhi[m] = g.fhi, out[m] = 1;
+        oc_etay_add(&S, &c.a);
+        ea[m][0] = c.a.e0, ea[m][1] = c.a.e1, ea[m][2] = c.a.e2;
+        m++;
+        continue;
+      }
+      if (have && k->kind == OC_E_DISC && !tf)
+        oc_edisc_taylor_f(k, x, y, R, &c.f); /* (its alpha's model: c.a) */
+      else
+        oc_enode_taylor_view(k, x, y, R, tf, &c, boxes);
+      if (c.a.v == 0 && oc_etay_is_const(&c.a)) continue;
+      if (oc_enode_holds(k, x, y) && c.a.v != 0) N += c.a.v * c.f.v; /* (ev) */
+      Nx += c.a.v * c.f.gx + c.f.v * c.a.gx;
+      Ny += c.a.v * c.f.gy + c.f.v * c.a.gy;
       oc_etay_add(&S, &c.a);
+      double pa[3] = {c.a.e0, oc_etay_gnorm(&c.a) + c.a.e1, c.a.e2};
+      double pf[3] = {c.f.e0, oc_etay_gnorm(&c.f) + c.f.e1, c.f.e2}, q[3];
+      oc_etay_polymul(pa, pf, R, q);
+      double ak = fabs(c.a.v);
+      rest[0] += ak * c.f.e0 + q[0];
+      rest[1] += ak * c.f.e1 + q[1];
+      rest[2] += ak * c.f.e2 + q[2];
+      fk[m] = c.f.v, out[m] = 0;
       ea[m][0] = c.a.e0, ea[m][1] = c.a.e1, ea[m][2] = c.a.e2;
       m++;
-      continue;
     }
-    if (have && k->kind == OC_E_DISC && !tf)
-      oc_edisc_taylor_f(k, x, y, R, &c.f); /* (its alpha's model: c.a) */
-    else
-      oc_enode_taylor_view(k, x, y, R, tf, &c, boxes);
-    if (c.a.v == 0 && oc_etay_is_const(&c.a)) continue;
-    if (oc_enode_holds(k, x, y) && c.a.v != 0) N += c.a.v * c.f.v; /* (ev) */
-    Nx += c.a.v * c.f.gx + c.f.v * c.a.gx;
-    Ny += c.a.v * c.f.gy + c.f.v * c.a.gy;
-    oc_etay_add(&S, &c.a);
-    double pa[3] = {c.a.e0, oc_etay_gnorm(&c.a) + c.a.e1, c.a.e2};
-    double pf[3] = {c.f.e0, oc_etay_gnorm(&c.f) + c.f.e1, c.f.e2}, q[3];
-    oc_etay_polymul(pa, pf, R, q);
-    double ak = fabs(c.a.v);
-    rest[0] += ak * c.f.e0 + q[0];
-    rest[1] += ak * c.f.e1 + q[1];
-    rest[2] += ak * c.f.e2 + q[2];
-    fk[m] = c.f.v, out[m] = 0;
-    ea[m][0] = c.a.e0, ea[m][1] = c.a.e1, ea[m][2] = c.a.e2;
-    m++;
-  }
   o->a = S;
   if (m == 0) {
     o->f = oc_etay_const(0);
@@ -1480,15 +1469,15 @@ int oc_eop_taylor_alpha(const oc_enode *n, double x, double y, double R,
     oc_erect ball = {x - R, y - R, x + R, y + R};
     *a = oc_etay_const(0);
     kid_iter it;
-    size_t i;
     kids_in(bl, ball.x0, ball.y0, ball.x1, ball.y1, &it);
-    while (kid_next(&it, &i)) {
-      const oc_enode *k = bl->kids[i];
-      oc_etay c;
-      if (!oc_enode_meets(k, &ball)) continue;
-      if (!oc_enode_taylor_alpha(k, x, y, R, &c, boxes)) return 0;
-      oc_etay_add(a, &c);
-    }
+    for (int w = 0; w < it.W; w++)
+      for (uint64_t mk = kid_word(&it, w); mk; mk &= mk - 1) {
+        const oc_enode *k = bl->kids[KID_INDEX(w, mk)];
+        oc_etay c;
+        if (!oc_enode_meets(k, &ball)) continue;
+        if (!oc_enode_taylor_alpha(k, x, y, R, &c, boxes)) return 0;
+        oc_etay_add(a, &c);
+      }
     return 1;
   }
   case OC_E_REPLACE:
