@@ -814,31 +814,16 @@ static inline oc_etay octave_model(double e, const double g[2], double s,
 static void plain_taylor(const oc_enoise *nz, const double *ev,
                          const double *ex, const double *ey, double R,
                          oc_etay *o) {
-  const double L = 2 * oc_noise3_lipschitz, H = 2 * oc_noise3_hessian;
   int turb = nz->kind == OC_ENOISE_TURBULENCE;
   double sum = 0, a = nz->amplitude, s = 1 / nz->wavelength;
-  double gx = 0, gy = 0, e0 = 0, e1 = 0, e2 = 0, Rk = R * OC_ETAY_CHOICE;
+  double gx = 0, gy = 0, e0 = 0, e1 = 0, e2 = 0;
   for (int i = 0; i < nz->octaves; i++) {
-    double g0 = 2 * ex[i], g1 = 2 * ey[i], e = 2 * ev[i] - 1; /* (oc_eta) */
-    double sg = 1, ae = e;
-    double quad = 0.5 * H * s * s, flat1 = L * s, flat0 = 1 + fabs(e);
-    int can_quad = 1;
-    if (turb) {
-      sg = e < 0 ? -1 : 1, ae = fabs(e);
-      flat0 = oc_fmax(ae, 1 - ae);
-      can_quad = ae > s * hypot(g0, g1) * R + quad * R * R;
-    }
-    double tx = 0, ty = 0, t0 = 0, t1 = 0, t2 = 0;
-    if (can_quad && quad * Rk * Rk <= oc_fmin(flat1 * Rk, flat0))
-      tx = sg * s * g0, ty = sg * s * g1, t2 = quad;
-    else if (flat1 * R * OC_ETAY_CHOICE <= flat0) /* (oc_etay_flat) */
-      t1 = flat1;
-    else
-      t0 = flat0;
-    sum += a * ae;
+    double g[2] = {2 * ex[i], 2 * ey[i]}, e = 2 * ev[i] - 1; /* (oc_eta) */
+    oc_etay t = octave_model(e, g, s, R, turb);              /* (inline) */
     double q = fabs(a);
-    gx += a * tx, gy += a * ty;
-    e0 += q * t0, e1 += q * t1, e2 += q * t2;
+    sum += a * t.v; /* (octave_term's value: |e| or e) */
+    gx += a * t.gx, gy += a * t.gy;
+    e0 += q * t.e0, e1 += q * t.e1, e2 += q * t.e2;
     a = a * nz->gain;
     s *= nz->lacunarity;
   }
