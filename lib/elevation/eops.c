@@ -1232,6 +1232,29 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
   int m = 0;
   kid_iter it;
   kids_in(bl, ball.x0, ball.y0, ball.x1, ball.y1, &it);
+  /* children that are all discs, at full detail: their weights' models
+  ** first (no noise), summed as below, so that a sum crossing T (no
+  ** rule: the caller's fallback) costs no noise model */
+  oc_etay ka[TAY_KIDS];
+  int nka = tf ? -1 : 0, j = 0; /* (-1: not kept) */
+  for (int w = 0; w < it.W && nka >= 0; w++)
+    for (uint64_t mk = kid_word(&it, w); mk; mk &= mk - 1) {
+      const oc_enode *k = bl->kids[KID_INDEX(w, mk)];
+      if (!oc_enode_meets(k, &ball)) continue;
+      if (k->kind != OC_E_DISC || nka == TAY_KIDS) {
+        nka = -1;
+        break;
+      }
+      oc_edisc_taylor_alpha(k, x, y, R, &ka[nka]);
+      if (!(ka[nka].v == 0 && oc_etay_is_const(&ka[nka])))
+        oc_etay_add(&S, &ka[nka]);
+      nka++;
+    }
+  if (nka >= 0) {
+    double dev = oc_etay_dev(&S, R);
+    if (!(S.v - dev >= T) && !(S.v + dev <= T)) return 0; /* (below) */
+  }
+  S = oc_etay_const(0);
   for (int w = 0; w < it.W; w++)
     for (uint64_t mk = kid_word(&it, w); mk; mk &= mk - 1) {
       const oc_enode *k = bl->kids[KID_INDEX(w, mk)];
@@ -1239,7 +1262,11 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
       if (m == TAY_KIDS || tay_partial(k)) return 0;
       oc_etaylor c;
       /* alpha_k's model first where it is cheap (no noise) */
-      int have = oc_enode_taylor_alpha(k, x, y, R, &c.a, boxes);
+      int have = 1;
+      if (nka >= 0)
+        c.a = ka[j++];
+      else
+        have = oc_enode_taylor_alpha(k, x, y, R, &c.a, boxes);
       if (have && c.a.v == 0 && c.a.gx == 0 && c.a.gy == 0) {
         /* alpha_k(p) = 0 (so grad alpha_k(p) = 0: alpha_k >= 0 is C1):
         ** alpha_k' (f_k' - f) is at most E_ak(r) sup|f_k - f|, f_k's range
