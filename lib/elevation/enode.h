@@ -143,8 +143,8 @@ typedef struct oc_eprim {
 /* blend: 56 bytes and 8 a child; from OC_EGRID_MIN to 64 OC_EGRID_WORDS
 ** children, then its grid (eops.c): G x G cells over its box (G =
 ** h.octaves), each the mask of the children whose box meets the cell,
-** W = ceil(nkids / 64) words a cell, G^2 W <= nkids (8 bytes a child at
-** most). A query visits the children of the cells it meets, in their
+** W = ceil(nkids / 64) words a cell, 2 G^2 W <= nkids (4 bytes a child
+** at most). A query visits the children of the cells it meets, in their
 ** order, and tests their boxes as before: the same children, the same
 ** sums, fewer tests. */
 typedef struct oc_eblend {
@@ -154,7 +154,7 @@ typedef struct oc_eblend {
   uint32_t nkids;
   oc_enode *kids[]; /* retained; then the grid's uint64_t masks */
 } oc_eblend;
-#define OC_EGRID_MIN 8
+#define OC_EGRID_MIN 24
 #define OC_EGRID_WORDS 4
 
 /* The words of a blend's grid with nkids children and G cells a side. */

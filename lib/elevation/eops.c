@@ -159,15 +159,16 @@ static inline uint64_t kid_word(const kid_iter *it, int w) {
 }
 #define KID_INDEX(w, m) (64 * (size_t)(w) + (size_t)__builtin_ctzll(m))
 
-/* Cells a side for n children (0: no grid): G^2 W <= n. */
+/* Cells a side for n children (0: no grid): G^2 W <= n / 2, 4 bytes a
+** child at most, so that the Table 1 scenes stay within the paper's
+** bytes (bench_elev --bytes: fig3's 18-child blend would not; smaller
+** blends test their children's boxes as fast as a grid's cells). */
 static int grid_side(size_t n) {
   size_t W = (n + 63) / 64;
   if (n < OC_EGRID_MIN || W > OC_EGRID_WORDS) return 0;
-  int G = (int)floor(sqrt((double)(n / W)));
-  while ((size_t)(G + 1) * (G + 1) * W <= n)
+  int G = 1;
+  while ((size_t)(G + 1) * (G + 1) * W * 2 <= n)
     G++;
-  while ((size_t)G * G * W > n)
-    G--;
   return G;
 }
 

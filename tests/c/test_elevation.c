@@ -1012,8 +1012,9 @@ START_TEST(taylor_models) {
 }
 END_TEST
 
-/* A blend's grid (enode.h, eops.c): blends of 20 and 70 children (one
-** and two words a cell) answer every query with the bits of the same
+/* A blend's grid (enode.h, eops.c): blends of 32 and 70 children (one
+** and two words a cell; 20 keep none) answer every query with the bits of the
+*same
 ** blends without their grid (every child tested in turn): values and
 ** gradients under each want, rows, first-order models (f and alpha, and
 ** alpha's alone) and bounds in boxes, at points inside, on cell edges and
@@ -1045,9 +1046,9 @@ START_TEST(blend_grid_matches_flat) {
   oc_enode_xform xf = {100, 50, 30, 0.7, 1, 0};
   oc_enode *kid0 = k[0];
   k[0] = EOK(oc_enode_transform(three, &xf, &err));
-  size_t sizes[2] = {20, N};
-  int sides[2] = {4, 5}; /* 16 <= 20, 25 x 2 <= 70 */
-  for (int t = 0; t < 2; t++) {
+  size_t sizes[3] = {20, 32, N};
+  int sides[3] = {0, 4, 4}; /* (none below 24), 2 x 16 <= 32, 4 x 16 <= 70 */
+  for (int t = 0; t < 3; t++) {
     size_t n = sizes[t], W = (n + 63) / 64;
     oc_enode *g = EOK(oc_enode_blend(k, n, &err));
     oc_enode *flat = EOK(oc_enode_blend(k, n, &err));
@@ -1056,13 +1057,13 @@ START_TEST(blend_grid_matches_flat) {
                       56 + 8 * n + 8 * W * sides[t] * sides[t]);
     flat->octaves = 0; /* (the same blend, every child tested) */
     oc_erect box = oc_enode_box(g);
-    double cw = (box.x1 - box.x0) / sides[t];
+    double cw = (box.x1 - box.x0) / (sides[t] ? sides[t] : 4);
     int checked = 0;
     for (int i = 0; i < GRID_POINTS; i++) {
       double x = oct_unif(&r, box.x0 - 50, box.x1 + 50);
       double y = oct_unif(&r, box.y0 - 50, box.y1 + 50);
       if (i % 5 == 0) /* on a cell's edge */
-        x = box.x0 + cw * (double)(i / 5 % (sides[t] + 1));
+        x = box.x0 + cw * (double)(i / 5 % (sides[t] + 2));
       double R = cw * pow(10, oct_unif(&r, -1, 1));
       for (int w = 0; w < 4; w++) {
         int want = (int[]){0, OC_EV_GRAD, OC_EV_LAZY, OC_EV_ALPHA}[w];
