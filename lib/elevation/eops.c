@@ -159,6 +159,23 @@ static inline uint64_t kid_word(const kid_iter *it, int w) {
 }
 #define KID_INDEX(w, m) (64 * (size_t)(w) + (size_t)__builtin_ctzll(m))
 
+/* The next child of it (cursor: word w, mask mk) whose box meets r; NULL
+** when none is left. */
+static inline const oc_enode *next_meeting(const oc_eblend *bl,
+                                           const kid_iter *it,
+                                           const oc_erect *r, int *w,
+                                           uint64_t *mk) {
+  for (;;) {
+    while (!*mk) {
+      if (++*w >= it->W) return NULL;
+      *mk = kid_word(it, *w);
+    }
+    const oc_enode *k = bl->kids[KID_INDEX(*w, *mk)];
+    *mk &= *mk - 1;
+    if (oc_enode_meets(k, r)) return k;
+  }
+}
+
 /* Cells a side for n children (0: no grid): G^2 W <= n / 2, 4 bytes a
 ** child at most, so that the Table 1 scenes stay within the paper's
 ** bytes (bench_elev --bytes: fig3's 18-child blend would not; smaller
@@ -1233,74 +1250,82 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
   int m = 0;
   kid_iter it;
   kids_in(bl, ball.x0, ball.y0, ball.x1, ball.y1, &it);
-  /* children that are all discs, at full detail: their weights' models
-  ** first (no noise), summed as below, so that a sum crossing T (no
-  ** rule: the caller's fallback) costs no noise model */
+  /* the children meeting the disc (up to TAY_KIDS: kk, nk; -1 beyond);
+  ** when they are all discs, at full detail, their weights' models first
+  ** (no noise), summed as below, so that a sum crossing T (no rule: the
+  ** caller's fallback) costs no noise model */
+  const oc_enode *kk[TAY_KIDS], *k;
   oc_etay ka[TAY_KIDS];
-  int nka = tf ? -1 : 0, j = 0; /* (-1: not kept) */
-  for (int w = 0; w < it.W && nka >= 0; w++)
-    for (uint64_t mk = kid_word(&it, w); mk; mk &= mk - 1) {
-      const oc_enode *k = bl->kids[KID_INDEX(w, mk)];
-      if (!oc_enode_meets(k, &ball)) continue;
-      if (k->kind != OC_E_DISC || nka == TAY_KIDS) {
-        nka = -1;
-        break;
-      }
-      oc_edisc_taylor_alpha(k, x, y, R, &ka[nka]);
-      if (!(ka[nka].v == 0 && oc_etay_is_const(&ka[nka])))
-        oc_etay_add(&S, &ka[nka]);
-      nka++;
+  int w = 0, nk = 0, discs = !tf, jk = 0;
+  uint64_t mk = kid_word(&it, 0);
+  while ((k = next_meeting(bl, &it, &ball, &w, &mk))) {
+    if (nk == TAY_KIDS) {
+      nk = -1;
+      break;
     }
-  if (nka >= 0) {
+    kk[nk++] = k;
+    discs = discs && k->kind == OC_E_DISC;
+  }
+  if (nk < 0) { /* (the children again, one by one) */
+    w = 0, mk = kid_word(&it, 0), discs = 0;
+  } else if (discs) {
+    for (int i = 0; i < nk; i++) {
+      oc_edisc_taylor_alpha(kk[i], x, y, R, &ka[i]);
+      if (!(ka[i].v == 0 && oc_etay_is_const(&ka[i]))) oc_etay_add(&S, &ka[i]);
+    }
     double dev = oc_etay_dev(&S, R);
     if (!(S.v - dev >= T) && !(S.v + dev <= T)) return 0; /* (below) */
+    S = oc_etay_const(0);
   }
-  S = oc_etay_const(0);
-  for (int w = 0; w < it.W; w++)
-    for (uint64_t mk = kid_word(&it, w); mk; mk &= mk - 1) {
-      const oc_enode *k = bl->kids[KID_INDEX(w, mk)];
-      if (!oc_enode_meets(k, &ball)) continue; /* alpha_k = 0 on the disc */
-      if (m == TAY_KIDS || tay_partial(k)) return 0;
-      oc_etaylor c;
-      /* alpha_k's model first where it is cheap (no noise) */
-      int have = 1;
-      if (nka >= 0)
-        c.a = ka[j++];
-      else
-        have = oc_enode_taylor_alpha(k, x, y, R, &c.a, boxes);
-      if (have && c.a.v == 0 && c.a.gx == 0 && c.a.gy == 0) {
-        /* alpha_k(p) = 0 (so grad alpha_k(p) = 0: alpha_k >= 0 is C1):
-        ** alpha_k' (f_k' - f) is at most E_ak(r) sup|f_k - f|, f_k's range
-        ** from its bound over the plane (no noise evaluated) */
-        if (oc_etay_is_const(&c.a)) continue;
-        oc_ebound g;
-        oc_enode_glob(k, &g);
-        fk[m] = g.flo, fhi[m] = g.fhi, out[m] = 1;
-        oc_etay_add(&S, &c.a);
-        ea[m][0] = c.a.e0, ea[m][1] = c.a.e1, ea[m][2] = c.a.e2;
-        m++;
-        continue;
-      }
-      if (have && k->kind == OC_E_DISC && !tf)
-        oc_edisc_taylor_f(k, x, y, R, &c.f); /* (its alpha's model: c.a) */
-      else
-        oc_enode_taylor_view(k, x, y, R, tf, &c, boxes);
-      if (c.a.v == 0 && oc_etay_is_const(&c.a)) continue;
-      if (oc_enode_holds(k, x, y) && c.a.v != 0) N += c.a.v * c.f.v; /* (ev) */
-      Nx += c.a.v * c.f.gx + c.f.v * c.a.gx;
-      Ny += c.a.v * c.f.gy + c.f.v * c.a.gy;
+  for (;;) {
+    if (nk >= 0) {
+      if (jk == nk) break;
+      k = kk[jk];
+    } else if (!(k = next_meeting(bl, &it, &ball, &w, &mk))) {
+      break; /* (alpha_k = 0 on the disc for the others) */
+    }
+    if (m == TAY_KIDS || tay_partial(k)) return 0;
+    oc_etaylor c;
+    /* alpha_k's model first where it is cheap (no noise) */
+    int have = 1;
+    if (discs)
+      c.a = ka[jk];
+    else
+      have = oc_enode_taylor_alpha(k, x, y, R, &c.a, boxes);
+    jk++;
+    if (have && c.a.v == 0 && c.a.gx == 0 && c.a.gy == 0) {
+      /* alpha_k(p) = 0 (so grad alpha_k(p) = 0: alpha_k >= 0 is C1):
+      ** alpha_k' (f_k' - f) is at most E_ak(r) sup|f_k - f|, f_k's range
+      ** from its bound over the plane (no noise evaluated) */
+      if (oc_etay_is_const(&c.a)) continue;
+      oc_ebound g;
+      oc_enode_glob(k, &g);
+      fk[m] = g.flo, fhi[m] = g.fhi, out[m] = 1;
       oc_etay_add(&S, &c.a);
-      double pa[3] = {c.a.e0, oc_etay_gnorm(&c.a) + c.a.e1, c.a.e2};
-      double pf[3] = {c.f.e0, oc_etay_gnorm(&c.f) + c.f.e1, c.f.e2}, q[3];
-      oc_etay_polymul(pa, pf, R, q);
-      double ak = fabs(c.a.v);
-      rest[0] += ak * c.f.e0 + q[0];
-      rest[1] += ak * c.f.e1 + q[1];
-      rest[2] += ak * c.f.e2 + q[2];
-      fk[m] = c.f.v, out[m] = 0;
       ea[m][0] = c.a.e0, ea[m][1] = c.a.e1, ea[m][2] = c.a.e2;
       m++;
+      continue;
     }
+    if (have && k->kind == OC_E_DISC && !tf)
+      oc_edisc_taylor_f(k, x, y, R, &c.f); /* (its alpha's model: c.a) */
+    else
+      oc_enode_taylor_view(k, x, y, R, tf, &c, boxes);
+    if (c.a.v == 0 && oc_etay_is_const(&c.a)) continue;
+    if (oc_enode_holds(k, x, y) && c.a.v != 0) N += c.a.v * c.f.v; /* (ev) */
+    Nx += c.a.v * c.f.gx + c.f.v * c.a.gx;
+    Ny += c.a.v * c.f.gy + c.f.v * c.a.gy;
+    oc_etay_add(&S, &c.a);
+    double pa[3] = {c.a.e0, oc_etay_gnorm(&c.a) + c.a.e1, c.a.e2};
+    double pf[3] = {c.f.e0, oc_etay_gnorm(&c.f) + c.f.e1, c.f.e2}, q[3];
+    oc_etay_polymul(pa, pf, R, q);
+    double ak = fabs(c.a.v);
+    rest[0] += ak * c.f.e0 + q[0];
+    rest[1] += ak * c.f.e1 + q[1];
+    rest[2] += ak * c.f.e2 + q[2];
+    fk[m] = c.f.v, out[m] = 0;
+    ea[m][0] = c.a.e0, ea[m][1] = c.a.e1, ea[m][2] = c.a.e2;
+    m++;
+  }
   o->a = S;
   if (m == 0) {
     o->f = oc_etay_const(0);
