@@ -143,8 +143,8 @@ typedef struct oc_eprim {
 /* blend: 56 bytes and 8 a child; from OC_EGRID_MIN to 64 OC_EGRID_WORDS
 ** children, then its grid (eops.c): G x G cells over its box (G =
 ** h.octaves), each the mask of the children whose box meets the cell,
-** W = ceil(nkids / 64) words a cell, 2 G^2 W <= nkids (4 bytes a child
-** at most). A query visits the children of the cells it meets, in their
+** W = ceil(nkids / 64) words a cell, 4 G^2 W <= 3 nkids (6 bytes a
+** child at most). A query visits the children of the cells it meets, in their
 ** order, and tests their boxes as before: the same children, the same
 ** sums, fewer tests. */
 typedef struct oc_eblend {

@@ -176,15 +176,16 @@ static inline const oc_enode *next_meeting(const oc_eblend *bl,
   }
 }
 
-/* Cells a side for n children (0: no grid): G^2 W <= n / 2, 4 bytes a
+/* Cells a side for n children (0: no grid): 4 G^2 W <= 3 n, 6 bytes a
 ** child at most, so that the Table 1 scenes stay within the paper's
-** bytes (bench_elev --bytes: fig3's 18-child blend would not; smaller
-** blends test their children's boxes as fast as a grid's cells). */
+** bytes (bench_elev --bytes: fig21's 45-child blend would not with 8;
+** blends below 24 children, fig3's 18, test their children's boxes as
+** fast as a grid's cells). */
 static int grid_side(size_t n) {
   size_t W = (n + 63) / 64;
   if (n < OC_EGRID_MIN || W > OC_EGRID_WORDS) return 0;
   int G = 1;
-  while ((size_t)(G + 1) * (G + 1) * W * 2 <= n)
+  while ((size_t)(G + 1) * (G + 1) * W * 4 <= 3 * n)
     G++;
   return G;
 }

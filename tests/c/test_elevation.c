@@ -1047,7 +1047,7 @@ START_TEST(blend_grid_matches_flat) {
   oc_enode *kid0 = k[0];
   k[0] = EOK(oc_enode_transform(three, &xf, &err));
   size_t sizes[3] = {20, 32, N};
-  int sides[3] = {0, 4, 4}; /* (none below 24), 2 x 16 <= 32, 4 x 16 <= 70 */
+  int sides[3] = {0, 4, 5}; /* (none below 24), 4 G^2 W <= 3 n */
   for (int t = 0; t < 3; t++) {
     size_t n = sizes[t], W = (n + 63) / 64;
     oc_enode *g = EOK(oc_enode_blend(k, n, &err));
