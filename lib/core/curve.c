@@ -695,12 +695,13 @@ static void tangent(const oc_pcurve *c, const piece *pc, double t, double *tx,
   if (v > 1e-12) *tx = sx / v, *ty = sy / v;
 }
 
-static void fill(const oc_pcurve *c, const piece *pc, double t,
+/* (with_s 0: out->s is NaN, oc_curve_s_at) */
+static void fill(const oc_pcurve *c, const piece *pc, double t, int with_s,
                  oc_curve_point *out) {
   size_t i = pc->i;
   out->piece = i;
   out->t = t;
-  out->s = c_s(c)[i] + s_of_t(c, pc, t);
+  out->s = with_s ? c_s(c)[i] + s_of_t(c, pc, t) : NAN;
   out->q = t >= 1 ? pc->p[pc->deg] : oc_bez_eval(pc->p, pc->deg, t);
   tangent(c, pc, t, &out->tx, &out->ty);
   out->nx = -out->ty, out->ny = out->tx;
@@ -726,7 +727,7 @@ int oc_curve_at(const oc_pcurve *c, double s, oc_curve_point *out) {
   }
   piece pc;
   piece_at(c, lo, &pc);
-  fill(c, &pc, t_of_s(c, &pc, s - c_s(c)[lo]), out);
+  fill(c, &pc, t_of_s(c, &pc, s - c_s(c)[lo]), 1, out);
   out->end = 0;
   return 1;
 }
@@ -755,8 +756,14 @@ typedef struct pending {
   uint32_t node, lo, hi;
 } pending;
 
-int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
-                     oc_curve_point *out) {
+double oc_curve_s_at(const oc_pcurve *c, const oc_curve_point *pt) {
+  piece pc;
+  piece_at(c, pt->piece, &pc);
+  return c_s(c)[pt->piece] + s_of_t(c, &pc, pt->t);
+}
+
+static int closest(const oc_pcurve *c, double x, double y, double r, int with_s,
+                   oc_curve_point *out) {
   if (!(r >= 0) || isnan(x) || isnan(y)) return 0;
   double lim = nextafter(r * r, INFINITY), best = lim, bt = 0;
   piece bp, pc;
@@ -790,11 +797,21 @@ int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
     }
   }
   if (!found) return 0;
-  fill(c, &bp, bt, out);
+  fill(c, &bp, bt, with_s, out);
   double cr = out->tx * (y - out->q.y) - out->ty * (x - out->q.x);
   double dist = sqrt(best);
   out->d = cr < 0 ? -dist : dist;
   return 1;
+}
+
+int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
+                     oc_curve_point *out) {
+  return closest(c, x, y, r, 1, out);
+}
+
+int oc_curve_closest_t(const oc_pcurve *c, double x, double y, double r,
+                       oc_curve_point *out) {
+  return closest(c, x, y, r, 0, out);
 }
 
 int oc_curve_within(const oc_pcurve *c, double x, double y, double r) {

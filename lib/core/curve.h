@@ -102,6 +102,12 @@ int oc_curve_far_from_segment(const oc_pcurve *c, double xa, double ya,
 ** point of the distance (bezier.h). */
 int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
                      oc_curve_point *out);
+/* The same point without its arc length (out->s is NaN: computing it is
+** a third of a query), for callers that may not need it; oc_curve_s_at
+** then gives the bits oc_curve_closest puts in out->s. */
+int oc_curve_closest_t(const oc_pcurve *c, double x, double y, double r,
+                       oc_curve_point *out);
+double oc_curve_s_at(const oc_pcurve *c, const oc_curve_point *pt);
 
 /* Whether some point of the curve lies within r of (x, y) in xy: what
 ** oc_curve_closest returns, without finding the closest point (the

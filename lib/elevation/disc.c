@@ -808,12 +808,38 @@ static inline oc_etay octave_model(double e, const double g[2], double s,
   return oc_etay_flat(ae, flat1, flat0, R);
 }
 
+/* noise_taylor's sum of plain or turbulent octaves: octave_model's
+** terms, scaled and added as oc_etay_scale and oc_etay_add would (the
+** same operations in the same order: the same bits), in registers. */
+static void plain_taylor(const oc_enoise *nz, const double *ev,
+                         const double *ex, const double *ey, double R,
+                         oc_etay *o) {
+  int turb = nz->kind == OC_ENOISE_TURBULENCE;
+  double sum = 0, a = nz->amplitude, s = 1 / nz->wavelength;
+  double gx = 0, gy = 0, e0 = 0, e1 = 0, e2 = 0;
+  for (int i = 0; i < nz->octaves; i++) {
+    double g[2] = {2 * ex[i], 2 * ey[i]}, e = 2 * ev[i] - 1; /* (oc_eta) */
+    oc_etay t = octave_model(e, g, s, R, turb);              /* (inline) */
+    double q = fabs(a);
+    sum += a * t.v; /* (octave_term's value: |e| or e) */
+    gx += a * t.gx, gy += a * t.gy;
+    e0 += q * t.e0, e1 += q * t.e1, e2 += q * t.e2;
+    a = a * nz->gain;
+    s *= nz->lacunarity;
+  }
+  *o = (oc_etay){sum, gx, gy, e0, e1, e2};
+}
+
 static void noise_taylor(const oc_enoise *nz, double u, double v, double R,
                          oc_etay *o) {
   /* every octave's noise first, in one call */
   double ev[OC_ENOISE_MAXOCT], ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
   int cnt = nz->octaves;
   octave_noise(nz, u, v, cnt, ev, ex, ey);
+  if (nz->kind != OC_ENOISE_RIDGED) {
+    plain_taylor(nz, ev, ex, ey, R, o);
+    return;
+  }
   double sum = 0, a = nz->amplitude, prev = 1, s = 1 / nz->wavelength;
   oc_etay m = oc_etay_const(0), tprev = oc_etay_const(1);
   for (int i = 0; i < cnt; i++) {

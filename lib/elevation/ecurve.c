@@ -107,7 +107,8 @@ void oc_ecurve_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
   oc_curve_point pt;
   s->ax = s->ay = s->fx = s->fy = 0;
   if (want & OC_EV_ALPHA) lazy = 1; /* no f: only the nearby curve */
-  if (!oc_curve_closest(d->c, x, y, lazy ? d->R : INFINITY, &pt)) {
+  /* (the arc length only where profiles are interpolated by it) */
+  if (!oc_curve_closest_t(d->c, x, y, lazy ? d->R : INFINITY, &pt)) {
     s->a = s->f = 0;
     return;
   }
@@ -145,6 +146,7 @@ void oc_ecurve_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
     }
   }
   double t, dc, dcs = 0, c;
+  if (d->np > 1) pt.s = oc_curve_s_at(d->c, &pt);
   size_t j, i = interval(d, pt.s, &t, &j);
   if (i == j) {
     c = oc_profile_eval(d->prof[i], dl, &dc);

@@ -28,7 +28,10 @@ size_t oc_enode_size(const oc_enode *n) {
   case OC_E_IMAGE:
     return sizeof(oc_eprim);
   case OC_E_BLEND:
-    return offsetof(oc_eblend, kids) + OC_EBLEND(n)->nkids * sizeof(oc_enode *);
+    return offsetof(oc_eblend, kids) +
+           OC_EBLEND(n)->nkids * sizeof(oc_enode *) +
+           oc_eblend_grid_words(OC_EBLEND(n)->nkids, n->octaves) *
+               sizeof(uint64_t);
   case OC_E_REPLACE:
     return offsetof(oc_ebin, par);
   case OC_E_ADD:
@@ -59,6 +62,14 @@ oc_enode *oc_enode_alloc(oc_ekind kind, size_t size, oc_enode *const *kids,
     k[i] = kids[i];
     oc_enode_retain(kids[i]);
   }
+  /* (a transform's, warp's, replace's or add's A is its first child) */
+  int partial = OC_EPRIM_KIND(kind) != 0;
+  if (kind == OC_E_XFORM || kind == OC_E_WARP || kind == OC_E_REPLACE ||
+      kind == OC_E_ADD || kind == OC_E_LOD)
+    partial = nkids > 0 && kids[0]->flags & OC_EF_PARTIAL;
+  if (kind == OC_E_LOD && nkids > 1)
+    partial = partial || kids[1]->flags & OC_EF_PARTIAL;
+  n->flags = partial ? OC_EF_PARTIAL : 0;
   return n;
 }
 

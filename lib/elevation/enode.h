@@ -92,6 +92,10 @@ struct oc_enode {
 #define OC_EF_BELOW 16 /* add: with an altitude weight (below_z, fade) */
 #define OC_EF_STEPF 32 /* add: the slope weight's step a float exactly */
 #define OC_EF_LERP 64  /* replace: the lerped weight */
+/* every kind: its f model holds only where its weight is > 0 (a curve,
+** lake or image, or an operator of one in A's place: eops.c,
+** tay_partial), set by oc_enode_alloc from the kind and the children */
+#define OC_EF_PARTIAL 128
 
 /* The parameters (doubles) operators store (eops.c, lod.c). A replace
 ** stores none (its weight is a flag); an add the altitude weight's
@@ -136,14 +140,27 @@ typedef struct oc_eprim {
   void *data;     /* owned (ecurve.c, lake.c, eimage.c) */
 } oc_eprim;
 
-/* blend: 56 bytes and 8 a child. */
+/* blend: 56 bytes and 8 a child; from OC_EGRID_MIN to 64 OC_EGRID_WORDS
+** children, then its grid (eops.c): G x G cells over its box (G =
+** h.octaves), each the mask of the children whose box meets the cell,
+** W = ceil(nkids / 64) words a cell, 4 G^2 W <= 3 nkids (6 bytes a
+** child at most). A query visits the children of the cells it meets, in their
+** order, and tests their boxes as before: the same children, the same
+** sums, fewer tests. */
 typedef struct oc_eblend {
   oc_enode h;
   oc_erectf box;
   oc_eboundf glob;
   uint32_t nkids;
-  oc_enode *kids[]; /* retained */
+  oc_enode *kids[]; /* retained; then the grid's uint64_t masks */
 } oc_eblend;
+#define OC_EGRID_MIN 24
+#define OC_EGRID_WORDS 4
+
+/* The words of a blend's grid with nkids children and G cells a side. */
+static inline size_t oc_eblend_grid_words(size_t nkids, int G) {
+  return (size_t)G * (size_t)G * ((nkids + 63) / 64);
+}
 
 /* replace (64 bytes), add (64; 80 with an altitude weight, 88 with a slope
 ** weight, 100 with both and a step that is a float, else 104), lod (88). */

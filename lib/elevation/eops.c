@@ -97,31 +97,143 @@ static double clamp01(double v, int *inside) {
 
 /* ---- blend ------------------------------------------------------------ */
 
+/* The grid of a blend (enode.h): its masks, after the children. */
+static const uint64_t *grid_masks(const oc_eblend *bl) {
+  return (const uint64_t *)(const void *)(bl->kids + bl->nkids);
+}
+
+/* The cell of v on an axis from lo, s = G / (hi - lo) cells a unit: a
+** monotone function of v (rounded subtraction and product, truncation,
+** clamps), so a child's box and a query's region that share a point
+** share a cell of both their ranges. NaN gives 0 (its box tests fail). */
+static int grid_cell(double v, double lo, double s, int G) {
+  double t = (v - lo) * s;
+  if (!(t >= 0)) return 0;
+  return t >= G ? G - 1 : (int)t;
+}
+
+/* The children a query over [x0, x1] x [y0, y1] may meet: those of the
+** cells that region meets (all when the blend has no grid), as W words
+** of 64 bits visited in order:
+**   for (int w = 0; w < it.W; w++)
+**     for (uint64_t m = kid_word(&it, w); m; m &= m - 1)
+**       ... bl->kids[KID_INDEX(w, m)] ... */
+typedef struct kid_iter {
+  uint64_t m[OC_EGRID_WORDS]; /* (with a grid) */
+  size_t n;
+  int W, grid;
+} kid_iter;
+
+static void kids_in(const oc_eblend *bl, double x0, double y0, double x1,
+                    double y1, kid_iter *it) {
+  int G = bl->h.octaves;
+  size_t n = bl->nkids;
+  it->n = n, it->W = (int)((n + 63) / 64), it->grid = G != 0;
+  if (!G) return;
+  double bx = bl->box.x0, by = bl->box.y0;
+  double sx = G / ((double)bl->box.x1 - bx), sy = G / ((double)bl->box.y1 - by);
+  int i0 = grid_cell(x0, bx, sx, G), i1 = grid_cell(x1, bx, sx, G);
+  int j0 = grid_cell(y0, by, sy, G), j1 = grid_cell(y1, by, sy, G);
+  const uint64_t *g = grid_masks(bl);
+  if (n <= 64) { /* (one word a cell: the common case) */
+    uint64_t m = 0;
+    for (int j = j0; j <= j1; j++)
+      for (int i = i0; i <= i1; i++)
+        m |= g[j * G + i];
+    it->m[0] = m;
+    return;
+  }
+  int W = it->W;
+  uint64_t m[OC_EGRID_WORDS] = {0};
+  for (int j = j0; j <= j1; j++)
+    for (int i = i0; i <= i1; i++)
+      for (int w = 0; w < W; w++)
+        m[w] |= g[((size_t)j * G + i) * W + w];
+  memcpy(it->m, m, sizeof m);
+}
+
+static inline uint64_t kid_word(const kid_iter *it, int w) {
+  if (it->grid) return it->m[w];
+  size_t left = it->n - 64 * (size_t)w;
+  return left >= 64 ? ~(uint64_t)0 : ((uint64_t)1 << left) - 1;
+}
+#define KID_INDEX(w, m) (64 * (size_t)(w) + (size_t)__builtin_ctzll(m))
+
+/* The next child of it (cursor: word w, mask mk) whose box meets r; NULL
+** when none is left. */
+static inline const oc_enode *next_meeting(const oc_eblend *bl,
+                                           const kid_iter *it,
+                                           const oc_erect *r, int *w,
+                                           uint64_t *mk) {
+  for (;;) {
+    while (!*mk) {
+      if (++*w >= it->W) return NULL;
+      *mk = kid_word(it, *w);
+    }
+    const oc_enode *k = bl->kids[KID_INDEX(*w, *mk)];
+    *mk &= *mk - 1;
+    if (oc_enode_meets(k, r)) return k;
+  }
+}
+
+/* Cells a side for n children (0: no grid): 4 G^2 W <= 3 n, 6 bytes a
+** child at most, so that the Table 1 scenes stay within the paper's
+** bytes (bench_elev --bytes: fig21's 45-child blend would not with 8;
+** blends below 24 children, fig3's 18, test their children's boxes as
+** fast as a grid's cells). */
+static int grid_side(size_t n) {
+  size_t W = (n + 63) / 64;
+  if (n < OC_EGRID_MIN || W > OC_EGRID_WORDS) return 0;
+  int G = 1;
+  while ((size_t)(G + 1) * (G + 1) * W * 4 <= 3 * n)
+    G++;
+  return G;
+}
+
+/* Fills blend e's grid from its children's boxes kbox (its box stored). */
+static void grid_build(oc_eblend *bl, const oc_erect *kbox) {
+  int G = bl->h.octaves, W = (int)((bl->nkids + 63) / 64);
+  double bx = bl->box.x0, by = bl->box.y0;
+  double sx = G / ((double)bl->box.x1 - bx), sy = G / ((double)bl->box.y1 - by);
+  uint64_t *g = (uint64_t *)(void *)(bl->kids + bl->nkids);
+  for (size_t k = 0; k < bl->nkids; k++) {
+    const oc_erect *b = &kbox[k];
+    int i0 = grid_cell(b->x0, bx, sx, G), i1 = grid_cell(b->x1, bx, sx, G);
+    int j0 = grid_cell(b->y0, by, sy, G), j1 = grid_cell(b->y1, by, sy, G);
+    for (int j = j0; j <= j1; j++)
+      for (int i = i0; i <= i1; i++)
+        g[((size_t)j * G + i) * W + k / 64] |= (uint64_t)1 << (k % 64);
+  }
+}
+
 static void blend_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
                      int want, oc_enode_sample *s) {
   int grad = want & OC_EV_GRAD, only = want & OC_EV_ALPHA;
   double N = 0, S = 0, nx = 0, ny = 0, sx = 0, sy = 0;
   const oc_eblend *bl = OC_EBLEND(n);
-  for (size_t i = 0; i < bl->nkids; i++) {
-    const oc_enode *k = bl->kids[i];
-    if (!oc_enode_holds(k, x, y))
-      continue; /* alpha = 0 there: no contribution */
-    oc_enode_sample c;
-    oc_enode_ev(k, x, y, ft, grad | OC_EV_LAZY | only, &c);
-    if (only) {
+  kid_iter it;
+  kids_in(bl, x, y, x, y, &it);
+  for (int w = 0; w < it.W; w++)
+    for (uint64_t mk = kid_word(&it, w); mk; mk &= mk - 1) {
+      const oc_enode *k = bl->kids[KID_INDEX(w, mk)];
+      if (!oc_enode_holds(k, x, y))
+        continue; /* alpha = 0 there: no contribution */
+      oc_enode_sample c;
+      oc_enode_ev(k, x, y, ft, grad | OC_EV_LAZY | only, &c);
+      if (only) {
+        S += c.a;
+        continue;
+      }
+      if (c.a == 0) continue;
+      N += c.a * c.f;
       S += c.a;
-      continue;
+      if (grad) {
+        nx += c.ax * c.f + c.a * c.fx;
+        ny += c.ay * c.f + c.a * c.fy;
+        sx += c.ax;
+        sy += c.ay;
+      }
     }
-    if (c.a == 0) continue;
-    N += c.a * c.f;
-    S += c.a;
-    if (grad) {
-      nx += c.ax * c.f + c.a * c.fx;
-      ny += c.ay * c.f + c.a * c.fy;
-      sx += c.ax;
-      sy += c.ay;
-    }
-  }
   s->a = S;
   s->ax = sx;
   s->ay = sy;
@@ -185,7 +297,7 @@ static void blend_combine(const oc_ebound *kb, size_t n, int plane,
   o->la = lasum;
 }
 
-#define KB_STACK 16
+#define KB_STACK 64 /* (3 kB: blends of up to 64 children allocate nothing) */
 
 static void blend_bound_in(const oc_enode *n, const oc_erect *b,
                            const oc_efootb *fb, oc_ebound *o) {
@@ -196,15 +308,18 @@ static void blend_bound_in(const oc_enode *n, const oc_erect *b,
     return;
   }
   size_t m = 0;
-  for (size_t i = 0; i < bl->nkids; i++) {
-    const oc_enode *k = bl->kids[i];
-    if (oc_enode_meets(k, b)) {
-      oc_enode_bnd(k, b, fb, &kb[m]);
-      /* alpha = 0 on the whole box: neither the child's f nor its
-      ** weight's slope counts there */
-      m += kb[m].ahi > 0;
+  kid_iter it;
+  kids_in(bl, b->x0, b->y0, b->x1, b->y1, &it);
+  for (int w = 0; w < it.W; w++)
+    for (uint64_t mk = kid_word(&it, w); mk; mk &= mk - 1) {
+      const oc_enode *k = bl->kids[KID_INDEX(w, mk)];
+      if (oc_enode_meets(k, b)) {
+        oc_enode_bnd(k, b, fb, &kb[m]);
+        /* alpha = 0 on the whole box: neither the child's f nor its
+        ** weight's slope counts there */
+        m += kb[m].ahi > 0;
+      }
     }
-  }
   blend_combine(kb, m, 0, o);
   if (kb != stack) free(kb);
 }
@@ -230,14 +345,29 @@ oc_enode *oc_enode_blend(oc_enode *const *kids, size_t n, oc_error *err) {
     oc_seterr(err, OC_ENOMEM, "out of memory (%zu children)", n);
     goto done;
   }
-  e = oc_enode_alloc(OC_E_BLEND, offsetof(oc_eblend, kids) + n * sizeof *kids,
+  /* the grid: over a box of positive finite sides (the box as
+  ** store_derived rounds it) */
+  oc_erect u = oc_enode_box(kids[0]);
+  oc_erectf uf;
+  for (size_t i = 0; i < n; i++) {
+    kbox[i] = oc_enode_box(kids[i]);
+    u = rect_union(u, kbox[i]);
+  }
+  oc_erect_round(&u, &uf);
+  int G = grid_side(n);
+  if (!(isfinite(uf.x0) && isfinite(uf.x1) && isfinite(uf.y0) &&
+        isfinite(uf.y1) && uf.x1 > uf.x0 && uf.y1 > uf.y0))
+    G = 0;
+  e = oc_enode_alloc(OC_E_BLEND,
+                     offsetof(oc_eblend, kids) + n * sizeof *kids +
+                         oc_eblend_grid_words(n, G) * sizeof(uint64_t),
                      kids, n, err);
   if (!e) goto done;
-  for (size_t i = 0; i < n; i++) {
+  for (size_t i = 0; i < n; i++)
     oc_enode_glob(kids[i], &kb[i]);
-    kbox[i] = oc_enode_box(kids[i]);
-  }
   store_derived(e, kb, kbox);
+  e->octaves = (uint8_t)G;
+  if (G) grid_build((oc_eblend *)e, kbox);
 done:
   free(kb);
   free(kbox);
@@ -343,7 +473,7 @@ static void store_binary(oc_enode *n, const oc_enode *a, const oc_enode *b) {
 oc_enode *oc_enode_replace(oc_enode *a, oc_enode *b, int lerp, oc_error *err) {
   oc_enode *n = binary(OC_E_REPLACE, a, b, offsetof(oc_ebin, par), err);
   if (!n) return NULL;
-  n->flags = lerp ? OC_EF_LERP : 0;
+  n->flags |= lerp ? OC_EF_LERP : 0;
   store_binary(n, a, b);
   return n;
 }
@@ -634,7 +764,7 @@ oc_enode *oc_enode_add(oc_enode *a, oc_enode *b, const oc_enode_add_params *p,
               (p->slope && (double)(float)step == step ? OC_EF_STEPF : 0);
   oc_enode *n = binary(OC_E_ADD, a, b, oc_eadd_size(flags), err);
   if (!n) return NULL;
-  n->flags = (uint8_t)flags;
+  n->flags |= (uint8_t)flags;
   double *par = ((oc_ebin *)n)->par;
   if (p->below) par[P_BZ] = p->below_z, par[P_FADE] = p->fade;
   if (p->slope) {
@@ -1006,22 +1136,26 @@ static void blend_ev_row(const oc_enode *n, const double *x, double y, int cnt,
   const oc_eblend *bl = OC_EBLEND(n);
   for (int m = 0; m < cnt; m++)
     N[m] = S[m] = 0;
-  for (size_t i = 0; i < bl->nkids; i++) {
-    const oc_enode *k = bl->kids[i];
-    int i0, i1;
-    oc_enode_row_span(k, x, y, cnt, &i0, &i1);
-    if (i0 >= i1) continue;
-    oc_enode_ev_row(k, x + i0, y, i1 - i0, OC_EV_LAZY | only, kf + i0, ka + i0);
-    for (int m = i0; m < i1; m++) {
-      if (only) {
+  kid_iter it;
+  kids_in(bl, x[0], y, x[cnt > 0 ? cnt - 1 : 0], y, &it);
+  for (int w = 0; cnt > 0 && w < it.W; w++)
+    for (uint64_t mk = kid_word(&it, w); mk; mk &= mk - 1) {
+      const oc_enode *k = bl->kids[KID_INDEX(w, mk)];
+      int i0, i1;
+      oc_enode_row_span(k, x, y, cnt, &i0, &i1);
+      if (i0 >= i1) continue;
+      oc_enode_ev_row(k, x + i0, y, i1 - i0, OC_EV_LAZY | only, kf + i0,
+                      ka + i0);
+      for (int m = i0; m < i1; m++) {
+        if (only) {
+          S[m] += ka[m];
+          continue;
+        }
+        if (ka[m] == 0) continue;
+        N[m] += ka[m] * kf[m];
         S[m] += ka[m];
-        continue;
       }
-      if (ka[m] == 0) continue;
-      N[m] += ka[m] * kf[m];
-      S[m] += ka[m];
     }
-  }
   for (int m = 0; m < cnt; m++) {
     a[m] = S[m];
     if (!only) f[m] = S[m] >= T ? N[m] / S[m] : N[m] / T;
@@ -1089,18 +1223,7 @@ int oc_eop_ev_row(const oc_enode *n, const double *x, double y, int cnt,
 ** a transform, warp, level of detail, replace or add of one (in A's place:
 ** their weight is A's). Their f models are not composed as they stand. */
 static int tay_partial(const oc_enode *n) {
-  switch (n->kind) {
-  case OC_E_XFORM:
-  case OC_E_WARP:
-    return tay_partial(OC_EUN(n)->kid);
-  case OC_E_LOD:
-    return tay_partial(OC_EBIN(n)->kids[0]) || tay_partial(OC_EBIN(n)->kids[1]);
-  case OC_E_REPLACE:
-  case OC_E_ADD:
-    return tay_partial(OC_EBIN(n)->kids[0]);
-  default:
-    return OC_EPRIM_KIND(n->kind) != 0;
-  }
+  return (n->flags & OC_EF_PARTIAL) != 0; /* (oc_enode_alloc) */
 }
 
 int oc_eop_taylor_partial(const oc_enode *n) {
@@ -1126,13 +1249,51 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
   double N = 0, Nx = 0, Ny = 0; /* N and sum a_k F_k + f_k A_k */
   oc_etay S = oc_etay_const(0);
   int m = 0;
-  for (size_t i = 0; i < bl->nkids; i++) {
-    const oc_enode *k = bl->kids[i];
-    if (!oc_enode_meets(k, &ball)) continue; /* alpha_k = 0 on the disc */
+  kid_iter it;
+  kids_in(bl, ball.x0, ball.y0, ball.x1, ball.y1, &it);
+  /* the children meeting the disc (up to TAY_KIDS: kk, nk; -1 beyond);
+  ** when they are all discs, at full detail, their weights' models first
+  ** (no noise), summed as below, so that a sum crossing T (no rule: the
+  ** caller's fallback) costs no noise model */
+  const oc_enode *kk[TAY_KIDS], *k;
+  oc_etay ka[TAY_KIDS];
+  int w = 0, nk = 0, discs = !tf, jk = 0;
+  uint64_t mk = kid_word(&it, 0);
+  while ((k = next_meeting(bl, &it, &ball, &w, &mk))) {
+    if (nk == TAY_KIDS) {
+      nk = -1;
+      break;
+    }
+    kk[nk++] = k;
+    discs = discs && k->kind == OC_E_DISC;
+  }
+  if (nk < 0) { /* (the children again, one by one) */
+    w = 0, mk = kid_word(&it, 0), discs = 0;
+  } else if (discs) {
+    for (int i = 0; i < nk; i++) {
+      oc_edisc_taylor_alpha(kk[i], x, y, R, &ka[i]);
+      if (!(ka[i].v == 0 && oc_etay_is_const(&ka[i]))) oc_etay_add(&S, &ka[i]);
+    }
+    double dev = oc_etay_dev(&S, R);
+    if (!(S.v - dev >= T) && !(S.v + dev <= T)) return 0; /* (below) */
+    S = oc_etay_const(0);
+  }
+  for (;;) {
+    if (nk >= 0) {
+      if (jk == nk) break;
+      k = kk[jk];
+    } else if (!(k = next_meeting(bl, &it, &ball, &w, &mk))) {
+      break; /* (alpha_k = 0 on the disc for the others) */
+    }
     if (m == TAY_KIDS || tay_partial(k)) return 0;
     oc_etaylor c;
     /* alpha_k's model first where it is cheap (no noise) */
-    int have = oc_enode_taylor_alpha(k, x, y, R, &c.a, boxes);
+    int have = 1;
+    if (discs)
+      c.a = ka[jk];
+    else
+      have = oc_enode_taylor_alpha(k, x, y, R, &c.a, boxes);
+    jk++;
     if (have && c.a.v == 0 && c.a.gx == 0 && c.a.gy == 0) {
       /* alpha_k(p) = 0 (so grad alpha_k(p) = 0: alpha_k >= 0 is C1):
       ** alpha_k' (f_k' - f) is at most E_ak(r) sup|f_k - f|, f_k's range
@@ -1361,13 +1522,16 @@ int oc_eop_taylor_alpha(const oc_enode *n, double x, double y, double R,
     const oc_eblend *bl = OC_EBLEND(n);
     oc_erect ball = {x - R, y - R, x + R, y + R};
     *a = oc_etay_const(0);
-    for (size_t i = 0; i < bl->nkids; i++) {
-      const oc_enode *k = bl->kids[i];
-      oc_etay c;
-      if (!oc_enode_meets(k, &ball)) continue;
-      if (!oc_enode_taylor_alpha(k, x, y, R, &c, boxes)) return 0;
-      oc_etay_add(a, &c);
-    }
+    kid_iter it;
+    kids_in(bl, ball.x0, ball.y0, ball.x1, ball.y1, &it);
+    for (int w = 0; w < it.W; w++)
+      for (uint64_t mk = kid_word(&it, w); mk; mk &= mk - 1) {
+        const oc_enode *k = bl->kids[KID_INDEX(w, mk)];
+        oc_etay c;
+        if (!oc_enode_meets(k, &ball)) continue;
+        if (!oc_enode_taylor_alpha(k, x, y, R, &c, boxes)) return 0;
+        oc_etay_add(a, &c);
+      }
     return 1;
   }
   case OC_E_REPLACE:

@@ -197,6 +197,14 @@ START_TEST(closest_matches_brute_force) {
     s += ref_arclen(&pcs[cp.piece], 0, cp.t, 2000);
     ck_assert_msg(fabs(s - cp.s) < 1e-8 * oc_curve_length(c),
                   "s %.12g vs %.12g", cp.s, s);
+    /* without the arc length: the same point, s NaN, then its bits */
+    oc_curve_point ct, cq;
+    memset(&ct, 0, sizeof ct), memset(&cq, 0, sizeof cq); /* (padding) */
+    ck_assert(oc_curve_closest(c, x, y, INFINITY, &cq));
+    ck_assert(oc_curve_closest_t(c, x, y, INFINITY, &ct));
+    ck_assert(isnan(ct.s));
+    ct.s = oc_curve_s_at(c, &ct);
+    ck_assert(!memcmp(&ct, &cq, sizeof ct));
     /* within r: the reference distance against r (away from the tie) */
     for (int m = 0; m < 3; m++) {
       double rad = ref * (m == 0 ? 0.97 : m == 1 ? 1.03 : 2.5);

@@ -988,12 +988,133 @@ START_TEST(taylor_models) {
     check_taylor(all[t], &r, 400);
   printf("taylor: the largest error is %.3f of its remainder\n", tay_worst);
   ck_assert(tay_worst > 0.01); /* (the checks do reach the bounds) */
+  /* partial f models (OC_EF_PARTIAL, set at allocation): a curve's and a
+  ** lake's, and an operator's of one in A's place, a transform's of one */
+  oc_enode *rv = EOK(oc_enode_replace(river, land, 0, &err));
+  oc_enode *rvm = EOK(oc_enode_transform(rv, &xg, &err));
+  oc_enode *rvb[2] = {rvm, d[0]};
+  oc_enode *rvbl = EOK(oc_enode_blend(rvb, 2, &err));
+  const oc_enode *part[] = {river, lake, rv, rvm};
+  const oc_enode *whole[] = {d[0], land, rep, crag, moved, mix, rvbl};
+  for (size_t t = 0; t < 4; t++)
+    ck_assert(oc_eop_taylor_partial(part[t]));
+  for (size_t t = 0; t < 7; t++)
+    ck_assert(!oc_eop_taylor_partial(whole[t]));
+  oc_enode_release(rvbl);
+  oc_enode_release(rvm);
+  oc_enode_release(rv);
   oc_enode *rel[] = {land,  islets, river, rep, lrep,  crag, sadd,
                      moved, warped, lake,  mix, small, insts};
   for (size_t t = 0; t < sizeof rel / sizeof *rel; t++)
     oc_enode_release(rel[t]);
   for (int i = 0; i < 5; i++)
     oc_enode_release(d[i]);
+}
+END_TEST
+
+/* A blend's grid (enode.h, eops.c): blends of 32 and 70 children (one
+** and two words a cell; 20 keep none) answer every query with the bits of the
+*same
+** blends without their grid (every child tested in turn): values and
+** gradients under each want, rows, first-order models (f and alpha, and
+** alpha's alone) and bounds in boxes, at points inside, on cell edges and
+** outside the box, for radii from a tenth of a cell to the whole box.
+** Its bytes: 8 G^2 W after the children. */
+#ifdef __SANITIZE_ADDRESS__
+#define GRID_POINTS 150
+#else
+#define GRID_POINTS 1500
+#endif
+
+static void same_taylor(const oc_etaylor *a, const oc_etaylor *b) {
+  ck_assert(!memcmp(a, b, sizeof *a));
+}
+
+START_TEST(blend_grid_matches_flat) {
+  oc_error err;
+  enum { N = 70 };
+  oc_enode *k[N];
+  oct_rng r = oct_rng_new(77);
+  for (int i = 0; i < N; i++) {
+    double x = oct_unif(&r, -500, 500), y = oct_unif(&r, -300, 300);
+    double rad = i % 7 == 0 ? oct_unif(&r, 200, 400) : oct_unif(&r, 10, 80);
+    k[i] = disc(x, y, rad, oct_unif(&r, 10, 100), (oc_enoise_kind)(i % 4), 5,
+                rad / 2, 3);
+  }
+  /* an operator child (a float box): a moved blend of three */
+  oc_enode *three = EOK(oc_enode_blend(k + 1, 3, &err));
+  oc_enode_xform xf = {100, 50, 30, 0.7, 1, 0};
+  oc_enode *kid0 = k[0];
+  k[0] = EOK(oc_enode_transform(three, &xf, &err));
+  size_t sizes[3] = {20, 32, N};
+  int sides[3] = {0, 4, 5}; /* (none below 24), 4 G^2 W <= 3 n */
+  for (int t = 0; t < 3; t++) {
+    size_t n = sizes[t], W = (n + 63) / 64;
+    oc_enode *g = EOK(oc_enode_blend(k, n, &err));
+    oc_enode *flat = EOK(oc_enode_blend(k, n, &err));
+    ck_assert_int_eq(g->octaves, sides[t]);
+    ck_assert_uint_eq(oc_enode_size(g),
+                      56 + 8 * n + 8 * W * sides[t] * sides[t]);
+    flat->octaves = 0; /* (the same blend, every child tested) */
+    oc_erect box = oc_enode_box(g);
+    double cw = (box.x1 - box.x0) / (sides[t] ? sides[t] : 4);
+    int checked = 0;
+    for (int i = 0; i < GRID_POINTS; i++) {
+      double x = oct_unif(&r, box.x0 - 50, box.x1 + 50);
+      double y = oct_unif(&r, box.y0 - 50, box.y1 + 50);
+      if (i % 5 == 0) /* on a cell's edge */
+        x = box.x0 + cw * (double)(i / 5 % (sides[t] + 2));
+      double R = cw * pow(10, oct_unif(&r, -1, 1));
+      for (int w = 0; w < 4; w++) {
+        int want = (int[]){0, OC_EV_GRAD, OC_EV_LAZY, OC_EV_ALPHA}[w];
+        oc_enode_sample a, b;
+        oc_enode_ev(g, x, y, NULL, want, &a);
+        oc_enode_ev(flat, x, y, NULL, want, &b);
+        ck_assert(same(a.a, b.a) && same(a.ax, b.ax) && same(a.ay, b.ay));
+        if (want & OC_EV_ALPHA) continue;
+        ck_assert(same(a.f, b.f) && same(a.fx, b.fx) && same(a.fy, b.fy));
+        checked += w == 1 && a.a > 0 && a.fx != 0;
+      }
+      oc_etaylor ma, mb;
+      int ba = 0, bb = 0;
+      oc_enode_taylor(g, x, y, R, &ma, &ba);
+      oc_enode_taylor(flat, x, y, R, &mb, &bb);
+      same_taylor(&ma, &mb);
+      ck_assert_int_eq(ba, bb);
+      oc_etay aa, ab;
+      int ha = oc_enode_taylor_alpha(g, x, y, R, &aa, &ba);
+      int hb = oc_enode_taylor_alpha(flat, x, y, R, &ab, &bb);
+      ck_assert_int_eq(ha, hb);
+      if (ha) ck_assert(!memcmp(&aa, &ab, sizeof aa));
+      oc_erect q = {x - R, y - R * 0.3, x + R * 0.5, y + R};
+      oc_ebound qa, qb;
+      oc_enode_bnd(g, &q, NULL, &qa);
+      oc_enode_bnd(flat, &q, NULL, &qb);
+      ck_assert(!memcmp(&qa, &qb, sizeof qa));
+      if (i % 50 == 0) { /* a row across the box */
+        double xs[OC_EROW], fa[OC_EROW], aa2[OC_EROW], fb[OC_EROW],
+            ab2[OC_EROW];
+        for (int m = 0; m < OC_EROW; m++)
+          xs[m] = x + m * cw / 7;
+        oc_enode_ev_row(g, xs, y, OC_EROW, 0, fa, aa2);
+        oc_enode_ev_row(flat, xs, y, OC_EROW, 0, fb, ab2);
+        ck_assert(!memcmp(fa, fb, sizeof fa) && !memcmp(aa2, ab2, sizeof aa2));
+      }
+    }
+    ck_assert_int_gt(checked, GRID_POINTS / 4); /* real values */
+    oc_enode_release(g);
+    oc_enode_release(flat);
+  }
+  /* NaN: no child, as without the grid */
+  oc_enode *g = EOK(oc_enode_blend(k, N, &err));
+  oc_enode_sample s;
+  oc_enode_ev(g, NAN, 3, NULL, OC_EV_GRAD, &s);
+  ck_assert(isnan(s.f) && isnan(s.a));
+  oc_enode_release(g);
+  for (int i = 0; i < N; i++)
+    oc_enode_release(k[i]);
+  oc_enode_release(three);
+  oc_enode_release(kid0);
 }
 END_TEST
 
@@ -1017,6 +1138,7 @@ int main(void) {
   tcase_add_test(tc, rows_match_points);
   tcase_add_test(tc, add_altitude_slope_bound);
   tcase_add_test(tc, taylor_models);
+  tcase_add_test(tc, blend_grid_matches_flat);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }
