@@ -42,6 +42,14 @@ int oc_etrace(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0, double t1,
 int oc_etrace_from(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0,
                    double t1, double d0, double step, double *t, double *evals);
 
+/* oc_etrace_from that also gives, on a hit of the surface (1), the unit
+** upward normal there in *n (NULL: not wanted), from the height gradient
+** of the refinement's last sample above the surface, where the hit is;
+** one more height call, counted in *evals, when no sample gave it. */
+int oc_etrace_hit(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0,
+                  double t1, double d0, double step, double *t, oc_vec3 *n,
+                  double *evals);
+
 /* A beam: the rays o + d (w + x r + y v) for (x, y) in [x0, x1] x
 ** [y0, y1] and depth d >= 0 (w, r, v the camera's orthonormal frame, so
 ** that |w + x r + y v| >= 1). */

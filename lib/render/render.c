@@ -177,14 +177,15 @@ static void geom_pixel(const gctx *g, int i, int j, double d, double step,
                        double share, float *out) {
   oc_vec3 D = ray_vec(&g->cam, i, j);
   double len = oc_len(D), t, ev = share;
+  oc_vec3 n; /* an elevation surface's hit: its normal from the tracer */
   oc_vec3 u = oc_mul(D, 1 / len);
   memset(out, 0, OC_RG_COUNT * sizeof *out);
   int hit = 0;
   if (d == INFINITY)
     hit = 0;
   else if (g->es)
-    hit = oc_etrace_from(&g->etr, g->cam.eye, u, d * len * (1 - 1e-12), g->far,
-                         0, PIXEL_STEP * step * len, &t, &ev);
+    hit = oc_etrace_hit(&g->etr, g->cam.eye, u, d * len * (1 - 1e-12), g->far,
+                        0, PIXEL_STEP * step * len, &t, &n, &ev);
   else
     hit = oc_trace(&g->tr, g->cam.eye, u, 0, g->far, 0, &t, &ev);
   if (!hit) {
@@ -192,10 +193,9 @@ static void geom_pixel(const gctx *g, int i, int j, double d, double step,
     out[OC_RG_EVALS] = (float)ev;
     return;
   }
-  oc_vec3 p = oc_add(g->cam.eye, oc_mul(u, t)), n;
+  oc_vec3 p = oc_add(g->cam.eye, oc_mul(u, t));
   if (g->es) {
-    n = hit == 2 ? oc_etracer_wall(&g->etr, p, u)
-                 : oc_esurface_normal(g->es, p.x, p.y, &ev);
+    if (hit == 2) n = oc_etracer_wall(&g->etr, p, u);
   } else {
     oc_vec3 gr;
     oc_program_gradient(g->prog, p, &gr);

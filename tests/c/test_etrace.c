@@ -281,30 +281,46 @@ START_TEST(tree_models_against_march) {
 }
 END_TEST
 
-/* A hit is located to 1/1000 of the tolerance, on the near side: from
-** straight above (h falls along every ray, one crossing), h > 0 at the
-** hit and h <= 0 that much further. */
+/* A hit is located to 1/100 of the tolerance (etrace.c REFINE_STOP), on
+** the near side: from straight above (h falls along every ray, one
+** crossing), h > 0 at the hit and h <= 0 that much further. Its normal
+** is the height gradient's there, taken from the refinement's samples:
+** the same calls as without it. */
 START_TEST(hits_located) {
   oc_elevation src = wave_source();
   oc_esurface es = {&src, NULL, NULL, 0.5};
   oc_render_params rp = view(oct_v(1, 2, 400), oct_v(0, 0, 0), 16, 16);
   double eps_k = 0.25 * 2 * tan(rp.camera.fov * PI / 360) / 1080;
-  double eps_min = 1e-7 * 400, ev = 0;
+  double eps_min = 1e-7 * 400, ev = 0, calls = 0;
   oc_etracer tr;
   oc_etracer_init(&tr, &es, OC_TRACE_SEGMENT, eps_k, eps_min);
   for (int j = 0; j < rp.height; j++)
     for (int i = 0; i < rp.width; i++) {
       oc_vec3 d = pixel_ray(&rp, i, j), o = rp.camera.eye;
-      double t;
+      double t, tn, evn = 0;
       ck_assert_int_eq(oc_etrace(&tr, o, d, 0, 1e5, 0, &t, &ev), 1);
-      double q = t + 1e-3 * (eps_k * t + eps_min) * (1 + 1e-9);
+      double q = t + 1e-2 * (eps_k * t + eps_min) * (1 + 1e-9);
       oc_vec3 p = oct_add(o, oct_mul(d, t)), r = oct_add(o, oct_mul(d, q));
       ck_assert_msg(p.z - wave_h(&WAVE, p.x, p.y, NULL) > 0, "pixel %d %d", i,
                     j);
       ck_assert_msg(r.z - wave_h(&WAVE, r.x, r.y, NULL) <= 0,
                     "pixel %d %d: the hit %.9f is short of the surface", i, j,
                     t);
+      oc_vec3 nm;
+      ck_assert_int_eq(oc_etrace_hit(&tr, o, d, 0, 1e5, 0, 0, &tn, &nm, &evn),
+                       1);
+      ck_assert(tn == t);
+      double g[2];
+      wave_h(&WAVE, p.x, p.y, g);
+      double l = sqrt(1 + g[0] * g[0] + g[1] * g[1]);
+      ck_assert_msg(fabs(nm.x + g[0] / l) < 1e-12 &&
+                        fabs(nm.y + g[1] / l) < 1e-12 &&
+                        fabs(nm.z - 1 / l) < 1e-12,
+                    "pixel %d %d: normal %g %g %g", i, j, nm.x, nm.y, nm.z);
+      calls += evn;
     }
+  /* no call for the normals */
+  ck_assert_msg(calls == ev, "%g calls with normals, %g without", calls, ev);
 }
 END_TEST
 
@@ -641,8 +657,11 @@ START_TEST(render_heightfield) {
     hits++;
     if (q[7] < 1e-3) continue; /* a side of the block */
     double g[2], z = oc_heightfield_height(hf, q[8], q[9], g);
-    ck_assert_msg(fabs(q[10] - z) < 0.05, "P.z %g, height %g", q[10], z);
     double l = sqrt(1 + g[0] * g[0] + g[1] * g[1]);
+    /* located to 1/100 of the tolerance along the ray, where h changes
+    ** at most 1 + |grad f| a unit (and float P) */
+    double loc = 1e-2 * 0.25 * 2 * tan(25 * PI / 180) / 40 * q[4] * (1 + l);
+    ck_assert_msg(fabs(q[10] - z) < loc + 1e-3, "P.z %g, height %g", q[10], z);
     ck_assert(fabs(q[7] - 1 / l) < 1e-3);
     oc_vec3 d = oct_sub(oct_v(q[8], q[9], q[10]), rp.camera.eye);
     ck_assert(fabs(oct_len(d) - q[4]) < 1e-2);
