@@ -254,6 +254,35 @@ static double model_step(double h, const double g[2], const double E[3],
   return lesser(s, e);
 }
 
+/* The step along q0 + s D (s >= 0) that the model m proves free of the
+** surface, up to smax: the first zero of its lower bound on the height,
+** L(q) = q_z - f - g.(q - p)_xy - E(|q - p|_xy) <= h(q), where |q -
+** p|_xy <= ra + s |D_xy| (ra = |q0 - p|_xy; E is nondecreasing), so
+** that L >= c0 - c1 s - c2 s^2 (model_step's form, *c0 the bound at q0),
+** and no farther than the model's disc; 0 where L(q0) <= 0 or q0 is off
+** the disc. */
+static double model_free(const oc_emodel *m, oc_vec3 q0, oc_vec3 D, double smax,
+                         double *lo) {
+  double ax = q0.x - m->x, ay = q0.y - m->y, ra = hypot(ax, ay);
+  double dxy = hypot(D.x, D.y);
+  const double *g = m->g, *E = m->E;
+  *lo = 0;
+  if (!(ra < m->R)) return 0;
+  double c0 =
+      q0.z - m->f - (g[0] * ax + g[1] * ay) - (E[0] + ra * (E[1] + ra * E[2]));
+  if (!(c0 > 0)) return 0;
+  *lo = c0;
+  if (dxy > 0) smax = lesser(smax, (m->R - ra) / dxy);
+  double k = D.z - (g[0] * D.x + g[1] * D.y);
+  double c1 = (E[1] + 2 * E[2] * ra) * dxy - k, c2 = E[2] * dxy * dxy, r;
+  if (c2 > 0)
+    r = 2 * c0 / (c1 + sqrt(c1 * c1 + 4 * c2 * c0));
+  else
+    r = c1 > 0 ? c0 / c1 : smax;
+  /* a hair short of the zero, where L may be 0 */
+  return lesser(r, smax) * (1 - 1e-9);
+}
+
 /* The step the candidate segment's box bound proves from a sample at
 ** height h (march's rule): *slope the slope's step (and *lam its bound),
 ** the step returned is that or, for a descending ray, the way down to the
@@ -297,13 +326,24 @@ static double box_step(const oc_etracer *tr, oc_vec3 p, oc_vec3 u, double uxy,
 ** the stretch behind it free; else the ray takes the plain step. Steps,
 ** hits, holes and walls are march's. */
 static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
-                        double t1, double d0, double delta0, double *thit,
-                        double *n, double ga[2], int *ga_ok) {
+                        double t1, double d0, double delta0,
+                        const oc_emodel *m0, double *thit, double *n,
+                        double ga[2], int *ga_ok) {
   const oc_elevation *src = tr->s->src;
   double uxy = hypot(u.x, u.y), delta = (t1 - t) / 16, prev = t, hp = 0;
   oc_vec3 ub = {-u.x, -u.y, -u.z};
   int have_prev = 0, relaxed = 0, model = 0;
   if (delta0 > 0) delta = delta0, model = 1;
+  if (model && m0 && m0->ok) {
+    /* a first step on the beam's model, no call: from t, where the
+    ** height is at least lo > 0 */
+    double lo, s = model_free(m0, at(o, u, t), u, t1 - t, &lo);
+    if (s > 0) {
+      prev = t, hp = lo, have_prev = 1;
+      t += s;
+      if (t >= t1) return 0;
+    }
+  }
   double rsafe = 0, rlam = 0; /* a relaxed step's proved part and slope */
   for (long k = 0; k < OC_TRACE_MAX_STEPS; k++) {
     oc_vec3 p = at(o, u, t);
@@ -389,10 +429,10 @@ static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
 }
 
 static int march(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
-                 double t1, double d0, double delta0, double *thit, double *n,
-                 double ga[2], int *ga_ok) {
+                 double t1, double d0, double delta0, const oc_emodel *m0,
+                 double *thit, double *n, double ga[2], int *ga_ok) {
   if (tr->mode == OC_TRACE_SEGMENT && tr->s->src->taylor)
-    return march_taylor(tr, o, u, t, t1, d0, delta0, thit, n, ga, ga_ok);
+    return march_taylor(tr, o, u, t, t1, d0, delta0, m0, thit, n, ga, ga_ok);
   const oc_elevation *src = tr->s->src;
   double uxy = hypot(u.x, u.y), delta = (t1 - t) / 16, prev = t, hp = 0;
   int accel = tr->mode == OC_TRACE_SEGMENT, have_prev = 0, relaxed = 0;
@@ -481,12 +521,12 @@ int oc_etrace(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0, double t1,
 int oc_etrace_from(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0,
                    double t1, double d0, double step, double *t,
                    double *evals) {
-  return oc_etrace_hit(tr, o, u, t0, t1, d0, step, t, NULL, evals);
+  return oc_etrace_hit(tr, o, u, t0, t1, d0, step, NULL, t, NULL, evals);
 }
 
 int oc_etrace_hit(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0,
-                  double t1, double d0, double step, double *t, oc_vec3 *nrm,
-                  double *evals) {
+                  double t1, double d0, double step, const oc_emodel *m,
+                  double *t, oc_vec3 *nrm, double *evals) {
   *t = INFINITY;
   double ts = t0;
   if (!clip(tr, o, u, &t0, &t1)) return 0;
@@ -494,7 +534,8 @@ int oc_etrace_hit(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0,
   if (t0 > ts) step = 0;
   double g[2];
   int g_ok = 0;
-  int hit = march(tr, o, u, t0, t1, d0, step, t, evals, nrm ? g : NULL, &g_ok);
+  int hit =
+      march(tr, o, u, t0, t1, d0, step, m, t, evals, nrm ? g : NULL, &g_ok);
   if (!hit) *t = INFINITY;
   if (hit == 1 && nrm) {
     if (g_ok) {
@@ -582,7 +623,8 @@ static oc_vec3 beam_dir(const oc_ebeam *b, double x, double y) {
 ** the step falls under BSTOP of the beam's width there (its rays' hits
 ** then differ: its parts go on). */
 static double beam_models(const oc_etracer *tr, const oc_ebeam *b, double d,
-                          double far, double e, double *evals, double *next) {
+                          double far, double e, double *evals, double *next,
+                          oc_emodel *m) {
   const oc_elevation *src = tr->s->src;
   oc_vec3 c = beam_dir(b, 0.5 * (b->x0 + b->x1), 0.5 * (b->y0 + b->y1));
   oc_vec3 D[4];
@@ -593,6 +635,14 @@ static double beam_models(const oc_etracer *tr, const oc_ebeam *b, double d,
     bxy[j] = hypot(D[j].x, D[j].y);
   }
   double width = greater(b->x1 - b->x0, b->y1 - b->y0);
+  if (m->ok && d < far) {
+    /* a first step on the enclosing beam's last model, no call: the least
+    ** its corners' rays take */
+    double s = lesser(e, far - d), lo;
+    for (int j = 0; j < 4 && s > 0; j++)
+      s = lesser(s, model_free(m, at(b->o, D[j], d), D[j], s, &lo));
+    if (s > 0) d += s;
+  }
   for (long k = 0; k < OC_TRACE_MAX_STEPS; k++) {
     *next = e;
     if (d >= far) return INFINITY;
@@ -603,8 +653,9 @@ static double beam_models(const oc_etracer *tr, const oc_ebeam *b, double d,
     oc_vec3 p = at(b->o, c, d);
     double g[2], E[3];
     (*evals)++;
-    double h = p.z - src->taylor(src->ud, p.x, p.y, R, g, E, NULL);
+    double f = src->taylor(src->ud, p.x, p.y, R, g, E, NULL), h = p.z - f;
     if (!(h == h)) return d; /* NaN: nothing proved */
+    *m = (oc_emodel){1, p.x, p.y, f, R, {g[0], g[1]}, {E[0], E[1], E[2]}};
     double s = e;
     for (int j = 0; j < 4; j++) {
       double ax = d * (D[j].x - c.x), ay = d * (D[j].y - c.y),
@@ -631,10 +682,12 @@ static double beam_models(const oc_etracer *tr, const oc_ebeam *b, double d,
 }
 
 double oc_etrace_beam(const oc_etracer *tr, const oc_ebeam *b, double d,
-                      double dmax, double *bounds, double *evals,
-                      double *next) {
+                      double dmax, double *bounds, double *evals, double *next,
+                      oc_emodel *m) {
   double unused = 0, from = next ? *next : 0;
+  oc_emodel none = {0};
   if (!next) next = &unused;
+  if (!m) m = &none;
   *next = 0;
   /* past the farthest corner of the domain's box no ray is in it (a ray
   ** at depth d is at least d from o) */
@@ -661,7 +714,8 @@ double oc_etrace_beam(const oc_etracer *tr, const oc_ebeam *b, double d,
     }
     if (e <= greater(0.5 * width * d, tol(tr, 0, d))) {
       if (models)
-        return beam_models(tr, b, d, far, BEAM_STEP * width * d, evals, next);
+        return beam_models(tr, b, d, far, BEAM_STEP * width * d, evals, next,
+                           m);
       return d;
     }
     e *= 0.5;
