@@ -27,9 +27,11 @@
 **  - Sphere tracing (`OC_TRACE_SPHERE`, section 7.1) uses the slope bound of
 **    the whole domain for every step: the baseline the paper compares to.
 ** Both clip the ray to the domain x [min f, max f] first, never step below
-** the pixel-footprint tolerance of trace.c, and count a hit at the first
-** sample on or below the surface (where the weight allows one), located
-** by regula falsi between it and the sample before. A hole's edge (where
+** the pixel-footprint tolerance of trace.c nor leave more than that
+** unproved, and count a hit at the first sample on or below the surface
+** (where the weight allows one), located between it and the sample
+** before by samples with gradients (refine), the last of which above the
+** surface gives the normal. A hole's edge (where
 ** the weight falls below T) is not bounded by the slopes: over a hole the
 ** steps are the slopes' as elsewhere (a ray may cross an edge within one
 ** step), and under its surface the tolerance, so that a ray passing under
