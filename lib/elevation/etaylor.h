@@ -41,8 +41,13 @@ typedef struct oc_etaylor {
 ** taken: the tracer's steps end well inside the candidate's disc. On
 ** bench_elev -qq, 1, 0.5, 0.25, 0.1 gave fig3 23.8, 20.2, 19.5, 23.3
 ** calls a pixel (without over-relaxation), 0.5, 0.35, 0.2, 0.1 gave 17.3,
-** 15.9, 14.9, 16.2 with it. */
-#define OC_ETAY_CHOICE 0.25
+** 15.9, 14.9, 16.2 with it. Since the tracer hands its beams' models on
+** and aims at the models' zeros (render/etrace.c), at bench_elev -q
+** (fig3, fig22, fig1, fig20) 0.15, 0.25, 0.35, 0.4, 0.5, 0.6, 0.7 gave
+** fig3 9.8, 8.9, 8.4, 8.3, 8.2, 8.4, 8.7 and fig22 13.6, 12.7, 12.2,
+** 12.1, 12.0, 12.1, 12.4; 0.4, 0.5, 0.6 fig1 11.8, 11.7, 11.9 (0.25:
+** 12.9) and fig20 12.8, 12.6, 12.8 (13.9). */
+#define OC_ETAY_CHOICE 0.5
 static inline oc_etay oc_etay_const(double c) {
   return (oc_etay){c, 0, 0, 0, 0, 0};
 }

@@ -27,9 +27,11 @@
 **  - Sphere tracing (`OC_TRACE_SPHERE`, section 7.1) uses the slope bound of
 **    the whole domain for every step: the baseline the paper compares to.
 ** Both clip the ray to the domain x [min f, max f] first, never step below
-** the pixel-footprint tolerance of trace.c, and count a hit at the first
-** sample on or below the surface (where the weight allows one), located
-** by regula falsi between it and the sample before. A hole's edge (where
+** the pixel-footprint tolerance of trace.c nor leave more than that
+** unproved, and count a hit at the first sample on or below the surface
+** (where the weight allows one), located between it and the sample
+** before by samples with gradients (refine), the last of which above the
+** surface gives the normal. A hole's edge (where
 ** the weight falls below T) is not bounded by the slopes: over a hole the
 ** steps are the slopes' as elsewhere (a ray may cross an edge within one
 ** step), and under its surface the tolerance, so that a ray passing under
@@ -83,6 +85,21 @@
 ** gave 13.0, 12.9, 12.9 (BSTOP 0.1). */
 #define BEAM_STEP 0.5
 #define BSTOP 0.2
+/* A hit is located to REFINE_STOP of the tolerance (refine). Measured on
+** bench_elev -q fig3 (calls a pixel, refinement and normals): Illinois
+** to 1e-3 with a normal call 10.8; samples with gradients (the normal
+** from the last above the surface), 1e-3, 1e-2, 5e-2 gave 9.9, 9.6, 9.4
+** (5e-2 turned 14 normals by more than a degree). */
+#define REFINE_STOP 1e-2
+/* A ray on models whose next zero (by the model's linear part) is
+** within a tolerance of the stretch it proved free samples AIM_PAST
+** tolerances past it, at least AIM_LEAST tolerances on. Measured on
+** bench_elev -q fig3 (calls a pixel, from 9.6): a tolerance past the
+** proved stretch 9.4; AIM_PAST 0.03, 0.1, 0.2 (AIM_LEAST 0) 9.2, 9.1,
+** 9.2; AIM_LEAST 0.25, 0.5 9.1, 9.2 (the floor keeps a ray grazing a
+** ridge from stepping by hairs). */
+#define AIM_PAST 0.1
+#define AIM_LEAST 0.25
 
 void oc_etracer_init(oc_etracer *tr, const oc_esurface *s,
                      oc_render_tracer mode, double eps_k, double eps_min) {
@@ -108,6 +125,14 @@ static inline oc_vec3 at(oc_vec3 o, oc_vec3 u, double t) {
 
 static inline double tol(const oc_etracer *tr, double d0, double t) {
   return tr->eps_k * (d0 + t) + tr->eps_min;
+}
+
+/* The unit upward normal of a surface whose height gradient is g. */
+static oc_vec3 normal_of(const double g[2]) {
+  oc_vec3 n = {-g[0], -g[1], 1};
+  double l = sqrt(n.x * n.x + n.y * n.y + 1);
+  if (!isfinite(l)) return (oc_vec3){0, 0, 1};
+  return (oc_vec3){n.x / l, n.y / l, 1 / l};
 }
 
 /* [t0, t1] clipped to the tracer's box; 0 when the ray misses it. */
@@ -151,25 +176,42 @@ static double height_above(const oc_etracer *tr, oc_vec3 p, int *solid,
   return h;
 }
 
-/* h(a) = ha > 0 >= h(b) = hb: regula falsi (Illinois), down to a small
-** fraction of the tolerance, keeping the end above the surface. */
+/* h(a) = ha > 0 >= h(b) = hb: the root located to REFINE_STOP of the
+** tolerance, keeping the end above the surface (returned). Each sample is
+** a height call with its gradient, whose derivative along the ray
+** (u_z - grad f . u_xy) gives a Newton estimate of the root from it (the
+** bracket's secant at first, or where Newton leaves the bracket); near
+** an end of the bracket the next sample goes a little past the estimate,
+** to close the bracket in one call. Where that does not halve the
+** bracket in three samples, bisection. ga (when not NULL) gets the
+** gradient at the returned end, *ga_ok whether a sample there gave it. */
 static double refine(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double a,
-                     double ha, double b, double hb, double d0, double *n) {
-  double stop = 1e-3 * tol(tr, d0, a);
-  int side = 0;
+                     double ha, double b, double hb, double d0, double *n,
+                     double ga[2], int *ga_ok) {
+  const oc_elevation *src = tr->s->src;
+  double stop = REFINE_STOP * tol(tr, d0, a);
+  double r = a + (b - a) * (ha / (ha - hb)), w = b - a;
   for (int k = 0; k < 24 && b - a > stop; k++) {
-    double m = a + (b - a) * (ha / (ha - hb));
-    if (!(m > a && m < b) || k % 4 == 3) m = 0.5 * (a + b);
-    double h = height_above(tr, at(o, u, m), NULL, n);
+    double m = r;
+    if (r - a <= 0.6 * stop)
+      m = r + 0.4 * stop; /* just past the root: closes the bracket */
+    else if (b - r <= 0.6 * stop)
+      m = r - 0.4 * stop;
+    if (!(m > a && m < b) || (k % 3 == 2 && b - a > 0.5 * w)) m = 0.5 * (a + b);
+    if (k % 3 == 2) w = b - a;
+    oc_vec3 p = at(o, u, m);
+    double g[2];
+    (*n)++;
+    double h = p.z - src->height(src->ud, p.x, p.y, g);
     if (h > 0) {
       a = m, ha = h;
-      if (side == -1) hb *= 0.5;
-      side = -1;
+      if (ga) ga[0] = g[0], ga[1] = g[1], *ga_ok = 1;
     } else {
       b = m, hb = h;
-      if (side == 1) ha *= 0.5;
-      side = 1;
     }
+    double kd = u.z - (g[0] * u.x + g[1] * u.y);
+    r = kd < 0 ? m - h / kd : NAN;
+    if (!(r > a && r < b)) r = a + (b - a) * (ha / (ha - hb));
   }
   return a;
 }
@@ -212,6 +254,35 @@ static double model_step(double h, const double g[2], const double E[3],
   else
     s = c1 > 0 ? c0 / c1 : e;
   return lesser(s, e);
+}
+
+/* The step along q0 + s D (s >= 0) that the model m proves free of the
+** surface, up to smax: the first zero of its lower bound on the height,
+** L(q) = q_z - f - g.(q - p)_xy - E(|q - p|_xy) <= h(q), where |q -
+** p|_xy <= ra + s |D_xy| (ra = |q0 - p|_xy; E is nondecreasing), so
+** that L >= c0 - c1 s - c2 s^2 (model_step's form, *c0 the bound at q0),
+** and no farther than the model's disc; 0 where L(q0) <= 0 or q0 is off
+** the disc. */
+static double model_free(const oc_emodel *m, oc_vec3 q0, oc_vec3 D, double smax,
+                         double *lo) {
+  double ax = q0.x - m->x, ay = q0.y - m->y, ra = hypot(ax, ay);
+  double dxy = hypot(D.x, D.y);
+  const double *g = m->g, *E = m->E;
+  *lo = 0;
+  if (!(ra < m->R)) return 0;
+  double c0 =
+      q0.z - m->f - (g[0] * ax + g[1] * ay) - (E[0] + ra * (E[1] + ra * E[2]));
+  if (!(c0 > 0)) return 0;
+  *lo = c0;
+  if (dxy > 0) smax = lesser(smax, (m->R - ra) / dxy);
+  double k = D.z - (g[0] * D.x + g[1] * D.y);
+  double c1 = (E[1] + 2 * E[2] * ra) * dxy - k, c2 = E[2] * dxy * dxy, r;
+  if (c2 > 0)
+    r = 2 * c0 / (c1 + sqrt(c1 * c1 + 4 * c2 * c0));
+  else
+    r = c1 > 0 ? c0 / c1 : smax;
+  /* a hair short of the zero, where L may be 0 */
+  return lesser(r, smax) * (1 - 1e-9);
 }
 
 /* The step the candidate segment's box bound proves from a sample at
@@ -257,13 +328,24 @@ static double box_step(const oc_etracer *tr, oc_vec3 p, oc_vec3 u, double uxy,
 ** the stretch behind it free; else the ray takes the plain step. Steps,
 ** hits, holes and walls are march's. */
 static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
-                        double t1, double d0, double delta0, double *thit,
-                        double *n) {
+                        double t1, double d0, double delta0,
+                        const oc_emodel *m0, double *thit, double *n,
+                        double ga[2], int *ga_ok) {
   const oc_elevation *src = tr->s->src;
   double uxy = hypot(u.x, u.y), delta = (t1 - t) / 16, prev = t, hp = 0;
   oc_vec3 ub = {-u.x, -u.y, -u.z};
   int have_prev = 0, relaxed = 0, model = 0;
   if (delta0 > 0) delta = delta0, model = 1;
+  if (model && m0 && m0->ok) {
+    /* a first step on the beam's model, no call: from t, where the
+    ** height is at least lo > 0 */
+    double lo, s = model_free(m0, at(o, u, t), u, t1 - t, &lo);
+    if (s > 0) {
+      prev = t, hp = lo, have_prev = 1;
+      t += s;
+      if (t >= t1) return 0;
+    }
+  }
   double rsafe = 0, rlam = 0; /* a relaxed step's proved part and slope */
   for (long k = 0; k < OC_TRACE_MAX_STEPS; k++) {
     oc_vec3 p = at(o, u, t);
@@ -293,7 +375,8 @@ static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
         *thit = t; /* through a side of the domain or of a hole */
         return 2;
       }
-      *thit = tr->refine ? refine(tr, o, u, prev, hp, t, h, d0, n) : t;
+      *thit =
+          tr->refine ? refine(tr, o, u, prev, hp, t, h, d0, n, ga, ga_ok) : t;
       return 1;
     }
     /* under the surface in a hole: the tolerance (its wall may be near) */
@@ -310,7 +393,19 @@ static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
       if (proved < TSW * e) next = 1;
     }
     proved = lesser(proved, e);
-    double s = greater(proved, tol(tr, d0, t));
+    double tl = tol(tr, d0, t), s = greater(proved, tl);
+    if (model && next && h > 0 && proved < e) {
+      /* the zero z of the model's linear part (a Newton step) within a
+      ** tolerance past the proved stretch: the sample goes AIM_PAST
+      ** tolerances past z, likely just under the surface, so that the
+      ** hit's bracket is short (not nearer than AIM_LEAST tolerances,
+      ** nor farther than one past the proved stretch: unproved no longer
+      ** than a tolerance step from there) */
+      double k = u.z - (g[0] * u.x + g[1] * u.y);
+      if (k < 0 && h < -k * (proved + tl))
+        s = lesser(proved + tl, greater(greater(proved, AIM_LEAST * tl),
+                                        h / -k + AIM_PAST * tl));
+    }
     if (t + s == t || t + proved >= t1 || t >= t1) return 0; /* left it */
     if (t + s > t1) s = t1 - t; /* (as march: sample the box's end) */
     prev = t, hp = h, have_prev = 1;
@@ -336,9 +431,10 @@ static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
 }
 
 static int march(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
-                 double t1, double d0, double delta0, double *thit, double *n) {
+                 double t1, double d0, double delta0, const oc_emodel *m0,
+                 double *thit, double *n, double ga[2], int *ga_ok) {
   if (tr->mode == OC_TRACE_SEGMENT && tr->s->src->taylor)
-    return march_taylor(tr, o, u, t, t1, d0, delta0, thit, n);
+    return march_taylor(tr, o, u, t, t1, d0, delta0, m0, thit, n, ga, ga_ok);
   const oc_elevation *src = tr->s->src;
   double uxy = hypot(u.x, u.y), delta = (t1 - t) / 16, prev = t, hp = 0;
   int accel = tr->mode == OC_TRACE_SEGMENT, have_prev = 0, relaxed = 0;
@@ -367,7 +463,8 @@ static int march(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
         *thit = t; /* through a side of the domain or of a hole */
         return 2;
       }
-      *thit = tr->refine ? refine(tr, o, u, prev, hp, t, h, d0, n) : t;
+      *thit =
+          tr->refine ? refine(tr, o, u, prev, hp, t, h, d0, n, ga, ga_ok) : t;
       return 1;
     }
     double s, grow = -1, rlam_of_step = 0;
@@ -426,13 +523,30 @@ int oc_etrace(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0, double t1,
 int oc_etrace_from(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0,
                    double t1, double d0, double step, double *t,
                    double *evals) {
+  return oc_etrace_hit(tr, o, u, t0, t1, d0, step, NULL, t, NULL, evals);
+}
+
+int oc_etrace_hit(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0,
+                  double t1, double d0, double step, const oc_emodel *m,
+                  double *t, oc_vec3 *nrm, double *evals) {
   *t = INFINITY;
   double ts = t0;
   if (!clip(tr, o, u, &t0, &t1)) return 0;
   /* entering the box after the start: the step does not apply */
   if (t0 > ts) step = 0;
-  int hit = march(tr, o, u, t0, t1, d0, step, t, evals);
+  double g[2];
+  int g_ok = 0;
+  int hit =
+      march(tr, o, u, t0, t1, d0, step, m, t, evals, nrm ? g : NULL, &g_ok);
   if (!hit) *t = INFINITY;
+  if (hit == 1 && nrm) {
+    if (g_ok) {
+      *nrm = normal_of(g);
+    } else {
+      oc_vec3 p = at(o, u, *t);
+      *nrm = oc_esurface_normal(tr->s, p.x, p.y, evals);
+    }
+  }
   return hit;
 }
 
@@ -511,7 +625,8 @@ static oc_vec3 beam_dir(const oc_ebeam *b, double x, double y) {
 ** the step falls under BSTOP of the beam's width there (its rays' hits
 ** then differ: its parts go on). */
 static double beam_models(const oc_etracer *tr, const oc_ebeam *b, double d,
-                          double far, double e, double *evals, double *next) {
+                          double far, double e, double *evals, double *next,
+                          oc_emodel *m) {
   const oc_elevation *src = tr->s->src;
   oc_vec3 c = beam_dir(b, 0.5 * (b->x0 + b->x1), 0.5 * (b->y0 + b->y1));
   oc_vec3 D[4];
@@ -522,6 +637,14 @@ static double beam_models(const oc_etracer *tr, const oc_ebeam *b, double d,
     bxy[j] = hypot(D[j].x, D[j].y);
   }
   double width = greater(b->x1 - b->x0, b->y1 - b->y0);
+  if (m->ok && d < far) {
+    /* a first step on the enclosing beam's last model, no call: the least
+    ** its corners' rays take */
+    double s = lesser(e, far - d), lo;
+    for (int j = 0; j < 4 && s > 0; j++)
+      s = lesser(s, model_free(m, at(b->o, D[j], d), D[j], s, &lo));
+    if (s > 0) d += s;
+  }
   for (long k = 0; k < OC_TRACE_MAX_STEPS; k++) {
     *next = e;
     if (d >= far) return INFINITY;
@@ -532,8 +655,9 @@ static double beam_models(const oc_etracer *tr, const oc_ebeam *b, double d,
     oc_vec3 p = at(b->o, c, d);
     double g[2], E[3];
     (*evals)++;
-    double h = p.z - src->taylor(src->ud, p.x, p.y, R, g, E, NULL);
+    double f = src->taylor(src->ud, p.x, p.y, R, g, E, NULL), h = p.z - f;
     if (!(h == h)) return d; /* NaN: nothing proved */
+    *m = (oc_emodel){1, p.x, p.y, f, R, {g[0], g[1]}, {E[0], E[1], E[2]}};
     double s = e;
     for (int j = 0; j < 4; j++) {
       double ax = d * (D[j].x - c.x), ay = d * (D[j].y - c.y),
@@ -560,10 +684,12 @@ static double beam_models(const oc_etracer *tr, const oc_ebeam *b, double d,
 }
 
 double oc_etrace_beam(const oc_etracer *tr, const oc_ebeam *b, double d,
-                      double dmax, double *bounds, double *evals,
-                      double *next) {
+                      double dmax, double *bounds, double *evals, double *next,
+                      oc_emodel *m) {
   double unused = 0, from = next ? *next : 0;
+  oc_emodel none = {0};
   if (!next) next = &unused;
+  if (!m) m = &none;
   *next = 0;
   /* past the farthest corner of the domain's box no ray is in it (a ray
   ** at depth d is at least d from o) */
@@ -590,7 +716,8 @@ double oc_etrace_beam(const oc_etracer *tr, const oc_ebeam *b, double d,
     }
     if (e <= greater(0.5 * width * d, tol(tr, 0, d))) {
       if (models)
-        return beam_models(tr, b, d, far, BEAM_STEP * width * d, evals, next);
+        return beam_models(tr, b, d, far, BEAM_STEP * width * d, evals, next,
+                           m);
       return d;
     }
     e *= 0.5;
@@ -624,8 +751,5 @@ oc_vec3 oc_esurface_normal(const oc_esurface *s, double x, double y,
   double g[2] = {0, 0};
   s->src->height(s->src->ud, x, y, g);
   (*evals)++;
-  oc_vec3 n = {-g[0], -g[1], 1};
-  double l = sqrt(n.x * n.x + n.y * n.y + 1);
-  if (!isfinite(l)) return (oc_vec3){0, 0, 1};
-  return (oc_vec3){n.x / l, n.y / l, 1 / l};
+  return normal_of(g);
 }

@@ -42,6 +42,24 @@ int oc_etrace(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0, double t1,
 int oc_etrace_from(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0,
                    double t1, double d0, double step, double *t, double *evals);
 
+/* A first-order model of the height around (x, y) (oc_elevation's
+** taylor, radius R): |f(q) - f - g.(q - (x, y))| <= E[0] + E[1] r + E[2]
+** r^2 for r = |q - (x, y)| <= R. ok 0: none. */
+typedef struct oc_emodel {
+  int ok;
+  double x, y, f, R, g[2], E[3];
+} oc_emodel;
+
+/* oc_etrace_from that also gives, on a hit of the surface (1), the unit
+** upward normal there in *n (NULL: not wanted), from the height gradient
+** of the refinement's last sample above the surface, where the hit is;
+** one more height call, counted in *evals, when no sample gave it. m
+** (when not NULL and ok, with step > 0): a model the ray's first step
+** may take without a call (its beam's last, oc_etrace_beam). */
+int oc_etrace_hit(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0,
+                  double t1, double d0, double step, const oc_emodel *m,
+                  double *t, oc_vec3 *n, double *evals);
+
 /* A beam: the rays o + d (w + x r + y v) for (x, y) in [x0, x1] x
 ** [y0, y1] and depth d >= 0 (w, r, v the camera's orthonormal frame, so
 ** that |w + x r + y v| >= 1). */
@@ -61,9 +79,13 @@ typedef struct oc_ebeam {
 ** (when not NULL): on entry a candidate step (in depth) to begin with, 0
 ** for the default (a part of a beam passes its beam's); on return the
 ** candidate for the rays' march on models from there, 0 when the beam
-** made no model step. */
+** made no model step. *m (when not NULL): on entry a model the beam's
+** first step on models may take without a call (its enclosing beam's
+** last), on return the last model the beam queried (unchanged when it
+** queried none). */
 double oc_etrace_beam(const oc_etracer *tr, const oc_ebeam *b, double d,
-                      double dmax, double *bounds, double *evals, double *next);
+                      double dmax, double *bounds, double *evals, double *next,
+                      oc_emodel *m);
 
 /* The outward normal of the wall hit at p by a ray along u: the nearest
 ** face of the box, or -u for a hole's wall. */

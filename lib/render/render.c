@@ -174,17 +174,18 @@ typedef struct gctx {
 ** distance along w; INFINITY: a miss); share: the height calls of the
 ** beams that took it there, its part of them (counted in its evals). */
 static void geom_pixel(const gctx *g, int i, int j, double d, double step,
-                       double share, float *out) {
+                       const oc_emodel *m, double share, float *out) {
   oc_vec3 D = ray_vec(&g->cam, i, j);
   double len = oc_len(D), t, ev = share;
+  oc_vec3 n; /* an elevation surface's hit: its normal from the tracer */
   oc_vec3 u = oc_mul(D, 1 / len);
   memset(out, 0, OC_RG_COUNT * sizeof *out);
   int hit = 0;
   if (d == INFINITY)
     hit = 0;
   else if (g->es)
-    hit = oc_etrace_from(&g->etr, g->cam.eye, u, d * len * (1 - 1e-12), g->far,
-                         0, PIXEL_STEP * step * len, &t, &ev);
+    hit = oc_etrace_hit(&g->etr, g->cam.eye, u, d * len * (1 - 1e-12), g->far,
+                        0, PIXEL_STEP * step * len, m, &t, &n, &ev);
   else
     hit = oc_trace(&g->tr, g->cam.eye, u, 0, g->far, 0, &t, &ev);
   if (!hit) {
@@ -192,10 +193,9 @@ static void geom_pixel(const gctx *g, int i, int j, double d, double step,
     out[OC_RG_EVALS] = (float)ev;
     return;
   }
-  oc_vec3 p = oc_add(g->cam.eye, oc_mul(u, t)), n;
+  oc_vec3 p = oc_add(g->cam.eye, oc_mul(u, t));
   if (g->es) {
-    n = hit == 2 ? oc_etracer_wall(&g->etr, p, u)
-                 : oc_esurface_normal(g->es, p.x, p.y, &ev);
+    if (hit == 2) n = oc_etracer_wall(&g->etr, p, u);
   } else {
     oc_vec3 gr;
     oc_program_gradient(g->prog, p, &gr);
@@ -216,10 +216,10 @@ static void geom_pixel(const gctx *g, int i, int j, double d, double step,
 
 /* The pixels [i0, i1) x [j0, j1), each ray from depth d. */
 static void geom_pixels(const gctx *g, int i0, int j0, int i1, int j1, double d,
-                        double step, double share) {
+                        double step, const oc_emodel *m, double share) {
   for (int j = j0; j < j1; j++)
     for (int i = i0; i < i1; i++)
-      geom_pixel(g, i, j, d, step, share,
+      geom_pixel(g, i, j, d, step, m, share,
                  g->px + ((size_t)j * g->cam.width + i) * OC_RG_COUNT);
 }
 
@@ -234,35 +234,35 @@ static void geom_pixels(const gctx *g, int i0, int j0, int i1, int j1, double d,
 ** made; step is the candidate step the enclosing beam ended with (0:
 ** none). */
 static void beam_block(const gctx *g, int i0, int j0, int i1, int j1, double d,
-                       double step, double share) {
+                       double step, oc_emodel m, double share) {
   int w = i1 - i0, h = j1 - j0;
   if (d != INFINITY) {
     oc_ebeam b;
     double calls = 0;
     beam_for(&g->cam, i0, j0, i1, j1, &b);
-    d = oc_etrace_beam(&g->etr, &b, d, g->far, NULL, &calls, &step);
+    d = oc_etrace_beam(&g->etr, &b, d, g->far, NULL, &calls, &step, &m);
     share += calls / ((double)w * h);
   }
   int least = g->es->src->taylor ? BEAM_MIN_MODELS : BEAM_MIN;
   if (d != INFINITY && (w > least || h > least)) {
     int im = w > least ? i0 + w / 2 : i1, jm = h > least ? j0 + h / 2 : j1;
-    beam_block(g, i0, j0, im, jm, d, step, share);
-    if (im < i1) beam_block(g, im, j0, i1, jm, d, step, share);
+    beam_block(g, i0, j0, im, jm, d, step, m, share);
+    if (im < i1) beam_block(g, im, j0, i1, jm, d, step, m, share);
     if (jm < j1) {
-      beam_block(g, i0, jm, im, j1, d, step, share);
-      if (im < i1) beam_block(g, im, jm, i1, j1, d, step, share);
+      beam_block(g, i0, jm, im, j1, d, step, m, share);
+      if (im < i1) beam_block(g, im, jm, i1, j1, d, step, m, share);
     }
     return;
   }
-  geom_pixels(g, i0, j0, i1, j1, d, step, share);
+  geom_pixels(g, i0, j0, i1, j1, d, step, &m, share);
 }
 
 static void geom_tile(const void *ctx, int x0, int y0, int x1, int y1) {
   const gctx *g = ctx;
   if (g->es && g->etr.mode == OC_TRACE_SEGMENT)
-    beam_block(g, x0, y0, x1, y1, 0, 0, 0);
+    beam_block(g, x0, y0, x1, y1, 0, 0, (oc_emodel){0}, 0);
   else
-    geom_pixels(g, x0, y0, x1, y1, 0, 0, 0);
+    geom_pixels(g, x0, y0, x1, y1, 0, 0, NULL, 0);
 }
 
 /* A terrain thinner than the rays' tolerance shows as scattered pixels

@@ -281,30 +281,46 @@ START_TEST(tree_models_against_march) {
 }
 END_TEST
 
-/* A hit is located to 1/1000 of the tolerance, on the near side: from
-** straight above (h falls along every ray, one crossing), h > 0 at the
-** hit and h <= 0 that much further. */
+/* A hit is located to 1/100 of the tolerance (etrace.c REFINE_STOP), on
+** the near side: from straight above (h falls along every ray, one
+** crossing), h > 0 at the hit and h <= 0 that much further. Its normal
+** is the height gradient's there, taken from the refinement's samples:
+** the same calls as without it. */
 START_TEST(hits_located) {
   oc_elevation src = wave_source();
   oc_esurface es = {&src, NULL, NULL, 0.5};
   oc_render_params rp = view(oct_v(1, 2, 400), oct_v(0, 0, 0), 16, 16);
   double eps_k = 0.25 * 2 * tan(rp.camera.fov * PI / 360) / 1080;
-  double eps_min = 1e-7 * 400, ev = 0;
+  double eps_min = 1e-7 * 400, ev = 0, calls = 0;
   oc_etracer tr;
   oc_etracer_init(&tr, &es, OC_TRACE_SEGMENT, eps_k, eps_min);
   for (int j = 0; j < rp.height; j++)
     for (int i = 0; i < rp.width; i++) {
       oc_vec3 d = pixel_ray(&rp, i, j), o = rp.camera.eye;
-      double t;
+      double t, tn, evn = 0;
       ck_assert_int_eq(oc_etrace(&tr, o, d, 0, 1e5, 0, &t, &ev), 1);
-      double q = t + 1e-3 * (eps_k * t + eps_min) * (1 + 1e-9);
+      double q = t + 1e-2 * (eps_k * t + eps_min) * (1 + 1e-9);
       oc_vec3 p = oct_add(o, oct_mul(d, t)), r = oct_add(o, oct_mul(d, q));
       ck_assert_msg(p.z - wave_h(&WAVE, p.x, p.y, NULL) > 0, "pixel %d %d", i,
                     j);
       ck_assert_msg(r.z - wave_h(&WAVE, r.x, r.y, NULL) <= 0,
                     "pixel %d %d: the hit %.9f is short of the surface", i, j,
                     t);
+      oc_vec3 nm;
+      ck_assert_int_eq(
+          oc_etrace_hit(&tr, o, d, 0, 1e5, 0, 0, NULL, &tn, &nm, &evn), 1);
+      ck_assert(tn == t);
+      double g[2];
+      wave_h(&WAVE, p.x, p.y, g);
+      double l = sqrt(1 + g[0] * g[0] + g[1] * g[1]);
+      ck_assert_msg(fabs(nm.x + g[0] / l) < 1e-12 &&
+                        fabs(nm.y + g[1] / l) < 1e-12 &&
+                        fabs(nm.z - 1 / l) < 1e-12,
+                    "pixel %d %d: normal %g %g %g", i, j, nm.x, nm.y, nm.z);
+      calls += evn;
     }
+  /* no call for the normals */
+  ck_assert_msg(calls == ev, "%g calls with normals, %g without", calls, ev);
 }
 END_TEST
 
@@ -381,7 +397,8 @@ static void beams_against_march(const oc_esurface *es,
   for (int j0 = 0; j0 < rp->height; j0 += bs)
     for (int i0 = 0; i0 < rp->width; i0 += bs) {
       oc_ebeam b = pixel_beam(rp, i0, j0, i0 + bs, j0 + bs);
-      double nb = 0, d = oc_etrace_beam(&tr, &b, 0, INFINITY, &nb, NULL, NULL);
+      double nb = 0,
+             d = oc_etrace_beam(&tr, &b, 0, INFINITY, &nb, NULL, NULL, NULL);
       double tmin = INFINITY;
       for (int v = 0; v <= 4; v++)
         for (int u = 0; u <= 4; u++) {
@@ -481,7 +498,9 @@ static void release_made(oc_enode **made) {
 ** stops its elevation ranges early, so its models carry it on). The
 ** depth it proves free stays before the spike; a beam proving its axis
 ** alone, without the margin for its width, strides on past the spike
-** (its axis meets the ground at depth 400). */
+** (its axis meets the ground at depth 400). A part of the beam at that
+** corner, and the corner ray, go on from the model the beam ended on
+** (their first step takes it without a call) and still meet the spike. */
 START_TEST(beam_margin_spike) {
   oc_enode *made[8];
   const double bump[2] = {60, 40};
@@ -497,8 +516,9 @@ START_TEST(beam_margin_spike) {
   b.r = oct_v(0, -1, 0), b.v = oct_v(0, 0, 1);
   b.x0 = -0.4, b.x1 = 0.4, b.y0 = -0.1, b.y1 = -0.05;
   double nb = 0, ne = 0, next = 0;
-  double d = oc_etrace_beam(&tr, &b, 0, INFINITY, &nb, &ne, &next);
-  ck_assert(ne > 0 && next > 0);
+  oc_emodel m = {0};
+  double d = oc_etrace_beam(&tr, &b, 0, INFINITY, &nb, &ne, &next, &m);
+  ck_assert(ne > 0 && next > 0 && m.ok);
   /* the corner ray (x0, y0) = (-0.4, -0.1) passes over the spike's
   ** centre at depth 150, 15 m up: it meets the spike first */
   oc_vec3 D = oct_v(1, 0.4, -0.1);
@@ -507,6 +527,28 @@ START_TEST(beam_margin_spike) {
   ck_assert_msg(tc < 150 * len, "the corner ray meets the spike at %g", tc);
   ck_assert_msg(d * len <= tc, "beam free to %g, its corner ray hits at %g",
                 d * len, tc);
+  /* the corner's part and ray from the beam's model */
+  oc_ebeam part = b;
+  part.x1 = -0.35, part.y1 = -0.09;
+  oc_emodel pm = m;
+  double pnext = next, pe = 0;
+  double dp = oc_etrace_beam(&tr, &part, d, INFINITY, &nb, &pe, &pnext, &pm);
+  ck_assert_msg(dp >= d && dp * len <= tc,
+                "part free from %g to %g, its corner ray hits at %g", d * len,
+                dp * len, tc);
+  double t, ev = 0, ev0 = 0, t0;
+  oc_vec3 u = oct_mul(D, 1 / len), n;
+  ck_assert_int_eq(oc_etrace_hit(&tr, b.o, u, d * len * (1 - 1e-12), 1e5, 0,
+                                 next * len, &m, &t, &n, &ev),
+                   1);
+  ck_assert_msg(fabs(t - tc) <= 0.01 + 4 * (1e-4 * tc + 1e-6),
+                "the corner ray from the model hits at %g, the march at %g", t,
+                tc);
+  /* the same hit without the model */
+  ck_assert_int_eq(oc_etrace_hit(&tr, b.o, u, d * len * (1 - 1e-12), 1e5, 0,
+                                 next * len, NULL, &t0, &n, &ev0),
+                   1);
+  ck_assert_msg(fabs(t - t0) <= 4 * (1e-4 * tc + 1e-6), "%g and %g", t, t0);
   src.release(src.ud);
   release_made(made);
 }
@@ -556,8 +598,10 @@ START_TEST(tiles_see_thin_spike) {
       const float *q = px + ((size_t)j * rp.width + i) * OC_RG_COUNT;
       oc_vec3 d = pixel_ray(&rp, i, j);
       double t, ev = 0;
-      int h = oc_etrace(&tr, rp.camera.eye, d, 0, 1e5, 0, &t, &ev);
-      alone += ev + (h == 1);
+      oc_vec3 nm;
+      int h = oc_etrace_hit(&tr, rp.camera.eye, d, 0, 1e5, 0, 0, NULL, &t, &nm,
+                            &ev);
+      alone += ev; /* normals included */
       tiled += q[OC_RG_EVALS];
       frac += q[OC_RG_EVALS] != floorf(q[OC_RG_EVALS]);
       double tt = q[OC_RG_HIT] > 0 ? q[OC_RG_Z] : INFINITY;
@@ -641,8 +685,11 @@ START_TEST(render_heightfield) {
     hits++;
     if (q[7] < 1e-3) continue; /* a side of the block */
     double g[2], z = oc_heightfield_height(hf, q[8], q[9], g);
-    ck_assert_msg(fabs(q[10] - z) < 0.05, "P.z %g, height %g", q[10], z);
     double l = sqrt(1 + g[0] * g[0] + g[1] * g[1]);
+    /* located to 1/100 of the tolerance along the ray, where h changes
+    ** at most 1 + |grad f| a unit (and float P) */
+    double loc = 1e-2 * 0.25 * 2 * tan(25 * PI / 180) / 40 * q[4] * (1 + l);
+    ck_assert_msg(fabs(q[10] - z) < loc + 1e-3, "P.z %g, height %g", q[10], z);
     ck_assert(fabs(q[7] - 1 / l) < 1e-3);
     oc_vec3 d = oct_sub(oct_v(q[8], q[9], q[10]), rp.camera.eye);
     ck_assert(fabs(oct_len(d) - q[4]) < 1e-2);
