@@ -139,47 +139,57 @@ static double noise_sum(const oc_enoise *nz, double u, double v, double g[2],
   return sum;
 }
 
-/* Range and Lipschitz bound of the noise sum, under footprints fb (NULL:
-** full detail): octave i weighted b_i in [0, bh], |grad b_i| <= lb, its
-** term (|term| <= 1) contributing a (bh lambda_term + lb). Octaves before
-** from count nothing (the ridged chain runs through them). */
-static void noise_bounds(const oc_enoise *nz, const oc_efootb *fb, int from,
-                         double *lo, double *hi, double *lip) {
-  double a = nz->amplitude, s = 1 / nz->wavelength, asum = 0, l = 0, lr = 0;
+/* Under footprints in [fb->lo, fb->hi], octave i's t_i = log2(w_i /
+** foot) lies in [tmin - i dt, tmax - i dt], dt = log2 lacunarity (one
+** log2 each, padded against the evaluator's rounding). */
+typedef struct octspan {
+  double tmin, tmax, dt;
+} octspan;
+
+static void oct_span(const oc_enoise *nz, const oc_efootb *fb, octspan *t) {
+  /* (log2 2 is 1: the default lacunarity spares the call) */
+  t->dt = nz->lacunarity == 2 ? 1 : log2(nz->lacunarity);
+  t->tmin = log2(nz->wavelength / fb->hi) - 1e-12;
+  t->tmax = fb->lo > 0 ? log2(nz->wavelength / fb->lo) + 1e-12 : INFINITY;
+}
+
+/* Range and Lipschitz bound {lo, hi, lip} of the noise sum in all, under
+** footprints fb with the spans ts (both NULL: full detail): octave i
+** weighted b_i in [0, bh], |grad b_i| <= lb, its term (|term| <= 1)
+** contributing a (bh lambda_term + lb). In part (when not NULL) the same
+** for the octaves from `from` on, those before counting nothing (the
+** ridged chain runs through them). One pass: each octave's filter bound
+** is made once for both. */
+static void noise_bounds(const oc_enoise *nz, const oc_efootb *fb,
+                         const octspan *ts, int from, double all[3],
+                         double part[3]) {
+  double a = nz->amplitude, s = 1 / nz->wavelength, lr = 0;
+  double asum[2] = {0, 0}, l[2] = {0, 0};
   double le = 2 * oc_noise3_lipschitz;
-  /* t_i = log2(w_i / foot) in [tmin - i dt, tmax - i dt] (one log2 each,
-  ** padded against the evaluator's rounding) */
-  double tmin = 0, tmax = 0, dt = log2(nz->lacunarity);
-  if (fb) {
-    tmin = log2(nz->wavelength / fb->hi) - 1e-12;
-    tmax = fb->lo > 0 ? log2(nz->wavelength / fb->lo) + 1e-12 : INFINITY;
-  }
   for (int i = 0; i < nz->octaves; i++) {
-    double bh = 1, lb = 0, bl;
+    double bh = 1, lb = 0, bl, li;
     if (fb)
-      oc_elod_kappa_bound_t(1 / s, tmin - i * dt, tmax - i * dt, fb, &bl, &bh,
-                            &lb);
+      oc_elod_kappa_bound_t(1 / s, ts->tmin - i * ts->dt, ts->tmax - i * ts->dt,
+                            fb, &bl, &bh, &lb);
     if (bh == 0) break;
-    if (i < from) { /* (the ridged chain only) */
-      lr = nz->kind == OC_ENOISE_RIDGED ? (i ? RIDGE_GAIN * lr : 0) + 2 * le * s
-                                        : 0;
-      a *= nz->gain, s *= nz->lacunarity;
-      continue;
-    }
-    asum += a * bh;
     if (nz->kind == OC_ENOISE_RIDGED) {
       /* |grad s_i| <= G |grad s_(i-1)| + 2 lambda_eta s_i */
       lr = (i ? RIDGE_GAIN * lr : 0) + 2 * le * s;
-      l += a * lr * bh + a * lb;
+      li = a * lr * bh + a * lb;
     } else {
-      l += a * le * s * bh + a * lb;
+      li = a * le * s * bh + a * lb;
     }
+    asum[0] += a * bh, l[0] += li;
+    if (i >= from) asum[1] += a * bh, l[1] += li;
     a *= nz->gain;
     s *= nz->lacunarity;
   }
-  *lo = nz->kind == OC_ENOISE_PLAIN ? -asum : 0;
-  *hi = asum;
-  *lip = l;
+  for (int k = 0; k < (part ? 2 : 1); k++) {
+    double *o = k ? part : all;
+    o[0] = nz->kind == OC_ENOISE_PLAIN ? -asum[k] : 0;
+    o[1] = asum[k];
+    o[2] = l[k];
+  }
 }
 
 /* ---- first-order models of continuous-LoD discs (etaylor.h) ------------
@@ -269,24 +279,20 @@ static int noise_local(const oc_enoise *nz, double u0, double v0, double u1,
                        double v1, double *lo, double *hi, double *lip);
 
 /* The noise's range and slope on the box [u0, u1] x [v0, v1] (relative to
-** the centre) under footprints fb: the leading octaves, whose filter is 1
+** the centre) under footprints: the j leading octaves, whose filter is 1
 ** on the whole box (t_i >= 1 at its largest footprint), bounded locally
 ** (noise_local: where it gains, the coarse octaves), the others by
-** noise_bounds' filtered rule (the ridged chain's global slopes). 0 where
-** no octave is kept whole or noise_local gains nothing. */
-static int noise_local_lod(const oc_enoise *nz, const oc_efootb *fb, double u0,
-                           double v0, double u1, double v1, double *lo,
-                           double *hi, double *lip) {
-  double tmin = log2(nz->wavelength / fb->hi) - 1e-12;
-  double dt = nz->lacunarity == 2 ? 1 : log2(nz->lacunarity);
+** noise_bounds' filtered rule (the ridged chain's global slopes), given
+** in rest. 0 where no octave is kept whole or noise_local gains
+** nothing. */
+static int noise_local_lod(const oc_enoise *nz, int j, const double rest[3],
+                           double u0, double v0, double u1, double v1,
+                           double *lo, double *hi, double *lip) {
   double l = 0, h = 0, lf = 0;
-  int j = 0;
-  while (j < nz->octaves && tmin - j * dt >= 1)
-    j++;
   oc_enoise whole = *nz;
   whole.octaves = j;
   if (!j || !noise_local(&whole, u0, v0, u1, v1, lo, hi, lip)) return 0;
-  if (j < nz->octaves) noise_bounds(nz, fb, j, &l, &h, &lf);
+  if (j < nz->octaves) l = rest[0], h = rest[1], lf = rest[2];
   /* rounding of the sums: a relative hair */
   double eps = 1e-12 * (fabs(*lo) + fabs(*hi) + fabs(l) + fabs(h));
   *lo += l - eps, *hi += h + eps;
@@ -294,17 +300,23 @@ static int noise_local_lod(const oc_enoise *nz, const oc_efootb *fb, double u0,
   return 1;
 }
 
-int oc_edisc_taylor_lod(const oc_enode *n, double x, double y, double R,
-                        const oc_etfoot *tf, oc_etaylor *o) {
+int oc_edisc_taylor_f_view(const oc_enode *n, double x, double y, double R,
+                           const oc_etfoot *tf, oc_etay *f) {
   const double *p = OC_EDISC(n)->par; /* cx, cy, r, height */
-  oc_enoise noise;
-  oc_edisc_noise(n, &noise);
-  if (noise.kind == OC_ENOISE_NONE) {
-    oc_edisc_taylor(n, x, y, R, o);
+  if (!tf || n->nzkind == OC_ENOISE_NONE) {
+    oc_edisc_taylor_f(n, x, y, R, f);
     return 1;
   }
-  if (!noise_taylor_lod(&noise, x - p[0], y - p[1], R, tf, &o->f)) return 0;
-  o->f.v = p[3] + o->f.v;
+  oc_enoise noise;
+  oc_edisc_noise(n, &noise);
+  if (!noise_taylor_lod(&noise, x - p[0], y - p[1], R, tf, f)) return 0;
+  f->v = p[3] + f->v;
+  return 1;
+}
+
+int oc_edisc_taylor_lod(const oc_enode *n, double x, double y, double R,
+                        const oc_etfoot *tf, oc_etaylor *o) {
+  if (!oc_edisc_taylor_f_view(n, x, y, R, tf, &o->f)) return 0;
   oc_edisc_taylor_alpha(n, x, y, R, &o->a);
   return 1;
 }
@@ -402,8 +414,9 @@ void oc_edisc_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
   octlod lod, *lp = NULL;
   if (ft && ft->v > 0 && noise.kind != OC_ENOISE_NONE) {
     double c = -1 / (ft->v * 0.69314718055994530942);
-    lod = (octlod){log2(noise.wavelength / ft->v), log2(noise.lacunarity),
-                   c * ft->gx, c * ft->gy};
+    /* (log2 2 is 1: the default lacunarity spares the call) */
+    double dt = noise.lacunarity == 2 ? 1 : log2(noise.lacunarity);
+    lod = (octlod){log2(noise.wavelength / ft->v), dt, c * ft->gx, c * ft->gy};
     lp = &lod;
   }
   s->f = p[3] + (noise.kind == OC_ENOISE_NONE
@@ -607,32 +620,28 @@ static int noise_local(const oc_enoise *nz, double u0, double v0, double u1,
   return 1;
 }
 
-/* noise_local at full detail (fb unused), for oc_edisc_bound_in's choice */
-static int noise_local_full(const oc_enoise *nz, const oc_efootb *fb, double u0,
-                            double v0, double u1, double v1, double *lo,
-                            double *hi, double *lip) {
-  (void)fb;
-  return noise_local(nz, u0, v0, u1, v1, lo, hi, lip);
-}
-
 void oc_edisc_bound_in(const oc_enode *node, const oc_erect *b,
                        const oc_efootb *fb, oc_ebound *o) {
   dview v, *n = &v; /* (the disc unpacked) */
   unpack(node, n);
   *o = n->glob;
   int filtered = 0; /* some octave may be weighted below 1 in the box */
-  /* (every octave kept in the box, the finest included: the glob's) */
-  if (fb && fb->hi > 0 && n->noise.kind != OC_ENOISE_NONE &&
-      log2(n->noise.wavelength / fb->hi) - 1e-12 -
-              (n->noise.octaves - 1) * log2(n->noise.lacunarity) <
-          1) {
-    /* the octaves the footprints keep */
-    double lo, hi, lip;
-    noise_bounds(&n->noise, fb, 0, &lo, &hi, &lip);
-    o->flo = n->par[3] + lo;
-    o->fhi = n->par[3] + hi;
-    o->lf = lip;
-    filtered = 1;
+  int j = 0;        /* then the leading octaves kept whole in the box */
+  double all[3], rest[3];
+  if (fb && fb->hi > 0 && n->noise.kind != OC_ENOISE_NONE) {
+    octspan ts;
+    oct_span(&n->noise, fb, &ts);
+    /* (every octave kept in the box, the finest included: the glob's) */
+    if (ts.tmin - (n->noise.octaves - 1) * ts.dt < 1) {
+      while (j < n->noise.octaves && ts.tmin - j * ts.dt >= 1)
+        j++;
+      /* the octaves the footprints keep; those after the j whole ones */
+      noise_bounds(&n->noise, fb, &ts, j, all, rest);
+      o->flo = n->par[3] + all[0];
+      o->fhi = n->par[3] + all[1];
+      o->lf = all[2];
+      filtered = 1;
+    }
   }
   if (!oc_erect_meets(&n->box, b)) {
     o->alo = o->ahi = o->la = 0;
@@ -641,10 +650,12 @@ void oc_edisc_bound_in(const oc_enode *node, const oc_erect *b,
   double nlo, nhi, nlip;
   /* the octaves' values at the centre bound the unfiltered sum only (or,
   ** filtered, the octaves kept whole on the box) */
+  double u0 = b->x0 - n->par[0], v0 = b->y0 - n->par[1];
+  double u1 = b->x1 - n->par[0], v1 = b->y1 - n->par[1];
   if (n->noise.kind != OC_ENOISE_NONE &&
-      (filtered ? noise_local_lod : noise_local_full)(
-          &n->noise, fb, b->x0 - n->par[0], b->y0 - n->par[1],
-          b->x1 - n->par[0], b->y1 - n->par[1], &nlo, &nhi, &nlip)) {
+      (filtered ? noise_local_lod(&n->noise, j, rest, u0, v0, u1, v1, &nlo,
+                                  &nhi, &nlip)
+                : noise_local(&n->noise, u0, v0, u1, v1, &nlo, &nhi, &nlip))) {
     o->flo = oc_efmax(o->flo, n->par[3] + nlo);
     o->fhi = oc_efmin(o->fhi, n->par[3] + nhi);
     o->lf = oc_efmin(o->lf, nlip);
@@ -702,7 +713,7 @@ static int check_noise(const oc_enode_noise *nz, oc_enoise *out,
 }
 
 oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err) {
-  oc_enoise nz;
+  oc_enoise nz = {.kind = OC_ENOISE_NONE}; /* (set by check_noise) */
   if (!p) {
     oc_seterr(err, OC_EINVAL, "disc: no parameters");
     return NULL;
@@ -723,7 +734,11 @@ oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err) {
   }
   if (check_noise(&p->noise, &nz, err)) return NULL;
   double lo = 0, hi = 0, lip = 0;
-  if (nz.kind != OC_ENOISE_NONE) noise_bounds(&nz, NULL, 0, &lo, &hi, &lip);
+  if (nz.kind != OC_ENOISE_NONE) {
+    double all[3];
+    noise_bounds(&nz, NULL, NULL, 0, all, NULL);
+    lo = all[0], hi = all[1], lip = all[2];
+  }
   oc_erect box = {p->cx - p->radius, p->cy - p->radius, p->cx + p->radius,
                   p->cy + p->radius};
   if (!isfinite(p->height + lo) || !isfinite(p->height + hi) ||
