@@ -235,43 +235,82 @@ static double octave_term(const oc_enoise *nz, int i, double e,
   return t->v;
 }
 
+/* A noise sum's model being summed octave by octave: the sum of the
+** terms (the value, as noise_sum adds it) and of the models times their
+** amplitudes; the next octave's amplitude a and frequency s; the ridged
+** chain's previous term and model. */
+typedef struct octsum {
+  double sum, a, s, prev;
+  oc_etay m, tprev;
+} octsum;
+
+static void octsum_init(const oc_enoise *nz, octsum *q) {
+  *q = (octsum){0, nz->amplitude,    1 / nz->wavelength,
+                1, oc_etay_const(0), oc_etay_const(1)};
+}
+
+/* Octaves [i0, i1) unfiltered, from their noise at p (ev, ex, ey, as
+** octave_noise gives it) into q: noise_taylor's sum, and a filtered sum's
+** octaves whose filter is 1 on the whole disc (the same bits: b = 1). */
+static inline __attribute__((always_inline)) void
+octaves_taylor(const oc_enoise *nz, int i0, int i1, const double *ev,
+               const double *ex, const double *ey, double R, octsum *q) {
+  double sum = q->sum, a = q->a, s = q->s, prev = q->prev;
+  oc_etay m = q->m, tprev = q->tprev;
+  for (int i = i0; i < i1; i++) {
+    double ge[2] = {2 * ex[i], 2 * ey[i]}, e = 2 * ev[i] - 1; /* (oc_eta) */
+    oc_etay t;
+    sum += a * octave_term(nz, i, e, ge, s, R, &prev, &tprev, &t);
+    oc_etay at = oc_etay_scale(&t, a);
+    oc_etay_add(&m, &at);
+    a = a * nz->gain;
+    s *= nz->lacunarity;
+  }
+  *q = (octsum){sum, a, s, prev, m, tprev};
+}
+
 /* The filtered sum's model at (u, v) = p - c, its value noise_sum's with
-** the footprint tf->p; 0 where a filter ramps and tau has no model. */
+** the footprint tf->p; 0 where a filter ramps and tau has no model. The
+** leading octaves, whose filter is 1 on the whole disc, are summed as
+** at full detail; each of the next is its filter's model times its
+** term's. */
 static int noise_taylor_lod(const oc_enoise *nz, double u, double v, double R,
                             const oc_etfoot *tf, oc_etay *o) {
   oc_etay tau;
   /* (log2 2 is 1: the default lacunarity spares the call) */
   double tlo, thi, dt = nz->lacunarity == 2 ? 1 : log2(nz->lacunarity);
   int curved = oc_elod_tau_taylor(nz->wavelength, tf, R, &tau, &tlo, &thi);
-  /* the octaves whose filter is not 0 on the whole disc, their noise at
-  ** p in one call (as noise_sum) */
+  /* the octaves whose filter is not 0 on the whole disc (cnt), the
+  ** leading ones whose filter is 1 there (whole); their noise at p in one
+  ** call (as noise_sum) */
   double ev[OC_ENOISE_MAXOCT], ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
-  int cnt = 0;
-  for (; cnt < nz->octaves && thi - cnt * dt > 0; cnt++)
-    if (!curved && tlo - cnt * dt < 1) return 0;
+  int cnt = 0, whole = 0;
+  while (cnt < nz->octaves && thi - cnt * dt > 0)
+    cnt++;
+  while (whole < cnt && tlo - whole * dt >= 1)
+    whole++;
+  if (!curved && whole < cnt) return 0;
   octave_noise(nz, u, v, cnt, ev, ex, ey);
-  double sum = 0, a = nz->amplitude, s = 1 / nz->wavelength, prev = 1;
-  oc_etay m = oc_etay_const(0), tprev = oc_etay_const(1);
+  octsum q;
+  octsum_init(nz, &q);
+  octaves_taylor(nz, 0, whole, ev, ex, ey, R, &q);
   int live = 1; /* noise_sum adds octave i (its filter at p is not 0) */
-  for (int i = 0; i < cnt; i++, a *= nz->gain, s *= nz->lacunarity) {
+  for (int i = whole; i < cnt; i++, q.a *= nz->gain, q.s *= nz->lacunarity) {
     double g[2] = {2 * ex[i], 2 * ey[i]}, db; /* (oc_eta) */
-    oc_etay ti = tau, T, at;
+    oc_etay ti = tau, T;
     ti.v = tau.v - i * dt;
     double bw = oc_elod_b(ti.v, &db);
-    double term = octave_term(nz, i, 2 * ev[i] - 1, g, s, R, &prev, &tprev, &T);
+    double term =
+        octave_term(nz, i, 2 * ev[i] - 1, g, q.s, R, &q.prev, &q.tprev, &T);
     live = live && bw != 0;
-    if (live) sum += a * bw * term;
-    if (tlo - i * dt >= 1) {
-      at = T;
-    } else {
-      oc_etay bm = oc_elod_b_taylor(&ti, tlo - i * dt, thi - i * dt, R);
-      at = oc_etay_mul(&bm, &T, R);
-    }
-    at = oc_etay_scale(&at, a);
-    oc_etay_add(&m, &at);
+    if (live) q.sum += q.a * bw * term;
+    oc_etay bm = oc_elod_b_taylor(&ti, tlo - i * dt, thi - i * dt, R);
+    oc_etay at = oc_etay_mul(&bm, &T, R);
+    at = oc_etay_scale(&at, q.a);
+    oc_etay_add(&q.m, &at);
   }
-  m.v = sum;
-  *o = m;
+  q.m.v = q.sum;
+  *o = q.m;
   return 1;
 }
 
@@ -829,19 +868,11 @@ static void noise_taylor(const oc_enoise *nz, double u, double v, double R,
   double ev[OC_ENOISE_MAXOCT], ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
   int cnt = nz->octaves;
   octave_noise(nz, u, v, cnt, ev, ex, ey);
-  double sum = 0, a = nz->amplitude, prev = 1, s = 1 / nz->wavelength;
-  oc_etay m = oc_etay_const(0), tprev = oc_etay_const(1);
-  for (int i = 0; i < cnt; i++) {
-    double ge[2] = {2 * ex[i], 2 * ey[i]}, e = 2 * ev[i] - 1; /* (oc_eta) */
-    oc_etay t;
-    sum += a * octave_term(nz, i, e, ge, s, R, &prev, &tprev, &t);
-    oc_etay at = oc_etay_scale(&t, a);
-    oc_etay_add(&m, &at);
-    a = a * nz->gain;
-    s *= nz->lacunarity;
-  }
-  m.v = sum; /* bit for bit noise_sum's (no level of detail) */
-  *o = m;
+  octsum q;
+  octsum_init(nz, &q);
+  octaves_taylor(nz, 0, cnt, ev, ex, ey, R, &q);
+  q.m.v = q.sum; /* bit for bit noise_sum's (no level of detail) */
+  *o = q.m;
 }
 
 void oc_edisc_taylor_alpha(const oc_enode *n, double x, double y, double R,
