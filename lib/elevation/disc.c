@@ -168,7 +168,9 @@ static void noise_bounds(const oc_enoise *nz, const oc_efootb *fb,
   double le = 2 * oc_noise3_lipschitz;
   for (int i = 0; i < nz->octaves; i++) {
     double bh = 1, lb = 0, bl, li;
-    if (fb)
+    /* (those before from, when it is the whole octaves' count, have bh 1
+    ** and lb 0: oc_elod_kappa_bound_t's, not asked) */
+    if (fb && i >= from)
       oc_elod_kappa_bound_t(1 / s, ts->tmin - i * ts->dt, ts->tmax - i * ts->dt,
                             fb, &bl, &bh, &lb);
     if (bh == 0) break;
@@ -285,10 +287,20 @@ static int noise_taylor_lod(const oc_enoise *nz, double u, double v, double R,
   ** call (as noise_sum) */
   double ev[OC_ENOISE_MAXOCT], ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
   int cnt = 0, whole = 0;
-  while (cnt < nz->octaves && thi - cnt * dt > 0)
-    cnt++;
-  while (whole < cnt && tlo - whole * dt >= 1)
-    whole++;
+  if (dt == 1) {
+    /* (the loops' tests without the loops: for integers i, thi - i > 0
+    ** exactly when i < thi, and tlo - i >= 1 when i + 1 <= tlo, the
+    ** differences rounding monotonically and none of those below 1
+    ** rounding up to it) */
+    double c = ceil(thi), w = floor(tlo);
+    cnt = c >= nz->octaves ? nz->octaves : c > 0 ? (int)c : 0;
+    whole = w >= cnt ? cnt : w > 0 ? (int)w : 0;
+  } else {
+    while (cnt < nz->octaves && thi - cnt * dt > 0)
+      cnt++;
+    while (whole < cnt && tlo - whole * dt >= 1)
+      whole++;
+  }
   if (!curved && whole < cnt) return 0;
   octave_noise(nz, u, v, cnt, ev, ex, ey);
   octsum q;
