@@ -512,8 +512,8 @@ static void check_view_taylor(const oc_enode *e, const oc_enode_view *v,
 ** footprint's), that tree scaled and rotated by a transform (the
 ** footprint in the child's units) and warped (a fallback), the scene of
 ** every operator, and an add by a slope weight (a fallback); far, near
-** and grazing views, and one whose eye is level with the tree's middle (the footprint reaches 0: no rule
-** for tau next to the eye). Remainders never exceeded; on the step trees'
+** and grazing views, and one whose eye is level with the tree's middle
+** (the footprint reaches 0: no rule for tau next to the eye). Remainders never exceeded; on the step trees'
 ** ramps the errors reach a good part of the remainders, so that zeroing
 ** the footprint's terms (tau's curvature or b''s) fails the check. */
 START_TEST(lod_taylor_models) {
