@@ -507,15 +507,16 @@ static void check_view_taylor(const oc_enode *e, const oc_enode_view *v,
 }
 
 /* Models under views (disc.c, lod.c, etaylor.h) on trees with every
-** operator: continuous-LoD discs of each noise (one with a lacunarity of
-** 2.5), the lod operator between flat discs (all its curvature the
+** operator: continuous-LoD discs of each noise (one with a lacunarity
+** of 2.5), the lod operator between flat discs (all its curvature the
 ** footprint's), that tree scaled and rotated by a transform (the
 ** footprint in the child's units) and warped (a fallback), the scene of
 ** every operator, and an add by a slope weight (a fallback); far, near
 ** and grazing views, and one whose eye is level with the tree's middle
-** (the footprint reaches 0: no rule for tau next to the eye). Remainders never exceeded; on the step trees'
-** ramps the errors reach a good part of the remainders, so that zeroing
-** the footprint's terms (tau's curvature or b''s) fails the check. */
+** (the footprint reaches 0: no rule for tau next to the eye).
+** Remainders never exceeded; on the step trees' ramps the errors reach
+** a good part of the remainders, so that zeroing the footprint's terms
+** (tau's curvature or b''s) fails the check. */
 START_TEST(lod_taylor_models) {
   oc_error err;
   oc_enode *st = step_tree();
