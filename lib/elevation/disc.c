@@ -139,47 +139,59 @@ static double noise_sum(const oc_enoise *nz, double u, double v, double g[2],
   return sum;
 }
 
-/* Range and Lipschitz bound of the noise sum, under footprints fb (NULL:
-** full detail): octave i weighted b_i in [0, bh], |grad b_i| <= lb, its
-** term (|term| <= 1) contributing a (bh lambda_term + lb). Octaves before
-** from count nothing (the ridged chain runs through them). */
-static void noise_bounds(const oc_enoise *nz, const oc_efootb *fb, int from,
-                         double *lo, double *hi, double *lip) {
-  double a = nz->amplitude, s = 1 / nz->wavelength, asum = 0, l = 0, lr = 0;
+/* Under footprints in [fb->lo, fb->hi], octave i's t_i = log2(w_i /
+** foot) lies in [tmin - i dt, tmax - i dt], dt = log2 lacunarity (one
+** log2 each, padded against the evaluator's rounding). */
+typedef struct octspan {
+  double tmin, tmax, dt;
+} octspan;
+
+static void oct_span(const oc_enoise *nz, const oc_efootb *fb, octspan *t) {
+  /* (log2 2 is 1: the default lacunarity spares the call) */
+  t->dt = nz->lacunarity == 2 ? 1 : log2(nz->lacunarity);
+  t->tmin = log2(nz->wavelength / fb->hi) - 1e-12;
+  t->tmax = fb->lo > 0 ? log2(nz->wavelength / fb->lo) + 1e-12 : INFINITY;
+}
+
+/* Range and Lipschitz bound {lo, hi, lip} of the noise sum in all, under
+** footprints fb with the spans ts (both NULL: full detail): octave i
+** weighted b_i in [0, bh], |grad b_i| <= lb, its term (|term| <= 1)
+** contributing a (bh lambda_term + lb). In part (when not NULL) the same
+** for the octaves from `from` on, those before counting nothing (the
+** ridged chain runs through them). One pass: each octave's filter bound
+** is made once for both. */
+static void noise_bounds(const oc_enoise *nz, const oc_efootb *fb,
+                         const octspan *ts, int from, double all[3],
+                         double part[3]) {
+  double a = nz->amplitude, s = 1 / nz->wavelength, lr = 0;
+  double asum[2] = {0, 0}, l[2] = {0, 0};
   double le = 2 * oc_noise3_lipschitz;
-  /* t_i = log2(w_i / foot) in [tmin - i dt, tmax - i dt] (one log2 each,
-  ** padded against the evaluator's rounding) */
-  double tmin = 0, tmax = 0, dt = log2(nz->lacunarity);
-  if (fb) {
-    tmin = log2(nz->wavelength / fb->hi) - 1e-12;
-    tmax = fb->lo > 0 ? log2(nz->wavelength / fb->lo) + 1e-12 : INFINITY;
-  }
   for (int i = 0; i < nz->octaves; i++) {
-    double bh = 1, lb = 0, bl;
-    if (fb)
-      oc_elod_kappa_bound_t(1 / s, tmin - i * dt, tmax - i * dt, fb, &bl, &bh,
-                            &lb);
+    double bh = 1, lb = 0, bl, li;
+    /* (those before from, when it is the whole octaves' count, have bh 1
+    ** and lb 0: oc_elod_kappa_bound_t's, not asked) */
+    if (fb && i >= from)
+      oc_elod_kappa_bound_t(1 / s, ts->tmin - i * ts->dt, ts->tmax - i * ts->dt,
+                            fb, &bl, &bh, &lb);
     if (bh == 0) break;
-    if (i < from) { /* (the ridged chain only) */
-      lr = nz->kind == OC_ENOISE_RIDGED ? (i ? RIDGE_GAIN * lr : 0) + 2 * le * s
-                                        : 0;
-      a *= nz->gain, s *= nz->lacunarity;
-      continue;
-    }
-    asum += a * bh;
     if (nz->kind == OC_ENOISE_RIDGED) {
       /* |grad s_i| <= G |grad s_(i-1)| + 2 lambda_eta s_i */
       lr = (i ? RIDGE_GAIN * lr : 0) + 2 * le * s;
-      l += a * lr * bh + a * lb;
+      li = a * lr * bh + a * lb;
     } else {
-      l += a * le * s * bh + a * lb;
+      li = a * le * s * bh + a * lb;
     }
+    asum[0] += a * bh, l[0] += li;
+    if (i >= from) asum[1] += a * bh, l[1] += li;
     a *= nz->gain;
     s *= nz->lacunarity;
   }
-  *lo = nz->kind == OC_ENOISE_PLAIN ? -asum : 0;
-  *hi = asum;
-  *lip = l;
+  for (int k = 0; k < (part ? 2 : 1); k++) {
+    double *o = k ? part : all;
+    o[0] = nz->kind == OC_ENOISE_PLAIN ? -asum[k] : 0;
+    o[1] = asum[k];
+    o[2] = l[k];
+  }
 }
 
 /* ---- first-order models of continuous-LoD discs (etaylor.h) ------------
@@ -225,43 +237,110 @@ static double octave_term(const oc_enoise *nz, int i, double e,
   return t->v;
 }
 
+/* A noise sum's model being summed octave by octave: the sum of the
+** terms (the value, as noise_sum adds it) and of the models times their
+** amplitudes; the next octave's amplitude a and frequency s; the ridged
+** chain's previous term and model. */
+typedef struct octsum {
+  double sum, a, s, prev;
+  oc_etay m, tprev;
+} octsum;
+
+static void octsum_init(const oc_enoise *nz, octsum *q) {
+  *q = (octsum){0, nz->amplitude,    1 / nz->wavelength,
+                1, oc_etay_const(0), oc_etay_const(1)};
+}
+
+/* Octaves [i0, i1) unfiltered, from their noise at p (ev, ex, ey, as
+** octave_noise gives it) into q: noise_taylor's sum, and a filtered sum's
+** octaves whose filter is 1 on the whole disc (the same bits: b = 1). */
+static inline __attribute__((always_inline)) void
+octaves_taylor(const oc_enoise *nz, int i0, int i1, const double *ev,
+               const double *ex, const double *ey, double R, octsum *q) {
+  double sum = q->sum, a = q->a, s = q->s, prev = q->prev;
+  oc_etay m = q->m, tprev = q->tprev;
+  if (nz->kind != OC_ENOISE_RIDGED) {
+    /* plain or turbulent: octave_model's terms scaled and added as
+    ** oc_etay_scale and oc_etay_add would (the same operations in the
+    ** same order: the same bits), in registers */
+    int turb = nz->kind == OC_ENOISE_TURBULENCE;
+    for (int i = i0; i < i1; i++) {
+      double g[2] = {2 * ex[i], 2 * ey[i]}, e = 2 * ev[i] - 1; /* (oc_eta) */
+      oc_etay t = octave_model(e, g, s, R, turb);              /* (inline) */
+      double aa = fabs(a);
+      sum += a * t.v; /* (octave_term's value: |e| or e) */
+      m.gx += a * t.gx, m.gy += a * t.gy;
+      m.e0 += aa * t.e0, m.e1 += aa * t.e1, m.e2 += aa * t.e2;
+      a = a * nz->gain;
+      s *= nz->lacunarity;
+    }
+    *q = (octsum){sum, a, s, prev, m, tprev};
+    return;
+  }
+  for (int i = i0; i < i1; i++) {
+    double ge[2] = {2 * ex[i], 2 * ey[i]}, e = 2 * ev[i] - 1; /* (oc_eta) */
+    oc_etay t;
+    sum += a * octave_term(nz, i, e, ge, s, R, &prev, &tprev, &t);
+    oc_etay at = oc_etay_scale(&t, a);
+    oc_etay_add(&m, &at);
+    a = a * nz->gain;
+    s *= nz->lacunarity;
+  }
+  *q = (octsum){sum, a, s, prev, m, tprev};
+}
+
 /* The filtered sum's model at (u, v) = p - c, its value noise_sum's with
-** the footprint tf->p; 0 where a filter ramps and tau has no model. */
+** the footprint tf->p; 0 where a filter ramps and tau has no model. The
+** leading octaves, whose filter is 1 on the whole disc, are summed as
+** at full detail; each of the next is its filter's model times its
+** term's. */
 static int noise_taylor_lod(const oc_enoise *nz, double u, double v, double R,
                             const oc_etfoot *tf, oc_etay *o) {
   oc_etay tau;
   /* (log2 2 is 1: the default lacunarity spares the call) */
   double tlo, thi, dt = nz->lacunarity == 2 ? 1 : log2(nz->lacunarity);
   int curved = oc_elod_tau_taylor(nz->wavelength, tf, R, &tau, &tlo, &thi);
-  /* the octaves whose filter is not 0 on the whole disc, their noise at
-  ** p in one call (as noise_sum) */
+  /* the octaves whose filter is not 0 on the whole disc (cnt), the
+  ** leading ones whose filter is 1 there (whole); their noise at p in one
+  ** call (as noise_sum) */
   double ev[OC_ENOISE_MAXOCT], ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
-  int cnt = 0;
-  for (; cnt < nz->octaves && thi - cnt * dt > 0; cnt++)
-    if (!curved && tlo - cnt * dt < 1) return 0;
+  int cnt = 0, whole = 0;
+  if (dt == 1) {
+    /* (the loops' tests without the loops: for integers i, thi - i > 0
+    ** exactly when i < thi, and tlo - i >= 1 when i + 1 <= tlo, the
+    ** differences rounding monotonically and none of those below 1
+    ** rounding up to it) */
+    double c = ceil(thi), w = floor(tlo);
+    cnt = c >= nz->octaves ? nz->octaves : c > 0 ? (int)c : 0;
+    whole = w >= cnt ? cnt : w > 0 ? (int)w : 0;
+  } else {
+    while (cnt < nz->octaves && thi - cnt * dt > 0)
+      cnt++;
+    while (whole < cnt && tlo - whole * dt >= 1)
+      whole++;
+  }
+  if (!curved && whole < cnt) return 0;
   octave_noise(nz, u, v, cnt, ev, ex, ey);
-  double sum = 0, a = nz->amplitude, s = 1 / nz->wavelength, prev = 1;
-  oc_etay m = oc_etay_const(0), tprev = oc_etay_const(1);
+  octsum q;
+  octsum_init(nz, &q);
+  octaves_taylor(nz, 0, whole, ev, ex, ey, R, &q);
   int live = 1; /* noise_sum adds octave i (its filter at p is not 0) */
-  for (int i = 0; i < cnt; i++, a *= nz->gain, s *= nz->lacunarity) {
+  for (int i = whole; i < cnt; i++, q.a *= nz->gain, q.s *= nz->lacunarity) {
     double g[2] = {2 * ex[i], 2 * ey[i]}, db; /* (oc_eta) */
-    oc_etay ti = tau, T, at;
+    oc_etay ti = tau, T;
     ti.v = tau.v - i * dt;
     double bw = oc_elod_b(ti.v, &db);
-    double term = octave_term(nz, i, 2 * ev[i] - 1, g, s, R, &prev, &tprev, &T);
+    double term =
+        octave_term(nz, i, 2 * ev[i] - 1, g, q.s, R, &q.prev, &q.tprev, &T);
     live = live && bw != 0;
-    if (live) sum += a * bw * term;
-    if (tlo - i * dt >= 1) {
-      at = T;
-    } else {
-      oc_etay bm = oc_elod_b_taylor(&ti, tlo - i * dt, thi - i * dt, R);
-      at = oc_etay_mul(&bm, &T, R);
-    }
-    at = oc_etay_scale(&at, a);
-    oc_etay_add(&m, &at);
+    if (live) q.sum += q.a * bw * term;
+    oc_etay bm = oc_elod_b_taylor(&ti, tlo - i * dt, thi - i * dt, R);
+    oc_etay at = oc_etay_mul(&bm, &T, R);
+    at = oc_etay_scale(&at, q.a);
+    oc_etay_add(&q.m, &at);
   }
-  m.v = sum;
-  *o = m;
+  q.m.v = q.sum;
+  *o = q.m;
   return 1;
 }
 
@@ -269,24 +348,20 @@ static int noise_local(const oc_enoise *nz, double u0, double v0, double u1,
                        double v1, double *lo, double *hi, double *lip);
 
 /* The noise's range and slope on the box [u0, u1] x [v0, v1] (relative to
-** the centre) under footprints fb: the leading octaves, whose filter is 1
+** the centre) under footprints: the j leading octaves, whose filter is 1
 ** on the whole box (t_i >= 1 at its largest footprint), bounded locally
 ** (noise_local: where it gains, the coarse octaves), the others by
-** noise_bounds' filtered rule (the ridged chain's global slopes). 0 where
-** no octave is kept whole or noise_local gains nothing. */
-static int noise_local_lod(const oc_enoise *nz, const oc_efootb *fb, double u0,
-                           double v0, double u1, double v1, double *lo,
-                           double *hi, double *lip) {
-  double tmin = log2(nz->wavelength / fb->hi) - 1e-12;
-  double dt = nz->lacunarity == 2 ? 1 : log2(nz->lacunarity);
+** noise_bounds' filtered rule (the ridged chain's global slopes), given
+** in rest. 0 where no octave is kept whole or noise_local gains
+** nothing. */
+static int noise_local_lod(const oc_enoise *nz, int j, const double rest[3],
+                           double u0, double v0, double u1, double v1,
+                           double *lo, double *hi, double *lip) {
   double l = 0, h = 0, lf = 0;
-  int j = 0;
-  while (j < nz->octaves && tmin - j * dt >= 1)
-    j++;
   oc_enoise whole = *nz;
   whole.octaves = j;
   if (!j || !noise_local(&whole, u0, v0, u1, v1, lo, hi, lip)) return 0;
-  if (j < nz->octaves) noise_bounds(nz, fb, j, &l, &h, &lf);
+  if (j < nz->octaves) l = rest[0], h = rest[1], lf = rest[2];
   /* rounding of the sums: a relative hair */
   double eps = 1e-12 * (fabs(*lo) + fabs(*hi) + fabs(l) + fabs(h));
   *lo += l - eps, *hi += h + eps;
@@ -294,17 +369,23 @@ static int noise_local_lod(const oc_enoise *nz, const oc_efootb *fb, double u0,
   return 1;
 }
 
-int oc_edisc_taylor_lod(const oc_enode *n, double x, double y, double R,
-                        const oc_etfoot *tf, oc_etaylor *o) {
+int oc_edisc_taylor_f_view(const oc_enode *n, double x, double y, double R,
+                           const oc_etfoot *tf, oc_etay *f) {
   const double *p = OC_EDISC(n)->par; /* cx, cy, r, height */
-  oc_enoise noise;
-  oc_edisc_noise(n, &noise);
-  if (noise.kind == OC_ENOISE_NONE) {
-    oc_edisc_taylor(n, x, y, R, o);
+  if (!tf || n->nzkind == OC_ENOISE_NONE) {
+    oc_edisc_taylor_f(n, x, y, R, f);
     return 1;
   }
-  if (!noise_taylor_lod(&noise, x - p[0], y - p[1], R, tf, &o->f)) return 0;
-  o->f.v = p[3] + o->f.v;
+  oc_enoise noise;
+  oc_edisc_noise(n, &noise);
+  if (!noise_taylor_lod(&noise, x - p[0], y - p[1], R, tf, f)) return 0;
+  f->v = p[3] + f->v;
+  return 1;
+}
+
+int oc_edisc_taylor_lod(const oc_enode *n, double x, double y, double R,
+                        const oc_etfoot *tf, oc_etaylor *o) {
+  if (!oc_edisc_taylor_f_view(n, x, y, R, tf, &o->f)) return 0;
   oc_edisc_taylor_alpha(n, x, y, R, &o->a);
   return 1;
 }
@@ -402,8 +483,9 @@ void oc_edisc_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
   octlod lod, *lp = NULL;
   if (ft && ft->v > 0 && noise.kind != OC_ENOISE_NONE) {
     double c = -1 / (ft->v * 0.69314718055994530942);
-    lod = (octlod){log2(noise.wavelength / ft->v), log2(noise.lacunarity),
-                   c * ft->gx, c * ft->gy};
+    /* (log2 2 is 1: the default lacunarity spares the call) */
+    double dt = noise.lacunarity == 2 ? 1 : log2(noise.lacunarity);
+    lod = (octlod){log2(noise.wavelength / ft->v), dt, c * ft->gx, c * ft->gy};
     lp = &lod;
   }
   s->f = p[3] + (noise.kind == OC_ENOISE_NONE
@@ -607,32 +689,28 @@ static int noise_local(const oc_enoise *nz, double u0, double v0, double u1,
   return 1;
 }
 
-/* noise_local at full detail (fb unused), for oc_edisc_bound_in's choice */
-static int noise_local_full(const oc_enoise *nz, const oc_efootb *fb, double u0,
-                            double v0, double u1, double v1, double *lo,
-                            double *hi, double *lip) {
-  (void)fb;
-  return noise_local(nz, u0, v0, u1, v1, lo, hi, lip);
-}
-
 void oc_edisc_bound_in(const oc_enode *node, const oc_erect *b,
                        const oc_efootb *fb, oc_ebound *o) {
   dview v, *n = &v; /* (the disc unpacked) */
   unpack(node, n);
   *o = n->glob;
   int filtered = 0; /* some octave may be weighted below 1 in the box */
-  /* (every octave kept in the box, the finest included: the glob's) */
-  if (fb && fb->hi > 0 && n->noise.kind != OC_ENOISE_NONE &&
-      log2(n->noise.wavelength / fb->hi) - 1e-12 -
-              (n->noise.octaves - 1) * log2(n->noise.lacunarity) <
-          1) {
-    /* the octaves the footprints keep */
-    double lo, hi, lip;
-    noise_bounds(&n->noise, fb, 0, &lo, &hi, &lip);
-    o->flo = n->par[3] + lo;
-    o->fhi = n->par[3] + hi;
-    o->lf = lip;
-    filtered = 1;
+  int j = 0;        /* then the leading octaves kept whole in the box */
+  double all[3], rest[3];
+  if (fb && fb->hi > 0 && n->noise.kind != OC_ENOISE_NONE) {
+    octspan ts;
+    oct_span(&n->noise, fb, &ts);
+    /* (every octave kept in the box, the finest included: the glob's) */
+    if (ts.tmin - (n->noise.octaves - 1) * ts.dt < 1) {
+      while (j < n->noise.octaves && ts.tmin - j * ts.dt >= 1)
+        j++;
+      /* the octaves the footprints keep; those after the j whole ones */
+      noise_bounds(&n->noise, fb, &ts, j, all, rest);
+      o->flo = n->par[3] + all[0];
+      o->fhi = n->par[3] + all[1];
+      o->lf = all[2];
+      filtered = 1;
+    }
   }
   if (!oc_erect_meets(&n->box, b)) {
     o->alo = o->ahi = o->la = 0;
@@ -641,10 +719,12 @@ void oc_edisc_bound_in(const oc_enode *node, const oc_erect *b,
   double nlo, nhi, nlip;
   /* the octaves' values at the centre bound the unfiltered sum only (or,
   ** filtered, the octaves kept whole on the box) */
+  double u0 = b->x0 - n->par[0], v0 = b->y0 - n->par[1];
+  double u1 = b->x1 - n->par[0], v1 = b->y1 - n->par[1];
   if (n->noise.kind != OC_ENOISE_NONE &&
-      (filtered ? noise_local_lod : noise_local_full)(
-          &n->noise, fb, b->x0 - n->par[0], b->y0 - n->par[1],
-          b->x1 - n->par[0], b->y1 - n->par[1], &nlo, &nhi, &nlip)) {
+      (filtered ? noise_local_lod(&n->noise, j, rest, u0, v0, u1, v1, &nlo,
+                                  &nhi, &nlip)
+                : noise_local(&n->noise, u0, v0, u1, v1, &nlo, &nhi, &nlip))) {
     o->flo = oc_efmax(o->flo, n->par[3] + nlo);
     o->fhi = oc_efmin(o->fhi, n->par[3] + nhi);
     o->lf = oc_efmin(o->lf, nlip);
@@ -702,7 +782,7 @@ static int check_noise(const oc_enode_noise *nz, oc_enoise *out,
 }
 
 oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err) {
-  oc_enoise nz;
+  oc_enoise nz = {.kind = OC_ENOISE_NONE}; /* (set by check_noise) */
   if (!p) {
     oc_seterr(err, OC_EINVAL, "disc: no parameters");
     return NULL;
@@ -723,7 +803,11 @@ oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err) {
   }
   if (check_noise(&p->noise, &nz, err)) return NULL;
   double lo = 0, hi = 0, lip = 0;
-  if (nz.kind != OC_ENOISE_NONE) noise_bounds(&nz, NULL, 0, &lo, &hi, &lip);
+  if (nz.kind != OC_ENOISE_NONE) {
+    double all[3];
+    noise_bounds(&nz, NULL, NULL, 0, all, NULL);
+    lo = all[0], hi = all[1], lip = all[2];
+  }
   oc_erect box = {p->cx - p->radius, p->cy - p->radius, p->cx + p->radius,
                   p->cy + p->radius};
   if (!isfinite(p->height + lo) || !isfinite(p->height + hi) ||
@@ -808,51 +892,17 @@ static inline oc_etay octave_model(double e, const double g[2], double s,
   return oc_etay_flat(ae, flat1, flat0, R);
 }
 
-/* noise_taylor's sum of plain or turbulent octaves: octave_model's
-** terms, scaled and added as oc_etay_scale and oc_etay_add would (the
-** same operations in the same order: the same bits), in registers. */
-static void plain_taylor(const oc_enoise *nz, const double *ev,
-                         const double *ex, const double *ey, double R,
-                         oc_etay *o) {
-  int turb = nz->kind == OC_ENOISE_TURBULENCE;
-  double sum = 0, a = nz->amplitude, s = 1 / nz->wavelength;
-  double gx = 0, gy = 0, e0 = 0, e1 = 0, e2 = 0;
-  for (int i = 0; i < nz->octaves; i++) {
-    double g[2] = {2 * ex[i], 2 * ey[i]}, e = 2 * ev[i] - 1; /* (oc_eta) */
-    oc_etay t = octave_model(e, g, s, R, turb);              /* (inline) */
-    double q = fabs(a);
-    sum += a * t.v; /* (octave_term's value: |e| or e) */
-    gx += a * t.gx, gy += a * t.gy;
-    e0 += q * t.e0, e1 += q * t.e1, e2 += q * t.e2;
-    a = a * nz->gain;
-    s *= nz->lacunarity;
-  }
-  *o = (oc_etay){sum, gx, gy, e0, e1, e2};
-}
-
 static void noise_taylor(const oc_enoise *nz, double u, double v, double R,
                          oc_etay *o) {
   /* every octave's noise first, in one call */
   double ev[OC_ENOISE_MAXOCT], ex[OC_ENOISE_MAXOCT], ey[OC_ENOISE_MAXOCT];
   int cnt = nz->octaves;
   octave_noise(nz, u, v, cnt, ev, ex, ey);
-  if (nz->kind != OC_ENOISE_RIDGED) {
-    plain_taylor(nz, ev, ex, ey, R, o);
-    return;
-  }
-  double sum = 0, a = nz->amplitude, prev = 1, s = 1 / nz->wavelength;
-  oc_etay m = oc_etay_const(0), tprev = oc_etay_const(1);
-  for (int i = 0; i < cnt; i++) {
-    double ge[2] = {2 * ex[i], 2 * ey[i]}, e = 2 * ev[i] - 1; /* (oc_eta) */
-    oc_etay t;
-    sum += a * octave_term(nz, i, e, ge, s, R, &prev, &tprev, &t);
-    oc_etay at = oc_etay_scale(&t, a);
-    oc_etay_add(&m, &at);
-    a = a * nz->gain;
-    s *= nz->lacunarity;
-  }
-  m.v = sum; /* bit for bit noise_sum's (no level of detail) */
-  *o = m;
+  octsum q;
+  octsum_init(nz, &q);
+  octaves_taylor(nz, 0, cnt, ev, ex, ey, R, &q);
+  q.m.v = q.sum; /* bit for bit noise_sum's (no level of detail) */
+  *o = q.m;
 }
 
 void oc_edisc_taylor_alpha(const oc_enode *n, double x, double y, double R,

@@ -445,6 +445,10 @@ void oc_edisc_taylor(const oc_enode *n, double x, double y, double R,
 ** rule (a filter ramps on a disc reaching a footprint of 0). */
 int oc_edisc_taylor_lod(const oc_enode *n, double x, double y, double R,
                         const oc_etfoot *tf, oc_etaylor *o);
+/* Its f model alone (tf NULL: oc_edisc_taylor_f's), for a caller that
+** made alpha's (a blend); 0 where oc_edisc_taylor_lod has no rule. */
+int oc_edisc_taylor_f_view(const oc_enode *n, double x, double y, double R,
+                           const oc_etfoot *tf, oc_etay *f);
 /* alpha's model alone (its value 0 where (x, y) is outside the disc),
 ** and f's alone: oc_edisc_taylor is the two */
 void oc_edisc_taylor_alpha(const oc_enode *n, double x, double y, double R,

@@ -1307,9 +1307,9 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
       m++;
       continue;
     }
-    if (have && k->kind == OC_E_DISC && !tf)
-      oc_edisc_taylor_f(k, x, y, R, &c.f); /* (its alpha's model: c.a) */
-    else
+    /* a disc's f model alone (its alpha's model: c.a) */
+    if (!(have && k->kind == OC_E_DISC &&
+          oc_edisc_taylor_f_view(k, x, y, R, tf, &c.f)))
       oc_enode_taylor_view(k, x, y, R, tf, &c, boxes);
     if (c.a.v == 0 && oc_etay_is_const(&c.a)) continue;
     if (oc_enode_holds(k, x, y) && c.a.v != 0) N += c.a.v * c.f.v; /* (ev) */

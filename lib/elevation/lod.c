@@ -45,10 +45,10 @@ void oc_eview_foot(const oc_eview *v, double x, double y, oc_efoot *ft) {
 }
 
 void oc_eview_footb(const oc_eview *v, const oc_erect *b, oc_efootb *fb) {
-  double dx = fmax(fmax(b->x0 - v->ex, v->ex - b->x1), 0);
-  double dy = fmax(fmax(b->y0 - v->ey, v->ey - b->y1), 0);
-  double fx = fmax(fabs(b->x0 - v->ex), fabs(b->x1 - v->ex));
-  double fy = fmax(fabs(b->y0 - v->ey), fabs(b->y1 - v->ey));
+  double dx = oc_fmax(oc_fmax(b->x0 - v->ex, v->ex - b->x1), 0);
+  double dy = oc_fmax(oc_fmax(b->y0 - v->ey, v->ey - b->y1), 0);
+  double fx = oc_fmax(fabs(b->x0 - v->ex), fabs(b->x1 - v->ex));
+  double fy = oc_fmax(fabs(b->y0 - v->ey), fabs(b->y1 - v->ey));
   double z2 = v->dz * v->dz;
   /* rounding: a relative hair each way */
   fb->lo = v->k * sqrt(dx * dx + dy * dy + z2) * (1 - 1e-12);
@@ -58,13 +58,13 @@ void oc_eview_footb(const oc_eview *v, const oc_erect *b, oc_efootb *fb) {
 
 /* max b' over [t0, t1] clamped to [0, 1] (b' rises to BP_AT, then falls) */
 static double bp_max(double t0, double t1) {
-  t0 = fmin(fmax(t0, 0), 1);
-  t1 = fmin(fmax(t1, 0), 1);
+  t0 = oc_fmin(oc_fmax(t0, 0), 1);
+  t1 = oc_fmin(oc_fmax(t1, 0), 1);
   if (t0 <= BP_AT && t1 >= BP_AT) return BP_MAX;
   double d0, d1;
   oc_elod_b(t0, &d0);
   oc_elod_b(t1, &d1);
-  return fmax(d0, d1) * (1 + 1e-12);
+  return oc_fmax(d0, d1) * (1 + 1e-12);
 }
 
 void oc_elod_kappa_bound_t(double w, double tmin, double tmax,
@@ -78,7 +78,7 @@ void oc_elod_kappa_bound_t(double w, double tmin, double tmax,
     return;
   }
   /* on the ramp foot lies in (w / 2, w): |grad t| <= k / (ln 2 foot) */
-  *lip = bp_max(tmin, tmax) * fb->k / (LN2 * fmax(fb->lo, w / 2));
+  *lip = bp_max(tmin, tmax) * fb->k / (LN2 * oc_fmax(fb->lo, w / 2));
 }
 
 void oc_elod_kappa_bound(double w, const oc_efootb *fb, double *lo, double *hi,
@@ -149,12 +149,14 @@ void oc_elod_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
 ** bound lt. */
 static void lod_combine(const oc_ebound *A, const oc_ebound *B, double lt,
                         oc_ebound *o) {
-  o->flo = fmin(A->flo, B->flo);
-  o->fhi = fmax(A->fhi, B->fhi);
-  o->alo = fmin(A->alo, B->alo);
-  o->ahi = fmax(A->ahi, B->ahi);
-  o->lf = fmax(A->lf, B->lf) + lt * fmax(A->fhi - B->flo, B->fhi - A->flo);
-  o->la = fmax(A->la, B->la) + lt * fmax(A->ahi - B->alo, B->ahi - A->alo);
+  o->flo = oc_fmin(A->flo, B->flo);
+  o->fhi = oc_fmax(A->fhi, B->fhi);
+  o->alo = oc_fmin(A->alo, B->alo);
+  o->ahi = oc_fmax(A->ahi, B->ahi);
+  o->lf =
+      oc_fmax(A->lf, B->lf) + lt * oc_fmax(A->fhi - B->flo, B->fhi - A->flo);
+  o->la =
+      oc_fmax(A->la, B->la) + lt * oc_fmax(A->ahi - B->alo, B->ahi - A->alo);
 }
 
 void oc_elod_bound_in(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
@@ -222,15 +224,15 @@ void oc_elod_derive(const oc_enode *n, const oc_ebound *kb,
   (void)n;
   const oc_erect *a = &kbox[0], *b = &kbox[1];
   /* under a view alpha may come from a: its box too */
-  *box = (oc_erect){fmin(a->x0, b->x0), fmin(a->y0, b->y0), fmax(a->x1, b->x1),
-                    fmax(a->y1, b->y1)};
+  *box = (oc_erect){oc_fmin(a->x0, b->x0), oc_fmin(a->y0, b->y0),
+                    oc_fmax(a->x1, b->x1), oc_fmax(a->y1, b->y1)};
   /* without a view the node is b (its slopes), with the ranges of both so
   ** that those of any view lie inside */
   *glob = kb[1];
-  glob->flo = fmin(kb[0].flo, kb[1].flo);
-  glob->fhi = fmax(kb[0].fhi, kb[1].fhi);
-  glob->alo = fmin(kb[0].alo, kb[1].alo);
-  glob->ahi = fmax(kb[0].ahi, kb[1].ahi);
+  glob->flo = oc_fmin(kb[0].flo, kb[1].flo);
+  glob->fhi = oc_fmax(kb[0].fhi, kb[1].fhi);
+  glob->alo = oc_fmin(kb[0].alo, kb[1].alo);
+  glob->ahi = oc_fmax(kb[0].ahi, kb[1].ahi);
 }
 
 /* ---- first-order models under a view (etaylor.h) -----------------------
@@ -267,9 +269,9 @@ static double bpp_abs(double t) {
 
 /* The largest |b''| on [lo, hi] (b'' is 0 outside [0, 1], 6 next to 0). */
 static double bpp_max(double lo, double hi) {
-  lo = fmin(fmax(lo, 0), 1), hi = fmin(fmax(hi, 0), 1);
-  double m = fmax(bpp_abs(lo), bpp_abs(hi));
-  if (lo <= SQRT35 && hi >= SQRT35) m = fmax(m, 4.8);
+  lo = oc_fmin(oc_fmax(lo, 0), 1), hi = oc_fmin(oc_fmax(hi, 0), 1);
+  double m = oc_fmax(bpp_abs(lo), bpp_abs(hi));
+  if (lo <= SQRT35 && hi >= SQRT35) m = oc_fmax(m, 4.8);
   return m * (1 + 1e-12);
 }
 
@@ -277,15 +279,17 @@ int oc_elod_tau_taylor(double w, const oc_etfoot *tf, double R, oc_etay *m,
                        double *lo, double *hi) {
   const oc_efoot *ft = &tf->p;
   double k = tf->b.k, kr = k * R * (1 + 1e-12);
-  double flo = fmax(tf->b.lo, ft->v - kr), fhi = fmin(tf->b.hi, ft->v + kr);
+  double flo = oc_fmax(tf->b.lo, ft->v - kr),
+         fhi = oc_fmin(tf->b.hi, ft->v + kr);
   double c = -1 / (ft->v * LN2); /* (as the discs' evaluation) */
   *m = (oc_etay){log2(w / ft->v), c * ft->gx, c * ft->gy, 0, 0, 0};
   /* tau's range without a log2 each: log2(w / fhi) = tau(p) - log2(fhi /
   ** foot(p)) and ln(1 + x) <= x; log2(w / flo) = tau(p) - log2(flo /
   ** foot(p)) and -ln y <= 1 / y - 1; padded against rounding */
   double pad = 1e-12 * (1 + fabs(m->v));
-  *lo = m->v - (fmax(fhi, ft->v) / ft->v - 1) / LN2 - pad;
-  *hi = flo > 0 ? m->v + (ft->v / fmin(flo, ft->v) - 1) / LN2 + pad : INFINITY;
+  *lo = m->v - (oc_fmax(fhi, ft->v) / ft->v - 1) / LN2 - pad;
+  *hi =
+      flo > 0 ? m->v + (ft->v / oc_fmin(flo, ft->v) - 1) / LN2 + pad : INFINITY;
   if (!(flo > 0)) return 0;
   m->e2 = 0.5 * k * k / (LN2 * flo * flo) * (1 + 1e-12);
   return 1;
@@ -297,7 +301,7 @@ oc_etay oc_elod_b_taylor(const oc_etay *t, double lo, double hi, double R) {
   oc_etay m = oc_etay_compose(t, bv, db, bpp_max(lo, hi), R);
   /* b is non-decreasing: it stays in [b(lo), b(hi)] (the gap to the far
   ** end, flat, where that is less) */
-  double gap = fmax(bv - oc_elod_b(lo, &d), oc_elod_b(hi, &d) - bv);
+  double gap = oc_fmax(bv - oc_elod_b(lo, &d), oc_elod_b(hi, &d) - bv);
   if (oc_etay_rem(&m, R) > gap) m = (oc_etay){bv, 0, 0, gap, 0, 0};
   return m;
 }

@@ -507,21 +507,26 @@ static void check_view_taylor(const oc_enode *e, const oc_enode_view *v,
 }
 
 /* Models under views (disc.c, lod.c, etaylor.h) on trees with every
-** operator: continuous-LoD discs of each noise, the lod operator between
-** flat discs (all its curvature the footprint's), that tree scaled and
-** rotated by a transform (the footprint in the child's units) and
-** warped (a fallback), the scene of every operator, and an add by a
-** slope weight (a fallback); far, near and grazing views, and one whose
-** eye is level with the tree's middle (the footprint reaches 0: no rule
-** for tau next to the eye). Remainders never exceeded; on the step trees'
-** ramps the errors reach a good part of the remainders, so that zeroing
-** the footprint's terms (tau's curvature or b''s) fails the check. */
+** operator: continuous-LoD discs of each noise (one with a lacunarity
+** of 2.5), the lod operator between flat discs (all its curvature the
+** footprint's), that tree scaled and rotated by a transform (the
+** footprint in the child's units) and warped (a fallback), the scene of
+** every operator, and an add by a slope weight (a fallback); far, near
+** and grazing views, and one whose eye is level with the tree's middle
+** (the footprint reaches 0: no rule for tau next to the eye).
+** Remainders never exceeded; on the step trees' ramps the errors reach
+** a good part of the remainders, so that zeroing the footprint's terms
+** (tau's curvature or b''s) fails the check. */
 START_TEST(lod_taylor_models) {
   oc_error err;
   oc_enode *st = step_tree();
   oc_enode_xform x = {300, -200, 25, 2.5, 1.3, 5};
   oc_enode *xst = EOK(oc_enode_transform(st, &x, &err));
+  /* a lacunarity other than 2 (the octave counts by loops, not ceil) */
+  oc_enode_disc_params lp = {
+      0, 0, 20000, 50, {OC_ENOISE_RIDGED, 100, 400, 8, 0.6, 2.5, 42}};
   oc_enode *trees[] = {disc(0, 0, 20000, 50, OC_ENOISE_PLAIN, 100, 400, 8),
+                       EOK(oc_enode_disc(&lp, &err)),
                        disc(0, 0, 20000, 50, OC_ENOISE_TURBULENCE, 100, 400, 8),
                        disc(0, 0, 20000, 50, OC_ENOISE_RIDGED, 100, 400, 8),
                        st,
@@ -538,9 +543,9 @@ START_TEST(lod_taylor_models) {
   tay_worst = ramp_worst = 0;
   for (size_t t = 0; t < nt; t++)
     for (int q = 0; q < 4; q++) {
-      if (q == 3 && t != 3) continue; /* level with the step tree's middle */
+      if (q == 3 && t != 4) continue; /* level with the step tree's middle */
       check_view_taylor(trees[t], &views[q], &r, 0);
-      if ((t == 3 || t == 4) && q > 0) /* (the first view has no ramp) */
+      if ((t == 4 || t == 5) && q > 0) /* (the first view has no ramp) */
         check_view_taylor(trees[t], &views[q], &r, 1);
     }
   printf("lod taylor: the largest error is %.3f of its remainder, %.3f "
