@@ -47,7 +47,7 @@ typedef struct oc_etaylor {
 ** fig3 9.8, 8.9, 8.4, 8.3, 8.2, 8.4, 8.7 and fig22 13.6, 12.7, 12.2,
 ** 12.1, 12.0, 12.1, 12.4; 0.4, 0.5, 0.6 fig1 11.8, 11.7, 11.9 (0.25:
 ** 12.9) and fig20 12.8, 12.6, 12.8 (13.9). */
-#define OC_ETAY_CHOICE 0.5
+#define OC_ETAY_CHOICE 0.25
 static inline oc_etay oc_etay_const(double c) {
   return (oc_etay){c, 0, 0, 0, 0, 0};
 }
