@@ -46,7 +46,11 @@ typedef struct oc_etaylor {
 ** (fig3, fig22, fig1, fig20) 0.15, 0.25, 0.35, 0.4, 0.5, 0.6, 0.7 gave
 ** fig3 9.8, 8.9, 8.4, 8.3, 8.2, 8.4, 8.7 and fig22 13.6, 12.7, 12.2,
 ** 12.1, 12.0, 12.1, 12.4; 0.4, 0.5, 0.6 fig1 11.8, 11.7, 11.9 (0.25:
-** 12.9) and fig20 12.8, 12.6, 12.8 (13.9). */
+** 12.9) and fig20 12.8, 12.6, 12.8 (13.9); but at 1920 x 1080 0.5 made
+** the calls dearer than it saved (idle, primary rays and normals: 0.5
+** against 0.25, fig3 7.6 against 5.3 s, fig22 15.5 against 12.7, fig21
+** 8.5 against 6.9, fig1 9.8 against 10.7): wider discs keep more octaves
+** quadratic and more blends' weights cross T. Seconds, not calls, chose. */
 #define OC_ETAY_CHOICE 0.25
 static inline oc_etay oc_etay_const(double c) {
   return (oc_etay){c, 0, 0, 0, 0, 0};
