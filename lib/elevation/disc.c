@@ -884,7 +884,14 @@ static inline oc_etay octave_model(double e, const double g[2], double s,
   if (absval) {
     sg = e < 0 ? -1 : 1, ae = fabs(e);
     flat0 = oc_fmax(ae, 1 - ae);
-    can_quad = ae > s * hypot(g[0], g[1]) * R + quad * R * R;
+    /* (sqrt of the squares is within a few ulps of hypot, a libm call
+    ** that showed in profiles: hypot decides only where the two sides
+    ** are that close, so that the decisions, and the bits, are its) */
+    double q2 = quad * R * R;
+    double rhs = s * sqrt(g[0] * g[0] + g[1] * g[1]) * R + q2;
+    if (fabs(ae - rhs) <= 1e-12 * (ae + rhs))
+      rhs = s * hypot(g[0], g[1]) * R + q2;
+    can_quad = ae > rhs;
   }
   double Rk = R * OC_ETAY_CHOICE;
   if (can_quad && quad * Rk * Rk <= oc_fmin(flat1 * Rk, flat0))
