@@ -51,6 +51,13 @@ static void octave_noise(const oc_enoise *nz, double u, double v, int n,
   if (n) oc_noise3_z0_multi(seed, px, py, (size_t)n, ev, ex, ey);
 }
 
+/* log2 of the lacunarity: the step of t_i = log2(w_i / foot) from one
+** octave to the next (log2 2 is 1: the default lacunarity spares the
+** call). */
+static inline double octave_dt(const oc_enoise *nz) {
+  return nz->lacunarity == 2 ? 1 : log2(nz->lacunarity);
+}
+
 /* Continuous level of detail (lod.c): octave i weighted b(t_i), t_i =
 ** log2(w_i / foot) = t0 - i dt, all with the gradient (gx, gy) of t. */
 typedef struct octlod {
@@ -147,8 +154,7 @@ typedef struct octspan {
 } octspan;
 
 static void oct_span(const oc_enoise *nz, const oc_efootb *fb, octspan *t) {
-  /* (log2 2 is 1: the default lacunarity spares the call) */
-  t->dt = nz->lacunarity == 2 ? 1 : log2(nz->lacunarity);
+  t->dt = octave_dt(nz);
   t->tmin = log2(nz->wavelength / fb->hi) - 1e-12;
   t->tmax = fb->lo > 0 ? log2(nz->wavelength / fb->lo) + 1e-12 : INFINITY;
 }
@@ -297,8 +303,7 @@ octaves_taylor(const oc_enoise *nz, int i0, int i1, const double *ev,
 static int noise_taylor_lod(const oc_enoise *nz, double u, double v, double R,
                             const oc_etfoot *tf, oc_etay *o) {
   oc_etay tau;
-  /* (log2 2 is 1: the default lacunarity spares the call) */
-  double tlo, thi, dt = nz->lacunarity == 2 ? 1 : log2(nz->lacunarity);
+  double tlo, thi, dt = octave_dt(nz);
   int curved = oc_elod_tau_taylor(nz->wavelength, tf, R, &tau, &tlo, &thi);
   /* the octaves whose filter is not 0 on the whole disc (cnt), the
   ** leading ones whose filter is 1 there (whole); their noise at p in one
@@ -483,9 +488,8 @@ void oc_edisc_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
   octlod lod, *lp = NULL;
   if (ft && ft->v > 0 && noise.kind != OC_ENOISE_NONE) {
     double c = -1 / (ft->v * 0.69314718055994530942);
-    /* (log2 2 is 1: the default lacunarity spares the call) */
-    double dt = noise.lacunarity == 2 ? 1 : log2(noise.lacunarity);
-    lod = (octlod){log2(noise.wavelength / ft->v), dt, c * ft->gx, c * ft->gy};
+    lod = (octlod){log2(noise.wavelength / ft->v), octave_dt(&noise),
+                   c * ft->gx, c * ft->gy};
     lp = &lod;
   }
   s->f = p[3] + (noise.kind == OC_ENOISE_NONE
@@ -576,10 +580,10 @@ void oc_edisc_ev_row(const oc_enode *n, const double *x, double y, int cnt,
 /* Distances from (cx, cy) to the nearest and farthest points of b. */
 static void rect_dist(const oc_erect *b, double cx, double cy, double *dmin,
                       double *dmax) {
-  double dx = oc_efmax(oc_efmax(b->x0 - cx, cx - b->x1), 0);
-  double dy = oc_efmax(oc_efmax(b->y0 - cy, cy - b->y1), 0);
-  double fx = oc_efmax(fabs(b->x0 - cx), fabs(b->x1 - cx));
-  double fy = oc_efmax(fabs(b->y0 - cy), fabs(b->y1 - cy));
+  double dx = oc_fmax(oc_fmax(b->x0 - cx, cx - b->x1), 0);
+  double dy = oc_fmax(oc_fmax(b->y0 - cy, cy - b->y1), 0);
+  double fx = oc_fmax(fabs(b->x0 - cx), fabs(b->x1 - cx));
+  double fy = oc_fmax(fabs(b->y0 - cy), fabs(b->y1 - cy));
   *dmin = sqrt(dx * dx + dy * dy);
   *dmax = sqrt(fx * fx + fy * fy);
 }
@@ -725,24 +729,24 @@ void oc_edisc_bound_in(const oc_enode *node, const oc_erect *b,
       (filtered ? noise_local_lod(&n->noise, j, rest, u0, v0, u1, v1, &nlo,
                                   &nhi, &nlip)
                 : noise_local(&n->noise, u0, v0, u1, v1, &nlo, &nhi, &nlip))) {
-    o->flo = oc_efmax(o->flo, n->par[3] + nlo);
-    o->fhi = oc_efmin(o->fhi, n->par[3] + nhi);
-    o->lf = oc_efmin(o->lf, nlip);
+    o->flo = oc_fmax(o->flo, n->par[3] + nlo);
+    o->fhi = oc_fmin(o->fhi, n->par[3] + nhi);
+    o->lf = oc_fmin(o->lf, nlip);
   }
   double dmin, dmax, r = n->par[2];
   rect_dist(b, n->par[0], n->par[1], &dmin, &dmax);
   /* rounding: alpha's bounds a hair wider than the formula */
-  o->alo = oc_efmax(0, wyvill(dmax / r) * (1 - 1e-12) - 1e-300);
-  o->ahi = oc_efmin(1, wyvill(dmin / r) * (1 + 1e-12));
+  o->alo = oc_fmax(0, wyvill(dmax / r) * (1 - 1e-12) - 1e-300);
+  o->ahi = oc_fmin(1, wyvill(dmin / r) * (1 + 1e-12));
   /* |grad alpha| = 6 x (1 - x^2)^2 / r at x = d / r rises up to x =
   ** 1/sqrt(5) (the global bound) and falls after: its largest value on
   ** [dmin, dmax] is there or at the end nearer to it */
-  double x0 = dmin / r, x1 = oc_efmin(dmax / r, 1), xs = 1 / sqrt(5.0);
+  double x0 = dmin / r, x1 = oc_fmin(dmax / r, 1), xs = 1 / sqrt(5.0);
   if (x0 >= 1) {
     o->la = 0; /* outside the disc: alpha = 0 on the whole box */
   } else if (x1 < xs || x0 > xs) {
     double x = x1 < xs ? x1 : x0, k = 1 - x * x;
-    o->la = oc_efmin(o->la, 6 * x * k * k / r * (1 + 1e-12));
+    o->la = oc_fmin(o->la, 6 * x * k * k / r * (1 + 1e-12));
   }
 }
 

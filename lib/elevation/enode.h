@@ -473,15 +473,6 @@ int oc_eop_taylor_alpha(const oc_enode *n, double x, double y, double R,
 void oc_enode_bnd(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
                   oc_ebound *o);
 
-/* fmax and fmin, inline (core/vec.h): box queries make many (2 % of a
-** render's instructions). */
-static inline double oc_efmax(double x, double y) {
-  return oc_fmax(x, y);
-}
-static inline double oc_efmin(double x, double y) {
-  return oc_fmin(x, y);
-}
-
 static inline int oc_erect_meets(const oc_erect *a, const oc_erect *b) {
   return a->x0 <= b->x1 && a->x1 >= b->x0 && a->y0 <= b->y1 && a->y1 >= b->y0;
 }

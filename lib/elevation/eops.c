@@ -269,26 +269,26 @@ static void blend_combine(const oc_ebound *kb, size_t n, int plane,
   double flo = INFINITY, fhi = -INFINITY, slo = 0, shi = 0, lmax = 0;
   double lasum = 0, lamax = 0, M = 0;
   for (size_t i = 0; i < n; i++) {
-    flo = oc_efmin(flo, kb[i].flo);
-    fhi = oc_efmax(fhi, kb[i].fhi);
+    flo = oc_fmin(flo, kb[i].flo);
+    fhi = oc_fmax(fhi, kb[i].fhi);
     slo += plane ? 0 : kb[i].alo; /* (the plane: some point is outside) */
     shi += kb[i].ahi;
-    lmax = oc_efmax(lmax, kb[i].lf);
+    lmax = oc_fmax(lmax, kb[i].lf);
     lasum += kb[i].la;
-    lamax = oc_efmax(lamax, kb[i].la);
-    M += kb[i].la * oc_efmax(fabs(kb[i].flo), fabs(kb[i].fhi));
+    lamax = oc_fmax(lamax, kb[i].la);
+    M += kb[i].la * oc_fmax(fabs(kb[i].flo), fabs(kb[i].fhi));
   }
-  double lam = oc_efmin(lasum, (double)(n - 1) * lamax);
+  double lam = oc_fmin(lasum, (double)(n - 1) * lamax);
   /* sum |grad alpha_i| |f_i - f| with f in [flo, fhi]: each child's own
   ** distance to that range is often far below its width */
   double dev = 0;
   for (size_t i = 0; i < n; i++)
-    dev += kb[i].la * oc_efmax(kb[i].fhi - flo, fhi - kb[i].flo);
-  o->lf = lmax + oc_efmin(lam * (fhi - flo), dev) / oc_efmax(slo, T);
+    dev += kb[i].la * oc_fmax(kb[i].fhi - flo, fhi - kb[i].flo);
+  o->lf = lmax + oc_fmin(lam * (fhi - flo), dev) / oc_fmax(slo, T);
   if (slo < T) { /* f fades towards 0 where sum alpha < T */
-    o->lf = oc_efmax(o->lf, lmax + M / T);
-    flo = oc_efmin(flo, 0);
-    fhi = oc_efmax(fhi, 0);
+    o->lf = oc_fmax(o->lf, lmax + M / T);
+    flo = oc_fmin(flo, 0);
+    fhi = oc_fmax(fhi, 0);
   }
   o->flo = flo;
   o->fhi = fhi;
@@ -430,22 +430,22 @@ static void replace_ev(const oc_enode *n, double x, double y,
 static void replace_combine(const oc_enode *n, const oc_ebound *A,
                             const oc_ebound *B, int bmeets, oc_ebound *o) {
   int lerp = (n->flags & OC_EF_LERP) != 0;
-  double wlo = bmeets ? oc_efmin(oc_efmax(B->alo, 0), 1) : 0;
-  double whi = bmeets ? oc_efmin(oc_efmax(B->ahi, 0), 1) : 0;
+  double wlo = bmeets ? oc_fmin(oc_fmax(B->alo, 0), 1) : 0;
+  double whi = bmeets ? oc_fmin(oc_fmax(B->ahi, 0), 1) : 0;
   double law = bmeets ? B->la : 0;
   *o = *A;
   if (whi > 0) {
-    o->flo = oc_efmin(A->flo, B->flo);
-    o->fhi = oc_efmax(A->fhi, B->fhi);
-    o->lf = oc_efmax(A->lf, B->lf) +
-            law * oc_efmax(A->fhi - B->flo, B->fhi - A->flo);
+    o->flo = oc_fmin(A->flo, B->flo);
+    o->fhi = oc_fmax(A->fhi, B->fhi);
+    o->lf =
+        oc_fmax(A->lf, B->lf) + law * oc_fmax(A->fhi - B->flo, B->fhi - A->flo);
   }
   if (lerp) {
     /* (1 - w) a + w^2 on [wlo, whi] x [alo, ahi]: convex in w */
-    double v = oc_efmin(oc_efmax(A->alo / 2, wlo), whi);
-    o->alo = oc_efmax(0, (1 - v) * A->alo + v * v);
-    o->ahi = oc_efmax((1 - wlo) * A->ahi + wlo * wlo,
-                      (1 - whi) * A->ahi + whi * whi);
+    double v = oc_fmin(oc_fmax(A->alo / 2, wlo), whi);
+    o->alo = oc_fmax(0, (1 - v) * A->alo + v * v);
+    o->ahi =
+        oc_fmax((1 - wlo) * A->ahi + wlo * wlo, (1 - whi) * A->ahi + whi * whi);
     o->la = A->la + law * (A->ahi + 2 * whi);
   }
 }
@@ -637,8 +637,8 @@ static void add_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
 static void add_combine(const oc_enode *n, const oc_ebound *A,
                         const oc_ebound *B, int bmeets, double lah,
                         oc_ebound *o) {
-  double clo = bmeets ? oc_efmin(oc_efmax(B->alo, 0), 1) : 0;
-  double chi = bmeets ? oc_efmin(oc_efmax(B->ahi, 0), 1) : 0;
+  double clo = bmeets ? oc_fmin(oc_fmax(B->alo, 0), 1) : 0;
+  double chi = bmeets ? oc_fmin(oc_fmax(B->ahi, 0), 1) : 0;
   double lc = bmeets ? B->la : 0;
   *o = *A;
   /* the altitude weight is 0 on the region where f_A >= below_z, 1
@@ -666,18 +666,18 @@ static void add_combine(const oc_enode *n, const oc_ebound *A,
       ** slope 6 t (1 - t) is at most its value at tmax if tmax < 1/2 */
       double c0 = cos(th0), phi = sp[P_SFADE];
       double tmax = (atan(sqrt(2.0) * lah) - th0) / phi * (1 + 1e-9) + 1e-9;
-      tmax = oc_efmax(tmax, 0);
+      tmax = oc_fmax(tmax, 0);
       double ss = tmax < 0.5 ? 6 * tmax * (1 - tmax) : 1.5;
       wlo = 0;
       lw += ss * c0 * c0 / phi * sqrt(2.0) * lah / h * (1 + 1e-9);
     }
     /* w f_B with w in [wlo, whi] */
     double p[4] = {wlo * B->flo, wlo * B->fhi, whi * B->flo, whi * B->fhi};
-    double plo = oc_efmin(oc_efmin(p[0], p[1]), oc_efmin(p[2], p[3]));
-    double phi = oc_efmax(oc_efmax(p[0], p[1]), oc_efmax(p[2], p[3]));
+    double plo = oc_fmin(oc_fmin(p[0], p[1]), oc_fmin(p[2], p[3]));
+    double phi = oc_fmax(oc_fmax(p[0], p[1]), oc_fmax(p[2], p[3]));
     o->flo = A->flo + plo;
     o->fhi = A->fhi + phi;
-    o->lf = A->lf + lw * oc_efmax(fabs(B->flo), fabs(B->fhi)) + whi * B->lf;
+    o->lf = A->lf + lw * oc_fmax(fabs(B->flo), fabs(B->fhi)) + whi * B->lf;
   }
   if (n->flags & OC_EF_SUMW) {
     o->alo = A->alo + clo * clo;

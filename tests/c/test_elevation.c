@@ -284,8 +284,8 @@ START_TEST(efmax_is_fmax) {
   int n = (int)(sizeof v / sizeof *v), differ = 0, pairs = 0;
   for (int i = 0; i < n; i++)
     for (int j = 0; j < n; j++, pairs++) {
-      double a = oc_efmax(v[i], v[j]), b = lmax(v[i], v[j]);
-      double c = oc_efmin(v[i], v[j]), d = lmin(v[i], v[j]);
+      double a = oc_fmax(v[i], v[j]), b = lmax(v[i], v[j]);
+      double c = oc_fmin(v[i], v[j]), d = lmin(v[i], v[j]);
       differ += memcmp(&a, &b, sizeof a) != 0 || memcmp(&c, &d, sizeof c) != 0;
     }
   ck_assert_int_eq(pairs, 144);
