@@ -463,7 +463,8 @@ static void curve_bound_in(const eimage *d, const oc_erect *b, oc_ebound *o) {
   double rho = 0.5 * hypot(b->x1 - b->x0, b->y1 - b->y0);
   oc_curve_point pt;
   double dc = INFINITY, s0 = 0, s1 = d->L;
-  if (oc_curve_closest(d->cv, cx, cy, INFINITY, &pt)) {
+  /* (the closest point alone: its arc length is not read) */
+  if (oc_curve_closest_t(d->cv, cx, cy, INFINITY, &pt)) {
     dc = hypot(cx - pt.q.x, cy - pt.q.y);
     /* every point of b has its closest point within dc + 2 rho of c,
     ** within tol of a chord of its span (and a hair for rounding) */

@@ -93,8 +93,9 @@ struct oc_enode {
 #define OC_EF_STEPF 32 /* add: the slope weight's step a float exactly */
 #define OC_EF_LERP 64  /* replace: the lerped weight */
 /* every kind: its f model holds only where its weight is > 0 (a curve,
-** lake or image, or an operator of one in A's place: eops.c,
-** tay_partial), set by oc_enode_alloc from the kind and the children */
+** lake or image, or an operator of one in A's place:
+** oc_eop_taylor_partial), set by oc_enode_alloc from the kind and the children
+ */
 #define OC_EF_PARTIAL 128
 
 /* The parameters (doubles) operators store (eops.c, lod.c). A replace
@@ -459,8 +460,11 @@ void oc_edisc_taylor_f(const oc_enode *n, double x, double y, double R,
 int oc_eop_taylor(const oc_enode *n, double x, double y, double R,
                   const oc_etfoot *tf, oc_etaylor *o, int *boxes);
 /* Whether n's f model holds only where its weight is > 0 (a curve's,
-** lake's or image's, and operators' in their place; eops.c). */
-int oc_eop_taylor_partial(const oc_enode *n);
+** lake's or image's, and operators' of one in A's place): its f model is
+** not composed as it stands (eops.c, lod.c). */
+static inline int oc_eop_taylor_partial(const oc_enode *n) {
+  return (n->flags & OC_EF_PARTIAL) != 0; /* (set by oc_enode_alloc) */
+}
 /* alpha's model alone, as oc_enode_taylor's (discs, and operators whose
 ** weight has its own rule: blends, transforms, replaces and adds with A's
 ** weight); 0 for the others. */

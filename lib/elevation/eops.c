@@ -112,6 +112,17 @@ static int grid_cell(double v, double lo, double s, int G) {
   return t >= G ? G - 1 : (int)t;
 }
 
+/* The cells [i0, i1] x [j0, j1] of blend bl's grid (G a side) that
+** [x0, x1] x [y0, y1] meets: the same arithmetic for the children's
+** boxes when the grid is built and for the queries, so that they agree. */
+static void grid_range(const oc_eblend *bl, int G, double x0, double y0,
+                       double x1, double y1, int r[4]) {
+  double bx = bl->box.x0, by = bl->box.y0;
+  double sx = G / ((double)bl->box.x1 - bx), sy = G / ((double)bl->box.y1 - by);
+  r[0] = grid_cell(x0, bx, sx, G), r[1] = grid_cell(x1, bx, sx, G);
+  r[2] = grid_cell(y0, by, sy, G), r[3] = grid_cell(y1, by, sy, G);
+}
+
 /* The children a query over [x0, x1] x [y0, y1] may meet: those of the
 ** cells that region meets (all when the blend has no grid), as W words
 ** of 64 bits visited in order:
@@ -130,10 +141,9 @@ static void kids_in(const oc_eblend *bl, double x0, double y0, double x1,
   size_t n = bl->nkids;
   it->n = n, it->W = (int)((n + 63) / 64), it->grid = G != 0;
   if (!G) return;
-  double bx = bl->box.x0, by = bl->box.y0;
-  double sx = G / ((double)bl->box.x1 - bx), sy = G / ((double)bl->box.y1 - by);
-  int i0 = grid_cell(x0, bx, sx, G), i1 = grid_cell(x1, bx, sx, G);
-  int j0 = grid_cell(y0, by, sy, G), j1 = grid_cell(y1, by, sy, G);
+  int r[4];
+  grid_range(bl, G, x0, y0, x1, y1, r);
+  int i0 = r[0], i1 = r[1], j0 = r[2], j1 = r[3];
   const uint64_t *g = grid_masks(bl);
   if (n <= 64) { /* (one word a cell: the common case) */
     uint64_t m = 0;
@@ -193,15 +203,13 @@ static int grid_side(size_t n) {
 /* Fills blend e's grid from its children's boxes kbox (its box stored). */
 static void grid_build(oc_eblend *bl, const oc_erect *kbox) {
   int G = bl->h.octaves, W = (int)((bl->nkids + 63) / 64);
-  double bx = bl->box.x0, by = bl->box.y0;
-  double sx = G / ((double)bl->box.x1 - bx), sy = G / ((double)bl->box.y1 - by);
-  uint64_t *g = (uint64_t *)(void *)(bl->kids + bl->nkids);
+  uint64_t *g = (uint64_t *)(uintptr_t)grid_masks(bl);
   for (size_t k = 0; k < bl->nkids; k++) {
     const oc_erect *b = &kbox[k];
-    int i0 = grid_cell(b->x0, bx, sx, G), i1 = grid_cell(b->x1, bx, sx, G);
-    int j0 = grid_cell(b->y0, by, sy, G), j1 = grid_cell(b->y1, by, sy, G);
-    for (int j = j0; j <= j1; j++)
-      for (int i = i0; i <= i1; i++)
+    int r[4];
+    grid_range(bl, G, b->x0, b->y0, b->x1, b->y1, r);
+    for (int j = r[2]; j <= r[3]; j++)
+      for (int i = r[0]; i <= r[1]; i++)
         g[((size_t)j * G + i) * W + k / 64] |= (uint64_t)1 << (k % 64);
   }
 }
@@ -310,16 +318,15 @@ static void blend_bound_in(const oc_enode *n, const oc_erect *b,
   size_t m = 0;
   kid_iter it;
   kids_in(bl, b->x0, b->y0, b->x1, b->y1, &it);
-  for (int w = 0; w < it.W; w++)
-    for (uint64_t mk = kid_word(&it, w); mk; mk &= mk - 1) {
-      const oc_enode *k = bl->kids[KID_INDEX(w, mk)];
-      if (oc_enode_meets(k, b)) {
-        oc_enode_bnd(k, b, fb, &kb[m]);
-        /* alpha = 0 on the whole box: neither the child's f nor its
-        ** weight's slope counts there */
-        m += kb[m].ahi > 0;
-      }
-    }
+  const oc_enode *k;
+  int w = 0;
+  uint64_t mk = kid_word(&it, 0);
+  while ((k = next_meeting(bl, &it, b, &w, &mk))) {
+    oc_enode_bnd(k, b, fb, &kb[m]);
+    /* alpha = 0 on the whole box: neither the child's f nor its weight's
+    ** slope counts there */
+    m += kb[m].ahi > 0;
+  }
   blend_combine(kb, m, 0, o);
   if (kb != stack) free(kb);
 }
@@ -1218,18 +1225,6 @@ int oc_eop_ev_row(const oc_enode *n, const double *x, double y, int cnt,
 /* At most this many children of a blend meet the disc (else fallback). */
 #define TAY_KIDS 64
 
-/* A node whose f model counts only where its weight is > 0: a curve's,
-** lake's or image's bounds hold there alone (ecurve.c), and so do those of
-** a transform, warp, level of detail, replace or add of one (in A's place:
-** their weight is A's). Their f models are not composed as they stand. */
-static int tay_partial(const oc_enode *n) {
-  return (n->flags & OC_EF_PARTIAL) != 0; /* (oc_enode_alloc) */
-}
-
-int oc_eop_taylor_partial(const oc_enode *n) {
-  return tay_partial(n);
-}
-
 /* blend, f = N / S where S = sum alpha_k >= T on the whole disc: with
 ** f the value at p, N' - f S' = sum alpha_k' (f_k' - f) and, writing each
 ** child's alpha_k' = a_k + A_k.d + x_k, f_k' = f_k + F_k.d + y_k, this is
@@ -1285,7 +1280,7 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
     } else if (!(k = next_meeting(bl, &it, &ball, &w, &mk))) {
       break; /* (alpha_k = 0 on the disc for the others) */
     }
-    if (m == TAY_KIDS || tay_partial(k)) return 0;
+    if (m == TAY_KIDS || oc_eop_taylor_partial(k)) return 0;
     oc_etaylor c;
     /* alpha_k's model first where it is cheap (no noise) */
     int have = 1;
@@ -1356,7 +1351,7 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
 }
 
 /* The flat model (no linear part) of psi = w (f_B - c) for a child B
-** whose f bounds hold only where its weight is > 0 (tay_partial), w =
+** whose f bounds hold only where its weight is > 0 (oc_eop_taylor_partial), w =
 ** clamp(alpha_B), from B's bound Bb on the disc's box: psi is continuous,
 ** 0 where w = 0, and where w > 0 its gradient is at most lambda_w sup|f_B
 ** - c| + sup w lambda_B; so psi is Lipschitz with that on every segment
@@ -1378,7 +1373,7 @@ static int weight_taylor(const oc_enode *B, double x, double y, double R,
                          oc_ebound *Bb, int *boxes) {
   oc_erect ball = {x - R, y - R, x + R, y + R};
   if (!oc_enode_meets(B, &ball)) return 0;
-  if (tay_partial(B)) {
+  if (oc_eop_taylor_partial(B)) {
     oc_enode_sample s;
     oc_enode_bnd(B, &ball, tf ? &tf->b : NULL, Bb);
     (*boxes)++;
@@ -1402,7 +1397,7 @@ static int weight_taylor(const oc_enode *B, double x, double y, double R,
 static int replace_taylor(const oc_enode *n, double x, double y, double R,
                           const oc_etfoot *tf, oc_etaylor *o, int *boxes) {
   const oc_enode *A = OC_EBIN(n)->kids[0], *B = OC_EBIN(n)->kids[1];
-  if (tay_partial(A)) return 0;
+  if (oc_eop_taylor_partial(A)) return 0;
   oc_etaylor a, b;
   oc_etay w;
   oc_ebound Bb;
@@ -1410,7 +1405,7 @@ static int replace_taylor(const oc_enode *n, double x, double y, double R,
   *o = a;
   if (!weight_taylor(B, x, y, R, tf, &b, &w, &Bb, boxes)) return 1;
   double fv = (1 - w.v) * a.f.v + w.v * b.f.v;
-  if (tay_partial(B)) {
+  if (oc_eop_taylor_partial(B)) {
     oc_etay psi = psi_flat(&Bb, a.f.v, w.v * (b.f.v - a.f.v), R);
     oc_etay d = a.f;
     d.v = 0;
@@ -1444,7 +1439,9 @@ static int replace_taylor(const oc_enode *n, double x, double y, double R,
 static int add_taylor(const oc_enode *n, double x, double y, double R,
                       const oc_etfoot *tf, oc_etaylor *o, int *boxes) {
   const oc_enode *A = OC_EBIN(n)->kids[0], *B = OC_EBIN(n)->kids[1];
-  if (n->flags & OC_EF_SLOPE || tay_partial(A) || tay_partial(B)) return 0;
+  if (n->flags & OC_EF_SLOPE || oc_eop_taylor_partial(A) ||
+      oc_eop_taylor_partial(B))
+    return 0;
   oc_etaylor a, b;
   oc_etay c;
   oc_ebound Bb;
@@ -1524,14 +1521,14 @@ int oc_eop_taylor_alpha(const oc_enode *n, double x, double y, double R,
     *a = oc_etay_const(0);
     kid_iter it;
     kids_in(bl, ball.x0, ball.y0, ball.x1, ball.y1, &it);
-    for (int w = 0; w < it.W; w++)
-      for (uint64_t mk = kid_word(&it, w); mk; mk &= mk - 1) {
-        const oc_enode *k = bl->kids[KID_INDEX(w, mk)];
-        oc_etay c;
-        if (!oc_enode_meets(k, &ball)) continue;
-        if (!oc_enode_taylor_alpha(k, x, y, R, &c, boxes)) return 0;
-        oc_etay_add(a, &c);
-      }
+    const oc_enode *k;
+    int w = 0;
+    uint64_t mk = kid_word(&it, 0);
+    while ((k = next_meeting(bl, &it, &ball, &w, &mk))) {
+      oc_etay c;
+      if (!oc_enode_taylor_alpha(k, x, y, R, &c, boxes)) return 0;
+      oc_etay_add(a, &c);
+    }
     return 1;
   }
   case OC_E_REPLACE:
