@@ -238,6 +238,13 @@ static inline double greater(double a, double b) {
   return a > b ? a : b;
 }
 
+/* The first positive zero of c0 - c1 s - c2 s^2 (c0 > 0, c2 >= 0; none
+** when there is none: c2 = 0 and c1 <= 0). */
+static inline double first_root(double c0, double c1, double c2, double none) {
+  if (c2 > 0) return 2 * c0 / (c1 + sqrt(c1 * c1 + 4 * c2 * c0));
+  return c1 > 0 ? c0 / c1 : none;
+}
+
 /* The step from t that a first-order model of f around the sample proves
 ** free (etaylor.h): for q = p + t u, r = t |u_xy| and, with the model's
 ** linear part g, h(p + t u) >= h + k t - E(r), k = u_z - g.u_xy; its
@@ -248,12 +255,8 @@ static double model_step(double h, const double g[2], const double E[3],
   double c0 = h - E[0];
   if (!(c0 > 0)) return 0;
   double k = u.z - (g[0] * u.x + g[1] * u.y);
-  double c1 = E[1] * uxy - k, c2 = E[2] * uxy * uxy, s;
-  if (c2 > 0)
-    s = 2 * c0 / (c1 + sqrt(c1 * c1 + 4 * c2 * c0));
-  else
-    s = c1 > 0 ? c0 / c1 : e;
-  return lesser(s, e);
+  double c1 = E[1] * uxy - k, c2 = E[2] * uxy * uxy;
+  return lesser(first_root(c0, c1, c2, e), e);
 }
 
 /* The step along q0 + s D (s >= 0) that the model m proves free of the
@@ -276,13 +279,9 @@ static double model_free(const oc_emodel *m, oc_vec3 q0, oc_vec3 D, double smax,
   *lo = c0;
   if (dxy > 0) smax = lesser(smax, (m->R - ra) / dxy);
   double k = D.z - (g[0] * D.x + g[1] * D.y);
-  double c1 = (E[1] + 2 * E[2] * ra) * dxy - k, c2 = E[2] * dxy * dxy, r;
-  if (c2 > 0)
-    r = 2 * c0 / (c1 + sqrt(c1 * c1 + 4 * c2 * c0));
-  else
-    r = c1 > 0 ? c0 / c1 : smax;
+  double c1 = (E[1] + 2 * E[2] * ra) * dxy - k, c2 = E[2] * dxy * dxy;
   /* a hair short of the zero, where L may be 0 */
-  return lesser(r, smax) * (1 - 1e-9);
+  return lesser(first_root(c0, c1, c2, smax), smax) * (1 - 1e-9);
 }
 
 /* The step the candidate segment's box bound proves from a sample at
@@ -515,15 +514,19 @@ static int march(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
   return 0;
 }
 
-int oc_etrace(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0, double t1,
-              double d0, double *t, double *evals) {
-  return oc_etrace_from(tr, o, u, t0, t1, d0, 0, t, evals);
+/* The unit upward normal at (x, y) from the height gradient: one height
+** call, counted in *evals. */
+static oc_vec3 esurface_normal(const oc_esurface *s, double x, double y,
+                               double *evals) {
+  double g[2] = {0, 0};
+  s->src->height(s->src->ud, x, y, g);
+  (*evals)++;
+  return normal_of(g);
 }
 
-int oc_etrace_from(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0,
-                   double t1, double d0, double step, double *t,
-                   double *evals) {
-  return oc_etrace_hit(tr, o, u, t0, t1, d0, step, NULL, t, NULL, evals);
+int oc_etrace(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0, double t1,
+              double d0, double *t, double *evals) {
+  return oc_etrace_hit(tr, o, u, t0, t1, d0, 0, NULL, t, NULL, evals);
 }
 
 int oc_etrace_hit(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0,
@@ -544,7 +547,7 @@ int oc_etrace_hit(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0,
       *nrm = normal_of(g);
     } else {
       oc_vec3 p = at(o, u, *t);
-      *nrm = oc_esurface_normal(tr->s, p.x, p.y, evals);
+      *nrm = esurface_normal(tr->s, p.x, p.y, evals);
     }
   }
   return hit;
@@ -560,6 +563,14 @@ int oc_etrace_hit(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0,
 ** on, doubling, and halves where that fails, down to about its own width
 ** (below which a box stops shrinking with the step). */
 
+/* The direction of the beam's ray through (x, y) of its image plane. */
+static oc_vec3 beam_dir(const oc_ebeam *b, double x, double y) {
+  oc_vec3 D = {b->w.x + x * b->r.x + y * b->v.x,
+               b->w.y + x * b->r.y + y * b->v.y,
+               b->w.z + x * b->r.z + y * b->v.z};
+  return D;
+}
+
 static void piece_box(const oc_ebeam *b, double da, double db, double lo[3],
                       double hi[3]) {
   for (int k = 0; k < 3; k++)
@@ -567,9 +578,7 @@ static void piece_box(const oc_ebeam *b, double da, double db, double lo[3],
   for (int k = 0; k < 8; k++) {
     double d = k & 1 ? db : da, x = k & 2 ? b->x1 : b->x0,
            y = k & 4 ? b->y1 : b->y0;
-    oc_vec3 D = {b->w.x + x * b->r.x + y * b->v.x,
-                 b->w.y + x * b->r.y + y * b->v.y,
-                 b->w.z + x * b->r.z + y * b->v.z};
+    oc_vec3 D = beam_dir(b, x, y);
     const double p[3] = {b->o.x + d * D.x, b->o.y + d * D.y, b->o.z + d * D.z};
     for (int c = 0; c < 3; c++)
       lo[c] = lesser(lo[c], p[c]), hi[c] = greater(hi[c], p[c]);
@@ -596,14 +605,6 @@ static int piece_free(const oc_etracer *tr, const double lo[3],
   else
     src->range(src->ud, x0, y0, x1, y1, &flo, &fhi);
   return lo[2] > fhi;
-}
-
-/* The direction of the beam's ray through (x, y) of its image plane. */
-static oc_vec3 beam_dir(const oc_ebeam *b, double x, double y) {
-  oc_vec3 D = {b->w.x + x * b->r.x + y * b->v.x,
-               b->w.y + x * b->r.y + y * b->v.y,
-               b->w.z + x * b->r.z + y * b->v.z};
-  return D;
 }
 
 /* The beam on the source's first-order models, from depth d (proved
@@ -667,12 +668,8 @@ static double beam_models(const oc_etracer *tr, const oc_ebeam *b, double d,
       if (!(c0 > 0)) return d;
       double kj = D[j].z - (g[0] * D[j].x + g[1] * D[j].y);
       double c1 = (E[1] + 2 * E[2] * ra) * bxy[j] - kj;
-      double c2 = E[2] * bxy[j] * bxy[j], r;
-      if (c2 > 0)
-        r = 2 * c0 / (c1 + sqrt(c1 * c1 + 4 * c2 * c0));
-      else
-        r = c1 > 0 ? c0 / c1 : e;
-      s = lesser(s, r);
+      double c2 = E[2] * bxy[j] * bxy[j];
+      s = lesser(s, first_root(c0, c1, c2, e));
     }
     /* a hair short of the first root, where L may be 0 */
     s *= 1 - 1e-9;
@@ -744,12 +741,4 @@ oc_vec3 oc_etracer_wall(const oc_etracer *tr, oc_vec3 p, oc_vec3 u) {
   double span = (tr->hi[0] - tr->lo[0]) + (tr->hi[1] - tr->lo[1]);
   if (!(best <= 1e-9 * span)) n = (oc_vec3){-u.x, -u.y, -u.z};
   return n;
-}
-
-oc_vec3 oc_esurface_normal(const oc_esurface *s, double x, double y,
-                           double *evals) {
-  double g[2] = {0, 0};
-  s->src->height(s->src->ud, x, y, g);
-  (*evals)++;
-  return normal_of(g);
 }

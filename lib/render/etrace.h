@@ -36,12 +36,6 @@ void oc_etracer_init(oc_etracer *tr, const oc_esurface *s,
 int oc_etrace(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0, double t1,
               double d0, double *t, double *evals);
 
-/* oc_etrace from t0, where the ray is known free of the surface, with
-** step (> 0) the candidate step to begin with on the source's models
-** (0: as oc_etrace). */
-int oc_etrace_from(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0,
-                   double t1, double d0, double step, double *t, double *evals);
-
 /* A first-order model of the height around (x, y) (oc_elevation's
 ** taylor, radius R): |f(q) - f - g.(q - (x, y))| <= E[0] + E[1] r + E[2]
 ** r^2 for r = |q - (x, y)| <= R. ok 0: none. */
@@ -50,7 +44,9 @@ typedef struct oc_emodel {
   double x, y, f, R, g[2], E[3];
 } oc_emodel;
 
-/* oc_etrace_from that also gives, on a hit of the surface (1), the unit
+/* oc_etrace from t0, where the ray is known free of the surface, with
+** step (> 0) the candidate step to begin with on the source's models (0:
+** as oc_etrace), that also gives, on a hit of the surface (1), the unit
 ** upward normal there in *n (NULL: not wanted), from the height gradient
 ** of the refinement's last sample above the surface, where the hit is;
 ** one more height call, counted in *evals, when no sample gave it. m
@@ -90,10 +86,5 @@ double oc_etrace_beam(const oc_etracer *tr, const oc_ebeam *b, double d,
 /* The outward normal of the wall hit at p by a ray along u: the nearest
 ** face of the box, or -u for a hole's wall. */
 oc_vec3 oc_etracer_wall(const oc_etracer *tr, oc_vec3 p, oc_vec3 u);
-
-/* The unit upward normal at (x, y) from the height gradient: one height
-** call, counted in *evals. */
-oc_vec3 oc_esurface_normal(const oc_esurface *s, double x, double y,
-                           double *evals);
 
 #endif
