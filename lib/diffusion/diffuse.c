@@ -84,6 +84,13 @@ typedef struct conv {
   oc_dwork work;
 } conv;
 
+/* Frees c's operators and buffers (c then as new). */
+static void conv_free(conv *c) {
+  oc_dgalerkin_free(&c->gal);
+  free(c->work.f);
+  c->work = (oc_dwork){0};
+}
+
 /* With tolerance > 0 the coarse operators of (kind, mask) into c->gal. */
 static int operators(conv *c, oc_dpyramid *py, const oc_diffusion_params *p,
                      oc_dkind kind, uint8_t mask, oc_error *err) {
@@ -173,9 +180,7 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
   if (!rc && st.strict_noise)
     rc =
         solve(&py, p, DK_LAPLACE, MAP_R, DF_NOISE, &cv, 0.725, 0.075, out, err);
-  oc_dgalerkin_free(&cv.gal);
-  free(cv.work.f);
-  cv.work.f = NULL;
+  conv_free(&cv);
   if (rc) goto done;
   oc_dpyramid_shrink(&py); /* the finest grid's maps are all that is left */
   const oc_dlevel *lv = &py.lv[0];
@@ -203,8 +208,7 @@ int oc_diffusion(const oc_diffusion_params *p, oc_diffusion_result *out,
   rc = oc_ddetail_grid(&dd, lv, oc_heightfield_samples_mut(out->height), detail,
                        p->progress, 0.8, 0.2, err);
 done:
-  oc_dgalerkin_free(&cv.gal);
-  free(cv.work.f);
+  conv_free(&cv);
   oc_dpyramid_free(&py);
   if (rc) oc_diffusion_result_clear(out);
   return rc;

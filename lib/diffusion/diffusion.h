@@ -254,8 +254,6 @@ typedef struct oc_dwork {
   float *f;
   size_t cap;
 } oc_dwork;
-/* At least floats floats (the old contents lost), or NULL (ENOMEM). */
-void *oc_dwork_get(oc_dwork *w, size_t floats);
 
 typedef struct oc_dsolve {
   oc_progress progress;

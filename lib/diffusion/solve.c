@@ -266,7 +266,8 @@ static int krylov(const vctx *v, const oc_dsolve *s, double tol, double *res,
   return rc;
 }
 
-void *oc_dwork_get(oc_dwork *w, size_t floats) {
+/* At least floats floats of w (the old contents lost), or NULL (ENOMEM). */
+static void *dwork_get(oc_dwork *w, size_t floats) {
   if (w->cap < floats) {
     free(w->f);
     w->f = malloc(floats * sizeof(float));
@@ -291,7 +292,7 @@ static int vcycles(oc_dpyramid *py, const oc_dop *op, const oc_dsolve *s,
   for (int k = 0; k < L; k++)
     need += 3 * (size_t)py->lv[k].nx * (size_t)py->lv[k].ny;
   float *all[5 * 32] = {NULL};
-  float *at = oc_dwork_get(w, need);
+  float *at = dwork_get(w, need);
   if (!at) rc = oc_seterr(err, OC_ENOMEM, "out of memory");
   v.e = all, v.b = all + L, v.r = all + 2 * L, v.c = all + 3 * L,
   v.ac = all + 4 * L;
