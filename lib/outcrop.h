@@ -1297,6 +1297,13 @@ typedef struct oc_esurface {
   double (*weight)(void *wud, double x, double y);
   void *wud;
   double T;
+  /* Optional (NULL: none): the largest weight on the box [x0, x1] x [y0,
+  ** y1] in *hi and a Lipschitz bound of the weight there in *lip, both
+  ** conservative. The tracer proves stretches of rays in holes free with
+  ** it (a wall is where the weight reaches T), instead of crossing a hole
+  ** by tolerance steps. */
+  void (*weight_bound)(void *wud, double x0, double y0, double x1, double y1,
+                       double *hi, double *lip);
 } oc_esurface;
 
 /* oc_render_elevation and its two phases for a surface with holes; the

@@ -167,6 +167,13 @@ static int solid_at(const oc_esurface *s, oc_vec3 p, double h) {
   return h > 0 || !s->weight || s->weight(s->wud, p.x, p.y) >= s->T;
 }
 
+/* solid_at, with the weight in *w when it was asked (else *w untouched). */
+static int solid_weight(const oc_esurface *s, oc_vec3 p, double h, double *w) {
+  if (h > 0 || !s->weight) return 1;
+  *w = s->weight(s->wud, p.x, p.y);
+  return *w >= s->T;
+}
+
 static double height_above(const oc_etracer *tr, oc_vec3 p, int *solid,
                            double *n) {
   const oc_esurface *s = tr->s;
@@ -311,6 +318,26 @@ static double box_step(const oc_etracer *tr, oc_vec3 p, oc_vec3 u, double uxy,
   return s;
 }
 
+/* The stretch from p, in a hole (its weight w < T), on a candidate
+** segment e that the surface's weight bound proves still in the hole (no
+** surface, hence no hit, there): all of it where the segment's box holds
+** no weight up to T, else as far as the weight's slope lets it rise to T
+** (an xy distance of (T - w) / lip); 0 (the tolerance, as before) without
+** a weight bound. */
+static double hole_step(const oc_etracer *tr, oc_vec3 p, oc_vec3 u, double uxy,
+                        double w, double e) {
+  const oc_esurface *s = tr->s;
+  if (!s->weight_bound || !(w < s->T)) return 0;
+  oc_vec3 q = at(p, u, e);
+  double hi, lip;
+  s->weight_bound(s->wud, lesser(p.x, q.x), lesser(p.y, q.y), greater(p.x, q.x),
+                  greater(p.y, q.y), &hi, &lip);
+  if (hi < s->T || uxy * e * lip < s->T - w) return e;
+  if (!(lip > 0)) return 0; /* NaN */
+  /* a hair short, where the weight may reach T */
+  return (s->T - w) / (lip * uxy) * (1 - 1e-9);
+}
+
 /* The accelerated march with the source's first-order models. A ray
 ** samples in one of two ways: a model query (h there and the step
 ** model_step proves over a candidate segment TGROW times the last step),
@@ -368,7 +395,8 @@ static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
         continue;
       }
     }
-    int solid = solid_at(tr->s, p, h);
+    double w = 1;
+    int solid = solid_weight(tr->s, p, h, &w);
     if (solid && h <= 0) {
       if (!(have_prev && hp > 0)) {
         *thit = t; /* through a side of the domain or of a hole */
@@ -378,7 +406,8 @@ static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
           tr->refine ? refine(tr, o, u, prev, hp, t, h, d0, n, ga, ga_ok) : t;
       return 1;
     }
-    /* under the surface in a hole: the tolerance (its wall may be near) */
+    /* under the surface in a hole: as far as the weight's bound proves
+    ** the ray still in it, else the tolerance (its wall may be near) */
     double proved = 0, slope = -1, lam = 0;
     int next = model;
     if (model) {
@@ -391,6 +420,7 @@ static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
       proved = box_step(tr, p, u, uxy, h, e, &slope, &lam);
       if (proved < TSW * e) next = 1;
     }
+    if (!solid) proved = hole_step(tr, p, u, uxy, w, e);
     proved = lesser(proved, e);
     double tl = tol(tr, d0, t), s = greater(proved, tl);
     if (model && next && h > 0 && proved < e) {

@@ -556,14 +556,14 @@ oc_image *oc_render_surface(const oc_esurface *es, const oc_render_params *rp,
 oc_image *oc_render_elevation(const oc_elevation *src,
                               const oc_render_params *rp, oc_render_stats *st,
                               oc_error *err) {
-  oc_esurface es = {src, NULL, NULL, 0.5};
+  oc_esurface es = {src, NULL, NULL, 0.5, NULL};
   return oc_render_surface(&es, rp, st, err);
 }
 
 oc_image *oc_render_elevation_geometry(const oc_elevation *src,
                                        const oc_render_params *rp,
                                        oc_error *err) {
-  oc_esurface es = {src, NULL, NULL, 0.5};
+  oc_esurface es = {src, NULL, NULL, 0.5, NULL};
   return oc_render_surface_geometry(&es, rp, err);
 }
 
@@ -571,7 +571,7 @@ oc_image *oc_render_elevation_shade(const oc_elevation *src,
                                     const oc_render_params *rp,
                                     const oc_image *geometry,
                                     const float *albedo, oc_error *err) {
-  oc_esurface es = {src, NULL, NULL, 0.5};
+  oc_esurface es = {src, NULL, NULL, 0.5, NULL};
   return oc_render_surface_shade(&es, rp, geometry, albedo, err);
 }
 

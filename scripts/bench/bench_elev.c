@@ -437,6 +437,14 @@ static double tree_weight(void *wud, double x, double y) {
   return oc_enode_weight(wud, x, y);
 }
 
+/* The weight's bound on a box, for rays crossing holes (oc_esurface). */
+static void tree_weight_bound(void *wud, double x0, double y0, double x1,
+                              double y1, double *hi, double *lip) {
+  oc_enode_bound b;
+  oc_enode_bound_in(wud, x0, y0, x1, y1, &b);
+  *hi = b.ahi, *lip = b.la;
+}
+
 static void params(const scene *s, oc_render_params *rp, int w, int h) {
   oc_render_defaults(rp);
   rp->camera.eye = s->eye;
@@ -463,6 +471,14 @@ static void counted_bound(void *ud, double x0, double y0, double x1, double y1,
 /* The first-order models' queries (the tracer's steps, each one height
 ** call) and the box queries they make inside (fallbacks: curves...). */
 static long counted_models, counted_model_boxes;
+
+/* The weight's box queries (rays in holes). */
+static void counted_weight_bound(void *wud, double x0, double y0, double x1,
+                                 double y1, double *hi, double *lip) {
+#pragma omp atomic
+  counted_bounds++;
+  tree_weight_bound(wud, x0, y0, x1, y1, hi, lip);
+}
 
 static double counted_taylor(void *ud, double x, double y, double R,
                              double g[2], double e[3], int *boxes) {
@@ -505,7 +521,7 @@ static void run_scene(const char *name, void (*build)(scene *), int prims,
   oc_error err;
   oc_elevation src;
   if (oc_enode_elevation(s.root, NULL, &src, &err)) die(name, &err);
-  oc_esurface es = {&src, tree_weight, s.root, OC_ENODE_T};
+  oc_esurface es = {&src, tree_weight, s.root, OC_ENODE_T, tree_weight_bound};
   oc_enode_stats es_st;
   if (oc_enode_get_stats(s.root, &es_st, &err)) die(name, &err);
   if (bytes_only) {
@@ -536,12 +552,14 @@ static void run_scene(const char *name, void (*build)(scene *), int prims,
   counted.bound = counted_bound;
   if (src.taylor) counted.taylor = counted_taylor;
   es.src = &counted;
+  es.weight_bound = counted_weight_bound;
   oc_image *cgeo = oc_render_surface_geometry(&es, &rp, &err);
   if (!cgeo) die(name, &err);
   oc_image_free(cgeo);
   double bounds = (double)(counted_bounds + counted_model_boxes);
   double models = (double)counted_models;
   es.src = &src;
+  es.weight_bound = tree_weight_bound;
   t0 = omp_get_wtime();
   oc_image *img = oc_render_surface_shade(&es, &rp, geo, NULL, &err);
   double shade_secs = omp_get_wtime() - t0;

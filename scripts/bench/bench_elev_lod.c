@@ -136,7 +136,7 @@ int main(void) {
     }
     /* both with the tree's weight (Omega_T), the LoD's under its view */
     oc_esurface es0 = {&src, m ? oc_enode_view_weight : tree_weight,
-                       m ? src.ud : (void *)e, OC_ENODE_T};
+                       m ? src.ud : (void *)e, OC_ENODE_T, NULL};
     double t0 = omp_get_wtime();
     clock_t c0 = clock();
     img[m] = oc_render_surface(&es0, &rp, &st[m], &err);

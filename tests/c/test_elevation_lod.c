@@ -605,7 +605,7 @@ START_TEST(lod_trace_against_march) {
   oc_elevation src;
   ck_assert_msg(oc_enode_elevation_view(e, NULL, &v, &src, &err) == OC_OK, "%s",
                 err.msg);
-  oc_esurface es = {&src, oc_enode_view_weight, src.ud, OC_ENODE_T};
+  oc_esurface es = {&src, oc_enode_view_weight, src.ud, OC_ENODE_T, NULL};
   /* the joint query (one traversal a step) answers range and slope; the
   ** march steps on first-order models */
   ck_assert(src.bound && src.taylor);
@@ -652,7 +652,7 @@ START_TEST(lod_trace_against_march) {
   ** models are the box bound's flat ones) */
   oc_elevation boxed = src;
   boxed.taylor = NULL;
-  oc_esurface eb = {&boxed, oc_enode_view_weight, src.ud, OC_ENODE_T};
+  oc_esurface eb = {&boxed, oc_enode_view_weight, src.ud, OC_ENODE_T, NULL};
   oc_etracer tb;
   oc_etracer_init(&tb, &eb, OC_TRACE_SEGMENT, eps_k, eps_min);
   double evb = 0;

@@ -192,7 +192,7 @@ START_TEST(heightfield_against_march) {
   oc_elevation src;
   oc_error e;
   ck_assert_int_eq(oc_heightfield_elevation(hf, &src, &e), OC_OK);
-  oc_esurface es = {&src, NULL, NULL, 0.5};
+  oc_esurface es = {&src, NULL, NULL, 0.5, NULL};
   oc_render_params rp =
       view(oct_v(-150, -250, 450), oct_v(600, 500, 20), 24, 16);
   double ev[2];
@@ -207,7 +207,7 @@ END_TEST
 
 START_TEST(analytic_against_march) {
   oc_elevation src = wave_source();
-  oc_esurface es = {&src, NULL, NULL, 0.5};
+  oc_esurface es = {&src, NULL, NULL, 0.5, NULL};
   oc_render_params rp =
       view(oct_v(-600, -700, 300), oct_v(100, 100, -60), 24, 16);
   double ev[2];
@@ -264,7 +264,7 @@ START_TEST(tree_models_against_march) {
   double dom[4] = {-450, -450, 450, 450};
   ck_assert_int_eq(oc_enode_elevation(tree, dom, &src, &err), OC_OK);
   ck_assert_ptr_nonnull(src.taylor);
-  oc_esurface es = {&src, tree_weight, tree, 0.5};
+  oc_esurface es = {&src, tree_weight, tree, 0.5, NULL};
   oc_render_params v =
       view(oct_v(-600, -550, 380), oct_v(60, 60, -150), TREE_W, TREE_H);
   double ev[2];
@@ -288,7 +288,7 @@ END_TEST
 ** the same calls as without it. */
 START_TEST(hits_located) {
   oc_elevation src = wave_source();
-  oc_esurface es = {&src, NULL, NULL, 0.5};
+  oc_esurface es = {&src, NULL, NULL, 0.5, NULL};
   oc_render_params rp = view(oct_v(1, 2, 400), oct_v(0, 0, 0), 16, 16);
   double eps_k = 0.25 * 2 * tan(rp.camera.fov * PI / 360) / 1080;
   double eps_min = 1e-7 * 400, ev = 0, calls = 0;
@@ -333,7 +333,7 @@ static double half(void *wud, double x, double y) {
 
 START_TEST(weight_makes_holes) {
   oc_elevation src = wave_source();
-  oc_esurface es = {&src, half, NULL, 0.5};
+  oc_esurface es = {&src, half, NULL, 0.5, NULL};
   oc_etracer tr;
   oc_etracer_init(&tr, &es, OC_TRACE_SEGMENT, 1e-4, 1e-6);
   double ev = 0, t;
@@ -360,6 +360,108 @@ START_TEST(weight_makes_holes) {
                     "pixel %d %d: %g, march %g", i, j, t, tref);
     }
   ck_assert(hits > 20);
+}
+END_TEST
+
+static oc_esurface tree_surface(oc_enode *tree, const double dom[4],
+                                oc_elevation *src);
+
+/* The tree's weight bound on a box (oc_esurface's weight_bound). */
+static long weight_bounds; /* calls of it (one thread) */
+static void tree_weight_bound(void *wud, double x0, double y0, double x1,
+                              double y1, double *hi, double *lip) {
+  oc_enode_bound b;
+  oc_enode_bound_in(wud, x0, y0, x1, y1, &b);
+  *hi = b.ahi, *lip = b.la;
+  weight_bounds++;
+}
+
+/* Rays under the surface level of a hole cross it on the weight's bound
+** (oc_esurface's weight_bound) instead of tolerance steps: a disc whose
+** terrain ends at 0.4542 of its radius (182 m), a second one beyond the
+** hole (from 509 m), and a pillar 6 m wide in the hole at x = 300 (its
+** terrain 3 m about its centre: alpha_A + alpha_C >= 1/2). The hits,
+** walls included, are the dense march's and those without the bound, and
+** the bound saves most calls; a ray along the hole's floor meets the
+** pillar's wall (the weight's slope keeps it from stepping over it). */
+#ifdef __SANITIZE_ADDRESS__
+#define HOLE_W 8
+#define HOLE_H 6
+#else
+#define HOLE_W 16
+#define HOLE_H 12
+#endif
+
+START_TEST(holes_crossed_on_weight_bound) {
+  oc_error err;
+  oc_enode_disc_params dp[3] = {
+      {0, 0, 400, 20, {OC_ENOISE_PLAIN, 6, 80, 4, 0, 0, 1}},
+      {600, 0, 200, 60, {OC_ENOISE_PLAIN, 10, 60, 4, 0, 0, 2}},
+      {300, 0, 6, 80, {OC_ENOISE_NONE, 0, 0, 0, 0, 0, 0}}};
+  oc_enode *k[4];
+  for (int i = 0; i < 3; i++)
+    ck_assert_ptr_nonnull(k[i] = oc_enode_disc(&dp[i], &err));
+  ck_assert_ptr_nonnull(k[3] = oc_enode_blend(k, 3, &err));
+  const double dom[4] = {-300, -250, 850, 250};
+  oc_elevation src;
+  oc_esurface plain = tree_surface(k[3], dom, &src), es = plain;
+  es.weight_bound = tree_weight_bound;
+  oc_etracer tb, tn;
+  double eps_k = 1e-4, eps_min = 1e-6;
+  oc_etracer_init(&tb, &es, OC_TRACE_SEGMENT, eps_k, eps_min);
+  oc_etracer_init(&tn, &plain, OC_TRACE_SEGMENT, eps_k, eps_min);
+  /* along the hole's floor (10 m, under A's f of about 20): the pillar's
+  ** wall at x = 297 (alpha_C = 0.416 there) */
+  double t, evb = 0, evn = 0;
+  weight_bounds = 0;
+  ck_assert_int_eq(
+      oc_etrace(&tb, oct_v(200, 0, 10), oct_v(1, 0, 0), 0, 1e4, 0, &t, &evb),
+      2);
+  double tw = march(&es, oct_v(200, 0, 10), oct_v(1, 0, 0), 200, 0.01);
+  ck_assert_msg(fabs(t - tw) < 0.02 + 2 * (eps_k * t + eps_min),
+                "wall at %.4f, march %.4f", t, tw);
+  ck_assert(fabs(t - 97.0) < 0.1);
+  ck_assert(weight_bounds > 0);
+  /* without it, tolerance steps from t = 0 (growing by 1e-4 a step) give
+  ** up before the wall (OC_TRACE_MAX_STEPS) */
+  ck_assert_int_eq(
+      oc_etrace(&tn, oct_v(200, 0, 10), oct_v(1, 0, 0), 0, 1e4, 0, &t, &evn),
+      0);
+  ck_assert_msg(evb < 100 && evn >= 16384,
+                "with the bound %g calls, "
+                "without %g",
+                evb, evn);
+  /* a view over the first disc, through the hole to the second */
+  oc_render_params rp =
+      view(oct_v(-250, -60, 45), oct_v(600, 0, 20), HOLE_W, HOLE_H);
+  int n = rp.width * rp.height, hits = 0, differ = 0;
+  evb = evn = 0;
+  for (int j = 0; j < rp.height; j++)
+    for (int i = 0; i < rp.width; i++) {
+      oc_vec3 d = pixel_ray(&rp, i, j), o = rp.camera.eye;
+      double t0, t1;
+      int h0 = oc_etrace(&tb, o, d, 0, 1e5, 0, &t0, &evb);
+      int h1 = oc_etrace(&tn, o, d, 0, 1e5, 0, &t1, &evn);
+      double tref = march(&es, o, d, 1400, 0.05);
+      if ((h0 != 0) != isfinite(tref) || (h0 != 0) != (h1 != 0)) {
+        differ++;
+        continue;
+      }
+      if (!h0) continue;
+      hits++;
+      double e = eps_k * tref + eps_min;
+      ck_assert_msg(fabs(t0 - tref) <= 0.05 + 4 * e,
+                    "pixel %d %d: %.6f, march %.6f", i, j, t0, tref);
+      ck_assert_msg(fabs(t0 - t1) <= 4 * e,
+                    "pixel %d %d: %.6f, without the bound %.6f", i, j, t0, t1);
+    }
+  ck_assert_msg(hits > n / 3, "only %d of %d rays hit", hits, n);
+  ck_assert_msg(differ <= n / 50, "%d of %d rays disagree", differ, n);
+  /* (16 x 12: 3437 calls against 73710) */
+  ck_assert_msg(evb * 5 < evn, "with the bound %g calls, without %g", evb, evn);
+  src.release(src.ud);
+  for (int i = 3; i >= 0; i--)
+    oc_enode_release(k[i]);
 }
 END_TEST
 
@@ -431,7 +533,7 @@ START_TEST(beams_conservative) {
   oc_elevation src;
   oc_error e;
   ck_assert_int_eq(oc_heightfield_elevation(hf, &src, &e), OC_OK);
-  oc_esurface es = {&src, NULL, NULL, 0.5};
+  oc_esurface es = {&src, NULL, NULL, 0.5, NULL};
   oc_render_params rp =
       view(oct_v(-150, -250, 450), oct_v(600, 500, 300), 64, 40);
   beams_against_march(&es, &rp, 8, 0.05);
@@ -439,7 +541,7 @@ START_TEST(beams_conservative) {
   oc_heightfield_release(hf);
   /* the analytic source, and the same with a hole */
   oc_elevation w = wave_source();
-  oc_esurface ws = {&w, NULL, NULL, 0.5};
+  oc_esurface ws = {&w, NULL, NULL, 0.5, NULL};
   rp = view(oct_v(-600, -700, 300), oct_v(100, 100, 200), 48, 32);
   beams_against_march(&ws, &rp, 4, 0.05);
   ws.weight = half;
@@ -481,7 +583,7 @@ static oc_esurface tree_surface(oc_enode *tree, const double dom[4],
                                 oc_elevation *src) {
   oc_error err;
   ck_assert_int_eq(oc_enode_elevation(tree, dom, src, &err), OC_OK);
-  return (oc_esurface){src, tree_weight, tree, 0.5};
+  return (oc_esurface){src, tree_weight, tree, 0.5, NULL};
 }
 
 static void release_made(oc_enode **made) {
@@ -780,6 +882,7 @@ static Suite *suite(void) {
   tcase_add_test(t, tree_models_against_march);
   tcase_add_test(t, hits_located);
   tcase_add_test(t, weight_makes_holes);
+  tcase_add_test(t, holes_crossed_on_weight_bound);
   tcase_add_test(t, beams_conservative);
   tcase_add_test(t, beam_margin_spike);
   tcase_add_test(t, tiles_see_thin_spike);
