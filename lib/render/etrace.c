@@ -423,6 +423,10 @@ static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
     if (!solid) proved = hole_step(tr, p, u, uxy, w, e);
     proved = lesser(proved, e);
     double tl = tol(tr, d0, t), s = greater(proved, tl);
+    /* a model proving less than the tolerance: the sample a tolerance
+    ** past its proof (as unproved as a tolerance step from t, and no
+    ** crawl by tolerances where the model's curvature bound is tight) */
+    if (model && next && h > 0 && proved < tl) s = proved + tl;
     if (model && next && h > 0 && proved < e) {
       /* the zero z of the model's linear part (a Newton step) within a
       ** tolerance past the proved stretch: the sample goes AIM_PAST
