@@ -338,6 +338,29 @@ static double hole_step(const oc_etracer *tr, oc_vec3 p, oc_vec3 u, double uxy,
   return (s->T - w) / (lip * uxy) * (1 - 1e-9);
 }
 
+/* The hit before a sample under the surface (h < 0) located on its model
+** (linear part g, remainder E), no call: back along the ray by s, the
+** height is within h - k s -+ E(s |u_xy|) (k its slope along u by the
+** model), so that it is above the surface at s_lo, where the lower bound
+** turns positive, and under it before s_hi, where the upper one does;
+** when s_lo - s_hi <= stop and s_lo <= smax (the model's disc, the
+** bracket), *s = s_lo (a point proved above the surface within stop of
+** one proved under it, as refine's) and 1. */
+static int model_root(double h, const double g[2], const double E[3], oc_vec3 u,
+                      double uxy, double smax, double stop, double *s) {
+  double k = u.z - (g[0] * u.x + g[1] * u.y), A = E[2] * uxy * uxy;
+  double B = -(k + E[1] * uxy), C = h - E[0]; /* L = C + B s - A s^2 */
+  double D = B * B + 4 * A * C;
+  if (!(C < 0 && B > 0 && D >= 0)) return 0;
+  double lo = -2 * C / (B + sqrt(D)) * (1 + 1e-9);
+  double Bh = -k + E[1] * uxy, Ch = h + E[0],
+         hi = 0; /* U = Ch + Bh s + A s^2 */
+  if (Ch < 0) hi = -2 * Ch / (Bh + sqrt(Bh * Bh - 4 * A * Ch));
+  if (!(lo <= smax && lo - hi <= stop)) return 0;
+  *s = lo;
+  return 1;
+}
+
 /* The accelerated march with the source's first-order models. A ray
 ** samples in one of two ways: a model query (h there and the step
 ** model_step proves over a candidate segment TGROW times the last step),
@@ -376,11 +399,10 @@ static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
   for (long k = 0; k < OC_TRACE_MAX_STEPS; k++) {
     oc_vec3 p = at(o, u, t);
     double e = lesser(delta, t1 - t), g[2], E[3], h;
-    double back = relaxed ? t - (prev + rsafe) : 0;
+    double back = relaxed ? t - (prev + rsafe) : 0, mR = greater(e, back) * uxy;
     (*n)++;
     if (model)
-      h = p.z -
-          src->taylor(src->ud, p.x, p.y, greater(e, back) * uxy, g, E, NULL);
+      h = p.z - src->taylor(src->ud, p.x, p.y, mR, g, E, NULL);
     else
       h = p.z - src->height(src->ud, p.x, p.y, NULL);
     if (h != h) return 0; /* NaN: no surface can be located */
@@ -401,6 +423,19 @@ static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
       if (!(have_prev && hp > 0)) {
         *thit = t; /* through a side of the domain or of a hole */
         return 2;
+      }
+      double a;
+      if (tr->refine && model &&
+          model_root(h, g, E, u, uxy, lesser(t - prev, mR / uxy),
+                     REFINE_STOP * tol(tr, d0, prev), &a)) {
+        /* located on the model: the normal from the gradient there */
+        oc_vec3 q = at(o, u, t - a);
+        double gq[2];
+        (*n)++;
+        src->height(src->ud, q.x, q.y, gq);
+        if (ga) ga[0] = gq[0], ga[1] = gq[1], *ga_ok = 1;
+        *thit = t - a;
+        return 1;
       }
       *thit =
           tr->refine ? refine(tr, o, u, prev, hp, t, h, d0, n, ga, ga_ok) : t;
