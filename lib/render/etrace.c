@@ -426,7 +426,8 @@ static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
       }
       double a;
       if (tr->refine && model &&
-          model_root(h, g, E, u, uxy, lesser(t - prev, mR / uxy),
+          model_root(h, g, E, u, uxy,
+                     uxy > 0 ? lesser(t - prev, mR / uxy) : t - prev,
                      REFINE_STOP * tol(tr, d0, prev), &a)) {
         /* located on the model: the normal from the gradient there */
         oc_vec3 q = at(o, u, t - a);
