@@ -35,7 +35,9 @@
 ** the weight falls below T) is not bounded by the slopes: over a hole the
 ** steps are the slopes' as elsewhere (a ray may cross an edge within one
 ** step), and under its surface the tolerance, so that a ray passing under
-** a hole meets its wall within that.
+** a hole meets its wall within that; on models, where the surface has a
+** weight bound (oc_esurface's weight_bound), as far as that proves the
+** ray still in the hole (hole_step), and the tolerance past it.
 */
 #include <math.h>
 
