@@ -734,9 +734,17 @@ int oc_curve_at(const oc_pcurve *c, double s, oc_curve_point *out) {
 
 /* ---- closest point --------------------------------------------------- */
 
-static double box_d2(const fbox *b, double x, double y) {
-  double dx = oc_fmax(0, oc_fmax(b->x0 - x, x - b->x1));
-  double dy = oc_fmax(0, oc_fmax(b->y0 - y, y - b->y1));
+/* The larger of a and b, a single maxsd (no NaN here: the queries check
+** theirs, the boxes are finite). */
+static inline double max2(double a, double b) {
+  return a > b ? a : b;
+}
+
+/* (squared: the sign of a zero, the only bits max2 may choose otherwise
+** than oc_fmax, squares away) */
+static inline double box_d2(const fbox *b, double x, double y) {
+  double dx = max2(max2(b->x0 - x, x - b->x1), 0);
+  double dy = max2(max2(b->y0 - y, y - b->y1), 0);
   return dx * dx + dy * dy;
 }
 
@@ -842,8 +850,9 @@ int oc_curve_within(const oc_pcurve *c, double x, double y, double r) {
     ** 75 % of the rest) */
     static const double at[3] = {0.5, 0.25, 0.75};
     for (int k = 0; pc.deg > 1 && k < 3; k++) {
-      oc_vec3 m = oc_bez_eval(pc.p, pc.deg, at[k]);
-      double dx = m.x - x, dy = m.y - y;
+      double mx, my;
+      oc_bez_xy(pc.p, pc.deg, at[k], &mx, &my);
+      double dx = mx - x, dy = my - y;
       if (dx * dx + dy * dy < lim) return 1;
     }
     double t; /* (out of reach: one test, oc_bez_closest's) */

@@ -137,9 +137,9 @@ void oc_ecurve_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
     dl = ex * pt.nx + ey * pt.ny;
   } else {
     dl = pt.d;
-    double kap = oc_curve_curvature_at(d->c, &pt);
-    double den = 1 - kap * dl;
-    if (grad && den > 0) {
+    /* (the curvature only for the gradient of s) */
+    double den = grad ? 1 - oc_curve_curvature_at(d->c, &pt) * dl : 0;
+    if (den > 0) {
       gsx = pt.tx / den;
       gsy = pt.ty / den;
       gz = oc_curve_grade_at(d->c, &pt);
