@@ -158,9 +158,10 @@ typedef struct oc_eblend {
 #define OC_EGRID_MIN 24
 #define OC_EGRID_WORDS 4
 
-/* The words of a blend's grid with nkids children and G cells a side. */
+/* The 8-byte words of a blend's grid with nkids children and G cells a
+** side: its two scales, G column masks and G row masks. */
 static inline size_t oc_eblend_grid_words(size_t nkids, int G) {
-  return (size_t)G * (size_t)G * ((nkids + 63) / 64);
+  return G ? 2 + 2 * (size_t)G * ((nkids + 63) / 64) : 0;
 }
 
 /* replace (64 bytes), add (64; 80 with an altitude weight, 88 with a slope
