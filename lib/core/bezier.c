@@ -218,10 +218,20 @@ void oc_bez_xy(const oc_vec3 *p, int n, double t, double *x, double *y) {
   case 2:
     xy_at(p, 2, t, x, y);
     return;
-  default:
+  case 1:
     xy_at(p, 1, t, x, y);
     return;
+  default:
+    xy_at(p, 0, t, x, y);
+    return;
   }
+}
+
+void oc_bez_d1_xy(const oc_vec3 *p, int n, double t, double *x, double *y) {
+  oc_vec3 h[OC_BEZ_MAXDEG];
+  for (int i = 0; i < n; i++)
+    h[i] = oc_mul(oc_sub(p[i + 1], p[i]), n);
+  oc_bez_xy(h, n - 1, t, x, y);
 }
 
 static double dist2_at(const oc_vec3 *p, int n, double x, double y, double t) {
@@ -232,11 +242,19 @@ static double dist2_at(const oc_vec3 *p, int n, double x, double y, double t) {
 
 /* ---- out of reach ------------------------------------------------------ */
 
+/* |(a, b)| for the out-of-reach tests, whose margin dwarfs an ulp: a
+** square root where the squares neither overflow nor lose their
+** precision to underflow, hypot (a libm call, 5x the time) else. */
+static inline double norm2(double a, double b) {
+  double s = a * a + b * b;
+  return s < 1e300 && (s > 1e-300 || s == 0) ? sqrt(s) : hypot(a, b);
+}
+
 /* The distance from (a, c) to the box [b0, b1] x [b2, b3]. */
 static double box_dist(double a, double c, const double b[4]) {
   double da = oc_fmax(oc_fmax(b[0] - a, a - b[1]), 0);
   double dc = oc_fmax(oc_fmax(b[2] - c, c - b[3]), 0);
-  return hypot(da, dc);
+  return norm2(da, dc);
 }
 
 /* The distance from (a, c) to the segment (a1, c1) (a2, c2). */
@@ -289,7 +307,7 @@ static double seg_box_dist(double a1, double c1, double a2, double c2,
 ** their differences far from the origin). */
 static int frame_far(const double *px, const double *py, int n, double xa,
                      double ya, double xb, double yb, double r, double mag) {
-  double ux = px[n] - px[0], uy = py[n] - py[0], l = hypot(ux, uy);
+  double ux = px[n] - px[0], uy = py[n] - py[0], l = norm2(ux, uy);
   if (!(l > 0) || !(r < INFINITY)) return 0;
   ux /= l, uy /= l;
   double b[4] = {INFINITY, -INFINITY, INFINITY, -INFINITY};

@@ -210,7 +210,8 @@ static int above_scale(const piece *pc, double v) {
 ** vanishes at an end, the direction to the nearest distinct control
 ** point, which is the limit of the tangent. */
 static void piece_dir(const piece *pc, double t, double *tx, double *ty) {
-  oc_vec3 d = oc_bez_d1(pc->p, pc->deg, t);
+  oc_vec3 d = {0, 0, 0};
+  oc_bez_d1_xy(pc->p, pc->deg, t, &d.x, &d.y);
   double v = hypot(d.x, d.y);
   if (!above_scale(pc, v)) {
     int n = pc->deg;
@@ -759,6 +760,17 @@ int oc_curve_far_from_segment(const oc_pcurve *c, double xa, double ya,
   return 1;
 }
 
+/* nextafter(v, INFINITY) for v >= 0 (finite or not), inline: the next
+** double up, by its bits. */
+static inline double next_up(double v) {
+  if (!(v < INFINITY)) return v;
+  uint64_t u;
+  memcpy(&u, &v, sizeof u);
+  u = v == 0 ? 1 : u + 1;
+  memcpy(&v, &u, sizeof v);
+  return v;
+}
+
 /* A pending node of the box tree: its index and its pieces [lo, hi). */
 typedef struct pending {
   uint32_t node, lo, hi;
@@ -773,7 +785,7 @@ double oc_curve_s_at(const oc_pcurve *c, const oc_curve_point *pt) {
 static int closest(const oc_pcurve *c, double x, double y, double r, int with_s,
                    oc_curve_point *out) {
   if (!(r >= 0) || isnan(x) || isnan(y)) return 0;
-  double lim = nextafter(r * r, INFINITY), best = lim, bt = 0;
+  double lim = next_up(r * r), best = lim, bt = 0;
   piece bp, pc;
   int found = 0;
   const fbox *bvh = c->bvh;
@@ -824,7 +836,7 @@ int oc_curve_closest_t(const oc_pcurve *c, double x, double y, double r,
 
 int oc_curve_within(const oc_pcurve *c, double x, double y, double r) {
   if (!(r >= 0) || isnan(x) || isnan(y)) return 0;
-  double lim = nextafter(r * r, INFINITY);
+  double lim = next_up(r * r);
   const fbox *bvh = c->bvh;
   pending st[128];
   int top = 0;
