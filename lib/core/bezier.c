@@ -111,7 +111,8 @@ static inline __attribute__((always_inline)) double bern_at(const double *c,
   return w[0];
 }
 
-static double bern_eval(const double *c, int m, double t) {
+static inline __attribute__((always_inline)) double bern_eval(const double *c,
+                                                              int m, double t) {
   switch (m) {
   case 5:
     return bern_at(c, 5, t);
@@ -141,7 +142,7 @@ static void bern_halves(const double *c, int m, double *l, double *r) {
   }
 }
 
-static int sign_changes(const double *c, int m) {
+static inline int sign_changes(const double *c, int m) {
   int v = 0, last = 0;
   for (int i = 0; i <= m; i++) {
     int s = (c[i] > 0) - (c[i] < 0);
@@ -167,8 +168,8 @@ typedef struct span {
 ** towards that end some 40 times: 22 iterations a root on bench_elev
 ** -qq fig22, up to 57; 4.4 on random cubics, whose roots moved by at
 ** most 2.4e-15 (37 % of them not at all). */
-static double solve_bracketed(const double *f, const double *df, int m,
-                              double a, double b) {
+static inline __attribute__((always_inline)) double
+solve_bracketed(const double *f, const double *df, int m, double a, double b) {
   double fa = bern_eval(f, m, a), t = 0.5 * (a + b);
   for (int it = 0; it < 100; it++) {
     double ft = bern_eval(f, m, t);
@@ -234,9 +235,10 @@ void oc_bez_d1_xy(const oc_vec3 *p, int n, double t, double *x, double *y) {
   oc_bez_xy(h, n - 1, t, x, y);
 }
 
-static double dist2_at(const oc_vec3 *p, int n, double x, double y, double t) {
+static inline __attribute__((always_inline)) double
+dist2_at(const oc_vec3 *p, int n, double x, double y, double t) {
   double qx, qy;
-  oc_bez_xy(p, n, t, &qx, &qy);
+  xy_at(p, n, t, &qx, &qy);
   return (qx - x) * (qx - x) + (qy - y) * (qy - y);
 }
 
@@ -359,7 +361,7 @@ static const double fw3[4][3] = {{1.0 * 1 / 1, 1.0 * 2 / 5, 1.0 * 1 / 10},
 
 /* The lower corner of the box of a span's control points of B - p: its
 ** distance to the origin, squared (the points are finite). */
-static double span_box_d2(const span *s, int n) {
+static inline double span_box_d2(const span *s, int n) {
   double lx = s->qx[0], hx = lx, ly = s->qy[0], hy = ly;
   for (int i = 1; i <= n; i++) {
     lx = s->qx[i] < lx ? s->qx[i] : lx, hx = s->qx[i] > hx ? s->qx[i] : hx;
@@ -370,18 +372,12 @@ static double span_box_d2(const span *s, int n) {
   return bx * bx + by * by;
 }
 
-double oc_bez_closest(const oc_vec3 *p, int n, double x, double y, double best2,
-                      double *t) {
+/* oc_bez_closest for a degree n of 2 or 3, inlined with n a constant (so
+** its small loops unrolled: the same operations, the same bits). */
+static inline __attribute__((always_inline)) double
+closest_deg(const oc_vec3 *p, int n, double x, double y, double best2,
+            double *t) {
   double best = best2;
-  if (n == 1) {
-    double dx = p[1].x - p[0].x, dy = p[1].y - p[0].y;
-    double ux = x - p[0].x, uy = y - p[0].y, l2 = dx * dx + dy * dy;
-    double u = l2 > 0 ? (ux * dx + uy * dy) / l2 : 0;
-    u = u < 0 ? 0 : u > 1 ? 1 : u;
-    double ex = ux - u * dx, ey = uy - u * dy, d2 = ex * ex + ey * ey;
-    if (d2 < best) *t = u;
-    return d2;
-  }
   int m = 2 * n - 1;
   /* Depth-first with the right half pushed first: the stack holds at most
   ** one pending sibling per level. The whole piece is the first span,
@@ -460,6 +456,19 @@ double oc_bez_closest(const oc_vec3 *p, int n, double x, double y, double best2,
     if (d2 < best) best = d2, *t = cand;
   }
   return best < best2 ? best : best2;
+}
+
+double oc_bez_closest(const oc_vec3 *p, int n, double x, double y, double best2,
+                      double *t) {
+  if (n == 3) return closest_deg(p, 3, x, y, best2, t);
+  if (n == 2) return closest_deg(p, 2, x, y, best2, t);
+  double dx = p[1].x - p[0].x, dy = p[1].y - p[0].y;
+  double ux = x - p[0].x, uy = y - p[0].y, l2 = dx * dx + dy * dy;
+  double u = l2 > 0 ? (ux * dx + uy * dy) / l2 : 0;
+  u = u < 0 ? 0 : u > 1 ? 1 : u;
+  double ex = ux - u * dx, ey = uy - u * dy, d2 = ex * ex + ey * ey;
+  if (d2 < best2) *t = u;
+  return d2;
 }
 
 /* ---- curvature ------------------------------------------------------- */
