@@ -27,14 +27,33 @@ static void casteljau(const oc_vec3 *p, int n, double t, oc_vec3 *left,
   }
 }
 
-oc_vec3 oc_bez_eval(const oc_vec3 *p, int n, double t) {
+/* (inlined with n a constant by oc_bez_eval: unrolled, the same
+** operations) */
+static inline __attribute__((always_inline)) oc_vec3 eval_at(const oc_vec3 *p,
+                                                             int n, double t) {
   oc_vec3 w[OC_BEZ_MAXDEG + 1];
+#pragma GCC unroll 4
   for (int i = 0; i <= n; i++)
     w[i] = p[i];
+#pragma GCC unroll 4
   for (int k = n; k > 0; k--)
+#pragma GCC unroll 4
     for (int i = 0; i < k; i++)
       w[i] = oc_add(oc_mul(w[i], 1 - t), oc_mul(w[i + 1], t));
   return w[0];
+}
+
+oc_vec3 oc_bez_eval(const oc_vec3 *p, int n, double t) {
+  switch (n) {
+  case 3:
+    return eval_at(p, 3, t);
+  case 2:
+    return eval_at(p, 2, t);
+  case 1:
+    return eval_at(p, 1, t);
+  default:
+    return eval_at(p, 0, t);
+  }
 }
 
 oc_vec3 oc_bez_d1(const oc_vec3 *p, int n, double t) {
