@@ -771,10 +771,15 @@ static inline double next_up(double v) {
   return v;
 }
 
-/* A pending node of the box tree: its index and its pieces [lo, hi). */
+/* A pending node of the box tree: its index and its pieces [lo, hi);
+** and with its box's squared distance to the query. */
 typedef struct pending {
   uint32_t node, lo, hi;
 } pending;
+typedef struct pending_d {
+  pending p;
+  double d2;
+} pending_d;
 
 double oc_curve_s_at(const oc_pcurve *c, const oc_curve_point *pt) {
   piece pc;
@@ -789,32 +794,29 @@ static int closest(const oc_pcurve *c, double x, double y, double r, int with_s,
   piece bp, pc;
   int found = 0;
   const fbox *bvh = c->bvh;
-  pending st[128];
+  /* (each entry keeps its box's distance, computed once: best only
+  ** falls, so a box dropped when pushed would be when popped) */
+  pending_d st[128];
   int top = 0;
-  st[top++] = (pending){0, 0, c->n};
+  st[top++] = (pending_d){{0, 0, c->n}, box_d2(&bvh[0], x, y)};
   while (top > 0) {
-    pending e = st[--top];
-    const fbox *b = &bvh[e.node];
-    if (box_d2(b, x, y) >= best) continue;
-    if (e.hi - e.lo == 1) {
-      piece_at(c, e.lo, &pc);
+    pending_d e = st[--top];
+    if (e.d2 >= best) continue;
+    if (e.p.hi - e.p.lo == 1) {
+      piece_at(c, e.p.lo, &pc);
       /* (oc_bez_closest first tests whether the piece is out of reach) */
       double t, d2 = oc_bez_closest(pc.p, pc.deg, x, y, best, &t);
       if (d2 < best) best = d2, bp = pc, bt = t, found = 1;
       continue;
     }
-    uint32_t mid = e.lo + (e.hi - e.lo) / 2;
-    pending l = {e.node + 1, e.lo, mid},
-            rr = {e.node + 2 * (mid - e.lo), mid, e.hi};
-    double dl = box_d2(&bvh[l.node], x, y), dr = box_d2(&bvh[rr.node], x, y);
+    uint32_t mid = e.p.lo + (e.p.hi - e.p.lo) / 2;
+    pending_d l = {{e.p.node + 1, e.p.lo, mid}, 0},
+              rr = {{e.p.node + 2 * (mid - e.p.lo), mid, e.p.hi}, 0};
+    l.d2 = box_d2(&bvh[l.p.node], x, y), rr.d2 = box_d2(&bvh[rr.p.node], x, y);
     /* nearer child on top; the tree is balanced, so 2 log2 n entries */
-    if (dl <= dr) {
-      st[top++] = rr;
-      st[top++] = l;
-    } else {
-      st[top++] = l;
-      st[top++] = rr;
-    }
+    pending_d *near = l.d2 <= rr.d2 ? &l : &rr, *far = near == &l ? &rr : &l;
+    if (far->d2 < best) st[top++] = *far;
+    if (near->d2 < best) st[top++] = *near;
   }
   if (!found) return 0;
   fill(c, &bp, bt, with_s, out);
