@@ -27,14 +27,33 @@ static void casteljau(const oc_vec3 *p, int n, double t, oc_vec3 *left,
   }
 }
 
-oc_vec3 oc_bez_eval(const oc_vec3 *p, int n, double t) {
+/* (inlined with n a constant by oc_bez_eval: unrolled, the same
+** operations) */
+static inline __attribute__((always_inline)) oc_vec3 eval_at(const oc_vec3 *p,
+                                                             int n, double t) {
   oc_vec3 w[OC_BEZ_MAXDEG + 1];
+#pragma GCC unroll 4
   for (int i = 0; i <= n; i++)
     w[i] = p[i];
+#pragma GCC unroll 4
   for (int k = n; k > 0; k--)
+#pragma GCC unroll 4
     for (int i = 0; i < k; i++)
       w[i] = oc_add(oc_mul(w[i], 1 - t), oc_mul(w[i + 1], t));
   return w[0];
+}
+
+oc_vec3 oc_bez_eval(const oc_vec3 *p, int n, double t) {
+  switch (n) {
+  case 3:
+    return eval_at(p, 3, t);
+  case 2:
+    return eval_at(p, 2, t);
+  case 1:
+    return eval_at(p, 1, t);
+  default:
+    return eval_at(p, 0, t);
+  }
 }
 
 oc_vec3 oc_bez_d1(const oc_vec3 *p, int n, double t) {
@@ -90,17 +109,43 @@ double oc_bez_arclen(const oc_vec3 *p, int n, double a, double b) {
 
 /* ---- closest point ------------------------------------------------------ */
 
-/* A polynomial in Bernstein form of degree m <= 5 on some interval. */
-static double bern_eval(const double *c, int m, double t) {
-  /* (de Casteljau; its first level read from c, not a copy of it) */
+/* A polynomial in Bernstein form of degree m <= 5 on some interval, at t:
+** de Casteljau, its first level read from c. bern_at is the loop;
+** bern_eval runs it with m a constant (a switch), so that the compiler
+** unrolls it into registers: the same operations in the same order, so
+** the same bits, at half the cost (the closest point's Newton steps make
+** most of its calls). */
+static inline __attribute__((always_inline)) double bern_at(const double *c,
+                                                            int m, double t) {
   double w[6], u = 1 - t;
   if (m == 0) return c[0];
+#pragma GCC unroll 6
   for (int i = 0; i < m; i++)
     w[i] = c[i] * u + c[i + 1] * t;
+#pragma GCC unroll 6
   for (int k = m - 1; k > 0; k--)
+#pragma GCC unroll 6
     for (int i = 0; i < k; i++)
       w[i] = w[i] * u + w[i + 1] * t;
   return w[0];
+}
+
+static inline __attribute__((always_inline)) double bern_eval(const double *c,
+                                                              int m, double t) {
+  switch (m) {
+  case 5:
+    return bern_at(c, 5, t);
+  case 4:
+    return bern_at(c, 4, t);
+  case 3:
+    return bern_at(c, 3, t);
+  case 2:
+    return bern_at(c, 2, t);
+  case 1:
+    return bern_at(c, 1, t);
+  default:
+    return bern_at(c, 0, t);
+  }
 }
 
 static void bern_halves(const double *c, int m, double *l, double *r) {
@@ -116,7 +161,7 @@ static void bern_halves(const double *c, int m, double *l, double *r) {
   }
 }
 
-static int sign_changes(const double *c, int m) {
+static inline int sign_changes(const double *c, int m) {
   int v = 0, last = 0;
   for (int i = 0; i <= m; i++) {
     int s = (c[i] > 0) - (c[i] < 0);
@@ -142,8 +187,8 @@ typedef struct span {
 ** towards that end some 40 times: 22 iterations a root on bench_elev
 ** -qq fig22, up to 57; 4.4 on random cubics, whose roots moved by at
 ** most 2.4e-15 (37 % of them not at all). */
-static double solve_bracketed(const double *f, const double *df, int m,
-                              double a, double b) {
+static inline __attribute__((always_inline)) double
+solve_bracketed(const double *f, const double *df, int m, double a, double b) {
   double fa = bern_eval(f, m, a), t = 0.5 * (a + b);
   for (int it = 0; it < 100; it++) {
     double ft = bern_eval(f, m, t);
@@ -167,18 +212,70 @@ static double solve_bracketed(const double *f, const double *df, int m,
   return t;
 }
 
-static double dist2_at(const oc_vec3 *p, int n, double x, double y, double t) {
-  oc_vec3 q = oc_bez_eval(p, n, t);
-  return (q.x - x) * (q.x - x) + (q.y - y) * (q.y - y);
+/* x and y of the piece at t: oc_bez_eval's operations on those two
+** coordinates alone (so its bits), unrolled for the degree. */
+static inline __attribute__((always_inline)) void
+xy_at(const oc_vec3 *p, int n, double t, double *x, double *y) {
+  double wx[OC_BEZ_MAXDEG + 1], wy[OC_BEZ_MAXDEG + 1], u = 1 - t;
+#pragma GCC unroll 4
+  for (int i = 0; i <= n; i++)
+    wx[i] = p[i].x, wy[i] = p[i].y;
+#pragma GCC unroll 4
+  for (int k = n; k > 0; k--)
+#pragma GCC unroll 4
+    for (int i = 0; i < k; i++) {
+      wx[i] = wx[i] * u + wx[i + 1] * t;
+      wy[i] = wy[i] * u + wy[i + 1] * t;
+    }
+  *x = wx[0], *y = wy[0];
+}
+
+void oc_bez_xy(const oc_vec3 *p, int n, double t, double *x, double *y) {
+  switch (n) {
+  case 3:
+    xy_at(p, 3, t, x, y);
+    return;
+  case 2:
+    xy_at(p, 2, t, x, y);
+    return;
+  case 1:
+    xy_at(p, 1, t, x, y);
+    return;
+  default:
+    xy_at(p, 0, t, x, y);
+    return;
+  }
+}
+
+void oc_bez_d1_xy(const oc_vec3 *p, int n, double t, double *x, double *y) {
+  oc_vec3 h[OC_BEZ_MAXDEG];
+  for (int i = 0; i < n; i++)
+    h[i] = oc_mul(oc_sub(p[i + 1], p[i]), n);
+  oc_bez_xy(h, n - 1, t, x, y);
+}
+
+static inline __attribute__((always_inline)) double
+dist2_at(const oc_vec3 *p, int n, double x, double y, double t) {
+  double qx, qy;
+  xy_at(p, n, t, &qx, &qy);
+  return (qx - x) * (qx - x) + (qy - y) * (qy - y);
 }
 
 /* ---- out of reach ------------------------------------------------------ */
+
+/* |(a, b)| for the out-of-reach tests, whose margin dwarfs an ulp: a
+** square root where the squares neither overflow nor lose their
+** precision to underflow, hypot (a libm call, 5x the time) else. */
+static inline double norm2(double a, double b) {
+  double s = a * a + b * b;
+  return s < 1e300 && (s > 1e-300 || s == 0) ? sqrt(s) : hypot(a, b);
+}
 
 /* The distance from (a, c) to the box [b0, b1] x [b2, b3]. */
 static double box_dist(double a, double c, const double b[4]) {
   double da = oc_fmax(oc_fmax(b[0] - a, a - b[1]), 0);
   double dc = oc_fmax(oc_fmax(b[2] - c, c - b[3]), 0);
-  return hypot(da, dc);
+  return norm2(da, dc);
 }
 
 /* The distance from (a, c) to the segment (a1, c1) (a2, c2). */
@@ -231,7 +328,7 @@ static double seg_box_dist(double a1, double c1, double a2, double c2,
 ** their differences far from the origin). */
 static int frame_far(const double *px, const double *py, int n, double xa,
                      double ya, double xb, double yb, double r, double mag) {
-  double ux = px[n] - px[0], uy = py[n] - py[0], l = hypot(ux, uy);
+  double ux = px[n] - px[0], uy = py[n] - py[0], l = norm2(ux, uy);
   if (!(l > 0) || !(r < INFINITY)) return 0;
   ux /= l, uy /= l;
   double b[4] = {INFINITY, -INFINITY, INFINITY, -INFINITY};
@@ -268,26 +365,52 @@ int oc_bez_far(const oc_vec3 *p, int n, double xa, double ya, double xb,
   return frame_far(px, py, n, xa, ya, xb, yb, r, mag);
 }
 
-double oc_bez_closest(const oc_vec3 *p, int n, double x, double y, double best2,
-                      double *t) {
-  double best = best2;
-  if (n == 1) {
-    double dx = p[1].x - p[0].x, dy = p[1].y - p[0].y;
-    double ux = x - p[0].x, uy = y - p[0].y, l2 = dx * dx + dy * dy;
-    double u = l2 > 0 ? (ux * dx + uy * dy) / l2 : 0;
-    u = u < 0 ? 0 : u > 1 ? 1 : u;
-    double ex = ux - u * dx, ey = uy - u * dy, d2 = ex * ex + ey * ey;
-    if (d2 < best) *t = u;
-    return d2;
+/* The weights of (B - p) . B' in Bernstein form of degree 2 n - 1:
+** coefficient i + j gets C(n, i) C(n - 1, j) / C(2 n - 1, i + j) (q_i .
+** d_j), q the control points of B - p and d those of B'. (The compiler
+** folds each quotient, correctly rounded, as the division at run time
+** gave it: the same bits.) */
+static const double fw2[3][2] = {{1.0 * 1 / 1, 1.0 * 1 / 3},
+                                 {2.0 * 1 / 3, 2.0 * 1 / 3},
+                                 {1.0 * 1 / 3, 1.0 * 1 / 1}};
+static const double fw3[4][3] = {{1.0 * 1 / 1, 1.0 * 2 / 5, 1.0 * 1 / 10},
+                                 {3.0 * 1 / 5, 3.0 * 2 / 10, 3.0 * 1 / 10},
+                                 {3.0 * 1 / 10, 3.0 * 2 / 10, 3.0 * 1 / 5},
+                                 {1.0 * 1 / 10, 1.0 * 2 / 5, 1.0 * 1 / 1}};
+
+/* The lower corner of the box of a span's control points of B - p: its
+** distance to the origin, squared (the points are finite). */
+static inline double span_box_d2(const span *s, int n) {
+  double lx = s->qx[0], hx = lx, ly = s->qy[0], hy = ly;
+  for (int i = 1; i <= n; i++) {
+    lx = s->qx[i] < lx ? s->qx[i] : lx, hx = s->qx[i] > hx ? s->qx[i] : hx;
+    ly = s->qy[i] < ly ? s->qy[i] : ly, hy = s->qy[i] > hy ? s->qy[i] : hy;
   }
+  double bx = lx > -hx ? lx : -hx, by = ly > -hy ? ly : -hy;
+  bx = bx > 0 ? bx : 0, by = by > 0 ? by : 0;
+  return bx * bx + by * by;
+}
+
+/* oc_bez_closest for a degree n of 2 or 3, inlined with n a constant (so
+** its small loops unrolled: the same operations, the same bits). */
+static inline __attribute__((always_inline)) double
+closest_deg(const oc_vec3 *p, int n, double x, double y, double best2,
+            double *t) {
+  double best = best2;
   int m = 2 * n - 1;
-  double qx[4], qy[4], dx[3], dy[3], f[6] = {0}, df[5];
+  /* Depth-first with the right half pushed first: the stack holds at most
+  ** one pending sibling per level. The whole piece is the first span,
+  ** filled in place (most pieces need no other). */
+  span st[64];
+  span *s = &st[0];
+  double dx[3], dy[3], df[5] = {0};
   for (int i = 0; i <= n; i++)
-    qx[i] = p[i].x - x, qy[i] = p[i].y - y;
+    s->qx[i] = p[i].x - x, s->qy[i] = p[i].y - y;
   /* the piece out of reach: what the search would give (one test, the
   ** whole span's; sub-spans below take their own) */
   double mag = fabs(x) + fabs(y) + fabs(p[0].x) + fabs(p[0].y);
-  if (frame_far(qx, qy, n, 0, 0, 0, 0, sqrt(best), mag)) return best2;
+  if (frame_far(s->qx, s->qy, n, 0, 0, 0, 0, sqrt(best), mag)) return best2;
+  const double *qx = s->qx, *qy = s->qy;
   /* (dist2_at at 0 and 1, the same bits: de Casteljau there gives the
   ** end points, up to the sign of a zero coordinate, which squares away) */
   double d0 = qx[0] * qx[0] + qy[0] * qy[0], d1 = qx[n] * qx[n] + qy[n] * qy[n];
@@ -296,54 +419,49 @@ double oc_bez_closest(const oc_vec3 *p, int n, double x, double y, double best2,
 
   for (int j = 0; j < n; j++)
     dx[j] = n * (qx[j + 1] - qx[j]), dy[j] = n * (qy[j + 1] - qy[j]);
+  double *f = s->f;
+  for (int l = 0; l < 6; l++)
+    f[l] = 0;
   for (int i = 0; i <= n; i++)
     for (int j = 0; j < n; j++)
-      f[i + j] += binom[n][i] * binom[n - 1][j] / binom[m][i + j] *
-                  (qx[i] * dx[j] + qy[i] * dy[j]);
+      f[i + j] +=
+          (n == 3 ? fw3[i][j] : fw2[i][j]) * (qx[i] * dx[j] + qy[i] * dy[j]);
   for (int l = 0; l < m; l++)
     df[l] = m * (f[l + 1] - f[l]);
-
-  /* Depth-first with the right half pushed first: the stack holds at most
-  ** one pending sibling per level. */
-  span st[64];
-  int top = 0;
-  st[top].a = 0, st[top].b = 1, st[top].depth = 0;
-  for (int i = 0; i <= m; i++)
-    st[top].f[i] = f[i];
-  for (int i = 0; i <= n; i++)
-    st[top].qx[i] = qx[i], st[top].qy[i] = qy[i];
-  top++;
+  /* (f of the whole piece kept for Newton: a split reuses st[0]; fixed
+  ** sizes, copied in registers) */
+  double fp[6];
+  for (int l = 0; l < 6; l++)
+    fp[l] = f[l];
+  s->a = 0, s->b = 1, s->depth = 0;
+  int top = 1;
   while (top > 0) {
-    span s = st[--top];
-    double lx = INFINITY, hx = -INFINITY, ly = INFINITY, hy = -INFINITY;
-    for (int i = 0; i <= n; i++) {
-      lx = oc_fmin(lx, s.qx[i]), hx = oc_fmax(hx, s.qx[i]);
-      ly = oc_fmin(ly, s.qy[i]), hy = oc_fmax(hy, s.qy[i]);
-    }
-    double bx = oc_fmax(0, oc_fmax(lx, -hx)), by = oc_fmax(0, oc_fmax(ly, -hy));
-    if (bx * bx + by * by >= best ||
-        (s.depth > 0 && frame_far(s.qx, s.qy, n, 0, 0, 0, 0, sqrt(best), mag)))
+    s = &st[--top]; /* (read before a push overwrites it) */
+    if (span_box_d2(s, n) >= best ||
+        (s->depth > 0 &&
+         frame_far(s->qx, s->qy, n, 0, 0, 0, 0, sqrt(best), mag)))
       continue;
     /* A root on a split point may leave no sign change on either side. */
-    if (s.f[0] == 0 && s.a > 0) {
-      double d2 = dist2_at(p, n, x, y, s.a);
-      if (d2 < best) best = d2, *t = s.a;
+    if (s->f[0] == 0 && s->a > 0) {
+      double d2 = dist2_at(p, n, x, y, s->a);
+      if (d2 < best) best = d2, *t = s->a;
     }
-    if (sign_changes(s.f, m) == 0) continue; /* no stationary point inside */
+    int v = sign_changes(s->f, m);
+    if (v == 0) continue; /* no stationary point inside */
     double cand = -1;
-    if (s.f[0] * s.f[m] < 0 && sign_changes(s.f, m) == 1) {
-      cand = solve_bracketed(f, df, m, s.a, s.b);
-    } else if (s.depth >= 52) {
-      cand = 0.5 * (s.a + s.b); /* a double root, pinned to rounding */
+    if (s->f[0] * s->f[m] < 0 && v == 1) {
+      cand = solve_bracketed(fp, df, m, s->a, s->b);
+    } else if (s->depth >= 52) {
+      cand = 0.5 * (s->a + s->b); /* a double root, pinned to rounding */
     } else {
       span l, r;
-      double mid = 0.5 * (s.a + s.b);
-      l.a = s.a, l.b = mid, r.a = mid, r.b = s.b;
-      l.depth = r.depth = s.depth + 1;
-      bern_halves(s.f, m, l.f, r.f);
+      double mid = 0.5 * (s->a + s->b);
+      l.a = s->a, l.b = mid, r.a = mid, r.b = s->b;
+      l.depth = r.depth = s->depth + 1;
+      bern_halves(s->f, m, l.f, r.f);
       oc_vec3 c[4], cl[4], cr[4];
       for (int i = 0; i <= n; i++)
-        c[i] = oc_v3(s.qx[i], s.qy[i], 0);
+        c[i] = oc_v3(s->qx[i], s->qy[i], 0);
       casteljau(c, n, 0.5, cl, cr);
       for (int i = 0; i <= n; i++) {
         l.qx[i] = cl[i].x, l.qy[i] = cl[i].y;
@@ -357,6 +475,19 @@ double oc_bez_closest(const oc_vec3 *p, int n, double x, double y, double best2,
     if (d2 < best) best = d2, *t = cand;
   }
   return best < best2 ? best : best2;
+}
+
+double oc_bez_closest(const oc_vec3 *p, int n, double x, double y, double best2,
+                      double *t) {
+  if (n == 3) return closest_deg(p, 3, x, y, best2, t);
+  if (n == 2) return closest_deg(p, 2, x, y, best2, t);
+  double dx = p[1].x - p[0].x, dy = p[1].y - p[0].y;
+  double ux = x - p[0].x, uy = y - p[0].y, l2 = dx * dx + dy * dy;
+  double u = l2 > 0 ? (ux * dx + uy * dy) / l2 : 0;
+  u = u < 0 ? 0 : u > 1 ? 1 : u;
+  double ex = ux - u * dx, ey = uy - u * dy, d2 = ex * ex + ey * ey;
+  if (d2 < best2) *t = u;
+  return d2;
 }
 
 /* ---- curvature ------------------------------------------------------- */

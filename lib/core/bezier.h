@@ -18,6 +18,10 @@
 
 /* The point at t in [0, 1] (de Casteljau, all three coordinates). */
 oc_vec3 oc_bez_eval(const oc_vec3 *p, int n, double t);
+/* Its x and y alone, the bits oc_bez_eval gives them (n 0 to 3). */
+void oc_bez_xy(const oc_vec3 *p, int n, double t, double *x, double *y);
+/* Its first derivative's x and y alone (oc_bez_d1's bits). */
+void oc_bez_d1_xy(const oc_vec3 *p, int n, double t, double *x, double *y);
 /* First and second derivatives with respect to t (zero beyond the degree). */
 oc_vec3 oc_bez_d1(const oc_vec3 *p, int n, double t);
 oc_vec3 oc_bez_d2(const oc_vec3 *p, int n, double t);

@@ -210,7 +210,8 @@ static int above_scale(const piece *pc, double v) {
 ** vanishes at an end, the direction to the nearest distinct control
 ** point, which is the limit of the tangent. */
 static void piece_dir(const piece *pc, double t, double *tx, double *ty) {
-  oc_vec3 d = oc_bez_d1(pc->p, pc->deg, t);
+  oc_vec3 d = {0, 0, 0};
+  oc_bez_d1_xy(pc->p, pc->deg, t, &d.x, &d.y);
   double v = hypot(d.x, d.y);
   if (!above_scale(pc, v)) {
     int n = pc->deg;
@@ -734,9 +735,17 @@ int oc_curve_at(const oc_pcurve *c, double s, oc_curve_point *out) {
 
 /* ---- closest point --------------------------------------------------- */
 
-static double box_d2(const fbox *b, double x, double y) {
-  double dx = oc_fmax(0, oc_fmax(b->x0 - x, x - b->x1));
-  double dy = oc_fmax(0, oc_fmax(b->y0 - y, y - b->y1));
+/* The larger of a and b, a single maxsd (no NaN here: the queries check
+** theirs, the boxes are finite). */
+static inline double max2(double a, double b) {
+  return a > b ? a : b;
+}
+
+/* (squared: the sign of a zero, the only bits max2 may choose otherwise
+** than oc_fmax, squares away) */
+static inline double box_d2(const fbox *b, double x, double y) {
+  double dx = max2(max2(b->x0 - x, x - b->x1), 0);
+  double dy = max2(max2(b->y0 - y, y - b->y1), 0);
   return dx * dx + dy * dy;
 }
 
@@ -751,10 +760,26 @@ int oc_curve_far_from_segment(const oc_pcurve *c, double xa, double ya,
   return 1;
 }
 
-/* A pending node of the box tree: its index and its pieces [lo, hi). */
+/* nextafter(v, INFINITY) for v >= 0 (finite or not), inline: the next
+** double up, by its bits. */
+static inline double next_up(double v) {
+  if (!(v < INFINITY)) return v;
+  uint64_t u;
+  memcpy(&u, &v, sizeof u);
+  u = v == 0 ? 1 : u + 1;
+  memcpy(&v, &u, sizeof v);
+  return v;
+}
+
+/* A pending node of the box tree: its index and its pieces [lo, hi);
+** and with its box's squared distance to the query. */
 typedef struct pending {
   uint32_t node, lo, hi;
 } pending;
+typedef struct pending_d {
+  pending p;
+  double d2;
+} pending_d;
 
 double oc_curve_s_at(const oc_pcurve *c, const oc_curve_point *pt) {
   piece pc;
@@ -765,36 +790,33 @@ double oc_curve_s_at(const oc_pcurve *c, const oc_curve_point *pt) {
 static int closest(const oc_pcurve *c, double x, double y, double r, int with_s,
                    oc_curve_point *out) {
   if (!(r >= 0) || isnan(x) || isnan(y)) return 0;
-  double lim = nextafter(r * r, INFINITY), best = lim, bt = 0;
+  double lim = next_up(r * r), best = lim, bt = 0;
   piece bp, pc;
   int found = 0;
   const fbox *bvh = c->bvh;
-  pending st[128];
+  /* (each entry keeps its box's distance, computed once: best only
+  ** falls, so a box dropped when pushed would be when popped) */
+  pending_d st[128];
   int top = 0;
-  st[top++] = (pending){0, 0, c->n};
+  st[top++] = (pending_d){{0, 0, c->n}, box_d2(&bvh[0], x, y)};
   while (top > 0) {
-    pending e = st[--top];
-    const fbox *b = &bvh[e.node];
-    if (box_d2(b, x, y) >= best) continue;
-    if (e.hi - e.lo == 1) {
-      piece_at(c, e.lo, &pc);
+    pending_d e = st[--top];
+    if (e.d2 >= best) continue;
+    if (e.p.hi - e.p.lo == 1) {
+      piece_at(c, e.p.lo, &pc);
       /* (oc_bez_closest first tests whether the piece is out of reach) */
       double t, d2 = oc_bez_closest(pc.p, pc.deg, x, y, best, &t);
       if (d2 < best) best = d2, bp = pc, bt = t, found = 1;
       continue;
     }
-    uint32_t mid = e.lo + (e.hi - e.lo) / 2;
-    pending l = {e.node + 1, e.lo, mid},
-            rr = {e.node + 2 * (mid - e.lo), mid, e.hi};
-    double dl = box_d2(&bvh[l.node], x, y), dr = box_d2(&bvh[rr.node], x, y);
+    uint32_t mid = e.p.lo + (e.p.hi - e.p.lo) / 2;
+    pending_d l = {{e.p.node + 1, e.p.lo, mid}, 0},
+              rr = {{e.p.node + 2 * (mid - e.p.lo), mid, e.p.hi}, 0};
+    l.d2 = box_d2(&bvh[l.p.node], x, y), rr.d2 = box_d2(&bvh[rr.p.node], x, y);
     /* nearer child on top; the tree is balanced, so 2 log2 n entries */
-    if (dl <= dr) {
-      st[top++] = rr;
-      st[top++] = l;
-    } else {
-      st[top++] = l;
-      st[top++] = rr;
-    }
+    pending_d *near = l.d2 <= rr.d2 ? &l : &rr, *far = near == &l ? &rr : &l;
+    if (far->d2 < best) st[top++] = *far;
+    if (near->d2 < best) st[top++] = *near;
   }
   if (!found) return 0;
   fill(c, &bp, bt, with_s, out);
@@ -816,7 +838,7 @@ int oc_curve_closest_t(const oc_pcurve *c, double x, double y, double r,
 
 int oc_curve_within(const oc_pcurve *c, double x, double y, double r) {
   if (!(r >= 0) || isnan(x) || isnan(y)) return 0;
-  double lim = nextafter(r * r, INFINITY);
+  double lim = next_up(r * r);
   const fbox *bvh = c->bvh;
   pending st[128];
   int top = 0;
@@ -842,8 +864,9 @@ int oc_curve_within(const oc_pcurve *c, double x, double y, double r) {
     ** 75 % of the rest) */
     static const double at[3] = {0.5, 0.25, 0.75};
     for (int k = 0; pc.deg > 1 && k < 3; k++) {
-      oc_vec3 m = oc_bez_eval(pc.p, pc.deg, at[k]);
-      double dx = m.x - x, dy = m.y - y;
+      double mx, my;
+      oc_bez_xy(pc.p, pc.deg, at[k], &mx, &my);
+      double dx = mx - x, dy = my - y;
       if (dx * dx + dy * dy < lim) return 1;
     }
     double t; /* (out of reach: one test, oc_bez_closest's) */

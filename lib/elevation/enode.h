@@ -143,11 +143,13 @@ typedef struct oc_eprim {
 
 /* blend: 56 bytes and 8 a child; from OC_EGRID_MIN to 64 OC_EGRID_WORDS
 ** children, then its grid (eops.c): G x G cells over its box (G =
-** h.octaves), each the mask of the children whose box meets the cell,
-** W = ceil(nkids / 64) words a cell, 4 G^2 W <= 3 nkids (6 bytes a
-** child at most). A query visits the children of the cells it meets, in their
-** order, and tests their boxes as before: the same children, the same
-** sums, fewer tests. */
+** h.octaves), stored as its two scales (cells a unit, doubles) and the
+** masks of the children whose box meets each of its G columns and G
+** rows, W = ceil(nkids / 64) words a mask, G the largest with 8 (2 + 2 G
+** W) <= 6 nkids (6 bytes a child at most). A query visits the children
+** of the cells it meets (its columns' masks ORed, ANDed with its rows'),
+** in their order, and tests their boxes as before: the same children,
+** the same sums, fewer tests. */
 typedef struct oc_eblend {
   oc_enode h;
   oc_erectf box;
@@ -158,9 +160,10 @@ typedef struct oc_eblend {
 #define OC_EGRID_MIN 24
 #define OC_EGRID_WORDS 4
 
-/* The words of a blend's grid with nkids children and G cells a side. */
+/* The 8-byte words of a blend's grid with nkids children and G cells a
+** side: its two scales, G column masks and G row masks. */
 static inline size_t oc_eblend_grid_words(size_t nkids, int G) {
-  return (size_t)G * (size_t)G * ((nkids + 63) / 64);
+  return G ? 2 + 2 * (size_t)G * ((nkids + 63) / 64) : 0;
 }
 
 /* replace (64 bytes), add (64; 80 with an altitude weight, 88 with a slope

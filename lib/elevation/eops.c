@@ -97,9 +97,17 @@ static double clamp01(double v, int *inside) {
 
 /* ---- blend ------------------------------------------------------------ */
 
-/* The grid of a blend (enode.h): its masks, after the children. */
+/* The grid of a blend (enode.h), after the children: its scales, then
+** the masks of its columns and of its rows. */
+typedef struct grid_head {
+  double sx, sy; /* G / the box's sides: cells a unit */
+} grid_head;
+
+static const grid_head *grid_of(const oc_eblend *bl) {
+  return (const grid_head *)(const void *)(bl->kids + bl->nkids);
+}
 static const uint64_t *grid_masks(const oc_eblend *bl) {
-  return (const uint64_t *)(const void *)(bl->kids + bl->nkids);
+  return (const uint64_t *)(const void *)(grid_of(bl) + 1);
 }
 
 /* The cell of v on an axis from lo, s = G / (hi - lo) cells a unit: a
@@ -114,13 +122,14 @@ static int grid_cell(double v, double lo, double s, int G) {
 
 /* The cells [i0, i1] x [j0, j1] of blend bl's grid (G a side) that
 ** [x0, x1] x [y0, y1] meets: the same arithmetic for the children's
-** boxes when the grid is built and for the queries, so that they agree. */
+** boxes when the grid is built and for the queries, so that they agree
+** (the scales stored: no division a query). */
 static void grid_range(const oc_eblend *bl, int G, double x0, double y0,
                        double x1, double y1, int r[4]) {
   double bx = bl->box.x0, by = bl->box.y0;
-  double sx = G / ((double)bl->box.x1 - bx), sy = G / ((double)bl->box.y1 - by);
-  r[0] = grid_cell(x0, bx, sx, G), r[1] = grid_cell(x1, bx, sx, G);
-  r[2] = grid_cell(y0, by, sy, G), r[3] = grid_cell(y1, by, sy, G);
+  const grid_head *gh = grid_of(bl);
+  r[0] = grid_cell(x0, bx, gh->sx, G), r[1] = grid_cell(x1, bx, gh->sx, G);
+  r[2] = grid_cell(y0, by, gh->sy, G), r[3] = grid_cell(y1, by, gh->sy, G);
 }
 
 /* The children a query over [x0, x1] x [y0, y1] may meet: those of the
@@ -128,7 +137,11 @@ static void grid_range(const oc_eblend *bl, int G, double x0, double y0,
 ** of 64 bits visited in order:
 **   for (int w = 0; w < it.W; w++)
 **     for (uint64_t m = kid_word(&it, w); m; m &= m - 1)
-**       ... bl->kids[KID_INDEX(w, m)] ... */
+**       ... bl->kids[KID_INDEX(w, m)] ...
+** A child's cells are a rectangle, as the region's: they share a cell
+** exactly when their columns and their rows overlap, so the masks of the
+** region's columns ORed, ANDed with those of its rows ORed, are the
+** children of its cells (G + G words where a G x G grid of masks had G^2). */
 typedef struct kid_iter {
   uint64_t m[OC_EGRID_WORDS]; /* (with a grid) */
   size_t n;
@@ -144,22 +157,26 @@ static void kids_in(const oc_eblend *bl, double x0, double y0, double x1,
   int r[4];
   grid_range(bl, G, x0, y0, x1, y1, r);
   int i0 = r[0], i1 = r[1], j0 = r[2], j1 = r[3];
-  const uint64_t *g = grid_masks(bl);
-  if (n <= 64) { /* (one word a cell: the common case) */
-    uint64_t m = 0;
+  const uint64_t *col = grid_masks(bl), *row = col + (size_t)G * it->W;
+  if (n <= 64) { /* (one word a column: the common case) */
+    uint64_t c = 0, w = 0;
+    for (int i = i0; i <= i1; i++)
+      c |= col[i];
     for (int j = j0; j <= j1; j++)
-      for (int i = i0; i <= i1; i++)
-        m |= g[j * G + i];
-    it->m[0] = m;
+      w |= row[j];
+    it->m[0] = c & w;
     return;
   }
   int W = it->W;
-  uint64_t m[OC_EGRID_WORDS] = {0};
+  uint64_t c[OC_EGRID_WORDS] = {0}, w[OC_EGRID_WORDS] = {0};
+  for (int i = i0; i <= i1; i++)
+    for (int k = 0; k < W; k++)
+      c[k] |= col[(size_t)i * W + k];
   for (int j = j0; j <= j1; j++)
-    for (int i = i0; i <= i1; i++)
-      for (int w = 0; w < W; w++)
-        m[w] |= g[((size_t)j * G + i) * W + w];
-  memcpy(it->m, m, sizeof m);
+    for (int k = 0; k < W; k++)
+      w[k] |= row[(size_t)j * W + k];
+  for (int k = 0; k < OC_EGRID_WORDS; k++)
+    it->m[k] = c[k] & w[k];
 }
 
 static inline uint64_t kid_word(const kid_iter *it, int w) {
@@ -195,22 +212,31 @@ static int grid_side(size_t n) {
   size_t W = (n + 63) / 64;
   if (n < OC_EGRID_MIN || W > OC_EGRID_WORDS) return 0;
   int G = 1;
-  while ((size_t)(G + 1) * (G + 1) * W * 4 <= 3 * n)
+  while (8 * oc_eblend_grid_words(n, G + 1) <= 6 * n && G < 255)
     G++;
   return G;
 }
 
-/* Fills blend e's grid from its children's boxes kbox (its box stored). */
+/* Fills blend e's grid from its children's boxes kbox (its box stored):
+** its scales, then each child's bit in the columns and rows its box
+** meets. */
 static void grid_build(oc_eblend *bl, const oc_erect *kbox) {
   int G = bl->h.octaves, W = (int)((bl->nkids + 63) / 64);
-  uint64_t *g = (uint64_t *)(uintptr_t)grid_masks(bl);
+  grid_head *gh = (grid_head *)(uintptr_t)grid_of(bl);
+  double bx = bl->box.x0, by = bl->box.y0;
+  gh->sx = G / ((double)bl->box.x1 - bx);
+  gh->sy = G / ((double)bl->box.y1 - by);
+  uint64_t *col = (uint64_t *)(uintptr_t)grid_masks(bl),
+           *row = col + (size_t)G * W;
   for (size_t k = 0; k < bl->nkids; k++) {
     const oc_erect *b = &kbox[k];
+    uint64_t bit = (uint64_t)1 << (k % 64);
     int r[4];
     grid_range(bl, G, b->x0, b->y0, b->x1, b->y1, r);
+    for (int i = r[0]; i <= r[1]; i++)
+      col[(size_t)i * W + k / 64] |= bit;
     for (int j = r[2]; j <= r[3]; j++)
-      for (int i = r[0]; i <= r[1]; i++)
-        g[((size_t)j * G + i) * W + k / 64] |= (uint64_t)1 << (k % 64);
+      row[(size_t)j * W + k / 64] |= bit;
   }
 }
 

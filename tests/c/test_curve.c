@@ -13,6 +13,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "core/bezier.h"
 #include "core/curve.h"
 #include "ocheck.h"
 
@@ -825,6 +826,82 @@ START_TEST(stored_layouts_answer_alike) {
 }
 END_TEST
 
+/* The closest point of a piece (oc_bez_closest) keeps its bits: golden
+** squared distances and parameters (hex) of cubic and quadratic pieces,
+** queries near and far, within a radius and not, as the Bernstein search
+** with de Casteljau's loops gave them before it was unrolled (bezier.c);
+** and the x-y fast paths give oc_bez_eval's and oc_bez_d1's bits. */
+START_TEST(closest_keeps_its_bits) {
+  double R = 100, K = KAPPA_Q;
+  oc_vec3 P[4][4] = {
+      {{R, 0, 0}, {R, R * K, 0}, {R * K, R, 0}, {0, R, 0}},
+      {{0, 0, 0}, {30, 20, 1}, {-10, 20, 2}, {20, 0, 3}},
+      {{-150, -260, 30}, {-120, -220, 40}, {-60, -200, 50}, {0, -180, 60}},
+      {{5, 5, 0}, {40, 10, 2}, {20, 60, 5}, {0, 0, 0}}};
+  int deg[4] = {3, 3, 3, 2};
+  double Q[6][3] = {{0, 0, INFINITY}, {60, 50, INFINITY}, {-90, -215, 17},
+                    {10, 12, 400},    {25, 30, INFINITY}, {-100, -250, 9}};
+  /* piece, query, d^2 (INFINITY: none within the radius), t */
+  static const struct {
+    int k, q;
+    double d2, t;
+  } gold[] = {
+      {0, 0, 0x1.388p+13, 0x0p+0},
+      {0, 1, 0x1.df9c1304a93bp+8, 0x1.c3a7f773e937ap-2},
+      {0, 2, INFINITY, -0x1p+0},
+      {0, 3, 0x1.bd04ee78d4357p+12, 0x1.1d49675e0f91ap-1},
+      {0, 4, 0x1.d061a63a72552p+11, 0x1.1df23ba71052bp-1},
+      {0, 5, INFINITY, -0x1p+0},
+      {1, 0, 0x0p+0, 0x0p+0},
+      {1, 1, 0x1.c6039bdb80e6ap+11, 0x1.8e40d60f0523fp-2},
+      {1, 2, INFINITY, -0x1p+0},
+      {1, 3, 0x1.7c61506a2936p+1, 0x1.06dcae8aba687p-2},
+      {1, 4, 0x1.acea8c2f1ec29p+8, 0x1.a65fa2b3344edp-2},
+      {1, 5, INFINITY, -0x1p+0},
+      {2, 0, 0x1.fa4p+14, 0x1p+0},
+      {2, 1, 0x1.b968p+15, 0x1p+0},
+      {2, 2, 0x1.81ab7c1db5496p-2, 0x1.e5a7e0b8a21adp-2},
+      {2, 3, 0x1.20c8p+15, 0x1p+0},
+      {2, 4, 0x1.5d6ap+15, 0x1p+0},
+      {2, 5, INFINITY, -0x1p+0},
+      {3, 0, 0x1.9p+5, 0x0p+0},
+      {3, 1, 0x1.3523ed19ab209p+10, 0x1.9c7705f10ba1ap-1},
+      {3, 2, INFINITY, -0x1p+0},
+      {3, 3, 0x1.063c3662ec592p+5, 0x1.b39367befb622p-4},
+      {3, 4, 0x1.49f2181b470f3p+2, 0x1.4921486431043p-1},
+      {3, 5, INFINITY, -0x1p+0},
+  };
+  for (size_t i = 0; i < sizeof gold / sizeof gold[0]; i++) {
+    int k = gold[i].k, q = gold[i].q;
+    double t = -1, b2 = Q[q][2] * Q[q][2];
+    double d2 = oc_bez_closest(P[k], deg[k], Q[q][0], Q[q][1], b2, &t);
+    if (gold[i].d2 == INFINITY) {
+      ck_assert(d2 >= b2 && t == -1);
+      continue;
+    }
+    ck_assert_msg(d2 == gold[i].d2 && t == gold[i].t,
+                  "piece %d query %d: %a at %a, golden %a at %a", k, q, d2, t,
+                  gold[i].d2, gold[i].t);
+  }
+  oct_rng r = oct_rng_new(41);
+  for (int i = 0; i < 2000; i++) {
+    oc_vec3 p[4];
+    for (int j = 0; j < 4; j++)
+      p[j] = (oc_vec3){oct_unif(&r, -1e3, 1e3), oct_unif(&r, -1e3, 1e3), 0};
+    double t = oct_unif(&r, 0, 1), x, y;
+    for (int n = 0; n <= 3; n++) {
+      oc_vec3 e = oc_bez_eval(p, n, t);
+      oc_bez_xy(p, n, t, &x, &y);
+      ck_assert(!memcmp(&x, &e.x, sizeof x) && !memcmp(&y, &e.y, sizeof y));
+      if (n == 0) continue;
+      e = oc_bez_d1(p, n, t);
+      oc_bez_d1_xy(p, n, t, &x, &y);
+      ck_assert(!memcmp(&x, &e.x, sizeof x) && !memcmp(&y, &e.y, sizeof y));
+    }
+  }
+}
+END_TEST
+
 int main(void) {
   setvbuf(stdout, NULL, _IOLBF, 0);
   Suite *s = suite_create("curve");
@@ -845,6 +922,7 @@ int main(void) {
   tcase_add_test(tc, queries_are_thread_safe);
   tcase_add_test(tc, catmull_keeps_its_points);
   tcase_add_test(tc, stored_layouts_answer_alike);
+  tcase_add_test(tc, closest_keeps_its_bits);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }

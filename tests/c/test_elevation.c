@@ -1013,13 +1013,13 @@ START_TEST(taylor_models) {
 END_TEST
 
 /* A blend's grid (enode.h, eops.c): blends of 32 and 70 children (one
-** and two words a cell; 20 keep none) answer every query with the bits of the
-*same
-** blends without their grid (every child tested in turn): values and
-** gradients under each want, rows, first-order models (f and alpha, and
-** alpha's alone) and bounds in boxes, at points inside, on cell edges and
-** outside the box, for radii from a tenth of a cell to the whole box.
-** Its bytes: 8 G^2 W after the children. */
+** and two words a column or row; 20 keep none) answer every query with
+** the bits of the same blends without their grid (every child tested in
+** turn): values and gradients under each want, rows, first-order models
+** (f and alpha, and alpha's alone) and bounds in boxes, at points inside,
+** on cell edges and outside the box, for radii from a tenth of a cell to
+** the whole box. Its bytes: two scales and 2 G W masks (8 bytes each)
+** after the children, G the largest with at most 6 bytes a child. */
 #ifdef __SANITIZE_ADDRESS__
 #define GRID_POINTS 150
 #else
@@ -1047,14 +1047,14 @@ START_TEST(blend_grid_matches_flat) {
   oc_enode *kid0 = k[0];
   k[0] = EOK(oc_enode_transform(three, &xf, &err));
   size_t sizes[3] = {20, 32, N};
-  int sides[3] = {0, 4, 5}; /* (none below 24), 4 G^2 W <= 3 n */
+  int sides[3] = {0, 11, 12}; /* (none below 24), 8 (2 + 2 G W) <= 6 n */
   for (int t = 0; t < 3; t++) {
     size_t n = sizes[t], W = (n + 63) / 64;
     oc_enode *g = EOK(oc_enode_blend(k, n, &err));
     oc_enode *flat = EOK(oc_enode_blend(k, n, &err));
     ck_assert_int_eq(g->octaves, sides[t]);
     ck_assert_uint_eq(oc_enode_size(g),
-                      56 + 8 * n + 8 * W * sides[t] * sides[t]);
+                      56 + 8 * n + (sides[t] ? 8 * (2 + 2 * W * sides[t]) : 0));
     flat->octaves = 0; /* (the same blend, every child tested) */
     oc_erect box = oc_enode_box(g);
     double cw = (box.x1 - box.x0) / (sides[t] ? sides[t] : 4);
