@@ -19,6 +19,9 @@
 #include "elevation/enode.h"
 #include "elevation/etaylor.h"
 
+_Static_assert(OC_ENOISE_MAXOCT <= OC_NOISE_MAXOCT,
+               "a disc's octaves fit oc_noise3_z0_octaves");
+
 /* Ridged octaves: w_i = clamp(RIDGE_GAIN s_(i-1), 0, 1). */
 #define RIDGE_GAIN 2.0
 
@@ -32,23 +35,16 @@ double oc_eta(uint64_t seed, double x, double y, double g[2]) {
   return 2 * n - 1;
 }
 
-static uint64_t octave_seed(uint64_t seed, int i) {
-  return oc_mix64(seed + 0x9e3779b97f4a7c15ull * (uint64_t)(i + 1));
-}
-
 /* The noise of octaves [0, n) of nz at (u, v) in one call
-** (oc_noise3_z0_multi: eight octaves at a time under AVX-512, else two,
+** (oc_noise3_z0_octaves: eight octaves at a time under AVX-512, else two,
 ** oc_noise3's values and gradients bit for bit; oc_eta remaps them), the
 ** gradients when ex and ey are not NULL. */
 static void octave_noise(const oc_enoise *nz, double u, double v, int n,
                          double *ev, double *ex, double *ey) {
-  uint64_t seed[OC_ENOISE_MAXOCT];
-  double px[OC_ENOISE_MAXOCT], py[OC_ENOISE_MAXOCT], s = 1 / nz->wavelength;
-  for (int i = 0; i < n; i++, s *= nz->lacunarity) {
-    seed[i] = octave_seed(nz->seed, i);
-    px[i] = s * u, py[i] = s * v;
-  }
-  if (n) oc_noise3_z0_multi(seed, px, py, (size_t)n, ev, ex, ey);
+  double s[OC_ENOISE_MAXOCT], f = 1 / nz->wavelength;
+  for (int i = 0; i < n; i++, f *= nz->lacunarity)
+    s[i] = f;
+  if (n) oc_noise3_z0_octaves(nz->seed, s, u, v, (size_t)n, ev, ex, ey);
 }
 
 /* log2 of the lacunarity: the step of t_i = log2(w_i / foot) from one
@@ -512,7 +508,7 @@ static void noise_sum_row(const oc_enoise *nz, const double *u, double v,
 #pragma omp simd
     for (int j = 0; j < cnt; j++)
       px[j] = s * u[j], py[j] = s * v;
-    oc_noise3_z0_row(octave_seed(nz->seed, i), px, py, (size_t)cnt, e);
+    oc_noise3_z0_row(oc_noise_octave_seed(nz->seed, i), px, py, (size_t)cnt, e);
 #pragma omp simd
     for (int j = 0; j < cnt; j++)
       e[j] = 2 * e[j] - 1; /* (oc_eta) */
