@@ -668,7 +668,7 @@ AVX512_INLINE void z0_lanes8(__m512i sd, __m512d px, __m512d py, __m512d *val,
 ** outside lanes padding; the results stored at val + m ... for the lanes. */
 AVX512_INLINE void z0_vec8(__m512i sd, __m512d px, __m512d py, __mmask8 lanes,
                            size_t m, double *val, double *gx, double *gy,
-                           int wg) {
+                           int wg, int whole) {
   const __m512d period = _mm512_set1_pd(REDUCE_PERIOD);
   /* is_huge: not |x| <= P and |y| <= P (NaN too); rare */
   __mmask8 huge =
@@ -692,6 +692,11 @@ AVX512_INLINE void z0_vec8(__m512i sd, __m512d px, __m512d py, __mmask8 lanes,
     g0 = _mm512_mask_mov_pd(g0, nonfinite, nan);
     g1 = _mm512_mask_mov_pd(g1, nonfinite, nan);
   }
+  if (whole) { /* (the padding lanes' too: the caller's room) */
+    _mm512_storeu_pd(val + m, v);
+    if (wg) _mm512_storeu_pd(gx + m, g0), _mm512_storeu_pd(gy + m, g1);
+    return;
+  }
   _mm512_mask_storeu_pd(val + m, lanes, v);
   if (wg) {
     _mm512_mask_storeu_pd(gx + m, lanes, g0);
@@ -708,7 +713,7 @@ AVX512_INLINE void z0_multi8(const uint64_t *seeds, const double *x,
     __mmask8 lanes = n - m < 8 ? (__mmask8)((1u << (n - m)) - 1) : 0xff;
     z0_vec8(_mm512_maskz_loadu_epi64(lanes, seeds + m),
             _mm512_maskz_loadu_pd(lanes, x + m),
-            _mm512_maskz_loadu_pd(lanes, y + m), lanes, m, val, gx, gy, wg);
+            _mm512_maskz_loadu_pd(lanes, y + m), lanes, m, val, gx, gy, wg, 0);
   }
 }
 
@@ -738,7 +743,7 @@ AVX512_INLINE void z0_octaves8(uint64_t seed, const double *s, double u,
     __m512i sd = mix64_8(_mm512_add_epi64(
         SET1Q(seed), _mm512_mullo_epi64(i, SET1Q(OCTAVE_SEED_STEP))));
     __m512d sc = _mm512_maskz_loadu_pd(lanes, s + m);
-    z0_vec8(sd, sc * u, sc * v, lanes, m, val, gx, gy, wg);
+    z0_vec8(sd, sc * u, sc * v, lanes, m, val, gx, gy, wg, 1);
   }
 }
 

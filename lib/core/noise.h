@@ -69,7 +69,10 @@ uint64_t oc_noise_octave_seed(uint64_t seed, int i);
 /* The octaves m < n (n <= OC_NOISE_MAXOCT) of a sum at one point (u, v):
 ** oc_noise3_z0_multi of the seeds oc_noise_octave_seed(seed, m) and the
 ** points (s[m] u, s[m] v), bit for bit (an elevation disc's noise, its
-** frequencies in s), the seeds made in the vector lanes under AVX-512. */
+** frequencies in s), the seeds made in the vector lanes under AVX-512.
+** val, gx and gy (when not NULL) have room for OC_NOISE_MAXOCT values:
+** those past n may be overwritten (whole vectors are stored, which the
+** caller's loads of single values then read straight from the store). */
 void oc_noise3_z0_octaves(uint64_t seed, const double *s, double u, double v,
                           size_t n, double *val, double *gx, double *gy);
 /* The same through the path isa; returns 0, or -1 (and does nothing)

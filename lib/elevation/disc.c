@@ -19,8 +19,8 @@
 #include "elevation/enode.h"
 #include "elevation/etaylor.h"
 
-_Static_assert(OC_ENOISE_MAXOCT <= OC_NOISE_MAXOCT,
-               "a disc's octaves fit oc_noise3_z0_octaves");
+_Static_assert(OC_ENOISE_MAXOCT == OC_NOISE_MAXOCT,
+               "a disc's octaves and their room: oc_noise3_z0_octaves'");
 
 /* Ridged octaves: w_i = clamp(RIDGE_GAIN s_(i-1), 0, 1). */
 #define RIDGE_GAIN 2.0

@@ -1118,6 +1118,67 @@ START_TEST(blend_grid_matches_flat) {
 }
 END_TEST
 
+/* A blend of discs alone (OC_EF_DISCS, set at construction) finds the
+** children a model's disc meets without branches, every child in order
+** (no grid) or through its grid's cells: the same models, bit for bit,
+** and the same box counts, as the same blend taking the general walk
+** (the flag cleared), at points inside, near and outside its box, for
+** radii from a child's tenth to the whole scene; the models hold
+** (check_taylor). Blends with another kind of child keep the flag clear. */
+#ifdef __SANITIZE_ADDRESS__
+#define DISC_BLEND_POINTS 100
+#else
+#define DISC_BLEND_POINTS 800
+#endif
+
+START_TEST(blend_of_discs_fast_path) {
+  oc_error err;
+  enum { N = 40 };
+  oc_enode *k[N];
+  oct_rng r = oct_rng_new(91);
+  for (int i = 0; i < N; i++) {
+    double x = oct_unif(&r, -400, 400), y = oct_unif(&r, -400, 400);
+    double rad = i == 0 ? 1500 : oct_unif(&r, 30, 250);
+    k[i] = disc(x, y, rad, oct_unif(&r, 10, 120), (oc_enoise_kind)(i % 4),
+                oct_unif(&r, 2, 20), rad / 2, 2 + i % 6);
+  }
+  size_t sizes[2] = {18, N}; /* no grid, and a grid */
+  int models = 0;
+  for (int t = 0; t < 2; t++) {
+    oc_enode *g = EOK(oc_enode_blend(k, sizes[t], &err));
+    oc_enode *walk = EOK(oc_enode_blend(k, sizes[t], &err));
+    ck_assert(g->flags & OC_EF_DISCS);
+    ck_assert_int_eq(g->octaves, t ? 5 : 0); /* (4 G^2 W <= 3 n) */
+    walk->flags &= (uint8_t)~OC_EF_DISCS;
+    for (int i = 0; i < DISC_BLEND_POINTS; i++) {
+      double x = oct_unif(&r, -600, 600), y = oct_unif(&r, -600, 600);
+      double R = pow(10, oct_unif(&r, 0, 3));
+      oc_etaylor ma, mb;
+      int ba = 0, bb = 0;
+      oc_enode_taylor(g, x, y, R, &ma, &ba);
+      oc_enode_taylor(walk, x, y, R, &mb, &bb);
+      same_taylor(&ma, &mb);
+      ck_assert_int_eq(ba, bb);
+      models += ba == 0; /* (a rule, not the box bound's fallback) */
+    }
+    check_taylor(g, &r, 500);
+    oc_enode_release(g);
+    oc_enode_release(walk);
+  }
+  ck_assert_int_gt(models, DISC_BLEND_POINTS); /* real models */
+  oc_enode *three = EOK(oc_enode_blend(k, 3, &err));
+  oc_enode_xform xf = {100, 50, 30, 0.7, 1, 0};
+  oc_enode *mixed[2] = {k[1], EOK(oc_enode_transform(three, &xf, &err))};
+  oc_enode *mb = EOK(oc_enode_blend(mixed, 2, &err));
+  ck_assert(!(mb->flags & OC_EF_DISCS));
+  oc_enode_release(mb);
+  oc_enode_release(mixed[1]);
+  oc_enode_release(three);
+  for (int i = 0; i < N; i++)
+    oc_enode_release(k[i]);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("elevation");
   TCase *tc = tcase_create("elevation");
@@ -1139,6 +1200,7 @@ int main(void) {
   tcase_add_test(tc, add_altitude_slope_bound);
   tcase_add_test(tc, taylor_models);
   tcase_add_test(tc, blend_grid_matches_flat);
+  tcase_add_test(tc, blend_of_discs_fast_path);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }

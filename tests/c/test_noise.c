@@ -1166,7 +1166,8 @@ END_TEST
 ** written out) and the points (s[m] u, s[m] v): every count up to 16
 ** (one or two vectors, padding lanes), frequencies growing as octaves'
 ** do and arbitrary ones, signed zeros, huge and NaN points; writes
-** nothing past n, and refuses more than 16 octaves or a missing path. */
+** nothing past its room of 16 values, and refuses more than 16 octaves
+** or a missing path. */
 START_TEST(noise_z0_octaves_paths) {
   enum { L = OC_NOISE_MAXOCT, PAD = 3 };
   const oc_noise_isa isa[3] = {OC_NOISE_ISA_AUTO, OC_NOISE_ISA_SSE2,
@@ -1215,7 +1216,7 @@ START_TEST(noise_z0_octaves_paths) {
         differ += !same_bits(v[m], ref) || !same_bits(w[m], ref) ||
                   !same_bits(gx[m], g.x) || !same_bits(gy[m], g.y);
       }
-      for (int m = n; m < L + PAD; m++)
+      for (int m = L; m < L + PAD; m++)
         spilled += v[m] != -7 || gx[m] != -7 || gy[m] != -7 || w[m] != -7;
     }
   }
