@@ -1350,6 +1350,7 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
   /* the children meeting the disc (alpha_k = 0 on it for the others) */
   const oc_enode *kk[TAY_KIDS];
   int discs, nk = kids_meeting(bl, &ball, kk, &discs);
+  double gS = -1; /* |grad S| once known */
   if (nk >= 0 && discs && !tf) {
     /* discs at full detail: their weights' models first (no noise), so
     ** that a sum crossing T (no rule: the caller's fallback) costs no
@@ -1364,7 +1365,8 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
       oc_etay_add(&q.S, &ka[na]);
       kk[na++] = kk[i];
     }
-    double dev = oc_etay_dev(&q.S, R);
+    gS = oc_etay_gnorm(&q.S); /* (S is final: the same bits below) */
+    double dev = gS * R + oc_etay_rem(&q.S, R); /* (oc_etay_dev) */
     if (!(q.S.v - dev >= T) && !(q.S.v + dev <= T)) return 0; /* (below) */
     for (int i = 0; i < na; i++) {
       oc_etaylor c;
@@ -1412,7 +1414,8 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
     o->f = oc_etay_const(0);
     return 1;
   }
-  double dev = oc_etay_dev(&S, R), Slo = S.v - dev;
+  if (gS < 0) gS = oc_etay_gnorm(&S);
+  double dev = gS * R + oc_etay_rem(&S, R), Slo = S.v - dev; /* (dev) */
   int conv = Slo >= T; /* else S <= T on the whole disc, or no rule */
   if (!conv && !(S.v + dev <= T)) return 0; /* max(S, T) has a kink */
   double f = conv ? q.N / S.v : 0, Q[3] = {q.rest[0], q.rest[1], q.rest[2]};
@@ -1430,7 +1433,7 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
   double gx = (q.Nx - f * S.gx) / S.v, gy = (q.Ny - f * S.gy) / S.v;
   double g = sqrt(gx * gx + gy * gy);
   /* r (|A_S| r + E_S(r)), truncated at R */
-  double P1 = S.e0, P2 = oc_etay_gnorm(&S) + S.e1 + R * S.e2;
+  double P1 = S.e0, P2 = gS + S.e1 + R * S.e2;
   o->f = (oc_etay){
       f, gx, gy, Q[0] / Slo, (Q[1] + g * P1) / Slo, (Q[2] + g * P2) / Slo};
   return 1;
@@ -1468,6 +1471,13 @@ static int weight_taylor(const oc_enode *B, double x, double y, double R,
     oc_enode_ev(B, x, y, tf ? &tf->p : NULL, OC_EV_LAZY, &s);
     b->f = oc_etay_const(s.f);
     b->a = oc_etay_flat(s.a, Bb->la, oc_fmax(Bb->ahi - s.a, s.a - Bb->alo), R);
+  } else if (B->kind == OC_E_DISC && !tf) {
+    /* (a disc's weight first: no noise where w = 0 on the whole disc) */
+    oc_edisc_taylor_alpha(B, x, y, R, &b->a);
+    *w = oc_etay_clamp01(&b->a, R);
+    if (w->v == 0 && oc_etay_is_const(w)) return 0;
+    oc_edisc_taylor_f(B, x, y, R, &b->f);
+    return 1;
   } else {
     oc_enode_taylor_view(B, x, y, R, tf, b, boxes);
   }

@@ -1179,6 +1179,62 @@ START_TEST(blend_of_discs_fast_path) {
 }
 END_TEST
 
+/* A disc's weight model decides "alpha is 0 on the whole disc" and "the
+** model is flat" from the squares and from an upper bound of the
+** gradient's norm where those are clear of the thresholds: the same
+** models, bit for bit, as the rule computed with its square roots
+** (written out here), at random points and at points within a few ulps of
+** |p - c| = (r + R)(1 + 1e-12), of q = 1 and of the flat switch. */
+static void ref_alpha(double cx, double cy, double r, double x, double y,
+                      double R, oc_etay *a) {
+  double u = x - cx, v = y - cy, q = (u * u + v * v) / (r * r);
+  if (sqrt(u * u + v * v) >= (r + R) * (1 + 1e-12)) {
+    *a = oc_etay_const(0);
+  } else if (q < 1) {
+    double k = 1 - q, c = -6 * k * k / (r * r);
+    *a = (oc_etay){k * k * k, c * u, c * v, 0, 0, 3 / (r * r)};
+  } else {
+    *a = (oc_etay){0, 0, 0, 0, 0, 3 / (r * r)};
+  }
+  double gap = fmax(a->v, 1 - a->v);
+  if (oc_etay_dev(a, R) > gap) *a = (oc_etay){a->v, 0, 0, gap, 0, 0};
+}
+
+START_TEST(disc_alpha_model_decisions) {
+  oct_rng r = oct_rng_new(57);
+  int flat = 0, zero = 0, lin = 0;
+  for (int i = 0; i < 20000; i++) {
+    double cx = oct_unif(&r, -1e3, 1e3), cy = oct_unif(&r, -1e3, 1e3);
+    double rad = pow(10, oct_unif(&r, -2, 4));
+    double R = rad * pow(10, oct_unif(&r, -4, 1)), th = oct_unif(&r, 0, 6.28);
+    double d = rad * oct_unif(&r, 0, 2) + oct_unif(&r, 0, 1) * R;
+    if (i % 4 == 1) /* at the "0 on the whole disc" switch */
+      d = nextafter((rad + R) * (1 + 1e-12), 0) * (1 + (i % 9 - 4) * 1e-16);
+    if (i % 4 == 2) /* at q = 1 */
+      d = rad * (1 + (i % 11 - 5) * 1.1e-16);
+    if (i % 4 == 1 || i % 4 == 2) /* (u and v as exact as can be) */
+      cx = cy = 0, th = i % 8 < 4 ? 0 : th;
+    double x = cx + d * cos(th), y = cy + d * sin(th);
+    if (i % 4 == 3) { /* about where the flat model takes over */
+      x = cx + rad * oct_unif(&r, 0.1, 0.9), y = cy;
+      R = rad * oct_unif(&r, 0.05, 1.5);
+    }
+    oc_enode *e = disc(cx, cy, rad, 0, OC_ENOISE_NONE, 0, 0, 0);
+    oc_etay a, b;
+    oc_edisc_taylor_alpha(e, x, y, R, &a);
+    ref_alpha(cx, cy, rad, x, y, R, &b);
+    ck_assert_msg(!memcmp(&a, &b, sizeof a), "disc %g at (%g, %g), R %g", rad,
+                  x - cx, y - cy, R);
+    zero += oc_etay_is_const(&a) && a.v == 0;
+    flat += a.e0 > 0;
+    lin += a.gx != 0;
+    oc_enode_release(e);
+  }
+  ck_assert(zero > 2000 && flat > 500 && lin > 2000);
+  printf("disc alpha models: %d zero, %d flat, %d linear\n", zero, flat, lin);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("elevation");
   TCase *tc = tcase_create("elevation");
@@ -1201,6 +1257,7 @@ int main(void) {
   tcase_add_test(tc, taylor_models);
   tcase_add_test(tc, blend_grid_matches_flat);
   tcase_add_test(tc, blend_of_discs_fast_path);
+  tcase_add_test(tc, disc_alpha_model_decisions);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }
