@@ -186,6 +186,61 @@ static inline const oc_enode *next_meeting(const oc_eblend *bl,
   }
 }
 
+/* At most this many children of a blend meet the disc (else fallback). */
+#define TAY_KIDS 64
+
+/* blend, f = N / S where S = sum alpha_k >= T on the whole disc: with
+** f the value at p, N' - f S' = sum alpha_k' (f_k' - f) and, writing each
+** child's alpha_k' = a_k + A_k.d + x_k, f_k' = f_k + F_k.d + y_k, this is
+** (sum a_k F_k + (f_k - f) A_k).d + Q = S G.d + Q with G the linear part
+** below and |Q| <= sum a_k E_fk + |f_k - f| E_ak + (|A_k| r + E_ak)(|F_k|
+** r + E_fk) (sum a_k (f_k - f) = 0). Then f' - f - G.d = (S G.d + Q) / S'
+** - G.d = (Q - G.d (S' - S)) / S', at most (Q + |G| r (|A_S| r + E_S)) /
+** inf S'. Where S <= T on the whole disc f = N / T, N the sum of the
+** products alpha_k f_k (product rule, etaylor.h). */
+/* oc_edisc_meets(k, b) without branches; k goes to *kk (kept where it
+** meets b: the caller's count then grows by 1). */
+static inline int disc_meets(const oc_enode *k, const oc_erect *b,
+                             const oc_enode **kk) {
+  const double *p = OC_EDISC(k)->par;
+  *kk = k;
+  return (p[0] - p[2] <= b->x1) & (p[0] + p[2] >= b->x0) &
+         (p[1] - p[2] <= b->y1) & (p[1] + p[2] >= b->y0);
+}
+
+/* The children of blend bl whose box meets the ball b, in order, into kk
+** (up to TAY_KIDS; -1 beyond), and whether they are all discs. A blend of
+** discs alone (OC_EF_DISCS) tests its children's boxes without branches
+** (oc_edisc_meets' comparisons): which ones a ball meets is a coin toss
+** for a branch predictor. */
+static int kids_meeting(const oc_eblend *bl, const oc_erect *b,
+                        const oc_enode **kk, int *discs) {
+  kid_iter it;
+  kids_in(bl, b->x0, b->y0, b->x1, b->y1, &it);
+  int nk = 0, w = 0;
+  uint64_t mk = kid_word(&it, 0);
+  if (bl->h.flags & OC_EF_DISCS && bl->nkids <= TAY_KIDS) {
+    *discs = 1;
+    if (!it.grid) { /* (every child, in order) */
+      for (uint32_t i = 0; i < bl->nkids; i++)
+        nk += disc_meets(bl->kids[i], b, &kk[nk]);
+      return nk;
+    }
+    for (; w < it.W; mk = ++w < it.W ? kid_word(&it, w) : 0)
+      for (; mk; mk &= mk - 1)
+        nk += disc_meets(bl->kids[KID_INDEX(w, mk)], b, &kk[nk]);
+    return nk;
+  }
+  const oc_enode *k;
+  *discs = 1;
+  while ((k = next_meeting(bl, &it, b, &w, &mk))) {
+    if (nk == TAY_KIDS) return -1;
+    kk[nk++] = k;
+    *discs = *discs && k->kind == OC_E_DISC;
+  }
+  return nk;
+}
+
 /* Cells a side for n children (0: no grid): 4 G^2 W <= 3 n, 6 bytes a
 ** child at most, so that the Table 1 scenes stay within the paper's
 ** bytes (bench_elev --bytes: fig21's 45-child blend would not with 8;
@@ -316,12 +371,19 @@ static void blend_bound_in(const oc_enode *n, const oc_erect *b,
     return;
   }
   size_t m = 0;
+  /* the children meeting the box (kids_meeting: without branches for a
+  ** blend of discs; beyond TAY_KIDS, nk < 0, one by one) */
+  const oc_enode *kk[TAY_KIDS], *k;
+  int discs, nk = kids_meeting(bl, b, kk, &discs), w = 0;
   kid_iter it;
-  kids_in(bl, b->x0, b->y0, b->x1, b->y1, &it);
-  const oc_enode *k;
-  int w = 0;
-  uint64_t mk = kid_word(&it, 0);
-  while ((k = next_meeting(bl, &it, b, &w, &mk))) {
+  uint64_t mk = 0;
+  if (nk < 0) {
+    kids_in(bl, b->x0, b->y0, b->x1, b->y1, &it);
+    mk = kid_word(&it, 0);
+  }
+  for (int i = 0;; i++) {
+    k = nk >= 0 ? (i < nk ? kk[i] : NULL) : next_meeting(bl, &it, b, &w, &mk);
+    if (!k) break;
     oc_enode_bnd(k, b, fb, &kb[m]);
     /* alpha = 0 on the whole box: neither the child's f nor its weight's
     ** slope counts there */
@@ -1225,61 +1287,6 @@ int oc_eop_ev_row(const oc_enode *n, const double *x, double y, int cnt,
 ** Each returns 0 when it has no rule there (the caller then falls back to
 ** the node's box bound, oc_enode_taylor_flat). The values are computed as
 ** the evaluators compute them (the same bits). */
-
-/* At most this many children of a blend meet the disc (else fallback). */
-#define TAY_KIDS 64
-
-/* blend, f = N / S where S = sum alpha_k >= T on the whole disc: with
-** f the value at p, N' - f S' = sum alpha_k' (f_k' - f) and, writing each
-** child's alpha_k' = a_k + A_k.d + x_k, f_k' = f_k + F_k.d + y_k, this is
-** (sum a_k F_k + (f_k - f) A_k).d + Q = S G.d + Q with G the linear part
-** below and |Q| <= sum a_k E_fk + |f_k - f| E_ak + (|A_k| r + E_ak)(|F_k|
-** r + E_fk) (sum a_k (f_k - f) = 0). Then f' - f - G.d = (S G.d + Q) / S'
-** - G.d = (Q - G.d (S' - S)) / S', at most (Q + |G| r (|A_S| r + E_S)) /
-** inf S'. Where S <= T on the whole disc f = N / T, N the sum of the
-** products alpha_k f_k (product rule, etaylor.h). */
-/* oc_edisc_meets(k, b) without branches; k goes to *kk (kept where it
-** meets b: the caller's count then grows by 1). */
-static inline int disc_meets(const oc_enode *k, const oc_erect *b,
-                             const oc_enode **kk) {
-  const double *p = OC_EDISC(k)->par;
-  *kk = k;
-  return (p[0] - p[2] <= b->x1) & (p[0] + p[2] >= b->x0) &
-         (p[1] - p[2] <= b->y1) & (p[1] + p[2] >= b->y0);
-}
-
-/* The children of blend bl whose box meets the ball b, in order, into kk
-** (up to TAY_KIDS; -1 beyond), and whether they are all discs. A blend of
-** discs alone (OC_EF_DISCS) tests its children's boxes without branches
-** (oc_edisc_meets' comparisons): which ones a ball meets is a coin toss
-** for a branch predictor. */
-static int kids_meeting(const oc_eblend *bl, const oc_erect *b,
-                        const oc_enode **kk, int *discs) {
-  kid_iter it;
-  kids_in(bl, b->x0, b->y0, b->x1, b->y1, &it);
-  int nk = 0, w = 0;
-  uint64_t mk = kid_word(&it, 0);
-  if (bl->h.flags & OC_EF_DISCS && bl->nkids <= TAY_KIDS) {
-    *discs = 1;
-    if (!it.grid) { /* (every child, in order) */
-      for (uint32_t i = 0; i < bl->nkids; i++)
-        nk += disc_meets(bl->kids[i], b, &kk[nk]);
-      return nk;
-    }
-    for (; w < it.W; mk = ++w < it.W ? kid_word(&it, w) : 0)
-      for (; mk; mk &= mk - 1)
-        nk += disc_meets(bl->kids[KID_INDEX(w, mk)], b, &kk[nk]);
-    return nk;
-  }
-  const oc_enode *k;
-  *discs = 1;
-  while ((k = next_meeting(bl, &it, b, &w, &mk))) {
-    if (nk == TAY_KIDS) return -1;
-    kk[nk++] = k;
-    *discs = *discs && k->kind == OC_E_DISC;
-  }
-  return nk;
-}
 
 /* A blend's model being summed child by child (blend_taylor): N, sum a_k
 ** F_k + f_k A_k, S, the remainders' sum, and per child its f_k (or, out,
