@@ -1200,10 +1200,16 @@ static void ref_alpha(double cx, double cy, double r, double x, double y,
   if (oc_etay_dev(a, R) > gap) *a = (oc_etay){a->v, 0, 0, gap, 0, 0};
 }
 
+#ifdef __SANITIZE_ADDRESS__
+#define ALPHA_POINTS 3000
+#else
+#define ALPHA_POINTS 20000
+#endif
+
 START_TEST(disc_alpha_model_decisions) {
   oct_rng r = oct_rng_new(57);
   int flat = 0, zero = 0, lin = 0;
-  for (int i = 0; i < 20000; i++) {
+  for (int i = 0; i < ALPHA_POINTS; i++) {
     double cx = oct_unif(&r, -1e3, 1e3), cy = oct_unif(&r, -1e3, 1e3);
     double rad = pow(10, oct_unif(&r, -2, 4));
     double R = rad * pow(10, oct_unif(&r, -4, 1)), th = oct_unif(&r, 0, 6.28);
@@ -1230,7 +1236,8 @@ START_TEST(disc_alpha_model_decisions) {
     lin += a.gx != 0;
     oc_enode_release(e);
   }
-  ck_assert(zero > 2000 && flat > 500 && lin > 2000);
+  ck_assert(zero > ALPHA_POINTS / 10 && flat > ALPHA_POINTS / 40 &&
+            lin > ALPHA_POINTS / 10);
   printf("disc alpha models: %d zero, %d flat, %d linear\n", zero, flat, lin);
 }
 END_TEST
