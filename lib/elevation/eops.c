@@ -189,15 +189,6 @@ static inline const oc_enode *next_meeting(const oc_eblend *bl,
 /* At most this many children of a blend meet the disc (else fallback). */
 #define TAY_KIDS 64
 
-/* blend, f = N / S where S = sum alpha_k >= T on the whole disc: with
-** f the value at p, N' - f S' = sum alpha_k' (f_k' - f) and, writing each
-** child's alpha_k' = a_k + A_k.d + x_k, f_k' = f_k + F_k.d + y_k, this is
-** (sum a_k F_k + (f_k - f) A_k).d + Q = S G.d + Q with G the linear part
-** below and |Q| <= sum a_k E_fk + |f_k - f| E_ak + (|A_k| r + E_ak)(|F_k|
-** r + E_fk) (sum a_k (f_k - f) = 0). Then f' - f - G.d = (S G.d + Q) / S'
-** - G.d = (Q - G.d (S' - S)) / S', at most (Q + |G| r (|A_S| r + E_S)) /
-** inf S'. Where S <= T on the whole disc f = N / T, N the sum of the
-** products alpha_k f_k (product rule, etaylor.h). */
 /* oc_edisc_meets(k, b) without branches; k goes to *kk (kept where it
 ** meets b: the caller's count then grows by 1). */
 static inline int disc_meets(const oc_enode *k, const oc_erect *b,
