@@ -34,16 +34,12 @@ static inline double oc_len(oc_vec3 a) {
 /* fmax and fmin as glibc computes them on x86-64 (maxsd and minsd: the
 ** second operand where they are equal, the other operand where one is
 ** NaN), inline: libm's are calls in this build (no -ffinite-math-only),
-** and box queries, models and curves' closest points make many. Written
-** so that gcc emits no branch (maxsd, then a conditional move for a NaN
-** y): where the larger of two varies, a branch on it is a coin toss. */
+** and box queries, models and curves' closest points make many. */
 static inline double oc_fmax(double x, double y) {
-  double m = x > y ? x : y;
-  return y != y ? x : m;
+  return x > y || y != y ? x : y;
 }
 static inline double oc_fmin(double x, double y) {
-  double m = x < y ? x : y;
-  return y != y ? x : m;
+  return x < y || y != y ? x : y;
 }
 static inline oc_vec3 oc_vmin(oc_vec3 a, oc_vec3 b) {
   return oc_v3(fmin(a.x, b.x), fmin(a.y, b.y), fmin(a.z, b.z));
