@@ -38,7 +38,8 @@ double oc_eta(uint64_t seed, double x, double y, double g[2]) {
 /* The noise of octaves [0, n) of nz at (u, v) in one call
 ** (oc_noise3_z0_octaves: eight octaves at a time under AVX-512, else two,
 ** oc_noise3's values and gradients bit for bit; oc_eta remaps them), the
-** gradients when ex and ey are not NULL. */
+** gradients when ex and ey are not NULL. ev, ex and ey have room for
+** OC_ENOISE_MAXOCT values (those past n may be overwritten). */
 static void octave_noise(const oc_enoise *nz, double u, double v, int n,
                          double *ev, double *ex, double *ey) {
   double s[OC_ENOISE_MAXOCT], f = 1 / nz->wavelength;
