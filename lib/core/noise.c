@@ -78,6 +78,9 @@
 #define RAW_HESS_MAX 0.64
 #define SCALE (0.5 / RAW_MAX)
 
+/* The step between the octaves' seeds of a sum (oc_noise_octave_seed). */
+#define OCTAVE_SEED_STEP 0x9e3779b97f4a7c15ull
+
 /* The lattice period used to reduce huge coordinates (a multiple of 3). */
 #define REDUCE_PERIOD (3.0 * 0x1p48)
 
@@ -661,44 +664,56 @@ AVX512_INLINE void z0_lanes8(__m512i sd, __m512d px, __m512d py, __m512d *val,
   if (wg) *gx = SCALE * g0, *gy = SCALE * g1;
 }
 
+/* One vector of z0_multi8: the lanes' seeds sd and points (px, py), those
+** outside lanes padding; the results stored at val + m ... for the lanes. */
+AVX512_INLINE void z0_vec8(__m512i sd, __m512d px, __m512d py, __mmask8 lanes,
+                           size_t m, double *val, double *gx, double *gy,
+                           int wg, int whole) {
+  const __m512d period = _mm512_set1_pd(REDUCE_PERIOD);
+  /* is_huge: not |x| <= P and |y| <= P (NaN too); rare */
+  __mmask8 huge =
+      (__mmask8) ~(_mm512_cmp_pd_mask(_mm512_abs_pd(px), period, _CMP_LE_OQ) &
+                   _mm512_cmp_pd_mask(_mm512_abs_pd(py), period, _CMP_LE_OQ));
+  __mmask8 nonfinite = 0;
+  if (huge & lanes) {
+    double bx[8], by[8];
+    _mm512_storeu_pd(bx, px), _mm512_storeu_pd(by, py);
+    for (unsigned l = 0; l < 8; l++)
+      if ((huge & lanes) >> l & 1 &&
+          !lane_point_slow(bx[l], by[l], &bx[l], &by[l]))
+        nonfinite |= (__mmask8)(1u << l);
+    px = _mm512_loadu_pd(bx), py = _mm512_loadu_pd(by);
+  }
+  __m512d v, g0 = _mm512_setzero_pd(), g1 = g0;
+  z0_lanes8(sd, px, py, &v, &g0, &g1, wg);
+  if (nonfinite) {
+    const __m512d nan = _mm512_set1_pd(NAN);
+    v = _mm512_mask_mov_pd(v, nonfinite, nan);
+    g0 = _mm512_mask_mov_pd(g0, nonfinite, nan);
+    g1 = _mm512_mask_mov_pd(g1, nonfinite, nan);
+  }
+  if (whole) { /* (the padding lanes' too: the caller's room) */
+    _mm512_storeu_pd(val + m, v);
+    if (wg) _mm512_storeu_pd(gx + m, g0), _mm512_storeu_pd(gy + m, g1);
+    return;
+  }
+  _mm512_mask_storeu_pd(val + m, lanes, v);
+  if (wg) {
+    _mm512_mask_storeu_pd(gx + m, lanes, g0);
+    _mm512_mask_storeu_pd(gy + m, lanes, g1);
+  }
+}
+
 /* The points m < n eight at a time, the last vector's missing points as
 ** padding lanes (masked loads and stores: nothing past n is touched). */
 AVX512_INLINE void z0_multi8(const uint64_t *seeds, const double *x,
                              const double *y, size_t n, double *val, double *gx,
                              double *gy, int wg) {
-  const __m512d period = _mm512_set1_pd(REDUCE_PERIOD);
   for (size_t m = 0; m < n; m += 8) {
     __mmask8 lanes = n - m < 8 ? (__mmask8)((1u << (n - m)) - 1) : 0xff;
-    __m512d px = _mm512_maskz_loadu_pd(lanes, x + m),
-            py = _mm512_maskz_loadu_pd(lanes, y + m);
-    __m512i sd = _mm512_maskz_loadu_epi64(lanes, seeds + m);
-    /* is_huge: not |x| <= P and |y| <= P (NaN too); rare */
-    __mmask8 huge =
-        (__mmask8) ~(_mm512_cmp_pd_mask(_mm512_abs_pd(px), period, _CMP_LE_OQ) &
-                     _mm512_cmp_pd_mask(_mm512_abs_pd(py), period, _CMP_LE_OQ));
-    __mmask8 nonfinite = 0;
-    if (huge & lanes) {
-      double bx[8], by[8];
-      _mm512_storeu_pd(bx, px), _mm512_storeu_pd(by, py);
-      for (unsigned l = 0; l < 8; l++)
-        if ((huge & lanes) >> l & 1 &&
-            !lane_point_slow(bx[l], by[l], &bx[l], &by[l]))
-          nonfinite |= (__mmask8)(1u << l);
-      px = _mm512_loadu_pd(bx), py = _mm512_loadu_pd(by);
-    }
-    __m512d v, g0 = _mm512_setzero_pd(), g1 = g0;
-    z0_lanes8(sd, px, py, &v, &g0, &g1, wg);
-    if (nonfinite) {
-      const __m512d nan = _mm512_set1_pd(NAN);
-      v = _mm512_mask_mov_pd(v, nonfinite, nan);
-      g0 = _mm512_mask_mov_pd(g0, nonfinite, nan);
-      g1 = _mm512_mask_mov_pd(g1, nonfinite, nan);
-    }
-    _mm512_mask_storeu_pd(val + m, lanes, v);
-    if (wg) {
-      _mm512_mask_storeu_pd(gx + m, lanes, g0);
-      _mm512_mask_storeu_pd(gy + m, lanes, g1);
-    }
+    z0_vec8(_mm512_maskz_loadu_epi64(lanes, seeds + m),
+            _mm512_maskz_loadu_pd(lanes, x + m),
+            _mm512_maskz_loadu_pd(lanes, y + m), lanes, m, val, gx, gy, wg, 0);
   }
 }
 
@@ -712,6 +727,35 @@ AVX512 static void z0_multi_avx512_g(const uint64_t *seeds, const double *x,
 AVX512 static void z0_multi_avx512_v(const uint64_t *seeds, const double *x,
                                      const double *y, size_t n, double *val) {
   z0_multi8(seeds, x, y, n, val, NULL, NULL, 0);
+}
+
+/* The octaves m < n of a sum (oc_noise3_z0_octaves) eight at a time: the
+** seeds oc_noise_octave_seed(seed, m) (the same sum and mix, lane by
+** lane) and the points s[m] (u, v), as products of the lanes' s[m] and
+** the broadcast u and v (the scalar products' bits). */
+AVX512_INLINE void z0_octaves8(uint64_t seed, const double *s, double u,
+                               double v, size_t n, double *val, double *gx,
+                               double *gy, int wg) {
+  const __m512i idx = _mm512_setr_epi64(1, 2, 3, 4, 5, 6, 7, 8);
+  for (size_t m = 0; m < n; m += 8) {
+    __mmask8 lanes = n - m < 8 ? (__mmask8)((1u << (n - m)) - 1) : 0xff;
+    __m512i i = _mm512_add_epi64(idx, SET1Q(m));
+    __m512i sd = mix64_8(_mm512_add_epi64(
+        SET1Q(seed), _mm512_mullo_epi64(i, SET1Q(OCTAVE_SEED_STEP))));
+    __m512d sc = _mm512_maskz_loadu_pd(lanes, s + m);
+    z0_vec8(sd, sc * u, sc * v, lanes, m, val, gx, gy, wg, 1);
+  }
+}
+
+AVX512 static void z0_octaves_avx512_g(uint64_t seed, const double *s, double u,
+                                       double v, size_t n, double *val,
+                                       double *gx, double *gy) {
+  z0_octaves8(seed, s, u, v, n, val, gx, gy, 1);
+}
+
+AVX512 static void z0_octaves_avx512_v(uint64_t seed, const double *s, double u,
+                                       double v, size_t n, double *val) {
+  z0_octaves8(seed, s, u, v, n, val, NULL, NULL, 0);
 }
 #endif
 
@@ -744,6 +788,39 @@ static inline void z0_multi(int avx, const uint64_t *seeds, const double *x,
     z0_multi_sse2(seeds, x, y, n, val, NULL, NULL, 0);
 }
 
+uint64_t oc_noise_octave_seed(uint64_t seed, int i) {
+  return oc_mix64(seed + OCTAVE_SEED_STEP * (uint64_t)(i + 1));
+}
+
+/* oc_noise3_z0_octaves through AVX-512 when avx, else the two-lane path
+** on the seeds and points made here. */
+static inline void z0_octaves(int avx, uint64_t seed, const double *s, double u,
+                              double v, size_t n, double *val, double *gx,
+                              double *gy) {
+  int wg = gx && gy;
+#ifdef HAVE_AVX512
+  if (avx) {
+    if (wg)
+      z0_octaves_avx512_g(seed, s, u, v, n, val, gx, gy);
+    else
+      z0_octaves_avx512_v(seed, s, u, v, n, val);
+    return;
+  }
+#else
+  (void)avx;
+#endif
+  uint64_t sd[OC_NOISE_MAXOCT];
+  double px[OC_NOISE_MAXOCT], py[OC_NOISE_MAXOCT];
+  for (size_t i = 0; i < n; i++) {
+    sd[i] = oc_noise_octave_seed(seed, (int)i);
+    px[i] = s[i] * u, py[i] = s[i] * v;
+  }
+  if (wg)
+    z0_multi_sse2(sd, px, py, n, val, gx, gy, 1);
+  else
+    z0_multi_sse2(sd, px, py, n, val, NULL, NULL, 0);
+}
+
 int oc_noise_isa_supported(oc_noise_isa isa) {
   switch (isa) {
   case OC_NOISE_ISA_AUTO:
@@ -768,6 +845,21 @@ int oc_noise3_z0_multi_isa(oc_noise_isa isa, const uint64_t *seeds,
 void oc_noise3_z0_multi(const uint64_t *seeds, const double *x, const double *y,
                         size_t n, double *val, double *gx, double *gy) {
   z0_multi(have_avx512(), seeds, x, y, n, val, gx, gy);
+}
+
+int oc_noise3_z0_octaves_isa(oc_noise_isa isa, uint64_t seed, const double *s,
+                             double u, double v, size_t n, double *val,
+                             double *gx, double *gy) {
+  if (!oc_noise_isa_supported(isa) || n > OC_NOISE_MAXOCT) return -1;
+  z0_octaves(isa == OC_NOISE_ISA_AVX512 ||
+                 (isa == OC_NOISE_ISA_AUTO && have_avx512()),
+             seed, s, u, v, n, val, gx, gy);
+  return 0;
+}
+
+void oc_noise3_z0_octaves(uint64_t seed, const double *s, double u, double v,
+                          size_t n, double *val, double *gx, double *gy) {
+  z0_octaves(have_avx512(), seed, s, u, v, n, val, gx, gy);
 }
 
 double oc_turb3(uint64_t seed, int octaves, oc_vec3 p, oc_vec3 *grad) {

@@ -59,6 +59,28 @@ int oc_noise3_z0_multi_isa(oc_noise_isa isa, const uint64_t *seeds,
                            const double *x, const double *y, size_t n,
                            double *val, double *gx, double *gy);
 
+/* The seed of octave i (from 0) of a sum of noise octaves seeded by seed:
+** oc_mix64(seed + 0x9e3779b97f4a7c15 (i + 1)) (elevation discs). */
+uint64_t oc_noise_octave_seed(uint64_t seed, int i);
+
+/* The most octaves oc_noise3_z0_octaves takes. */
+#define OC_NOISE_MAXOCT 16
+
+/* The octaves m < n (n <= OC_NOISE_MAXOCT) of a sum at one point (u, v):
+** oc_noise3_z0_multi of the seeds oc_noise_octave_seed(seed, m) and the
+** points (s[m] u, s[m] v), bit for bit (an elevation disc's noise, its
+** frequencies in s), the seeds made in the vector lanes under AVX-512.
+** val, gx and gy (when not NULL) have room for OC_NOISE_MAXOCT values:
+** those past n may be overwritten (whole vectors are stored, which the
+** caller's loads of single values then read straight from the store). */
+void oc_noise3_z0_octaves(uint64_t seed, const double *s, double u, double v,
+                          size_t n, double *val, double *gx, double *gy);
+/* The same through the path isa; returns 0, or -1 (and does nothing)
+** when this processor lacks it or n > OC_NOISE_MAXOCT. */
+int oc_noise3_z0_octaves_isa(oc_noise_isa isa, uint64_t seed, const double *s,
+                             double u, double v, size_t n, double *val,
+                             double *gx, double *gy);
+
 /* t(p); gradient when grad != NULL. octaves >= 1. */
 double oc_turb3(uint64_t seed, int octaves, oc_vec3 p, oc_vec3 *grad);
 /* Upper bound of t: sum 2^-k = 2 - 2^(1-octaves); t >= 0. */

@@ -19,6 +19,9 @@
 #include "elevation/enode.h"
 #include "elevation/etaylor.h"
 
+_Static_assert(OC_ENOISE_MAXOCT == OC_NOISE_MAXOCT,
+               "a disc's octaves and their room: oc_noise3_z0_octaves'");
+
 /* Ridged octaves: w_i = clamp(RIDGE_GAIN s_(i-1), 0, 1). */
 #define RIDGE_GAIN 2.0
 
@@ -32,23 +35,17 @@ double oc_eta(uint64_t seed, double x, double y, double g[2]) {
   return 2 * n - 1;
 }
 
-static uint64_t octave_seed(uint64_t seed, int i) {
-  return oc_mix64(seed + 0x9e3779b97f4a7c15ull * (uint64_t)(i + 1));
-}
-
 /* The noise of octaves [0, n) of nz at (u, v) in one call
-** (oc_noise3_z0_multi: eight octaves at a time under AVX-512, else two,
+** (oc_noise3_z0_octaves: eight octaves at a time under AVX-512, else two,
 ** oc_noise3's values and gradients bit for bit; oc_eta remaps them), the
-** gradients when ex and ey are not NULL. */
+** gradients when ex and ey are not NULL. ev, ex and ey have room for
+** OC_ENOISE_MAXOCT values (those past n may be overwritten). */
 static void octave_noise(const oc_enoise *nz, double u, double v, int n,
                          double *ev, double *ex, double *ey) {
-  uint64_t seed[OC_ENOISE_MAXOCT];
-  double px[OC_ENOISE_MAXOCT], py[OC_ENOISE_MAXOCT], s = 1 / nz->wavelength;
-  for (int i = 0; i < n; i++, s *= nz->lacunarity) {
-    seed[i] = octave_seed(nz->seed, i);
-    px[i] = s * u, py[i] = s * v;
-  }
-  if (n) oc_noise3_z0_multi(seed, px, py, (size_t)n, ev, ex, ey);
+  double s[OC_ENOISE_MAXOCT], f = 1 / nz->wavelength;
+  for (int i = 0; i < n; i++, f *= nz->lacunarity)
+    s[i] = f;
+  if (n) oc_noise3_z0_octaves(nz->seed, s, u, v, (size_t)n, ev, ex, ey);
 }
 
 /* log2 of the lacunarity: the step of t_i = log2(w_i / foot) from one
@@ -512,7 +509,7 @@ static void noise_sum_row(const oc_enoise *nz, const double *u, double v,
 #pragma omp simd
     for (int j = 0; j < cnt; j++)
       px[j] = s * u[j], py[j] = s * v;
-    oc_noise3_z0_row(octave_seed(nz->seed, i), px, py, (size_t)cnt, e);
+    oc_noise3_z0_row(oc_noise_octave_seed(nz->seed, i), px, py, (size_t)cnt, e);
 #pragma omp simd
     for (int j = 0; j < cnt; j++)
       e[j] = 2 * e[j] - 1; /* (oc_eta) */
@@ -916,26 +913,48 @@ static void noise_taylor(const oc_enoise *nz, double u, double v, double R,
   *o = q.m;
 }
 
+/* sqrt(d2) >= lim (lim >= 0), the correctly rounded sqrt's answer: from
+** the squares where they differ by more than their roundings can (a
+** relative 1e-13; lim's square a normal number), else by the sqrt. */
+static inline int sqrt_ge(double d2, double lim) {
+  double l2 = lim * lim;
+  if (l2 >= 0x1p-1000 && l2 <= 0x1p1000) {
+    if (d2 > l2 * (1 + 1e-13)) return 1;
+    if (d2 < l2 * (1 - 1e-13)) return 0;
+  }
+  return sqrt(d2) >= lim;
+}
+
 void oc_edisc_taylor_alpha(const oc_enode *n, double x, double y, double R,
                            oc_etay *a) {
   const double *p = OC_EDISC(n)->par; /* cx, cy, r, height */
   double u = x - p[0], v = y - p[1], r = p[2];
-  double q = (u * u + v * v) / (r * r);
+  double d2 = u * u + v * v, q = d2 / (r * r);
   /* alpha = G(|p - c|^2 / r^2), G(q) = (1 - q)^3 on [0, 1], 0 beyond, is
   ** C2 (G, G', G'' vanish at q = 1); its Hessian's eigenvalues are 2 G' /
   ** r^2 = -6 (1 - q)^2 / r^2 across and (1 - q)(30 q - 6) / r^2 along
   ** p - c, both in [-6, 4.8] / r^2: the remainder is at most 3 |d|^2 /
   ** r^2. Beyond |p - c| >= r + R alpha is 0 on the whole disc. */
-  if (sqrt(u * u + v * v) >= (r + R) * (1 + 1e-12)) {
-    *a = oc_etay_const(0);
-  } else if (q < 1) {
-    double k = 1 - q, c = -6 * k * k / (r * r);
-    *a = (oc_etay){k * k * k, c * u, c * v, 0, 0, 3 / (r * r)};
-  } else {
-    *a = (oc_etay){0, 0, 0, 0, 0, 3 / (r * r)};
+  if (sqrt_ge(d2, (r + R) * (1 + 1e-12))) {
+    *a = oc_etay_const(0); /* (its deviation 0: within the gap, 1) */
+    return;
   }
   /* alpha lies in [0, 1]: at most the gap to the far end (flat) */
+  double e2 = 3 / (r * r), rem = 0 + R * (0 + R * e2); /* (oc_etay_rem) */
+  if (!(q < 1)) {
+    /* (no linear part: the deviation is 0 R + rem, the gap 1) */
+    *a = (oc_etay){0, 0, 0, 0, 0, e2};
+    if (0 * R + rem > 1) *a = (oc_etay){0, 0, 0, 1, 0, 0};
+    return;
+  }
+  double k = 1 - q, c = -6 * k * k / (r * r);
+  *a = (oc_etay){k * k * k, c * u, c * v, 0, 0, e2};
   double gap = oc_fmax(a->v, 1 - a->v);
+  /* oc_etay_dev(a, R) > gap: not where an upper bound of it, |gx| + |gy|
+  ** for the norm and a relative 1e-12 over the roundings, is within the
+  ** gap (a small disc: the commonest case), else computed */
+  double gx = fabs(a->gx), gy = fabs(a->gy);
+  if ((gx + gy) * R * (1 + 1e-12) + rem * (1 + 1e-12) <= gap) return;
   if (oc_etay_dev(a, R) > gap) *a = (oc_etay){a->v, 0, 0, gap, 0, 0};
 }
 

@@ -87,6 +87,7 @@ struct oc_enode {
 /* Flags. */
 #define OC_EF_GLF 1    /* disc: gain and lacunarity are floats exactly */
 #define OC_EF_GLDEF 2  /* disc: they are 1/2 and 2 (not stored) */
+#define OC_EF_DISCS 1  /* blend: every child is a disc (eops.c) */
 #define OC_EF_SLOPE 4  /* add: with a slope weight (its angle, fade, step) */
 #define OC_EF_SUMW 8   /* add: alpha = alpha_A + w^2 */
 #define OC_EF_BELOW 16 /* add: with an altitude weight (below_z, fade) */
@@ -95,7 +96,7 @@ struct oc_enode {
 /* every kind: its f model holds only where its weight is > 0 (a curve,
 ** lake or image, or an operator of one in A's place:
 ** oc_eop_taylor_partial), set by oc_enode_alloc from the kind and the children
- */
+*/
 #define OC_EF_PARTIAL 128
 
 /* The parameters (doubles) operators store (eops.c, lod.c). A replace

@@ -203,6 +203,52 @@ static inline const oc_enode *next_meeting(const oc_eblend *bl,
   }
 }
 
+/* At most this many children of a blend meet the disc (else fallback). */
+#define TAY_KIDS 64
+
+/* oc_edisc_meets(k, b) without branches; k goes to *kk (kept where it
+** meets b: the caller's count then grows by 1). */
+static inline int disc_meets(const oc_enode *k, const oc_erect *b,
+                             const oc_enode **kk) {
+  const double *p = OC_EDISC(k)->par;
+  *kk = k;
+  return (p[0] - p[2] <= b->x1) & (p[0] + p[2] >= b->x0) &
+         (p[1] - p[2] <= b->y1) & (p[1] + p[2] >= b->y0);
+}
+
+/* The children of blend bl whose box meets the ball b, in order, into kk
+** (up to TAY_KIDS; -1 beyond), and whether they are all discs. A blend of
+** discs alone (OC_EF_DISCS) tests its children's boxes without branches
+** (oc_edisc_meets' comparisons): which ones a ball meets is a coin toss
+** for a branch predictor. */
+static int kids_meeting(const oc_eblend *bl, const oc_erect *b,
+                        const oc_enode **kk, int *discs) {
+  kid_iter it;
+  kids_in(bl, b->x0, b->y0, b->x1, b->y1, &it);
+  int nk = 0, w = 0;
+  uint64_t mk = kid_word(&it, 0);
+  if (bl->h.flags & OC_EF_DISCS && bl->nkids <= TAY_KIDS) {
+    *discs = 1;
+    if (!it.grid) { /* (every child, in order) */
+      for (uint32_t i = 0; i < bl->nkids; i++)
+        nk += disc_meets(bl->kids[i], b, &kk[nk]);
+      return nk;
+    }
+    for (; w < it.W; mk = ++w < it.W ? kid_word(&it, w) : 0)
+      for (; mk; mk &= mk - 1)
+        nk += disc_meets(bl->kids[KID_INDEX(w, mk)], b, &kk[nk]);
+    return nk;
+  }
+  const oc_enode *k;
+  *discs = 1;
+  while ((k = next_meeting(bl, &it, b, &w, &mk))) {
+    if (nk == TAY_KIDS) return -1;
+    kk[nk++] = k;
+    *discs = *discs && k->kind == OC_E_DISC;
+  }
+  return nk;
+}
+
 /* Cells a side for n children (0: no grid): 4 G^2 W <= 3 n, 6 bytes a
 ** child at most, so that the Table 1 scenes stay within the paper's
 ** bytes (bench_elev --bytes: fig21's 45-child blend would not with 8;
@@ -342,12 +388,19 @@ static void blend_bound_in(const oc_enode *n, const oc_erect *b,
     return;
   }
   size_t m = 0;
+  /* the children meeting the box (kids_meeting: without branches for a
+  ** blend of discs; beyond TAY_KIDS, nk < 0, one by one) */
+  const oc_enode *kk[TAY_KIDS], *k;
+  int discs, nk = kids_meeting(bl, b, kk, &discs), w = 0;
   kid_iter it;
-  kids_in(bl, b->x0, b->y0, b->x1, b->y1, &it);
-  const oc_enode *k;
-  int w = 0;
-  uint64_t mk = kid_word(&it, 0);
-  while ((k = next_meeting(bl, &it, b, &w, &mk))) {
+  uint64_t mk = 0;
+  if (nk < 0) {
+    kids_in(bl, b->x0, b->y0, b->x1, b->y1, &it);
+    mk = kid_word(&it, 0);
+  }
+  for (int i = 0;; i++) {
+    k = nk >= 0 ? (i < nk ? kk[i] : NULL) : next_meeting(bl, &it, b, &w, &mk);
+    if (!k) break;
     oc_enode_bnd(k, b, fb, &kb[m]);
     /* alpha = 0 on the whole box: neither the child's f nor its weight's
     ** slope counts there */
@@ -400,6 +453,10 @@ oc_enode *oc_enode_blend(oc_enode *const *kids, size_t n, oc_error *err) {
     oc_enode_glob(kids[i], &kb[i]);
   store_derived(e, kb, kbox);
   e->octaves = (uint8_t)G;
+  int discs = 1;
+  for (size_t i = 0; i < n; i++)
+    discs = discs && kids[i]->kind == OC_E_DISC;
+  e->flags |= discs ? OC_EF_DISCS : 0;
   if (G) grid_build((oc_eblend *)e, kbox);
 done:
   free(kb);
@@ -1248,8 +1305,54 @@ int oc_eop_ev_row(const oc_enode *n, const double *x, double y, int cnt,
 ** the node's box bound, oc_enode_taylor_flat). The values are computed as
 ** the evaluators compute them (the same bits). */
 
-/* At most this many children of a blend meet the disc (else fallback). */
-#define TAY_KIDS 64
+/* A blend's model being summed child by child (blend_taylor): N, sum a_k
+** F_k + f_k A_k, S, the remainders' sum, and per child its f_k (or, out,
+** the range of f_k) and alpha_k's remainder. */
+typedef struct blendsum {
+  double N, Nx, Ny, rest[3];
+  oc_etay S;
+  int m;
+  double fk[TAY_KIDS], fhi[TAY_KIDS], ea[TAY_KIDS][3];
+  unsigned char out[TAY_KIDS];
+} blendsum;
+
+/* Adds child k, its models c (alpha_k(p) != 0 or its gradient not 0),
+** to q; S too unless the caller summed it. */
+static inline void blend_add(blendsum *q, const oc_enode *k,
+                             const oc_etaylor *c, double x, double y, double R,
+                             int add_s) {
+  int m = q->m;
+  if (oc_enode_holds(k, x, y) && c->a.v != 0)
+    q->N += c->a.v * c->f.v; /* (ev) */
+  q->Nx += c->a.v * c->f.gx + c->f.v * c->a.gx;
+  q->Ny += c->a.v * c->f.gy + c->f.v * c->a.gy;
+  if (add_s) oc_etay_add(&q->S, &c->a);
+  double pa[3] = {c->a.e0, oc_etay_gnorm(&c->a) + c->a.e1, c->a.e2};
+  double pf[3] = {c->f.e0, oc_etay_gnorm(&c->f) + c->f.e1, c->f.e2}, r[3];
+  oc_etay_polymul(pa, pf, R, r);
+  double ak = fabs(c->a.v);
+  q->rest[0] += ak * c->f.e0 + r[0];
+  q->rest[1] += ak * c->f.e1 + r[1];
+  q->rest[2] += ak * c->f.e2 + r[2];
+  q->fk[m] = c->f.v, q->out[m] = 0;
+  q->ea[m][0] = c->a.e0, q->ea[m][1] = c->a.e1, q->ea[m][2] = c->a.e2;
+  q->m = m + 1;
+}
+
+/* Adds child k whose alpha_k(p) = 0 (so grad alpha_k(p) = 0: alpha_k >= 0
+** is C1), its model a not constant: alpha_k' (f_k' - f) is at most
+** E_ak(r) sup|f_k - f|, f_k's range from its bound over the plane (no
+** noise evaluated). */
+static inline void blend_add_out(blendsum *q, const oc_enode *k,
+                                 const oc_etay *a, int add_s) {
+  int m = q->m;
+  oc_ebound g;
+  oc_enode_glob(k, &g);
+  q->fk[m] = g.flo, q->fhi[m] = g.fhi, q->out[m] = 1;
+  if (add_s) oc_etay_add(&q->S, a);
+  q->ea[m][0] = a->e0, q->ea[m][1] = a->e1, q->ea[m][2] = a->e2;
+  q->m = m + 1;
+}
 
 /* blend, f = N / S where S = sum alpha_k >= T on the whole disc: with
 ** f the value at p, N' - f S' = sum alpha_k' (f_k' - f) and, writing each
@@ -1264,113 +1367,97 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
                         const oc_etfoot *tf, oc_etaylor *o, int *boxes) {
   const oc_eblend *bl = OC_EBLEND(n);
   oc_erect ball = {x - R, y - R, x + R, y + R};
-  /* per child: f_k, or (out) the range of f_k, and alpha_k's remainder */
-  double fk[TAY_KIDS], fhi[TAY_KIDS], ea[TAY_KIDS][3], rest[3] = {0, 0, 0};
-  unsigned char out[TAY_KIDS];
-  double N = 0, Nx = 0, Ny = 0; /* N and sum a_k F_k + f_k A_k */
-  oc_etay S = oc_etay_const(0);
-  int m = 0;
-  kid_iter it;
-  kids_in(bl, ball.x0, ball.y0, ball.x1, ball.y1, &it);
-  /* the children meeting the disc (up to TAY_KIDS: kk, nk; -1 beyond);
-  ** when they are all discs, at full detail, their weights' models first
-  ** (no noise), summed as below, so that a sum crossing T (no rule: the
-  ** caller's fallback) costs no noise model */
-  const oc_enode *kk[TAY_KIDS], *k;
-  oc_etay ka[TAY_KIDS];
-  int w = 0, nk = 0, discs = !tf, jk = 0;
-  uint64_t mk = kid_word(&it, 0);
-  while ((k = next_meeting(bl, &it, &ball, &w, &mk))) {
-    if (nk == TAY_KIDS) {
-      nk = -1;
-      break;
-    }
-    kk[nk++] = k;
-    discs = discs && k->kind == OC_E_DISC;
-  }
-  if (nk < 0) { /* (the children again, one by one) */
-    w = 0, mk = kid_word(&it, 0), discs = 0;
-  } else if (discs) {
+  blendsum q;
+  q.N = q.Nx = q.Ny = q.rest[0] = q.rest[1] = q.rest[2] = 0;
+  q.S = oc_etay_const(0);
+  q.m = 0;
+  /* the children meeting the disc (alpha_k = 0 on it for the others) */
+  const oc_enode *kk[TAY_KIDS];
+  int discs, nk = kids_meeting(bl, &ball, kk, &discs);
+  double gS = -1; /* |grad S| once known */
+  if (nk >= 0 && discs && !tf) {
+    /* discs at full detail: their weights' models first (no noise), so
+    ** that a sum crossing T (no rule: the caller's fallback) costs no
+    ** noise model; those that are 0 on the whole disc dropped. Then the
+    ** others' f models, in the same order: S is the sum of the same
+    ** models in the same order as the general rule's below */
+    oc_etay ka[TAY_KIDS];
+    int na = 0;
     for (int i = 0; i < nk; i++) {
-      oc_edisc_taylor_alpha(kk[i], x, y, R, &ka[i]);
-      if (!(ka[i].v == 0 && oc_etay_is_const(&ka[i]))) oc_etay_add(&S, &ka[i]);
+      oc_edisc_taylor_alpha(kk[i], x, y, R, &ka[na]);
+      if (ka[na].v == 0 && oc_etay_is_const(&ka[na])) continue;
+      oc_etay_add(&q.S, &ka[na]);
+      kk[na++] = kk[i];
     }
-    double dev = oc_etay_dev(&S, R);
-    if (!(S.v - dev >= T) && !(S.v + dev <= T)) return 0; /* (below) */
-    S = oc_etay_const(0);
+    gS = oc_etay_gnorm(&q.S); /* (S is final: the same bits below) */
+    double dev = gS * R + oc_etay_rem(&q.S, R); /* (oc_etay_dev) */
+    if (!(q.S.v - dev >= T) && !(q.S.v + dev <= T)) return 0; /* (below) */
+    for (int i = 0; i < na; i++) {
+      oc_etaylor c;
+      c.a = ka[i];
+      if (c.a.v == 0 && c.a.gx == 0 && c.a.gy == 0) {
+        blend_add_out(&q, kk[i], &c.a, 0);
+        continue;
+      }
+      oc_edisc_taylor_f(kk[i], x, y, R, &c.f);
+      blend_add(&q, kk[i], &c, x, y, R, 0);
+    }
+  } else {
+    /* (beyond TAY_KIDS, nk < 0: the children again, one by one) */
+    kid_iter it;
+    int w = 0;
+    uint64_t mk = 0;
+    if (nk < 0) {
+      kids_in(bl, ball.x0, ball.y0, ball.x1, ball.y1, &it);
+      mk = kid_word(&it, 0);
+    }
+    for (int i = 0;; i++) {
+      const oc_enode *k = nk >= 0 ? (i < nk ? kk[i] : NULL)
+                                  : next_meeting(bl, &it, &ball, &w, &mk);
+      if (!k) break;
+      if (q.m == TAY_KIDS || oc_eop_taylor_partial(k)) return 0;
+      oc_etaylor c;
+      /* alpha_k's model first where it is cheap (no noise) */
+      int have = oc_enode_taylor_alpha(k, x, y, R, &c.a, boxes);
+      if (have && c.a.v == 0 && c.a.gx == 0 && c.a.gy == 0) {
+        if (!oc_etay_is_const(&c.a)) blend_add_out(&q, k, &c.a, 1);
+        continue;
+      }
+      /* a disc's f model alone (its alpha's model: c.a) */
+      if (!(have && k->kind == OC_E_DISC &&
+            oc_edisc_taylor_f_view(k, x, y, R, tf, &c.f)))
+        oc_enode_taylor_view(k, x, y, R, tf, &c, boxes);
+      if (c.a.v == 0 && oc_etay_is_const(&c.a)) continue;
+      blend_add(&q, k, &c, x, y, R, 1);
+    }
   }
-  for (;;) {
-    if (nk >= 0) {
-      if (jk == nk) break;
-      k = kk[jk];
-    } else if (!(k = next_meeting(bl, &it, &ball, &w, &mk))) {
-      break; /* (alpha_k = 0 on the disc for the others) */
-    }
-    if (m == TAY_KIDS || oc_eop_taylor_partial(k)) return 0;
-    oc_etaylor c;
-    /* alpha_k's model first where it is cheap (no noise) */
-    int have = 1;
-    if (discs)
-      c.a = ka[jk];
-    else
-      have = oc_enode_taylor_alpha(k, x, y, R, &c.a, boxes);
-    jk++;
-    if (have && c.a.v == 0 && c.a.gx == 0 && c.a.gy == 0) {
-      /* alpha_k(p) = 0 (so grad alpha_k(p) = 0: alpha_k >= 0 is C1):
-      ** alpha_k' (f_k' - f) is at most E_ak(r) sup|f_k - f|, f_k's range
-      ** from its bound over the plane (no noise evaluated) */
-      if (oc_etay_is_const(&c.a)) continue;
-      oc_ebound g;
-      oc_enode_glob(k, &g);
-      fk[m] = g.flo, fhi[m] = g.fhi, out[m] = 1;
-      oc_etay_add(&S, &c.a);
-      ea[m][0] = c.a.e0, ea[m][1] = c.a.e1, ea[m][2] = c.a.e2;
-      m++;
-      continue;
-    }
-    /* a disc's f model alone (its alpha's model: c.a) */
-    if (!(have && k->kind == OC_E_DISC &&
-          oc_edisc_taylor_f_view(k, x, y, R, tf, &c.f)))
-      oc_enode_taylor_view(k, x, y, R, tf, &c, boxes);
-    if (c.a.v == 0 && oc_etay_is_const(&c.a)) continue;
-    if (oc_enode_holds(k, x, y) && c.a.v != 0) N += c.a.v * c.f.v; /* (ev) */
-    Nx += c.a.v * c.f.gx + c.f.v * c.a.gx;
-    Ny += c.a.v * c.f.gy + c.f.v * c.a.gy;
-    oc_etay_add(&S, &c.a);
-    double pa[3] = {c.a.e0, oc_etay_gnorm(&c.a) + c.a.e1, c.a.e2};
-    double pf[3] = {c.f.e0, oc_etay_gnorm(&c.f) + c.f.e1, c.f.e2}, q[3];
-    oc_etay_polymul(pa, pf, R, q);
-    double ak = fabs(c.a.v);
-    rest[0] += ak * c.f.e0 + q[0];
-    rest[1] += ak * c.f.e1 + q[1];
-    rest[2] += ak * c.f.e2 + q[2];
-    fk[m] = c.f.v, out[m] = 0;
-    ea[m][0] = c.a.e0, ea[m][1] = c.a.e1, ea[m][2] = c.a.e2;
-    m++;
-  }
+  oc_etay S = q.S;
+  int m = q.m;
   o->a = S;
   if (m == 0) {
     o->f = oc_etay_const(0);
     return 1;
   }
-  double dev = oc_etay_dev(&S, R), Slo = S.v - dev;
+  if (gS < 0) gS = oc_etay_gnorm(&S);
+  double dev = gS * R + oc_etay_rem(&S, R), Slo = S.v - dev; /* (dev) */
   int conv = Slo >= T; /* else S <= T on the whole disc, or no rule */
   if (!conv && !(S.v + dev <= T)) return 0; /* max(S, T) has a kink */
-  double f = conv ? N / S.v : 0, Q[3] = {rest[0], rest[1], rest[2]};
+  double f = conv ? q.N / S.v : 0, Q[3] = {q.rest[0], q.rest[1], q.rest[2]};
   for (int j = 0; j < m; j++) {
     /* |f_k - f| (|f_k| where S <= T), or its bound for an outer child */
-    double d = out[j] ? oc_fmax(fhi[j] - f, f - fk[j]) : fabs(fk[j] - f);
-    if (out[j] && !conv) d = oc_fmax(fabs(fk[j]), fabs(fhi[j]));
-    Q[0] += d * ea[j][0], Q[1] += d * ea[j][1], Q[2] += d * ea[j][2];
+    double d =
+        q.out[j] ? oc_fmax(q.fhi[j] - f, f - q.fk[j]) : fabs(q.fk[j] - f);
+    if (q.out[j] && !conv) d = oc_fmax(fabs(q.fk[j]), fabs(q.fhi[j]));
+    Q[0] += d * q.ea[j][0], Q[1] += d * q.ea[j][1], Q[2] += d * q.ea[j][2];
   }
   if (!conv) {
-    o->f = (oc_etay){N / T, Nx / T, Ny / T, Q[0] / T, Q[1] / T, Q[2] / T};
+    o->f = (oc_etay){q.N / T, q.Nx / T, q.Ny / T, Q[0] / T, Q[1] / T, Q[2] / T};
     return 1;
   }
-  double gx = (Nx - f * S.gx) / S.v, gy = (Ny - f * S.gy) / S.v;
+  double gx = (q.Nx - f * S.gx) / S.v, gy = (q.Ny - f * S.gy) / S.v;
   double g = sqrt(gx * gx + gy * gy);
   /* r (|A_S| r + E_S(r)), truncated at R */
-  double P1 = S.e0, P2 = oc_etay_gnorm(&S) + S.e1 + R * S.e2;
+  double P1 = S.e0, P2 = gS + S.e1 + R * S.e2;
   o->f = (oc_etay){
       f, gx, gy, Q[0] / Slo, (Q[1] + g * P1) / Slo, (Q[2] + g * P2) / Slo};
   return 1;
@@ -1408,6 +1495,13 @@ static int weight_taylor(const oc_enode *B, double x, double y, double R,
     oc_enode_ev(B, x, y, tf ? &tf->p : NULL, OC_EV_LAZY, &s);
     b->f = oc_etay_const(s.f);
     b->a = oc_etay_flat(s.a, Bb->la, oc_fmax(Bb->ahi - s.a, s.a - Bb->alo), R);
+  } else if (B->kind == OC_E_DISC && !tf) {
+    /* (a disc's weight first: no noise where w = 0 on the whole disc) */
+    oc_edisc_taylor_alpha(B, x, y, R, &b->a);
+    *w = oc_etay_clamp01(&b->a, R);
+    if (w->v == 0 && oc_etay_is_const(w)) return 0;
+    oc_edisc_taylor_f(B, x, y, R, &b->f);
+    return 1;
   } else {
     oc_enode_taylor_view(B, x, y, R, tf, b, boxes);
   }

@@ -1118,6 +1118,130 @@ START_TEST(blend_grid_matches_flat) {
 }
 END_TEST
 
+/* A blend of discs alone (OC_EF_DISCS, set at construction) finds the
+** children a model's disc meets without branches, every child in order
+** (no grid) or through its grid's cells: the same models, bit for bit,
+** and the same box counts, as the same blend taking the general walk
+** (the flag cleared), at points inside, near and outside its box, for
+** radii from a child's tenth to the whole scene; the models hold
+** (check_taylor). Blends with another kind of child keep the flag clear. */
+#ifdef __SANITIZE_ADDRESS__
+#define DISC_BLEND_POINTS 100
+#else
+#define DISC_BLEND_POINTS 800
+#endif
+
+START_TEST(blend_of_discs_fast_path) {
+  oc_error err;
+  enum { N = 40 };
+  oc_enode *k[N];
+  oct_rng r = oct_rng_new(91);
+  for (int i = 0; i < N; i++) {
+    double x = oct_unif(&r, -400, 400), y = oct_unif(&r, -400, 400);
+    double rad = i == 0 ? 1500 : oct_unif(&r, 30, 250);
+    k[i] = disc(x, y, rad, oct_unif(&r, 10, 120), (oc_enoise_kind)(i % 4),
+                oct_unif(&r, 2, 20), rad / 2, 2 + i % 6);
+  }
+  size_t sizes[2] = {18, N}; /* no grid, and a grid */
+  int models = 0;
+  for (int t = 0; t < 2; t++) {
+    oc_enode *g = EOK(oc_enode_blend(k, sizes[t], &err));
+    oc_enode *walk = EOK(oc_enode_blend(k, sizes[t], &err));
+    ck_assert(g->flags & OC_EF_DISCS);
+    ck_assert_int_eq(g->octaves, t ? 5 : 0); /* (4 G^2 W <= 3 n) */
+    walk->flags &= (uint8_t)~OC_EF_DISCS;
+    for (int i = 0; i < DISC_BLEND_POINTS; i++) {
+      double x = oct_unif(&r, -600, 600), y = oct_unif(&r, -600, 600);
+      double R = pow(10, oct_unif(&r, 0, 3));
+      oc_etaylor ma, mb;
+      int ba = 0, bb = 0;
+      oc_enode_taylor(g, x, y, R, &ma, &ba);
+      oc_enode_taylor(walk, x, y, R, &mb, &bb);
+      same_taylor(&ma, &mb);
+      ck_assert_int_eq(ba, bb);
+      models += ba == 0; /* (a rule, not the box bound's fallback) */
+    }
+    check_taylor(g, &r, 500);
+    oc_enode_release(g);
+    oc_enode_release(walk);
+  }
+  ck_assert_int_gt(models, DISC_BLEND_POINTS); /* real models */
+  oc_enode *three = EOK(oc_enode_blend(k, 3, &err));
+  oc_enode_xform xf = {100, 50, 30, 0.7, 1, 0};
+  oc_enode *mixed[2] = {k[1], EOK(oc_enode_transform(three, &xf, &err))};
+  oc_enode *mb = EOK(oc_enode_blend(mixed, 2, &err));
+  ck_assert(!(mb->flags & OC_EF_DISCS));
+  oc_enode_release(mb);
+  oc_enode_release(mixed[1]);
+  oc_enode_release(three);
+  for (int i = 0; i < N; i++)
+    oc_enode_release(k[i]);
+}
+END_TEST
+
+/* A disc's weight model decides "alpha is 0 on the whole disc" and "the
+** model is flat" from the squares and from an upper bound of the
+** gradient's norm where those are clear of the thresholds: the same
+** models, bit for bit, as the rule computed with its square roots
+** (written out here), at random points and at points within a few ulps of
+** |p - c| = (r + R)(1 + 1e-12), of q = 1 and of the flat switch. */
+static void ref_alpha(double cx, double cy, double r, double x, double y,
+                      double R, oc_etay *a) {
+  double u = x - cx, v = y - cy, q = (u * u + v * v) / (r * r);
+  if (sqrt(u * u + v * v) >= (r + R) * (1 + 1e-12)) {
+    *a = oc_etay_const(0);
+  } else if (q < 1) {
+    double k = 1 - q, c = -6 * k * k / (r * r);
+    *a = (oc_etay){k * k * k, c * u, c * v, 0, 0, 3 / (r * r)};
+  } else {
+    *a = (oc_etay){0, 0, 0, 0, 0, 3 / (r * r)};
+  }
+  double gap = fmax(a->v, 1 - a->v);
+  if (oc_etay_dev(a, R) > gap) *a = (oc_etay){a->v, 0, 0, gap, 0, 0};
+}
+
+#ifdef __SANITIZE_ADDRESS__
+#define ALPHA_POINTS 3000
+#else
+#define ALPHA_POINTS 20000
+#endif
+
+START_TEST(disc_alpha_model_decisions) {
+  oct_rng r = oct_rng_new(57);
+  int flat = 0, zero = 0, lin = 0;
+  for (int i = 0; i < ALPHA_POINTS; i++) {
+    double cx = oct_unif(&r, -1e3, 1e3), cy = oct_unif(&r, -1e3, 1e3);
+    double rad = pow(10, oct_unif(&r, -2, 4));
+    double R = rad * pow(10, oct_unif(&r, -4, 1)), th = oct_unif(&r, 0, 6.28);
+    double d = rad * oct_unif(&r, 0, 2) + oct_unif(&r, 0, 1) * R;
+    if (i % 4 == 1) /* at the "0 on the whole disc" switch */
+      d = nextafter((rad + R) * (1 + 1e-12), 0) * (1 + (i % 9 - 4) * 1e-16);
+    if (i % 4 == 2) /* at q = 1 */
+      d = rad * (1 + (i % 11 - 5) * 1.1e-16);
+    if (i % 4 == 1 || i % 4 == 2) /* (u and v as exact as can be) */
+      cx = cy = 0, th = i % 8 < 4 ? 0 : th;
+    double x = cx + d * cos(th), y = cy + d * sin(th);
+    if (i % 4 == 3) { /* about where the flat model takes over */
+      x = cx + rad * oct_unif(&r, 0.1, 0.9), y = cy;
+      R = rad * oct_unif(&r, 0.05, 1.5);
+    }
+    oc_enode *e = disc(cx, cy, rad, 0, OC_ENOISE_NONE, 0, 0, 0);
+    oc_etay a, b;
+    oc_edisc_taylor_alpha(e, x, y, R, &a);
+    ref_alpha(cx, cy, rad, x, y, R, &b);
+    ck_assert_msg(!memcmp(&a, &b, sizeof a), "disc %g at (%g, %g), R %g", rad,
+                  x - cx, y - cy, R);
+    zero += oc_etay_is_const(&a) && a.v == 0;
+    flat += a.e0 > 0;
+    lin += a.gx != 0;
+    oc_enode_release(e);
+  }
+  ck_assert(zero > ALPHA_POINTS / 10 && flat > ALPHA_POINTS / 40 &&
+            lin > ALPHA_POINTS / 10);
+  printf("disc alpha models: %d zero, %d flat, %d linear\n", zero, flat, lin);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("elevation");
   TCase *tc = tcase_create("elevation");
@@ -1139,6 +1263,8 @@ int main(void) {
   tcase_add_test(tc, add_altitude_slope_bound);
   tcase_add_test(tc, taylor_models);
   tcase_add_test(tc, blend_grid_matches_flat);
+  tcase_add_test(tc, blend_of_discs_fast_path);
+  tcase_add_test(tc, disc_alpha_model_decisions);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }

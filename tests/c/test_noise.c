@@ -1160,6 +1160,83 @@ START_TEST(noise_z0_multi_paths) {
 }
 END_TEST
 
+/* oc_noise3_z0_octaves (a disc's octaves at one point, their seeds and
+** points made inside) gives, through each path, oc_noise3's bits at the
+** seeds oc_mix64(seed + 0x9e3779b97f4a7c15 (m + 1)) (the formula, here
+** written out) and the points (s[m] u, s[m] v): every count up to 16
+** (one or two vectors, padding lanes), frequencies growing as octaves'
+** do and arbitrary ones, signed zeros, huge and NaN points; writes
+** nothing past its room of 16 values, and refuses more than 16 octaves
+** or a missing path. */
+START_TEST(noise_z0_octaves_paths) {
+  enum { L = OC_NOISE_MAXOCT, PAD = 3 };
+  const oc_noise_isa isa[3] = {OC_NOISE_ISA_AUTO, OC_NOISE_ISA_SSE2,
+                               OC_NOISE_ISA_AVX512};
+  oc_rng r = oc_rng_stream(31, 9);
+  double s[L + 1] = {0}, v[L + PAD], gx[L + PAD], gy[L + PAD], w[L + PAD];
+  ck_assert_int_eq(
+      oc_noise3_z0_octaves_isa(OC_NOISE_ISA_SSE2, 1, s, 0, 0, L + 1, v, gx, gy),
+      -1);
+  int differ = 0, points = 0, spilled = 0, paths = 0;
+  for (int k = 0; k < 120; k++) {
+    int n = k % (L + 1);
+    uint64_t seed = k % 5 == 0 ? (uint64_t)k : oc_rng_next(&r);
+    double u = (oc_rng_uniform(&r) - 0.5) * 4000;
+    double vv = (oc_rng_uniform(&r) - 0.5) * 4000;
+    double f = ldexp(1, (int)(oc_rng_uniform(&r) * 12) - 10);
+    for (int m = 0; m < n; m++, f *= k % 3 ? 2 : 1.7)
+      s[m] = k % 7 == 3 ? oc_rng_uniform(&r) * 3 : f;
+    if (k % 11 == 4) u = -0.0, vv = 0.0;
+    if (n > 2 && k % 11 == 5) s[n - 1] = 1e300;
+    if (n > 1 && k % 11 == 6) u = NAN;
+    if (k % 11 == 7) vv = 3 * 0x1p48;
+    for (int p = 0; p < 3; p++) {
+      for (int m = 0; m < L + PAD; m++)
+        v[m] = gx[m] = gy[m] = w[m] = -7;
+      if (!oc_noise_isa_supported(isa[p])) {
+        ck_assert_int_eq(oc_noise3_z0_octaves_isa(isa[p], seed, s, u, vv,
+                                                  (size_t)n, v, gx, gy),
+                         -1);
+        spilled += v[0] != -7;
+        continue;
+      }
+      paths++;
+      ck_assert_int_eq(oc_noise3_z0_octaves_isa(isa[p], seed, s, u, vv,
+                                                (size_t)n, v, gx, gy),
+                       0);
+      ck_assert_int_eq(oc_noise3_z0_octaves_isa(isa[p], seed, s, u, vv,
+                                                (size_t)n, w, NULL, NULL),
+                       0);
+      for (int m = 0; m < n; m++, points++) {
+        uint64_t sd =
+            oc_mix64(seed + 0x9e3779b97f4a7c15ull * (uint64_t)(m + 1));
+        differ += sd != oc_noise_octave_seed(seed, m);
+        oc_vec3 g;
+        double ref = oc_noise3(sd, oc_v3(s[m] * u, s[m] * vv, 0), &g);
+        differ += !same_bits(v[m], ref) || !same_bits(w[m], ref) ||
+                  !same_bits(gx[m], g.x) || !same_bits(gy[m], g.y);
+      }
+      for (int m = L; m < L + PAD; m++)
+        spilled += v[m] != -7 || gx[m] != -7 || gy[m] != -7 || w[m] != -7;
+    }
+  }
+  /* 7 rounds of 0..16 octaves, then 0..0, per path that runs */
+  ck_assert_int_eq(points, paths / 120 * (7 * 136 + 0));
+  ck_assert_int_eq(paths % 120, 0);
+  ck_assert_int_eq(differ, 0);
+  ck_assert_int_eq(spilled, 0);
+  /* the automatic path is the default call's */
+  for (int m = 0; m < L; m++)
+    s[m] = ldexp(1, m - 8);
+  oc_noise3_z0_octaves(77, s, 123.25, -40.5, L, v, gx, gy);
+  oc_noise3_z0_octaves_isa(OC_NOISE_ISA_AUTO, 77, s, 123.25, -40.5, L, w, NULL,
+                           NULL);
+  for (int m = 0; m < L; m++)
+    differ += !same_bits(v[m], w[m]);
+  ck_assert_int_eq(differ, 0);
+}
+END_TEST
+
 /* ---- turbulence ------------------------------------------------------ */
 
 START_TEST(turbulence_bounds_and_definition) {
@@ -1289,6 +1366,7 @@ int main(void) {
   tcase_add_test(tc, noise_rows_on_plane);
   tcase_add_test(tc, noise_z0_multi_matches);
   tcase_add_test(tc, noise_z0_multi_paths);
+  tcase_add_test(tc, noise_z0_octaves_paths);
   tcase_add_test(tc, turbulence_bounds_and_definition);
   tcase_add_test(tc, turbulence_gradient_and_lipschitz);
   tcase_add_test(tc, noise_hessian_on_planes);
