@@ -1148,7 +1148,7 @@ START_TEST(blend_of_discs_fast_path) {
     oc_enode *g = EOK(oc_enode_blend(k, sizes[t], &err));
     oc_enode *walk = EOK(oc_enode_blend(k, sizes[t], &err));
     ck_assert(g->flags & OC_EF_DISCS);
-    ck_assert_int_eq(g->octaves, t ? 5 : 0); /* (4 G^2 W <= 3 n) */
+    ck_assert_int_eq(g->octaves, t ? 14 : 0); /* (8 words(n, G) <= 6 n) */
     walk->flags &= (uint8_t)~OC_EF_DISCS;
     for (int i = 0; i < DISC_BLEND_POINTS; i++) {
       double x = oct_unif(&r, -600, 600), y = oct_unif(&r, -600, 600);
