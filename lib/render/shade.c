@@ -33,20 +33,20 @@
 ** nearer hits (smaller footprints) start on the source itself */
 #define LEV_SPAN 1024.0
 /* An AO sample at distance d asks for the footprint AO_FOOT d. */
-#define AO_FOOT 1.0
+#define AO_FOOT 2.0
 /* A shadow ray's footprint at t is SHADOW_FOOT F + cone t, F = pixel z
 ** the pixel's at the hit; its pieces span LEV_PIECE levels; its march
-** starts from a candidate step of START_STEP F (first piece) or
-** START_PIECE of the piece (the others). Measured on bench_elev_lod at
-** 480 x 270 (instructions of the shading, callgrind; 15.0 10^9 without
-** levels): shadow rays alone 10.7 10^9 without levels; SHADOW_FOOT 1, 2,
-** 4 with START_STEP 8 (4) 6.6, 5.8, 8.2 (7.4, 5.9, 5.2), pieces of one
-** level 1.2 times the CPU of two; the AO alone 3.9 10^9 without levels,
-** AO_FOOT 0.5, 1, 2 2.5, 2.2, 1.7 (mean colour change 0.0001, 0.0003,
-** 0.0007). */
-#define SHADOW_FOOT 2.0
+** starts on models from a candidate step of START_STEP F (first piece)
+** or START_PIECE of the piece (the others). Measured on bench_elev_lod at
+** 480 x 270 (callgrind, instructions of the shading phase; 15.0 10^9
+** without levels, 0.4 10^9 without shadows and AO): with shadows, no AO,
+** 11.1 10^9 without levels, SHADOW_FOOT 1, 2, 4 with START_STEP 8 (4)
+** 6.6, 5.8, 8.2 (7.4, 5.9, 5.2), pieces of one level 1.2 times the CPU
+** of two; with AO, no shadows, 4.3 10^9 without levels, AO_FOOT 0.5, 1,
+** 2 2.9, 2.6, 2.1 (mean colour change 0.0001, 0.0003, 0.0007). */
+#define SHADOW_FOOT 4.0
 #define LEV_PIECE 2
-#define START_STEP 8.0
+#define START_STEP 4.0
 #define START_PIECE 0.25
 
 int oc_shader_lod(oc_shader *sh, oc_error *err) {
