@@ -511,6 +511,11 @@ typedef struct oc_render_params {
   oc_vec3 sun_direction; /* towards the sun (normalised here) */
   double sun_color[3];   /* linear RGB, >= 0 */
   double sun_intensity;  /* >= 0 */
+  double sun_radius;     /* the sun's angular radius, radians in [0, 0.1]
+                         ** (0.00465): under a level-of-detail source
+                         ** (oc_elevation's coarser) a shadow ray's cone,
+                         ** at least a pixel's, widens by it, and detail
+                         ** finer than the cone is dropped */
   double sky[3];         /* linear RGB of the sky: ambient and misses */
   int shadows;           /* 1: shadow rays towards the sun */
   int ao;                /* 1: ambient occlusion */
@@ -562,7 +567,8 @@ typedef struct oc_render_params {
 
 /* Fills `rp` with the defaults: a 640 x 360 view of nothing in particular
 ** (set the camera), sun from (-0.5, -0.4, 0.77) colour (1, 0.95, 0.86)
-** intensity 2.2, sky (0.45, 0.6, 0.85), shadows and AO on, no fog (fog
+** intensity 2.2 angular radius 0.00465, sky (0.45, 0.6, 0.85), shadows and AO
+*on, no fog (fog
 ** colour = sky), no background (sky), texture 0.3, rule colours with
 ** derived levels, segment tracer, AOV channels on, exposure 0, tone
 ** OC_TONE_CLAMP; camera up (0, 0, 1), fov 40 degrees (vertical). */
@@ -1254,6 +1260,17 @@ typedef struct oc_elevation {
   ** lib/elevation/etaylor.h). */
   double (*taylor)(void *ud, double x, double y, double R, double g[2],
                    double e[3], int *boxes);
+  /* Optional (NULL: the source has one level of detail, which every query
+  ** gets): the same surface with the detail finer than a footprint m >= 0
+  ** (metres) dropped, for queries that need less detail than a pixel's
+  ** (a level-of-detail render's shadow rays and AO, render/shade.c). Fills
+  ** *out holding one reference of its own (drop it with
+  ** out->release(out->ud)), on the same domain; its weight, where the
+  ** source's is a function of ud (oc_enode_view_weight), is that
+  ** function of out->ud. Level-of-detail trees (oc_enode_elevation_view):
+  ** the view's footprint foot(p) becomes sqrt(foot(p)^2 + m^2). OC_OK, or
+  ** an error code with err. */
+  int (*coarser)(void *ud, double m, struct oc_elevation *out, oc_error *err);
 } oc_elevation;
 
 /* The source of a heightfield: its Catmull-Rom interpolant over the grid's

@@ -174,7 +174,8 @@ static void read_camera(const oclua_fields *f, oc_render_params *rp,
 }
 
 static void read_sun(const oclua_fields *f, oc_render_params *rp) {
-  static const char *const known[] = {"direction", "color", "intensity", NULL};
+  static const char *const known[] = {"direction", "color", "intensity",
+                                      "radius", NULL};
   oclua_fields s;
   oc_vec3 d;
   if (!open_sub(f, "sun", &s, known)) return;
@@ -184,6 +185,9 @@ static void read_sun(const oclua_fields *f, oc_render_params *rp) {
   read_rgb(&s, "color", rp->sun_color, 0);
   rp->sun_intensity =
       oclua_field_optnumber(&s, "intensity", OCLUA_FINITE, rp->sun_intensity);
+  /* (its range is the lib's to check) */
+  rp->sun_radius =
+      oclua_field_optnumber(&s, "radius", OCLUA_FINITE, rp->sun_radius);
   close_sub(f->L);
 }
 

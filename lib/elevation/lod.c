@@ -399,11 +399,13 @@ int oc_enode_eval_view(const oc_enode *e, double x, double y,
   return OC_OK;
 }
 
-/* What a view source holds: the tree (retained) and the view. */
+/* What a view source holds: the tree (retained), the view and the
+** domain. */
 typedef struct vsrc {
   int refs;
   oc_enode *e;
   oc_eview v;
+  double d[4];
 } vsrc;
 
 static double vsrc_height(void *ud, double x, double y, double grad[2]) {
@@ -486,6 +488,58 @@ double oc_enode_view_weight(void *ud, double x, double y) {
   return s.a;
 }
 
+static int vsrc_coarser(void *ud, double m, oc_elevation *out, oc_error *err);
+
+/* The source of tree e under view w on domain d. */
+static int vsrc_new(oc_enode *e, const oc_eview *w, const double d[4],
+                    oc_elevation *src, oc_error *err) {
+  vsrc *q = malloc(sizeof *q);
+  if (!q) return oc_seterr(err, OC_ENOMEM, "out of memory");
+  q->refs = 1;
+  q->e = e;
+  q->v = *w;
+  for (int k = 0; k < 4; k++)
+    q->d[k] = d[k];
+  oc_enode_retain(e);
+  *src = (oc_elevation){.height = vsrc_height,
+                        .range = vsrc_range,
+                        .slope = vsrc_slope,
+                        .bound = vsrc_both,
+                        .taylor = vsrc_taylor,
+                        .retain = vsrc_retain,
+                        .release = vsrc_release,
+                        .coarser = vsrc_coarser,
+                        .ud = q,
+                        .x0 = d[0],
+                        .y0 = d[1],
+                        .x1 = d[2],
+                        .y1 = d[3]};
+  return OC_OK;
+}
+
+/* A coarser level: foot(p) = k sqrt(|p - e_xy|^2 + dz^2) becomes
+** sqrt(foot(p)^2 + m^2) = k sqrt(|p - e_xy|^2 + dz^2 + (m / k)^2), the
+** same view with dz raised to hypot(dz, m / k): a footprint of the same
+** form, C1 and k-Lipschitz with the Hessian bound above, so every bound
+** and model of this file holds for it unchanged. (k = 0, full detail,
+** has no such form: the level is the source itself.) */
+static int vsrc_coarser(void *ud, double m, oc_elevation *out, oc_error *err) {
+  const vsrc *q = ud;
+  if (!(m >= 0) || isinf(m))
+    return oc_seterr(err, OC_EINVAL,
+                     "a coarser level's footprint must be finite and >= 0 "
+                     "(got %g)",
+                     m);
+  oc_eview w = q->v;
+  if (w.k > 0 && m > 0) w.dz = hypot(w.dz, m / w.k);
+  if (!isfinite(w.dz))
+    return oc_seterr(err, OC_EINVAL,
+                     "a coarser level's footprint %g is too large for the "
+                     "view's k %g",
+                     m, w.k);
+  return vsrc_new(q->e, &w, q->d, out, err);
+}
+
 int oc_enode_elevation_view(oc_enode *e, const double *domain,
                             const oc_enode_view *v, oc_elevation *src,
                             oc_error *err) {
@@ -495,23 +549,5 @@ int oc_enode_elevation_view(oc_enode *e, const double *domain,
   int rc = make_view(e, v, &w, err);
   if (!rc) rc = oc_enode_domain(e, &w, domain, d, err);
   if (rc) return rc;
-  vsrc *q = malloc(sizeof *q);
-  if (!q) return oc_seterr(err, OC_ENOMEM, "out of memory");
-  q->refs = 1;
-  q->e = e;
-  q->v = w;
-  oc_enode_retain(e);
-  *src = (oc_elevation){.height = vsrc_height,
-                        .range = vsrc_range,
-                        .slope = vsrc_slope,
-                        .bound = vsrc_both,
-                        .taylor = vsrc_taylor,
-                        .retain = vsrc_retain,
-                        .release = vsrc_release,
-                        .ud = q,
-                        .x0 = d[0],
-                        .y0 = d[1],
-                        .x1 = d[2],
-                        .y1 = d[3]};
-  return OC_OK;
+  return vsrc_new(e, &w, d, src, err);
 }

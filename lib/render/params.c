@@ -19,6 +19,7 @@ void oc_render_defaults(oc_render_params *rp) {
       .sun_direction = {-0.5, -0.4, 0.77},
       .sun_color = {1, 0.95, 0.86},
       .sun_intensity = 2.2,
+      .sun_radius = 0.00465, /* the sun's, seen from the Earth */
       .sky = {0.45, 0.6, 0.85},
       .shadows = 1,
       .ao = 1,
@@ -185,6 +186,10 @@ int oc_render_check_shade(const oc_render_params *rp, oc_error *err) {
     return oc_seterr(err, OC_EINVAL,
                      "'sun.intensity' must be finite and >= 0 (got %s)",
                      oc_numstr(rp->sun_intensity, b));
+  if (!(rp->sun_radius >= 0 && rp->sun_radius <= 0.1))
+    return oc_seterr(err, OC_EINVAL,
+                     "'sun.radius' must be in [0, 0.1] radians (got %s)",
+                     oc_numstr(rp->sun_radius, b));
   if (!color_ok(rp->sky, 3, 1e6))
     return oc_seterr(err, OC_EINVAL,
                      "'sky' components must be finite and >= 0");

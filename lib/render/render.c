@@ -468,8 +468,14 @@ static oc_image *shade(const oc_program *prog, const oc_esurface *es,
   sh->ao_step = rp->ao_distance > 0 ? rp->ao_distance : s.cam.scale / 150;
   sh->tex_scale = rp->texture_scale > 0 ? rp->texture_scale : s.cam.scale / 12;
   resolve_levels(sh, rp, s.geo, (size_t)rp->width * rp->height);
-  if (run_tiles(rp->width, rp->height, shade_tile, &s, &rp->progress, base,
-                span)) {
+  if (oc_shader_lod(sh, err)) {
+    oc_image_free(img);
+    return NULL;
+  }
+  int stop = run_tiles(rp->width, rp->height, shade_tile, &s, &rp->progress,
+                       base, span);
+  oc_shader_release(sh);
+  if (stop) {
     oc_image_free(img);
     oc_seterr(err, OC_ECANCEL, "rendering cancelled");
     return NULL;

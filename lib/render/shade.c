@@ -5,10 +5,166 @@
 ** that miss. All radiometry is in linear RGB.
 */
 #include <math.h>
+#include <stdlib.h>
 
+#include "core/error.h"
 #include "render/shade.h"
 
 #define AO_SAMPLES 5
+
+/* ---- secondary rays under a level of detail ------------------------------
+** A level-of-detail source (oc_enode_elevation_view) keeps the detail a
+** pixel shows where a primary ray meets it. Secondary rays need less
+** (ray cones, Amanatides 1984; ray differentials, Igehy 1999): a shadow
+** ray leaves the hit with the pixel's footprint F = pixel z and widens
+** by the sun's angular radius (at least a pixel's angle), so detail
+** finer than F + cone t at t along it changes the shadow by less than
+** its penumbra's blur; an AO sample at distance d along the normal
+** stands for the heights within about d of it. Both query coarser levels
+** of the source (oc_elevation's coarser), made once per image: level j
+** drops the detail finer than lev0 2^j, and a query asking for a
+** footprint m takes the level of m rounded down (at most twice the
+** detail asked; none below lev0). Sources without levels (grids, exact
+** trees) are traced as they are: exact renders do not change. The
+** levels are made before the tiles and only read by them (every
+** thread the same levels: the image does not depend on threads). */
+#define NLEV 24
+/* lev0 is a pixel's footprint at 1/LEV_SPAN of the domain's diagonal:
+** nearer hits (smaller footprints) start on the source itself */
+#define LEV_SPAN 1024.0
+/* An AO sample at distance d asks for the footprint AO_FOOT d. */
+#define AO_FOOT 2.0
+/* A shadow ray's footprint at t is SHADOW_FOOT F + cone t, F = pixel z
+** the pixel's at the hit; its pieces span LEV_PIECE levels; its march
+** starts on models from a candidate step of START_STEP F (first piece)
+** or START_PIECE of the piece (the others). Measured on bench_elev_lod at
+** 480 x 270 (callgrind, instructions of the shading phase; 15.0 10^9
+** without levels, 0.4 10^9 without shadows and AO): with shadows, no AO,
+** 11.1 10^9 without levels, SHADOW_FOOT 1, 2, 4 with START_STEP 8 (4)
+** 6.6, 5.8, 8.2 (7.4, 5.9, 5.2), pieces of one level 1.2 times the CPU
+** of two; with AO, no shadows, 4.3 10^9 without levels, AO_FOOT 0.5, 1,
+** 2 2.9, 2.6, 2.1 (mean colour change 0.0001, 0.0003, 0.0007). */
+#define SHADOW_FOOT 4.0
+#define LEV_PIECE 2
+#define START_STEP 4.0
+#define START_PIECE 0.25
+
+int oc_shader_lod(oc_shader *sh, oc_error *err) {
+  const oc_render_params *rp = sh->rp;
+  const oc_esurface *es = sh->es;
+  sh->lev = NULL;
+  sh->nlev = 0;
+  sh->pixel = oc_render_pixel_angle(rp);
+  sh->cone = fmax(rp->sun_radius, sh->pixel);
+  if (!es || !es->src->coarser || !(rp->shadows || rp->ao)) return OC_OK;
+  const oc_elevation *s = es->src;
+  sh->lev0 = sh->pixel * hypot(s->x1 - s->x0, s->y1 - s->y0) / LEV_SPAN;
+  if (!(sh->lev0 > 0) || !isfinite(ldexp(sh->lev0, NLEV))) return OC_OK;
+  for (int k = 0; k < 3; k++)
+    sh->lo[k] = sh->etracer.lo[k], sh->hi[k] = sh->etracer.hi[k];
+  sh->lev = calloc(NLEV, sizeof *sh->lev);
+  if (!sh->lev)
+    return oc_seterr(err, OC_ENOMEM, "out of memory for the shading's levels");
+  for (int j = 0; j < NLEV; j++) {
+    oc_shade_level *l = &sh->lev[j];
+    int rc = s->coarser(s->ud, ldexp(sh->lev0, j), &l->src, err);
+    if (rc) {
+      oc_shader_release(sh);
+      return rc;
+    }
+    sh->nlev = j + 1;
+    l->es = *es;
+    l->es.src = &l->src;
+    if (es->wud == s->ud) l->es.wud = l->src.ud; /* the source's own weight */
+    const oc_etracer *et = &sh->etracer;
+    oc_etracer_init(&l->tr, &l->es, et->mode, et->eps_k, et->eps_min);
+    l->tr.refine = 0;
+    for (int k = 0; k < 3; k++) {
+      sh->lo[k] = fmin(sh->lo[k], l->tr.lo[k]);
+      sh->hi[k] = fmax(sh->hi[k], l->tr.hi[k]);
+    }
+  }
+  return OC_OK;
+}
+
+void oc_shader_release(oc_shader *sh) {
+  for (int j = 0; j < sh->nlev; j++)
+    if (sh->lev[j].src.release) sh->lev[j].src.release(sh->lev[j].src.ud);
+  free(sh->lev);
+  sh->lev = NULL;
+  sh->nlev = 0;
+}
+
+/* The level for footprint m: floor(log2(m / lev0)), at most the last; -1
+** below lev0 (the source itself). */
+static int level_of(const oc_shader *sh, double m) {
+  if (!(m >= sh->lev0)) return -1;
+  int e;
+  frexp(m / sh->lev0, &e); /* m / lev0 in [2^(e - 1), 2^e) */
+  return e - 1 < sh->nlev ? e - 1 : sh->nlev - 1;
+}
+
+/* The source an AO sample at distance d queries. */
+static const oc_elevation *ao_source(const oc_shader *sh, double d) {
+  int j = sh->nlev ? level_of(sh, AO_FOOT * d) : -1;
+  return j < 0 ? sh->es->src : &sh->lev[j].src;
+}
+
+/* Where o + t u leaves the box of the levels (t >= t0; t0 when it is
+** not in it then). */
+static double box_exit(const oc_shader *sh, oc_vec3 o, oc_vec3 u, double t0) {
+  const double oo[3] = {o.x, o.y, o.z}, uu[3] = {u.x, u.y, u.z};
+  double t1 = INFINITY;
+  for (int k = 0; k < 3; k++) {
+    if (uu[k] == 0) {
+      if (oo[k] < sh->lo[k] || oo[k] > sh->hi[k]) return t0;
+      continue;
+    }
+    double ta = (sh->lo[k] - oo[k]) / uu[k], tb = (sh->hi[k] - oo[k]) / uu[k];
+    t1 = fmin(t1, fmax(ta, tb));
+  }
+  return fmax(t0, t1);
+}
+
+/* A shadow ray from o (off along it, hit at distance z) under a level of
+** detail: in pieces, each on the level of the footprint F + cone t at its
+** start, to where that footprint has grown by LEV_PIECE levels (each
+** piece a march of its own: fewer, longer pieces restart less often).
+** The first piece's level may lie above o (its detail below the pixel's
+** is gone): where its first sample is under that level, o is lifted to
+** off above it and the piece traced again (a pixel shows no shadow of
+** detail it cannot show). A march on models starts from a candidate step
+** of START_STEP footprints (its first piece) or START_PIECE of its piece
+** (the others). Returns 1 when lit. */
+static int lod_shadow(const oc_shader *sh, oc_vec3 o, double off, double z,
+                      double *evals) {
+  double F = SHADOW_FOOT * sh->pixel * z, t = off, th;
+  int j = level_of(sh, F + sh->cone * off), lifted = j < 0;
+  double far = fmin(sh->far, box_exit(sh, o, sh->sun, t));
+  while (t < far) {
+    const oc_etracer *tr = j < 0 ? &sh->etracer : &sh->lev[j].tr;
+    double t1 = far;
+    if (j + LEV_PIECE < sh->nlev)
+      t1 = fmin(t1, (ldexp(sh->lev0, j + LEV_PIECE) - F) / sh->cone);
+    double step = t == off ? START_STEP * F : START_PIECE * (t1 - t);
+    int hit =
+        oc_etrace_hit(tr, o, sh->sun, t, t1, z, step, NULL, &th, NULL, evals);
+    if (hit == 2 && th <= t && !lifted) {
+      const oc_elevation *s = tr->s->src;
+      double h = o.z - s->height(s->ud, o.x, o.y, NULL);
+      *evals += 1;
+      lifted = 1;
+      if (h < off) {
+        o.z += off - h;
+        continue;
+      }
+    }
+    if (hit) return 0;
+    t = t1;
+    j += LEV_PIECE;
+  }
+  return 1;
+}
 
 /* Ambient occlusion of an elevation surface from heights along the
 ** normal: leaving the surface along n, the height above it grows at
@@ -17,10 +173,10 @@
 ** shortfall, relative to the distance, is the occlusion. */
 static double eocclusion(const oc_shader *sh, oc_vec3 p, oc_vec3 n,
                          double *evals) {
-  const oc_elevation *src = sh->es->src;
   double occ = 0, w = 0.5;
   for (int k = 1; k <= AO_SAMPLES; k++, w *= 0.5) {
     double d = k * sh->ao_step;
+    const oc_elevation *src = ao_source(sh, d);
     oc_vec3 q = {p.x + d * n.x, p.y + d * n.y, p.z + d * n.z};
     double h = q.z - src->height(src->ud, q.x, q.y, NULL);
     *evals += 1;
@@ -65,6 +221,7 @@ static double shadow(const oc_shader *sh, oc_vec3 p, oc_vec3 n, double z,
     const oc_etracer *et = &sh->etracer;
     double off = 4 * (et->eps_k * z + et->eps_min), t;
     oc_vec3 o = {p.x + off * n.x, p.y + off * n.y, p.z + off * n.z};
+    if (sh->nlev) return lod_shadow(sh, o, off, z, evals);
     return oc_etrace(et, o, sh->sun, off, sh->far, z, &t, evals) ? 0 : 1;
   }
   const oc_tracer *tr = &sh->tracer;

@@ -10,6 +10,14 @@
 #include "render/etrace.h"
 #include "render/trace.h"
 
+/* A coarser level of a level-of-detail source (oc_elevation's coarser)
+** with its surface and its shadow rays' tracer. */
+typedef struct oc_shade_level {
+  oc_elevation src;
+  oc_esurface es;
+  oc_etracer tr;
+} oc_shade_level;
+
 /* Everything shading needs, resolved once per image. */
 typedef struct oc_shader {
   const oc_render_params *rp;
@@ -24,7 +32,22 @@ typedef struct oc_shader {
   double ao_step;   /* metres between AO samples */
   double tex_scale; /* metres per texture period */
   double far;       /* shadow rays end there */
+  /* Secondary rays of a level-of-detail source (oc_shader_lod): level j
+  ** drops the detail finer than lev0 2^j; none when nlev is 0. */
+  oc_shade_level *lev;
+  int nlev;
+  double lev0;
+  double lo[3], hi[3]; /* the box of every level's tracer */
+  double pixel;        /* a pixel's angle (oc_render_pixel_angle) */
+  double cone;         /* a shadow ray's footprint widens by cone a metre */
 } oc_shader;
+
+/* Makes the coarser levels of sh's source for its shadow rays and AO
+** (none for fields and sources without levels), once sh's other fields
+** are set; oc_shader_release frees them (and may be called after a
+** failure). OC_OK, or an error code with err. */
+int oc_shader_lod(oc_shader *sh, oc_error *err);
+void oc_shader_release(oc_shader *sh);
 
 /* Albedo by the rules or the field palette at p with unit normal n, the
 ** triplanar variation not included; *evals counts field evaluations. */

@@ -184,30 +184,48 @@ START_TEST(footprint_zero_is_full_detail) {
 }
 END_TEST
 
-/* The disc's f under a view: h + sum b(t_i) term_i, term_i the
-** difference of discs with i + 1 and i octaves at full detail. */
+/* Discs d[i] with i octaves (d[0] one) of wavelength OCT_WL over height
+** OCT_H, for i <= OCT_N. */
+#define OCT_N 8
+#define OCT_WL 400.0
+#define OCT_H 50.0
+static void octave_discs(oc_enode **d, oc_enoise_kind kind) {
+  for (int i = 0; i <= OCT_N; i++)
+    d[i] = disc(0, 0, 20000, OCT_H, kind, 100, OCT_WL, i ? i : 1);
+}
+
+/* d[OCT_N]'s f at (x, y) under footprint ft: h + sum b(t_i) term_i,
+** term_i the difference of discs with i + 1 and i octaves at full
+** detail; *ramps counts the octaves on their filter's ramp. */
+static double octave_ref(oc_enode *const *d, double h, double wl, double ft,
+                         double x, double y, int *ramps) {
+  double ref = h;
+  for (int i = 0; i < OCT_N; i++) {
+    oc_enode_sample a, b;
+    oc_enode_eval(d[i + 1], x, y, &a);
+    if (i) oc_enode_eval(d[i], x, y, &b);
+    double term = i ? a.f - b.f : a.f - h;
+    double t = log2(wl / pow(2, i) / ft);
+    *ramps += t > 0 && t < 1;
+    ref += bfilt(t) * term;
+  }
+  return ref;
+}
+
+/* The disc's f under a view against octave_ref. */
 static void check_disc_kind(oc_enoise_kind kind) {
-  const int N = 8;
-  const double wl = 400, h = 50;
-  oc_enode *d[9];
-  for (int i = 0; i <= N; i++)
-    d[i] = disc(0, 0, 20000, h, kind, 100, wl, i ? i : 1);
+  const int N = OCT_N;
+  const double wl = OCT_WL, h = OCT_H;
+  oc_enode *d[OCT_N + 1];
+  octave_discs(d, kind);
   oc_enode_view v = {{-3000, 500, 2500}, 2e-3};
   double dz = mid_dz(d[N], &v);
   oct_rng r = oct_rng_new(11 + kind);
   int ramps = 0;
   for (int k = 0; k < 3000; k++) {
     double x = oct_unif(&r, -12000, 12000), y = oct_unif(&r, -12000, 12000);
-    double ft = foot(&v, dz, x, y), ref = h;
-    for (int i = 0; i < N; i++) {
-      oc_enode_sample a, b;
-      oc_enode_eval(d[i + 1], x, y, &a);
-      if (i) oc_enode_eval(d[i], x, y, &b);
-      double term = i ? a.f - b.f : a.f - h;
-      double t = log2(wl / pow(2, i) / ft);
-      ramps += t > 0 && t < 1;
-      ref += bfilt(t) * term;
-    }
+    double ft = foot(&v, dz, x, y);
+    double ref = octave_ref(d, h, wl, ft, x, y, &ramps);
     oc_enode_sample s;
     evalv(d[N], x, y, &v, &s);
     ck_assert_msg(fabs(s.f - ref) <= 1e-9 * (1 + fabs(ref)),
@@ -691,6 +709,82 @@ START_TEST(lod_trace_against_march) {
 }
 END_TEST
 
+/* A coarser level (oc_elevation's coarser: shadow rays and AO of LoD
+** renders): the disc's f with every footprint foot replaced by sqrt(foot^2
+** + m^2), the octave sum of check_disc_kind; m = 0 the source bit for
+** bit; exact sources have no levels, so their renders ignore the sun's
+** radius that widens the shadow rays' cones. */
+START_TEST(coarser_levels) {
+  const int N = OCT_N;
+  const double wl = OCT_WL, h = OCT_H;
+  oc_enode *d[OCT_N + 1], **dd = d;
+  oc_enode_view v = {{-3000, 500, 2500}, 1e-3};
+  octave_discs(dd, OC_ENOISE_PLAIN);
+  double dz = mid_dz(d[N], &v);
+  oc_error err;
+  oc_elevation src;
+  ck_assert_msg(oc_enode_elevation_view(d[N], NULL, &v, &src, &err) == OC_OK,
+                "%s", err.msg);
+  ck_assert(src.coarser != NULL);
+  const double ms[] = {0, 3, 40, 250};
+  oct_rng r = oct_rng_new(5);
+  int ramps = 0;
+  for (size_t j = 0; j < sizeof ms / sizeof *ms; j++) {
+    oc_elevation c;
+    ck_assert_msg(src.coarser(src.ud, ms[j], &c, &err) == OC_OK, "%s", err.msg);
+    ck_assert(c.x0 == src.x0 && c.y0 == src.y0 && c.x1 == src.x1 &&
+              c.y1 == src.y1);
+    for (int k = 0; k < 400; k++) {
+      double x = oct_unif(&r, -6000, 6000), y = oct_unif(&r, -6000, 6000);
+      double ft = hypot(foot(&v, dz, x, y), ms[j]);
+      double ref = octave_ref(d, h, wl, ft, x, y, &ramps);
+      double f = c.height(c.ud, x, y, NULL);
+      ck_assert_msg(fabs(f - ref) <= 1e-9 * (1 + fabs(ref)),
+                    "m %g at (%g, %g): %.12g, sum %.12g", ms[j], x, y, f, ref);
+      if (ms[j] == 0) ck_assert(f == src.height(src.ud, x, y, NULL));
+      /* its weight is the tree's under the level's view */
+      ck_assert(oc_enode_view_weight(c.ud, x, y) ==
+                oc_enode_view_weight(src.ud, x, y));
+    }
+    c.release(c.ud);
+  }
+  ck_assert_msg(ramps > 1000, "only %d samples on a ramp", ramps);
+  oc_elevation bad;
+  ck_assert(src.coarser(src.ud, -1, &bad, &err) == OC_EINVAL);
+  ck_assert(src.coarser(src.ud, NAN, &bad, &err) == OC_EINVAL);
+  src.release(src.ud);
+  /* the exact source: no levels, the same image for any sun radius */
+  oc_elevation ex;
+  ck_assert(oc_enode_elevation(d[N], NULL, &ex, &err) == OC_OK);
+  ck_assert(ex.coarser == NULL);
+  oc_esurface es = {&ex, NULL, NULL, OC_ENODE_T};
+  oc_render_params rp;
+  oc_render_defaults(&rp);
+  rp.camera.eye = oct_v(-3000, 500, 2500);
+  rp.camera.target = oct_v(0, 0, 0);
+  rp.width = 24;
+  rp.height = 16;
+  rp.sun_direction = oct_v(-1, 0, 0.3); /* low: some shadows */
+  oc_image *img[2];
+  for (int k = 0; k < 2; k++) {
+    rp.sun_radius = k ? 0.1 : 0;
+    img[k] = oc_render_surface(&es, &rp, NULL, &err);
+    ck_assert_msg(img[k], "%s", err.msg);
+  }
+  ck_assert(
+      memcmp(oc_image_cdata(img[0]), oc_image_cdata(img[1]),
+             (size_t)24 * 16 * oc_image_channels(img[0]) * sizeof(float)) == 0);
+  oc_image_free(img[0]);
+  oc_image_free(img[1]);
+  rp.sun_radius = 0.2;
+  ck_assert(oc_render_check_shade(&rp, &err) == OC_EINVAL);
+  ck_assert(strstr(err.msg, "sun.radius") != NULL);
+  ex.release(ex.ud);
+  for (int i = 0; i <= N; i++)
+    oc_enode_release(d[i]);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("elevation_lod");
   TCase *tc = tcase_create("lod");
@@ -703,6 +797,7 @@ int main(void) {
   tcase_add_test(tc, bounds_with_lod);
   tcase_add_test(tc, lod_taylor_models);
   tcase_add_loop_test(tc, lod_trace_against_march, 0, 2);
+  tcase_add_test(tc, coarser_levels);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }
