@@ -17,6 +17,7 @@
 */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "core/error.h"
 #include "core/fround.h"
@@ -249,6 +250,7 @@ int oc_heightfield_elevation(oc_heightfield *hf, oc_elevation *src,
                      nx, ny);
   }
   oc_heightfield_retain(hf);
+  memset(src, 0, sizeof *src); /* hooks a grid lacks (coarser...) NULL */
   src->height = hf_height;
   src->range = hf_range;
   src->slope = hf_slope;
