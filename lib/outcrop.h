@@ -567,11 +567,11 @@ typedef struct oc_render_params {
 
 /* Fills `rp` with the defaults: a 640 x 360 view of nothing in particular
 ** (set the camera), sun from (-0.5, -0.4, 0.77) colour (1, 0.95, 0.86)
-** intensity 2.2 angular radius 0.00465, sky (0.45, 0.6, 0.85), shadows and AO
-*on, no fog (fog
-** colour = sky), no background (sky), texture 0.3, rule colours with
-** derived levels, segment tracer, AOV channels on, exposure 0, tone
-** OC_TONE_CLAMP; camera up (0, 0, 1), fov 40 degrees (vertical). */
+** intensity 2.2 angular radius 0.00465, sky (0.45, 0.6, 0.85), shadows
+** and AO on, no fog (fog colour = sky), no background (sky), texture
+** 0.3, rule colours with derived levels, segment tracer, AOV channels
+** on, exposure 0, tone OC_TONE_CLAMP; camera up (0, 0, 1), fov 40
+** degrees (vertical). */
 void oc_render_defaults(oc_render_params *rp);
 
 /* The default framing (render/framing.c), the one the Lua front end uses:
@@ -1314,13 +1314,15 @@ typedef struct oc_esurface {
   double (*weight)(void *wud, double x, double y);
   void *wud;
   double T;
-  /* Optional (NULL: none): the largest weight on the box [x0, x1] x [y0,
-  ** y1] in *hi and a Lipschitz bound of the weight there in *lip, both
-  ** conservative. The tracer proves stretches of rays in holes free with
-  ** it (a wall is where the weight reaches T), instead of crossing a hole
-  ** by tolerance steps. */
+  /* Optional (NULL: none): bounds of weight(wud, .) on the box [x0, x1] x
+  ** [y0, y1] (x0 <= x1, y0 <= y1) as oc_elevation's weight_range gives
+  ** them, lo <= weight <= hi and a Lipschitz bound lip there: where the
+  ** weight is the source's own, that hook (trees: src.weight_range). The
+  ** tracer proves stretches of rays in holes free with it (a wall is
+  ** where the weight reaches T), instead of crossing a hole by tolerance
+  ** steps. */
   void (*weight_bound)(void *wud, double x0, double y0, double x1, double y1,
-                       double *hi, double *lip);
+                       double *lo, double *hi, double *lip);
 } oc_esurface;
 
 /* oc_render_elevation and its two phases for a surface with holes; the

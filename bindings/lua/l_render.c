@@ -446,14 +446,6 @@ static double tree_weight(void *wud, double x, double y) {
   return oc_enode_weight(wud, x, y);
 }
 
-/* The tree's weight bound on a box (rays cross holes with it). */
-static void tree_weight_bound(void *wud, double x0, double y0, double x1,
-                              double y1, double *hi, double *lip) {
-  oc_enode_bound b;
-  oc_enode_bound_in(wud, x0, y0, x1, y1, &b);
-  *hi = b.ahi, *lip = b.la;
-}
-
 static const oc_esurface *surface_at(lua_State *L, int idx, double T) {
   oc_enode *tree = oclua_testenode(L, idx);
   oc_heightfield *hf = tree ? NULL : oclua_checkheightfield(L, idx, FNAME);
@@ -472,7 +464,7 @@ static const oc_esurface *surface_at(lua_State *L, int idx, double T) {
   s->es.src = &s->src;
   /* a tree's terrain is where its weight reaches 1/2 (Omega_T) */
   s->es.weight = tree ? tree_weight : NULL;
-  s->es.weight_bound = tree ? tree_weight_bound : NULL;
+  s->es.weight_bound = tree ? s->src.weight_range : NULL; /* (holes) */
   s->es.wud = tree;
   s->es.T = tree ? OC_ENODE_T : T;
   return &s->es;

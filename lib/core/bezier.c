@@ -110,11 +110,10 @@ double oc_bez_arclen(const oc_vec3 *p, int n, double a, double b) {
 /* ---- closest point ------------------------------------------------------ */
 
 /* A polynomial in Bernstein form of degree m <= 5 on some interval, at t:
-** de Casteljau, its first level read from c. bern_at is the loop;
-** bern_eval runs it with m a constant (a switch), so that the compiler
-** unrolls it into registers: the same operations in the same order, so
-** the same bits, at half the cost (the closest point's Newton steps make
-** most of its calls). */
+** de Casteljau, its first level read from c. Its callers are inlined
+** with m a constant, so that the compiler unrolls it into registers: the
+** same operations in the same order, so the same bits, at half the cost
+** (the closest point's Newton steps make most of its calls). */
 static inline __attribute__((always_inline)) double bern_at(const double *c,
                                                             int m, double t) {
   double w[6], u = 1 - t;
@@ -128,24 +127,6 @@ static inline __attribute__((always_inline)) double bern_at(const double *c,
     for (int i = 0; i < k; i++)
       w[i] = w[i] * u + w[i + 1] * t;
   return w[0];
-}
-
-static inline __attribute__((always_inline)) double bern_eval(const double *c,
-                                                              int m, double t) {
-  switch (m) {
-  case 5:
-    return bern_at(c, 5, t);
-  case 4:
-    return bern_at(c, 4, t);
-  case 3:
-    return bern_at(c, 3, t);
-  case 2:
-    return bern_at(c, 2, t);
-  case 1:
-    return bern_at(c, 1, t);
-  default:
-    return bern_at(c, 0, t);
-  }
 }
 
 static void bern_halves(const double *c, int m, double *l, double *r) {
@@ -189,15 +170,15 @@ typedef struct span {
 ** most 2.4e-15 (37 % of them not at all). */
 static inline __attribute__((always_inline)) double
 solve_bracketed(const double *f, const double *df, int m, double a, double b) {
-  double fa = bern_eval(f, m, a), t = 0.5 * (a + b);
+  double fa = bern_at(f, m, a), t = 0.5 * (a + b);
   for (int it = 0; it < 100; it++) {
-    double ft = bern_eval(f, m, t);
+    double ft = bern_at(f, m, t);
     if (ft == 0) return t;
     if ((ft > 0) == (fa > 0))
       a = t;
     else
       b = t;
-    double d = bern_eval(df, m - 1, t);
+    double d = bern_at(df, m - 1, t);
     double tn = t - ft / d;
     if (!(tn > a && tn < b)) {
       if (tn >= b && tn - b <= 4e-16) return b;
@@ -263,19 +244,11 @@ dist2_at(const oc_vec3 *p, int n, double x, double y, double t) {
 
 /* ---- out of reach ------------------------------------------------------ */
 
-/* |(a, b)| for the out-of-reach tests, whose margin dwarfs an ulp: a
-** square root where the squares neither overflow nor lose their
-** precision to underflow, hypot (a libm call, 5x the time) else. */
-static inline double norm2(double a, double b) {
-  double s = a * a + b * b;
-  return s < 1e300 && (s > 1e-300 || s == 0) ? sqrt(s) : hypot(a, b);
-}
-
 /* The distance from (a, c) to the box [b0, b1] x [b2, b3]. */
 static double box_dist(double a, double c, const double b[4]) {
   double da = oc_fmax(oc_fmax(b[0] - a, a - b[1]), 0);
   double dc = oc_fmax(oc_fmax(b[2] - c, c - b[3]), 0);
-  return norm2(da, dc);
+  return oc_norm2_fast(da, dc);
 }
 
 /* The distance from (a, c) to the segment (a1, c1) (a2, c2). */
@@ -328,7 +301,7 @@ static double seg_box_dist(double a1, double c1, double a2, double c2,
 ** their differences far from the origin). */
 static int frame_far(const double *px, const double *py, int n, double xa,
                      double ya, double xb, double yb, double r, double mag) {
-  double ux = px[n] - px[0], uy = py[n] - py[0], l = norm2(ux, uy);
+  double ux = px[n] - px[0], uy = py[n] - py[0], l = oc_norm2_fast(ux, uy);
   if (!(l > 0) || !(r < INFINITY)) return 0;
   ux /= l, uy /= l;
   double b[4] = {INFINITY, -INFINITY, INFINITY, -INFINITY};

@@ -797,10 +797,9 @@ uint64_t oc_noise_octave_seed(uint64_t seed, int i) {
 static inline void z0_octaves(int avx, uint64_t seed, const double *s, double u,
                               double v, size_t n, double *val, double *gx,
                               double *gy) {
-  int wg = gx && gy;
 #ifdef HAVE_AVX512
   if (avx) {
-    if (wg)
+    if (gx && gy)
       z0_octaves_avx512_g(seed, s, u, v, n, val, gx, gy);
     else
       z0_octaves_avx512_v(seed, s, u, v, n, val);
@@ -815,10 +814,7 @@ static inline void z0_octaves(int avx, uint64_t seed, const double *s, double u,
     sd[i] = oc_noise_octave_seed(seed, (int)i);
     px[i] = s[i] * u, py[i] = s[i] * v;
   }
-  if (wg)
-    z0_multi_sse2(sd, px, py, n, val, gx, gy, 1);
-  else
-    z0_multi_sse2(sd, px, py, n, val, NULL, NULL, 0);
+  z0_multi(0, sd, px, py, n, val, gx, gy);
 }
 
 int oc_noise_isa_supported(oc_noise_isa isa) {

@@ -31,6 +31,14 @@ static inline oc_vec3 oc_cross(oc_vec3 a, oc_vec3 b) {
 static inline double oc_len(oc_vec3 a) {
   return sqrt(oc_dot(a, a));
 }
+/* |(a, b)| for tests against a margin that dwarfs an ulp: a square root
+** where the squares neither overflow nor lose their precision to
+** underflow, hypot (a libm call, 5x the time) else. */
+static inline double oc_norm2_fast(double a, double b) {
+  double s = a * a + b * b;
+  return s < 1e300 && (s > 1e-300 || s == 0) ? sqrt(s) : hypot(a, b);
+}
+
 /* fmax and fmin as glibc computes them on x86-64 (maxsd and minsd: the
 ** second operand where they are equal, the other operand where one is
 ** NaN), inline: libm's are calls in this build (no -ffinite-math-only),

@@ -177,11 +177,7 @@ void oc_ecurve_bound_in(const oc_enode *n, const oc_erect *b,
   ** it: none within R + rho of its centre, rho its half-diagonal (and a
   ** hair for rounding) */
   double cx = 0.5 * (b->x0 + b->x1), cy = 0.5 * (b->y0 + b->y1);
-  double w = b->x1 - b->x0, h = b->y1 - b->y0, s = w * w + h * h;
-  /* (a square root, an ulp within hypot's, which the margin of r dwarfs,
-  ** where the squares stay normal: hypot is 5x the time) */
-  double rho =
-      0.5 * (s < 1e300 && (s > 1e-300 || s == 0) ? sqrt(s) : hypot(w, h));
+  double rho = 0.5 * oc_norm2_fast(b->x1 - b->x0, b->y1 - b->y0);
   double r = (d->R + rho) * (1 + 1e-12) + 1e-9;
   if (!oc_curve_within(d->c, cx, cy, r)) o->alo = o->ahi = o->la = 0;
 }

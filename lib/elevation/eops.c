@@ -216,31 +216,43 @@ static inline int disc_meets(const oc_enode *k, const oc_erect *b,
          (p[1] - p[2] <= b->y1) & (p[1] + p[2] >= b->y0);
 }
 
+/* The children of a blend of discs alone (OC_EF_DISCS, at most TAY_KIDS
+** of them) whose box meets the ball b, in order, into kk. Their boxes
+** are tested without branches (oc_edisc_meets' comparisons): which ones
+** a ball meets is a coin toss for a branch predictor. */
+static int discs_meeting(const oc_eblend *bl, const oc_erect *b,
+                         const oc_enode **kk) {
+  kid_iter it;
+  kids_in(bl, b->x0, b->y0, b->x1, b->y1, &it);
+  int nk = 0, w = 0;
+  if (!it.grid) { /* (every child, in order) */
+    for (uint32_t i = 0; i < bl->nkids; i++)
+      nk += disc_meets(bl->kids[i], b, &kk[nk]);
+    return nk;
+  }
+  for (uint64_t mk = kid_word(&it, 0); w < it.W;
+       mk = ++w < it.W ? kid_word(&it, w) : 0)
+    for (; mk; mk &= mk - 1)
+      nk += disc_meets(bl->kids[KID_INDEX(w, mk)], b, &kk[nk]);
+  return nk;
+}
+
+/* Whether blend bl's children meeting b go through discs_meeting. */
+static inline int discs_only(const oc_eblend *bl) {
+  return bl->h.flags & OC_EF_DISCS && bl->nkids <= TAY_KIDS;
+}
+
 /* The children of blend bl whose box meets the ball b, in order, into kk
-** (up to TAY_KIDS; -1 beyond), and whether they are all discs. A blend of
-** discs alone (OC_EF_DISCS) tests its children's boxes without branches
-** (oc_edisc_meets' comparisons): which ones a ball meets is a coin toss
-** for a branch predictor. */
+** (up to TAY_KIDS; -1 beyond), and whether they are all discs. */
 static int kids_meeting(const oc_eblend *bl, const oc_erect *b,
                         const oc_enode **kk, int *discs) {
+  *discs = 1;
+  if (discs_only(bl)) return discs_meeting(bl, b, kk);
   kid_iter it;
   kids_in(bl, b->x0, b->y0, b->x1, b->y1, &it);
   int nk = 0, w = 0;
   uint64_t mk = kid_word(&it, 0);
-  if (bl->h.flags & OC_EF_DISCS && bl->nkids <= TAY_KIDS) {
-    *discs = 1;
-    if (!it.grid) { /* (every child, in order) */
-      for (uint32_t i = 0; i < bl->nkids; i++)
-        nk += disc_meets(bl->kids[i], b, &kk[nk]);
-      return nk;
-    }
-    for (; w < it.W; mk = ++w < it.W ? kid_word(&it, w) : 0)
-      for (; mk; mk &= mk - 1)
-        nk += disc_meets(bl->kids[KID_INDEX(w, mk)], b, &kk[nk]);
-    return nk;
-  }
   const oc_enode *k;
-  *discs = 1;
   while ((k = next_meeting(bl, &it, b, &w, &mk))) {
     if (nk == TAY_KIDS) return -1;
     kk[nk++] = k;
@@ -249,16 +261,16 @@ static int kids_meeting(const oc_eblend *bl, const oc_erect *b,
   return nk;
 }
 
-/* Cells a side for n children (0: no grid): 4 G^2 W <= 3 n, 6 bytes a
-** child at most, so that the Table 1 scenes stay within the paper's
-** bytes (bench_elev --bytes: fig21's 45-child blend would not with 8;
-** blends below 24 children, fig3's 18, test their children's boxes as
-** fast as a grid's cells). */
+/* Cells a side for n children (0: no grid): the most with 8
+** oc_eblend_grid_words(n, G) <= 6 n, 6 bytes a child at most, so that
+** the Table 1 scenes stay within the paper's bytes (bench_elev --bytes);
+** blends below 24 children (fig3's 18) test their children's boxes as
+** fast as a grid's cells. */
 static int grid_side(size_t n) {
   size_t W = (n + 63) / 64;
   if (n < OC_EGRID_MIN || W > OC_EGRID_WORDS) return 0;
   int G = 1;
-  while (8 * oc_eblend_grid_words(n, G + 1) <= 6 * n && G < 255)
+  while (8 * oc_eblend_grid_words(n, G + 1) <= 6 * n)
     G++;
   return G;
 }
@@ -388,23 +400,25 @@ static void blend_bound_in(const oc_enode *n, const oc_erect *b,
     return;
   }
   size_t m = 0;
-  /* the children meeting the box (kids_meeting: without branches for a
-  ** blend of discs; beyond TAY_KIDS, nk < 0, one by one) */
-  const oc_enode *kk[TAY_KIDS], *k;
-  int discs, nk = kids_meeting(bl, b, kk, &discs), w = 0;
-  kid_iter it;
-  uint64_t mk = 0;
-  if (nk < 0) {
+  /* alpha = 0 on the whole box: neither a child's f nor its weight's
+  ** slope counts there */
+  if (discs_only(bl)) {
+    const oc_enode *kk[TAY_KIDS];
+    int nk = discs_meeting(bl, b, kk);
+    for (int i = 0; i < nk; i++) {
+      oc_enode_bnd(kk[i], b, fb, &kb[m]);
+      m += kb[m].ahi > 0;
+    }
+  } else {
+    kid_iter it;
     kids_in(bl, b->x0, b->y0, b->x1, b->y1, &it);
-    mk = kid_word(&it, 0);
-  }
-  for (int i = 0;; i++) {
-    k = nk >= 0 ? (i < nk ? kk[i] : NULL) : next_meeting(bl, &it, b, &w, &mk);
-    if (!k) break;
-    oc_enode_bnd(k, b, fb, &kb[m]);
-    /* alpha = 0 on the whole box: neither the child's f nor its weight's
-    ** slope counts there */
-    m += kb[m].ahi > 0;
+    const oc_enode *k;
+    int w = 0;
+    uint64_t mk = kid_word(&it, 0);
+    while ((k = next_meeting(bl, &it, b, &w, &mk))) {
+      oc_enode_bnd(k, b, fb, &kb[m]);
+      m += kb[m].ahi > 0;
+    }
   }
   blend_combine(kb, m, 0, o);
   if (kb != stack) free(kb);

@@ -160,28 +160,25 @@ static int clip(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double *t0,
   return 1;
 }
 
-/* h at p, one height call; with solid, *solid: the weight allows a
-** surface there, asked only under the surface (h <= 0 or NaN), the one
-** place where a caller reads it. */
 /* Whether a sample at height h above the surface at p is solid ground
-** (above it, or where the surface exists: a hole has none). */
-static int solid_at(const oc_esurface *s, oc_vec3 p, double h) {
-  return h > 0 || !s->weight || s->weight(s->wud, p.x, p.y) >= s->T;
-}
-
-/* solid_at, with the weight in *w when it was asked (else *w untouched). */
+** (above it, or where the surface exists: a hole has none), with the
+** weight in *w when it was asked (else *w untouched). */
 static int solid_weight(const oc_esurface *s, oc_vec3 p, double h, double *w) {
   if (h > 0 || !s->weight) return 1;
   *w = s->weight(s->wud, p.x, p.y);
   return *w >= s->T;
 }
 
+/* h at p, one height call; with solid, *solid: the weight allows a
+** surface there, asked only under the surface (h <= 0 or NaN), the one
+** place where a caller reads it. */
 static double height_above(const oc_etracer *tr, oc_vec3 p, int *solid,
                            double *n) {
   const oc_esurface *s = tr->s;
   (*n)++;
   double h = p.z - s->src->height(s->src->ud, p.x, p.y, NULL);
-  if (solid) *solid = solid_at(s, p, h);
+  double w;
+  if (solid) *solid = solid_weight(s, p, h, &w);
   return h;
 }
 
@@ -331,9 +328,9 @@ static double hole_step(const oc_etracer *tr, oc_vec3 p, oc_vec3 u, double uxy,
   const oc_esurface *s = tr->s;
   if (!s->weight_bound || !(w < s->T)) return 0;
   oc_vec3 q = at(p, u, e);
-  double hi, lip;
+  double lo, hi, lip;
   s->weight_bound(s->wud, lesser(p.x, q.x), lesser(p.y, q.y), greater(p.x, q.x),
-                  greater(p.y, q.y), &hi, &lip);
+                  greater(p.y, q.y), &lo, &hi, &lip);
   if (hi < s->T || uxy * e * lip < s->T - w) return e;
   if (!(lip > 0)) return 0; /* NaN */
   /* a hair short, where the weight may reach T */

@@ -10,7 +10,7 @@
 #include "core/error.h"
 #include "render/shade.h"
 
-#define AO_SAMPLES 5
+#define AO_SAMPLES OC_AO_SAMPLES
 
 /* ---- secondary rays under a level of detail ------------------------------
 ** A level-of-detail source (oc_enode_elevation_view) keeps the detail a
@@ -49,6 +49,15 @@
 #define START_STEP 4.0
 #define START_PIECE 0.25
 
+/* The level for footprint m: floor(log2(m / lev0)), at most the last; -1
+** below lev0 (the source itself). */
+static int level_of(const oc_shader *sh, double m) {
+  if (!(m >= sh->lev0)) return -1;
+  int e;
+  frexp(m / sh->lev0, &e); /* m / lev0 in [2^(e - 1), 2^e) */
+  return e - 1 < sh->nlev ? e - 1 : sh->nlev - 1;
+}
+
 int oc_shader_lod(oc_shader *sh, oc_error *err) {
   const oc_render_params *rp = sh->rp;
   const oc_esurface *es = sh->es;
@@ -56,6 +65,8 @@ int oc_shader_lod(oc_shader *sh, oc_error *err) {
   sh->nlev = 0;
   sh->pixel = oc_render_pixel_angle(rp);
   sh->cone = fmax(rp->sun_radius, sh->pixel);
+  for (int k = 0; k < AO_SAMPLES; k++)
+    sh->ao_src[k] = es ? es->src : NULL;
   if (!es || !es->src->coarser || !(rp->shadows || rp->ao)) return OC_OK;
   const oc_elevation *s = es->src;
   sh->lev0 = sh->pixel * hypot(s->x1 - s->x0, s->y1 - s->y0) / LEV_SPAN;
@@ -73,8 +84,10 @@ int oc_shader_lod(oc_shader *sh, oc_error *err) {
       return rc;
     }
     sh->nlev = j + 1;
+    if (!rp->shadows) continue; /* (AO asks the sources alone) */
     l->es = *es;
     l->es.src = &l->src;
+    l->es.weight_bound = NULL; /* (the full detail's weight's) */
     if (es->wud == s->ud) l->es.wud = l->src.ud; /* the source's own weight */
     const oc_etracer *et = &sh->etracer;
     oc_etracer_init(&l->tr, &l->es, et->mode, et->eps_k, et->eps_min);
@@ -83,6 +96,11 @@ int oc_shader_lod(oc_shader *sh, oc_error *err) {
       sh->lo[k] = fmin(sh->lo[k], l->tr.lo[k]);
       sh->hi[k] = fmax(sh->hi[k], l->tr.hi[k]);
     }
+  }
+  for (int k = 0; k < AO_SAMPLES; k++) {
+    double d = (k + 1) * sh->ao_step; /* (as eocclusion's) */
+    int j = level_of(sh, AO_FOOT * d);
+    if (j >= 0) sh->ao_src[k] = &sh->lev[j].src;
   }
   return OC_OK;
 }
@@ -93,21 +111,6 @@ void oc_shader_release(oc_shader *sh) {
   free(sh->lev);
   sh->lev = NULL;
   sh->nlev = 0;
-}
-
-/* The level for footprint m: floor(log2(m / lev0)), at most the last; -1
-** below lev0 (the source itself). */
-static int level_of(const oc_shader *sh, double m) {
-  if (!(m >= sh->lev0)) return -1;
-  int e;
-  frexp(m / sh->lev0, &e); /* m / lev0 in [2^(e - 1), 2^e) */
-  return e - 1 < sh->nlev ? e - 1 : sh->nlev - 1;
-}
-
-/* The source an AO sample at distance d queries. */
-static const oc_elevation *ao_source(const oc_shader *sh, double d) {
-  int j = sh->nlev ? level_of(sh, AO_FOOT * d) : -1;
-  return j < 0 ? sh->es->src : &sh->lev[j].src;
 }
 
 /* Where o + t u leaves the box of the levels (t >= t0; t0 when it is
@@ -176,7 +179,7 @@ static double eocclusion(const oc_shader *sh, oc_vec3 p, oc_vec3 n,
   double occ = 0, w = 0.5;
   for (int k = 1; k <= AO_SAMPLES; k++, w *= 0.5) {
     double d = k * sh->ao_step;
-    const oc_elevation *src = ao_source(sh, d);
+    const oc_elevation *src = sh->ao_src[k - 1];
     oc_vec3 q = {p.x + d * n.x, p.y + d * n.y, p.z + d * n.z};
     double h = q.z - src->height(src->ud, q.x, q.y, NULL);
     *evals += 1;

@@ -10,6 +10,9 @@
 #include "render/etrace.h"
 #include "render/trace.h"
 
+/* Heights an elevation surface's ambient occlusion samples. */
+#define OC_AO_SAMPLES 5
+
 /* A coarser level of a level-of-detail source (oc_elevation's coarser)
 ** with its surface and its shadow rays' tracer. */
 typedef struct oc_shade_level {
@@ -40,6 +43,8 @@ typedef struct oc_shader {
   double lo[3], hi[3]; /* the box of every level's tracer */
   double pixel;        /* a pixel's angle (oc_render_pixel_angle) */
   double cone;         /* a shadow ray's footprint widens by cone a metre */
+  /* the source each AO sample of an elevation surface queries */
+  const oc_elevation *ao_src[OC_AO_SAMPLES];
 } oc_shader;
 
 /* Makes the coarser levels of sh's source for its shadow rays and AO

@@ -437,14 +437,6 @@ static double tree_weight(void *wud, double x, double y) {
   return oc_enode_weight(wud, x, y);
 }
 
-/* The weight's bound on a box, for rays crossing holes (oc_esurface). */
-static void tree_weight_bound(void *wud, double x0, double y0, double x1,
-                              double y1, double *hi, double *lip) {
-  oc_enode_bound b;
-  oc_enode_bound_in(wud, x0, y0, x1, y1, &b);
-  *hi = b.ahi, *lip = b.la;
-}
-
 static void params(const scene *s, oc_render_params *rp, int w, int h) {
   oc_render_defaults(rp);
   rp->camera.eye = s->eye;
@@ -474,10 +466,11 @@ static long counted_models, counted_model_boxes;
 
 /* The weight's box queries (rays in holes). */
 static void counted_weight_bound(void *wud, double x0, double y0, double x1,
-                                 double y1, double *hi, double *lip) {
+                                 double y1, double *lo, double *hi,
+                                 double *lip) {
 #pragma omp atomic
   counted_bounds++;
-  tree_weight_bound(wud, x0, y0, x1, y1, hi, lip);
+  counted_inner->weight_range(wud, x0, y0, x1, y1, lo, hi, lip);
 }
 
 static double counted_taylor(void *ud, double x, double y, double R,
@@ -521,7 +514,7 @@ static void run_scene(const char *name, void (*build)(scene *), int prims,
   oc_error err;
   oc_elevation src;
   if (oc_enode_elevation(s.root, NULL, &src, &err)) die(name, &err);
-  oc_esurface es = {&src, tree_weight, s.root, OC_ENODE_T, tree_weight_bound};
+  oc_esurface es = {&src, tree_weight, s.root, OC_ENODE_T, src.weight_range};
   oc_enode_stats es_st;
   if (oc_enode_get_stats(s.root, &es_st, &err)) die(name, &err);
   if (bytes_only) {
@@ -559,7 +552,7 @@ static void run_scene(const char *name, void (*build)(scene *), int prims,
   double bounds = (double)(counted_bounds + counted_model_boxes);
   double models = (double)counted_models;
   es.src = &src;
-  es.weight_bound = tree_weight_bound;
+  es.weight_bound = src.weight_range;
   t0 = omp_get_wtime();
   oc_image *img = oc_render_surface_shade(&es, &rp, geo, NULL, &err);
   double shade_secs = omp_get_wtime() - t0;
