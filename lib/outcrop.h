@@ -1749,11 +1749,15 @@ int oc_enode_eval_view(const oc_enode *e, double x, double y,
 ** under the view), and so do its first-order models (taylor: the octave
 ** filters and the lod operators' t composed with a proved model of
 ** log2(w / foot); lib/elevation/lod.c). The source's weight for oc_esurface is
-** oc_enode_view_weight with wud = src->ud. Holds one reference to e. */
+** oc_enode_view_weight with wud = src->ud, and its weight_bound
+** oc_enode_view_weight_bound (the weight's bounds on a box under the
+** view). Holds one reference to e. */
 int oc_enode_elevation_view(oc_enode *e, const double *domain,
                             const oc_enode_view *v, oc_elevation *src,
                             oc_error *err);
 double oc_enode_view_weight(void *ud, double x, double y);
+void oc_enode_view_weight_bound(void *ud, double x0, double y0, double x1,
+                                double y1, double *lo, double *hi, double *lip);
 /* The size of a pixel at unit distance on the camera's axis, 2 tan(fov /
 ** 2) / height (render/render.c): a view's k is c times it. */
 double oc_render_pixel_angle(const oc_render_params *rp);

@@ -509,7 +509,7 @@ static void surface_lod(lua_State *L, int idx, const oc_esurface *es,
   if (s->src.release) s->src.release(s->src.ud);
   s->src = src;
   s->es.weight = oc_enode_view_weight;
-  s->es.weight_bound = NULL; /* the view's weight is not the tree's */
+  s->es.weight_bound = oc_enode_view_weight_bound; /* (holes) */
   s->es.wud = src.ud;
 }
 

@@ -488,6 +488,16 @@ double oc_enode_view_weight(void *ud, double x, double y) {
   return s.a;
 }
 
+void oc_enode_view_weight_bound(void *ud, double x0, double y0, double x1,
+                                double y1, double *lo, double *hi,
+                                double *lip) {
+  oc_ebound b;
+  vsrc_bound(ud, x0, y0, x1, y1, &b);
+  *lo = b.alo;
+  *hi = b.ahi;
+  *lip = b.la;
+}
+
 static int vsrc_coarser(void *ud, double m, oc_elevation *out, oc_error *err);
 
 /* The source of tree e under view w on domain d. */

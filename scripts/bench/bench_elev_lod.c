@@ -134,9 +134,12 @@ int main(void) {
       if (oc_enode_elevation_view(e, NULL, &v, &src, &err))
         die("lod source", &err);
     }
-    /* both with the tree's weight (Omega_T), the LoD's under its view */
+    /* both with the tree's weight (Omega_T) and its bounds on boxes
+    ** (rays cross holes with them), the LoD's under its view: as Lua
+    ** renders them */
     oc_esurface es0 = {&src, m ? oc_enode_view_weight : tree_weight,
-                       m ? src.ud : (void *)e, OC_ENODE_T, NULL};
+                       m ? src.ud : (void *)e, OC_ENODE_T,
+                       m ? oc_enode_view_weight_bound : src.weight_range};
     double t0 = omp_get_wtime();
     clock_t c0 = clock();
     img[m] = oc_render_surface(&es0, &rp, &st[m], &err);

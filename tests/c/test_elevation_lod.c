@@ -623,9 +623,13 @@ START_TEST(lod_trace_against_march) {
   oc_elevation src;
   ck_assert_msg(oc_enode_elevation_view(e, NULL, &v, &src, &err) == OC_OK, "%s",
                 err.msg);
-  oc_esurface es = {&src, oc_enode_view_weight, src.ud, OC_ENODE_T, NULL};
+  /* rays in holes (beyond the base disc's Omega_T) cross them on the
+  ** view's weight bounds */
+  oc_esurface es = {&src, oc_enode_view_weight, src.ud, OC_ENODE_T,
+                    oc_enode_view_weight_bound};
   /* the joint query (one traversal a step) answers range and slope; the
-  ** march steps on first-order models */
+  ** march steps on first-order models; the weight's bounds are the
+  ** view's box bounds' (bounds_with_lod checks those) */
   ck_assert(src.bound && src.taylor);
   for (int k = 0; k < 40; k++) {
     double x0 = -2000 + 97.3 * k, y0 = -1500 + 71.9 * k, sz = 3.0 * (k + 1);
@@ -634,6 +638,11 @@ START_TEST(lod_trace_against_march) {
     src.range(src.ud, x0, y0, x0 + sz, y0 + 0.5 * sz, &rlo, &rhi);
     ck_assert(lo == rlo && hi == rhi && lo < hi);
     ck_assert(lam == src.slope(src.ud, x0, y0, x0 + sz, y0 + 0.5 * sz));
+    oc_ebound b;
+    bound_view(e, &v, x0, y0, x0 + sz, y0 + 0.5 * sz, &b);
+    oc_enode_view_weight_bound(src.ud, x0, y0, x0 + sz, y0 + 0.5 * sz, &rlo,
+                               &rhi, &lam);
+    ck_assert(rlo == b.alo && rhi == b.ahi && lam == b.la && b.flo == lo);
   }
   oc_vec3 w = oct_sub(target, eye);
   w = oct_mul(w, 1 / oct_len(w));
@@ -757,7 +766,7 @@ START_TEST(coarser_levels) {
   oc_elevation ex;
   ck_assert(oc_enode_elevation(d[N], NULL, &ex, &err) == OC_OK);
   ck_assert(ex.coarser == NULL);
-  oc_esurface es = {&ex, NULL, NULL, OC_ENODE_T};
+  oc_esurface es = {&ex, NULL, NULL, OC_ENODE_T, NULL};
   oc_render_params rp;
   oc_render_defaults(&rp);
   rp.camera.eye = oct_v(-3000, 500, 2500);
