@@ -137,17 +137,16 @@ static oc_vec3 normal_of(const double g[2]) {
   return (oc_vec3){n.x / l, n.y / l, 1 / l};
 }
 
-/* [t0, t1] clipped to the tracer's box; 0 when the ray misses it. */
-static int clip(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double *t0,
-                double *t1) {
+int oc_etrace_clip(const double lo[3], const double hi[3], oc_vec3 o, oc_vec3 u,
+                   double *t0, double *t1) {
   double a = *t0, b = *t1;
   const double oo[3] = {o.x, o.y, o.z}, uu[3] = {u.x, u.y, u.z};
   for (int k = 0; k < 3; k++) {
     if (uu[k] == 0) {
-      if (oo[k] < tr->lo[k] || oo[k] > tr->hi[k]) return 0;
+      if (oo[k] < lo[k] || oo[k] > hi[k]) return 0;
       continue;
     }
-    double ta = (tr->lo[k] - oo[k]) / uu[k], tb = (tr->hi[k] - oo[k]) / uu[k];
+    double ta = (lo[k] - oo[k]) / uu[k], tb = (hi[k] - oo[k]) / uu[k];
     if (ta > tb) {
       double x = ta;
       ta = tb, tb = x;
@@ -603,7 +602,7 @@ int oc_etrace_hit(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0,
                   double *t, oc_vec3 *nrm, double *evals) {
   *t = INFINITY;
   double ts = t0;
-  if (!clip(tr, o, u, &t0, &t1)) return 0;
+  if (!oc_etrace_clip(tr->lo, tr->hi, o, u, &t0, &t1)) return 0;
   /* entering the box after the start: the step does not apply */
   if (t0 > ts) step = 0;
   double g[2];

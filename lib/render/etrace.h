@@ -33,6 +33,11 @@ void oc_etracer_init(oc_etracer *tr, const oc_esurface *s,
 ** side of the domain's box or of a hole), 0 on a miss (or after
 ** OC_TRACE_MAX_STEPS steps); adds the height calls made to *evals.
 ** Allocation-free. */
+/* [t0, t1] clipped to the box [lo, hi] (a tracer's, or a union of
+** tracers'); 0 when the ray o + t u misses it there. */
+int oc_etrace_clip(const double lo[3], const double hi[3], oc_vec3 o, oc_vec3 u,
+                   double *t0, double *t1);
+
 int oc_etrace(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t0, double t1,
               double d0, double *t, double *evals);
 

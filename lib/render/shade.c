@@ -113,22 +113,6 @@ void oc_shader_release(oc_shader *sh) {
   sh->nlev = 0;
 }
 
-/* Where o + t u leaves the box of the levels (t >= t0; t0 when it is
-** not in it then). */
-static double box_exit(const oc_shader *sh, oc_vec3 o, oc_vec3 u, double t0) {
-  const double oo[3] = {o.x, o.y, o.z}, uu[3] = {u.x, u.y, u.z};
-  double t1 = INFINITY;
-  for (int k = 0; k < 3; k++) {
-    if (uu[k] == 0) {
-      if (oo[k] < sh->lo[k] || oo[k] > sh->hi[k]) return t0;
-      continue;
-    }
-    double ta = (sh->lo[k] - oo[k]) / uu[k], tb = (sh->hi[k] - oo[k]) / uu[k];
-    t1 = fmin(t1, fmax(ta, tb));
-  }
-  return fmax(t0, t1);
-}
-
 /* A shadow ray from o (off along it, hit at distance z) under a level of
 ** detail: in pieces, each on the level of the footprint F + cone t at its
 ** start, to where that footprint has grown by LEV_PIECE levels (each
@@ -143,7 +127,8 @@ static int lod_shadow(const oc_shader *sh, oc_vec3 o, double off, double z,
                       double *evals) {
   double F = SHADOW_FOOT * sh->pixel * z, t = off, th;
   int j = level_of(sh, F + sh->cone * off), lifted = j < 0;
-  double far = fmin(sh->far, box_exit(sh, o, sh->sun, t));
+  double t0 = t, far = sh->far; /* (to where it leaves the levels' box) */
+  if (!oc_etrace_clip(sh->lo, sh->hi, o, sh->sun, &t0, &far)) return 1;
   while (t < far) {
     const oc_etracer *tr = j < 0 ? &sh->etracer : &sh->lev[j].tr;
     double t1 = far;
