@@ -55,11 +55,11 @@ static double wave_slope(void *ud, double x0, double y0, double x1, double y1) {
 static wave WAVE = {40, 10, 60};
 
 static oc_elevation wave_source(void) {
-  /* no weight, no joint bound, no row path, no model (the last five): a
-  ** surface everywhere */
-  oc_elevation e = {wave_h, wave_range, wave_slope, NULL, NULL,
-                    &WAVE,  -500,       -500,       500,  500,
-                    NULL,   NULL,       NULL,       NULL, NULL};
+  /* no weight, no joint bound, no row path, no model, no coarser levels
+  ** (the last six): a surface everywhere */
+  oc_elevation e = {wave_h, wave_range, wave_slope, NULL, NULL, &WAVE,
+                    -500,   -500,       500,        500,  NULL, NULL,
+                    NULL,   NULL,       NULL,       NULL};
   return e;
 }
 
