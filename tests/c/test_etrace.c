@@ -281,6 +281,89 @@ START_TEST(tree_models_against_march) {
 }
 END_TEST
 
+/* A flat ground f = 0 whose models declare a curvature remainder C r^2
+** (a loose but valid bound): a ray descending at a shallow slope takes
+** model steps the remainder limits, relaxed (etrace.c TRELAX). Each
+** taylor call records its sample. */
+typedef struct curved_flat {
+  double C;
+  int n;
+  double x[4096];
+} curved_flat;
+
+static double flat_h(void *ud, double x, double y, double g[2]) {
+  (void)ud, (void)x, (void)y;
+  if (g) g[0] = g[1] = 0;
+  return 0;
+}
+
+static void flat_range(void *ud, double x0, double y0, double x1, double y1,
+                       double *lo, double *hi) {
+  (void)ud, (void)x0, (void)y0, (void)x1, (void)y1;
+  *lo = 0, *hi = 50; /* loose: the ray starts inside the domain's box */
+}
+
+static double flat_slope(void *ud, double x0, double y0, double x1, double y1) {
+  (void)ud, (void)x0, (void)y0, (void)x1, (void)y1;
+  return 1;
+}
+
+static double flat_taylor(void *ud, double x, double y, double R, double g[2],
+                          double e[3], int *boxes) {
+  curved_flat *c = ud;
+  (void)y, (void)R, (void)boxes;
+  if (c->n < 4096) c->x[c->n++] = x;
+  g[0] = g[1] = 0;
+  e[0] = e[1] = 0, e[2] = c->C;
+  return 0;
+}
+
+/* A relaxed model step goes a tolerance past TRELAX times the proved one
+** (the tolerance a step may leave unproved), and never further: every
+** step is at most TRELAX times the first zero of the model's bound plus
+** the tolerance, and the steps well above the tolerance take that
+** tolerance; the hit is where the ray meets z = 0. */
+START_TEST(relaxed_steps_take_the_tolerance) {
+  curved_flat cf = {1e-3, 0, {0}};
+  oc_elevation src = {flat_h, flat_range, flat_slope,  NULL, NULL, &cf,
+                      -2000,  -2000,      2000,        2000, NULL, NULL,
+                      NULL,   NULL,       flat_taylor, NULL};
+  oc_esurface es = {&src, NULL, NULL, 0.5, NULL};
+  double eps_k = 1e-3, eps_min = 1e-6;
+  oc_etracer tr;
+  oc_etracer_init(&tr, &es, OC_TRACE_SEGMENT, eps_k, eps_min);
+  oc_vec3 o = oct_v(-1500, 0, 10), u = oct_v(1, 0, -0.005);
+  u = oct_mul(u, 1 / oct_len(u));
+  double t, ev = 0;
+  oc_vec3 nrm;
+  /* a candidate step: the ray starts on models */
+  ck_assert_int_eq(oc_etrace_hit(&tr, o, u, 0, 1e5, 0, 10, NULL, &t, &nrm, &ev),
+                   1);
+  double exact = -o.z / u.z;
+  ck_assert_msg(fabs(t - exact) <= eps_k * exact + eps_min, "hit %.6f, %.6f", t,
+                exact);
+  ck_assert(fabs(nrm.z - 1) < 1e-12);
+  ck_assert_int_gt(cf.n, 3);
+  int wide = 0, long_steps = 0;
+  for (int i = 0; i + 1 < cf.n; i++) {
+    double ta = (cf.x[i] - o.x) / u.x, tb = (cf.x[i + 1] - o.x) / u.x;
+    double h = o.z + ta * u.z, c2 = cf.C * u.x * u.x;
+    /* the first zero of h - (-u_z) s - C s^2 */
+    double root = 2 * h / (-u.z + sqrt(u.z * u.z + 4 * c2 * h));
+    double tl = eps_k * tb + eps_min;
+    ck_assert_msg(tb - ta <= 1.7 * root + tl + 1e-9 * tb,
+                  "step %d: %.6f from %.6f, proved %.6f", i, tb - ta, ta, root);
+    if (root > 2 * tl && tb > ta) {
+      long_steps++;
+      wide += tb - ta > 1.7 * root + 0.5 * tl;
+    }
+  }
+  ck_assert_int_gt(long_steps, 3);
+  ck_assert_msg(wide * 2 > long_steps,
+                "%d of %d relaxed steps took the tolerance", wide, long_steps);
+}
+END_TEST
+
 /* A hit is located to 1/100 of the tolerance (etrace.c REFINE_STOP), on
 ** the near side: from straight above (h falls along every ray, one
 ** crossing), h > 0 at the hit and h <= 0 that much further. Its normal
@@ -883,6 +966,7 @@ static Suite *suite(void) {
   tcase_add_test(t, analytic_against_march);
   tcase_add_test(t, tree_models_against_march);
   tcase_add_test(t, hits_located);
+  tcase_add_test(t, relaxed_steps_take_the_tolerance);
   tcase_add_test(t, weight_makes_holes);
   tcase_add_test(t, holes_crossed_on_weight_bound);
   tcase_add_test(t, beams_conservative);
