@@ -286,7 +286,7 @@ END_TEST
 ** model steps the remainder limits, relaxed (etrace.c TRELAX). Each
 ** taylor call records its sample. */
 typedef struct curved_flat {
-  double C;
+  double C, top; /* the remainder's r^2 term, the ranges' top */
   int n;
   double x[4096];
 } curved_flat;
@@ -299,8 +299,9 @@ static double flat_h(void *ud, double x, double y, double g[2]) {
 
 static void flat_range(void *ud, double x0, double y0, double x1, double y1,
                        double *lo, double *hi) {
-  (void)ud, (void)x0, (void)y0, (void)x1, (void)y1;
-  *lo = 0, *hi = 50; /* loose: the ray starts inside the domain's box */
+  const curved_flat *c = ud;
+  (void)x0, (void)y0, (void)x1, (void)y1;
+  *lo = 0, *hi = c->top; /* loose */
 }
 
 static double flat_slope(void *ud, double x0, double y0, double x1, double y1) {
@@ -324,7 +325,8 @@ static double flat_taylor(void *ud, double x, double y, double R, double g[2],
 ** the tolerance, and the steps well above the tolerance take that
 ** tolerance; the hit is where the ray meets z = 0. */
 START_TEST(relaxed_steps_take_the_tolerance) {
-  curved_flat cf = {1e-3, 0, {0}};
+  /* (the ray starts inside the domain's box) */
+  curved_flat cf = {1e-3, 50, 0, {0}};
   oc_elevation src = {flat_h, flat_range, flat_slope,  NULL, NULL, &cf,
                       -2000,  -2000,      2000,        2000, NULL, NULL,
                       NULL,   NULL,       flat_taylor, NULL};
@@ -361,6 +363,56 @@ START_TEST(relaxed_steps_take_the_tolerance) {
   ck_assert_int_gt(long_steps, 3);
   ck_assert_msg(wide * 2 > long_steps,
                 "%d of %d relaxed steps took the tolerance", wide, long_steps);
+}
+END_TEST
+
+/* A beam's model steps are over-relaxed as a ray's (etrace.c BRELAX): on
+** the curved flat ground, some of its steps go past the least first zero
+** of its corners' bounds (a plain step never does), and the depth it
+** returns is still free for every corner ray. */
+START_TEST(beam_steps_relaxed) {
+  /* (the beam strides on the ranges down to z = 5, then on models) */
+  curved_flat cf = {1e-3, 5, 0, {0}};
+  oc_elevation src = {flat_h, flat_range, flat_slope,  NULL, NULL, &cf,
+                      -2000,  -2000,      2000,        2000, NULL, NULL,
+                      NULL,   NULL,       flat_taylor, NULL};
+  oc_esurface es = {&src, NULL, NULL, 0.5, NULL};
+  oc_etracer tr;
+  oc_etracer_init(&tr, &es, OC_TRACE_SEGMENT, 1e-4, 1e-6);
+  oc_ebeam b;
+  b.o = oct_v(-1500, 0, 10);
+  b.w = oct_v(1, 0, -0.005);
+  b.w = oct_mul(b.w, 1 / oct_len(b.w));
+  b.r = oct_v(0, 1, 0);
+  b.v = oct_v(0.005, 0, 1);
+  b.v = oct_mul(b.v, 1 / oct_len(b.v));
+  b.x0 = b.y0 = -1e-4, b.x1 = b.y1 = 1e-4;
+  double evals = 0, next = 0;
+  oc_emodel m = {0};
+  double d = oc_etrace_beam(&tr, &b, 0, 1e5, NULL, &evals, &next, &m);
+  ck_assert(isfinite(d) && d > 0);
+  ck_assert_int_gt(cf.n, 3);
+  oc_vec3 D[4], c = b.w; /* the corners' rays, the axis (x = y = 0) */
+  for (int j = 0; j < 4; j++) {
+    double x = j & 1 ? b.x1 : b.x0, y = j & 2 ? b.y1 : b.y0;
+    D[j] = oct_add(b.w, oct_add(oct_mul(b.r, x), oct_mul(b.v, y)));
+    /* descending: free before d when above the ground at d */
+    ck_assert_msg(b.o.z + d * D[j].z > 0, "corner %d under at %.6f", j, d);
+  }
+  int past = 0;
+  for (int i = 0; i + 1 < cf.n; i++) {
+    double da = (cf.x[i] - b.o.x) / c.x, db = (cf.x[i + 1] - b.o.x) / c.x;
+    double least = INFINITY;
+    for (int j = 0; j < 4; j++) {
+      double ax = da * (D[j].x - c.x), ay = da * (D[j].y - c.y);
+      double ra = hypot(ax, ay), bxy = hypot(D[j].x, D[j].y);
+      double c0 = b.o.z + da * D[j].z - cf.C * ra * ra;
+      double c1 = 2 * cf.C * ra * bxy - D[j].z, c2 = cf.C * bxy * bxy;
+      least = fmin(least, 2 * c0 / (c1 + sqrt(c1 * c1 + 4 * c2 * c0)));
+    }
+    past += db - da > 1.2 * least;
+  }
+  ck_assert_msg(past > 0, "no beam step past its proof in %d", cf.n);
 }
 END_TEST
 
@@ -967,6 +1019,7 @@ static Suite *suite(void) {
   tcase_add_test(t, tree_models_against_march);
   tcase_add_test(t, hits_located);
   tcase_add_test(t, relaxed_steps_take_the_tolerance);
+  tcase_add_test(t, beam_steps_relaxed);
   tcase_add_test(t, weight_makes_holes);
   tcase_add_test(t, holes_crossed_on_weight_bound);
   tcase_add_test(t, beams_conservative);
