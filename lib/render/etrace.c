@@ -360,11 +360,19 @@ static double hole_step(const oc_etracer *tr, oc_vec3 p, oc_vec3 u, double uxy,
 ** height is within h - k s -+ E(s |u_xy|) (k its slope along u by the
 ** model), so that it is above the surface at s_lo, where the lower bound
 ** turns positive, and under it before s_hi, where the upper one does;
-** when s_lo - s_hi <= stop and s_lo <= smax (the model's disc, the
-** bracket), *s = s_lo (a point proved above the surface within stop of
-** one proved under it, as refine's) and 1. */
-static int model_root(double h, const double g[2], const double E[3], oc_vec3 u,
-                      double uxy, double smax, double stop, double *s) {
+** the lower bound stays positive back to s_lo2, its second zero. When
+** s_lo <= smax (the model's disc, the bracket), those and 1: the hit is
+** in [t - s_lo, t], a bracket of no call (located there when s_lo - s_hi
+** is within refine's stop, model_hit). Measured on bench_elev -q (calls
+** a pixel, fig3 and fig22, from 7.40 and 10.40, where the model located
+** a hit only within the stop and a relaxed sample under the surface sent
+** the ray back to its plain step): refine from [t - s_lo, t] instead of
+** the samples' bracket 7.35, 10.35; a relaxed sample under the surface
+** taken as the hit's bracket when s_lo2 reaches the stretch proved before
+** it 7.19, 10.23; both 7.15, 10.19. */
+static int model_back(double h, const double g[2], const double E[3], oc_vec3 u,
+                      double uxy, double smax, double *s_lo, double *s_hi,
+                      double *s_lo2) {
   double k = u.z - (g[0] * u.x + g[1] * u.y), A = E[2] * uxy * uxy;
   double B = -(k + E[1] * uxy), C = h - E[0]; /* L = C + B s - A s^2 */
   double D = B * B + 4 * A * C;
@@ -373,9 +381,33 @@ static int model_root(double h, const double g[2], const double E[3], oc_vec3 u,
   double Bh = -k + E[1] * uxy, Ch = h + E[0],
          hi = 0; /* U = Ch + Bh s + A s^2 */
   if (Ch < 0) hi = -2 * Ch / (Bh + sqrt(Bh * Bh - 4 * A * Ch));
-  if (!(lo <= smax && lo - hi <= stop)) return 0;
-  *s = lo;
+  if (!(lo <= smax)) return 0;
+  *s_lo = lo, *s_hi = hi;
+  /* L's second zero, a hair short: L > 0 between the two */
+  *s_lo2 = A > 0 ? (B + sqrt(D)) / (2 * A) * (1 - 1e-9) : INFINITY;
   return 1;
+}
+
+/* The hit in [t - s_lo, t] (model_back's: a point above the surface, the
+** sample under it, the ray above the surface before them as far as the
+** tolerance allows): on the model when s_lo - s_hi is within refine's
+** stop (the normal a call at t - s_lo), else refine from that bracket,
+** its upper end at the model's linear estimate there. */
+static double model_hit(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
+                        double h, const double g[2], double s_lo, double s_hi,
+                        double d0, double *n, double ga[2], int *ga_ok) {
+  const oc_elevation *src = tr->s->src;
+  double a = t - s_lo;
+  if (s_lo - s_hi <= REFINE_STOP * tol(tr, d0, a)) {
+    oc_vec3 q = at(o, u, a);
+    double gq[2];
+    (*n)++;
+    src->height(src->ud, q.x, q.y, gq);
+    if (ga) ga[0] = gq[0], ga[1] = gq[1], *ga_ok = 1;
+    return a;
+  }
+  double k = u.z - (g[0] * u.x + g[1] * u.y);
+  return refine(tr, o, u, a, greater(h - k * s_lo, 0), t, h, d0, n, ga, ga_ok);
 }
 
 /* The accelerated march with the source's first-order models. A ray
@@ -392,7 +424,10 @@ static int model_root(double h, const double g[2], const double E[3], oc_vec3 u,
 ** own proof (the model over a disc reaching back to where the last proof
 ** ended, a descending ray rising backwards; or the slope as march) shows
 ** the stretch behind it free (on models, up to a tolerance's gap); else
-** the ray takes the plain step (on models, a tolerance past it). Steps,
+** the ray takes the plain step (on models, a tolerance past it), unless
+** the sample is under the surface and its model proves the ray above it
+** back to that stretch: then the hit is bracketed there (model_back).
+** Steps,
 ** hits, holes and walls are march's. */
 static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
                         double t1, double d0, double delta0,
@@ -432,6 +467,18 @@ static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
       ** before by the tolerance there, rtl: a tolerance step's gap) */
       int ok = model ? h > 0 && model_step(h, g, E, ub, uxy, back) >= back - rtl
                      : h > 0 && (kb <= 0 || prev + rsafe + h / kb >= t);
+      if (!ok && model && tr->refine) {
+        /* under the surface: its model proves the ray above it back
+        ** from s_lo to s_lo2; where that reaches the stretch proved
+        ** before (to its tolerance), the hit is the crossing after s_lo */
+        double w = 1, lo, hi, lo2;
+        if (h <= 0 && solid_weight(tr->s, p, h, &w) &&
+            model_back(h, g, E, u, uxy, back, &lo, &hi, &lo2) &&
+            lesser(lo2, uxy > 0 ? mR / uxy : INFINITY) >= back - rtl) {
+          *thit = model_hit(tr, o, u, t, h, g, lo, hi, d0, n, ga, ga_ok);
+          return 1;
+        }
+      }
       if (!ok) {
         t = prev + rsafe; /* not proved: the plain step */
         /* on models, a tolerance past it (unproved as a tolerance step),
@@ -448,18 +495,12 @@ static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
         *thit = t; /* through a side of the domain or of a hole */
         return 2;
       }
-      double a;
+      double lo, hi, lo2;
       if (tr->refine && model &&
-          model_root(h, g, E, u, uxy,
-                     uxy > 0 ? lesser(t - prev, mR / uxy) : t - prev,
-                     REFINE_STOP * tol(tr, d0, prev), &a)) {
-        /* located on the model: the normal from the gradient there */
-        oc_vec3 q = at(o, u, t - a);
-        double gq[2];
-        (*n)++;
-        src->height(src->ud, q.x, q.y, gq);
-        if (ga) ga[0] = gq[0], ga[1] = gq[1], *ga_ok = 1;
-        *thit = t - a;
+          model_back(h, g, E, u, uxy,
+                     uxy > 0 ? lesser(t - prev, mR / uxy) : t - prev, &lo, &hi,
+                     &lo2)) {
+        *thit = model_hit(tr, o, u, t, h, g, lo, hi, d0, n, ga, ga_ok);
         return 1;
       }
       *thit =

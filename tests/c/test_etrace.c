@@ -363,6 +363,23 @@ START_TEST(relaxed_steps_take_the_tolerance) {
   ck_assert_int_gt(long_steps, 3);
   ck_assert_msg(wide * 2 > long_steps,
                 "%d of %d relaxed steps took the tolerance", wide, long_steps);
+  /* steeply down on a tighter remainder, where a relaxed sample lands
+  ** under the ground: it is the ray's last model query (its model
+  ** brackets the hit: no plain step back) */
+  cf.C = 0.05, cf.n = 0;
+  u = oct_v(1, 0, -1);
+  u = oct_mul(u, 1 / oct_len(u));
+  ck_assert_int_eq(oc_etrace_hit(&tr, o, u, 0, 1e5, 0, 1, NULL, &t, &nrm, &ev),
+                   1);
+  exact = -o.z / u.z;
+  ck_assert_msg(fabs(t - exact) <= eps_k * exact + eps_min, "hit %.6f, %.6f", t,
+                exact);
+  ck_assert_int_gt(cf.n, 2);
+  for (int i = 0; i + 1 < cf.n; i++) {
+    double ti = (cf.x[i] - o.x) / u.x;
+    ck_assert_msg(o.z + ti * u.z > 0, "sample %d of %d under the ground", i,
+                  cf.n);
+  }
 }
 END_TEST
 
