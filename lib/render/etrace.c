@@ -71,9 +71,14 @@
 ** then 8.7, 11.8 and 10.9, 15.0: the backward proof of a model reaches
 ** about as far as the forward one, s, so that 2 s fails); the tolerance
 ** step (proved < tol: proved + tol) up to proved < 1.43 tol 8.0, 11.3
-** instead of the relaxed step's tolerance. */
+** instead of the relaxed step's tolerance. With these, the beams'
+** relaxation and model_back (calls of fig3 and fig22 together at -q):
+** TRELAX 1.5, 1.6, 1.7, 1.8 gave 4512664, 4464520, 4495294, 4692554
+** (fig1, fig19, fig20, fig21 10.25, 4.58, 10.78, 4.01 calls a pixel at
+** 1.6, 10.28, 4.67, 10.77, 4.07 at 1.7); TGROW 1.4, 1.7 4513486,
+** 4504874. */
 #define TGROW 1.5
-#define TRELAX 1.7
+#define TRELAX 1.6
 /* A ray on box steps turns to models where its step is under TSW of the
 ** candidate; on models, it asks the box bound too where the model's step
 ** is under TBOX of the candidate, and goes back to box steps when that

@@ -353,11 +353,11 @@ START_TEST(relaxed_steps_take_the_tolerance) {
     /* the first zero of h - (-u_z) s - C s^2 */
     double root = 2 * h / (-u.z + sqrt(u.z * u.z + 4 * c2 * h));
     double tl = eps_k * tb + eps_min;
-    ck_assert_msg(tb - ta <= 1.7 * root + tl + 1e-9 * tb,
+    ck_assert_msg(tb - ta <= 1.6 * root + tl + 1e-9 * tb,
                   "step %d: %.6f from %.6f, proved %.6f", i, tb - ta, ta, root);
     if (root > 2 * tl && tb > ta) {
       long_steps++;
-      wide += tb - ta > 1.7 * root + 0.5 * tl;
+      wide += tb - ta > 1.6 * root + 0.5 * tl;
     }
   }
   ck_assert_int_gt(long_steps, 3);
