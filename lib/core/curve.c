@@ -787,11 +787,13 @@ double oc_curve_s_at(const oc_pcurve *c, const oc_curve_point *pt) {
   return c_s(c)[pt->piece] + s_of_t(c, &pc, pt->t);
 }
 
-static int closest(const oc_pcurve *c, double x, double y, double r, int with_s,
-                   oc_curve_point *out) {
+/* The closest piece and parameter within r, and its squared distance
+** *d2: 0 when none is within r. */
+static int search(const oc_pcurve *c, double x, double y, double r, piece *bp,
+                  double *bt, double *d2) {
   if (!(r >= 0) || isnan(x) || isnan(y)) return 0;
-  double lim = next_up(r * r), best = lim, bt = 0;
-  piece bp, pc;
+  double lim = next_up(r * r), best = lim;
+  piece pc;
   int found = 0;
   const fbox *bvh = c->bvh;
   /* (each entry keeps its box's distance, computed once: best only
@@ -805,8 +807,8 @@ static int closest(const oc_pcurve *c, double x, double y, double r, int with_s,
     if (e.p.hi - e.p.lo == 1) {
       piece_at(c, e.p.lo, &pc);
       /* (oc_bez_closest first tests whether the piece is out of reach) */
-      double t, d2 = oc_bez_closest(pc.p, pc.deg, x, y, best, &t);
-      if (d2 < best) best = d2, bp = pc, bt = t, found = 1;
+      double t, d = oc_bez_closest(pc.p, pc.deg, x, y, best, &t);
+      if (d < best) best = d, *bp = pc, *bt = t, found = 1;
       continue;
     }
     uint32_t mid = e.p.lo + (e.p.hi - e.p.lo) / 2;
@@ -818,12 +820,39 @@ static int closest(const oc_pcurve *c, double x, double y, double r, int with_s,
     if (far->d2 < best) st[top++] = *far;
     if (near->d2 < best) st[top++] = *near;
   }
-  if (!found) return 0;
-  fill(c, &bp, bt, with_s, out);
+  *d2 = best;
+  return found;
+}
+
+/* out from the search's piece, parameter and squared distance. */
+static void answer(const oc_pcurve *c, const piece *bp, double bt, double d2,
+                   double x, double y, int with_s, oc_curve_point *out) {
+  fill(c, bp, bt, with_s, out);
   double cr = out->tx * (y - out->q.y) - out->ty * (x - out->q.x);
-  double dist = sqrt(best);
+  double dist = sqrt(d2);
   out->d = cr < 0 ? -dist : dist;
+}
+
+static int closest(const oc_pcurve *c, double x, double y, double r, int with_s,
+                   oc_curve_point *out) {
+  piece bp;
+  double bt = 0, d2;
+  if (!search(c, x, y, r, &bp, &bt, &d2)) return 0;
+  answer(c, &bp, bt, d2, x, y, with_s, out);
   return 1;
+}
+
+int oc_curve_closest_within(const oc_pcurve *c, double x, double y, double rin,
+                            double r, oc_curve_point *out, double *d2) {
+  piece bp;
+  double bt = 0;
+  if (!search(c, x, y, r, &bp, &bt, d2)) return 0;
+  /* (a search with rin keeps the boxes and pieces nearer than its limit,
+  ** which hold the minimum when it is below that limit: the same piece
+  ** and parameter) */
+  if (!(*d2 < next_up(rin * rin))) return 1;
+  answer(c, &bp, bt, *d2, x, y, 0, out);
+  return 2;
 }
 
 int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,

@@ -108,6 +108,15 @@ int oc_curve_closest(const oc_pcurve *c, double x, double y, double r,
 int oc_curve_closest_t(const oc_pcurve *c, double x, double y, double r,
                        oc_curve_point *out);
 double oc_curve_s_at(const oc_pcurve *c, const oc_curve_point *pt);
+/* Two radii rin <= r in one search: 0 when no point of the curve lies
+** within r of (x, y); 1 when one does but none within rin (out
+** untouched); 2 when one lies within rin, out then holding the bits
+** oc_curve_closest_t(c, x, y, rin, out) gives. *d2 (when not 0): the
+** squared distance of the closest point found. For a caller that asks
+** both whether the curve comes near a box and its closest point near
+** the box's centre (ecurve.c: an elevation curve's weight in a replace). */
+int oc_curve_closest_within(const oc_pcurve *c, double x, double y, double rin,
+                            double r, oc_curve_point *out, double *d2);
 
 /* Whether some point of the curve lies within r of (x, y) in xy: what
 ** oc_curve_closest returns, without finding the closest point (the

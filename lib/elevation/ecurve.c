@@ -98,20 +98,12 @@ void oc_ecurve_ev_row(const oc_enode *n, const double *x, double y, int cnt,
   }
 }
 
-/* (No scale of a curve is dropped by the level of detail: ft unused.) */
-void oc_ecurve_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
-                  int want, oc_enode_sample *s) {
-  (void)ft;
-  const ecurve *d = OC_EPRIM(n)->data;
-  int grad = want & OC_EV_GRAD, lazy = want & OC_EV_LAZY;
-  oc_curve_point pt;
-  s->ax = s->ay = s->fx = s->fy = 0;
-  if (want & OC_EV_ALPHA) lazy = 1; /* no f: only the nearby curve */
-  /* (the arc length only where profiles are interpolated by it) */
-  if (!oc_curve_closest_t(d->c, x, y, lazy ? d->R : INFINITY, &pt)) {
-    s->a = s->f = 0;
-    return;
-  }
+/* The sample at (x, y) from its closest point pt (oc_ecurve_ev's after
+** its search; lazy when the search was within R). */
+static void sample_at(const ecurve *d, double x, double y, oc_curve_point *pt_,
+                      int want, int lazy, oc_enode_sample *s) {
+  oc_curve_point pt = *pt_;
+  int grad = want & OC_EV_GRAD;
   double ex = x - pt.q.x, ey = y - pt.q.y, dist = hypot(ex, ey);
   /* alpha */
   double w = d->R - d->core, u = fmax(0, dist - d->core) / w;
@@ -162,6 +154,59 @@ void oc_ecurve_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
     s->fx = (gz + dcs) * gsx + dc * pt.nx;
     s->fy = (gz + dcs) * gsy + dc * pt.ny;
   }
+}
+
+/* (No scale of a curve is dropped by the level of detail: ft unused.) */
+void oc_ecurve_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
+                  int want, oc_enode_sample *s) {
+  (void)ft;
+  const ecurve *d = OC_EPRIM(n)->data;
+  int lazy = want & OC_EV_LAZY;
+  oc_curve_point pt;
+  s->ax = s->ay = s->fx = s->fy = 0;
+  if (want & OC_EV_ALPHA) lazy = 1; /* no f: only the nearby curve */
+  /* (the arc length only where profiles are interpolated by it) */
+  if (!oc_curve_closest_t(d->c, x, y, lazy ? d->R : INFINITY, &pt)) {
+    s->a = s->f = 0;
+    return;
+  }
+  sample_at(d, x, y, &pt, want, lazy, s);
+}
+
+/* The bound's test (oc_ecurve_bound_in) and the lazy sample at the box's
+** centre from one closest-point search out to R + rho, rather than the
+** box test's search and then the sample's: the search answers the box
+** test where its distance is clear of R + rho by a margin (1e-7 of it,
+** which dwarfs the roundings of the distances, plus the offset of (x, y)
+** from the box's centre as oc_ecurve_bound_in rounds it); within that
+** margin the box test itself decides (the same answer, so the same
+** bits). */
+int oc_ecurve_weight_in(const oc_enode *n, double x, double y,
+                        const oc_erect *b, oc_ebound *o, oc_enode_sample *s,
+                        int *boxes) {
+  const ecurve *d = OC_EPRIM(n)->data;
+  *o = OC_EPRIM(n)->glob;
+  s->ax = s->ay = s->fx = s->fy = 0;
+  s->a = s->f = 0;
+  if (!oc_erect_meets(&OC_EPRIM(n)->box, b)) {
+    o->alo = o->ahi = o->la = 0;
+    return 0;
+  }
+  /* (oc_ecurve_bound_in's radius, the same bits) */
+  double cx = 0.5 * (b->x0 + b->x1), cy = 0.5 * (b->y0 + b->y1);
+  double rho = 0.5 * oc_norm2_fast(b->x1 - b->x0, b->y1 - b->y0);
+  double r = (d->R + rho) * (1 + 1e-12) + 1e-9;
+  double m = 1e-7 * r + 2 * (fabs(cx - x) + fabs(cy - y));
+  oc_curve_point pt;
+  double d2;
+  int got = oc_curve_closest_within(d->c, x, y, d->R, r + m, &pt, &d2);
+  if (got == 0 || (!(d2 < (r - m) * (r - m)) &&
+                   (++*boxes, !oc_curve_within(d->c, cx, cy, r)))) {
+    o->alo = o->ahi = o->la = 0;
+    return 0;
+  }
+  if (got == 2) sample_at(d, x, y, &pt, OC_EV_LAZY, 1, s);
+  return 1;
 }
 
 void oc_ecurve_bound_in(const oc_enode *n, const oc_erect *b,

@@ -1502,11 +1502,17 @@ static int weight_taylor(const oc_enode *B, double x, double y, double R,
   if (!oc_enode_meets(B, &ball)) return 0;
   if (oc_eop_taylor_partial(B)) {
     oc_enode_sample s;
-    oc_enode_bnd(B, &ball, tf ? &tf->b : NULL, Bb);
-    (*boxes)++;
-    if (!(Bb->ahi > 0)) return 0;
-    /* (lazy: f may be 0 where alpha_B = 0, where w = 0 and psi = 0) */
-    oc_enode_ev(B, x, y, tf ? &tf->p : NULL, OC_EV_LAZY, &s);
+    if (B->kind == OC_E_CURVE) {
+      /* (its box bound and sample from one closest-point search; a
+      ** curve has no level of detail: no footprints) */
+      if (!oc_ecurve_weight_in(B, x, y, &ball, Bb, &s, boxes)) return 0;
+    } else {
+      oc_enode_bnd(B, &ball, tf ? &tf->b : NULL, Bb);
+      (*boxes)++;
+      if (!(Bb->ahi > 0)) return 0;
+      /* (lazy: f may be 0 where alpha_B = 0, where w = 0 and psi = 0) */
+      oc_enode_ev(B, x, y, tf ? &tf->p : NULL, OC_EV_LAZY, &s);
+    }
     b->f = oc_etay_const(s.f);
     b->a = oc_etay_flat(s.a, Bb->la, oc_fmax(Bb->ahi - s.a, s.a - Bb->alo), R);
   } else if (B->kind == OC_E_DISC && !tf) {

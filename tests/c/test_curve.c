@@ -902,6 +902,47 @@ START_TEST(closest_keeps_its_bits) {
 }
 END_TEST
 
+/* Two radii in one search (oc_curve_closest_within): 2 with the bits of
+** oc_curve_closest_t at the inner radius where it finds a point, 1 where
+** only the outer radius holds one, 0 where neither does, on a winding
+** Catmull-Rom road (bench_elev's fig22) and queries all round it. */
+START_TEST(closest_within_answers_both) {
+  oc_error err;
+  oc_vec3 P[16];
+  for (int i = 0; i < 16; i++) {
+    double u = (double)i / 15;
+    P[i] = oct_v(150 * sin(7.85 * u), -260 + 520 * u, 30 + 140 * u);
+  }
+  oc_pcurve *c = oc_curve_catmull(P, 16, &err);
+  ck_assert_ptr_nonnull(c);
+  oct_rng g = oct_rng_new(2207);
+  int seen[3] = {0, 0, 0};
+  for (int i = 0; i < 4000; i++) {
+    double x = oct_unif(&g, -260, 260), y = oct_unif(&g, -330, 330);
+    double rin = oct_unif(&g, 1, 40), r = rin + oct_unif(&g, 0, 60);
+    oc_curve_point ref, got;
+    memset(&ref, 0, sizeof ref), memset(&got, 0, sizeof got); /* (padding) */
+    int in = oc_curve_closest_t(c, x, y, rin, &ref);
+    double d2 = -1;
+    int k = oc_curve_closest_within(c, x, y, rin, r, &got, &d2);
+    ck_assert_int_eq(k == 2, in);
+    ck_assert_int_eq(k >= 1, oc_curve_within(c, x, y, r));
+    if (k == 2) ck_assert(!memcmp(&got, &ref, sizeof got));
+    if (k >= 1) {
+      oc_curve_point all;
+      ck_assert(oc_curve_closest_t(c, x, y, INFINITY, &all));
+      ck_assert(d2 == all.d * all.d ||
+                fabs(sqrt(d2) - fabs(all.d)) <= 1e-12 * (1 + fabs(all.d)));
+      ck_assert(d2 < r * r * (1 + 1e-12));
+    }
+    seen[k]++;
+  }
+  for (int k = 0; k < 3; k++)
+    ck_assert_int_ge(seen[k], 200);
+  oc_curve_free(c);
+}
+END_TEST
+
 int main(void) {
   setvbuf(stdout, NULL, _IOLBF, 0);
   Suite *s = suite_create("curve");
@@ -923,6 +964,7 @@ int main(void) {
   tcase_add_test(tc, catmull_keeps_its_points);
   tcase_add_test(tc, stored_layouts_answer_alike);
   tcase_add_test(tc, closest_keeps_its_bits);
+  tcase_add_test(tc, closest_within_answers_both);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "core/curve.h"
 #include "core/rng.h"
 #include "elevation/enode.h"
 #include "etaycheck.h"
@@ -739,6 +740,86 @@ START_TEST(curve_river_road) {
 }
 END_TEST
 
+/* A replace's weight query of its curve (oc_ecurve_weight_in, the closest
+** point out to R + rho answering the box test and the lazy sample): the
+** bits of oc_ecurve_bound_in and oc_ecurve_ev (OC_EV_LAZY), at random
+** points and at points whose distance to the road is the box test's
+** radius to within 1e-7 (where the box test itself decides); no box
+** query but there. And a replace's model over the road: no box query near
+** it (one per model before). */
+START_TEST(curve_weight_in_one_search) {
+  oc_error err;
+  oc_vec3 P[16];
+  for (int i = 0; i < 16; i++) {
+    double u = (double)i / 15;
+    P[i] = (oc_vec3){150 * sin(7.85 * u), -260 + 520 * u, 30 + 140 * u};
+  }
+  oc_enode_road_params dp = {P, 16, OC_ECURVE_CATMULL, 0, -1, 0};
+  oc_enode *road = EOK(oc_enode_road(&dp, &err));
+  oc_pcurve *sk = oc_ecurve_skeleton(P, 16, OC_ECURVE_CATMULL, &err);
+  ck_assert_ptr_nonnull(sk);
+  double Rc = 3.5 + 1.5 + 12, len = oc_curve_length(sk); /* (the preset's) */
+  oct_rng g = oct_rng_new(2211);
+  int boxes = 0, near = 0, zero = 0, band = 0;
+  for (int i = 0; i < 6000; i++) {
+    double x, y, R = 50 * pow(10, oct_unif(&g, -3, 0));
+    if (i % 2) {
+      x = oct_unif(&g, -200, 200), y = oct_unif(&g, -300, 300);
+    } else {
+      /* on the normal of a point of the skeleton, at the box test's
+      ** radius (R + rho) within a few 1e-8 of it */
+      oc_curve_point q;
+      ck_assert(oc_curve_at(sk, oct_unif(&g, 0.05, 0.95) * len, &q));
+      double rho = R * sqrt(2),
+             d = (Rc + rho) * (1 + 3e-8 * oct_unif(&g, -1, 1));
+      d *= (i / 2) % 2 ? 1 : -1;
+      x = q.q.x + d * q.nx, y = q.q.y + d * q.ny;
+    }
+    oc_erect b = {x - R, y - R, x + R, y + R};
+    oc_ebound ref, got;
+    oc_enode_sample rs, gs;
+    memset(&rs, 0, sizeof rs), memset(&gs, 0, sizeof gs);
+    oc_ecurve_bound_in(road, &b, NULL, &ref);
+    int nb = 0, k = oc_ecurve_weight_in(road, x, y, &b, &got, &gs, &nb);
+    ck_assert(!memcmp(&ref, &got, sizeof ref));
+    ck_assert_int_eq(k, ref.ahi > 0);
+    boxes += nb;
+    band += nb && i % 2 == 0;
+    if (!k) {
+      zero++;
+      continue;
+    }
+    oc_ecurve_ev(road, x, y, NULL, OC_EV_LAZY, &rs);
+    ck_assert_msg(!memcmp(&rs, &gs, sizeof rs), "sample at (%.17g, %.17g)", x,
+                  y);
+    near += gs.a > 0;
+  }
+  ck_assert_int_ge(near, 300);
+  ck_assert_int_ge(zero, 300);
+  ck_assert_int_ge(band, 100); /* the box test decided in the band */
+  ck_assert_int_le(boxes - band, 30);
+  /* a replace over the road: near it the model makes no box query */
+  oc_enode *hill = EOK(oc_enode_disc(
+      &(oc_enode_disc_params){
+          0, 0, 900, 50, {OC_ENOISE_NONE, 0, 1, 1, 0, 0, 0}},
+      &err));
+  oc_enode *rep = EOK(oc_enode_replace(hill, road, 0, &err));
+  oc_curve_point q;
+  ck_assert(oc_curve_at(sk, 0.5 * len, &q));
+  oc_etaylor m;
+  int nb = 0;
+  oc_enode_taylor(rep, q.q.x + 4 * q.nx, q.q.y + 4 * q.ny, 2, &m, &nb);
+  ck_assert_int_eq(nb, 0);
+  oc_enode_sample s;
+  oc_enode_ev(rep, q.q.x + 4 * q.nx, q.q.y + 4 * q.ny, NULL, 0, &s);
+  ck_assert(m.f.v == s.f);
+  oc_curve_free(sk);
+  oc_enode_release(rep);
+  oc_enode_release(hill);
+  oc_enode_release(road);
+}
+END_TEST
+
 START_TEST(bad_input) {
   oc_error err;
   oc_enode_disc_params p = {0, 0, NAN, 0, {OC_ENOISE_NONE, 0, 1, 1, 0, 0, 0}};
@@ -1258,6 +1339,7 @@ int main(void) {
   tcase_add_test(tc, warp_bijective_only);
   tcase_add_test(tc, dag_stats_and_source);
   tcase_add_test(tc, curve_river_road);
+  tcase_add_test(tc, curve_weight_in_one_search);
   tcase_add_test(tc, bad_input);
   tcase_add_test(tc, rows_match_points);
   tcase_add_test(tc, add_altitude_slope_bound);
