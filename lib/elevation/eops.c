@@ -22,6 +22,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+
 #include "core/error.h"
 #include "core/noise.h"
 #include "core/rng.h"
@@ -212,8 +216,21 @@ static inline int disc_meets(const oc_enode *k, const oc_erect *b,
                              const oc_enode **kk) {
   const double *p = OC_EDISC(k)->par;
   *kk = k;
+#ifdef __SSE2__
+  /* the x and y tests in the two lanes of one register: the same
+  ** differences, sums and comparisons, 17 instructions a child where the
+  ** scalar tests took 25 (taylor a call, CPU time on one thread, best of
+  ** 5 interleaved runs of a replay of bench_elev -q's queries: fig3
+  ** 0.425 -> 0.414 us, fig1 0.712 -> 0.704, fig21 0.532 -> 0.523) */
+  __m128d c = _mm_loadu_pd(p), r = _mm_set1_pd(p[2]);
+  __m128d lo = _mm_setr_pd(b->x0, b->y0), hi = _mm_setr_pd(b->x1, b->y1);
+  __m128d m = _mm_and_pd(_mm_cmple_pd(_mm_sub_pd(c, r), hi),
+                         _mm_cmpge_pd(_mm_add_pd(c, r), lo));
+  return _mm_movemask_pd(m) == 3;
+#else
   return (p[0] - p[2] <= b->x1) & (p[0] + p[2] >= b->x0) &
          (p[1] - p[2] <= b->y1) & (p[1] + p[2] >= b->y0);
+#endif
 }
 
 /* The children of a blend of discs alone (OC_EF_DISCS, at most TAY_KIDS

@@ -34,9 +34,17 @@
 ** and the data of curves and images, each shared node or grid once;
 ** `elev.bytes_per_node.<scene>`, the nodes alone per node, and
 ** `elev.bytes_per_node_with_data.<scene>`), no rendering.
+** `bench_elev --replay [-q | -qq] [fig1 ...]`: the cost of a call alone,
+** without the march around it: the first-order model queries (taylor)
+** and box queries (bound) of a one-thread geometry render recorded, then
+** replayed on one thread, each hook's CPU time a call the best of 3
+** passes (`elev.replay_taylor_us.<scene>`, `elev.replay_bound_us`), and
+** hashes of the replayed outputs and of the geometry image (`#` lines:
+** a change that keeps the same bits keeps them).
 */
 #include <math.h>
 #include <omp.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -48,6 +56,8 @@
 static int shrink = 1;
 /* bench_elev --bytes: the trees' memory, no rendering */
 static int bytes_only = 0;
+/* bench_elev --replay: the calls of a render replayed alone */
+static int replay = 0;
 
 static void die(const char *what, const oc_error *err) {
   fprintf(stderr, "bench_elev: %s: %s\n", what, err->msg);
@@ -597,6 +607,127 @@ static void run_scene(const char *name, void (*build)(scene *), int prims,
     oc_enode_release(s.made[i]);
 }
 
+/* ---- bench_elev --replay ---------------------------------------------- */
+
+/* A recorded query: the taylor hook's (x, y, R) or bound's box. */
+typedef struct rquery {
+  double a[4];
+} rquery;
+
+typedef struct rlog {
+  rquery *q;
+  size_t n, cap;
+} rlog;
+
+static rlog rec_taylor, rec_bound;
+
+static void rlog_add(rlog *l, double a, double b, double c, double d) {
+  if (l->n == l->cap) {
+    l->cap = l->cap ? 2 * l->cap : 4096;
+    l->q = realloc(l->q, l->cap * sizeof *l->q);
+    if (!l->q) {
+      fprintf(stderr, "bench_elev: out of memory\n");
+      exit(1);
+    }
+  }
+  l->q[l->n++] = (rquery){{a, b, c, d}};
+}
+
+static double rec_taylor_fn(void *ud, double x, double y, double R, double g[2],
+                            double e[3], int *boxes) {
+  rlog_add(&rec_taylor, x, y, R, 0);
+  return counted_inner->taylor(ud, x, y, R, g, e, boxes);
+}
+
+static void rec_bound_fn(void *ud, double x0, double y0, double x1, double y1,
+                         double *lo, double *hi, double *slope) {
+  rlog_add(&rec_bound, x0, y0, x1, y1);
+  counted_inner->bound(ud, x0, y0, x1, y1, lo, hi, slope);
+}
+
+/* FNV-1a over n bytes, from h. */
+static uint64_t fnv(uint64_t h, const void *p, size_t n) {
+  const unsigned char *c = p;
+  for (size_t i = 0; i < n; i++)
+    h = (h ^ c[i]) * 0x100000001b3ull;
+  return h;
+}
+
+static double thread_secs(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* The queries of l through src's hook (taylor, else bound), 3 passes:
+** the best pass's CPU seconds a call, the first pass's outputs hashed. */
+static double replay_log(const oc_elevation *src, const rlog *l, int taylor,
+                         uint64_t *hash) {
+  double best = INFINITY;
+  *hash = 0xcbf29ce484222325ull;
+  for (int pass = 0; pass < 3; pass++) {
+    double t0 = thread_secs(), sink = 0;
+    for (size_t k = 0; k < l->n; k++) {
+      const double *a = l->q[k].a;
+      double o[7] = {0};
+      if (taylor) {
+        int boxes = 0;
+        o[0] = src->taylor(src->ud, a[0], a[1], a[2], o + 1, o + 3, &boxes);
+        o[6] = boxes;
+      } else {
+        src->bound(src->ud, a[0], a[1], a[2], a[3], o, o + 1, o + 2);
+      }
+      if (!pass) *hash = fnv(*hash, o, sizeof o);
+      sink += o[0];
+    }
+    double t = thread_secs() - t0;
+    if (sink != sink) t += 0; /* (the calls' results used) */
+    if (t < best) best = t;
+  }
+  return l->n ? best / (double)l->n : 0;
+}
+
+static void replay_scene(const char *name, void (*build)(scene *)) {
+  scene s;
+  memset(&s, 0, sizeof s);
+  s.name = name;
+  s.rng = 0x5eed0000u + (uint64_t)strlen(name) * 977;
+  build(&s);
+  oc_error err;
+  oc_elevation src;
+  if (oc_enode_elevation(s.root, NULL, &src, &err)) die(name, &err);
+  oc_render_params rp;
+  params(&s, &rp, 1920 / shrink, 1080 / shrink);
+  oc_elevation rec = src;
+  counted_inner = &src;
+  rec.bound = rec_bound_fn;
+  if (src.taylor) rec.taylor = rec_taylor_fn;
+  oc_esurface es = {&rec, tree_weight, s.root, OC_ENODE_T, src.weight_range};
+  rec_taylor.n = rec_bound.n = 0;
+  omp_set_num_threads(1); /* (the logs in the order of one thread) */
+  oc_image *geo = oc_render_surface_geometry(&es, &rp, &err);
+  omp_set_num_threads(2);
+  if (!geo) die(name, &err);
+  size_t nf = (size_t)oc_image_width(geo) * oc_image_height(geo) * OC_RG_COUNT;
+  uint64_t hg =
+      fnv(0xcbf29ce484222325ull, oc_image_cdata(geo), nf * sizeof(float));
+  oc_image_free(geo);
+  uint64_t ht = 0, hb;
+  double ut = src.taylor ? replay_log(&src, &rec_taylor, 1, &ht) : 0;
+  double ub = replay_log(&src, &rec_bound, 0, &hb);
+  printf("# %s replay at %d x %d: %zu taylor and %zu bound calls of a "
+         "one-thread geometry render\n",
+         name, rp.width, rp.height, rec_taylor.n, rec_bound.n);
+  printf("# %s replay hashes: taylor %016llx bound %016llx geometry %016llx\n",
+         name, (unsigned long long)ht, (unsigned long long)hb,
+         (unsigned long long)hg);
+  printf("elev.replay_taylor_us.%s: %.3f us\n", name, 1e6 * ut);
+  printf("elev.replay_bound_us.%s: %.3f us\n", name, 1e6 * ub);
+  src.release(src.ud);
+  for (int i = 0; i < s.nmade; i++)
+    oc_enode_release(s.made[i]);
+}
+
 int main(int argc, char **argv) {
   omp_set_num_threads(2);
   static const struct {
@@ -607,10 +738,11 @@ int main(int argc, char **argv) {
                 {"fig19", fig19, 15, 3},  {"fig20", fig20, 78, 10},
                 {"fig21", fig21, 50, 25}, {"fig22", fig22, 148, 9}};
   /* bench_elev [scene...]: only those (hf for the heightfield) */
+  if (argc > 1 && !strcmp(argv[1], "--replay")) replay = 1, argc--, argv++;
   if (argc > 1 && !strcmp(argv[1], "-q")) shrink = 4, argc--, argv++;
   if (argc > 1 && !strcmp(argv[1], "-qq")) shrink = 8, argc--, argv++;
   if (argc > 1 && !strcmp(argv[1], "--bytes")) bytes_only = 1, argc--, argv++;
-  int hf = argc < 2 && !bytes_only;
+  int hf = argc < 2 && !bytes_only && !replay;
   for (int a = 1; a < argc; a++)
     hf |= !strcmp(argv[a], "hf");
   if (hf) heightfield_bench();
@@ -618,7 +750,9 @@ int main(int argc, char **argv) {
     int pick = argc < 2;
     for (int a = 1; a < argc; a++)
       pick |= !strcmp(argv[a], scenes[i].name);
-    if (pick)
+    if (pick && replay)
+      replay_scene(scenes[i].name, scenes[i].build);
+    else if (pick)
       run_scene(scenes[i].name, scenes[i].build, scenes[i].prims, scenes[i].ops,
                 i == 0);
   }

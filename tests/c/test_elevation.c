@@ -1260,6 +1260,51 @@ START_TEST(blend_of_discs_fast_path) {
 }
 END_TEST
 
+/* A child's box that touches the model's disc (its box, [x - R, x + R]
+** x [y - R, y + R]) exactly on one side is met, on each of the four
+** sides, by the fast path as by the general walk: the same models, bit
+** for bit; the touching child counts (its weight's model, 0 at p but not
+** on the whole disc, adds its remainder to the sum's), and a hair
+** farther it does not. (Dyadic coordinates: the boxes' sides are exact.) */
+START_TEST(blend_of_discs_touching) {
+  oc_error err;
+  oc_enode *k[2] = {disc(256, 0, 4096, 50, OC_ENOISE_PLAIN, 4, 300, 3),
+                    disc(256, 0, 256, 20, OC_ENOISE_PLAIN, 2, 40, 3)};
+  oc_enode *g = EOK(oc_enode_blend(k, 2, &err));
+  oc_enode *walk = EOK(oc_enode_blend(k, 2, &err));
+  ck_assert(g->flags & OC_EF_DISCS);
+  walk->flags &= (uint8_t)~OC_EF_DISCS;
+  const double R = 16, d = 256 + R;
+  const double at[4][2] = {{256 + d, 0}, {256 - d, 0}, {256, d}, {256, -d}};
+  for (int side = 0; side < 4; side++) {
+    double x = at[side][0], y = at[side][1];
+    oc_etaylor ma, mb, mf;
+    int ba = 0, bb = 0;
+    oc_enode_taylor(g, x, y, R, &ma, &ba);
+    oc_enode_taylor(walk, x, y, R, &mb, &bb);
+    same_taylor(&ma, &mb);
+    ck_assert_int_eq(ba, 0);
+    /* a hair away from the small disc: it no longer meets the box */
+    double fx = side == 0   ? nextafter(x, INFINITY)
+                : side == 1 ? nextafter(x, -INFINITY)
+                            : x;
+    double fy = side == 2   ? nextafter(y, INFINITY)
+                : side == 3 ? nextafter(y, -INFINITY)
+                            : y;
+    oc_enode_taylor(g, fx, fy, R, &mf, &ba);
+    oc_enode_taylor(walk, fx, fy, R, &mb, &bb);
+    same_taylor(&mf, &mb);
+    /* the touching disc's weight remainder, 3 / r^2, in the sum's */
+    ck_assert(ma.a.e2 > mf.a.e2);
+    ck_assert_double_eq_tol(ma.a.e2 - mf.a.e2, 3.0 / (256 * 256), 1e-15);
+  }
+  oc_enode_release(g);
+  oc_enode_release(walk);
+  oc_enode_release(k[0]);
+  oc_enode_release(k[1]);
+}
+END_TEST
+
 /* A disc's weight model decides "alpha is 0 on the whole disc" and "the
 ** model is flat" from the squares and from an upper bound of the
 ** gradient's norm where those are clear of the thresholds: the same
@@ -1346,6 +1391,7 @@ int main(void) {
   tcase_add_test(tc, taylor_models);
   tcase_add_test(tc, blend_grid_matches_flat);
   tcase_add_test(tc, blend_of_discs_fast_path);
+  tcase_add_test(tc, blend_of_discs_touching);
   tcase_add_test(tc, disc_alpha_model_decisions);
   suite_add_tcase(s, tc);
   return oct_run(s);
