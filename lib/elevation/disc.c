@@ -314,13 +314,9 @@ static int noise_taylor_lod(const oc_enoise *nz, double u, double v, double R,
     ** rounding up to it; ceil and floor by comparisons and truncation:
     ** without SSE4.1 each was a libm-like sequence of ~15 instructions
     ** per disc, callgrind) */
-    if (!(thi > 0)) /* (NaN too) */
-      cnt = 0;
-    else if (thi > nz->octaves - 1)
-      cnt = nz->octaves;
-    else
-      cnt = (int)thi + (thi > (int)thi);                   /* ceil */
-    whole = !(tlo >= 1) ? 0 : tlo >= cnt ? cnt : (int)tlo; /* floor */
+    double c = ceil(thi), w = floor(tlo);
+    cnt = c >= nz->octaves ? nz->octaves : c > 0 ? (int)c : 0;
+    whole = w >= cnt ? cnt : w > 0 ? (int)w : 0;
   } else {
     while (cnt < nz->octaves && thi - cnt * dt > 0)
       cnt++;
