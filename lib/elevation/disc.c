@@ -311,9 +311,7 @@ static int noise_taylor_lod(const oc_enoise *nz, double u, double v, double R,
     /* (the loops' tests without the loops: for integers i, thi - i > 0
     ** exactly when i < thi, and tlo - i >= 1 when i + 1 <= tlo, the
     ** differences rounding monotonically and none of those below 1
-    ** rounding up to it; ceil and floor by comparisons and truncation:
-    ** without SSE4.1 each was a libm-like sequence of ~15 instructions
-    ** per disc, callgrind) */
+    ** rounding up to it) */
     double c = ceil(thi), w = floor(tlo);
     cnt = c >= nz->octaves ? nz->octaves : c > 0 ? (int)c : 0;
     whole = w >= cnt ? cnt : w > 0 ? (int)w : 0;
