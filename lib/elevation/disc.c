@@ -332,11 +332,18 @@ static int noise_taylor_lod(const oc_enoise *nz, double u, double v, double R,
     oc_etay ti = tau, T;
     ti.v = tau.v - i * dt;
     double bw = oc_elod_b(ti.v, &db);
-    double term =
-        octave_term(nz, i, 2 * ev[i] - 1, g, q.s, R, &q.prev, &q.tprev, &T);
+    double e = 2 * ev[i] - 1, term;
+    if (nz->kind != OC_ENOISE_RIDGED) { /* (octave_term's, inline) */
+      int turb = nz->kind == OC_ENOISE_TURBULENCE;
+      T = octave_model(e, g, q.s, R, turb);
+      term = turb ? fabs(e) : e;
+    } else {
+      term = octave_term(nz, i, e, g, q.s, R, &q.prev, &q.tprev, &T);
+    }
     live = live && bw != 0;
     if (live) q.sum += q.a * bw * term;
-    oc_etay bm = oc_elod_b_taylor(&ti, tlo - i * dt, thi - i * dt, R);
+    oc_etay bm =
+        oc_elod_b_taylor_at(&ti, bw, db, tlo - i * dt, thi - i * dt, R);
     oc_etay at = oc_etay_mul(&bm, &T, R);
     at = oc_etay_scale(&at, q.a);
     oc_etay_add(&q.m, &at);

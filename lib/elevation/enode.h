@@ -436,7 +436,17 @@ void oc_enode_taylor(const oc_enode *n, double x, double y, double R,
 typedef struct oc_etfoot {
   oc_efoot p;
   oc_efootb b;
+  /* The parts of tau = log2(w / foot)'s model (oc_elod_tau_taylor) that
+  ** do not depend on w, for the disc of radius R (oc_etfoot_prep; R NaN:
+  ** none): every disc under a node shares them, and they cost five
+  ** divisions a disc (oc_elod_tau_taylor took 2.5 % of bench_elev_lod's
+  ** LoD primary rays, perf). */
+  double R, tc, dlo, dhi, e2;
+  int curved;
 } oc_etfoot;
+/* Fills tf's shared parts of tau's model for the disc of radius R (tf->p
+** and tf->b set). */
+void oc_etfoot_prep(oc_etfoot *tf, double R);
 /* oc_enode_taylor under a view (tf NULL: full detail, oc_enode_taylor):
 ** f and alpha at (x, y) are the bits oc_enode_ev gives with the footprint
 ** tf->p. Discs (continuous LoD), lod operators and the operators with
@@ -517,6 +527,36 @@ static inline double oc_elod_b(double t, double *db) {
   return 1 - q * q * q;
 }
 
+/* The largest |b''| on [lo, hi]: b'' = 6 (1 - t^2) (1 - 5 t^2) on (0, 1),
+** 0 outside; |b''| falls from 6 at 0 to 0 at 1 / sqrt 5, rises to 4.8 at
+** sqrt(3/5) and falls to 0 at 1. */
+static inline double oc_elod_bpp_max(double lo, double hi) {
+  lo = oc_fmin(oc_fmax(lo, 0), 1), hi = oc_fmin(oc_fmax(hi, 0), 1);
+  double ql = lo * lo, qh = hi * hi;
+  double m = oc_fmax(fabs(6 * (1 - ql) * (1 - 5 * ql)),
+                     fabs(6 * (1 - qh) * (1 - 5 * qh)));
+  if (lo <= 0.7745966692414834 && hi >= 0.7745966692414834) m = oc_fmax(m, 4.8);
+  return m * (1 + 1e-12);
+}
+
+/* oc_elod_b_taylor (lod.c: b composed with t's model by the chain rule,
+** or the flat gap to b's far end where less) with bv and db =
+** oc_elod_b(t->v): inline for the discs' filtered octaves, whose filter
+** value they have already computed (one call and two b's fewer per
+** ramping octave: the same bits). */
+static inline oc_etay oc_elod_b_taylor_at(const oc_etay *t, double bv,
+                                          double db, double lo, double hi,
+                                          double R) {
+  double d;
+  if (hi <= 0 || lo >= 1) return oc_etay_const(bv);
+  oc_etay m = oc_etay_compose(t, bv, db, oc_elod_bpp_max(lo, hi), R);
+  /* b is non-decreasing: it stays in [b(lo), b(hi)] (the gap to the far
+  ** end, flat, where that is less) */
+  double gap = oc_fmax(bv - oc_elod_b(lo, &d), oc_elod_b(hi, &d) - bv);
+  if (oc_etay_rem(&m, R) > gap) m = (oc_etay){bv, 0, 0, gap, 0, 0};
+  return m;
+}
+
 /* For a detail of wavelength w under footprints in fb: the range of
 ** kappa = b(log2(w / foot)) and its Lipschitz bound. */
 void oc_elod_kappa_bound(double w, const oc_efootb *fb, double *lo, double *hi,
@@ -542,7 +582,9 @@ void oc_elod_bound_in(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
 ** p: its model (value log2(w / tf->p.v), as evaluation computes it) and
 ** its range [*lo, *hi] on the disc |q - p| <= R; returns 0 when the
 ** footprint may reach 0 there (no bound of tau's curvature: m's
-** remainder is then left 0 and must not be used). */
+** remainder is then left 0 and must not be used). The parts that do not
+** depend on w come from tf when it was prepared for R (oc_etfoot_prep),
+** else are made afresh: the same bits either way. */
 int oc_elod_tau_taylor(double w, const oc_etfoot *tf, double R, oc_etay *m,
                        double *lo, double *hi);
 /* b(t) for the model t of an argument whose range on the disc is [lo,

@@ -1647,6 +1647,7 @@ static int xform_taylor(const oc_enode *n, double x, double y, double R,
   if (tf) {
     xform_foot(n, m, &tf->p, &cf.p);
     xform_footb(n, &tf->b, &cf.b);
+    oc_etfoot_prep(&cf, R * is * (1 + 1e-12));
   }
   oc_enode_taylor_view(OC_EUN(n)->kid, m[0] * u + m[1] * v, m[2] * u + m[3] * v,
                        R * is * (1 + 1e-12), tf ? &cf : NULL, &c, boxes);

@@ -256,54 +256,46 @@ void oc_elod_derive(const oc_enode *n, const oc_ebound *kb,
 ** (b' = 6 t (1 - t^2)^2 vanishes at both ends) with b'' = 6 (1 - t^2)
 ** (1 - 5 t^2) on (0, 1) and 0 outside, so b(t(q)) composes by the
 ** chain rule of etaylor.h (oc_etay_compose) with M the largest |b''| on
-** t's range: |b''| falls from 6 at 0 to 0 at 1 / sqrt 5, then rises to
-** 4.8 at sqrt(3/5) and falls to 0 at 1. */
+** t's range (oc_elod_bpp_max, enode.h): |b''| falls from 6 at 0 to 0
+** at 1 / sqrt 5, then rises to 4.8 at sqrt(3/5) and falls to 0 at 1. */
 
-#define SQRT35 0.7745966692414834 /* sqrt(3/5): b'' is -4.8 there */
-
-/* |b''(t)| for t in [0, 1] */
-static double bpp_abs(double t) {
-  double q = t * t;
-  return fabs(6 * (1 - q) * (1 - 5 * q));
-}
-
-/* The largest |b''| on [lo, hi] (b'' is 0 outside [0, 1], 6 next to 0). */
-static double bpp_max(double lo, double hi) {
-  lo = oc_fmin(oc_fmax(lo, 0), 1), hi = oc_fmin(oc_fmax(hi, 0), 1);
-  double m = oc_fmax(bpp_abs(lo), bpp_abs(hi));
-  if (lo <= SQRT35 && hi >= SQRT35) m = oc_fmax(m, 4.8);
-  return m * (1 + 1e-12);
-}
-
-int oc_elod_tau_taylor(double w, const oc_etfoot *tf, double R, oc_etay *m,
-                       double *lo, double *hi) {
+void oc_etfoot_prep(oc_etfoot *tf, double R) {
   const oc_efoot *ft = &tf->p;
   double k = tf->b.k, kr = k * R * (1 + 1e-12);
   double flo = oc_fmax(tf->b.lo, ft->v - kr),
          fhi = oc_fmin(tf->b.hi, ft->v + kr);
-  double c = -1 / (ft->v * LN2); /* (as the discs' evaluation) */
-  *m = (oc_etay){log2(w / ft->v), c * ft->gx, c * ft->gy, 0, 0, 0};
+  tf->R = R;
+  tf->tc = -1 / (ft->v * LN2); /* (as the discs' evaluation) */
   /* tau's range without a log2 each: log2(w / fhi) = tau(p) - log2(fhi /
   ** foot(p)) and ln(1 + x) <= x; log2(w / flo) = tau(p) - log2(flo /
-  ** foot(p)) and -ln y <= 1 / y - 1; padded against rounding */
-  double pad = 1e-12 * (1 + fabs(m->v));
-  *lo = m->v - (oc_fmax(fhi, ft->v) / ft->v - 1) / LN2 - pad;
-  *hi =
-      flo > 0 ? m->v + (ft->v / oc_fmin(flo, ft->v) - 1) / LN2 + pad : INFINITY;
-  if (!(flo > 0)) return 0;
-  m->e2 = 0.5 * k * k / (LN2 * flo * flo) * (1 + 1e-12);
+  ** foot(p)) and -ln y <= 1 / y - 1 */
+  tf->dlo = (oc_fmax(fhi, ft->v) / ft->v - 1) / LN2;
+  tf->curved = flo > 0;
+  tf->dhi = tf->curved ? (ft->v / oc_fmin(flo, ft->v) - 1) / LN2 : INFINITY;
+  tf->e2 = tf->curved ? 0.5 * k * k / (LN2 * flo * flo) * (1 + 1e-12) : 0;
+}
+
+int oc_elod_tau_taylor(double w, const oc_etfoot *tf, double R, oc_etay *m,
+                       double *lo, double *hi) {
+  oc_etfoot own;
+  if (!(tf->R == R)) { /* (not prepared for this disc) */
+    own = *tf;
+    oc_etfoot_prep(&own, R);
+    tf = &own;
+  }
+  double v = log2(w / tf->p.v);
+  *m = (oc_etay){v, tf->tc * tf->p.gx, tf->tc * tf->p.gy, 0, 0, 0};
+  double pad = 1e-12 * (1 + fabs(v)); /* (against rounding) */
+  *lo = v - tf->dlo - pad;
+  *hi = tf->curved ? v + tf->dhi + pad : INFINITY;
+  if (!tf->curved) return 0;
+  m->e2 = tf->e2;
   return 1;
 }
 
 oc_etay oc_elod_b_taylor(const oc_etay *t, double lo, double hi, double R) {
-  double db, bv = oc_elod_b(t->v, &db), d;
-  if (hi <= 0 || lo >= 1) return oc_etay_const(bv);
-  oc_etay m = oc_etay_compose(t, bv, db, bpp_max(lo, hi), R);
-  /* b is non-decreasing: it stays in [b(lo), b(hi)] (the gap to the far
-  ** end, flat, where that is less) */
-  double gap = oc_fmax(bv - oc_elod_b(lo, &d), oc_elod_b(hi, &d) - bv);
-  if (oc_etay_rem(&m, R) > gap) m = (oc_etay){bv, 0, 0, gap, 0, 0};
-  return m;
+  double db, bv = oc_elod_b(t->v, &db);
+  return oc_elod_b_taylor_at(t, bv, db, lo, hi, R);
 }
 
 /* g + t (h - g) for models g, h of the two children and t's: the
@@ -463,6 +455,7 @@ static double vsrc_taylor(void *ud, double x, double y, double R, double g[2],
   oc_erect r = {x - R, y - R, x + R, y + R};
   oc_eview_foot(&q->v, x, y, &tf.p);
   oc_eview_footb(&q->v, &r, &tf.b);
+  if (tf.p.v > 0) oc_etfoot_prep(&tf, R);
   return oc_enode_taylor_src(q->e, x, y, R, tf.p.v > 0 ? &tf : NULL, g, e,
                              boxes);
 }

@@ -507,9 +507,23 @@ static void check_view_taylor(const oc_enode *e, const oc_enode_view *v,
     oc_erect box = {x - R, y - R, x + R, y + R};
     oc_eview_foot(&w, x, y, &tf.p);
     oc_eview_footb(&w, &box, &tf.b);
+    if (tf.p.v > 0) oc_etfoot_prep(&tf, R);
     oc_etaylor m;
     int boxes = 0;
     oc_enode_taylor_view(e, x, y, R, tf.p.v > 0 ? &tf : NULL, &m, &boxes);
+    if (tf.p.v > 0) {
+      /* tau's shared parts prepared for another disc (here or under a
+      ** transform: R is not the disc's) are made afresh: the same bits */
+      oc_etfoot other = tf;
+      oc_etfoot_prep(&other, 2 * R);
+      oc_etaylor m2;
+      int boxes2 = 0;
+      oc_enode_taylor_view(e, x, y, R, &other, &m2, &boxes2);
+      ck_assert_msg(!memcmp(&m, &m2, sizeof m) && boxes == boxes2,
+                    "%s at (%g, %g): the model with tau's parts prepared "
+                    "for 2R differs",
+                    oc_enode_kind(e), x, y);
+    }
     oc_enode_sample s, sa;
     oc_enode_ev(e, x, y, &tf.p, 0, &s);
     oc_enode_ev(e, x, y, &tf.p, OC_EV_ALPHA, &sa);
