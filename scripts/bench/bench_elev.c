@@ -40,7 +40,10 @@
 ** replayed on one thread, each hook's CPU time a call the best of 3
 ** passes (`elev.replay_taylor_us.<scene>`, `elev.replay_bound_us`), and
 ** hashes of the replayed outputs and of the geometry image (`#` lines:
-** a change that keeps the same bits keeps them).
+** a change that keeps the same bits keeps them). Instructions a call:
+**   valgrind --tool=callgrind --toggle-collect='replay_log*' \
+**       build/release/bench/bench_elev --replay -qq fig22
+** (callgrind runs the noise's scalar path, not its AVX-512 one).
 */
 #include <math.h>
 #include <omp.h>
