@@ -319,6 +319,14 @@ static double flat_taylor(void *ud, double x, double y, double R, double g[2],
   return 0;
 }
 
+/* z = 0 over a 4 km square, its models' remainder cf's */
+static oc_elevation curved_flat_source(curved_flat *cf) {
+  oc_elevation src = {flat_h, flat_range, flat_slope,  NULL, NULL, cf,
+                      -2000,  -2000,      2000,        2000, NULL, NULL,
+                      NULL,   NULL,       flat_taylor, NULL};
+  return src;
+}
+
 /* A relaxed model step goes a tolerance past TRELAX times the proved one
 ** (the tolerance a step may leave unproved), and never further: every
 ** step is at most TRELAX times the first zero of the model's bound plus
@@ -327,9 +335,7 @@ static double flat_taylor(void *ud, double x, double y, double R, double g[2],
 START_TEST(relaxed_steps_take_the_tolerance) {
   /* (the ray starts inside the domain's box) */
   curved_flat cf = {1e-3, 50, 0, {0}};
-  oc_elevation src = {flat_h, flat_range, flat_slope,  NULL, NULL, &cf,
-                      -2000,  -2000,      2000,        2000, NULL, NULL,
-                      NULL,   NULL,       flat_taylor, NULL};
+  oc_elevation src = curved_flat_source(&cf);
   oc_esurface es = {&src, NULL, NULL, 0.5, NULL};
   double eps_k = 1e-3, eps_min = 1e-6;
   oc_etracer tr;
@@ -390,9 +396,7 @@ END_TEST
 START_TEST(beam_steps_relaxed) {
   /* (the beam strides on the ranges down to z = 5, then on models) */
   curved_flat cf = {1e-3, 5, 0, {0}};
-  oc_elevation src = {flat_h, flat_range, flat_slope,  NULL, NULL, &cf,
-                      -2000,  -2000,      2000,        2000, NULL, NULL,
-                      NULL,   NULL,       flat_taylor, NULL};
+  oc_elevation src = curved_flat_source(&cf);
   oc_esurface es = {&src, NULL, NULL, 0.5, NULL};
   oc_etracer tr;
   oc_etracer_init(&tr, &es, OC_TRACE_SEGMENT, 1e-4, 1e-6);
