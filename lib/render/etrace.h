@@ -80,9 +80,10 @@ typedef struct oc_ebeam {
 ** *evals. INFINITY when every ray leaves the domain, or passes depth
 ** dmax, unhit. *bounds (when not NULL) counts the range queries. *next
 ** (when not NULL): on entry a candidate step (in depth) to begin with, 0
-** for the default (a part of a beam passes its beam's); on return the
-** candidate for the rays' march on models from there, 0 when the beam
-** made no model step. *m (when not NULL): on entry a model the beam's
+** for the default (a part of a beam passes its beam's: with a model in
+** *m, the part turns to models where its first range query fails); on
+** return the candidate for the rays' march on models from there, 0 when
+** the beam made no model step. *m (when not NULL): on entry a model the beam's
 ** first step on models may take without a call (its enclosing beam's
 ** last), on return the last model the beam queried (unchanged when it
 ** queried none). */
