@@ -5,11 +5,14 @@
 ** before anything is allocated, so an absurd resolution coming from a
 ** script is an error message, never an exhausted machine.
 */
+#define _DEFAULT_SOURCE /* madvise */
 #include <ctype.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/mman.h>
 
 #include "core/error.h"
 #include "core/kvlist.h"
@@ -23,6 +26,25 @@
 #define MAX_KEY 79                /* PNG's limit for text chunk keywords */
 #define MAX_VALUE 65535
 #define MAX_META 1024
+
+/* Pixels of an image this large go on huge pages where the system has
+** them (2 MiB, asked for): a render writes its images' pixels once each,
+** and the first write to every 4 KiB page faulted. Measured (a 1920 x
+** 1080 x 9 geometry image, 75 MB, written once): 200 to 270 ms of CPU on
+** 4 KiB pages, 14 to 60 ms on huge ones (the faults of bench_elev fig3's
+** geometry 18329 to 455). */
+#define HUGE_BYTES (4u << 20)
+#define HUGE_PAGE ((uintptr_t)2 << 20)
+
+static void advise_huge(void *p, size_t bytes) {
+#ifdef MADV_HUGEPAGE
+  uintptr_t a = ((uintptr_t)p + HUGE_PAGE - 1) & ~(HUGE_PAGE - 1);
+  uintptr_t b = ((uintptr_t)p + bytes) & ~(HUGE_PAGE - 1);
+  if (bytes >= HUGE_BYTES && b > a) madvise((void *)a, b - a, MADV_HUGEPAGE);
+#else
+  (void)p, (void)bytes;
+#endif
+}
 
 struct oc_image {
   int width, height, channels;
@@ -61,6 +83,7 @@ oc_image *oc_image_new(int width, int height, int channels, oc_error *err) {
   oc_image *img = calloc(1, sizeof *img);
   if (img) {
     img->data = calloc((size_t)n, sizeof(float));
+    if (img->data) advise_huge(img->data, (size_t)bytes);
     img->names = calloc((size_t)channels, sizeof *img->names);
   }
   if (!img || !img->data || !img->names) {

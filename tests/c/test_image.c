@@ -165,6 +165,49 @@ START_TEST(new_and_free) {
 }
 END_TEST
 
+/* The kB of huge pages in the mapping of /proc/self/smaps holding p; -1
+** when the system has no transparent huge pages to give (or no smaps). */
+static long huge_kb_at(const void *p) {
+  FILE *t = fopen("/sys/kernel/mm/transparent_hugepage/enabled", "r");
+  char mode[128] = "";
+  if (!t) return -1;
+  if (!fgets(mode, sizeof mode, t)) mode[0] = '\0';
+  fclose(t);
+  if (strstr(mode, "[never]") || !strstr(mode, "[")) return -1;
+  FILE *f = fopen("/proc/self/smaps", "r");
+  if (!f) return -1;
+  char line[512];
+  int in = 0;
+  long kb = -1;
+  unsigned long a = (unsigned long)p;
+  while (fgets(line, sizeof line, f)) {
+    unsigned long lo, hi;
+    if (sscanf(line, "%lx-%lx ", &lo, &hi) == 2)
+      in = a >= lo && a < hi;
+    else if (in && sscanf(line, "AnonHugePages: %ld kB", &kb) == 1)
+      break;
+  }
+  fclose(f);
+  return kb;
+}
+
+/* A large image's pixels are asked for on huge pages (image.c
+** HUGE_BYTES): written once over, they are, where the system gives
+** them; and zeroed as any image's. */
+START_TEST(large_on_huge_pages) {
+  oc_image *img = oc_image_new(1024, 1024, 4, NULL); /* 16 MiB */
+  ck_assert_ptr_nonnull(img);
+  float *d = oc_image_data(img);
+  for (size_t k = 0; k < (size_t)1024 * 1024 * 4; k += 1024) {
+    ck_assert_float_eq(d[k], 0.0f);
+    d[k] = 1.0f;
+  }
+  long kb = huge_kb_at(d + 2 * 1024 * 1024);
+  if (kb >= 0) ck_assert_msg(kb >= 2048, "%ld kB on huge pages", kb);
+  oc_image_free(img);
+}
+END_TEST
+
 static void new_einval(int w, int h, int c, const char *param) {
   oc_error e = {0};
   oc_image *img = oc_image_new(w, h, c, &e);
@@ -698,6 +741,7 @@ static Suite *suite(void) {
   Suite *s = suite_create("image");
   TCase *t = tcase_create("buffers");
   tcase_add_test(t, new_and_free);
+  tcase_add_test(t, large_on_huge_pages);
   tcase_add_test(t, size_limits);
   tcase_add_test(t, absurd_sizes);
   tcase_add_test(t, channel_names);
