@@ -91,9 +91,17 @@
 ** instructions, 0.9 with 0.25 3.64 and 1.53, 0.9 with 0.1 3.44 and 1.51
 ** (the box queries cost fig3 more than the calls they save). A ray's
 ** relaxations are not limited (before the box steps, one failure a ray
-** took fig3 to 15.2 calls and fig21 to 8.1). */
+** took fig3 to 15.2 calls and fig21 to 8.1). Since the beams' parts go
+** on on models (oc_etrace_beam), at 1920 x 1080 (a pixel: calls, range
+** queries; the replayed costs of both, us: fig3 0.42, 0.30; fig21 0.56,
+** 0.37; fig22 0.84, 0.73; fig1 0.76, 0.66) TBOX 0.1, 0.01, 0 gave fig3
+** 4.66, 0.55; 4.66, 0.37; 4.66, 0.35; fig21 4.72, 1.25; 4.71, 0.96;
+** 4.86, 0.37; fig22 6.65, 0.61; 6.65, 0.33; 6.65, 0.29; and 0.1, 0 fig1
+** 6.04, 0.59; 6.04, 0.33 (at -q fig19 and fig20 too the least cost at
+** 0.01 or 0). 0.01 keeps the box for models that collapse (a step of 1 %
+** of its candidate), where at 0 a ray crawls on them. */
 #define TSW 0.9
-#define TBOX 0.1
+#define TBOX 0.01
 /* A beam on models (beam_models) starts from where its ranges stopped
 ** with a candidate of BEAM_STEP times its width there, and stops where
 ** its step falls under BSTOP times that width (its parts, or its rays,
@@ -420,20 +428,20 @@ static double model_hit(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
 ** model_step proves over a candidate segment TGROW times the last step),
 ** or a height call and the candidate's box bound (march's step, RELAX and
 ** GROW). A ray starts on box steps (cheap while it is high above the
-** terrain) and turns to models where a box step is short (under TBOX of
+** terrain) and turns to models where a box step is short (under TSW of
 ** its candidate: a slope limits it, the model's is Newton-like there);
-** where a model step is that short, the box bound is asked too and the
-** longer step taken, and when the box's wins the ray goes back to box
-** steps (the model is poor there: octaves folded by |eta|, whose sign
-** the model cannot prove). A relaxed step's sample is kept only when its
-** own proof (the model over a disc reaching back to where the last proof
-** ended, a descending ray rising backwards; or the slope as march) shows
-** the stretch behind it free (on models, up to a tolerance's gap); else
-** the ray takes the plain step (on models, a tolerance past it), unless
-** the sample is under the surface and its model proves the ray above it
-** back to that stretch: then the hit is bracketed there (model_back).
-** Steps,
-** hits, holes and walls are march's. */
+** where a model step is under TBOX of its candidate (collapsed there),
+** the box bound is asked too and the longer step taken, and when the
+** box's wins the ray goes back to box steps (the model is poor there:
+** octaves folded by |eta|, whose sign the model cannot prove). A
+** relaxed step's sample is kept only when its own proof (the model over
+** a disc reaching back to where the last proof ended, a descending ray
+** rising backwards; or the slope as march) shows the stretch behind it
+** free (on models, up to a tolerance's gap); else the ray takes the plain
+** step (on models, a tolerance past it), unless the sample is under the
+** surface and its model proves the ray above it back to that stretch:
+** then the hit is bracketed there (model_back). Steps, hits, holes and
+** walls are march's. */
 static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
                         double t1, double d0, double delta0,
                         const oc_emodel *m0, double *thit, double *n,

@@ -327,6 +327,63 @@ static oc_elevation curved_flat_source(curved_flat *cf) {
   return src;
 }
 
+/* Flat ground z = 0 whose models have no linear part and a slope a (a
+** remainder a r), its range queries counted. */
+typedef struct rough_flat {
+  double a;
+  int ranges;
+} rough_flat;
+
+static void rough_range(void *ud, double x0, double y0, double x1, double y1,
+                        double *lo, double *hi) {
+  (void)x0, (void)y0, (void)x1, (void)y1;
+  ((rough_flat *)ud)->ranges++;
+  *lo = 0, *hi = 50; /* loose */
+}
+
+static double rough_taylor(void *ud, double x, double y, double R, double g[2],
+                           double e[3], int *boxes) {
+  (void)x, (void)y, (void)R, (void)boxes;
+  g[0] = g[1] = 0;
+  e[0] = e[2] = 0, e[1] = ((rough_flat *)ud)->a;
+  return 0;
+}
+
+/* A ray on models asks the box bound only where a model's step is under
+** TBOX (1 %) of its candidate (the model is poor there, the box may stride
+** on): from a first step of about 9 % of its candidate (models of slope
+** 1) the ray makes no range query (3 at TBOX 0.1); from one of 0.5 %
+** (slope 20) it does (none at TBOX 0); both hit z = 0 where the ray
+** does. */
+START_TEST(models_ask_boxes_only_when_poor) {
+  for (int k = 0; k < 2; k++) {
+    rough_flat rf = {k ? 20 : 1, 0};
+    oc_elevation src = {flat_h, rough_range, flat_slope,   NULL, NULL, &rf,
+                        -2000,  -2000,       2000,         2000, NULL, NULL,
+                        NULL,   NULL,        rough_taylor, NULL};
+    oc_esurface es = {&src, NULL, NULL, 0.5, NULL};
+    oc_etracer tr;
+    oc_etracer_init(&tr, &es, OC_TRACE_SEGMENT, 1e-4, 1e-6);
+    rf.ranges = 0;
+    oc_vec3 o = oct_v(0, 0, 10), u = oct_v(1, 0, -0.1), n;
+    u = oct_mul(u, 1 / oct_len(u));
+    double t, ev = 0, exact = -o.z / u.z;
+    /* (starting on models, a candidate of 100 m: the first step 9.1 and
+    ** 0.50 m) */
+    ck_assert_int_eq(
+        oc_etrace_hit(&tr, o, u, 0, 1e4, 0, 100, NULL, &t, &n, &ev), 1);
+    ck_assert_msg(fabs(t - exact) <= 1e-4 * exact + 1e-6, "hit %.6f, %.6f", t,
+                  exact);
+    if (k)
+      ck_assert_msg(rf.ranges > 0, "a %g: %d ranges, %g calls", rf.a, rf.ranges,
+                    ev);
+    else
+      ck_assert_msg(rf.ranges == 0, "a %g: %d ranges, %g calls", rf.a,
+                    rf.ranges, ev);
+  }
+}
+END_TEST
+
 /* A relaxed model step goes a tolerance past TRELAX times the proved one
 ** (the tolerance a step may leave unproved), and never further: every
 ** step is at most TRELAX times the first zero of the model's bound plus
@@ -1043,6 +1100,7 @@ static Suite *suite(void) {
   tcase_add_test(t, tree_models_against_march);
   tcase_add_test(t, hits_located);
   tcase_add_test(t, relaxed_steps_take_the_tolerance);
+  tcase_add_test(t, models_ask_boxes_only_when_poor);
   tcase_add_test(t, beam_steps_relaxed);
   tcase_add_test(t, weight_makes_holes);
   tcase_add_test(t, holes_crossed_on_weight_bound);
