@@ -37,6 +37,7 @@ typedef struct ecurve {
   double *at; /* arc lengths of the profiles, increasing */
   oc_profile **prof;
   double R, core;
+  double clo, chi; /* the profiles' range of c */
 } ecurve;
 
 void oc_ecurve_free(void *data) {
@@ -181,6 +182,20 @@ void oc_ecurve_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
 ** from the box's centre as oc_ecurve_bound_in rounds it); within that
 ** margin the box test itself decides (the same answer, so the same
 ** bits). */
+/* f's range where alpha > 0 in a box: q within R of a point of the box,
+** so within r = R + rho of its centre (cx, cy), its z that of the pieces
+** near there (oc_curve_z_near) rather than the whole curve's (a road
+** climbing 140 m has pieces rising 10: the replace's model over the
+** road, psi_flat, is Lipschitz in |f_B - f_A| over the box). o holds the
+** bound over the plane, tightened. */
+static void local_f(const ecurve *d, double cx, double cy, double r,
+                    oc_ebound *o) {
+  double zlo, zhi;
+  if (!oc_curve_z_near(d->c, cx, cy, r, &zlo, &zhi)) return;
+  o->flo = fmax(o->flo, zlo + d->clo);
+  o->fhi = fmin(o->fhi, zhi + d->chi);
+}
+
 int oc_ecurve_weight_in(const oc_enode *n, double x, double y,
                         const oc_erect *b, oc_ebound *o, oc_enode_sample *s,
                         int *boxes) {
@@ -206,6 +221,7 @@ int oc_ecurve_weight_in(const oc_enode *n, double x, double y,
     return 0;
   }
   if (got == 2) sample_at(d, x, y, &pt, OC_EV_LAZY, 1, s);
+  local_f(d, cx, cy, r, o);
   return 1;
 }
 
@@ -224,7 +240,10 @@ void oc_ecurve_bound_in(const oc_enode *n, const oc_erect *b,
   double cx = 0.5 * (b->x0 + b->x1), cy = 0.5 * (b->y0 + b->y1);
   double rho = 0.5 * oc_norm2_fast(b->x1 - b->x0, b->y1 - b->y0);
   double r = (d->R + rho) * (1 + 1e-12) + 1e-9;
-  if (!oc_curve_within(d->c, cx, cy, r)) o->alo = o->ahi = o->la = 0;
+  if (!oc_curve_within(d->c, cx, cy, r))
+    o->alo = o->ahi = o->la = 0;
+  else
+    local_f(d, cx, cy, r, o);
 }
 
 oc_pcurve *oc_ecurve_skeleton(const oc_vec3 *P, size_t m,
@@ -328,6 +347,7 @@ oc_enode *oc_enode_curve(const oc_enode_curve_params *p, oc_error *err) {
       dcs = fmax(dcs, fmax(hi - plo, phi - lo) / (d->at[i] - d->at[i - 1]));
     }
   }
+  d->clo = clo, d->chi = chi;
   oc_aabb bx = oc_curve_bounds(d->c, p->radius);
   double grade = oc_curve_grade_max(d->c);
   double lf = (grade + dcs) / (1 - p->radius * kap) + dcd;

@@ -820,6 +820,51 @@ START_TEST(curve_weight_in_one_search) {
 }
 END_TEST
 
+/* A curve's f range in a box (where alpha > 0, as its bounds hold) is
+** that of the pieces near the box, not the whole curve's: on bench_elev's
+** fig22 road, climbing 140 m, boxes up to 40 m wide hold every sampled f
+** where alpha > 0 and most span less than 30 m (the replace's model over
+** the road is Lipschitz in that span: 22 % fewer height calls on fig22). */
+START_TEST(curve_bound_is_local) {
+  oc_error err;
+  oc_vec3 P[16];
+  for (int i = 0; i < 16; i++) {
+    double u = (double)i / 15;
+    P[i] = (oc_vec3){150 * sin(7.85 * u), -260 + 520 * u, 30 + 140 * u};
+  }
+  oc_enode_road_params dp = {P, 16, OC_ECURVE_CATMULL, 0, -1, 0};
+  oc_enode *road = EOK(oc_enode_road(&dp, &err));
+  double box[4], glo, ghi;
+  oc_enode_get_bounds(road, box, &glo, &ghi);
+  ck_assert(ghi - glo > 140);
+  oct_rng g = oct_rng_new(2219);
+  int active = 0, narrow = 0, samples = 0;
+  for (int i = 0; i < 3000; i++) {
+    double x = oct_unif(&g, -200, 200), y = oct_unif(&g, -300, 300);
+    double w = 40 * pow(10, oct_unif(&g, -2, 0));
+    oc_enode_bound b;
+    oc_enode_bound_in(road, x, y, x + w, y + w, &b);
+    if (!(b.ahi > 0)) continue;
+    active++;
+    ck_assert(b.flo >= glo && b.fhi <= ghi);
+    narrow += b.fhi - b.flo < 30;
+    for (int k = 0; k < 40; k++) {
+      oc_enode_sample s;
+      oc_enode_eval(road, x + w * oct_unif(&g, 0, 1),
+                    y + w * oct_unif(&g, 0, 1), &s);
+      if (!(s.a > 0)) continue;
+      samples++;
+      ck_assert_msg(s.f >= b.flo && s.f <= b.fhi, "f %.15g outside [%g, %g]",
+                    s.f, b.flo, b.fhi);
+    }
+  }
+  ck_assert_int_ge(active, 300);
+  ck_assert_int_ge(samples, 3000);
+  ck_assert_int_ge(narrow, active * 9 / 10);
+  oc_enode_release(road);
+}
+END_TEST
+
 START_TEST(bad_input) {
   oc_error err;
   oc_enode_disc_params p = {0, 0, NAN, 0, {OC_ENOISE_NONE, 0, 1, 1, 0, 0, 0}};
@@ -1384,6 +1429,7 @@ int main(void) {
   tcase_add_test(tc, warp_bijective_only);
   tcase_add_test(tc, dag_stats_and_source);
   tcase_add_test(tc, curve_river_road);
+  tcase_add_test(tc, curve_bound_is_local);
   tcase_add_test(tc, curve_weight_in_one_search);
   tcase_add_test(tc, bad_input);
   tcase_add_test(tc, rows_match_points);
