@@ -742,7 +742,9 @@ END_TEST
 
 /* A replace's weight query of its curve (oc_ecurve_weight_in, the closest
 ** point out to R + rho answering the box test and the lazy sample): the
-** bits of oc_ecurve_bound_in and oc_ecurve_ev (OC_EV_LAZY), at random
+** bits of oc_ecurve_bound_in's decision and f bound, alpha's range and
+** slope within its and holding on the box (from the distance found),
+** and the bits of oc_ecurve_ev (OC_EV_LAZY), at random
 ** points and at points whose distance to the road is the box test's
 ** radius to within 1e-7 (where the box test itself decides); no box
 ** query but there. And a replace's model over the road: no box query near
@@ -760,7 +762,7 @@ START_TEST(curve_weight_in_one_search) {
   ck_assert_ptr_nonnull(sk);
   double Rc = 3.5 + 1.5 + 12, len = oc_curve_length(sk); /* (the preset's) */
   oct_rng g = oct_rng_new(2211);
-  int boxes = 0, near = 0, zero = 0, band = 0;
+  int boxes = 0, near = 0, zero = 0, band = 0, tight = 0;
   for (int i = 0; i < 6000; i++) {
     double x, y, R = 50 * pow(10, oct_unif(&g, -3, 0));
     if (i % 2) {
@@ -781,8 +783,21 @@ START_TEST(curve_weight_in_one_search) {
     memset(&rs, 0, sizeof rs), memset(&gs, 0, sizeof gs);
     oc_ecurve_bound_in(road, &b, NULL, &ref);
     int nb = 0, k = oc_ecurve_weight_in(road, x, y, &b, &got, &gs, &nb);
-    ck_assert(!memcmp(&ref, &got, sizeof ref));
+    /* the box test's f bound; alpha's from the distance found, within
+    ** the box test's and holding on the box */
+    ck_assert(ref.flo == got.flo && ref.fhi == got.fhi && ref.lf == got.lf);
+    ck_assert(got.alo >= ref.alo && got.ahi <= ref.ahi && got.la <= ref.la);
     ck_assert_int_eq(k, ref.ahi > 0);
+    tight += k && (got.ahi < 1 || got.alo > 0 || got.la < ref.la / 2);
+    for (int j = 0; k && j < 20; j++) {
+      oc_enode_sample a;
+      double px = x + R * oct_unif(&g, -1, 1), py = y + R * oct_unif(&g, -1, 1);
+      oc_ecurve_ev(road, px, py, NULL, OC_EV_GRAD, &a);
+      ck_assert_msg(a.a >= got.alo && a.a <= got.ahi,
+                    "alpha %.17g outside [%.17g, %.17g]", a.a, got.alo,
+                    got.ahi);
+      ck_assert(hypot(a.ax, a.ay) <= got.la * (1 + 1e-9) + 1e-15);
+    }
     boxes += nb;
     band += nb && i % 2 == 0;
     if (!k) {
@@ -798,6 +813,7 @@ START_TEST(curve_weight_in_one_search) {
   ck_assert_int_ge(zero, 300);
   ck_assert_int_ge(band, 100); /* the box test decided in the band */
   ck_assert_int_le(boxes - band, 30);
+  ck_assert_int_ge(tight, 300);
   /* a replace over the road: near it the model makes no box query */
   oc_enode *hill = EOK(oc_enode_disc(
       &(oc_enode_disc_params){
