@@ -350,6 +350,23 @@ START_TEST(disc_local_bounds) {
   printf("disc local bounds: sampled |grad f| up to %.3f of the bound\n",
          worst);
   ck_assert(worst > 0.5);
+  /* a small box in a corner of the disc's square, outside its circle:
+  ** alpha = 0 on it, so no noise evaluated for a local f bound (its f
+  ** counts nowhere): the whole plane's f bound, alpha's 0; a box just
+  ** inside the circle gets its local bound */
+  oc_error err;
+  oc_enode_disc_params p = {
+      3, -2, 400, 20, {OC_ENOISE_PLAIN, 12, 50, 5, 0, 0, 0}};
+  oc_enode *d = EOK(oc_enode_disc(&p, &err));
+  double box[4], lo, hi, c = 3 + 400 * 0.95, e = -2 + 400 * 0.95;
+  oc_enode_get_bounds(d, box, &lo, &hi);
+  oc_enode_bound b;
+  oc_enode_bound_in(d, c, e, c + 1, e + 1, &b);
+  ck_assert(b.alo == 0 && b.ahi == 0 && b.la == 0);
+  ck_assert(b.flo == lo && b.fhi == hi && b.lf == oc_enode_lipschitz(d));
+  oc_enode_bound_in(d, 3 + 280, -2 + 280, 3 + 281, -2 + 281, &b);
+  ck_assert(b.ahi > 0 && b.fhi - b.flo < 0.5 * (hi - lo));
+  oc_enode_release(d);
 }
 END_TEST
 
