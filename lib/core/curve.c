@@ -904,6 +904,37 @@ int oc_curve_within(const oc_pcurve *c, double x, double y, double r) {
   return 0;
 }
 
+int oc_curve_z_near(const oc_pcurve *c, double x, double y, double r,
+                    double *zlo, double *zhi) {
+  if (!(r >= 0) || isnan(x) || isnan(y)) return 0;
+  double lim = next_up(r * r), lo = INFINITY, hi = -INFINITY;
+  const fbox *bvh = c->bvh;
+  pending st[128];
+  int top = 0, got = 0;
+  st[top++] = (pending){0, 0, c->n};
+  while (top > 0) {
+    pending e = st[--top];
+    if (box_d2(&bvh[e.node], x, y) >= lim) continue;
+    if (e.hi - e.lo > 1) {
+      uint32_t mid = e.lo + (e.hi - e.lo) / 2;
+      st[top++] = (pending){e.node + 2 * (mid - e.lo), mid, e.hi};
+      st[top++] = (pending){e.node + 1, e.lo, mid};
+      continue;
+    }
+    piece pc;
+    piece_at(c, e.lo, &pc);
+    for (int k = 0; k <= pc.deg; k++)
+      lo = fmin(lo, pc.p[k].z), hi = fmax(hi, pc.p[k].z);
+    got = 1;
+  }
+  if (!got) return 0;
+  /* (de Casteljau's convex combinations round within a few ulps of the
+  ** hull) */
+  double m = 1e-12 * fmax(fabs(lo), fabs(hi));
+  *zlo = lo - m, *zhi = hi + m;
+  return 1;
+}
+
 /* ---- flattening ------------------------------------------------------- */
 
 typedef struct flat_ctx {

@@ -124,6 +124,14 @@ int oc_curve_closest_within(const oc_pcurve *c, double x, double y, double rin,
 ** point is within r needs no root finding). */
 int oc_curve_within(const oc_pcurve *c, double x, double y, double r);
 
+/* The elevations of the curve's points within r of (x, y) in xy lie in
+** [*zlo, *zhi]: the range of the control points' z of the pieces whose
+** boxes come within r (a Bézier piece lies in its control points' hull),
+** widened by a relative 1e-12 for the evaluation's roundings. Returns 0
+** (zlo, zhi untouched) when no piece's box comes within r. */
+int oc_curve_z_near(const oc_pcurve *c, double x, double y, double r,
+                    double *zlo, double *zhi);
+
 /* An upper bound of the planar curvature |kappa| inside the pieces,
 ** rigorous up to rounding and within about 1 % of the true maximum
 ** (bezier.h); 0 for a polyline, INFINITY where a Bézier piece's

@@ -724,6 +724,15 @@ void oc_edisc_bound_in(const oc_enode *node, const oc_erect *b,
     o->alo = o->ahi = o->la = 0;
     return;
   }
+  double dmin, dmax, r = n->par[2];
+  rect_dist(b, n->par[0], n->par[1], &dmin, &dmax);
+  if (dmin / r >= 1) {
+    /* alpha = 0 on the whole box: its f counts nowhere (a blend drops
+    ** the child, an add or replace weighs it by 0), so no noise for a
+    ** local f bound (the box meets the disc's square in its corners) */
+    o->alo = o->ahi = o->la = 0;
+    return;
+  }
   double nlo, nhi, nlip;
   /* the octaves' values at the centre bound the unfiltered sum only (or,
   ** filtered, the octaves kept whole on the box) */
@@ -737,8 +746,6 @@ void oc_edisc_bound_in(const oc_enode *node, const oc_erect *b,
     o->fhi = oc_fmin(o->fhi, n->par[3] + nhi);
     o->lf = oc_fmin(o->lf, nlip);
   }
-  double dmin, dmax, r = n->par[2];
-  rect_dist(b, n->par[0], n->par[1], &dmin, &dmax);
   /* rounding: alpha's bounds a hair wider than the formula */
   o->alo = oc_fmax(0, wyvill(dmax / r) * (1 - 1e-12) - 1e-300);
   o->ahi = oc_fmin(1, wyvill(dmin / r) * (1 + 1e-12));

@@ -388,10 +388,11 @@ void oc_ecurve_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
 void oc_ecurve_bound_in(const oc_enode *n, const oc_erect *b,
                         const oc_efootb *fb, oc_ebound *o);
 /* A replace's two queries of its curve B (eops.c, weight_taylor) in one:
-** oc_ecurve_bound_in(n, b) in *o and, where its weight is not 0 on b,
-** oc_ecurve_ev(n, x, y, OC_EV_LAZY) in *s, (x, y) the centre of b; the
-** same bits. Returns 0 where alpha = 0 on b (*s unset then); *boxes grows
-** by the box queries it still makes (rare: ecurve.c). */
+** oc_ecurve_bound_in(n, b) in *o (its decision and f bound; alpha's range
+** and slope tighter, from the distance found) and, where its weight is
+** not 0 on b, oc_ecurve_ev(n, x, y, OC_EV_LAZY) in *s, (x, y) the centre
+** of b, the same bits. Returns 0 where alpha = 0 on b (*s unset then);
+** *boxes grows by the box queries it still makes (rare: ecurve.c). */
 int oc_ecurve_weight_in(const oc_enode *n, double x, double y,
                         const oc_erect *b, oc_ebound *o, oc_enode_sample *s,
                         int *boxes);

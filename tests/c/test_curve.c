@@ -943,6 +943,60 @@ START_TEST(closest_within_answers_both) {
 }
 END_TEST
 
+/* The elevations near a point (oc_curve_z_near): every point of the
+** winding, climbing road of closest_within_answers_both within r of the
+** query, sampled densely by arc length, has its z in the range; the range
+** is local (a few pieces' rise, not the road's 140 m) and 0 is returned
+** where no piece's box comes within r. */
+START_TEST(z_near_holds_and_is_local) {
+  oc_error err;
+  oc_vec3 P[16];
+  for (int i = 0; i < 16; i++) {
+    double u = (double)i / 15;
+    P[i] = oct_v(150 * sin(7.85 * u), -260 + 520 * u, 30 + 140 * u);
+  }
+  oc_pcurve *c = oc_curve_catmull(P, 16, &err);
+  ck_assert_ptr_nonnull(c);
+  double len = oc_curve_length(c);
+  enum { NS = 4000 };
+  static oc_curve_point at[NS + 1];
+  for (int k = 0; k <= NS; k++)
+    ck_assert(oc_curve_at(c, len * k / NS, &at[k]));
+  oct_rng g = oct_rng_new(2213);
+  int got = 0, none = 0, narrow = 0;
+  for (int i = 0; i < 3000; i++) {
+    double x = oct_unif(&g, -260, 260), y = oct_unif(&g, -330, 330);
+    double r = oct_unif(&g, 1, 60), lo = NAN, hi = NAN;
+    int k = oc_curve_z_near(c, x, y, r, &lo, &hi);
+    int within = oc_curve_within(c, x, y, r);
+    if (!k) {
+      ck_assert(!within);
+      ck_assert(isnan(lo) && isnan(hi)); /* (untouched) */
+      none++;
+      continue;
+    }
+    got++;
+    for (int j = 0; j <= NS; j++)
+      if (hypot(at[j].q.x - x, at[j].q.y - y) <= r)
+        ck_assert_msg(at[j].q.z >= lo && at[j].q.z <= hi,
+                      "z %.15g at s %g outside [%.15g, %.15g]", at[j].q.z,
+                      at[j].s, lo, hi);
+    narrow += within && hi - lo < 40;
+  }
+  ck_assert_int_ge(got, 500);
+  ck_assert_int_ge(none, 500);
+  ck_assert_int_ge(narrow, 300);
+  /* (the whole road's range: 140 m; a piece rises 9.3 m) */
+  double lo, hi;
+  ck_assert(oc_curve_z_near(c, P[7].x, P[7].y, 1, &lo, &hi));
+  ck_assert(lo <= P[7].z && hi >= P[7].z && hi - lo < 2 * 9.4);
+  ck_assert(!oc_curve_z_near(c, 1000, 0, 10, &lo, &hi));
+  ck_assert(!oc_curve_z_near(c, NAN, 0, 10, &lo, &hi));
+  ck_assert(!oc_curve_z_near(c, 0, 0, -1, &lo, &hi));
+  oc_curve_free(c);
+}
+END_TEST
+
 int main(void) {
   setvbuf(stdout, NULL, _IOLBF, 0);
   Suite *s = suite_create("curve");
@@ -965,6 +1019,7 @@ int main(void) {
   tcase_add_test(tc, stored_layouts_answer_alike);
   tcase_add_test(tc, closest_keeps_its_bits);
   tcase_add_test(tc, closest_within_answers_both);
+  tcase_add_test(tc, z_near_holds_and_is_local);
   suite_add_tcase(s, tc);
   return oct_run(s);
 }

@@ -350,6 +350,23 @@ START_TEST(disc_local_bounds) {
   printf("disc local bounds: sampled |grad f| up to %.3f of the bound\n",
          worst);
   ck_assert(worst > 0.5);
+  /* a small box in a corner of the disc's square, outside its circle:
+  ** alpha = 0 on it, so no noise evaluated for a local f bound (its f
+  ** counts nowhere): the whole plane's f bound, alpha's 0; a box just
+  ** inside the circle gets its local bound */
+  oc_error err;
+  oc_enode_disc_params p = {
+      3, -2, 400, 20, {OC_ENOISE_PLAIN, 12, 50, 5, 0, 0, 0}};
+  oc_enode *d = EOK(oc_enode_disc(&p, &err));
+  double box[4], lo, hi, c = 3 + 400 * 0.95, e = -2 + 400 * 0.95;
+  oc_enode_get_bounds(d, box, &lo, &hi);
+  oc_enode_bound b;
+  oc_enode_bound_in(d, c, e, c + 1, e + 1, &b);
+  ck_assert(b.alo == 0 && b.ahi == 0 && b.la == 0);
+  ck_assert(b.flo == lo && b.fhi == hi && b.lf == oc_enode_lipschitz(d));
+  oc_enode_bound_in(d, 3 + 280, -2 + 280, 3 + 281, -2 + 281, &b);
+  ck_assert(b.ahi > 0 && b.fhi - b.flo < 0.5 * (hi - lo));
+  oc_enode_release(d);
 }
 END_TEST
 
@@ -742,7 +759,9 @@ END_TEST
 
 /* A replace's weight query of its curve (oc_ecurve_weight_in, the closest
 ** point out to R + rho answering the box test and the lazy sample): the
-** bits of oc_ecurve_bound_in and oc_ecurve_ev (OC_EV_LAZY), at random
+** bits of oc_ecurve_bound_in's decision and f bound, alpha's range and
+** slope within its and holding on the box (from the distance found),
+** and the bits of oc_ecurve_ev (OC_EV_LAZY), at random
 ** points and at points whose distance to the road is the box test's
 ** radius to within 1e-7 (where the box test itself decides); no box
 ** query but there. And a replace's model over the road: no box query near
@@ -760,7 +779,7 @@ START_TEST(curve_weight_in_one_search) {
   ck_assert_ptr_nonnull(sk);
   double Rc = 3.5 + 1.5 + 12, len = oc_curve_length(sk); /* (the preset's) */
   oct_rng g = oct_rng_new(2211);
-  int boxes = 0, near = 0, zero = 0, band = 0;
+  int boxes = 0, near = 0, zero = 0, band = 0, tight = 0;
   for (int i = 0; i < 6000; i++) {
     double x, y, R = 50 * pow(10, oct_unif(&g, -3, 0));
     if (i % 2) {
@@ -781,8 +800,21 @@ START_TEST(curve_weight_in_one_search) {
     memset(&rs, 0, sizeof rs), memset(&gs, 0, sizeof gs);
     oc_ecurve_bound_in(road, &b, NULL, &ref);
     int nb = 0, k = oc_ecurve_weight_in(road, x, y, &b, &got, &gs, &nb);
-    ck_assert(!memcmp(&ref, &got, sizeof ref));
+    /* the box test's f bound; alpha's from the distance found, within
+    ** the box test's and holding on the box */
+    ck_assert(ref.flo == got.flo && ref.fhi == got.fhi && ref.lf == got.lf);
+    ck_assert(got.alo >= ref.alo && got.ahi <= ref.ahi && got.la <= ref.la);
     ck_assert_int_eq(k, ref.ahi > 0);
+    tight += k && (got.ahi < 1 || got.alo > 0 || got.la < ref.la / 2);
+    for (int j = 0; k && j < 20; j++) {
+      oc_enode_sample a;
+      double px = x + R * oct_unif(&g, -1, 1), py = y + R * oct_unif(&g, -1, 1);
+      oc_ecurve_ev(road, px, py, NULL, OC_EV_GRAD, &a);
+      ck_assert_msg(a.a >= got.alo && a.a <= got.ahi,
+                    "alpha %.17g outside [%.17g, %.17g]", a.a, got.alo,
+                    got.ahi);
+      ck_assert(hypot(a.ax, a.ay) <= got.la * (1 + 1e-9) + 1e-15);
+    }
     boxes += nb;
     band += nb && i % 2 == 0;
     if (!k) {
@@ -798,6 +830,7 @@ START_TEST(curve_weight_in_one_search) {
   ck_assert_int_ge(zero, 300);
   ck_assert_int_ge(band, 100); /* the box test decided in the band */
   ck_assert_int_le(boxes - band, 30);
+  ck_assert_int_ge(tight, 300);
   /* a replace over the road: near it the model makes no box query */
   oc_enode *hill = EOK(oc_enode_disc(
       &(oc_enode_disc_params){
@@ -816,6 +849,51 @@ START_TEST(curve_weight_in_one_search) {
   oc_curve_free(sk);
   oc_enode_release(rep);
   oc_enode_release(hill);
+  oc_enode_release(road);
+}
+END_TEST
+
+/* A curve's f range in a box (where alpha > 0, as its bounds hold) is
+** that of the pieces near the box, not the whole curve's: on bench_elev's
+** fig22 road, climbing 140 m, boxes up to 40 m wide hold every sampled f
+** where alpha > 0 and most span less than 30 m (the replace's model over
+** the road is Lipschitz in that span: 22 % fewer height calls on fig22). */
+START_TEST(curve_bound_is_local) {
+  oc_error err;
+  oc_vec3 P[16];
+  for (int i = 0; i < 16; i++) {
+    double u = (double)i / 15;
+    P[i] = (oc_vec3){150 * sin(7.85 * u), -260 + 520 * u, 30 + 140 * u};
+  }
+  oc_enode_road_params dp = {P, 16, OC_ECURVE_CATMULL, 0, -1, 0};
+  oc_enode *road = EOK(oc_enode_road(&dp, &err));
+  double box[4], glo, ghi;
+  oc_enode_get_bounds(road, box, &glo, &ghi);
+  ck_assert(ghi - glo > 140);
+  oct_rng g = oct_rng_new(2219);
+  int active = 0, narrow = 0, samples = 0;
+  for (int i = 0; i < 3000; i++) {
+    double x = oct_unif(&g, -200, 200), y = oct_unif(&g, -300, 300);
+    double w = 40 * pow(10, oct_unif(&g, -2, 0));
+    oc_enode_bound b;
+    oc_enode_bound_in(road, x, y, x + w, y + w, &b);
+    if (!(b.ahi > 0)) continue;
+    active++;
+    ck_assert(b.flo >= glo && b.fhi <= ghi);
+    narrow += b.fhi - b.flo < 30;
+    for (int k = 0; k < 40; k++) {
+      oc_enode_sample s;
+      oc_enode_eval(road, x + w * oct_unif(&g, 0, 1),
+                    y + w * oct_unif(&g, 0, 1), &s);
+      if (!(s.a > 0)) continue;
+      samples++;
+      ck_assert_msg(s.f >= b.flo && s.f <= b.fhi, "f %.15g outside [%g, %g]",
+                    s.f, b.flo, b.fhi);
+    }
+  }
+  ck_assert_int_ge(active, 300);
+  ck_assert_int_ge(samples, 3000);
+  ck_assert_int_ge(narrow, active * 9 / 10);
   oc_enode_release(road);
 }
 END_TEST
@@ -1384,6 +1462,7 @@ int main(void) {
   tcase_add_test(tc, warp_bijective_only);
   tcase_add_test(tc, dag_stats_and_source);
   tcase_add_test(tc, curve_river_road);
+  tcase_add_test(tc, curve_bound_is_local);
   tcase_add_test(tc, curve_weight_in_one_search);
   tcase_add_test(tc, bad_input);
   tcase_add_test(tc, rows_match_points);
