@@ -190,15 +190,16 @@ START_TEST(bytes_per_kind) {
   oc_enode *bi = EOK(oc_enode_blend(ki, 3, &err));
   ck_assert_uint_eq(bytes_of(bi),
                     oc_enode_size(bi) + bytes_of(img) + bytes_of(img2) - gb);
-  /* the nodes alone, and a river's data: its record and its profile's
-  ** place (64), the profile's 6 knots (doubles: the stream's depth 0.8 is
+  /* the nodes alone, and a river's data: its record (with its profiles'
+  ** range of heights) and its profile's place (80), the profile's 6 knots
+  *(doubles: the stream's depth 0.8 is
   ** no float; 8 + 96) and the skeleton (572: 8 points kept, control
   ** points derived); a profile the same as the one before is stored once,
   ** and knots that are floats exactly take 4 bytes each */
   oc_enode_stats st;
   ck_assert_int_eq(oc_enode_get_stats(riv, &st, &err), OC_OK);
   ck_assert_uint_eq(st.node_bytes, 96);
-  ck_assert_uint_eq(st.bytes, 96 + 64 + 104 + 572);
+  ck_assert_uint_eq(st.bytes, 96 + 80 + 104 + 572);
   ck_assert_int_eq(oc_enode_get_stats(bi, &st, &err), OC_OK);
   ck_assert_uint_eq(st.node_bytes, oc_enode_size(bi) + oc_enode_size(img) +
                                        oc_enode_size(img2));
@@ -219,7 +220,7 @@ START_TEST(bytes_per_kind) {
   ck_assert_uint_eq(bytes_of(three), bytes_of(single) + 32 + 8 + 96);
   oc_pcurve *sk = oc_ecurve_skeleton(pts, 8, OC_ECURVE_CATMULL, &err);
   ck_assert_msg(sk != NULL, "%s", err.msg);
-  ck_assert_uint_eq(bytes_of(single), 96 + 64 + 8 + 48 + oc_curve_bytes(sk));
+  ck_assert_uint_eq(bytes_of(single), 96 + 80 + 8 + 48 + oc_curve_bytes(sk));
   oc_curve_free(sk);
   oc_enode_release(one);
   oc_enode_release(single);
