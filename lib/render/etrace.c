@@ -728,20 +728,26 @@ static void beam_corners(const oc_ebeam *b, oc_vec3 D[4]) {
 
 static void piece_box(const oc_ebeam *b, const oc_vec3 corner[4], double da,
                       double db, double lo[3], double hi[3]) {
-  for (int k = 0; k < 3; k++)
-    lo[k] = INFINITY, hi[k] = -INFINITY;
+  /* in locals, unrolled: lo and hi may alias *b for the compiler, which
+  ** then reloaded b->o at every vertex */
+  const oc_vec3 o = b->o;
+  double lx = INFINITY, ly = INFINITY, lz = INFINITY;
+  double hx = -INFINITY, hy = -INFINITY, hz = -INFINITY;
   for (int k = 0; k < 8; k++) {
     double d = k & 1 ? db : da;
     oc_vec3 D = corner[k >> 1];
-    const double p[3] = {b->o.x + d * D.x, b->o.y + d * D.y, b->o.z + d * D.z};
-    for (int c = 0; c < 3; c++)
-      lo[c] = lesser(lo[c], p[c]), hi[c] = greater(hi[c], p[c]);
+    double px = o.x + d * D.x, py = o.y + d * D.y, pz = o.z + d * D.z;
+    lx = lesser(lx, px), hx = greater(hx, px);
+    ly = lesser(ly, py), hy = greater(hy, py);
+    lz = lesser(lz, pz), hz = greater(hz, pz);
   }
   /* rounding of the vertices: a relative hair outward */
-  for (int c = 0; c < 3; c++) {
-    double pad = 1e-9 * (fabs(lo[c]) + fabs(hi[c]));
-    lo[c] -= pad, hi[c] += pad;
-  }
+  double pad = 1e-9 * (fabs(lx) + fabs(hx));
+  lo[0] = lx - pad, hi[0] = hx + pad;
+  pad = 1e-9 * (fabs(ly) + fabs(hy));
+  lo[1] = ly - pad, hi[1] = hy + pad;
+  pad = 1e-9 * (fabs(lz) + fabs(hz));
+  lo[2] = lz - pad, hi[2] = hz + pad;
 }
 
 /* 1 when no ray of the piece whose box is lo, hi meets the surface. */
