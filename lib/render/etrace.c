@@ -183,8 +183,10 @@ int oc_etrace_clip(const double lo[3], const double hi[3], oc_vec3 o, oc_vec3 u,
       double x = ta;
       ta = tb, tb = x;
     }
-    a = fmax(a, ta);
-    b = fmin(b, tb);
+    /* fmax and fmin to the bit (glibc's: maxsd, minsd, and the other
+    ** operand where one is NaN), inline: they were library calls */
+    a = a > ta || ta != ta ? a : ta;
+    b = b < tb || tb != tb ? b : tb;
   }
   if (!(a <= b)) return 0;
   *t0 = a, *t1 = b;
@@ -793,8 +795,10 @@ static double beam_models(const oc_etracer *tr, const oc_ebeam *b,
   const oc_elevation *src = tr->s->src;
   oc_vec3 c = beam_dir(b, 0.5 * (b->x0 + b->x1), 0.5 * (b->y0 + b->y1));
   double dxy[4], bxy[4]; /* |(D_j - c)_xy|, |D_j,xy| */
+  oc_vec3 dc[4];         /* D_j - c, for every step */
   for (int j = 0; j < 4; j++) {
-    dxy[j] = hypot(D[j].x - c.x, D[j].y - c.y);
+    dc[j] = (oc_vec3){D[j].x - c.x, D[j].y - c.y, D[j].z - c.z};
+    dxy[j] = hypot(dc[j].x, dc[j].y);
     bxy[j] = hypot(D[j].x, D[j].y);
   }
   double width = greater(b->x1 - b->x0, b->y1 - b->y0);
@@ -826,8 +830,8 @@ static double beam_models(const oc_etracer *tr, const oc_ebeam *b,
     double s = e;
     int ok = 1;
     for (int j = 0; j < 4 && ok; j++) {
-      double ax = d * (D[j].x - c.x), ay = d * (D[j].y - c.y),
-             az = d * (D[j].z - c.z), ra = d * dxy[j];
+      double ax = d * dc[j].x, ay = d * dc[j].y, az = d * dc[j].z,
+             ra = d * dxy[j];
       double c0 =
           h + az - (g[0] * ax + g[1] * ay) - (E[0] + ra * (E[1] + ra * E[2]));
       if (!(c0 > 0)) {
