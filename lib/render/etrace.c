@@ -183,8 +183,10 @@ int oc_etrace_clip(const double lo[3], const double hi[3], oc_vec3 o, oc_vec3 u,
       double x = ta;
       ta = tb, tb = x;
     }
-    a = fmax(a, ta);
-    b = fmin(b, tb);
+    /* fmax and fmin to the bit (glibc's: maxsd, minsd, and the other
+    ** operand where one is NaN), inline: they were library calls */
+    a = a > ta || ta != ta ? a : ta;
+    b = b < tb || tb != tb ? b : tb;
   }
   if (!(a <= b)) return 0;
   *t0 = a, *t1 = b;
@@ -302,11 +304,10 @@ static double model_step(double h, const double g[2], const double E[3],
 ** p|_xy <= ra + s |D_xy| (ra = |q0 - p|_xy; E is nondecreasing), so
 ** that L >= c0 - c1 s - c2 s^2 (model_step's form, *c0 the bound at q0),
 ** and no farther than the model's disc; 0 where L(q0) <= 0 or q0 is off
-** the disc. */
-static double model_free(const oc_emodel *m, oc_vec3 q0, oc_vec3 D, double smax,
-                         double *lo) {
+** the disc. dxy is hypot(D.x, D.y), which the callers have already. */
+static double model_free(const oc_emodel *m, oc_vec3 q0, oc_vec3 D, double dxy,
+                         double smax, double *lo) {
   double ax = q0.x - m->x, ay = q0.y - m->y, ra = hypot(ax, ay);
-  double dxy = hypot(D.x, D.y);
   const double *g = m->g, *E = m->E;
   *lo = 0;
   if (!(ra < m->R)) return 0;
@@ -454,7 +455,7 @@ static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
   if (model && m0 && m0->ok) {
     /* a first step on the beam's model, no call: from t, where the
     ** height is at least lo > 0 */
-    double lo, s = model_free(m0, at(o, u, t), u, t1 - t, &lo);
+    double lo, s = model_free(m0, at(o, u, t), u, uxy, t1 - t, &lo);
     if (s > 0) {
       prev = t, hp = lo, have_prev = 1;
       t += s;
@@ -719,23 +720,36 @@ static oc_vec3 beam_dir(const oc_ebeam *b, double x, double y) {
   return D;
 }
 
-static void piece_box(const oc_ebeam *b, double da, double db, double lo[3],
-                      double hi[3]) {
-  for (int k = 0; k < 3; k++)
-    lo[k] = INFINITY, hi[k] = -INFINITY;
+/* The directions of the beam's 4 corner rays, corner j through (j & 1 ?
+** x1 : x0, j & 2 ? y1 : y0): computed once a beam, not at every piece's
+** 8 vertices. */
+static void beam_corners(const oc_ebeam *b, oc_vec3 D[4]) {
+  for (int j = 0; j < 4; j++)
+    D[j] = beam_dir(b, j & 1 ? b->x1 : b->x0, j & 2 ? b->y1 : b->y0);
+}
+
+static void piece_box(const oc_ebeam *b, const oc_vec3 corner[4], double da,
+                      double db, double lo[3], double hi[3]) {
+  /* in locals, unrolled: lo and hi may alias *b for the compiler, which
+  ** then reloaded b->o at every vertex */
+  const oc_vec3 o = b->o;
+  double lx = INFINITY, ly = INFINITY, lz = INFINITY;
+  double hx = -INFINITY, hy = -INFINITY, hz = -INFINITY;
   for (int k = 0; k < 8; k++) {
-    double d = k & 1 ? db : da, x = k & 2 ? b->x1 : b->x0,
-           y = k & 4 ? b->y1 : b->y0;
-    oc_vec3 D = beam_dir(b, x, y);
-    const double p[3] = {b->o.x + d * D.x, b->o.y + d * D.y, b->o.z + d * D.z};
-    for (int c = 0; c < 3; c++)
-      lo[c] = lesser(lo[c], p[c]), hi[c] = greater(hi[c], p[c]);
+    double d = k & 1 ? db : da;
+    oc_vec3 D = corner[k >> 1];
+    double px = o.x + d * D.x, py = o.y + d * D.y, pz = o.z + d * D.z;
+    lx = lesser(lx, px), hx = greater(hx, px);
+    ly = lesser(ly, py), hy = greater(hy, py);
+    lz = lesser(lz, pz), hz = greater(hz, pz);
   }
   /* rounding of the vertices: a relative hair outward */
-  for (int c = 0; c < 3; c++) {
-    double pad = 1e-9 * (fabs(lo[c]) + fabs(hi[c]));
-    lo[c] -= pad, hi[c] += pad;
-  }
+  double pad = 1e-9 * (fabs(lx) + fabs(hx));
+  lo[0] = lx - pad, hi[0] = hx + pad;
+  pad = 1e-9 * (fabs(ly) + fabs(hy));
+  lo[1] = ly - pad, hi[1] = hy + pad;
+  pad = 1e-9 * (fabs(lz) + fabs(hz));
+  lo[2] = lz - pad, hi[2] = hz + pad;
 }
 
 /* 1 when no ray of the piece whose box is lo, hi meets the surface. */
@@ -775,16 +789,16 @@ static int piece_free(const oc_etracer *tr, const double lo[3],
 ** then differ: its parts go on). A step the models limit is relaxed as a
 ** ray's (BRELAX), the corners' bounds at its end run backwards (their
 ** rays' direction reversed) proving the stretch behind it. */
-static double beam_models(const oc_etracer *tr, const oc_ebeam *b, double d,
-                          double far, double e, double *evals, double *next,
-                          oc_emodel *m) {
+static double beam_models(const oc_etracer *tr, const oc_ebeam *b,
+                          const oc_vec3 D[4], double d, double far, double e,
+                          double *evals, double *next, oc_emodel *m) {
   const oc_elevation *src = tr->s->src;
   oc_vec3 c = beam_dir(b, 0.5 * (b->x0 + b->x1), 0.5 * (b->y0 + b->y1));
-  oc_vec3 D[4];
   double dxy[4], bxy[4]; /* |(D_j - c)_xy|, |D_j,xy| */
+  oc_vec3 dc[4];         /* D_j - c, for every step */
   for (int j = 0; j < 4; j++) {
-    D[j] = beam_dir(b, j & 1 ? b->x1 : b->x0, j & 2 ? b->y1 : b->y0);
-    dxy[j] = hypot(D[j].x - c.x, D[j].y - c.y);
+    dc[j] = (oc_vec3){D[j].x - c.x, D[j].y - c.y, D[j].z - c.z};
+    dxy[j] = hypot(dc[j].x, dc[j].y);
     bxy[j] = hypot(D[j].x, D[j].y);
   }
   double width = greater(b->x1 - b->x0, b->y1 - b->y0);
@@ -793,7 +807,7 @@ static double beam_models(const oc_etracer *tr, const oc_ebeam *b, double d,
     ** its corners' rays take */
     double s = lesser(e, far - d), lo;
     for (int j = 0; j < 4 && s > 0; j++)
-      s = lesser(s, model_free(m, at(b->o, D[j], d), D[j], s, &lo));
+      s = lesser(s, model_free(m, at(b->o, D[j], d), D[j], bxy[j], s, &lo));
     if (s > 0) d += s;
   }
   /* a relaxed step to d from dsafe, proved free, until its model proves
@@ -816,8 +830,8 @@ static double beam_models(const oc_etracer *tr, const oc_ebeam *b, double d,
     double s = e;
     int ok = 1;
     for (int j = 0; j < 4 && ok; j++) {
-      double ax = d * (D[j].x - c.x), ay = d * (D[j].y - c.y),
-             az = d * (D[j].z - c.z), ra = d * dxy[j];
+      double ax = d * dc[j].x, ay = d * dc[j].y, az = d * dc[j].z,
+             ra = d * dxy[j];
       double c0 =
           h + az - (g[0] * ax + g[1] * ay) - (E[0] + ra * (E[1] + ra * E[2]));
       if (!(c0 > 0)) {
@@ -886,10 +900,12 @@ double oc_etrace_beam(const oc_etracer *tr, const oc_ebeam *b, double d,
   ** 6.04, 0.59. Going on models at once, no range query: fig3 4.72,
   ** 0.29 but fig22 at -q 11.6, 0.75 against 10.1, 1.77 before. */
   int part = models && m->ok && from > 0;
+  oc_vec3 corner[4];
+  beam_corners(b, corner);
   for (long k = 0; k < OC_TRACE_MAX_STEPS && d < far; k++) {
     e = lesser(e, far - d);
     double lo[3], hi[3];
-    piece_box(b, d, d + e, lo, hi);
+    piece_box(b, corner, d, d + e, lo, hi);
     if (piece_free(tr, lo, hi, bounds)) {
       if (d + e == d) return d;
       d += e;
@@ -898,8 +914,8 @@ double oc_etrace_beam(const oc_etracer *tr, const oc_ebeam *b, double d,
     }
     if (part || e <= greater(0.5 * width * d, tol(tr, 0, d))) {
       if (models)
-        return beam_models(tr, b, d, far, BEAM_STEP * width * d, evals, next,
-                           m);
+        return beam_models(tr, b, corner, d, far, BEAM_STEP * width * d, evals,
+                           next, m);
       return d;
     }
     e *= 0.5;
