@@ -736,12 +736,18 @@ AVX512 static void z0_multi_avx512_v(const uint64_t *seeds, const double *x,
 AVX512_INLINE void z0_octaves8(uint64_t seed, const double *s, double u,
                                double v, size_t n, double *val, double *gx,
                                double *gy, int wg) {
-  const __m512i idx = _mm512_setr_epi64(1, 2, 3, 4, 5, 6, 7, 8);
+  /* (l + 1) OCTAVE_SEED_STEP in lane l, folded at compile time: a
+  ** vector's seeds are these plus seed + m STEP (the same sums modulo
+  ** 2^64), no 64-bit vector multiply per call */
+#define STEPS(l) (long long)((l)*OCTAVE_SEED_STEP)
+  const __m512i steps =
+      _mm512_setr_epi64(STEPS(1), STEPS(2), STEPS(3), STEPS(4), STEPS(5),
+                        STEPS(6), STEPS(7), STEPS(8));
+#undef STEPS
   for (size_t m = 0; m < n; m += 8) {
     __mmask8 lanes = n - m < 8 ? (__mmask8)((1u << (n - m)) - 1) : 0xff;
-    __m512i i = _mm512_add_epi64(idx, SET1Q(m));
-    __m512i sd = mix64_8(_mm512_add_epi64(
-        SET1Q(seed), _mm512_mullo_epi64(i, SET1Q(OCTAVE_SEED_STEP))));
+    __m512i sd =
+        mix64_8(_mm512_add_epi64(SET1Q(seed + m * OCTAVE_SEED_STEP), steps));
     __m512d sc = _mm512_maskz_loadu_pd(lanes, s + m);
     z0_vec8(sd, sc * u, sc * v, lanes, m, val, gx, gy, wg, 1);
   }
