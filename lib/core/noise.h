@@ -81,6 +81,18 @@ int oc_noise3_z0_octaves_isa(oc_noise_isa isa, uint64_t seed, const double *s,
                              double u, double v, size_t n, double *val,
                              double *gx, double *gy);
 
+/* oc_noise3_z0_octaves of the frequencies s[m] = f 2^m (f doubled m
+** times: a disc's octaves at the default lacunarity), bit for bit, the
+** frequencies made in the vector lanes under AVX-512 rather than in a
+** loop by the caller. */
+void oc_noise3_z0_octaves2(uint64_t seed, double f, double u, double v,
+                           size_t n, double *val, double *gx, double *gy);
+/* The same through the path isa; returns 0, or -1 (and does nothing)
+** when this processor lacks it or n > OC_NOISE_MAXOCT. */
+int oc_noise3_z0_octaves2_isa(oc_noise_isa isa, uint64_t seed, double f,
+                              double u, double v, size_t n, double *val,
+                              double *gx, double *gy);
+
 /* t(p); gradient when grad != NULL. octaves >= 1. */
 double oc_turb3(uint64_t seed, int octaves, oc_vec3 p, oc_vec3 *grad);
 /* Upper bound of t: sum 2^-k = 2 - 2^(1-octaves); t >= 0. */
