@@ -73,9 +73,9 @@
 #define G3 (1.0 / 6.0)
 
 /* Proved bounds of the raw sum and its gradient (see above). */
-#define RAW_MAX 0.013008
-#define RAW_GRAD_MAX 0.0908
-#define RAW_HESS_MAX 0.64
+#define RAW_MAX OC_NOISE3_RAW_MAX           /* 0.013008 */
+#define RAW_GRAD_MAX OC_NOISE3_RAW_GRAD_MAX /* 0.0908 */
+#define RAW_HESS_MAX OC_NOISE3_RAW_HESS_MAX /* 0.64 */
 #define SCALE (0.5 / RAW_MAX)
 
 /* The step between the octaves' seeds of a sum (oc_noise_octave_seed). */
@@ -84,8 +84,8 @@
 /* The lattice period used to reduce huge coordinates (a multiple of 3). */
 #define REDUCE_PERIOD (3.0 * 0x1p48)
 
-const double oc_noise3_lipschitz = 0.5 * RAW_GRAD_MAX / RAW_MAX;
-const double oc_noise3_hessian = 0.5 * RAW_HESS_MAX / RAW_MAX;
+const double oc_noise3_lipschitz = OC_NOISE3_LIPSCHITZ;
+const double oc_noise3_hessian = OC_NOISE3_HESSIAN;
 
 /* Pairs g, -g next to each other: the mean is 1/2 by symmetry. */
 static const double grad12[12][3] = {

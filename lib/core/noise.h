@@ -22,6 +22,16 @@ extern const double oc_noise3_lipschitz;
 ** plane the gradient's part in it changes by at most this much per unit
 ** of distance (elevation discs sample the plane z = 0). */
 extern const double oc_noise3_hessian;
+/* The two as constant expressions, the same doubles (noise.c defines
+** them so), for hot code that then folds its products of them at compile
+** time instead of loading and scaling them on every call: the proved
+** bounds of the raw sum, its gradient and Hessian (noise.c), and the
+** scale n = 1/2 + raw / (2 RAW_MAX). */
+#define OC_NOISE3_RAW_MAX 0.013008
+#define OC_NOISE3_RAW_GRAD_MAX 0.0908
+#define OC_NOISE3_RAW_HESS_MAX 0.64
+#define OC_NOISE3_LIPSCHITZ (0.5 * OC_NOISE3_RAW_GRAD_MAX / OC_NOISE3_RAW_MAX)
+#define OC_NOISE3_HESSIAN (0.5 * OC_NOISE3_RAW_HESS_MAX / OC_NOISE3_RAW_MAX)
 
 /* n(p) in [0, 1]; stores the gradient in *grad when grad != NULL. */
 double oc_noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad);
