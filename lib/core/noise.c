@@ -73,9 +73,9 @@
 #define G3 (1.0 / 6.0)
 
 /* Proved bounds of the raw sum and its gradient (see above). */
-#define RAW_MAX 0.013008
-#define RAW_GRAD_MAX 0.0908
-#define RAW_HESS_MAX 0.64
+#define RAW_MAX OC_NOISE3_RAW_MAX           /* 0.013008 */
+#define RAW_GRAD_MAX OC_NOISE3_RAW_GRAD_MAX /* 0.0908 */
+#define RAW_HESS_MAX OC_NOISE3_RAW_HESS_MAX /* 0.64 */
 #define SCALE (0.5 / RAW_MAX)
 
 /* The step between the octaves' seeds of a sum (oc_noise_octave_seed). */
@@ -84,8 +84,8 @@
 /* The lattice period used to reduce huge coordinates (a multiple of 3). */
 #define REDUCE_PERIOD (3.0 * 0x1p48)
 
-const double oc_noise3_lipschitz = 0.5 * RAW_GRAD_MAX / RAW_MAX;
-const double oc_noise3_hessian = 0.5 * RAW_HESS_MAX / RAW_MAX;
+const double oc_noise3_lipschitz = OC_NOISE3_LIPSCHITZ;
+const double oc_noise3_hessian = OC_NOISE3_HESSIAN;
 
 /* Pairs g, -g next to each other: the mean is 1/2 by symmetry. */
 static const double grad12[12][3] = {
@@ -733,16 +733,28 @@ AVX512 static void z0_multi_avx512_v(const uint64_t *seeds, const double *x,
 ** seeds oc_noise_octave_seed(seed, m) (the same sum and mix, lane by
 ** lane) and the points s[m] (u, v), as products of the lanes' s[m] and
 ** the broadcast u and v (the scalar products' bits). */
-AVX512_INLINE void z0_octaves8(uint64_t seed, const double *s, double u,
-                               double v, size_t n, double *val, double *gx,
-                               double *gy, int wg) {
-  const __m512i idx = _mm512_setr_epi64(1, 2, 3, 4, 5, 6, 7, 8);
+AVX512_INLINE void z0_octaves8(uint64_t seed, const double *s, double f,
+                               double u, double v, size_t n, double *val,
+                               double *gx, double *gy, int wg) {
+  /* s NULL: s[m] = f 2^m, lane l of a vector f 2^m times 2^l (products
+  ** by powers of 2, exact: the bits of f doubled m + l times, infinities
+  ** alike), the padding lanes 0 */
+  const __m512d pow2 = _mm512_setr_pd(1, 2, 4, 8, 16, 32, 64, 128);
+  /* (l + 1) OCTAVE_SEED_STEP in lane l, folded at compile time: a
+  ** vector's seeds are these plus seed + m STEP (the same sums modulo
+  ** 2^64), no 64-bit vector multiply per call */
+#define STEPS(l) (long long)((l)*OCTAVE_SEED_STEP)
+  const __m512i steps =
+      _mm512_setr_epi64(STEPS(1), STEPS(2), STEPS(3), STEPS(4), STEPS(5),
+                        STEPS(6), STEPS(7), STEPS(8));
+#undef STEPS
   for (size_t m = 0; m < n; m += 8) {
     __mmask8 lanes = n - m < 8 ? (__mmask8)((1u << (n - m)) - 1) : 0xff;
-    __m512i i = _mm512_add_epi64(idx, SET1Q(m));
-    __m512i sd = mix64_8(_mm512_add_epi64(
-        SET1Q(seed), _mm512_mullo_epi64(i, SET1Q(OCTAVE_SEED_STEP))));
-    __m512d sc = _mm512_maskz_loadu_pd(lanes, s + m);
+    __m512i sd =
+        mix64_8(_mm512_add_epi64(SET1Q(seed + m * OCTAVE_SEED_STEP), steps));
+    __m512d sc = s ? _mm512_maskz_loadu_pd(lanes, s + m)
+                   : _mm512_maskz_mul_pd(lanes, pow2, _mm512_set1_pd(f));
+    f *= 256; /* (the next vector's f 2^m) */
     z0_vec8(sd, sc * u, sc * v, lanes, m, val, gx, gy, wg, 1);
   }
 }
@@ -750,12 +762,25 @@ AVX512_INLINE void z0_octaves8(uint64_t seed, const double *s, double u,
 AVX512 static void z0_octaves_avx512_g(uint64_t seed, const double *s, double u,
                                        double v, size_t n, double *val,
                                        double *gx, double *gy) {
-  z0_octaves8(seed, s, u, v, n, val, gx, gy, 1);
+  z0_octaves8(seed, s, 0, u, v, n, val, gx, gy, 1);
 }
 
 AVX512 static void z0_octaves_avx512_v(uint64_t seed, const double *s, double u,
                                        double v, size_t n, double *val) {
-  z0_octaves8(seed, s, u, v, n, val, NULL, NULL, 0);
+  z0_octaves8(seed, s, 0, u, v, n, val, NULL, NULL, 0);
+}
+
+/* The same with the frequencies f 2^m (each compiled for itself: no
+** loads of s, no test of it). */
+AVX512 static void z0_octaves2_avx512_g(uint64_t seed, double f, double u,
+                                        double v, size_t n, double *val,
+                                        double *gx, double *gy) {
+  z0_octaves8(seed, NULL, f, u, v, n, val, gx, gy, 1);
+}
+
+AVX512 static void z0_octaves2_avx512_v(uint64_t seed, double f, double u,
+                                        double v, size_t n, double *val) {
+  z0_octaves8(seed, NULL, f, u, v, n, val, NULL, NULL, 0);
 }
 #endif
 
@@ -817,6 +842,28 @@ static inline void z0_octaves(int avx, uint64_t seed, const double *s, double u,
   z0_multi(0, sd, px, py, n, val, gx, gy);
 }
 
+/* oc_noise3_z0_octaves2: z0_octaves of the frequencies f 2^m, made in
+** the lanes under AVX-512, else doubled here as a disc's loop did. */
+static inline void z0_octaves2(int avx, uint64_t seed, double f, double u,
+                               double v, size_t n, double *val, double *gx,
+                               double *gy) {
+#ifdef HAVE_AVX512
+  if (avx) {
+    if (gx && gy)
+      z0_octaves2_avx512_g(seed, f, u, v, n, val, gx, gy);
+    else
+      z0_octaves2_avx512_v(seed, f, u, v, n, val);
+    return;
+  }
+#else
+  (void)avx;
+#endif
+  double s[OC_NOISE_MAXOCT];
+  for (size_t i = 0; i < n; i++, f *= 2)
+    s[i] = f;
+  z0_octaves(0, seed, s, u, v, n, val, gx, gy);
+}
+
 int oc_noise_isa_supported(oc_noise_isa isa) {
   switch (isa) {
   case OC_NOISE_ISA_AUTO:
@@ -856,6 +903,21 @@ int oc_noise3_z0_octaves_isa(oc_noise_isa isa, uint64_t seed, const double *s,
 void oc_noise3_z0_octaves(uint64_t seed, const double *s, double u, double v,
                           size_t n, double *val, double *gx, double *gy) {
   z0_octaves(have_avx512(), seed, s, u, v, n, val, gx, gy);
+}
+
+int oc_noise3_z0_octaves2_isa(oc_noise_isa isa, uint64_t seed, double f,
+                              double u, double v, size_t n, double *val,
+                              double *gx, double *gy) {
+  if (!oc_noise_isa_supported(isa) || n > OC_NOISE_MAXOCT) return -1;
+  z0_octaves2(isa == OC_NOISE_ISA_AVX512 ||
+                  (isa == OC_NOISE_ISA_AUTO && have_avx512()),
+              seed, f, u, v, n, val, gx, gy);
+  return 0;
+}
+
+void oc_noise3_z0_octaves2(uint64_t seed, double f, double u, double v,
+                           size_t n, double *val, double *gx, double *gy) {
+  z0_octaves2(have_avx512(), seed, f, u, v, n, val, gx, gy);
 }
 
 double oc_turb3(uint64_t seed, int octaves, oc_vec3 p, oc_vec3 *grad) {

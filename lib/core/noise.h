@@ -22,6 +22,16 @@ extern const double oc_noise3_lipschitz;
 ** plane the gradient's part in it changes by at most this much per unit
 ** of distance (elevation discs sample the plane z = 0). */
 extern const double oc_noise3_hessian;
+/* The two as constant expressions, the same doubles (noise.c defines
+** them so), for hot code that then folds its products of them at compile
+** time instead of loading and scaling them on every call: the proved
+** bounds of the raw sum, its gradient and Hessian (noise.c), and the
+** scale n = 1/2 + raw / (2 RAW_MAX). */
+#define OC_NOISE3_RAW_MAX 0.013008
+#define OC_NOISE3_RAW_GRAD_MAX 0.0908
+#define OC_NOISE3_RAW_HESS_MAX 0.64
+#define OC_NOISE3_LIPSCHITZ (0.5 * OC_NOISE3_RAW_GRAD_MAX / OC_NOISE3_RAW_MAX)
+#define OC_NOISE3_HESSIAN (0.5 * OC_NOISE3_RAW_HESS_MAX / OC_NOISE3_RAW_MAX)
 
 /* n(p) in [0, 1]; stores the gradient in *grad when grad != NULL. */
 double oc_noise3(uint64_t seed, oc_vec3 p, oc_vec3 *grad);
@@ -80,6 +90,18 @@ void oc_noise3_z0_octaves(uint64_t seed, const double *s, double u, double v,
 int oc_noise3_z0_octaves_isa(oc_noise_isa isa, uint64_t seed, const double *s,
                              double u, double v, size_t n, double *val,
                              double *gx, double *gy);
+
+/* oc_noise3_z0_octaves of the frequencies s[m] = f 2^m (f doubled m
+** times: a disc's octaves at the default lacunarity), bit for bit, the
+** frequencies made in the vector lanes under AVX-512 rather than in a
+** loop by the caller. */
+void oc_noise3_z0_octaves2(uint64_t seed, double f, double u, double v,
+                           size_t n, double *val, double *gx, double *gy);
+/* The same through the path isa; returns 0, or -1 (and does nothing)
+** when this processor lacks it or n > OC_NOISE_MAXOCT. */
+int oc_noise3_z0_octaves2_isa(oc_noise_isa isa, uint64_t seed, double f,
+                              double u, double v, size_t n, double *val,
+                              double *gx, double *gy);
 
 /* t(p); gradient when grad != NULL. octaves >= 1. */
 double oc_turb3(uint64_t seed, int octaves, oc_vec3 p, oc_vec3 *grad);

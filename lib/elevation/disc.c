@@ -43,6 +43,14 @@ double oc_eta(uint64_t seed, double x, double y, double g[2]) {
 static void octave_noise(const oc_enoise *nz, double u, double v, int n,
                          double *ev, double *ex, double *ey) {
   double s[OC_ENOISE_MAXOCT], f = 1 / nz->wavelength;
+  /* the default lacunarity: the frequencies f 2^i made in the kernel's
+  ** lanes (oc_noise3_z0_octaves2, the same bits); this loop's dependent
+  ** products, stored then reloaded as a vector, cost 20 % of a 5-octave
+  ** call (57.3 -> 46.9 ns, best of 6 x 2M calls, AVX-512) */
+  if (nz->lacunarity == 2) {
+    if (n) oc_noise3_z0_octaves2(nz->seed, f, u, v, (size_t)n, ev, ex, ey);
+    return;
+  }
   for (int i = 0; i < n; i++, f *= nz->lacunarity)
     s[i] = f;
   if (n) oc_noise3_z0_octaves(nz->seed, s, u, v, (size_t)n, ev, ex, ey);
@@ -645,7 +653,7 @@ static inline double greater(double a, double b) {
 ** saved. Returns 0 when the first octave already gains nothing. */
 static int noise_local(const oc_enoise *nz, double u0, double v0, double u1,
                        double v1, double *lo, double *hi, double *lip) {
-  const double L = 2 * oc_noise3_lipschitz, H = 2 * oc_noise3_hessian;
+  const double L = 2 * OC_NOISE3_LIPSCHITZ, H = 2 * OC_NOISE3_HESSIAN;
   double u = 0.5 * (u0 + u1), v = 0.5 * (v0 + v1);
   /* half-sides, a hair wider than the box: the rounding of the centre, of
   ** p - c in the evaluator and of s p */
@@ -907,7 +915,7 @@ oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err) {
 ** units: value e, octave gradient g (in lattice units), frequency s. */
 static inline oc_etay octave_model(double e, const double g[2], double s,
                                    double R, int absval) {
-  const double L = 2 * oc_noise3_lipschitz, H = 2 * oc_noise3_hessian;
+  const double L = 2 * OC_NOISE3_LIPSCHITZ, H = 2 * OC_NOISE3_HESSIAN;
   double sg = 1, ae = e;
   double quad = 0.5 * H * s * s, flat1 = L * s, flat0 = 1 + fabs(e);
   int can_quad = 1;

@@ -1237,6 +1237,82 @@ START_TEST(noise_z0_octaves_paths) {
 }
 END_TEST
 
+/* oc_noise3_z0_octaves2 (the frequencies f 2^m made inside) gives, through
+** each path, oc_noise3_z0_octaves' bits at s[m] = f doubled m times: every
+** count up to 16, f ordinary, subnormal, 0, and so large that the last
+** octaves' frequencies overflow to infinity (their points NaN) or their
+** points are huge; NaN and signed-zero points; writes nothing past its
+** room of 16 values, and refuses more than 16 octaves or a missing path. */
+START_TEST(noise_z0_octaves2_paths) {
+  enum { L = OC_NOISE_MAXOCT, PAD = 3 };
+  const oc_noise_isa isa[3] = {OC_NOISE_ISA_AUTO, OC_NOISE_ISA_SSE2,
+                               OC_NOISE_ISA_AVX512};
+  oc_rng r = oc_rng_stream(32, 9);
+  double s[L], v[L + PAD], gx[L + PAD], gy[L + PAD], w[L + PAD];
+  double rv[L + PAD], rgx[L + PAD], rgy[L + PAD];
+  ck_assert_int_eq(oc_noise3_z0_octaves2_isa(OC_NOISE_ISA_SSE2, 1, 1, 0, 0,
+                                             L + 1, v, gx, gy),
+                   -1);
+  int differ = 0, points = 0, spilled = 0, paths = 0, infinite = 0;
+  for (int k = 0; k < 136; k++) {
+    int n = k % (L + 1);
+    uint64_t seed = k % 5 == 0 ? (uint64_t)k : oc_rng_next(&r);
+    double u = (oc_rng_uniform(&r) - 0.5) * 4000;
+    double vv = (oc_rng_uniform(&r) - 0.5) * 4000;
+    double f =
+        ldexp(1 + oc_rng_uniform(&r), (int)(oc_rng_uniform(&r) * 12) - 10);
+    if (k % 9 == 1) f = 0x1.8p-1070;    /* subnormal */
+    if (k % 9 == 2) f = 0;              /* (an infinite wavelength) */
+    if (k % 9 == 3) f = 0x1.fp1015;     /* f 2^m overflows from m = 8 */
+    if (k % 9 == 4) f = ldexp(1.5, 40); /* huge points, reduced */
+    if (k % 11 == 4) u = -0.0, vv = 0.0;
+    if (n > 1 && k % 11 == 6) u = NAN;
+    double fm = f;
+    for (int m = 0; m < n; m++, fm *= 2)
+      s[m] = fm, infinite += isinf(fm);
+    for (int p = 0; p < 3; p++) {
+      for (int m = 0; m < L + PAD; m++)
+        v[m] = gx[m] = gy[m] = w[m] = -7;
+      if (!oc_noise_isa_supported(isa[p])) {
+        ck_assert_int_eq(oc_noise3_z0_octaves2_isa(isa[p], seed, f, u, vv,
+                                                   (size_t)n, v, gx, gy),
+                         -1);
+        spilled += v[0] != -7;
+        continue;
+      }
+      paths++;
+      ck_assert_int_eq(oc_noise3_z0_octaves2_isa(isa[p], seed, f, u, vv,
+                                                 (size_t)n, v, gx, gy),
+                       0);
+      ck_assert_int_eq(oc_noise3_z0_octaves2_isa(isa[p], seed, f, u, vv,
+                                                 (size_t)n, w, NULL, NULL),
+                       0);
+      ck_assert_int_eq(oc_noise3_z0_octaves_isa(isa[p], seed, s, u, vv,
+                                                (size_t)n, rv, rgx, rgy),
+                       0);
+      for (int m = 0; m < n; m++, points++)
+        differ += !same_bits(v[m], rv[m]) || !same_bits(w[m], rv[m]) ||
+                  !same_bits(gx[m], rgx[m]) || !same_bits(gy[m], rgy[m]);
+      for (int m = L; m < L + PAD; m++)
+        spilled += v[m] != -7 || gx[m] != -7 || gy[m] != -7 || w[m] != -7;
+    }
+  }
+  /* 8 rounds of 0..16 octaves per path that runs */
+  ck_assert_int_eq(points, paths / 136 * (8 * 136));
+  ck_assert_int_eq(paths % 136, 0);
+  ck_assert_int_eq(differ, 0);
+  ck_assert_int_eq(spilled, 0);
+  ck_assert_int_gt(infinite, 0);
+  /* the automatic path is the default call's */
+  oc_noise3_z0_octaves2(77, 0x1p-8, 123.25, -40.5, L, v, gx, gy);
+  oc_noise3_z0_octaves2_isa(OC_NOISE_ISA_AUTO, 77, 0x1p-8, 123.25, -40.5, L, w,
+                            NULL, NULL);
+  for (int m = 0; m < L; m++)
+    differ += !same_bits(v[m], w[m]);
+  ck_assert_int_eq(differ, 0);
+}
+END_TEST
+
 /* ---- turbulence ------------------------------------------------------ */
 
 START_TEST(turbulence_bounds_and_definition) {
@@ -1367,6 +1443,7 @@ int main(void) {
   tcase_add_test(tc, noise_z0_multi_matches);
   tcase_add_test(tc, noise_z0_multi_paths);
   tcase_add_test(tc, noise_z0_octaves_paths);
+  tcase_add_test(tc, noise_z0_octaves2_paths);
   tcase_add_test(tc, turbulence_bounds_and_definition);
   tcase_add_test(tc, turbulence_gradient_and_lipschitz);
   tcase_add_test(tc, noise_hessian_on_planes);
