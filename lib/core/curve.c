@@ -865,24 +865,48 @@ int oc_curve_closest_t(const oc_pcurve *c, double x, double y, double r,
   return closest(c, x, y, r, 0, out);
 }
 
+/* The pieces whose boxes come within sqrt(lim) of (x, y), in the box
+** tree's depth-first order: walk_next gives them one at a time (a
+** search may stop at the first that answers it). */
+typedef struct near_walk {
+  const fbox *bvh;
+  double x, y, lim;
+  pending st[128];
+  int top;
+} near_walk;
+
+static void walk_start(near_walk *w, const oc_pcurve *c, double x, double y,
+                       double lim) {
+  w->bvh = c->bvh, w->x = x, w->y = y, w->lim = lim;
+  w->top = 0;
+  w->st[w->top++] = (pending){0, 0, c->n};
+}
+
+static int walk_next(near_walk *w, uint32_t *leaf) {
+  while (w->top > 0) {
+    pending e = w->st[--w->top];
+    if (box_d2(&w->bvh[e.node], w->x, w->y) >= w->lim) continue;
+    if (e.hi - e.lo > 1) {
+      uint32_t mid = e.lo + (e.hi - e.lo) / 2;
+      w->st[w->top++] = (pending){e.node + 2 * (mid - e.lo), mid, e.hi};
+      w->st[w->top++] = (pending){e.node + 1, e.lo, mid};
+      continue;
+    }
+    *leaf = e.lo;
+    return 1;
+  }
+  return 0;
+}
+
 int oc_curve_within(const oc_pcurve *c, double x, double y, double r) {
   if (!(r >= 0) || isnan(x) || isnan(y)) return 0;
   double lim = next_up(r * r);
-  const fbox *bvh = c->bvh;
-  pending st[128];
-  int top = 0;
-  st[top++] = (pending){0, 0, c->n};
-  while (top > 0) {
-    pending e = st[--top];
-    if (box_d2(&bvh[e.node], x, y) >= lim) continue;
-    if (e.hi - e.lo > 1) {
-      uint32_t mid = e.lo + (e.hi - e.lo) / 2;
-      st[top++] = (pending){e.node + 2 * (mid - e.lo), mid, e.hi};
-      st[top++] = (pending){e.node + 1, e.lo, mid};
-      continue;
-    }
+  near_walk w;
+  uint32_t i;
+  walk_start(&w, c, x, y, lim);
+  while (walk_next(&w, &i)) {
     piece pc;
-    piece_at(c, e.lo, &pc);
+    piece_at(c, i, &pc);
     /* the ends lie on the curve: no root finding when one is near */
     for (int k = 0; k <= pc.deg; k += pc.deg) {
       double dx = pc.p[k].x - x, dy = pc.p[k].y - y;
@@ -908,21 +932,13 @@ int oc_curve_z_near(const oc_pcurve *c, double x, double y, double r,
                     double *zlo, double *zhi) {
   if (!(r >= 0) || isnan(x) || isnan(y)) return 0;
   double lim = next_up(r * r), lo = INFINITY, hi = -INFINITY;
-  const fbox *bvh = c->bvh;
-  pending st[128];
-  int top = 0, got = 0;
-  st[top++] = (pending){0, 0, c->n};
-  while (top > 0) {
-    pending e = st[--top];
-    if (box_d2(&bvh[e.node], x, y) >= lim) continue;
-    if (e.hi - e.lo > 1) {
-      uint32_t mid = e.lo + (e.hi - e.lo) / 2;
-      st[top++] = (pending){e.node + 2 * (mid - e.lo), mid, e.hi};
-      st[top++] = (pending){e.node + 1, e.lo, mid};
-      continue;
-    }
+  near_walk w;
+  uint32_t i;
+  int got = 0;
+  walk_start(&w, c, x, y, lim);
+  while (walk_next(&w, &i)) {
     piece pc;
-    piece_at(c, e.lo, &pc);
+    piece_at(c, i, &pc);
     for (int k = 0; k <= pc.deg; k++)
       lo = fmin(lo, pc.p[k].z), hi = fmax(hi, pc.p[k].z);
     got = 1;
