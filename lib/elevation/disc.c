@@ -222,14 +222,8 @@ static oc_etay octave_model(double e, const double g[2], double s, double R,
 ** units), as noise_sum computes it, and its model in *t; the ridged
 ** chain's previous term and model in *prev and *tprev (updated). Full
 ** detail (noise_taylor) and the filtered sum alike. */
-static double octave_term(const oc_enoise *nz, int i, double e,
-                          const double g[2], double s, double R, double *prev,
-                          oc_etay *tprev, oc_etay *t) {
-  if (nz->kind != OC_ENOISE_RIDGED) {
-    int turb = nz->kind == OC_ENOISE_TURBULENCE;
-    *t = octave_model(e, g, s, R, turb);
-    return turb ? fabs(e) : e;
-  }
+static double ridged_term(int i, double e, const double g[2], double s,
+                          double R, double *prev, oc_etay *tprev, oc_etay *t) {
   /* w rho^2, rho = 1 - |eta| (|eta|'s model negated, plus 1), w =
   ** clamp(2 t_(i-1)) */
   double r = 1 - fabs(e), w = 1;
@@ -246,6 +240,18 @@ static double octave_term(const oc_enoise *nz, int i, double e,
   t->v = *prev = w * r * r;
   *tprev = *t;
   return t->v;
+}
+
+/* (plain and turbulent terms inline: a call showed in the LoD sums) */
+static inline __attribute__((always_inline)) double
+octave_term(const oc_enoise *nz, int i, double e, const double g[2], double s,
+            double R, double *prev, oc_etay *tprev, oc_etay *t) {
+  if (nz->kind != OC_ENOISE_RIDGED) {
+    int turb = nz->kind == OC_ENOISE_TURBULENCE;
+    *t = octave_model(e, g, s, R, turb);
+    return turb ? fabs(e) : e;
+  }
+  return ridged_term(i, e, g, s, R, prev, tprev, t);
 }
 
 /* A noise sum's model being summed octave by octave: the sum of the
@@ -300,23 +306,6 @@ octaves_taylor(const oc_enoise *nz, int i0, int i1, const double *ev,
   *q = (octsum){sum, a, s, prev, m, tprev};
 }
 
-/* m += a (bm T): oc_etay_mul, oc_etay_scale and oc_etay_add in
-** registers (the same operations in the same order: the same bits; the
-** call to oc_etay_mul, not inlined, showed in callgrind). */
-static inline __attribute__((always_inline)) void
-ramp_add(oc_etay *m, const oc_etay *bm, const oc_etay *T, double a, double R) {
-  double pa[3] = {bm->e0, oc_etay_gnorm(bm) + bm->e1, bm->e2};
-  double pb[3] = {T->e0, oc_etay_gnorm(T) + T->e1, T->e2}, c[3];
-  oc_etay_polymul(pa, pb, R, c);
-  double ka = fabs(bm->v), kb = fabs(T->v), k = fabs(a);
-  m->v += a * (bm->v * T->v);
-  m->gx += a * (bm->v * T->gx + T->v * bm->gx);
-  m->gy += a * (bm->v * T->gy + T->v * bm->gy);
-  m->e0 += k * (ka * T->e0 + kb * bm->e0 + c[0]);
-  m->e1 += k * (ka * T->e1 + kb * bm->e1 + c[1]);
-  m->e2 += k * (ka * T->e2 + kb * bm->e2 + c[2]);
-}
-
 /* The filtered sum's model at (u, v) = p - c, its value noise_sum's with
 ** the footprint tf->p; 0 where a filter ramps and tau has no model. The
 ** leading octaves, whose filter is 1 on the whole disc, are summed as
@@ -357,19 +346,15 @@ static int noise_taylor_lod(const oc_enoise *nz, double u, double v, double R,
     oc_etay ti = tau, T;
     ti.v = tau.v - i * dt;
     double bw = oc_elod_b(ti.v, &db);
-    double e = 2 * ev[i] - 1, term;
-    if (nz->kind != OC_ENOISE_RIDGED) { /* (octave_term's, inline) */
-      int turb = nz->kind == OC_ENOISE_TURBULENCE;
-      T = octave_model(e, g, q.s, R, turb);
-      term = turb ? fabs(e) : e;
-    } else {
-      term = octave_term(nz, i, e, g, q.s, R, &q.prev, &q.tprev, &T);
-    }
+    double term =
+        octave_term(nz, i, 2 * ev[i] - 1, g, q.s, R, &q.prev, &q.tprev, &T);
     live = live && bw != 0;
     if (live) q.sum += q.a * bw * term;
     oc_etay bm =
         oc_elod_b_taylor_at(&ti, bw, db, tlo - i * dt, thi - i * dt, R);
-    ramp_add(&q.m, &bm, &T, q.a, R);
+    oc_etay at = oc_etay_mul(&bm, &T, R); /* (inline: in registers) */
+    at = oc_etay_scale(&at, q.a);
+    oc_etay_add(&q.m, &at);
   }
   q.m.v = q.sum;
   *o = q.m;

@@ -41,6 +41,7 @@
 */
 #include <math.h>
 
+#include "core/vec.h"
 #include "render/etrace.h"
 #include "render/trace.h"
 
@@ -183,10 +184,9 @@ int oc_etrace_clip(const double lo[3], const double hi[3], oc_vec3 o, oc_vec3 u,
       double x = ta;
       ta = tb, tb = x;
     }
-    /* fmax and fmin to the bit (glibc's: maxsd, minsd, and the other
-    ** operand where one is NaN), inline: they were library calls */
-    a = a > ta || ta != ta ? a : ta;
-    b = b < tb || tb != tb ? b : tb;
+    /* (fmax and fmin to the bit, inline: they were library calls) */
+    a = oc_fmax(a, ta);
+    b = oc_fmin(b, tb);
   }
   if (!(a <= b)) return 0;
   *t0 = a, *t1 = b;
