@@ -443,6 +443,9 @@ typedef struct oc_etfoot {
   ** divisions a disc (oc_elod_tau_taylor took 2.5 % of bench_elev_lod's
   ** LoD primary rays, perf). */
   double R, tc, dlo, dhi, e2;
+  /* the norm of tau's linear part (oc_etay_gnorm of it), for the discs'
+  ** ramping octaves (disc.c, noise_taylor_lod) */
+  double tg;
   int curved;
 } oc_etfoot;
 /* Fills tf's shared parts of tau's model for the disc of radius R (tf->p
