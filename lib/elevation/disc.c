@@ -311,8 +311,8 @@ octaves_taylor(const oc_enoise *nz, int i0, int i1, const double *ev,
 ** leading octaves, whose filter is 1 on the whole disc, are summed as
 ** at full detail; each of the next is its filter's model times its
 ** term's. */
-static int noise_taylor_lod(const oc_enoise *nz, double u, double v, double R,
-                            const oc_etfoot *tf, oc_etay *o) {
+static int noise_taylor_lod(const oc_enoise *nz, double lw, double u, double v,
+                            double R, const oc_etfoot *tf, oc_etay *o) {
   oc_etay tau;
   oc_etfoot own;
   if (!(tf->R == R)) { /* (not prepared for this disc: as oc_elod_tau_taylor) */
@@ -321,7 +321,7 @@ static int noise_taylor_lod(const oc_enoise *nz, double u, double v, double R,
     tf = &own;
   }
   double tlo, thi, dt = octave_dt(nz);
-  int curved = oc_elod_tau_taylor(nz->wavelength, tf, R, &tau, &tlo, &thi);
+  int curved = oc_elod_tau_taylor_l(lw, tf, &tau, &tlo, &thi);
   /* the octaves whose filter is not 0 on the whole disc (cnt), the
   ** leading ones whose filter is 1 there (whole); their noise at p in one
   ** call (as noise_sum) */
@@ -429,7 +429,8 @@ int oc_edisc_taylor_f_view(const oc_enode *n, double x, double y, double R,
   }
   oc_enoise noise;
   oc_edisc_noise(n, &noise);
-  if (!noise_taylor_lod(&noise, x - p[0], y - p[1], R, tf, f)) return 0;
+  if (!noise_taylor_lod(&noise, oc_edisc_lw(n), x - p[0], y - p[1], R, tf, f))
+    return 0;
   f->v = p[3] + f->v;
   return 1;
 }
@@ -467,9 +468,8 @@ void oc_edisc_noise(const oc_enode *n, oc_enoise *nz) {
 
 size_t oc_edisc_size(int nzkind, int flags) {
   if (nzkind == OC_ENOISE_NONE) return offsetof(oc_edisc, amplitude);
-  if (flags & OC_EF_GLDEF) return offsetof(oc_edisc, gl);
-  if (flags & OC_EF_GLF) return offsetof(oc_edisc, gl) + 2 * sizeof(float);
-  return offsetof(oc_edisc, gl) + 2 * sizeof(double);
+  if (flags & OC_EF_GLDEF) return offsetof(oc_edisc, gl) + sizeof(double);
+  return offsetof(oc_edisc, gl) + 2 * sizeof(double); /* (GLF: and lw) */
 }
 
 /* The bound over the whole plane: the noise's, from noise_bounds at
@@ -534,8 +534,9 @@ void oc_edisc_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
   octlod lod, *lp = NULL;
   if (ft && ft->v > 0 && noise.kind != OC_ENOISE_NONE) {
     double c = -1 / (ft->v * 0.69314718055994530942);
-    lod = (octlod){log2(noise.wavelength / ft->v), octave_dt(&noise),
-                   c * ft->gx, c * ft->gy};
+    /* (t0 as the models' tau: oc_elod_tau_taylor_l) */
+    lod = (octlod){oc_edisc_lw(n) - log2(ft->v), octave_dt(&noise), c * ft->gx,
+                   c * ft->gy};
     lp = &lod;
   }
   s->f = p[3] + (noise.kind == OC_ENOISE_NONE
@@ -901,9 +902,12 @@ oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err) {
     d->nhi = hi;
     d->nlip = lip;
     n->flags = (uint8_t)flags;
-    if (flags & OC_EF_GLF) {
+    if (flags & OC_EF_GLDEF) {
+      d->gl.lw = log2(nz.wavelength);
+    } else if (flags & OC_EF_GLF) {
       d->gl.f[0] = (float)nz.gain;
       d->gl.f[1] = (float)nz.lacunarity;
+      d->gl.lwf = log2(nz.wavelength);
     } else if (!flags) {
       d->gl.d[0] = nz.gain;
       d->gl.d[1] = nz.lacunarity;

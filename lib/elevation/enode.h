@@ -116,8 +116,8 @@ typedef struct oc_eboundf {
   float flo, fhi, alo, ahi, lf, la;
 } oc_eboundf;
 
-/* disc: 40 bytes; with a noise 80, 88 when gain and lacunarity are not
-** the defaults but floats, 96 else. */
+/* disc: 40 bytes; with a noise 88, 96 when gain and lacunarity are not
+** the defaults (floats or not). */
 typedef struct oc_edisc {
   oc_enode h;
   double par[4]; /* cx, cy, radius, height */
@@ -127,10 +127,16 @@ typedef struct oc_edisc {
   /* the noise sum's bound over the plane (disc.c, noise_bounds): its
   ** range [-nhi, nhi] (plain) or [0, nhi], its Lipschitz bound nlip */
   double nhi, nlip;
+  /* gain, lacunarity (none with OC_EF_GLDEF), then log2(wavelength)
+  ** where it fits the 96 bytes of the general case (oc_edisc_lw) */
   union {
-    float f[2]; /* OC_EF_GLF */
+    double lw; /* OC_EF_GLDEF */
+    struct {
+      float f[2];
+      double lwf;
+    }; /* OC_EF_GLF */
     double d[2];
-  } gl; /* gain, lacunarity (none with OC_EF_GLDEF) */
+  } gl;
 } oc_edisc;
 
 /* curve, lake, image: 96 bytes, and their data (skeleton, profiles,
@@ -444,8 +450,9 @@ typedef struct oc_etfoot {
   ** LoD primary rays, perf). */
   double R, tc, dlo, dhi, e2;
   /* the norm of tau's linear part (oc_etay_gnorm of it), for the discs'
-  ** ramping octaves (disc.c, noise_taylor_lod) */
-  double tg;
+  ** ramping octaves (disc.c, noise_taylor_lod); log2(p.v), the discs'
+  ** tau(p) being their lw minus it (oc_edisc.lw) */
+  double tg, lf;
   int curved;
 } oc_etfoot;
 /* Fills tf's shared parts of tau's model for the disc of radius R (tf->p
@@ -591,6 +598,34 @@ void oc_elod_bound_in(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
 ** else are made afresh: the same bits either way. */
 int oc_elod_tau_taylor(double w, const oc_etfoot *tf, double R, oc_etay *m,
                        double *lo, double *hi);
+/* The same for a disc, tau(p) = lw - tf->lf (oc_edisc.lw, its evaluation's
+** t0 bit for bit), tf prepared for R (oc_etfoot_prep): a subtraction
+** where a log2 per disc and a call were (its latency stalled the LoD sum,
+** whose octave counts it decides). */
+/* log2 of a noisy disc's wavelength: under a view its octave i's t =
+** log2(w_i / foot) is lw - log2(foot) - i dt, the footprint's log2 made
+** once per query for every disc's model (oc_etfoot.lf) and the disc's
+** kept where the gain and lacunarity leave room (the default ones: the
+** commonest), else made here. A log2 per disc model was 15 of its 130
+** ns (10 octaves, 5-7 of them kept). */
+static inline double oc_edisc_lw(const oc_enode *n) {
+  const oc_edisc *d = (const oc_edisc *)n;
+  if (n->flags & OC_EF_GLDEF) return d->gl.lw;
+  if (n->flags & OC_EF_GLF) return d->gl.lwf;
+  return log2(d->wavelength);
+}
+
+static inline int oc_elod_tau_taylor_l(double lw, const oc_etfoot *tf,
+                                       oc_etay *m, double *lo, double *hi) {
+  double v = lw - tf->lf;
+  *m = (oc_etay){v, tf->tc * tf->p.gx, tf->tc * tf->p.gy, 0, 0, 0};
+  double pad = 1e-12 * (1 + fabs(v)); /* (against rounding) */
+  *lo = v - tf->dlo - pad;
+  *hi = tf->curved ? v + tf->dhi + pad : INFINITY;
+  if (!tf->curved) return 0;
+  m->e2 = tf->e2;
+  return 1;
+}
 /* b(t) for the model t of an argument whose range on the disc is [lo,
 ** hi]: its value oc_elod_b(t->v). */
 oc_etay oc_elod_b_taylor(const oc_etay *t, double lo, double hi, double R);
