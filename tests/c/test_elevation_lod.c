@@ -591,6 +591,69 @@ START_TEST(lod_taylor_models) {
 }
 END_TEST
 
+/* A disc's log2 of its wavelength, kept where its gain and lacunarity
+** leave room (the defaults, floats exactly: 88 and 96 bytes) and made
+** where they do not (96), is log2's bits either way (enode.h,
+** oc_edisc_lw); under a view its models' tau(p) is that minus the
+** footprint's log2 made once per query (oc_etfoot_prep: lf, and tg the
+** norm of tau's linear part, both the bits the per-disc rule computed),
+** the evaluator's t0 the same bits, so that for each storage the LoD
+** models are the evaluator's values and hold (check_view_taylor), on
+** ramping octaves too (a near view: every point's finest kept octave
+** ramps). */
+START_TEST(disc_lod_wavelength_log) {
+  oc_error err;
+  double gl[3][2] = {{0, 0}, {0.375, 2}, {0.45, 2.13}};
+  size_t bytes[3] = {88, 96, 96};
+  oc_enoise_kind kinds[3] = {OC_ENOISE_PLAIN, OC_ENOISE_TURBULENCE,
+                             OC_ENOISE_RIDGED};
+  oc_enode_view views[2] = {{{-500, 300, 900}, 3e-3}, {{3000, 0, 5000}, 0.02}};
+  oct_rng r = oct_rng_new(31);
+  tay_worst = ramp_worst = 0;
+  for (int g = 0; g < 3; g++) {
+    oc_enode_disc_params p = {
+        0, 0, 20000, 50, {kinds[g], 100, 437, 9, gl[g][0], gl[g][1], 5 + g}};
+    oc_enode *d = EOK(oc_enode_disc(&p, &err));
+    ck_assert_uint_eq(oc_enode_size(d), bytes[g]);
+    double lw = oc_edisc_lw(d);
+    ck_assert(lw == log2(437.0));
+    for (int q = 0; q < 2; q++) {
+      check_view_taylor(d, &views[q], &r, 0);
+      oc_eview w = {views[q].eye[0], views[q].eye[1], mid_dz(d, &views[q]),
+                    views[q].k};
+      for (int i = 0; i < 50; i++) {
+        double x = oct_unif(&r, -4500, 4000), y = oct_unif(&r, -4500, 4000);
+        double R = 4000 * pow(10, oct_unif(&r, -3.5, -0.3));
+        oc_etfoot tf;
+        oc_erect box = {x - R, y - R, x + R, y + R};
+        oc_eview_foot(&w, x, y, &tf.p);
+        oc_eview_footb(&w, &box, &tf.b);
+        oc_etfoot_prep(&tf, R);
+        oc_etay m, ml;
+        double lo, hi, lol, hil;
+        int c = oc_elod_tau_taylor(437, &tf, R, &m, &lo, &hi);
+        int cl = oc_elod_tau_taylor_l(lw, &tf, &ml, &lol, &hil);
+        ck_assert(tf.lf == log2(tf.p.v) && tf.tg == oc_etay_gnorm(&m));
+        ck_assert(ml.v == lw - tf.lf && c == cl);
+        ck_assert(ml.gx == m.gx && ml.gy == m.gy && ml.e2 == m.e2);
+        /* log2(w / foot) and log2 w - log2 foot: a few ulps apart, well
+        ** inside the ranges' padding of 1e-12 */
+        ck_assert(fabs(ml.v - m.v) <= 1e-14 * (1 + fabs(m.v)));
+        ck_assert(lol <= ml.v && ml.v <= hil);
+        /* the evaluator's filtered sum is the model's value */
+        oc_enode_sample s;
+        oc_etay f;
+        oc_enode_ev(d, x, y, &tf.p, 0, &s);
+        ck_assert(oc_edisc_taylor_f_view(d, x, y, R, &tf, &f));
+        ck_assert_msg(f.v == s.f, "f %.17g, eval %.17g", f.v, s.f);
+      }
+    }
+    oc_enode_release(d);
+  }
+  ck_assert(tay_worst <= 1 && tay_worst > 0.01);
+}
+END_TEST
+
 /* ---- tracing --------------------------------------------------------- */
 
 /* First t where o + t d is on or below the surface (inside the domain,
@@ -819,6 +882,7 @@ int main(void) {
   tcase_add_loop_test(tc, gradients_with_lod, 0, 2);
   tcase_add_test(tc, bounds_with_lod);
   tcase_add_test(tc, lod_taylor_models);
+  tcase_add_test(tc, disc_lod_wavelength_log);
   tcase_add_loop_test(tc, lod_trace_against_march, 0, 2);
   tcase_add_test(tc, coarser_levels);
   suite_add_tcase(s, tc);
