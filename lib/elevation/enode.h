@@ -21,6 +21,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "core/log2.h"
 #include "core/pmap.h"
 #include "core/vec.h"
 #include "elevation/etaylor.h"
@@ -116,8 +117,8 @@ typedef struct oc_eboundf {
   float flo, fhi, alo, ahi, lf, la;
 } oc_eboundf;
 
-/* disc: 40 bytes; with a noise 88, 96 when gain and lacunarity are not
-** the defaults (floats or not). */
+/* disc: 40 bytes; with a noise 80, 88 when gain and lacunarity are not
+** the defaults but floats, 96 else. */
 typedef struct oc_edisc {
   oc_enode h;
   double par[4]; /* cx, cy, radius, height */
@@ -127,16 +128,10 @@ typedef struct oc_edisc {
   /* the noise sum's bound over the plane (disc.c, noise_bounds): its
   ** range [-nhi, nhi] (plain) or [0, nhi], its Lipschitz bound nlip */
   double nhi, nlip;
-  /* gain, lacunarity (none with OC_EF_GLDEF), then log2(wavelength)
-  ** where it fits the 96 bytes of the general case (oc_edisc_lw) */
   union {
-    double lw; /* OC_EF_GLDEF */
-    struct {
-      float f[2];
-      double lwf;
-    }; /* OC_EF_GLF */
+    float f[2]; /* OC_EF_GLF */
     double d[2];
-  } gl;
+  } gl; /* gain, lacunarity (none with OC_EF_GLDEF) */
 } oc_edisc;
 
 /* curve, lake, image: 96 bytes, and their data (skeleton, profiles,
@@ -451,7 +446,7 @@ typedef struct oc_etfoot {
   double R, tc, dlo, dhi, e2;
   /* the norm of tau's linear part (oc_etay_gnorm of it), for the discs'
   ** ramping octaves (disc.c, noise_taylor_lod); log2(p.v), the discs'
-  ** tau(p) being their lw minus it (oc_edisc.lw) */
+  ** tau(p) being their lw minus it (oc_edisc_lw) */
   double tg, lf;
   int curved;
 } oc_etfoot;
@@ -598,23 +593,21 @@ void oc_elod_bound_in(const oc_enode *n, const oc_erect *b, const oc_efootb *fb,
 ** else are made afresh: the same bits either way. */
 int oc_elod_tau_taylor(double w, const oc_etfoot *tf, double R, oc_etay *m,
                        double *lo, double *hi);
-/* The same for a disc, tau(p) = lw - tf->lf (oc_edisc.lw, its evaluation's
-** t0 bit for bit), tf prepared for R (oc_etfoot_prep): a subtraction
-** where a log2 per disc and a call were (its latency stalled the LoD sum,
-** whose octave counts it decides). */
 /* log2 of a noisy disc's wavelength: under a view its octave i's t =
 ** log2(w_i / foot) is lw - log2(foot) - i dt, the footprint's log2 made
 ** once per query for every disc's model (oc_etfoot.lf) and the disc's
-** kept where the gain and lacunarity leave room (the default ones: the
-** commonest), else made here. A log2 per disc model was 15 of its 130
-** ns (10 octaves, 5-7 of them kept). */
+** made here inline (core/log2.h: within 2e-15 + 2^-52 |lw| of log2 w,
+** the models' tau and the evaluation's t0 alike). glibc's log2 per disc
+** model was 15-18 of its 130 ns (10 octaves, 5-7 of them kept); keeping
+** lw in the disc saved them but cost 8 bytes a disc. */
 static inline double oc_edisc_lw(const oc_enode *n) {
-  const oc_edisc *d = (const oc_edisc *)n;
-  if (n->flags & OC_EF_GLDEF) return d->gl.lw;
-  if (n->flags & OC_EF_GLF) return d->gl.lwf;
-  return log2(d->wavelength);
+  return oc_log2(((const oc_edisc *)n)->wavelength);
 }
 
+/* The same for a disc, tau(p) = lw - tf->lf (oc_edisc_lw, its evaluation's
+** t0 bit for bit), tf prepared for R (oc_etfoot_prep): a subtraction
+** where a call of log2 per disc was (its latency stalled the LoD sum,
+** whose octave counts it decides). */
 static inline int oc_elod_tau_taylor_l(double lw, const oc_etfoot *tf,
                                        oc_etay *m, double *lo, double *hi) {
   double v = lw - tf->lf;

@@ -180,14 +180,15 @@ END_TEST
 ** oc_eta (plain, |eta| or the ridged chain t_i = w_i (1 - |eta_i|)^2,
 ** w_i = clamp(2 t_(i-1), 0, 1)), under a footprint ft weighted
 ** b(log2(w_i / foot)) (the lod filter, with its gradient's terms), t_0
-** = log2(w) - log2(foot) (a disc keeps log2(w): enode.h, oc_edisc_lw). */
+** = log2 w - log2 foot, log2 w made inline as a disc makes it (enode.h,
+** oc_edisc_lw: core/log2.h). */
 static double ref_noise(const oc_enoise *nz, double u, double v,
                         const oc_efoot *ft, double g[2]) {
   double sum = 0, a = nz->amplitude, s = 1 / nz->wavelength, prev = 1;
   double pg[2] = {0, 0}, t0 = 0, dt = 0, c = 0;
   g[0] = g[1] = 0;
   if (ft) {
-    t0 = log2(nz->wavelength) - log2(ft->v), dt = log2(nz->lacunarity);
+    t0 = oc_log2(nz->wavelength) - log2(ft->v), dt = log2(nz->lacunarity);
     c = -1 / (ft->v * 0.69314718055994530942);
   }
   for (int i = 0; i < nz->octaves; i++, s *= nz->lacunarity) {
@@ -639,16 +640,16 @@ START_TEST(dag_stats_and_source) {
   ck_assert_uint_eq(st.nodes, 4); /* hill shared */
   ck_assert_uint_eq(st.primitives, 2);
   /* nodes are allocated at their kind's size (enode.h): a noisy disc
-  ** 8 + 4 parameters + amplitude, wavelength, seed, the noise's range
-  ** and slope over the plane and log2 of the wavelength (8 each), gain
-  ** and lacunarity the defaults (not stored); a transform 8 + a float
-  ** box + its child + 8 parameters; a blend 8 + float box and bound + a
-  ** count + its 3 children; each counted once */
-  ck_assert_uint_eq(oc_enode_size(base), 8 + 4 * 8 + 6 * 8);
-  ck_assert_uint_eq(oc_enode_size(hill), 88);
+  ** 8 + 4 parameters + amplitude, wavelength, seed and the noise's
+  ** range and slope over the plane (8 each), gain and lacunarity the
+  ** defaults (not stored); a transform 8 + a float box + its child + 8
+  ** parameters; a blend 8 + float box and bound + a count + its 3
+  ** children; each counted once */
+  ck_assert_uint_eq(oc_enode_size(base), 8 + 4 * 8 + 5 * 8);
+  ck_assert_uint_eq(oc_enode_size(hill), 80);
   ck_assert_uint_eq(oc_enode_size(moved), 8 + 16 + 8 + 8 * 8);
   ck_assert_uint_eq(oc_enode_size(e), 8 + 16 + 24 + 8 + 3 * 8);
-  ck_assert_uint_eq(st.bytes, 88 + 88 + 96 + 80);
+  ck_assert_uint_eq(st.bytes, 80 + 80 + 96 + 80);
   /* the source answers the tree's own values and bounds */
   oc_elevation src;
   ck_assert_int_eq(oc_enode_elevation(e, NULL, &src, &err), OC_OK);

@@ -591,20 +591,58 @@ START_TEST(lod_taylor_models) {
 }
 END_TEST
 
-/* A disc's log2 of its wavelength, kept where its gain and lacunarity
-** leave room (the defaults, floats exactly: 88 and 96 bytes) and made
-** where they do not (96), is log2's bits either way (enode.h,
-** oc_edisc_lw); under a view its models' tau(p) is that minus the
-** footprint's log2 made once per query (oc_etfoot_prep: lf, and tg the
-** norm of tau's linear part, both the bits the per-disc rule computed),
-** the evaluator's t0 the same bits, so that for each storage the LoD
-** models are the evaluator's values and hold (check_view_taylor), on
-** ramping octaves too (a near view: every point's finest kept octave
-** ramps). */
+/* oc_log2 (core/log2.h), the log2 of a disc's wavelength under a view:
+** within 2e-15 + 2^-52 |log2 w| of log2 w (long double's, 64 bits) on
+** 10^5 wavelengths from 1e-3 to 1e9 and on mantissas j / 128, (j +
+** 1/2) / 128 (where its table's index turns) and just below (j + 1) /
+** 128 in several octaves, powers of two exact; oc_log2_coarse within
+** log2(1 / (1 - 2^-8)) < 0.00565 of it,
+** the margin disc.c's octave counts take below their 2^-7. */
+START_TEST(log2_inline_accuracy) {
+  oct_rng r = oct_rng_new(59);
+  double worst = 0, cworst = 0;
+  for (int i = 0; i < 100000 + 128 * 3 * 12; i++) {
+    double w;
+    if (i < 100000) {
+      w = pow(10, oct_unif(&r, -3, 9));
+    } else {
+      int k = i - 100000, j = k % 128, e = (k / 384) - 5;
+      double m = 1 + (j + 0.5 * ((k / 128) % 3)) / 128; /* j, j + 1/2 */
+      if ((k / 128) % 3 == 2) m = nextafter(1 + (j + 1) / 128.0, 0);
+      w = ldexp(m, 3 * e);
+    }
+    double lw = oc_log2(w), lc = oc_log2_coarse(w);
+    long double ex = log2l((long double)w);
+    double err = (double)fabsl((long double)lw - ex);
+    ck_assert_msg(err <= 2e-15 + 0x1p-52 * fabs(lw), "log2 %.17g: %g off", w,
+                  err);
+    if (err > worst) worst = err;
+    double cerr = fabs(lc - lw);
+    ck_assert_msg(cerr < 0.00565, "coarse log2 %.17g: %g off", w, cerr);
+    if (cerr > cworst) cworst = cerr;
+  }
+  for (int e = -20; e <= 40; e++)
+    ck_assert(oc_log2(ldexp(1, e)) == e);
+  /* (the bound is not loose by orders: the polynomial and sums round) */
+  ck_assert(worst > 1e-17 && cworst > 0.005);
+  printf("oc_log2: at most %.3g from log2, coarse %.5f\n", worst, cworst);
+}
+END_TEST
+
+/* A disc's log2 of its wavelength, made inline (enode.h, oc_edisc_lw:
+** core/log2.h, no bytes kept: a noisy disc is 80 bytes, 88 with float
+** gain and lacunarity, 96 else), within 1e-14 of log2's; under a view
+** its models' tau(p) is that minus the footprint's log2 made once per
+** query (oc_etfoot_prep: lf, and tg the norm of tau's linear part, both
+** the bits the per-disc rule computed), the evaluator's t0 the same bits,
+** so that for each storage the LoD models are the evaluator's values and
+** hold (check_view_taylor), on ramping octaves too (a near view: every
+** point's finest kept octave ramps), the octave counts made from the
+** coarse log2 where it is sure and from tau's range where not. */
 START_TEST(disc_lod_wavelength_log) {
   oc_error err;
   double gl[3][2] = {{0, 0}, {0.375, 2}, {0.45, 2.13}};
-  size_t bytes[3] = {88, 96, 96};
+  size_t bytes[3] = {80, 88, 96};
   oc_enoise_kind kinds[3] = {OC_ENOISE_PLAIN, OC_ENOISE_TURBULENCE,
                              OC_ENOISE_RIDGED};
   oc_enode_view views[2] = {{{-500, 300, 900}, 3e-3}, {{3000, 0, 5000}, 0.02}};
@@ -616,7 +654,7 @@ START_TEST(disc_lod_wavelength_log) {
     oc_enode *d = EOK(oc_enode_disc(&p, &err));
     ck_assert_uint_eq(oc_enode_size(d), bytes[g]);
     double lw = oc_edisc_lw(d);
-    ck_assert(lw == log2(437.0));
+    ck_assert(lw == oc_log2(437.0) && fabs(lw - log2(437.0)) <= 1e-14);
     for (int q = 0; q < 2; q++) {
       check_view_taylor(d, &views[q], &r, 0);
       oc_eview w = {views[q].eye[0], views[q].eye[1], mid_dz(d, &views[q]),
@@ -646,6 +684,28 @@ START_TEST(disc_lod_wavelength_log) {
         oc_enode_ev(d, x, y, &tf.p, 0, &s);
         ck_assert(oc_edisc_taylor_f_view(d, x, y, R, &tf, &f));
         ck_assert_msg(f.v == s.f, "f %.17g, eval %.17g", f.v, s.f);
+      }
+      /* a sweep across footprints (a line away from the eye, tau moving
+      ** by 1e-3 octave or less a step, the radius scattered): the octave
+      ** counts near each threshold, from the coarse log2 where it is sure
+      ** and from tau's range where not, keep model and evaluator equal
+      ** (a count one too low, or a ramping octave taken whole, would not:
+      ** with a margin of 2^-11 instead of 2^-7, below the coarse log2's
+      ** error, point 2156 of the near view differs by 1.2e-9) */
+      for (int i = 0; i < 3000; i++) {
+        double x = -4500 + 8500 * (i / 3000.0), y = 0.2 * x + 100;
+        double R = 4000 * pow(10, -3.5 + 3.2 * ((i * 7) % 3000) / 3000.0);
+        oc_etfoot tf;
+        oc_erect box = {x - R, y - R, x + R, y + R};
+        oc_eview_foot(&w, x, y, &tf.p);
+        oc_eview_footb(&w, &box, &tf.b);
+        oc_etfoot_prep(&tf, R);
+        oc_enode_sample s;
+        oc_etay f;
+        oc_enode_ev(d, x, y, &tf.p, 0, &s);
+        if (oc_edisc_taylor_f_view(d, x, y, R, &tf, &f))
+          ck_assert_msg(f.v == s.f, "sweep %d: f %.17g, eval %.17g", i, f.v,
+                        s.f);
       }
     }
     oc_enode_release(d);
@@ -882,6 +942,7 @@ int main(void) {
   tcase_add_loop_test(tc, gradients_with_lod, 0, 2);
   tcase_add_test(tc, bounds_with_lod);
   tcase_add_test(tc, lod_taylor_models);
+  tcase_add_test(tc, log2_inline_accuracy);
   tcase_add_test(tc, disc_lod_wavelength_log);
   tcase_add_loop_test(tc, lod_trace_against_march, 0, 2);
   tcase_add_test(tc, coarser_levels);

@@ -137,7 +137,7 @@ START_TEST(bytes_per_kind) {
   struct {
     oc_enode *e;
     size_t bytes;
-  } want[] = {{plain, 40}, {noisy, 88}, {fl, 96},    {odd, 96},   {riv, 96},
+  } want[] = {{plain, 40}, {noisy, 80}, {fl, 88},    {odd, 96},   {riv, 96},
               {lake, 96},  {img, 96},   {bl, 72},    {rep, 64},   {lerp, 64},
               {add, 64},   {addb, 80},  {adds, 100}, {adds1, 88}, {moved, 96},
               {warp, 72},  {lod, 88}};
