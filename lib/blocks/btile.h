@@ -24,6 +24,11 @@ typedef struct oc_bdisc {
   double r;
 } oc_bdisc;
 
+/* A fracture disc's radius is at most this many tile sizes: a larger one
+** cuts the periodic tile over and over (its images grow as the cube of
+** radius / size) and tells nothing more. */
+#define OC_BTILE_MAX_DISC_SIZES 16.0
+
 /* A periodic image of a disc (its centre shifted by a multiple of s) with
 ** the box around it. */
 typedef struct oc_bimage {
@@ -71,8 +76,8 @@ struct oc_btile {
   size_t merged; /* small clusters merged into a neighbour (merge.c) */
   size_t nauth;  /* authored blocks (authored.c), the last nauth of block */
   oc_bblock *auth;
-  size_t gcut;   /* a loaded tile's cut edges (tio.c): its g holds only
-                 ** the count of edges, g.ne, and no arrays */
+  size_t gcut; /* a loaded tile's cut edges (tio.c): its g holds only
+               ** the count of edges, g.ne, and no arrays */
   double seconds;
 };
 

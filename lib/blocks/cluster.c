@@ -227,7 +227,8 @@ int oc_bclusters_make(oc_btile *t, oc_error *err) {
   int rc = OC_ENOMEM;
   if (!order || !tried || !t->label || !t->unwrap || !w.mem) goto done;
   oc_aabb in = {{-s, -s, -s}, {2 * s, 2 * s, 2 * s}};
-  if (oc_bdiscs_images(t, in, &im, &w.nim, err)) goto done;
+  if ((rc = oc_bdiscs_images(t, in, &im, &w.nim, err))) goto done;
+  rc = OC_ENOMEM;
   w.im = im;
   w.near = malloc((w.nim ? w.nim : 1) * sizeof *w.near);
   w.cand = malloc((w.nim ? w.nim : 1) * sizeof *w.cand);

@@ -175,17 +175,49 @@ int oc_bdiscs_make(oc_btile *t, oc_error *err) {
 
 /* Image index range along one axis: shifts k with [c + k s - e, c + k s +
 ** e] meeting [lo, hi]. */
-static void krange(double c, double e, double s, double lo, double hi, int *k0,
-                   int *k1) {
-  *k0 = (int)ceil((lo - c - e) / s);
-  *k1 = (int)floor((hi - c + e) / s);
+static void krange(double c, double e, double s, double lo, double hi,
+                   double *k0, double *k1) {
+  *k0 = ceil((lo - c - e) / s);
+  *k1 = floor((hi - c + e) / s);
 }
+
+/* At most this many images of all discs together: the tile's checks
+** keep radii within OC_BTILE_MAX_DISC_SIZES sizes, but many large discs
+** could still ask for billions. Table 1's tiles make about 2 000; 5
+** million (250 discs of 16 sizes) took 139 s to cut the graph. */
+#define MAX_IMAGES 1e6
 
 int oc_bdiscs_images(const oc_btile *t, oc_aabb in, oc_bimage **out, size_t *n,
                      oc_error *err) {
   double s = t->pp.size;
   size_t cap = 0, m = 0;
   int k0[3], k1[3];
+  /* the images' count first, in doubles: ranges are refused before a
+  ** loop or an int sees them; counted over the widest box the tile asks
+  ** ([-s, 2s] a side: clusters and merging), so that the first call (the
+  ** graph's cut, over a smaller box) refuses what a later one would,
+  ** before its work */
+  double total = 0;
+  for (size_t i = 0; i < t->nd; i++) {
+    const oc_bdisc *d = &t->disc[i];
+    double n3[3] = {d->n.x, d->n.y, d->n.z}, c3[3] = {d->c.x, d->c.y, d->c.z};
+    double lo3[3] = {fmin(in.lo.x, -s), fmin(in.lo.y, -s), fmin(in.lo.z, -s)},
+           hi3[3] = {fmax(in.hi.x, 2 * s), fmax(in.hi.y, 2 * s),
+                     fmax(in.hi.z, 2 * s)},
+           cnt = 1;
+    for (int a = 0; a < 3; a++) {
+      double e = d->r * sqrt(fmax(0, 1 - n3[a] * n3[a])), a0, a1;
+      krange(c3[a], e, s, lo3[a], hi3[a], &a0, &a1);
+      cnt *= a1 >= a0 ? a1 - a0 + 1 : 0;
+    }
+    total += cnt;
+  }
+  if (!(total <= MAX_IMAGES))
+    return oc_seterr(err, OC_EINVAL,
+                     "the fracture discs make %g periodic images in the tile "
+                     "(at most %g): smaller 'disc_radius' or fewer "
+                     "'fractures'",
+                     total, MAX_IMAGES);
   for (int pass = 0; pass < 2; pass++) {
     for (size_t i = 0; i < t->nd; i++) {
       const oc_bdisc *d = &t->disc[i];
@@ -194,7 +226,9 @@ int oc_bdiscs_images(const oc_btile *t, oc_aabb in, oc_bimage **out, size_t *n,
              hi3[3] = {in.hi.x, in.hi.y, in.hi.z}, e[3];
       for (int a = 0; a < 3; a++) {
         e[a] = d->r * sqrt(fmax(0, 1 - n3[a] * n3[a]));
-        krange(c3[a], e[a], s, lo3[a], hi3[a], &k0[a], &k1[a]);
+        double a0, a1;
+        krange(c3[a], e[a], s, lo3[a], hi3[a], &a0, &a1);
+        k0[a] = (int)a0, k1[a] = (int)a1; /* (within MAX_IMAGES: small) */
       }
       for (int kz = k0[2]; kz <= k1[2]; kz++)
         for (int ky = k0[1]; ky <= k1[1]; ky++)

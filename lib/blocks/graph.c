@@ -156,7 +156,8 @@ static int cut(oc_btile *t, const cells *c, oc_error *err) {
   oc_bimage *im;
   size_t nim;
   oc_aabb in = {{-reach, -reach, -reach}, {s + reach, s + reach, s + reach}};
-  if (oc_bdiscs_images(t, in, &im, &nim, err)) return OC_ENOMEM;
+  int rc = oc_bdiscs_images(t, in, &im, &nim, err);
+  if (rc) return rc;
   for (size_t d = 0; d < nim; d++) {
     const oc_bimage *D = &im[d];
     double lo[3] = {D->box.lo.x - reach, D->box.lo.y - reach,

@@ -138,7 +138,8 @@ int oc_bclusters_merge(oc_btile *t, oc_error *err) {
   double s = t->pp.size;
   oc_aabb in = {{-s, -s, -s}, {2 * s, 2 * s, 2 * s}};
   if (!l.head || !l.tail || !l.count || !l.next || !renum) goto done;
-  if (oc_bdiscs_images(t, in, &im, &nim, err)) goto done;
+  if ((rc = oc_bdiscs_images(t, in, &im, &nim, err))) goto done;
+  rc = OC_ENOMEM;
   for (size_t c = 0; c < nc; c++)
     l.head[c] = l.tail[c] = NONE;
   for (size_t i = 0; i < n; i++) {
@@ -165,7 +166,8 @@ int oc_bclusters_merge(oc_btile *t, oc_error *err) {
   t->ncl = m;
   rc = 0;
 done:
-  if (rc) oc_seterr(err, OC_ENOMEM, "out of memory for merging clusters");
+  if (rc == OC_ENOMEM)
+    oc_seterr(err, OC_ENOMEM, "out of memory for merging clusters");
   free(l.head);
   free(l.tail);
   free(l.count);

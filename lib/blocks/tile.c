@@ -91,6 +91,11 @@ static int check(const oc_btile_params *pp, oc_error *err) {
                      "'disc_radius' must be {lo, hi} with 0 < lo <= hi (got "
                      "%g, %g)",
                      pp->disc_lo, pp->disc_hi);
+  if (pp->disc_hi > OC_BTILE_MAX_DISC_SIZES * pp->size)
+    return oc_seterr(err, OC_EINVAL,
+                     "'disc_radius' %g is too large for a tile of 'size' %g "
+                     "(at most %g sizes)",
+                     pp->disc_hi, pp->size, OC_BTILE_MAX_DISC_SIZES);
   if (!(pp->rounding >= 0) || !isfinite(pp->rounding))
     return oc_seterr(err, OC_EINVAL, "'rounding' must be >= 0 (got %g)",
                      pp->rounding);
@@ -116,6 +121,11 @@ static int check(const oc_btile_params *pp, oc_error *err) {
       return oc_seterr(err, OC_EINVAL,
                        "'discs[%zu].radius' must be > 0 (got %g)", i + 1,
                        d->radius);
+    if (d->radius > OC_BTILE_MAX_DISC_SIZES * pp->size)
+      return oc_seterr(err, OC_EINVAL,
+                       "'discs[%zu].radius' %g is too large for a tile of "
+                       "'size' %g (at most %g sizes)",
+                       i + 1, d->radius, pp->size, OC_BTILE_MAX_DISC_SIZES);
   }
   return 0;
 }

@@ -110,6 +110,20 @@ describe("outcrop.blocks.tile errors", function()
     check(function() B.tile{disc_radius = {3, 1}} end, "outcrop.blocks.tile", "'disc_radius' must be {lo, hi}")
     check(function() B.tile{size = 8, radius = 0.5, fractures = 5000} end, "outcrop.blocks.tile", "could place only")
   end)
+
+  it("refuses discs that would wrap the periodic tile without end", function()
+    -- (a fuzzer's disc radius of math.maxinteger made 3.7e17 images a side)
+    check(function() B.tile{size = 6, radius = 0.75, disc_radius = {6, math.maxinteger}} end,
+      "outcrop.blocks.tile", "'disc_radius' 9.22337e+18 is too large for a tile of 'size' 6 (at most 16 sizes)")
+    check(function() B.tile{size = 8, radius = 0.5, discs = {{center = {1, 2, 3}, normal = {0, 0, 1}, radius = 1e9}}} end,
+      "outcrop.blocks.tile", "'discs[1].radius' 1e+09 is too large")
+    -- each within 16 sizes, but 500 of them make 1.7 million images
+    check(function() B.tile{disc_radius = {300, 320}, fractures = 500} end,
+      "outcrop.blocks.tile", "periodic images in the tile (at most 1e+06)")
+    -- 16 sizes still builds
+    local big = B.tile{size = 8, radius = 0.5, disc_radius = {100, 128}, fractures = 2, spacing = 1}
+    assert.is_true(big:stats().blocks >= 1)
+  end)
 end)
 
 describe("outcrop.blocks.replicate", function()
