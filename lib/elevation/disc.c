@@ -216,18 +216,20 @@ static void noise_bounds(const oc_enoise *nz, const oc_efootb *fb,
 ** there is its term's model alone. */
 
 static oc_etay octave_model(double e, const double g[2], double s, double R,
-                            int absval);
+                            int absval, double k);
 
 /* Octave i's term at frequency s from its noise e (gradient g, lattice
 ** units), as noise_sum computes it, and its model in *t; the ridged
-** chain's previous term and model in *prev and *tprev (updated). Full
-** detail (noise_taylor) and the filtered sum alike. */
+** chain's previous term and model in *prev and *tprev (updated), k
+** octave_model's split. Full detail (noise_taylor) and the filtered sum
+** alike. */
 static double ridged_term(int i, double e, const double g[2], double s,
-                          double R, double *prev, oc_etay *tprev, oc_etay *t) {
+                          double R, double k, double *prev, oc_etay *tprev,
+                          oc_etay *t) {
   /* w rho^2, rho = 1 - |eta| (|eta|'s model negated, plus 1), w =
   ** clamp(2 t_(i-1)) */
   double r = 1 - fabs(e), w = 1;
-  oc_etay rho = octave_model(e, g, s, R, 1), wm = oc_etay_const(1);
+  oc_etay rho = octave_model(e, g, s, R, 1, k), wm = oc_etay_const(1);
   rho.v = r, rho.gx = -rho.gx, rho.gy = -rho.gy;
   if (i > 0) {
     w = RIDGE_GAIN * *prev;
@@ -245,13 +247,13 @@ static double ridged_term(int i, double e, const double g[2], double s,
 /* (plain and turbulent terms inline: a call showed in the LoD sums) */
 static inline __attribute__((always_inline)) double
 octave_term(const oc_enoise *nz, int i, double e, const double g[2], double s,
-            double R, double *prev, oc_etay *tprev, oc_etay *t) {
+            double R, double k, double *prev, oc_etay *tprev, oc_etay *t) {
   if (nz->kind != OC_ENOISE_RIDGED) {
     int turb = nz->kind == OC_ENOISE_TURBULENCE;
-    *t = octave_model(e, g, s, R, turb);
+    *t = octave_model(e, g, s, R, turb, k);
     return turb ? fabs(e) : e;
   }
-  return ridged_term(i, e, g, s, R, prev, tprev, t);
+  return ridged_term(i, e, g, s, R, k, prev, tprev, t);
 }
 
 /* A noise sum's model being summed octave by octave: the sum of the
@@ -273,7 +275,8 @@ static void octsum_init(const oc_enoise *nz, octsum *q) {
 ** octaves whose filter is 1 on the whole disc (the same bits: b = 1). */
 static inline __attribute__((always_inline)) void
 octaves_taylor(const oc_enoise *nz, int i0, int i1, const double *ev,
-               const double *ex, const double *ey, double R, octsum *q) {
+               const double *ex, const double *ey, double R, double k,
+               octsum *q) {
   double sum = q->sum, a = q->a, s = q->s, prev = q->prev;
   oc_etay m = q->m, tprev = q->tprev;
   if (nz->kind != OC_ENOISE_RIDGED) {
@@ -283,7 +286,7 @@ octaves_taylor(const oc_enoise *nz, int i0, int i1, const double *ev,
     int turb = nz->kind == OC_ENOISE_TURBULENCE;
     for (int i = i0; i < i1; i++) {
       double g[2] = {2 * ex[i], 2 * ey[i]}, e = 2 * ev[i] - 1; /* (oc_eta) */
-      oc_etay t = octave_model(e, g, s, R, turb);              /* (inline) */
+      oc_etay t = octave_model(e, g, s, R, turb, k);           /* (inline) */
       double aa = fabs(a);
       sum += a * t.v; /* (octave_term's value: |e| or e) */
       m.gx += a * t.gx, m.gy += a * t.gy;
@@ -297,7 +300,7 @@ octaves_taylor(const oc_enoise *nz, int i0, int i1, const double *ev,
   for (int i = i0; i < i1; i++) {
     double ge[2] = {2 * ex[i], 2 * ey[i]}, e = 2 * ev[i] - 1; /* (oc_eta) */
     oc_etay t;
-    sum += a * octave_term(nz, i, e, ge, s, R, &prev, &tprev, &t);
+    sum += a * octave_term(nz, i, e, ge, s, R, k, &prev, &tprev, &t);
     oc_etay at = oc_etay_scale(&t, a);
     oc_etay_add(&m, &at);
     a = a * nz->gain;
@@ -372,7 +375,7 @@ static int noise_taylor_lod(const oc_enoise *nz, double lw, double u, double v,
   octave_noise(nz, u, v, cnt, ev, ex, ey);
   octsum q;
   octsum_init(nz, &q);
-  octaves_taylor(nz, 0, whole, ev, ex, ey, R, &q);
+  octaves_taylor(nz, 0, whole, ev, ex, ey, R, OC_ETAY_LOD_CHOICE, &q);
   /* the ramping octaves on locals: with q's fields passed by address
   ** (the ridged chain) q lived in memory, its fields stored one by one
   ** and reloaded in pairs, a stalled store forwarding (perf annotate:
@@ -397,7 +400,8 @@ static int noise_taylor_lod(const oc_enoise *nz, double lw, double u, double v,
     double lo = tlo - i * dt, hi = thi - i * dt;
     double bw = oc_elod_b(tau.v - i * dt, &db);
     oc_etay t;
-    double term = octave_term(nz, i, 2 * ev[i] - 1, g, s, R, &prev, &tprev, &t);
+    double term = octave_term(nz, i, 2 * ev[i] - 1, g, s, R, OC_ETAY_LOD_CHOICE,
+                              &prev, &tprev, &t);
     live = live && bw != 0;
     if (live) sum += a * bw * term;
     double bgx = 0, bgy = 0, bg = 0, be2 = 0; /* b's model but its value */
@@ -949,11 +953,12 @@ oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err) {
 **    (Taylor with the integral remainder, |Hessian| <= H s^2);
 **  - or flat (no linear part): |eta(s q) - eta(s p)| <= L s r, and <= 1 +
 **    |eta(s p)| (eta lies in [-1, 1]);
-** whichever bounds the remainder lower at r = OC_ETAY_CHOICE R (each
-** holds up to R). Octaves coarser than R are quadratic (tiny near p),
-** finer ones flat. |eta| (turbulence) is eta
-** times its sign where that sign is proved constant on the disc (|eta(s
-** p)| above its first-order deviation s |grad eta| R + H s^2 R^2 / 2),
+** whichever bounds the remainder lower at r = k R (each holds up to R;
+** k is OC_ETAY_CHOICE, OC_ETAY_LOD_CHOICE for the models under a view).
+** Octaves coarser than R are quadratic (tiny near p), finer ones flat.
+** |eta| (turbulence) is eta times its sign where that sign is proved
+** constant on the disc (|eta(s p)| above its first-order deviation s
+** |grad eta| R + H s^2 R^2 / 2),
 ** else flat (|eta| is L-Lipschitz and in [0, 1]). A ridged octave t_i =
 ** w_i rho_i^2, rho_i = 1 - |eta_i|, w_i = clamp(2 t_(i-1), 0, 1), is
 ** composed by the product and clamp rules (etaylor.h) from rho_i's model
@@ -962,7 +967,7 @@ oc_enode *oc_enode_disc(const oc_enode_disc_params *p, oc_error *err) {
 /* eta (or |eta| with abs, its sign proved constant) in the octave's world
 ** units: value e, octave gradient g (in lattice units), frequency s. */
 static inline oc_etay octave_model(double e, const double g[2], double s,
-                                   double R, int absval) {
+                                   double R, int absval, double k) {
   const double L = 2 * OC_NOISE3_LIPSCHITZ, H = 2 * OC_NOISE3_HESSIAN;
   double sg = 1, ae = e;
   double quad = 0.5 * H * s * s, flat1 = L * s, flat0 = 1 + fabs(e);
@@ -979,10 +984,10 @@ static inline oc_etay octave_model(double e, const double g[2], double s,
       rhs = s * hypot(g[0], g[1]) * R + q2;
     can_quad = ae > rhs;
   }
-  double Rk = R * OC_ETAY_CHOICE;
+  double Rk = R * k;
   if (can_quad && quad * Rk * Rk <= oc_fmin(flat1 * Rk, flat0))
     return (oc_etay){ae, sg * s * g[0], sg * s * g[1], 0, 0, quad};
-  return oc_etay_flat(ae, flat1, flat0, R);
+  return oc_etay_flat_at(ae, flat1, flat0, R, k);
 }
 
 static void noise_taylor(const oc_enoise *nz, double u, double v, double R,
@@ -993,7 +998,7 @@ static void noise_taylor(const oc_enoise *nz, double u, double v, double R,
   octave_noise(nz, u, v, cnt, ev, ex, ey);
   octsum q;
   octsum_init(nz, &q);
-  octaves_taylor(nz, 0, cnt, ev, ex, ey, R, &q);
+  octaves_taylor(nz, 0, cnt, ev, ex, ey, R, OC_ETAY_CHOICE, &q);
   q.m.v = q.sum; /* bit for bit noise_sum's (no level of detail) */
   *o = q.m;
 }

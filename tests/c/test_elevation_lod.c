@@ -714,6 +714,50 @@ START_TEST(disc_lod_wavelength_log) {
 }
 END_TEST
 
+/* The LoD models split an octave into quadratic or flat at r =
+** OC_ETAY_LOD_CHOICE R (etaylor.h), not the exact models' OC_ETAY_CHOICE
+** R. Under a view whose footprint is far below every octave (each
+** filter 1: the exact octaves, the same value bits) a plain and a
+** turbulent disc's LoD model is never above the exact one's remainder
+** at that radius (each octave's smaller bound there) and below it where
+** an octave's choice differs (at 0.25 both: the same models, no point
+** lower). */
+START_TEST(lod_octave_choice) {
+  oc_enoise_kind kinds[2] = {OC_ENOISE_PLAIN, OC_ENOISE_TURBULENCE};
+  oc_enode_view v = {{-500, 300, 900}, 1e-9};
+  oct_rng r = oct_rng_new(12);
+  int lower = 0, n = 0;
+  for (int g = 0; g < 2; g++) {
+    oc_enode *d = disc(0, 0, 20000, 50, kinds[g], 100, 400, 8);
+    oc_eview w = {v.eye[0], v.eye[1], mid_dz(d, &v), v.k};
+    for (int i = 0; i < 400; i++, n++) {
+      double x = oct_unif(&r, -4500, 4000), y = oct_unif(&r, -4500, 4000);
+      double R = 4000 * pow(10, oct_unif(&r, -3.5, -0.3));
+      oc_etfoot tf;
+      oc_erect box = {x - R, y - R, x + R, y + R};
+      oc_eview_foot(&w, x, y, &tf.p);
+      oc_eview_footb(&w, &box, &tf.b);
+      ck_assert(tf.p.v > 0 && tf.p.v < 1e-3);
+      oc_etfoot_prep(&tf, R);
+      oc_etay fl, fe;
+      ck_assert(oc_edisc_taylor_f_view(d, x, y, R, &tf, &fl));
+      oc_edisc_taylor_f(d, x, y, R, &fe);
+      ck_assert(fl.v == fe.v);
+      double rk = OC_ETAY_LOD_CHOICE * R;
+      double el = oc_etay_rem(&fl, rk), ee = oc_etay_rem(&fe, rk);
+      ck_assert_msg(el <= ee * (1 + 1e-12), "(%g, %g) R %g: %.17g > %.17g", x,
+                    y, R, el, ee);
+      lower += el < ee * (1 - 1e-9);
+    }
+    oc_enode_release(d);
+  }
+  printf("lod octave choice: %d of %d LoD models below the exact ones' "
+         "remainder at %g R\n",
+         lower, n, OC_ETAY_LOD_CHOICE);
+  ck_assert_int_gt(lower, n / 20);
+}
+END_TEST
+
 /* ---- tracing --------------------------------------------------------- */
 
 /* First t where o + t d is on or below the surface (inside the domain,
@@ -944,6 +988,7 @@ int main(void) {
   tcase_add_test(tc, lod_taylor_models);
   tcase_add_test(tc, log2_inline_accuracy);
   tcase_add_test(tc, disc_lod_wavelength_log);
+  tcase_add_test(tc, lod_octave_choice);
   tcase_add_loop_test(tc, lod_trace_against_march, 0, 2);
   tcase_add_test(tc, coarser_levels);
   suite_add_tcase(s, tc);
