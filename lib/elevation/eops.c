@@ -1347,6 +1347,13 @@ typedef struct blendsum {
   unsigned char out[TAY_KIDS];
 } blendsum;
 
+/* No child summed yet (the arrays are filled as children come). */
+static inline void blendsum_zero(blendsum *q) {
+  q->N = q->Nx = q->Ny = q->rest[0] = q->rest[1] = q->rest[2] = 0;
+  q->S = oc_etay_const(0);
+  q->m = 0;
+}
+
 /* Adds child k, its models c (alpha_k(p) != 0 or its gradient not 0),
 ** to q; S too unless the caller summed it. */
 static inline void blend_add(blendsum *q, const oc_enode *k,
@@ -1399,9 +1406,7 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
   const oc_eblend *bl = OC_EBLEND(n);
   oc_erect ball = {x - R, y - R, x + R, y + R};
   blendsum q;
-  q.N = q.Nx = q.Ny = q.rest[0] = q.rest[1] = q.rest[2] = 0;
-  q.S = oc_etay_const(0);
-  q.m = 0;
+  blendsum_zero(&q);
   /* the children meeting the disc (alpha_k = 0 on it for the others) */
   const oc_enode *kk[TAY_KIDS];
   int discs, nk = kids_meeting(bl, &ball, kk, &discs);
@@ -1444,9 +1449,7 @@ static int blend_taylor(const oc_enode *n, double x, double y, double R,
       blend_add(&q, kd[i], &c, x, y, R, 0);
     }
     if (general) { /* (afresh) */
-      q.N = q.Nx = q.Ny = q.rest[0] = q.rest[1] = q.rest[2] = 0;
-      q.S = oc_etay_const(0);
-      q.m = 0;
+      blendsum_zero(&q);
       gS = -1;
     }
   }

@@ -465,6 +465,16 @@ END_TEST
 /* The largest |error| / remainder seen, and on the step trees' ramps
 ** that of the models with a remainder of degree 2 (the footprint's
 ** curvature terms alone: its e2 and b''s). */
+/* The footprint at (x, y) and over the box of the model's disc of radius
+** R under w, prepared for R (as the tracer asks) where it is positive. */
+static void ball_foot(const oc_eview *w, double x, double y, double R,
+                      oc_etfoot *tf) {
+  oc_erect box = {x - R, y - R, x + R, y + R};
+  oc_eview_foot(w, x, y, &tf->p);
+  oc_eview_footb(w, &box, &tf->b);
+  if (tf->p.v > 0) oc_etfoot_prep(tf, R);
+}
+
 static double tay_worst, ramp_worst;
 
 /* f and alpha under a view, with the footprint at the point */
@@ -504,10 +514,7 @@ static void check_view_taylor(const oc_enode *e, const oc_enode_view *v,
       R = d1 * pow(10, oct_unif(r, -4, -1));
     }
     oc_etfoot tf;
-    oc_erect box = {x - R, y - R, x + R, y + R};
-    oc_eview_foot(&w, x, y, &tf.p);
-    oc_eview_footb(&w, &box, &tf.b);
-    if (tf.p.v > 0) oc_etfoot_prep(&tf, R);
+    ball_foot(&w, x, y, R, &tf);
     oc_etaylor m;
     int boxes = 0;
     oc_enode_taylor_view(e, x, y, R, tf.p.v > 0 ? &tf : NULL, &m, &boxes);
@@ -663,10 +670,7 @@ START_TEST(disc_lod_wavelength_log) {
         double x = oct_unif(&r, -4500, 4000), y = oct_unif(&r, -4500, 4000);
         double R = 4000 * pow(10, oct_unif(&r, -3.5, -0.3));
         oc_etfoot tf;
-        oc_erect box = {x - R, y - R, x + R, y + R};
-        oc_eview_foot(&w, x, y, &tf.p);
-        oc_eview_footb(&w, &box, &tf.b);
-        oc_etfoot_prep(&tf, R);
+        ball_foot(&w, x, y, R, &tf);
         oc_etay m, ml;
         double lo, hi, lol, hil;
         int c = oc_elod_tau_taylor(437, &tf, R, &m, &lo, &hi);
@@ -696,10 +700,7 @@ START_TEST(disc_lod_wavelength_log) {
         double x = -4500 + 8500 * (i / 3000.0), y = 0.2 * x + 100;
         double R = 4000 * pow(10, -3.5 + 3.2 * ((i * 7) % 3000) / 3000.0);
         oc_etfoot tf;
-        oc_erect box = {x - R, y - R, x + R, y + R};
-        oc_eview_foot(&w, x, y, &tf.p);
-        oc_eview_footb(&w, &box, &tf.b);
-        oc_etfoot_prep(&tf, R);
+        ball_foot(&w, x, y, R, &tf);
         oc_enode_sample s;
         oc_etay f;
         oc_enode_ev(d, x, y, &tf.p, 0, &s);
@@ -734,11 +735,8 @@ START_TEST(lod_octave_choice) {
       double x = oct_unif(&r, -4500, 4000), y = oct_unif(&r, -4500, 4000);
       double R = 4000 * pow(10, oct_unif(&r, -3.5, -0.3));
       oc_etfoot tf;
-      oc_erect box = {x - R, y - R, x + R, y + R};
-      oc_eview_foot(&w, x, y, &tf.p);
-      oc_eview_footb(&w, &box, &tf.b);
+      ball_foot(&w, x, y, R, &tf);
       ck_assert(tf.p.v > 0 && tf.p.v < 1e-3);
-      oc_etfoot_prep(&tf, R);
       oc_etay fl, fe;
       ck_assert(oc_edisc_taylor_f_view(d, x, y, R, &tf, &fl));
       oc_edisc_taylor_f(d, x, y, R, &fe);
