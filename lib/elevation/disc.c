@@ -335,11 +335,7 @@ static int noise_taylor_lod(const oc_enoise *nz, double lw, double u, double v,
                             double R, const oc_etfoot *tf, oc_etay *o) {
   oc_etay tau;
   oc_etfoot own;
-  if (!(tf->R == R)) { /* (not prepared for this disc: as oc_elod_tau_taylor) */
-    own = *tf;
-    oc_etfoot_prep(&own, R);
-    tf = &own;
-  }
+  tf = oc_etfoot_for(tf, R, &own);
   double tlo, thi, dt = octave_dt(nz);
   int curved = oc_elod_tau_taylor_l(lw, tf, &tau, &tlo, &thi);
   /* the octaves whose filter is not 0 on the whole disc (cnt), the

@@ -453,6 +453,14 @@ typedef struct oc_etfoot {
 /* Fills tf's shared parts of tau's model for the disc of radius R (tf->p
 ** and tf->b set). */
 void oc_etfoot_prep(oc_etfoot *tf, double R);
+/* tf when it was prepared for R, else a copy of it in *own prepared for R. */
+static inline const oc_etfoot *oc_etfoot_for(const oc_etfoot *tf, double R,
+                                             oc_etfoot *own) {
+  if (tf->R == R) return tf;
+  *own = *tf;
+  oc_etfoot_prep(own, R);
+  return own;
+}
 /* oc_enode_taylor under a view (tf NULL: full detail, oc_enode_taylor):
 ** f and alpha at (x, y) are the bits oc_enode_ev gives with the footprint
 ** tf->p. Discs (continuous LoD), lod operators and the operators with
@@ -608,9 +616,16 @@ static inline double oc_edisc_lw(const oc_enode *n) {
 ** t0 bit for bit), tf prepared for R (oc_etfoot_prep): a subtraction
 ** where a call of log2 per disc was (its latency stalled the LoD sum,
 ** whose octave counts it decides). */
+static inline int oc_elod_tau_taylor_v(double v, const oc_etfoot *tf,
+                                       oc_etay *m, double *lo, double *hi);
 static inline int oc_elod_tau_taylor_l(double lw, const oc_etfoot *tf,
                                        oc_etay *m, double *lo, double *hi) {
-  double v = lw - tf->lf;
+  return oc_elod_tau_taylor_v(lw - tf->lf, tf, m, lo, hi);
+}
+/* tau's model from its value v at p, tf prepared for R: both rules' (the
+** disc's lw - lf, the lod operator's log2(w / foot)). */
+static inline int oc_elod_tau_taylor_v(double v, const oc_etfoot *tf,
+                                       oc_etay *m, double *lo, double *hi) {
   *m = (oc_etay){v, tf->tc * tf->p.gx, tf->tc * tf->p.gy, 0, 0, 0};
   double pad = 1e-12 * (1 + fabs(v)); /* (against rounding) */
   *lo = v - tf->dlo - pad;

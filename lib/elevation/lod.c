@@ -281,19 +281,8 @@ void oc_etfoot_prep(oc_etfoot *tf, double R) {
 int oc_elod_tau_taylor(double w, const oc_etfoot *tf, double R, oc_etay *m,
                        double *lo, double *hi) {
   oc_etfoot own;
-  if (!(tf->R == R)) { /* (not prepared for this disc) */
-    own = *tf;
-    oc_etfoot_prep(&own, R);
-    tf = &own;
-  }
-  double v = log2(w / tf->p.v);
-  *m = (oc_etay){v, tf->tc * tf->p.gx, tf->tc * tf->p.gy, 0, 0, 0};
-  double pad = 1e-12 * (1 + fabs(v)); /* (against rounding) */
-  *lo = v - tf->dlo - pad;
-  *hi = tf->curved ? v + tf->dhi + pad : INFINITY;
-  if (!tf->curved) return 0;
-  m->e2 = tf->e2;
-  return 1;
+  tf = oc_etfoot_for(tf, R, &own);
+  return oc_elod_tau_taylor_v(log2(w / tf->p.v), tf, m, lo, hi);
 }
 
 oc_etay oc_elod_b_taylor(const oc_etay *t, double lo, double hi, double R) {
