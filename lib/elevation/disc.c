@@ -160,8 +160,9 @@ typedef struct octspan {
 
 static void oct_span(const oc_enoise *nz, const oc_efootb *fb, octspan *t) {
   t->dt = octave_dt(nz);
-  t->tmin = log2(nz->wavelength / fb->hi) - 1e-12;
-  t->tmax = fb->lo > 0 ? log2(nz->wavelength / fb->lo) + 1e-12 : INFINITY;
+  t->tmin = oc_log2_any(nz->wavelength / fb->hi) - 1e-12;
+  t->tmax =
+      fb->lo > 0 ? oc_log2_any(nz->wavelength / fb->lo) + 1e-12 : INFINITY;
 }
 
 /* Range and Lipschitz bound {lo, hi, lip} of the noise sum in all, under
@@ -563,8 +564,8 @@ void oc_edisc_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
   if (ft && ft->v > 0 && noise.kind != OC_ENOISE_NONE) {
     double c = -1 / (ft->v * 0.69314718055994530942);
     /* (t0 as the models' tau: oc_elod_tau_taylor_l) */
-    lod = (octlod){oc_edisc_lw(n) - log2(ft->v), octave_dt(&noise), c * ft->gx,
-                   c * ft->gy};
+    lod = (octlod){oc_edisc_lw(n) - oc_log2_any(ft->v), octave_dt(&noise),
+                   c * ft->gx, c * ft->gy};
     lp = &lod;
   }
   s->f = p[3] + (noise.kind == OC_ENOISE_NONE

@@ -275,7 +275,7 @@ void oc_etfoot_prep(oc_etfoot *tf, double R) {
   tf->e2 = tf->curved ? 0.5 * k * k / (LN2 * flo * flo) * (1 + 1e-12) : 0;
   double gx = tf->tc * ft->gx, gy = tf->tc * ft->gy; /* (tau's linear part) */
   tf->tg = sqrt(gx * gx + gy * gy);
-  tf->lf = log2(ft->v);
+  tf->lf = oc_log2_any(ft->v);
 }
 
 int oc_elod_tau_taylor(double w, const oc_etfoot *tf, double R, oc_etay *m,

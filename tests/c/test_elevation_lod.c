@@ -604,7 +604,8 @@ END_TEST
 ** 1/2) / 128 (where its table's index turns) and just below (j + 1) /
 ** 128 in several octaves, powers of two exact; oc_log2_coarse within
 ** log2(1 / (1 - 2^-8)) < 0.00565 of it,
-** the margin disc.c's octave counts take below their 2^-7. */
+** the margin disc.c's octave counts take below their 2^-7; oc_log2_any
+** libm's log2 off the normal numbers. */
 START_TEST(log2_inline_accuracy) {
   oct_rng r = oct_rng_new(59);
   double worst = 0, cworst = 0;
@@ -630,6 +631,13 @@ START_TEST(log2_inline_accuracy) {
   }
   for (int e = -20; e <= 40; e++)
     ck_assert(oc_log2(ldexp(1, e)) == e);
+  /* oc_log2_any (footprints, user numbers): oc_log2 on normal numbers,
+  ** libm's log2 where oc_log2's table would read a wrong exponent */
+  ck_assert(oc_log2_any(437.0) == oc_log2(437.0));
+  ck_assert(oc_log2_any(0x1p-1022) == -1022);
+  ck_assert(oc_log2_any(0x1p-1060) == -1060); /* subnormal */
+  ck_assert(oc_log2_any(0) == -INFINITY && oc_log2_any(INFINITY) == INFINITY);
+  ck_assert(isnan(oc_log2_any(NAN)) && isnan(oc_log2_any(-1)));
   /* (the bound is not loose by orders: the polynomial and sums round) */
   ck_assert(worst > 1e-17 && cworst > 0.005);
   printf("oc_log2: at most %.3g from log2, coarse %.5f\n", worst, cworst);
@@ -640,8 +648,9 @@ END_TEST
 ** core/log2.h, no bytes kept: a noisy disc is 80 bytes, 88 with float
 ** gain and lacunarity, 96 else), within 1e-14 of log2's; under a view
 ** its models' tau(p) is that minus the footprint's log2 made once per
-** query (oc_etfoot_prep: lf, and tg the norm of tau's linear part, both
-** the bits the per-disc rule computed), the evaluator's t0 the same bits,
+** query (oc_etfoot_prep: lf, oc_log2_any of the footprint, within 1e-14
+** of libm's, and tg the norm of tau's linear part, the bits the per-disc
+** rule computed), the evaluator's t0 the same bits,
 ** so that for each storage the LoD models are the evaluator's values and
 ** hold (check_view_taylor), on ramping octaves too (a near view: every
 ** point's finest kept octave ramps), the octave counts made from the
@@ -675,7 +684,8 @@ START_TEST(disc_lod_wavelength_log) {
         double lo, hi, lol, hil;
         int c = oc_elod_tau_taylor(437, &tf, R, &m, &lo, &hi);
         int cl = oc_elod_tau_taylor_l(lw, &tf, &ml, &lol, &hil);
-        ck_assert(tf.lf == log2(tf.p.v) && tf.tg == oc_etay_gnorm(&m));
+        ck_assert(tf.lf == oc_log2_any(tf.p.v) && tf.tg == oc_etay_gnorm(&m));
+        ck_assert(fabs(tf.lf - log2(tf.p.v)) <= 1e-14 * (1 + fabs(tf.lf)));
         ck_assert(ml.v == lw - tf.lf && c == cl);
         ck_assert(ml.gx == m.gx && ml.gy == m.gy && ml.e2 == m.e2);
         /* log2(w / foot) and log2 w - log2 foot: a few ulps apart, well
