@@ -180,15 +180,17 @@ END_TEST
 ** oc_eta (plain, |eta| or the ridged chain t_i = w_i (1 - |eta_i|)^2,
 ** w_i = clamp(2 t_(i-1), 0, 1)), under a footprint ft weighted
 ** b(log2(w_i / foot)) (the lod filter, with its gradient's terms), t_0
-** = log2 w - log2 foot, log2 w made inline as a disc makes it (enode.h,
-** oc_edisc_lw: core/log2.h). */
+** = log2 w - log2 foot, both logarithms made inline as a disc makes them
+** (enode.h, oc_edisc_lw, and disc.c: core/log2.h's oc_log2 and
+** oc_log2_any). */
 static double ref_noise(const oc_enoise *nz, double u, double v,
                         const oc_efoot *ft, double g[2]) {
   double sum = 0, a = nz->amplitude, s = 1 / nz->wavelength, prev = 1;
   double pg[2] = {0, 0}, t0 = 0, dt = 0, c = 0;
   g[0] = g[1] = 0;
   if (ft) {
-    t0 = oc_log2(nz->wavelength) - log2(ft->v), dt = log2(nz->lacunarity);
+    t0 = oc_log2(nz->wavelength) - oc_log2_any(ft->v);
+    dt = log2(nz->lacunarity);
     c = -1 / (ft->v * 0.69314718055994530942);
   }
   for (int i = 0; i < nz->octaves; i++, s *= nz->lacunarity) {
