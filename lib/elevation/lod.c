@@ -24,9 +24,6 @@
 #include "elevation/enode.h"
 
 #define LN2 0.69314718055994530942
-/* max of b'(t) = 6 t (1 - t^2)^2 on [0, 1], at t = 1 / sqrt 5 */
-#define BP_MAX 1.7173994704548507
-#define BP_AT 0.44721359549995794
 /* par slots: wavelength, k0, k1 */
 enum { P_W = 0, P_K0 = 1, P_K1 = 2 };
 
@@ -56,17 +53,6 @@ void oc_eview_footb(const oc_eview *v, const oc_erect *b, oc_efootb *fb) {
   fb->k = v->k;
 }
 
-/* max b' over [t0, t1] clamped to [0, 1] (b' rises to BP_AT, then falls) */
-static double bp_max(double t0, double t1) {
-  t0 = oc_fmin(oc_fmax(t0, 0), 1);
-  t1 = oc_fmin(oc_fmax(t1, 0), 1);
-  if (t0 <= BP_AT && t1 >= BP_AT) return BP_MAX;
-  double d0, d1;
-  oc_elod_b(t0, &d0);
-  oc_elod_b(t1, &d1);
-  return oc_fmax(d0, d1) * (1 + 1e-12);
-}
-
 void oc_elod_kappa_bound_t(double w, double tmin, double tmax,
                            const oc_efootb *fb, double *lo, double *hi,
                            double *lip) {
@@ -78,7 +64,7 @@ void oc_elod_kappa_bound_t(double w, double tmin, double tmax,
     return;
   }
   /* on the ramp foot lies in (w / 2, w): |grad t| <= k / (ln 2 foot) */
-  *lip = bp_max(tmin, tmax) * fb->k / (LN2 * oc_fmax(fb->lo, w / 2));
+  *lip = oc_elod_bp_max(tmin, tmax) * fb->k / (LN2 * oc_fmax(fb->lo, w / 2));
 }
 
 void oc_elod_kappa_bound(double w, const oc_efootb *fb, double *lo, double *hi,

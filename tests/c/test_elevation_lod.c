@@ -693,6 +693,46 @@ START_TEST(footprint_prep_rules) {
 }
 END_TEST
 
+/* The disc's box bounds' filter factor (disc.c, noise_bounds): per box
+** min(k / (ln 2 lo), 2 k s_i / ln 2) (1 + 1e-14), s_i the octave's
+** frequency by products, no less than oc_elod_kappa_bound_t's k / (ln 2
+** max(lo, w_i / 2)) with w_i = 1 / s_i and within 1e-13 of it;
+** oc_elod_kappa_bound_c with that factor gives kappa_bound_t's range bit
+** for bit and its Lipschitz bound within 1e-13, on random footprint
+** ranges (lo 0 too) and octaves from 10 m to 10 km, lacunarities 1.7 to
+** 2.5. */
+START_TEST(kappa_bound_factor) {
+  oct_rng r = oct_rng_new(67);
+  int ramps = 0;
+  for (int i = 0; i < 20000; i++) {
+    double k = pow(10, oct_unif(&r, -4, -1));
+    double lo = i % 16 ? pow(10, oct_unif(&r, -1, 3)) : 0;
+    oc_efootb fb = {lo, lo * oct_unif(&r, 1, 3) + oct_unif(&r, 0.1, 10), k};
+    double wl = pow(10, oct_unif(&r, 1, 4)), lac = oct_unif(&r, 1.7, 2.5);
+    double s = 1 / wl, dt = log2(lac);
+    double tmin = log2(wl / fb.hi) - 1e-12;
+    double tmax = lo > 0 ? log2(wl / lo) + 1e-12 : INFINITY;
+    double clo = lo > 0 ? k / (0.69314718055994530942 * lo) : INFINITY;
+    double cs = 2 * k / 0.69314718055994530942;
+    for (int o = 0; o < 12; o++, s *= lac) {
+      double c = fmin(clo, cs * s) * (1 + 1e-14);
+      double ct = k / (0.69314718055994530942 * fmax(lo, 1 / s / 2));
+      ck_assert_msg(c >= ct && c <= ct * (1 + 1e-13), "c %.17g against %.17g",
+                    c, ct);
+      double l0, h0, p0, l1, h1, p1;
+      oc_elod_kappa_bound_t(1 / s, tmin - o * dt, tmax - o * dt, &fb, &l0, &h0,
+                            &p0);
+      oc_elod_kappa_bound_c(tmin - o * dt, tmax - o * dt, c, &l1, &h1, &p1);
+      ck_assert(l0 == l1 && h0 == h1);
+      ck_assert_msg(p1 >= p0 && p1 <= p0 * (1 + 1e-13),
+                    "lip %.17g against %.17g", p1, p0);
+      ramps += p0 > 0;
+    }
+  }
+  ck_assert(ramps > 10000);
+}
+END_TEST
+
 /* oc_log2 (core/log2.h), the log2 of a disc's wavelength under a view:
 ** within 2e-15 + 2^-52 |log2 w| of log2 w (long double's, 64 bits) on
 ** 10^5 wavelengths from 1e-3 to 1e9 and on mantissas j / 128, (j +
@@ -1090,6 +1130,7 @@ int main(void) {
   tcase_add_test(tc, bounds_with_lod);
   tcase_add_test(tc, lod_taylor_models);
   tcase_add_test(tc, footprint_prep_rules);
+  tcase_add_test(tc, kappa_bound_factor);
   tcase_add_test(tc, log2_inline_accuracy);
   tcase_add_test(tc, disc_lod_wavelength_log);
   tcase_add_test(tc, lod_octave_choice);
