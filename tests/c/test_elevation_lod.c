@@ -598,6 +598,58 @@ START_TEST(lod_taylor_models) {
 }
 END_TEST
 
+/* A view source's weight (oc_enode_view_weight: alpha alone, no noise
+** sums, OC_EV_ALPHA) is bit for bit alpha of the full evaluation under
+** the view (oc_enode_eval_view) and of a lazy one, on the step trees
+** (lod operators: half the points where their t ramps, the alpha-only
+** path through both children), transformed and instanced, and the
+** scenes of every operator, under near, far and grazing views. */
+START_TEST(view_weight_alpha_only) {
+  oc_error err;
+  oc_enode *st = step_tree();
+  oc_enode_xform x = {300, -200, 25, 2.5, 1.3, 5};
+  oc_enode *trees[] = {st, EOK(oc_enode_transform(st, &x, &err)),
+                       step_instance(), scene(), slope_scene()};
+  oc_enode_view views[] = {
+      {{-500, 300, 900}, 3e-3}, {{3000, 0, 5000}, 0.02}, {{100, 0, 10}, 1}};
+  oct_rng r = oct_rng_new(83);
+  int n = 0;
+  for (size_t t = 0; t < sizeof trees / sizeof *trees; t++)
+    for (int q = 0; q < 3; q++) {
+      oc_elevation src;
+      ck_assert(oc_enode_elevation_view(trees[t], NULL, &views[q], &src,
+                                        &err) == OC_OK);
+      const oc_enode_view *v = &views[q];
+      double dz = mid_dz(trees[t], v);
+      double d0 = sqrt(fmax(0, 170 * 170 / (v->k * v->k) - dz * dz));
+      double d1 = sqrt(fmax(0, 225 * 225 / (v->k * v->k) - dz * dz));
+      for (int i = 0; i < 400; i++) {
+        double px = oct_unif(&r, -4500, 4000), py = oct_unif(&r, -4500, 4000);
+        if (i % 2 && d1 > d0) {
+          double d = oct_unif(&r, d0, d1), th = oct_unif(&r, 0, 2 * PI);
+          px = v->eye[0] + d * cos(th), py = v->eye[1] + d * sin(th);
+        }
+        oc_enode_sample s, l;
+        ck_assert(oc_enode_eval_view(trees[t], px, py, v, &s, &err) == OC_OK);
+        oc_efoot ft;
+        oc_eview w = {v->eye[0], v->eye[1], dz, v->k};
+        oc_eview_foot(&w, px, py, &ft);
+        oc_enode_ev(trees[t], px, py, &ft, OC_EV_LAZY, &l);
+        double a = oc_enode_view_weight(src.ud, px, py);
+        ck_assert_msg(!memcmp(&a, &s.a, sizeof a) &&
+                          !memcmp(&a, &l.a, sizeof a),
+                      "%s at (%g, %g): weight %.17g, alpha %.17g (lazy %.17g)",
+                      oc_enode_kind(trees[t]), px, py, a, s.a, l.a);
+        n += a > 0 && a < 1;
+      }
+      src.release(src.ud);
+    }
+  ck_assert(n > 500);
+  for (size_t t = 0; t < sizeof trees / sizeof *trees; t++)
+    oc_enode_release(trees[t]);
+}
+END_TEST
+
 /* tau's shared parts (oc_etfoot_prep, two divisions): on random views
 ** (the eye level with the point too: footprints near 0) and discs, dlo
 ** and dhi bound log2(fhi / foot(p)) and log2(foot(p) / flo) no less
@@ -1130,6 +1182,7 @@ int main(void) {
   tcase_add_test(tc, bounds_with_lod);
   tcase_add_test(tc, lod_taylor_models);
   tcase_add_test(tc, footprint_prep_rules);
+  tcase_add_test(tc, view_weight_alpha_only);
   tcase_add_test(tc, kappa_bound_factor);
   tcase_add_test(tc, log2_inline_accuracy);
   tcase_add_test(tc, disc_lod_wavelength_log);
