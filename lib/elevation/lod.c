@@ -29,7 +29,10 @@ enum { P_W = 0, P_K0 = 1, P_K1 = 2 };
 
 /* ---- views ------------------------------------------------------------- */
 
-void oc_eview_foot(const oc_eview *v, double x, double y, oc_efoot *ft) {
+/* (inline in this file's per-query paths: vsrc_taylor's footprint, box
+** footprints and prep are one sequence, no calls or reloads) */
+static inline void view_foot(const oc_eview *v, double x, double y,
+                             oc_efoot *ft) {
   double u = x - v->ex, w = y - v->ey;
   double r = sqrt(u * u + w * w + v->dz * v->dz);
   ft->v = v->k * r;
@@ -41,7 +44,8 @@ void oc_eview_foot(const oc_eview *v, double x, double y, oc_efoot *ft) {
   }
 }
 
-void oc_eview_footb(const oc_eview *v, const oc_erect *b, oc_efootb *fb) {
+static inline void view_footb(const oc_eview *v, const oc_erect *b,
+                              oc_efootb *fb) {
   double dx = oc_fmax(oc_fmax(b->x0 - v->ex, v->ex - b->x1), 0);
   double dy = oc_fmax(oc_fmax(b->y0 - v->ey, v->ey - b->y1), 0);
   double fx = oc_fmax(fabs(b->x0 - v->ex), fabs(b->x1 - v->ex));
@@ -51,6 +55,14 @@ void oc_eview_footb(const oc_eview *v, const oc_erect *b, oc_efootb *fb) {
   fb->lo = v->k * sqrt(dx * dx + dy * dy + z2) * (1 - 1e-12);
   fb->hi = v->k * sqrt(fx * fx + fy * fy + z2) * (1 + 1e-12);
   fb->k = v->k;
+}
+
+void oc_eview_foot(const oc_eview *v, double x, double y, oc_efoot *ft) {
+  view_foot(v, x, y, ft);
+}
+
+void oc_eview_footb(const oc_eview *v, const oc_erect *b, oc_efootb *fb) {
+  view_footb(v, b, fb);
 }
 
 void oc_elod_kappa_bound_t(double w, double tmin, double tmax,
@@ -248,7 +260,8 @@ void oc_elod_derive(const oc_enode *n, const oc_ebound *kb,
 ** t's range (oc_elod_bpp_max, enode.h): |b''| falls from 6 at 0 to 0
 ** at 1 / sqrt 5, then rises to 4.8 at sqrt(3/5) and falls to 0 at 1. */
 
-void oc_etfoot_prep(oc_etfoot *tf, double R) {
+static inline __attribute__((always_inline)) void tfoot_prep(oc_etfoot *tf,
+                                                             double R) {
   const oc_efoot *ft = &tf->p;
   double k = tf->b.k, kr = k * R * (1 + 1e-12), v = ft->v;
   double flo = oc_fmax(tf->b.lo, v - kr), fhi = oc_fmin(tf->b.hi, v + kr);
@@ -275,6 +288,10 @@ void oc_etfoot_prep(oc_etfoot *tf, double R) {
   double gx = tf->tc * ft->gx, gy = tf->tc * ft->gy; /* (tau's linear part) */
   tf->tg = sqrt(gx * gx + gy * gy);
   tf->lf = oc_log2_any(v);
+}
+
+void oc_etfoot_prep(oc_etfoot *tf, double R) {
+  tfoot_prep(tf, R);
 }
 
 /* A similarity's child (eops.c, xform_taylor): its footprint is foot / s
@@ -433,7 +450,7 @@ static double vsrc_height(void *ud, double x, double y, double grad[2]) {
   const vsrc *q = ud;
   oc_enode_sample s;
   oc_efoot ft;
-  oc_eview_foot(&q->v, x, y, &ft);
+  view_foot(&q->v, x, y, &ft);
   oc_enode_ev(q->e, x, y, &ft, grad ? OC_EV_GRAD : 0, &s);
   if (grad) {
     grad[0] = s.fx;
@@ -446,7 +463,7 @@ static void vsrc_bound(const vsrc *q, double x0, double y0, double x1,
                        double y1, oc_ebound *b) {
   oc_erect r = {x0, y0, x1, y1};
   oc_efootb fb;
-  oc_eview_footb(&q->v, &r, &fb);
+  view_footb(&q->v, &r, &fb);
   oc_enode_bnd(q->e, &r, &fb, b);
 }
 
@@ -482,9 +499,9 @@ static double vsrc_taylor(void *ud, double x, double y, double R, double g[2],
   const vsrc *q = ud;
   oc_etfoot tf;
   oc_erect r = {x - R, y - R, x + R, y + R};
-  oc_eview_foot(&q->v, x, y, &tf.p);
-  oc_eview_footb(&q->v, &r, &tf.b);
-  if (tf.p.v > 0) oc_etfoot_prep(&tf, R);
+  view_foot(&q->v, x, y, &tf.p);
+  view_footb(&q->v, &r, &tf.b);
+  if (tf.p.v > 0) tfoot_prep(&tf, R);
   return oc_enode_taylor_src(q->e, x, y, R, tf.p.v > 0 ? &tf : NULL, g, e,
                              boxes);
 }
@@ -509,7 +526,7 @@ double oc_enode_view_weight(void *ud, double x, double y) {
   if (!isfinite(x) || !isfinite(y)) return NAN;
   oc_enode_sample s;
   oc_efoot ft;
-  oc_eview_foot(&q->v, x, y, &ft);
+  view_foot(&q->v, x, y, &ft);
   oc_enode_ev(q->e, x, y, &ft, OC_EV_ALPHA, &s);
   return s.a;
 }
