@@ -178,13 +178,22 @@ static void noise_bounds(const oc_enoise *nz, const oc_efootb *fb,
   double a = nz->amplitude, s = 1 / nz->wavelength, lr = 0;
   double asum[2] = {0, 0}, l[2] = {0, 0};
   double le = 2 * oc_noise3_lipschitz;
+  /* |grad t_i| on octave i's ramp, k / (ln 2 max(lo, w_i / 2)) (lod.c,
+  ** oc_elod_kappa_bound_t), is min(k / (ln 2 lo), 2 k s_i / ln 2): two
+  ** constants a box where two divisions an octave were (1 / s_i and the
+  ** quotient), padded for s_i's rounding (a product an octave) */
+  double clo = 0, cs = 0;
+  if (fb) {
+    clo = fb->lo > 0 ? fb->k / (0.69314718055994530942 * fb->lo) : INFINITY;
+    cs = 2 * fb->k / 0.69314718055994530942;
+  }
   for (int i = 0; i < nz->octaves; i++) {
     double bh = 1, lb = 0, bl, li;
     /* (those before from, when it is the whole octaves' count, have bh 1
     ** and lb 0: oc_elod_kappa_bound_t's, not asked) */
     if (fb && i >= from)
-      oc_elod_kappa_bound_t(1 / s, ts->tmin - i * ts->dt, ts->tmax - i * ts->dt,
-                            fb, &bl, &bh, &lb);
+      oc_elod_kappa_bound_c(ts->tmin - i * ts->dt, ts->tmax - i * ts->dt,
+                            oc_fmin(clo, cs * s) * (1 + 1e-14), &bl, &bh, &lb);
     if (bh == 0) break;
     if (nz->kind == OC_ENOISE_RIDGED) {
       /* |grad s_i| <= G |grad s_(i-1)| + 2 lambda_eta s_i */

@@ -453,6 +453,12 @@ typedef struct oc_etfoot {
 /* Fills tf's shared parts of tau's model for the disc of radius R (tf->p
 ** and tf->b set). */
 void oc_etfoot_prep(oc_etfoot *tf, double R);
+/* The prep of a similarity's child (scale s, footprint cp = tf->p / s
+** with its gradient mapped, disc radius Rc = R / s (1 + 1e-12)) from
+** tf's for R (lod.c): tc and lf as oc_etfoot_prep(cf, Rc) makes them,
+** the rest bounding its (dlo, dhi, e2 and tg no less). */
+void oc_etfoot_scaled(const oc_etfoot *tf, double R, double s,
+                      const oc_efoot *cp, double Rc, oc_etfoot *cf);
 /* tf when it was prepared for R, else a copy of it in *own prepared for R. */
 static inline const oc_etfoot *oc_etfoot_for(const oc_etfoot *tf, double R,
                                              oc_etfoot *own) {
@@ -569,6 +575,33 @@ static inline oc_etay oc_elod_b_taylor_at(const oc_etay *t, double bv,
   double gap = oc_fmax(bv - oc_elod_b(lo, &d), oc_elod_b(hi, &d) - bv);
   if (oc_etay_rem(&m, R) > gap) m = (oc_etay){bv, 0, 0, gap, 0, 0};
   return m;
+}
+
+/* The largest b' on [t0, t1] clamped to [0, 1]: b' = 6 t (1 - t^2)^2
+** rises to its maximum 1.7173994704548507 at t = 1 / sqrt 5, then
+** falls. */
+static inline double oc_elod_bp_max(double t0, double t1) {
+  t0 = oc_fmin(oc_fmax(t0, 0), 1);
+  t1 = oc_fmin(oc_fmax(t1, 0), 1);
+  if (t0 <= 0.44721359549995794 && t1 >= 0.44721359549995794)
+    return 1.7173994704548507;
+  double d0, d1;
+  oc_elod_b(t0, &d0);
+  oc_elod_b(t1, &d1);
+  return oc_fmax(d0, d1) * (1 + 1e-12);
+}
+
+/* oc_elod_kappa_bound_t's range, and its Lipschitz bound from a factor c
+** >= k / (ln 2 max(fb->lo, w / 2)) the caller made (|grad t| on the
+** ramp): lip = max b' c. A disc's box bound makes c per octave from two
+** constants a box (disc.c, noise_bounds: two divisions fewer an
+** octave). */
+static inline void oc_elod_kappa_bound_c(double tmin, double tmax, double c,
+                                         double *lo, double *hi, double *lip) {
+  double d;
+  *lo = oc_elod_b(tmin, &d);
+  *hi = oc_elod_b(tmax, &d);
+  *lip = tmax <= 0 || tmin >= 1 ? 0 : oc_elod_bp_max(tmin, tmax) * c;
 }
 
 /* For a detail of wavelength w under footprints in fb: the range of

@@ -1664,13 +1664,14 @@ static int xform_taylor(const oc_enode *n, double x, double y, double R,
   double u = x - par[P_TX], v = y - par[P_TY], is = 1 / par[P_SCALE];
   oc_etaylor c;
   oc_etfoot cf;
+  double Rc = R * is * (1 + 1e-12);
   if (tf) {
-    xform_foot(n, m, &tf->p, &cf.p);
-    xform_footb(n, &tf->b, &cf.b);
-    oc_etfoot_prep(&cf, R * is * (1 + 1e-12));
+    oc_efoot cp;
+    xform_foot(n, m, &tf->p, &cp);
+    oc_etfoot_scaled(tf, R, par[P_SCALE], &cp, Rc, &cf);
   }
   oc_enode_taylor_view(OC_EUN(n)->kid, m[0] * u + m[1] * v, m[2] * u + m[3] * v,
-                       R * is * (1 + 1e-12), tf ? &cf : NULL, &c, boxes);
+                       Rc, tf ? &cf : NULL, &c, boxes);
   double vs = par[P_VS], k = fabs(vs), is2 = is * is;
   o->f = (oc_etay){vs * c.f.v + par[P_VO],
                    vs * (m[0] * c.f.gx + m[2] * c.f.gy),

@@ -24,15 +24,15 @@
 #include "elevation/enode.h"
 
 #define LN2 0.69314718055994530942
-/* max of b'(t) = 6 t (1 - t^2)^2 on [0, 1], at t = 1 / sqrt 5 */
-#define BP_MAX 1.7173994704548507
-#define BP_AT 0.44721359549995794
 /* par slots: wavelength, k0, k1 */
 enum { P_W = 0, P_K0 = 1, P_K1 = 2 };
 
 /* ---- views ------------------------------------------------------------- */
 
-void oc_eview_foot(const oc_eview *v, double x, double y, oc_efoot *ft) {
+/* (inline in this file's per-query paths: vsrc_taylor's footprint, box
+** footprints and prep are one sequence, no calls or reloads) */
+static inline void view_foot(const oc_eview *v, double x, double y,
+                             oc_efoot *ft) {
   double u = x - v->ex, w = y - v->ey;
   double r = sqrt(u * u + w * w + v->dz * v->dz);
   ft->v = v->k * r;
@@ -44,7 +44,8 @@ void oc_eview_foot(const oc_eview *v, double x, double y, oc_efoot *ft) {
   }
 }
 
-void oc_eview_footb(const oc_eview *v, const oc_erect *b, oc_efootb *fb) {
+static inline void view_footb(const oc_eview *v, const oc_erect *b,
+                              oc_efootb *fb) {
   double dx = oc_fmax(oc_fmax(b->x0 - v->ex, v->ex - b->x1), 0);
   double dy = oc_fmax(oc_fmax(b->y0 - v->ey, v->ey - b->y1), 0);
   double fx = oc_fmax(fabs(b->x0 - v->ex), fabs(b->x1 - v->ex));
@@ -56,15 +57,12 @@ void oc_eview_footb(const oc_eview *v, const oc_erect *b, oc_efootb *fb) {
   fb->k = v->k;
 }
 
-/* max b' over [t0, t1] clamped to [0, 1] (b' rises to BP_AT, then falls) */
-static double bp_max(double t0, double t1) {
-  t0 = oc_fmin(oc_fmax(t0, 0), 1);
-  t1 = oc_fmin(oc_fmax(t1, 0), 1);
-  if (t0 <= BP_AT && t1 >= BP_AT) return BP_MAX;
-  double d0, d1;
-  oc_elod_b(t0, &d0);
-  oc_elod_b(t1, &d1);
-  return oc_fmax(d0, d1) * (1 + 1e-12);
+void oc_eview_foot(const oc_eview *v, double x, double y, oc_efoot *ft) {
+  view_foot(v, x, y, ft);
+}
+
+void oc_eview_footb(const oc_eview *v, const oc_erect *b, oc_efootb *fb) {
+  view_footb(v, b, fb);
 }
 
 void oc_elod_kappa_bound_t(double w, double tmin, double tmax,
@@ -78,7 +76,7 @@ void oc_elod_kappa_bound_t(double w, double tmin, double tmax,
     return;
   }
   /* on the ramp foot lies in (w / 2, w): |grad t| <= k / (ln 2 foot) */
-  *lip = bp_max(tmin, tmax) * fb->k / (LN2 * oc_fmax(fb->lo, w / 2));
+  *lip = oc_elod_bp_max(tmin, tmax) * fb->k / (LN2 * oc_fmax(fb->lo, w / 2));
 }
 
 void oc_elod_kappa_bound(double w, const oc_efootb *fb, double *lo, double *hi,
@@ -128,12 +126,15 @@ void oc_elod_ev(const oc_enode *n, double x, double y, const oc_efoot *ft,
     oc_enode_ev(A, x, y, ft, want, s);
     return;
   }
-  /* both: neither may leave f unset where its own weight is 0 */
+  /* both: neither may leave f unset where its own weight is 0 (alpha
+  ** alone: no f) */
+  int only = want & OC_EV_ALPHA;
   oc_enode_sample a, b;
-  oc_enode_ev(A, x, y, ft, grad, &a);
-  oc_enode_ev(B, x, y, ft, grad, &b);
-  s->f = (1 - t) * a.f + t * b.f;
+  oc_enode_ev(A, x, y, ft, grad | only, &a);
+  oc_enode_ev(B, x, y, ft, grad | only, &b);
   s->a = (1 - t) * a.a + t * b.a;
+  if (only) return;
+  s->f = (1 - t) * a.f + t * b.f;
   if (!grad) {
     s->fx = s->fy = s->ax = s->ay = 0;
     return;
@@ -259,23 +260,78 @@ void oc_elod_derive(const oc_enode *n, const oc_ebound *kb,
 ** t's range (oc_elod_bpp_max, enode.h): |b''| falls from 6 at 0 to 0
 ** at 1 / sqrt 5, then rises to 4.8 at sqrt(3/5) and falls to 0 at 1. */
 
-void oc_etfoot_prep(oc_etfoot *tf, double R) {
+static inline __attribute__((always_inline)) void tfoot_prep(oc_etfoot *tf,
+                                                             double R) {
   const oc_efoot *ft = &tf->p;
-  double k = tf->b.k, kr = k * R * (1 + 1e-12);
-  double flo = oc_fmax(tf->b.lo, ft->v - kr),
-         fhi = oc_fmin(tf->b.hi, ft->v + kr);
+  double k = tf->b.k, kr = k * R * (1 + 1e-12), v = ft->v;
+  double flo = oc_fmax(tf->b.lo, v - kr), fhi = oc_fmin(tf->b.hi, v + kr);
   tf->R = R;
-  tf->tc = -1 / (ft->v * LN2); /* (as the discs' evaluation) */
+  tf->tc = -1 / (v * LN2); /* (as the discs' evaluation) */
   /* tau's range without a log2 each: log2(w / fhi) = tau(p) - log2(fhi /
-  ** foot(p)) and ln(1 + x) <= x; log2(w / flo) = tau(p) - log2(flo /
-  ** foot(p)) and -ln y <= 1 / y - 1 */
-  tf->dlo = (oc_fmax(fhi, ft->v) / ft->v - 1) / LN2;
+  ** foot(p)) and ln(1 + x) <= x, so log2(fhi / foot(p)) <= (fhi - v) / (v
+  ** ln 2) = (fhi - v) |tc|; log2(w / flo) = tau(p) - log2(flo / foot(p))
+  ** and -ln y <= 1 / y - 1, so log2(v / fl) <= (v - fl) / (fl ln 2), fl =
+  ** min(flo, v). Two divisions where five were (the quotients by ln 2
+  ** and by v are tc's and q's products: within 3 ulps, padded 1e-15).
+  ** (perf of fig21's LoD primary rays: the prep 2.6 % before, 2.3 %
+  ** after; most of it waits on the footprint's square root) */
+  tf->dlo = (oc_fmax(fhi, v) - v) * -tf->tc * (1 + 1e-15);
   tf->curved = flo > 0;
-  tf->dhi = tf->curved ? (ft->v / oc_fmin(flo, ft->v) - 1) / LN2 : INFINITY;
-  tf->e2 = tf->curved ? 0.5 * k * k / (LN2 * flo * flo) * (1 + 1e-12) : 0;
+  if (tf->curved) {
+    double fl = oc_fmin(flo, v), q = 1 / (fl * LN2);
+    tf->dhi = (v - fl) * q * (1 + 1e-15);
+    /* k^2 / (2 ln 2 fl^2) = k^2 ln 2 q^2 / 2 */
+    tf->e2 = 0.5 * k * k * (LN2 * q * q) * (1 + 1e-12);
+  } else {
+    tf->dhi = INFINITY;
+    tf->e2 = 0;
+  }
   double gx = tf->tc * ft->gx, gy = tf->tc * ft->gy; /* (tau's linear part) */
   tf->tg = sqrt(gx * gx + gy * gy);
-  tf->lf = oc_log2_any(ft->v);
+  tf->lf = oc_log2_any(v);
+}
+
+void oc_etfoot_prep(oc_etfoot *tf, double R) {
+  tfoot_prep(tf, R);
+}
+
+/* A similarity's child (eops.c, xform_taylor): its footprint is foot / s
+** and its disc of radius Rc = R / s (1 + 1e-12) is the parent's disc of
+** radius R (to the map's rounding), so tau's parts follow from the
+** parent's, tf prepared for R: tc and lf as evaluation makes them (the
+** models' values and linear parts: the same bits as oc_etfoot_prep), tg
+** times s (|grad foot_c| = |grad foot|), dlo and dhi unchanged and e2
+** times s^2 (ratios of footprints and k / foot scale so), padded for the
+** radius' hair (the direct prep's k Rc (1 + 1e-12) is k R (1 + 2e-12) /
+** s: flo moves by 1e-12 k R / s, 1e-12 ln 2 dhi of itself, so dlo by
+** 1e-12 of itself, dhi by 1e-12 (1 + ln 2 dhi) and e2 by 2e-12 ln 2 dhi;
+** padded twice that, and rounding). Where the footprint may come near 0
+** on the disc (dhi > 2^20), the direct prep. A division, a square root
+** and the footprint's range's arithmetic fewer per instance: the
+** transforms' preps were a third of oc_etfoot_prep's calls in
+** bench_elev_lod's fig21; oc_etfoot_scaled takes 0.35-0.64 % of its LoD
+** primary rays (perf), where the transforms' preps took about 0.85 %. */
+void oc_etfoot_scaled(const oc_etfoot *tf, double R, double s,
+                      const oc_efoot *cp, double Rc, oc_etfoot *cf) {
+  double is = 1 / s;
+  cf->p = *cp;
+  cf->b = (oc_efootb){tf->b.lo * is, tf->b.hi * is, tf->b.k};
+  oc_etfoot own;
+  tf = oc_etfoot_for(tf, R, &own); /* (the same bits however tf came) */
+  if (!tf->curved || !(tf->dhi <= 0x1p20)) {
+    oc_etfoot_prep(cf, Rc);
+    return;
+  }
+  double v = cp->v;
+  cf->R = Rc;
+  cf->tc = -1 / (v * LN2);
+  cf->lf = oc_log2_any(v);
+  cf->curved = 1;
+  double h = 2e-12 * (1 + tf->dhi);
+  cf->dlo = tf->dlo * (1 + 2e-12) + 1e-15;
+  cf->dhi = tf->dhi * (1 + h) + 1e-15;
+  cf->e2 = tf->e2 * (s * s) * (1 + 1.5 * h);
+  cf->tg = tf->tg * s * (1 + 1e-14);
 }
 
 int oc_elod_tau_taylor(double w, const oc_etfoot *tf, double R, oc_etay *m,
@@ -396,7 +452,7 @@ static double vsrc_height(void *ud, double x, double y, double grad[2]) {
   const vsrc *q = ud;
   oc_enode_sample s;
   oc_efoot ft;
-  oc_eview_foot(&q->v, x, y, &ft);
+  view_foot(&q->v, x, y, &ft);
   oc_enode_ev(q->e, x, y, &ft, grad ? OC_EV_GRAD : 0, &s);
   if (grad) {
     grad[0] = s.fx;
@@ -409,7 +465,7 @@ static void vsrc_bound(const vsrc *q, double x0, double y0, double x1,
                        double y1, oc_ebound *b) {
   oc_erect r = {x0, y0, x1, y1};
   oc_efootb fb;
-  oc_eview_footb(&q->v, &r, &fb);
+  view_footb(&q->v, &r, &fb);
   oc_enode_bnd(q->e, &r, &fb, b);
 }
 
@@ -445,9 +501,9 @@ static double vsrc_taylor(void *ud, double x, double y, double R, double g[2],
   const vsrc *q = ud;
   oc_etfoot tf;
   oc_erect r = {x - R, y - R, x + R, y + R};
-  oc_eview_foot(&q->v, x, y, &tf.p);
-  oc_eview_footb(&q->v, &r, &tf.b);
-  if (tf.p.v > 0) oc_etfoot_prep(&tf, R);
+  view_foot(&q->v, x, y, &tf.p);
+  view_footb(&q->v, &r, &tf.b);
+  if (tf.p.v > 0) tfoot_prep(&tf, R);
   return oc_enode_taylor_src(q->e, x, y, R, tf.p.v > 0 ? &tf : NULL, g, e,
                              boxes);
 }
@@ -463,13 +519,17 @@ static void vsrc_release(void *ud) {
   free(q);
 }
 
+/* alpha alone (OC_EV_ALPHA, as oc_enode_weight: the same bits as
+** alpha's in a full evaluation, no noise sum; with OC_EV_LAZY it summed
+** the noise of every disc with a weight, 3.7 % of bench_elev_lod's LoD
+** primary rays' instructions at 240 x 135) */
 double oc_enode_view_weight(void *ud, double x, double y) {
   const vsrc *q = ud;
   if (!isfinite(x) || !isfinite(y)) return NAN;
   oc_enode_sample s;
   oc_efoot ft;
-  oc_eview_foot(&q->v, x, y, &ft);
-  oc_enode_ev(q->e, x, y, &ft, OC_EV_LAZY, &s);
+  view_foot(&q->v, x, y, &ft);
+  oc_enode_ev(q->e, x, y, &ft, OC_EV_ALPHA, &s);
   return s.a;
 }
 

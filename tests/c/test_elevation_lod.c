@@ -598,6 +598,193 @@ START_TEST(lod_taylor_models) {
 }
 END_TEST
 
+/* A view source's weight (oc_enode_view_weight: alpha alone, no noise
+** sums, OC_EV_ALPHA) is bit for bit alpha of the full evaluation under
+** the view (oc_enode_eval_view) and of a lazy one, on the step trees
+** (lod operators: half the points where their t ramps, the alpha-only
+** path through both children), transformed and instanced, and the
+** scenes of every operator, under near, far and grazing views. */
+START_TEST(view_weight_alpha_only) {
+  oc_error err;
+  oc_enode *st = step_tree();
+  oc_enode_xform x = {300, -200, 25, 2.5, 1.3, 5};
+  oc_enode *trees[] = {st, EOK(oc_enode_transform(st, &x, &err)),
+                       step_instance(), scene(), slope_scene()};
+  oc_enode_view views[] = {
+      {{-500, 300, 900}, 3e-3}, {{3000, 0, 5000}, 0.02}, {{100, 0, 10}, 1}};
+  oct_rng r = oct_rng_new(83);
+  int n = 0;
+  for (size_t t = 0; t < sizeof trees / sizeof *trees; t++)
+    for (int q = 0; q < 3; q++) {
+      oc_elevation src;
+      ck_assert(oc_enode_elevation_view(trees[t], NULL, &views[q], &src,
+                                        &err) == OC_OK);
+      const oc_enode_view *v = &views[q];
+      double dz = mid_dz(trees[t], v);
+      double d0 = sqrt(fmax(0, 170 * 170 / (v->k * v->k) - dz * dz));
+      double d1 = sqrt(fmax(0, 225 * 225 / (v->k * v->k) - dz * dz));
+      for (int i = 0; i < 400; i++) {
+        double px = oct_unif(&r, -4500, 4000), py = oct_unif(&r, -4500, 4000);
+        if (i % 2 && d1 > d0) {
+          double d = oct_unif(&r, d0, d1), th = oct_unif(&r, 0, 2 * PI);
+          px = v->eye[0] + d * cos(th), py = v->eye[1] + d * sin(th);
+        }
+        oc_enode_sample s, l;
+        ck_assert(oc_enode_eval_view(trees[t], px, py, v, &s, &err) == OC_OK);
+        oc_efoot ft;
+        oc_eview w = {v->eye[0], v->eye[1], dz, v->k};
+        oc_eview_foot(&w, px, py, &ft);
+        oc_enode_ev(trees[t], px, py, &ft, OC_EV_LAZY, &l);
+        double a = oc_enode_view_weight(src.ud, px, py);
+        ck_assert_msg(!memcmp(&a, &s.a, sizeof a) &&
+                          !memcmp(&a, &l.a, sizeof a),
+                      "%s at (%g, %g): weight %.17g, alpha %.17g (lazy %.17g)",
+                      oc_enode_kind(trees[t]), px, py, a, s.a, l.a);
+        n += a > 0 && a < 1;
+      }
+      src.release(src.ud);
+    }
+  ck_assert(n > 500);
+  for (size_t t = 0; t < sizeof trees / sizeof *trees; t++)
+    oc_enode_release(trees[t]);
+}
+END_TEST
+
+/* tau's shared parts (oc_etfoot_prep, two divisions): on random views
+** (the eye level with the point too: footprints near 0) and discs, dlo
+** and dhi bound log2(fhi / foot(p)) and log2(foot(p) / flo) no less
+** tightly than the rule of five divisions did (within 1e-12 of (fhi /
+** foot(p) - 1) / ln 2 and (foot(p) / flo - 1) / ln 2, and no less, long
+** double's), e2 k^2 / (2 ln 2 flo^2) within 1e-11. A
+** similarity's child (oc_etfoot_scaled, eops.c's transforms: scales 0.2
+** to 5, any rotation) has the direct prep's tc, lf, curved, R and
+** footprints bit for bit and dlo, dhi, e2 and tg no less, within 1e-9
+** (dhi and e2: 1e-11 (1 + dhi), the pads for the radius' hair);
+** the same bits when tf was prepared for another radius; where the
+** footprint comes near 0 on the disc, the direct prep's all. */
+START_TEST(footprint_prep_rules) {
+  oct_rng r = oct_rng_new(61);
+  int derived = 0, direct = 0;
+  for (int i = 0; i < 20000; i++) {
+    oc_eview w = {oct_unif(&r, -5000, 5000), oct_unif(&r, -5000, 5000),
+                  i % 4   ? oct_unif(&r, 10, 3000)
+                  : i % 8 ? oct_unif(&r, 0, 1e-5)
+                          : 0,
+                  pow(10, oct_unif(&r, -4, -1))};
+    double x = oct_unif(&r, -5000, 5000), y = oct_unif(&r, -5000, 5000);
+    if (i % 4 == 0) x = w.ex + oct_unif(&r, -3, 3), y = w.ey;
+    double R = 4000 * pow(10, oct_unif(&r, -4, -0.3));
+    oc_etfoot tf;
+    ball_foot(&w, x, y, R, &tf);
+    if (!(tf.p.v > 0)) continue;
+    const oc_efoot *ft = &tf.p;
+    double kr = tf.b.k * R * (1 + 1e-12);
+    double flo = fmax(tf.b.lo, ft->v - kr), fhi = fmin(tf.b.hi, ft->v + kr);
+    /* (the bounds ln(1 + x) <= x and -ln y <= 1 / y - 1: as tight as
+    ** the five divisions' (fhi / v - 1) / ln 2 and (v / flo - 1) / ln 2) */
+    long double lo2 =
+        log1pl(((long double)fmax(fhi, ft->v) - ft->v) / ft->v) / logl(2);
+    long double dlo = ((long double)fmax(fhi, ft->v) - ft->v) / ft->v / logl(2);
+    ck_assert_msg(tf.dlo >= lo2 && tf.dlo >= dlo &&
+                      tf.dlo <= dlo * (1 + 1e-12L) + 1e-300,
+                  "dlo %.17g against %.17Lg", tf.dlo, dlo);
+    ck_assert(tf.curved == (flo > 0));
+    if (tf.curved) {
+      long double fl = fmin(flo, ft->v);
+      long double hi2 = log1pl(((long double)ft->v - fl) / fl) / logl(2);
+      long double dhi = ((long double)ft->v - fl) / fl / logl(2);
+      long double e2 = 0.5L * tf.b.k * tf.b.k / (logl(2) * flo * flo);
+      ck_assert_msg(tf.dhi >= hi2 && tf.dhi >= dhi &&
+                        tf.dhi <= dhi * (1 + 1e-12L) + 1e-300,
+                    "dhi %.17g against %.17Lg", tf.dhi, dhi);
+      ck_assert_msg(tf.e2 >= e2 && tf.e2 <= e2 * (1 + 1e-11L),
+                    "e2 %.17g against %.17Lg", tf.e2, e2);
+    }
+    /* the child's */
+    double s = pow(5, oct_unif(&r, -1, 1)), th = oct_unif(&r, 0, 2 * PI);
+    double is = 1 / s, Rc = R * is * (1 + 1e-12);
+    oc_efoot cp = {ft->v * is, cos(th) * ft->gx - sin(th) * ft->gy,
+                   sin(th) * ft->gx + cos(th) * ft->gy};
+    oc_etfoot d, c, c2, other = tf;
+    d.p = cp;
+    d.b = (oc_efootb){tf.b.lo * is, tf.b.hi * is, tf.b.k};
+    oc_etfoot_prep(&d, Rc);
+    oc_etfoot_scaled(&tf, R, s, &cp, Rc, &c);
+    oc_etfoot_prep(&other, 2 * R);
+    oc_etfoot_scaled(&other, R, s, &cp, Rc, &c2);
+    /* (field by field: the struct's tail padding is not written) */
+    double cf[] = {c.p.v, c.p.gx, c.p.gy, c.b.lo, c.b.hi, c.b.k, c.R,
+                   c.tc,  c.dlo,  c.dhi,  c.e2,   c.tg,   c.lf,  c.curved};
+    double cf2[] = {c2.p.v, c2.p.gx, c2.p.gy, c2.b.lo,  c2.b.hi,
+                    c2.b.k, c2.R,    c2.tc,   c2.dlo,   c2.dhi,
+                    c2.e2,  c2.tg,   c2.lf,   c2.curved};
+    ck_assert(!memcmp(cf, cf2, sizeof cf));
+    ck_assert(!memcmp(&c.p, &d.p, sizeof d.p) &&
+              !memcmp(&c.b, &d.b, sizeof d.b));
+    ck_assert(c.R == d.R && c.tc == d.tc && c.lf == d.lf &&
+              c.curved == d.curved);
+    if (!tf.curved || tf.dhi > 0x1p20) {
+      ck_assert(c.dlo == d.dlo && c.dhi == d.dhi && c.e2 == d.e2 &&
+                c.tg == d.tg);
+      direct++;
+      continue;
+    }
+    derived++;
+    ck_assert_msg(c.dlo >= d.dlo && c.dlo <= d.dlo * (1 + 1e-9) + 1e-14,
+                  "dlo %.17g, direct %.17g (s %g)", c.dlo, d.dlo, s);
+    ck_assert_msg(c.dhi >= d.dhi &&
+                      c.dhi <= d.dhi * (1 + 1e-11 * (1 + tf.dhi)) + 1e-14,
+                  "dhi %.17g, direct %.17g (s %g)", c.dhi, d.dhi, s);
+    ck_assert_msg(c.e2 >= d.e2 && c.e2 <= d.e2 * (1 + 1e-11 * (1 + tf.dhi)),
+                  "e2 %.17g, direct %.17g (s %g)", c.e2, d.e2, s);
+    ck_assert_msg(c.tg >= d.tg && c.tg <= d.tg * (1 + 1e-9),
+                  "tg %.17g, direct %.17g (s %g)", c.tg, d.tg, s);
+  }
+  printf("footprint prep: %d children derived, %d prepared\n", derived, direct);
+  ck_assert(derived > 5000 && direct > 50);
+}
+END_TEST
+
+/* The disc's box bounds' filter factor (disc.c, noise_bounds): per box
+** min(k / (ln 2 lo), 2 k s_i / ln 2) (1 + 1e-14), s_i the octave's
+** frequency by products, no less than oc_elod_kappa_bound_t's k / (ln 2
+** max(lo, w_i / 2)) with w_i = 1 / s_i and within 1e-13 of it;
+** oc_elod_kappa_bound_c with that factor gives kappa_bound_t's range bit
+** for bit and its Lipschitz bound within 1e-13, on random footprint
+** ranges (lo 0 too) and octaves from 10 m to 10 km, lacunarities 1.7 to
+** 2.5. */
+START_TEST(kappa_bound_factor) {
+  oct_rng r = oct_rng_new(67);
+  int ramps = 0;
+  for (int i = 0; i < 20000; i++) {
+    double k = pow(10, oct_unif(&r, -4, -1));
+    double lo = i % 16 ? pow(10, oct_unif(&r, -1, 3)) : 0;
+    oc_efootb fb = {lo, lo * oct_unif(&r, 1, 3) + oct_unif(&r, 0.1, 10), k};
+    double wl = pow(10, oct_unif(&r, 1, 4)), lac = oct_unif(&r, 1.7, 2.5);
+    double s = 1 / wl, dt = log2(lac);
+    double tmin = log2(wl / fb.hi) - 1e-12;
+    double tmax = lo > 0 ? log2(wl / lo) + 1e-12 : INFINITY;
+    double clo = lo > 0 ? k / (0.69314718055994530942 * lo) : INFINITY;
+    double cs = 2 * k / 0.69314718055994530942;
+    for (int o = 0; o < 12; o++, s *= lac) {
+      double c = fmin(clo, cs * s) * (1 + 1e-14);
+      double ct = k / (0.69314718055994530942 * fmax(lo, 1 / s / 2));
+      ck_assert_msg(c >= ct && c <= ct * (1 + 1e-13), "c %.17g against %.17g",
+                    c, ct);
+      double l0, h0, p0, l1, h1, p1;
+      oc_elod_kappa_bound_t(1 / s, tmin - o * dt, tmax - o * dt, &fb, &l0, &h0,
+                            &p0);
+      oc_elod_kappa_bound_c(tmin - o * dt, tmax - o * dt, c, &l1, &h1, &p1);
+      ck_assert(l0 == l1 && h0 == h1);
+      ck_assert_msg(p1 >= p0 && p1 <= p0 * (1 + 1e-13),
+                    "lip %.17g against %.17g", p1, p0);
+      ramps += p0 > 0;
+    }
+  }
+  ck_assert(ramps > 10000);
+}
+END_TEST
+
 /* oc_log2 (core/log2.h), the log2 of a disc's wavelength under a view:
 ** within 2e-15 + 2^-52 |log2 w| of log2 w (long double's, 64 bits) on
 ** 10^5 wavelengths from 1e-3 to 1e9 and on mantissas j / 128, (j +
@@ -994,6 +1181,9 @@ int main(void) {
   tcase_add_loop_test(tc, gradients_with_lod, 0, 2);
   tcase_add_test(tc, bounds_with_lod);
   tcase_add_test(tc, lod_taylor_models);
+  tcase_add_test(tc, footprint_prep_rules);
+  tcase_add_test(tc, view_weight_alpha_only);
+  tcase_add_test(tc, kappa_bound_factor);
   tcase_add_test(tc, log2_inline_accuracy);
   tcase_add_test(tc, disc_lod_wavelength_log);
   tcase_add_test(tc, lod_octave_choice);
