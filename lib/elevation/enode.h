@@ -453,12 +453,13 @@ typedef struct oc_etfoot {
 /* Fills tf's shared parts of tau's model for the disc of radius R (tf->p
 ** and tf->b set). */
 void oc_etfoot_prep(oc_etfoot *tf, double R);
-/* The prep of a similarity's child (scale s, footprint cp = tf->p / s
-** with its gradient mapped, disc radius Rc = R / s (1 + 1e-12)) from
-** tf's for R (lod.c): tc and lf as oc_etfoot_prep(cf, Rc) makes them,
-** the rest bounding its (dlo, dhi, e2 and tg no less). */
-void oc_etfoot_scaled(const oc_etfoot *tf, double R, double s,
-                      const oc_efoot *cp, double Rc, oc_etfoot *cf);
+/* The prep of a similarity's child (scale s, disc radius Rc = R / s (1
+** + 1e-12); cf->p and cf->b set, tf's footprints mapped into the
+** child's units) from tf's for R (lod.c): tc and lf as
+** oc_etfoot_prep(cf, Rc) makes them, the rest bounding its (dlo, dhi, e2
+** and tg no less). */
+void oc_etfoot_scaled(const oc_etfoot *tf, double R, double s, double Rc,
+                      oc_etfoot *cf);
 /* tf when it was prepared for R, else a copy of it in *own prepared for R. */
 static inline const oc_etfoot *oc_etfoot_for(const oc_etfoot *tf, double R,
                                              oc_etfoot *own) {

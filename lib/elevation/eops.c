@@ -1666,9 +1666,9 @@ static int xform_taylor(const oc_enode *n, double x, double y, double R,
   oc_etfoot cf;
   double Rc = R * is * (1 + 1e-12);
   if (tf) {
-    oc_efoot cp;
-    xform_foot(n, m, &tf->p, &cp);
-    oc_etfoot_scaled(tf, R, par[P_SCALE], &cp, Rc, &cf);
+    xform_foot(n, m, &tf->p, &cf.p);
+    xform_footb(n, &tf->b, &cf.b);
+    oc_etfoot_scaled(tf, R, par[P_SCALE], Rc, &cf);
   }
   oc_enode_taylor_view(OC_EUN(n)->kid, m[0] * u + m[1] * v, m[2] * u + m[3] * v,
                        Rc, tf ? &cf : NULL, &c, boxes);

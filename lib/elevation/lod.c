@@ -68,15 +68,10 @@ void oc_eview_footb(const oc_eview *v, const oc_erect *b, oc_efootb *fb) {
 void oc_elod_kappa_bound_t(double w, double tmin, double tmax,
                            const oc_efootb *fb, double *lo, double *hi,
                            double *lip) {
-  double d;
-  *lo = oc_elod_b(tmin, &d);
-  *hi = oc_elod_b(tmax, &d);
-  if (tmax <= 0 || tmin >= 1) {
-    *lip = 0;
-    return;
-  }
-  /* on the ramp foot lies in (w / 2, w): |grad t| <= k / (ln 2 foot) */
-  *lip = oc_elod_bp_max(tmin, tmax) * fb->k / (LN2 * oc_fmax(fb->lo, w / 2));
+  /* on the ramp foot lies in (w / 2, w): |grad t| <= k / (ln 2 foot)
+  ** (max b' times that, as (max b' k) / (ln 2 foot)) */
+  oc_elod_kappa_bound_c(tmin, tmax, 1, lo, hi, lip);
+  if (*lip != 0) *lip = *lip * fb->k / (LN2 * oc_fmax(fb->lo, w / 2));
 }
 
 void oc_elod_kappa_bound(double w, const oc_efootb *fb, double *lo, double *hi,
@@ -311,18 +306,15 @@ void oc_etfoot_prep(oc_etfoot *tf, double R) {
 ** transforms' preps were a third of oc_etfoot_prep's calls in
 ** bench_elev_lod's fig21; oc_etfoot_scaled takes 0.35-0.64 % of its LoD
 ** primary rays (perf), where the transforms' preps took about 0.85 %. */
-void oc_etfoot_scaled(const oc_etfoot *tf, double R, double s,
-                      const oc_efoot *cp, double Rc, oc_etfoot *cf) {
-  double is = 1 / s;
-  cf->p = *cp;
-  cf->b = (oc_efootb){tf->b.lo * is, tf->b.hi * is, tf->b.k};
+void oc_etfoot_scaled(const oc_etfoot *tf, double R, double s, double Rc,
+                      oc_etfoot *cf) {
   oc_etfoot own;
   tf = oc_etfoot_for(tf, R, &own); /* (the same bits however tf came) */
   if (!tf->curved || !(tf->dhi <= 0x1p20)) {
     oc_etfoot_prep(cf, Rc);
     return;
   }
-  double v = cp->v;
+  double v = cf->p.v;
   cf->R = Rc;
   cf->tc = -1 / (v * LN2);
   cf->lf = oc_log2_any(v);

@@ -55,12 +55,11 @@
 #include <string.h>
 #include <time.h>
 
+#include "benchout.h"
 #include "outcrop.h"
 
 /* bench_elev -q: every size divided by 4 (while working on the code) */
 static int shrink = 1;
-/* OUTCROP_BENCH_ROUNDS=n (default 3): each scene's timed render n times */
-static int rounds = 3;
 /* bench_elev --bytes: the trees' memory, no rendering */
 static int bytes_only = 0;
 /* bench_elev --replay: the calls of a render replayed alone */
@@ -553,7 +552,7 @@ static void run_scene(const char *name, void (*build)(scene *), int prims,
   ** spell of a shared machine then rarely sets the figure */
   double secs = INFINITY, cpu = INFINITY;
   oc_image *geo = NULL;
-  for (int r = 0; r < rounds; r++) {
+  for (int r = 0, rounds = bench_rounds(); r < rounds; r++) {
     double t0 = omp_get_wtime();
     clock_t c0 = clock();
     oc_image *g = oc_render_surface_geometry(&es, &rp, &err);
@@ -747,8 +746,6 @@ static void replay_scene(const char *name, void (*build)(scene *)) {
 
 int main(int argc, char **argv) {
   omp_set_num_threads(2);
-  const char *rn = getenv("OUTCROP_BENCH_ROUNDS");
-  if (rn && atoi(rn) > 0) rounds = atoi(rn) < 20 ? atoi(rn) : 20;
   static const struct {
     const char *name;
     void (*build)(scene *);

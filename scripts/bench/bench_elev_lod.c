@@ -127,11 +127,9 @@ int main(void) {
   ** alternating, each timed by its fastest round; on a shared machine a
   ** slow spell then rarely hits only one of them (the renders are the
   ** same bits every round) */
-  const char *rn = getenv("OUTCROP_BENCH_ROUNDS");
-  int rounds = rn && atoi(rn) > 0 ? atoi(rn) : 3;
-  if (rounds > 20) rounds = 20;
+  int rounds = bench_rounds();
   double secs[2] = {INFINITY, INFINITY}, cpu[2] = {INFINITY, INFINITY};
-  double all[2][20];
+  double all[2][BENCH_MAX_ROUNDS];
   oc_render_stats st[2];
   oc_image *img[2] = {NULL, NULL};
   oc_elevation src[2];

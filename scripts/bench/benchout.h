@@ -5,7 +5,8 @@
 ** (so two builds can be compared byte for byte); with
 ** OUTCROP_BENCH_ONLY=part,part set, it runs only the parts named (each
 ** benchmark's main says which names it knows). Unset, a benchmark runs
-** every part and writes nothing, as before.
+** every part and writes nothing, as before. OUTCROP_BENCH_ROUNDS=n sets
+** how many renders the timed ones take the fastest of (bench_rounds).
 */
 #ifndef BENCHOUT_H
 #define BENCHOUT_H
@@ -30,6 +31,17 @@ static inline int bench_wanted(const char *part) {
     s = e + 1;
   }
   return 0;
+}
+
+/* How many times a benchmark times a render to keep its fastest (the
+** renders are the same bits each time; a slow spell of a shared machine
+** then rarely sets the figure): OUTCROP_BENCH_ROUNDS when it is a number
+** from 1, at most BENCH_MAX_ROUNDS, else 3. */
+#define BENCH_MAX_ROUNDS 20
+static inline int bench_rounds(void) {
+  const char *rn = getenv("OUTCROP_BENCH_ROUNDS");
+  int n = rn ? atoi(rn) : 0;
+  return n < 1 ? 3 : n > BENCH_MAX_ROUNDS ? BENCH_MAX_ROUNDS : n;
 }
 
 /* DIR/name in buf, or 0 when OUTCROP_BENCH_OUT is unset (nothing kept). */

@@ -709,9 +709,11 @@ START_TEST(footprint_prep_rules) {
     d.p = cp;
     d.b = (oc_efootb){tf.b.lo * is, tf.b.hi * is, tf.b.k};
     oc_etfoot_prep(&d, Rc);
-    oc_etfoot_scaled(&tf, R, s, &cp, Rc, &c);
+    c.p = c2.p = cp;
+    c.b = c2.b = d.b;
+    oc_etfoot_scaled(&tf, R, s, Rc, &c);
     oc_etfoot_prep(&other, 2 * R);
-    oc_etfoot_scaled(&other, R, s, &cp, Rc, &c2);
+    oc_etfoot_scaled(&other, R, s, Rc, &c2);
     /* (field by field: the struct's tail padding is not written) */
     double cf[] = {c.p.v, c.p.gx, c.p.gy, c.b.lo, c.b.hi, c.b.k, c.R,
                    c.tc,  c.dlo,  c.dhi,  c.e2,   c.tg,   c.lf,  c.curved};
