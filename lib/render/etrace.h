@@ -19,10 +19,14 @@ typedef struct oc_etracer {
   double L;            /* slope bound over the whole domain */
   /* Steps are at least eps = eps_k * (distance from the eye) + eps_min, as
   ** the 3D tracers' (trace.h); a hit is the first sample below the
-  ** surface, then located by regula falsi. */
+  ** surface, then located to OC_ETRACE_REFINE_STOP of eps. */
   double eps_k, eps_min;
   int refine; /* 1: locate hits (0 for shadow rays) */
 } oc_etracer;
+
+/* A hit is located to this fraction of the tolerance along the ray
+** (etrace.c, where it was measured). */
+#define OC_ETRACE_REFINE_STOP 5e-2
 
 void oc_etracer_init(oc_etracer *tr, const oc_esurface *s,
                      oc_render_tracer mode, double eps_k, double eps_min);

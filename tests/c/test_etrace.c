@@ -494,11 +494,11 @@ START_TEST(beam_steps_relaxed) {
 }
 END_TEST
 
-/* A hit is located to 1/100 of the tolerance (etrace.c REFINE_STOP), on
+/* A hit is located to OC_ETRACE_REFINE_STOP of the tolerance, on
 ** the near side: from straight above (h falls along every ray, one
 ** crossing), h > 0 at the hit and h <= 0 that much further. Its normal
-** is the height gradient's there, taken from the refinement's samples:
-** the same calls as without it. */
+** is the height gradient's there, mostly taken from the refinement's
+** samples. */
 START_TEST(hits_located) {
   oc_elevation src = wave_source();
   oc_esurface es = {&src, NULL, NULL, 0.5, NULL};
@@ -512,7 +512,7 @@ START_TEST(hits_located) {
       oc_vec3 d = pixel_ray(&rp, i, j), o = rp.camera.eye;
       double t, tn, evn = 0;
       ck_assert_int_eq(oc_etrace(&tr, o, d, 0, 1e5, 0, &t, &ev), 1);
-      double q = t + 1e-2 * (eps_k * t + eps_min) * (1 + 1e-9);
+      double q = t + OC_ETRACE_REFINE_STOP * (eps_k * t + eps_min) * (1 + 1e-9);
       oc_vec3 p = oct_add(o, oct_mul(d, t)), r = oct_add(o, oct_mul(d, q));
       ck_assert_msg(p.z - wave_h(&WAVE, p.x, p.y, NULL) > 0, "pixel %d %d", i,
                     j);
@@ -532,8 +532,11 @@ START_TEST(hits_located) {
                     "pixel %d %d: normal %g %g %g", i, j, nm.x, nm.y, nm.z);
       calls += evn;
     }
-  /* no call for the normals */
-  ck_assert_msg(calls == ev, "%g calls with normals, %g without", calls, ev);
+  /* the normals from the refinement's samples: a call of its own only
+  ** where every sample fell under the surface (the last one closing the
+  ** bracket from below: 3 of these 256 hits; 3 % of them at most) */
+  ck_assert_msg(calls >= ev && calls <= ev + 0.03 * rp.width * rp.height,
+                "%g calls with normals, %g without", calls, ev);
 }
 END_TEST
 
@@ -1006,9 +1009,10 @@ START_TEST(render_heightfield) {
     if (q[7] < 1e-3) continue; /* a side of the block */
     double g[2], z = oc_heightfield_height(hf, q[8], q[9], g);
     double l = sqrt(1 + g[0] * g[0] + g[1] * g[1]);
-    /* located to 1/100 of the tolerance along the ray, where h changes
-    ** at most 1 + |grad f| a unit (and float P) */
-    double loc = 1e-2 * 0.25 * 2 * tan(25 * PI / 180) / 40 * q[4] * (1 + l);
+    /* located to OC_ETRACE_REFINE_STOP of the tolerance along the ray,
+    ** where h changes at most 1 + |grad f| a unit (and float P) */
+    double loc = OC_ETRACE_REFINE_STOP * 0.25 * 2 * tan(25 * PI / 180) / 40 *
+                 q[4] * (1 + l);
     ck_assert_msg(fabs(q[10] - z) < loc + 1e-3, "P.z %g, height %g", q[10], z);
     ck_assert(fabs(q[7] - 1 / l) < 1e-3);
     oc_vec3 d = oct_sub(oct_v(q[8], q[9], q[10]), rp.camera.eye);
