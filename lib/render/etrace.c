@@ -138,6 +138,19 @@
 ** 4.02, 4.01 s, run in turns). The tolerance itself is a quarter
 ** pixel (render.c EPS_PIXEL): 5e-2 of it is 1/80 of a pixel. */
 #define REFINE_STOP OC_ETRACE_REFINE_STOP
+/* A hit that the model of the sample under the surface locates alone
+** (model_hit) takes its normal from that model's linear part g, no call,
+** where the model's remainder is quadratic but for roundings: its g is
+** then the gradient at the sample to within e1 + 2 sqrt(2 e0 e2) (from
+** |(grad f - g).d| r <= e0 + e1 r + 2 e2 r^2, f's curvature within the
+** model's, at the best r), at most GRAD_MODEL; the sample lies a
+** tenth of a tolerance or so past the hit (AIM_PAST). Else a call at
+** the hit, as before. On bench_elev fig3 at 1920 x 1080 the model-located
+** hits' calls went from 0.35 to 0.0065 a pixel (all calls 4.24 -> 3.90),
+** the normals moved by 0.07 degrees on average, 910 of 1 181 717 by more
+** than 1 (at most 2.3: crests, where the normal turns that much within
+** 1/40 of a pixel), the hits themselves not at all. */
+#define GRAD_MODEL 1e-4
 /* A ray on models whose next zero (by the model's linear part) is
 ** within a tolerance of the stretch it proved free samples AIM_PAST
 ** tolerances past it, at least AIM_LEAST tolerances on. Measured on
@@ -417,14 +430,21 @@ static int model_back(double h, const double g[2], const double E[3], oc_vec3 u,
 /* The hit in [t - s_lo, t] (model_back's: a point above the surface, the
 ** sample under it, the ray above the surface before them as far as the
 ** tolerance allows): on the model when s_lo - s_hi is within refine's
-** stop (the normal a call at t - s_lo), else refine from that bracket,
-** its upper end at the model's linear estimate there. */
+** stop (the normal, when ga is asked for, the model's own where it is
+** quadratic, GRAD_MODEL, else a call at t - s_lo), else refine from that
+** bracket, its upper end at the model's linear estimate there. */
 static double model_hit(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
-                        double h, const double g[2], double s_lo, double s_hi,
-                        double d0, double *n, double ga[2], int *ga_ok) {
+                        double h, const double g[2], const double E[3],
+                        double s_lo, double s_hi, double d0, double *n,
+                        double ga[2], int *ga_ok) {
   const oc_elevation *src = tr->s->src;
   double a = t - s_lo;
   if (s_lo - s_hi <= REFINE_STOP * tol(tr, d0, a)) {
+    if (!ga) return a;
+    if (E[1] + 2 * sqrt(2 * E[0] * E[2]) <= GRAD_MODEL) {
+      ga[0] = g[0], ga[1] = g[1], *ga_ok = 1;
+      return a;
+    }
     oc_vec3 q = at(o, u, a);
     double gq[2];
     (*n)++;
@@ -501,7 +521,7 @@ static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
         if (h <= 0 && solid_weight(tr->s, p, h, &w) &&
             model_back(h, g, E, u, uxy, back, &lo, &hi, &lo2) &&
             lesser(lo2, uxy > 0 ? mR / uxy : INFINITY) >= back - rtl) {
-          *thit = model_hit(tr, o, u, t, h, g, lo, hi, d0, n, ga, ga_ok);
+          *thit = model_hit(tr, o, u, t, h, g, E, lo, hi, d0, n, ga, ga_ok);
           return 1;
         }
       }
@@ -526,7 +546,7 @@ static int march_taylor(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
           model_back(h, g, E, u, uxy,
                      uxy > 0 ? lesser(t - prev, mR / uxy) : t - prev, &lo, &hi,
                      &lo2)) {
-        *thit = model_hit(tr, o, u, t, h, g, lo, hi, d0, n, ga, ga_ok);
+        *thit = model_hit(tr, o, u, t, h, g, E, lo, hi, d0, n, ga, ga_ok);
         return 1;
       }
       *thit =

@@ -57,9 +57,11 @@ typedef struct oc_emodel {
 ** step (> 0) the candidate step to begin with on the source's models (0:
 ** as oc_etrace), that also gives, on a hit of the surface (1), the unit
 ** upward normal there in *n (NULL: not wanted), from the height gradient
-** of the refinement's last sample above the surface, where the hit is
-** (a sample there, one call, where the model of the sample under the
-** surface located the hit alone); one more height call, counted in
+** of the refinement's last sample above the surface, where the hit is;
+** where the model of the sample under the surface located the hit alone,
+** that model's linear part (the gradient at that sample, a tenth of
+** a tolerance or so past the hit) when the model is quadratic there, else
+** a sample at the hit (one call); one more height call, counted in
 ** *evals, when no sample gave it. m
 ** (when not NULL and ok, with step > 0): a model the ray's first step
 ** may take without a call (its beam's last, oc_etrace_beam). */
