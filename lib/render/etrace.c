@@ -120,24 +120,23 @@
 ** gave 7.7, 10.6; 7.5, 10.5; 7.4, 10.4 (beams 804960); 7.4, 10.5; 8.1,
 ** 11.3. */
 #define BRELAX 1.7
-/* A hit is located to REFINE_STOP of the tolerance (refine). Measured on
-** bench_elev -q fig3 (calls a pixel, refinement and normals): Illinois
-** to 1e-3 with a normal call 10.8; samples with gradients (the normal
-** from the last above the surface), 1e-3, 1e-2, 5e-2 gave 9.9, 9.6, 9.4
-** (5e-2 turned 14 normals by more than a degree). Since the models
-** bracket hits (model_back), at 1920 x 1080 (bench_elev fig3, a pixel:
-** refine's calls and model_hit's, all calls) 1e-2, 5e-2, 1e-1 gave 0.72
-** and 0.29, 4.42; 0.50 and 0.35, 4.24; 0.41 and 0.37, 4.16: a model's
-** bracket (its remainder, about e2 r^2 back from the sample) is mostly
-** a few 1e-2 tolerances wide, so that 1e-2 took two calls in it where
-** 5e-2 takes one. Of fig3's 1 181 717 hits, 5e-2 against 1e-2 moved
-** the normals by 0.005 degrees on average (1 271 by more than 0.1, 34
-** by more than 1: crests) and the depths by 1e-6 of theirs; 1e-1 by
-** 0.011 degrees (84 over 1) for 2 % fewer calls more, and the primary
-** rays' CPU time was no lower (3.87, 3.88 s against 3.90, 4.02 s; 1e-2
-** 4.02, 4.01 s, run in turns). The tolerance itself is a quarter
-** pixel (render.c EPS_PIXEL): 5e-2 of it is 1/80 of a pixel. */
-#define REFINE_STOP OC_ETRACE_REFINE_STOP
+/* OC_ETRACE_REFINE_STOP (etrace.h): a hit is located to that fraction of the
+** tolerance (refine). Measured on bench_elev -q fig3 (calls a pixel,
+** refinement and normals): Illinois to 1e-3 with a normal call 10.8; samples
+** with gradients (the normal from the last above the surface), 1e-3, 1e-2,
+** 5e-2 gave 9.9, 9.6, 9.4 (5e-2 turned 14 normals by more than a degree).
+** Since the models bracket hits (model_back), at 1920 x 1080 (bench_elev
+** fig3, a pixel: refine's calls and model_hit's, all calls) 1e-2, 5e-2, 1e-1
+** gave 0.72 and 0.29, 4.42; 0.50 and 0.35, 4.24; 0.41 and 0.37, 4.16: a
+** model's bracket (its remainder, about e2 r^2 back from the sample) is
+** mostly a few 1e-2 tolerances wide, so that 1e-2 took two calls in it where
+** 5e-2 takes one. Of fig3's 1 181 717 hits, 5e-2 against 1e-2 moved the
+** normals by 0.005 degrees on average (1 271 by more than 0.1, 34 by more
+** than 1: crests) and the depths by 1e-6 of theirs; 1e-1 by 0.011 degrees
+** (84 over 1) for 2 % fewer calls more, and the primary rays' CPU time was
+** no lower (3.87, 3.88 s against 3.90, 4.02 s; 1e-2 4.02, 4.01 s, run in
+** turns). The tolerance itself is a quarter pixel (render.c EPS_PIXEL): 5e-2
+** of it is 1/80 of a pixel. */
 /* A hit that the model of the sample under the surface locates alone
 ** (model_hit) takes its normal from that model's linear part g, no call,
 ** where the model's remainder is quadratic but for roundings: its g is
@@ -240,8 +239,8 @@ static double height_above(const oc_etracer *tr, oc_vec3 p, int *solid,
   return h;
 }
 
-/* h(a) = ha > 0 >= h(b) = hb: the root located to REFINE_STOP of the
-** tolerance, keeping the end above the surface (returned). Each sample is
+/* h(a) = ha > 0 >= h(b) = hb: the root located to OC_ETRACE_REFINE_STOP of
+** the tolerance, keeping the end above the surface (returned). Each sample is
 ** a height call with its gradient, whose derivative along the ray
 ** (u_z - grad f . u_xy) gives a Newton estimate of the root from it (the
 ** bracket's secant at first, or where Newton leaves the bracket); near
@@ -253,7 +252,7 @@ static double refine(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double a,
                      double ha, double b, double hb, double d0, double *n,
                      double ga[2], int *ga_ok) {
   const oc_elevation *src = tr->s->src;
-  double stop = REFINE_STOP * tol(tr, d0, a);
+  double stop = OC_ETRACE_REFINE_STOP * tol(tr, d0, a);
   double r = a + (b - a) * (ha / (ha - hb)), w = b - a;
   for (int k = 0; k < 24 && b - a > stop; k++) {
     double m = r;
@@ -439,7 +438,7 @@ static double model_hit(const oc_etracer *tr, oc_vec3 o, oc_vec3 u, double t,
                         double ga[2], int *ga_ok) {
   const oc_elevation *src = tr->s->src;
   double a = t - s_lo;
-  if (s_lo - s_hi <= REFINE_STOP * tol(tr, d0, a)) {
+  if (s_lo - s_hi <= OC_ETRACE_REFINE_STOP * tol(tr, d0, a)) {
     if (!ga) return a;
     if (E[1] + 2 * sqrt(2 * E[0] * E[2]) <= GRAD_MODEL) {
       ga[0] = g[0], ga[1] = g[1], *ga_ok = 1;
